@@ -1,0 +1,85 @@
+/* Robust estimation (Jones et al. 2003, Eq. 3): p' = sum Pi_q(p) a_q f g / k(p), Pi_q(p) = p + t n_q
+ * with t = n_q . (c_q - p), f = exp(-|c_q - p|^2 / (2 sigma_f^2)), g = exp(-t^2 / (2 sigma_g^2)).
+ *
+ * robust_vertex: one work-item per vertex (grid order) writes
+ *   vertex_result[v] = (displacement p' - p in cell units, k' = sum of the weights used)
+ *   vertex_extra[v]  = (sum a f, the exponent shift e_s, 0, 0): k(p) = k' exp(-e_s) in mean-area units.
+ * When every influence exponent exceeds RS_RESCUE_EXPONENT, float32 weights would underflow; the
+ * sums are then redone with the smallest exponent subtracted (e_s), as the reference path does.
+ * `want_confidence` = 0 skips sum a f (one exp per pair instead of two).
+ */
+
+__kernel void robust_vertex(uint vertex_count, float reach2, float inv_2sf2, float inv_2sg2,
+                            int want_confidence,
+                            __global const float4 *vertex_local, __global const int4 *vertex_cell,
+                            __global const float4 *facet_centroid, __global const float4 *normal,
+                            __global const int4 *cell_coord, __global const uint *cell_start,
+                            __global const int *table, uint table_mask,
+                            __global float4 *vertex_result, __global float4 *vertex_extra) {
+    uint v = get_global_id(0);
+    if (v >= vertex_count)
+        return;
+    float3 p = vertex_local[v].xyz;
+    int4 home = vertex_cell[v];
+    float k = 0.0f, kf = 0.0f, e_min = MAXFLOAT;
+    float3 acc = (float3)(0.0f);
+    int cells[27];
+    int cell_count = 0;
+    for (int dx = -1; dx <= 1; dx++)
+        for (int dy = -1; dy <= 1; dy++)
+            for (int dz = -1; dz <= 1; dz++) {
+                int cell = grid_find(cell_coord, table, table_mask, home.x + dx, home.y + dy,
+                                     home.z + dz);
+                cells[cell_count++] = cell;
+                if (cell < 0)
+                    continue;
+                float3 pc = p - (float3)((float)dx, (float)dy, (float)dz);
+                uint end = cell_start[cell + 1];
+                for (uint q = cell_start[cell]; q < end; q++) {
+                    float4 c = facet_centroid[q];
+                    float3 d = c.xyz - pc;
+                    float d2 = dot(d, d);
+                    if (d2 <= reach2) {
+                        float3 n = normal[q].xyz;
+                        float t = dot(n, d);
+                        float e = t * t * inv_2sg2;
+                        float w = exp(c.w - d2 * inv_2sf2 - e);
+                        acc += (w * t) * n;
+                        k += w;
+                        e_min = fmin(e_min, e);
+                        if (want_confidence)
+                            kf += exp(c.w - d2 * inv_2sf2);
+                    }
+                }
+            }
+    float shift = 0.0f;
+    if (e_min > RS_RESCUE_EXPONENT && e_min < MAXFLOAT) {
+        shift = e_min;
+        k = 0.0f;
+        acc = (float3)(0.0f);
+        int i = 0;
+        for (int dx = -1; dx <= 1; dx++)
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dz = -1; dz <= 1; dz++) {
+                    int cell = cells[i++];
+                    if (cell < 0)
+                        continue;
+                    float3 pc = p - (float3)((float)dx, (float)dy, (float)dz);
+                    uint end = cell_start[cell + 1];
+                    for (uint q = cell_start[cell]; q < end; q++) {
+                        float4 c = facet_centroid[q];
+                        float3 d = c.xyz - pc;
+                        float d2 = dot(d, d);
+                        if (d2 <= reach2) {
+                            float3 n = normal[q].xyz;
+                            float t = dot(n, d);
+                            float w = exp(c.w - d2 * inv_2sf2 - (t * t * inv_2sg2 - shift));
+                            acc += (w * t) * n;
+                            k += w;
+                        }
+                    }
+                }
+    }
+    vertex_result[v] = k > 0.0f ? (float4)(acc / k, k) : (float4)(0.0f);
+    vertex_extra[v] = (float4)(kf, shift, 0.0f, 0.0f);
+}

@@ -1,0 +1,298 @@
+/* Choosing an OpenCL device and owning (or sharing) its context and queue. */
+#define _POSIX_C_SOURCE 200809L
+#include "rsmooth_internal.h"
+#include "rsmooth_cl.h"
+
+#include <ctype.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_PLATFORMS 16
+#define MAX_DEVICES 64
+
+rsmooth_status rs_cl_fail(rsmooth_error *error, cl_int code, const char *call, const char *what) {
+    rsmooth_status st = rs_fail(error, RSMOOTH_ERROR_OPENCL, call, "%s failed with %s (%d)%s%s",
+                                call, rs_cl_error_name(code), (int)code, what ? ": " : "",
+                                what ? what : "");
+    if (error)
+        error->cl_error = code;
+    return st;
+}
+
+const char *rs_cl_error_name(cl_int code) {
+    switch (code) {
+#define NAME(c)                                                                                    \
+    case c:                                                                                        \
+        return #c;
+        NAME(CL_SUCCESS)
+        NAME(CL_DEVICE_NOT_FOUND)
+        NAME(CL_DEVICE_NOT_AVAILABLE)
+        NAME(CL_COMPILER_NOT_AVAILABLE)
+        NAME(CL_MEM_OBJECT_ALLOCATION_FAILURE)
+        NAME(CL_OUT_OF_RESOURCES)
+        NAME(CL_OUT_OF_HOST_MEMORY)
+        NAME(CL_BUILD_PROGRAM_FAILURE)
+        NAME(CL_INVALID_VALUE)
+        NAME(CL_INVALID_DEVICE_TYPE)
+        NAME(CL_INVALID_PLATFORM)
+        NAME(CL_INVALID_DEVICE)
+        NAME(CL_INVALID_CONTEXT)
+        NAME(CL_INVALID_COMMAND_QUEUE)
+        NAME(CL_INVALID_MEM_OBJECT)
+        NAME(CL_INVALID_PROGRAM)
+        NAME(CL_INVALID_PROGRAM_EXECUTABLE)
+        NAME(CL_INVALID_KERNEL_NAME)
+        NAME(CL_INVALID_KERNEL)
+        NAME(CL_INVALID_ARG_INDEX)
+        NAME(CL_INVALID_ARG_VALUE)
+        NAME(CL_INVALID_ARG_SIZE)
+        NAME(CL_INVALID_KERNEL_ARGS)
+        NAME(CL_INVALID_WORK_DIMENSION)
+        NAME(CL_INVALID_WORK_GROUP_SIZE)
+        NAME(CL_INVALID_WORK_ITEM_SIZE)
+        NAME(CL_INVALID_GLOBAL_OFFSET)
+        NAME(CL_INVALID_EVENT_WAIT_LIST)
+        NAME(CL_INVALID_OPERATION)
+        NAME(CL_INVALID_BUFFER_SIZE)
+        NAME(CL_INVALID_GLOBAL_WORK_SIZE)
+        NAME(CL_INVALID_BUILD_OPTIONS)
+#undef NAME
+    case -1001: /* CL_PLATFORM_NOT_FOUND_KHR: the ICD loader found no platform */
+        return "CL_PLATFORM_NOT_FOUND_KHR";
+    }
+    return "unknown OpenCL error";
+}
+
+static void lower(char *s) {
+    for (; *s; s++)
+        *s = (char)tolower((unsigned char)*s);
+}
+
+typedef struct candidate {
+    cl_platform_id platform;
+    cl_device_id device;
+    cl_device_type type;
+    int platform_index, device_index;
+    char name[256]; /* "platform / device" */
+} candidate;
+
+/* Every device of every platform, in clGetPlatformIDs / clGetDeviceIDs order. */
+static int list_devices(candidate *out, int capacity) {
+    cl_platform_id platforms[MAX_PLATFORMS];
+    cl_uint platform_count = 0;
+    if (clGetPlatformIDs(MAX_PLATFORMS, platforms, &platform_count) != CL_SUCCESS)
+        return 0;
+    int n = 0;
+    for (cl_uint p = 0; p < platform_count && p < MAX_PLATFORMS; p++) {
+        cl_device_id devices[MAX_DEVICES];
+        cl_uint device_count = 0;
+        if (clGetDeviceIDs(platforms[p], CL_DEVICE_TYPE_ALL, MAX_DEVICES, devices, &device_count) !=
+            CL_SUCCESS)
+            continue;
+        char platform_name[96] = "";
+        clGetPlatformInfo(platforms[p], CL_PLATFORM_NAME, sizeof platform_name - 1, platform_name,
+                          NULL);
+        for (cl_uint d = 0; d < device_count && d < MAX_DEVICES && n < capacity; d++) {
+            candidate *c = &out[n++];
+            c->platform = platforms[p];
+            c->device = devices[d];
+            c->platform_index = (int)p;
+            c->device_index = (int)d;
+            c->type = 0;
+            clGetDeviceInfo(devices[d], CL_DEVICE_TYPE, sizeof c->type, &c->type, NULL);
+            char device_name[128] = "";
+            clGetDeviceInfo(devices[d], CL_DEVICE_NAME, sizeof device_name - 1, device_name, NULL);
+            snprintf(c->name, sizeof c->name, "%s / %s", platform_name, device_name);
+        }
+    }
+    return n;
+}
+
+static rsmooth_status pick_device(const char *spec, candidate *chosen, rsmooth_error *error) {
+    static const char where[] = "rsmooth_context_create";
+    candidate all[MAX_DEVICES];
+    int n = list_devices(all, MAX_DEVICES);
+    if (n == 0)
+        return rs_fail(error, RSMOOTH_ERROR_NO_DEVICE, where,
+                       "no OpenCL platform or device found (is an ICD such as pocl-opencl-icd "
+                       "installed?)");
+    char want[128];
+    snprintf(want, sizeof want, "%s", spec);
+    lower(want);
+    int pi = -1, di = -1;
+    char tail;
+    if (strcmp(want, "auto") == 0 || want[0] == '\0') {
+        for (int pass = 0; pass < 3; pass++)
+            for (int i = 0; i < n; i++) {
+                bool ok = pass == 0   ? (all[i].type & CL_DEVICE_TYPE_GPU) != 0
+                          : pass == 1 ? (all[i].type & CL_DEVICE_TYPE_CPU) != 0
+                                      : true;
+                if (ok) {
+                    *chosen = all[i];
+                    return RSMOOTH_OK;
+                }
+            }
+    } else if (strcmp(want, "gpu") == 0 || strcmp(want, "cpu") == 0) {
+        cl_device_type t = want[0] == 'g' ? CL_DEVICE_TYPE_GPU : CL_DEVICE_TYPE_CPU;
+        for (int i = 0; i < n; i++)
+            if (all[i].type & t) {
+                *chosen = all[i];
+                return RSMOOTH_OK;
+            }
+        return rs_fail(error, RSMOOTH_ERROR_NO_DEVICE, where, "no OpenCL %s device found",
+                       want[0] == 'g' ? "GPU" : "CPU");
+    } else if (sscanf(want, "%d:%d%c", &pi, &di, &tail) == 2) {
+        for (int i = 0; i < n; i++)
+            if (all[i].platform_index == pi && all[i].device_index == di) {
+                *chosen = all[i];
+                return RSMOOTH_OK;
+            }
+        return rs_fail(error, RSMOOTH_ERROR_NO_DEVICE, where,
+                       "no OpenCL device %d on platform %d", di, pi);
+    } else {
+        for (int i = 0; i < n; i++) {
+            char name[256];
+            snprintf(name, sizeof name, "%s", all[i].name);
+            lower(name);
+            if (strstr(name, want)) {
+                *chosen = all[i];
+                return RSMOOTH_OK;
+            }
+        }
+        return rs_fail(error, RSMOOTH_ERROR_NO_DEVICE, where,
+                       "no OpenCL device name contains \"%s\"", spec);
+    }
+    return rs_fail(error, RSMOOTH_ERROR_NO_DEVICE, where, "no OpenCL device found");
+}
+
+/* Work-group size: 64 where the device allows it (an explicit size helps PoCL vectorize). */
+static size_t choose_local_size(cl_device_id device) {
+    size_t max_size = 1;
+    clGetDeviceInfo(device, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof max_size, &max_size, NULL);
+    size_t local = 64;
+    while (local > max_size)
+        local /= 2;
+    return local ? local : 1;
+}
+
+static rsmooth_context *new_context(void) {
+    rsmooth_context *ctx = rs_calloc_array(1, sizeof *ctx);
+    return ctx;
+}
+
+rsmooth_status rsmooth_context_create(const char *device, rsmooth_context **out,
+                                      rsmooth_error *error) {
+    static const char where[] = "rsmooth_context_create";
+    rs_error_clear(error);
+    if (!out)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "ctx is NULL");
+    *out = NULL;
+    if (!device)
+        device = getenv("RSMOOTH_DEVICE");
+    if (!device)
+        device = "auto";
+    candidate chosen;
+    rsmooth_status st = pick_device(device, &chosen, error);
+    if (st != RSMOOTH_OK)
+        return st;
+    rsmooth_context *ctx = new_context();
+    if (!ctx)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the context");
+    ctx->device = chosen.device;
+    snprintf(ctx->device_name, sizeof ctx->device_name, "%s", chosen.name);
+    ctx->local_size = choose_local_size(chosen.device);
+    cl_context_properties props[] = {CL_CONTEXT_PLATFORM, (cl_context_properties)chosen.platform,
+                                     0};
+    cl_int err = CL_SUCCESS;
+    ctx->context = clCreateContext(props, 1, &chosen.device, NULL, NULL, &err);
+    if (err != CL_SUCCESS) {
+        st = rs_cl_fail(error, err, "clCreateContext", chosen.name);
+        goto fail;
+    }
+    ctx->queue = clCreateCommandQueue(ctx->context, chosen.device, 0, &err);
+    if (err != CL_SUCCESS) {
+        st = rs_cl_fail(error, err, "clCreateCommandQueue", chosen.name);
+        goto fail;
+    }
+    st = rs_cl_build_program(ctx, error);
+    if (st != RSMOOTH_OK)
+        goto fail;
+    *out = ctx;
+    return RSMOOTH_OK;
+fail:
+    rsmooth_context_destroy(ctx);
+    return st;
+}
+
+rsmooth_status rsmooth_context_create_from_queue(cl_command_queue queue, rsmooth_context **out,
+                                                 rsmooth_error *error) {
+    static const char where[] = "rsmooth_context_create_from_queue";
+    rs_error_clear(error);
+    if (!out)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "ctx is NULL");
+    *out = NULL;
+    if (!queue)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "queue is NULL");
+    cl_context context = NULL;
+    cl_device_id device = NULL;
+    cl_int err = clGetCommandQueueInfo(queue, CL_QUEUE_CONTEXT, sizeof context, &context, NULL);
+    if (err == CL_SUCCESS)
+        err = clGetCommandQueueInfo(queue, CL_QUEUE_DEVICE, sizeof device, &device, NULL);
+    if (err != CL_SUCCESS) {
+        rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                "queue is not a valid OpenCL command queue (%s)", rs_cl_error_name(err));
+        if (error)
+            error->cl_error = err;
+        return RSMOOTH_ERROR_INVALID_ARGUMENT;
+    }
+    rsmooth_context *ctx = new_context();
+    if (!ctx)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the context");
+    clRetainCommandQueue(queue);
+    clRetainContext(context);
+    ctx->queue = queue;
+    ctx->context = context;
+    ctx->device = device;
+    ctx->local_size = choose_local_size(device);
+    cl_platform_id platform = NULL;
+    char platform_name[96] = "", device_name[128] = "";
+    clGetDeviceInfo(device, CL_DEVICE_PLATFORM, sizeof platform, &platform, NULL);
+    clGetPlatformInfo(platform, CL_PLATFORM_NAME, sizeof platform_name - 1, platform_name, NULL);
+    clGetDeviceInfo(device, CL_DEVICE_NAME, sizeof device_name - 1, device_name, NULL);
+    snprintf(ctx->device_name, sizeof ctx->device_name, "%s / %s", platform_name, device_name);
+    rsmooth_status st = rs_cl_build_program(ctx, error);
+    if (st != RSMOOTH_OK) {
+        rsmooth_context_destroy(ctx);
+        return st;
+    }
+    *out = ctx;
+    return RSMOOTH_OK;
+}
+
+void rsmooth_context_destroy(rsmooth_context *ctx) {
+    if (!ctx)
+        return;
+    for (int k = 0; k < RS_KERNEL_COUNT; k++)
+        if (ctx->kernels[k])
+            clReleaseKernel(ctx->kernels[k]);
+    if (ctx->program)
+        clReleaseProgram(ctx->program);
+    if (ctx->queue)
+        clReleaseCommandQueue(ctx->queue);
+    if (ctx->context)
+        clReleaseContext(ctx->context);
+    rs_free(ctx);
+}
+
+const char *rsmooth_context_device_name(const rsmooth_context *ctx) {
+    return ctx ? ctx->device_name : "";
+}
+
+double rsmooth_context_build_ms(const rsmooth_context *ctx) {
+    return ctx ? ctx->build_ms : 0;
+}
+
+cl_command_queue rsmooth_context_queue(const rsmooth_context *ctx) {
+    return ctx ? ctx->queue : NULL;
+}

@@ -1,0 +1,112 @@
+/* Assembling and building the OpenCL program: a generated prelude, then common.cl, then one file per
+ * phase. Kernels are embedded at build time; RSMOOTH_KERNEL_DIR loads them from a directory instead. */
+#define _POSIX_C_SOURCE 200809L
+#include "rsmooth_internal.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+extern const unsigned char rs_kernel_common[], rs_kernel_mollify[], rs_kernel_estimate[];
+extern const size_t rs_kernel_common_size, rs_kernel_mollify_size, rs_kernel_estimate_size;
+
+/* Constants the host and kernels must agree on. Runtime values (sigmas, counts) are kernel
+ * arguments, so changing them never rebuilds the program. */
+static const char prelude[] = "#define RS_DEGENERATE_SINE 1e-6f\n"
+                              "#define RS_RESCUE_EXPONENT 40.0f\n";
+
+/* Default options: relaxed math lets PoCL vectorize exp(); precision is checked against the
+ * double-precision reference path by the tests. */
+static const char default_options[] = "-cl-std=CL1.2 -cl-fast-relaxed-math";
+
+static char *read_text_file(const char *dir, const char *name, size_t *size) {
+    char path[4096];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    char *text = NULL;
+    if (fseek(f, 0, SEEK_END) == 0) {
+        long n = ftell(f);
+        if (n >= 0 && fseek(f, 0, SEEK_SET) == 0) {
+            text = rs_alloc_array((size_t)n + 1, 1);
+            if (text && fread(text, 1, (size_t)n, f) == (size_t)n) {
+                text[n] = '\0';
+                *size = (size_t)n;
+            } else {
+                rs_free(text);
+                text = NULL;
+            }
+        }
+    }
+    fclose(f);
+    return text;
+}
+
+rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error) {
+    static const char *const names[] = {"common.cl", "mollify.cl", "estimate.cl"};
+    const char *sources[4] = {prelude, (const char *)rs_kernel_common,
+                              (const char *)rs_kernel_mollify, (const char *)rs_kernel_estimate};
+    size_t sizes[4] = {sizeof prelude - 1, rs_kernel_common_size, rs_kernel_mollify_size,
+                       rs_kernel_estimate_size};
+    char *loaded[3] = {NULL, NULL, NULL};
+    rsmooth_status st = RSMOOTH_OK;
+    const char *dir = getenv("RSMOOTH_KERNEL_DIR");
+    if (dir && *dir) {
+        for (int i = 0; i < 3; i++) {
+            loaded[i] = read_text_file(dir, names[i], &sizes[i + 1]);
+            if (!loaded[i]) {
+                st = rs_fail(error, RSMOOTH_ERROR_IO, "RSMOOTH_KERNEL_DIR",
+                             "cannot read %s/%s", dir, names[i]);
+                goto done;
+            }
+            sources[i + 1] = loaded[i];
+        }
+    }
+
+    double t0 = rs_now_ms();
+    cl_int err = CL_SUCCESS;
+    ctx->program = clCreateProgramWithSource(ctx->context, 4, sources, sizes, &err);
+    if (err != CL_SUCCESS) {
+        st = rs_cl_fail(error, err, "clCreateProgramWithSource", ctx->device_name);
+        goto done;
+    }
+    char options[1024];
+    const char *extra = getenv("RSMOOTH_BUILD_OPTIONS");
+    snprintf(options, sizeof options, "%s %s", default_options, extra ? extra : "");
+    err = clBuildProgram(ctx->program, 1, &ctx->device, options, NULL, NULL);
+    if (err != CL_SUCCESS) {
+        st = rs_cl_fail(error, err, "clBuildProgram", ctx->device_name);
+        if (error) {
+            error->status = st = RSMOOTH_ERROR_KERNEL_BUILD;
+            /* The log may exceed our buffer, and OpenCL refuses short buffers: fetch it whole. */
+            size_t log_size = 0;
+            clGetProgramBuildInfo(ctx->program, ctx->device, CL_PROGRAM_BUILD_LOG, 0, NULL,
+                                  &log_size);
+            char *log = rs_alloc_array(log_size + 1, 1);
+            if (log && clGetProgramBuildInfo(ctx->program, ctx->device, CL_PROGRAM_BUILD_LOG,
+                                             log_size, log, NULL) == CL_SUCCESS) {
+                log[log_size] = '\0';
+                snprintf(error->build_log, sizeof error->build_log, "%s", log);
+            }
+            rs_free(log);
+        } else {
+            st = RSMOOTH_ERROR_KERNEL_BUILD;
+        }
+        goto done;
+    }
+    static const char *const kernel_names[RS_KERNEL_COUNT] = {
+        "mollify_vertex", "mollified_facet_normal", "robust_vertex"};
+    for (int k = 0; k < RS_KERNEL_COUNT; k++) {
+        ctx->kernels[k] = clCreateKernel(ctx->program, kernel_names[k], &err);
+        if (err != CL_SUCCESS) {
+            st = rs_cl_fail(error, err, "clCreateKernel", kernel_names[k]);
+            goto done;
+        }
+    }
+    ctx->build_ms = rs_now_ms() - t0;
+done:
+    for (int i = 0; i < 3; i++)
+        rs_free(loaded[i]);
+    return st;
+}

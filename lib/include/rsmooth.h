@@ -1,0 +1,232 @@
+/*
+ * rsmooth: feature-preserving, non-iterative smoothing of triangle meshes on OpenCL devices.
+ *
+ * Implements Jones, Durand and Desbrun, "Non-Iterative, Feature-Preserving Mesh Smoothing",
+ * ACM SIGGRAPH 2003. Every vertex p moves to a robust, weighted average of its projections onto the
+ * planes of nearby triangles q (Eq. 3 of the paper):
+ *
+ *     p' = sum_q Pi_q(p) a_q f(|c_q - p|) g(|Pi_q(p) - p|) / k(p),   k(p) = sum_q a_q f g
+ *
+ * with c_q the centroid, a_q the area, Pi_q(p) the projection of p onto the plane of q (whose normal
+ * comes from a "mollified" copy of the mesh, smoothed by a plain Gaussian of width sigma_f / 2),
+ * f a spatial Gaussian of width sigma_f and g an influence Gaussian of width sigma_g. Gaussians are
+ * exp(-x^2 / (2 sigma^2)). Facets whose centroid lies farther than cutoff * sigma_f are ignored.
+ * One pass, no iteration and no connectivity: triangle soups, non-manifold and cracked meshes work.
+ *
+ * Usage sketch (arrays in, arrays out; the caller owns every array):
+ *
+ *     rsmooth_params params;
+ *     rsmooth_params_init(&params);             // sigma_f = 2, sigma_g = 0.5 mean edge lengths
+ *     params.sigma_f = 1.5;
+ *     rsmooth_context *ctx = NULL;
+ *     rsmooth_error err;
+ *     if (rsmooth_context_create(NULL, &ctx, &err) == RSMOOTH_OK) {   // default device
+ *         rsmooth_smooth(ctx, RSMOOTH_FLOAT32, xyz, vertex_count, indices, triangle_count,
+ *                        &params, out_xyz, NULL, NULL, NULL, &err);
+ *         rsmooth_context_destroy(ctx);
+ *     } else {                                   // no OpenCL: the double-precision reference path
+ *         rsmooth_smooth_reference(RSMOOTH_FLOAT32, xyz, vertex_count, indices, triangle_count,
+ *                                  &params, out_xyz, NULL, NULL, NULL, &err);
+ *     }
+ *
+ * Interoperation with a caller's own OpenCL queue lives in rsmooth_cl.h, so this header needs no
+ * OpenCL headers.
+ */
+#ifndef RSMOOTH_H
+#define RSMOOTH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define RSMOOTH_VERSION_MAJOR 0
+#define RSMOOTH_VERSION_MINOR 1
+#define RSMOOTH_VERSION_PATCH 0
+
+#if defined(_WIN32)
+#if defined(RSMOOTH_BUILDING_LIBRARY) && defined(RSMOOTH_SHARED)
+#define RSMOOTH_API __declspec(dllexport)
+#elif defined(RSMOOTH_SHARED)
+#define RSMOOTH_API __declspec(dllimport)
+#else
+#define RSMOOTH_API
+#endif
+#else
+#define RSMOOTH_API __attribute__((visibility("default")))
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---------------------------------------------------------------------------------------------- */
+/* Status and error detail                                                                          */
+/* ---------------------------------------------------------------------------------------------- */
+
+/* Every call that can fail returns one of these; RSMOOTH_OK (0) is success. They name classes of
+ * failure; the optional rsmooth_error carries the detail. */
+typedef enum rsmooth_status {
+    RSMOOTH_OK = 0,
+    RSMOOTH_ERROR_INVALID_ARGUMENT = 1, /* NULL array, index out of range, bad sigma, non-finite... */
+    RSMOOTH_ERROR_OUT_OF_MEMORY = 2,    /* host allocation failed, or a size overflows size_t */
+    RSMOOTH_ERROR_IO = 3,               /* a file could not be opened, read or written */
+    RSMOOTH_ERROR_PARSE = 4,            /* a mesh file is malformed */
+    RSMOOTH_ERROR_NO_DEVICE = 5,        /* no OpenCL platform, or no device matches the choice */
+    RSMOOTH_ERROR_KERNEL_BUILD = 6,     /* the OpenCL program failed to build (see build_log) */
+    RSMOOTH_ERROR_OPENCL = 7,           /* an OpenCL call failed (see cl_error and where) */
+    RSMOOTH_ERROR_UNSUPPORTED = 8       /* valid request this build or device cannot do */
+} rsmooth_status;
+
+/* Static, human-readable text for a status. Never NULL; thread-safe. */
+RSMOOTH_API const char *rsmooth_status_str(rsmooth_status status);
+
+/* Optional detail of a failure, filled by any call given a non-NULL pointer to one. On success it is
+ * reset (status RSMOOTH_OK, empty strings). The library never prints: callers show these fields. */
+typedef struct rsmooth_error {
+    rsmooth_status status;
+    int cl_error;          /* raw cl_int of the failing OpenCL call, 0 if none */
+    char where[64];        /* failing function, OpenCL call or kernel, e.g. "clEnqueueNDRangeKernel" */
+    char message[256];     /* one sentence on what went wrong, e.g. "index 7 >= vertex count 5" */
+    int64_t line;          /* parse errors: 1-based line (text formats), else -1 */
+    int64_t byte_offset;   /* parse errors: byte offset of the offending token, else -1 */
+    char build_log[2048];  /* kernel build failures: the head of the OpenCL build log */
+} rsmooth_error;
+
+/* ---------------------------------------------------------------------------------------------- */
+/* Parameters                                                                                       */
+/* ---------------------------------------------------------------------------------------------- */
+
+typedef enum rsmooth_scalar {
+    RSMOOTH_FLOAT32 = 0, /* positions are float[3] per vertex */
+    RSMOOTH_FLOAT64 = 1  /* positions are double[3] per vertex (georeferenced scans, CAD in mm...) */
+} rsmooth_scalar;
+
+/* Filter parameters. Fill with rsmooth_params_init() first, then change fields: struct_size lets
+ * later versions add fields without breaking callers compiled against this one. */
+typedef struct rsmooth_params {
+    size_t struct_size;    /* sizeof(rsmooth_params), set by rsmooth_params_init */
+    double sigma_f;        /* spatial width: how far a triangle's influence reaches. In mean edge
+                            * lengths unless `absolute`. > 0 and finite. Default 2. */
+    double sigma_g;        /* influence width: how far a predicted position may be from the vertex
+                            * before it counts as an outlier (a feature on the other side). Same units
+                            * as sigma_f. > 0; +INFINITY turns the influence weight off. Default 0.5. */
+    int absolute;          /* 0: sigmas in mean edge lengths (default); 1: in the mesh's units */
+    double cutoff;         /* facets farther than cutoff * sigma_f are ignored. (0, 5]. Default 2 */
+    double mollify_cutoff; /* mollification radius in units of sigma_f, (0, cutoff]; 0 (default)
+                            * means the same radius as `cutoff` (the published setting) */
+    int mollify;           /* 1 (default): predict with mollified normals; 0: with the input's own
+                            * (the paper's Fig. 4 ablation) */
+} rsmooth_params;
+
+/* Fills `params` with the defaults above. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if params is NULL. */
+RSMOOTH_API rsmooth_status rsmooth_params_init(rsmooth_params *params);
+
+/* Mean length of the mesh's unique undirected edges (an edge shared by two triangles counts once),
+ * in the mesh's units: the unit of relative sigmas. Writes 0 when there is no edge of non-zero length.
+ * Fails like rsmooth_smooth_reference on bad arrays. Thread-safe. */
+RSMOOTH_API rsmooth_status rsmooth_mean_edge_length(rsmooth_scalar scalar, const void *positions,
+                                                    size_t vertex_count, const uint32_t *indices,
+                                                    size_t triangle_count, double *out_length,
+                                                    rsmooth_error *error);
+
+/* Figures of one filter run, filled when a non-NULL pointer is passed. Times in milliseconds;
+ * stages a path does not have are 0. */
+typedef struct rsmooth_report {
+    size_t vertex_count;
+    size_t triangle_count;        /* triangles given */
+    size_t facet_count;           /* triangles with non-zero area: the ones that carry weight */
+    double mean_edge_length;      /* in mesh units */
+    double sigma_f;               /* absolute, mesh units */
+    double sigma_g;               /* absolute, mesh units (+INFINITY when the influence is off) */
+    double radius;                /* cutoff * sigma_f: the reach of a vertex, mesh units */
+    size_t grid_cell_count;       /* occupied grid cells */
+    char device[128];             /* "reference (double, 1 thread)" or the OpenCL device name */
+    double ms_setup;              /* program build / context work done for this call */
+    double ms_facets;             /* facet data and mean edge length */
+    double ms_grid;               /* grid build and vertex ordering */
+    double ms_upload;
+    double ms_mollify;            /* vertex mollification */
+    double ms_normals;            /* normals of the mollified copy */
+    double ms_robust;             /* robust estimation */
+    double ms_download;
+    double ms_total;              /* the whole filter call */
+} rsmooth_report;
+
+/* ---------------------------------------------------------------------------------------------- */
+/* Layer 1: arrays in, arrays out                                                                   */
+/* ---------------------------------------------------------------------------------------------- */
+
+/* The filter in double precision on one CPU thread: the oracle of the OpenCL path and the fallback
+ * when no OpenCL device exists.
+ *
+ * scalar         type of `positions` and `out_positions`.
+ * positions      3 * vertex_count floats or doubles (x, y, z per vertex), finite. Borrowed.
+ * vertex_count   >= 1 and < 2^32.
+ * indices        3 * triangle_count vertex indices, each < vertex_count. May be NULL only when
+ *                triangle_count is 0 (then nothing moves). Any soup is fine: duplicated, unreferenced
+ *                or disconnected vertices, non-manifold edges, zero-area triangles.
+ * params         NULL means defaults (rsmooth_params_init).
+ * out_positions  3 * vertex_count values of `scalar`, in the input's vertex order. Must not overlap
+ *                `positions`.
+ * out_weight     optional (NULL): vertex_count floats receiving k(p) = sum a f g (area units).
+ * out_confidence optional (NULL): vertex_count floats receiving k(p) / sum a f, in [0, 1]; 0 where
+ *                no facet is within reach (such vertices keep their position).
+ * report         optional (NULL): figures of the run.
+ * error          optional (NULL): detail on failure.
+ *
+ * Returns RSMOOTH_OK, RSMOOTH_ERROR_INVALID_ARGUMENT (then no output is written) or
+ * RSMOOTH_ERROR_OUT_OF_MEMORY (outputs undefined). Thread-safe (no shared state). */
+RSMOOTH_API rsmooth_status rsmooth_smooth_reference(rsmooth_scalar scalar, const void *positions,
+                                                    size_t vertex_count, const uint32_t *indices,
+                                                    size_t triangle_count,
+                                                    const rsmooth_params *params,
+                                                    void *out_positions, float *out_weight,
+                                                    float *out_confidence, rsmooth_report *report,
+                                                    rsmooth_error *error);
+
+/* ---------------------------------------------------------------------------------------------- */
+/* Layer 2: an OpenCL context object                                                                */
+/* ---------------------------------------------------------------------------------------------- */
+
+/* Owns (or shares) an OpenCL context, device, queue and the built program. */
+typedef struct rsmooth_context rsmooth_context;
+
+/* Creates a context on the device named by `device`:
+ *   NULL        use the RSMOOTH_DEVICE environment variable if set, else "auto";
+ *   "auto"      first GPU of any platform, else first CPU device, else the first device;
+ *   "gpu"/"cpu" first device of that type;
+ *   "P:D"       device D of platform P (0-based, in clGetPlatformIDs/clGetDeviceIDs order);
+ *   other text  first device whose "platform device" name contains it (case-insensitive).
+ * The program is built here (PoCL caches binaries on disk in POCL_CACHE_DIR). Developers may set
+ * RSMOOTH_KERNEL_DIR to load kernels/ *.cl from a directory instead of the embedded copies, and
+ * RSMOOTH_BUILD_OPTIONS to append OpenCL build options.
+ * Returns RSMOOTH_ERROR_NO_DEVICE, RSMOOTH_ERROR_KERNEL_BUILD, RSMOOTH_ERROR_OPENCL, ... with *ctx
+ * set to NULL on failure. Thread-safe; the context itself must be used by one thread at a time. */
+RSMOOTH_API rsmooth_status rsmooth_context_create(const char *device, rsmooth_context **ctx,
+                                                  rsmooth_error *error);
+
+/* Releases everything the context holds. Accepts NULL. */
+RSMOOTH_API void rsmooth_context_destroy(rsmooth_context *ctx);
+
+/* "Platform name / device name" of the context's device; valid while ctx lives. */
+RSMOOTH_API const char *rsmooth_context_device_name(const rsmooth_context *ctx);
+
+/* Milliseconds the context's creation spent building the OpenCL program. */
+RSMOOTH_API double rsmooth_context_build_ms(const rsmooth_context *ctx);
+
+/* The filter on the context's device, float32 arithmetic in cell-local coordinates (so meshes far
+ * from the origin lose nothing). Same arguments, outputs and argument errors as
+ * rsmooth_smooth_reference; the result agrees with it to about 1e-4 mean edge lengths, and two
+ * runs on the same device are bit-identical. Also returns RSMOOTH_ERROR_OPENCL (outputs undefined)
+ * when the device fails, e.g. runs out of memory. */
+RSMOOTH_API rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar,
+                                          const void *positions, size_t vertex_count,
+                                          const uint32_t *indices, size_t triangle_count,
+                                          const rsmooth_params *params, void *out_positions,
+                                          float *out_weight, float *out_confidence,
+                                          rsmooth_report *report, rsmooth_error *error);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* RSMOOTH_H */

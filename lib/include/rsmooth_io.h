@@ -1,0 +1,99 @@
+/*
+ * rsmooth_io: reading and writing the mesh files scanners and tools produce (library target
+ * rsmooth::io, separate from rsmooth::rsmooth so hosts that pass arrays do not pull it in).
+ *
+ * Parsing from a memory buffer is the core (testable without a disk); the file functions are thin
+ * wrappers. Formats: Wavefront OBJ, Stanford PLY (ascii, binary little- and big-endian on input;
+ * ascii and binary little-endian on output).
+ *
+ *     rsmooth_mesh *mesh = NULL;
+ *     rsmooth_error err;
+ *     if (rsmooth_mesh_read_file("scan.ply", &mesh, &err) != RSMOOTH_OK)
+ *         fprintf(stderr, "scan.ply: %s (line %lld)\n", err.message, (long long)err.line);
+ *     ... rsmooth_smooth_reference(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
+ *                                  mesh->triangles, mesh->triangle_count, ...);
+ *     rsmooth_mesh_destroy(mesh);
+ */
+#ifndef RSMOOTH_IO_H
+#define RSMOOTH_IO_H
+
+#include "rsmooth.h"
+
+#include <stdio.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum rsmooth_format {
+    RSMOOTH_FORMAT_AUTO = 0,       /* reading: from the content; writing: from the path's extension */
+    RSMOOTH_FORMAT_OBJ = 1,
+    RSMOOTH_FORMAT_PLY_ASCII = 2,
+    RSMOOTH_FORMAT_PLY_BINARY = 3, /* little-endian on output; either endianness on input */
+    RSMOOTH_FORMAT_PLY_BINARY_BE = 4 /* input only */
+} rsmooth_format;
+
+/* A mesh read from a file. All arrays are owned by the mesh and freed by rsmooth_mesh_destroy. */
+typedef struct rsmooth_mesh {
+    size_t vertex_count;
+    double *positions;          /* 3 * vertex_count: x, y, z per vertex, file order */
+    rsmooth_scalar precision;   /* precision the file stored positions in: FLOAT32 for PLY float,
+                                 * FLOAT64 for PLY double and for text (OBJ) coordinates */
+    size_t face_count;          /* polygons as in the file */
+    uint32_t *face_offsets;     /* face_count + 1 entries: face i is
+                                 * face_indices[face_offsets[i] .. face_offsets[i + 1]) */
+    uint32_t *face_indices;     /* 0-based vertex indices */
+    size_t triangle_count;      /* the faces fanned into triangles (v0, vi, vi+1) */
+    uint32_t *triangles;        /* 3 * triangle_count */
+    rsmooth_format source_format; /* format it was read from */
+
+    /* Optional per-vertex extras written when non-NULL (the readers leave them NULL). */
+    float *vertex_quality;      /* vertex_count values: PLY "quality" property */
+    uint8_t *vertex_colors;     /* 3 * vertex_count RGB bytes: PLY red/green/blue, OBJ "v x y z r g b" */
+} rsmooth_mesh;
+
+/* Parses a whole file held in memory. `name` (may be NULL) is only used to pick the format when
+ * `format` is AUTO and the content is ambiguous. On failure *mesh is NULL and `error` holds the line
+ * (text) or byte offset (binary) and what is wrong; status RSMOOTH_ERROR_PARSE for malformed content
+ * (truncation, bad numbers, indices out of range, faces with fewer than 3 vertices, non-finite
+ * coordinates, counts larger than the data can hold), RSMOOTH_ERROR_OUT_OF_MEMORY. Thread-safe. */
+RSMOOTH_API rsmooth_status rsmooth_mesh_read_memory(const void *data, size_t size,
+                                                    rsmooth_format format, rsmooth_mesh **mesh,
+                                                    rsmooth_error *error);
+
+/* Reads a file: format from the content (PLY magic) else OBJ. RSMOOTH_ERROR_IO when the path cannot
+ * be opened or read (a directory, missing, unreadable), else as rsmooth_mesh_read_memory. */
+RSMOOTH_API rsmooth_status rsmooth_mesh_read_file(const char *path, rsmooth_mesh **mesh,
+                                                  rsmooth_error *error);
+
+/* Writes `mesh` (its faces as polygons, not the fanned triangles) to an open stream. `format` must
+ * not be AUTO. Returns RSMOOTH_ERROR_IO when the stream fails. */
+RSMOOTH_API rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, FILE *stream,
+                                                     rsmooth_format format, rsmooth_error *error);
+
+/* Writes `mesh` to `path` (created or truncated). AUTO picks the format from the extension: .obj,
+ * .ply (binary little-endian). Callers that must never leave a partial file write to a temporary
+ * path and rename it (the rsmooth command does). */
+RSMOOTH_API rsmooth_status rsmooth_mesh_write_file(const rsmooth_mesh *mesh, const char *path,
+                                                   rsmooth_format format, rsmooth_error *error);
+
+/* The format a path's extension names (case-insensitive .obj, .ply), or AUTO if none. */
+RSMOOTH_API rsmooth_format rsmooth_format_from_path(const char *path);
+
+/* Allocates an empty mesh with room for the given counts (arrays zeroed; face_offsets[0] = 0).
+ * Used by generators and tests. */
+RSMOOTH_API rsmooth_status rsmooth_mesh_create(size_t vertex_count, size_t face_count,
+                                               size_t face_index_count, rsmooth_mesh **mesh,
+                                               rsmooth_error *error);
+
+/* Recomputes `triangles` by fanning the faces. */
+RSMOOTH_API rsmooth_status rsmooth_mesh_triangulate(rsmooth_mesh *mesh, rsmooth_error *error);
+
+/* Frees the mesh and everything it owns. Accepts NULL. */
+RSMOOTH_API void rsmooth_mesh_destroy(rsmooth_mesh *mesh);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* RSMOOTH_IO_H */

@@ -1,0 +1,181 @@
+/* Public entry points of the mesh file library: format dispatch, whole-file reads and file writes.
+ */
+#define _POSIX_C_SOURCE 200809L
+#include "io/io_internal.h"
+
+#include <errno.h>
+#include <string.h>
+#include <sys/stat.h>
+
+static bool has_ply_magic(const char *data, size_t size) {
+    return size >= 4 && memcmp(data, "ply", 3) == 0 && (data[3] == '\n' || data[3] == '\r');
+}
+
+rsmooth_status rsmooth_mesh_read_memory(const void *data, size_t size, rsmooth_format format,
+                                        rsmooth_mesh **mesh, rsmooth_error *error) {
+    static const char where[] = "rsmooth_mesh_read_memory";
+    rs_error_clear(error);
+    if (!mesh)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "mesh is NULL");
+    *mesh = NULL;
+    if (!data && size > 0)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "data is NULL");
+    const char *bytes = data ? (const char *)data : "";
+    switch (format) {
+    case RSMOOTH_FORMAT_AUTO:
+        return has_ply_magic(bytes, size) ? rs_io_ply_read(bytes, size, mesh, error)
+                                          : rs_io_obj_read(bytes, size, mesh, error);
+    case RSMOOTH_FORMAT_OBJ:
+        return rs_io_obj_read(bytes, size, mesh, error);
+    case RSMOOTH_FORMAT_PLY_ASCII:
+    case RSMOOTH_FORMAT_PLY_BINARY:
+    case RSMOOTH_FORMAT_PLY_BINARY_BE: /* the header names the encoding */
+        return rs_io_ply_read(bytes, size, mesh, error);
+    }
+    return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "unknown format %d", (int)format);
+}
+
+/* Reads the whole stream; regular files in one allocation of their size, others by doubling. */
+static rsmooth_status read_all(FILE *file, const char *path, size_t size_hint, char **out_data,
+                               size_t *out_size, rsmooth_error *error) {
+    static const char where[] = "rsmooth_mesh_read_file";
+    size_t capacity =
+        size_hint < SIZE_MAX - 1 ? size_hint + 1 : size_hint; /* +1: EOF in one read */
+    if (capacity < 4096)
+        capacity = 4096;
+    char *data = rs_alloc_array(capacity, 1);
+    if (!data)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "%zu bytes for '%s'", capacity,
+                       path);
+    size_t size = 0;
+    for (;;) {
+        if (size == capacity) {
+            size_t grown = capacity <= SIZE_MAX / 2 ? capacity * 2 : SIZE_MAX;
+            char *bigger = grown > capacity ? rs_realloc_array(data, grown, 1) : NULL;
+            if (!bigger) {
+                rs_free(data);
+                return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "reading '%s'", path);
+            }
+            data = bigger;
+            capacity = grown;
+        }
+        errno = 0;
+        size_t got = fread(data + size, 1, capacity - size, file);
+        size += got;
+        if (got == 0 || size < capacity) {
+            if (ferror(file)) {
+                int e = errno;
+                rs_free(data);
+                return rs_fail(error, RSMOOTH_ERROR_IO, where, "cannot read '%s': %s", path,
+                               e ? strerror(e) : "read error");
+            }
+            if (feof(file))
+                break;
+        }
+    }
+    *out_data = data;
+    *out_size = size;
+    return RSMOOTH_OK;
+}
+
+rsmooth_status rsmooth_mesh_read_file(const char *path, rsmooth_mesh **mesh, rsmooth_error *error) {
+    static const char where[] = "rsmooth_mesh_read_file";
+    rs_error_clear(error);
+    if (!mesh)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "mesh is NULL");
+    *mesh = NULL;
+    if (!path)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "path is NULL");
+    FILE *file = fopen(path, "rb");
+    if (!file)
+        return rs_fail(error, RSMOOTH_ERROR_IO, where, "cannot open '%s': %s", path,
+                       strerror(errno));
+    struct stat st;
+    if (fstat(fileno(file), &st) != 0) {
+        int e = errno;
+        fclose(file);
+        return rs_fail(error, RSMOOTH_ERROR_IO, where, "cannot stat '%s': %s", path, strerror(e));
+    }
+    if (S_ISDIR(st.st_mode)) {
+        fclose(file);
+        return rs_fail(error, RSMOOTH_ERROR_IO, where, "cannot read '%s': %s", path,
+                       strerror(EISDIR));
+    }
+    size_t hint = 0;
+    if (S_ISREG(st.st_mode) && st.st_size > 0)
+        hint = (uint64_t)st.st_size < SIZE_MAX ? (size_t)st.st_size : SIZE_MAX - 1;
+    char *data = NULL;
+    size_t size = 0;
+    rsmooth_status status = read_all(file, path, hint, &data, &size, error);
+    fclose(file); /* read-only: nothing to lose on close */
+    if (status != RSMOOTH_OK)
+        return status;
+    status = rsmooth_mesh_read_memory(data, size, RSMOOTH_FORMAT_AUTO, mesh, error);
+    rs_free(data);
+    return status;
+}
+
+rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, FILE *stream,
+                                         rsmooth_format format, rsmooth_error *error) {
+    static const char where[] = "rsmooth_mesh_write_stream";
+    rs_error_clear(error);
+    if (!stream)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "stream is NULL");
+    rsmooth_status status = rs_io_mesh_check(mesh, where, error);
+    if (status != RSMOOTH_OK)
+        return status;
+    switch (format) {
+    case RSMOOTH_FORMAT_OBJ:
+        return rs_io_obj_write(mesh, stream, error);
+    case RSMOOTH_FORMAT_PLY_ASCII:
+        return rs_io_ply_write(mesh, stream, false, error);
+    case RSMOOTH_FORMAT_PLY_BINARY:
+        return rs_io_ply_write(mesh, stream, true, error);
+    case RSMOOTH_FORMAT_PLY_BINARY_BE:
+        return rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, where,
+                       "big-endian PLY output is not supported");
+    case RSMOOTH_FORMAT_AUTO:
+        break;
+    }
+    return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "format %d: give OBJ or PLY",
+                   (int)format);
+}
+
+rsmooth_status rsmooth_mesh_write_file(const rsmooth_mesh *mesh, const char *path,
+                                       rsmooth_format format, rsmooth_error *error) {
+    static const char where[] = "rsmooth_mesh_write_file";
+    rs_error_clear(error);
+    if (!path)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "path is NULL");
+    if (format == RSMOOTH_FORMAT_AUTO) {
+        format = rsmooth_format_from_path(path);
+        if (format == RSMOOTH_FORMAT_AUTO)
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                           "cannot tell the format of '%s' (use .obj or .ply)", path);
+    }
+    /* Check before creating the file, so a bad mesh leaves no file behind. */
+    rsmooth_status status = rs_io_mesh_check(mesh, where, error);
+    if (status != RSMOOTH_OK)
+        return status;
+    if (format == RSMOOTH_FORMAT_PLY_BINARY_BE)
+        return rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, where,
+                       "big-endian PLY output is not supported");
+    FILE *file = fopen(path, "wb");
+    if (!file)
+        return rs_fail(error, RSMOOTH_ERROR_IO, where, "cannot create '%s': %s", path,
+                       strerror(errno));
+    status = rsmooth_mesh_write_stream(mesh, file, format, error);
+    errno = 0;
+    bool closed = fclose(file) == 0;
+    if (status == RSMOOTH_ERROR_IO) {
+        char detail[sizeof error->message]; /* rs_fail clears `error` before formatting */
+        snprintf(detail, sizeof detail, "%s", error ? error->message : "write failed");
+        return rs_fail(error, RSMOOTH_ERROR_IO, where, "writing '%s': %s", path, detail);
+    }
+    if (status != RSMOOTH_OK)
+        return status;
+    if (!closed)
+        return rs_fail(error, RSMOOTH_ERROR_IO, where, "writing '%s': %s", path,
+                       errno ? strerror(errno) : "close failed");
+    return RSMOOTH_OK;
+}

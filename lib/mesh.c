@@ -1,0 +1,241 @@
+/* Argument checks and per-facet data (centroid c_q, area a_q, unit normal n_q) shared by both paths. */
+#include "rsmooth_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+static double coordinate(rsmooth_scalar scalar, const void *positions, size_t i) {
+    return scalar == RSMOOTH_FLOAT32 ? (double)((const float *)positions)[i]
+                                     : ((const double *)positions)[i];
+}
+
+rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions,
+                                    size_t vertex_count, const uint32_t *indices,
+                                    size_t triangle_count, rsmooth_error *error,
+                                    const char *where) {
+    if (scalar != RSMOOTH_FLOAT32 && scalar != RSMOOTH_FLOAT64)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "scalar must be RSMOOTH_FLOAT32 or RSMOOTH_FLOAT64 (got %d)", (int)scalar);
+    if (!positions)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "positions is NULL");
+    if (vertex_count == 0)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "the mesh has no vertices");
+    if (vertex_count > UINT32_MAX)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "vertex count %zu exceeds the 32-bit index range", vertex_count);
+    size_t scalar_size = scalar == RSMOOTH_FLOAT32 ? sizeof(float) : sizeof(double);
+    if (rs_mul_overflows(vertex_count, 3 * scalar_size))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "vertex count %zu overflows the size of the position array", vertex_count);
+    if (triangle_count > 0 && !indices)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "indices is NULL but triangle count is %zu", triangle_count);
+    if (rs_mul_overflows(triangle_count, 3 * sizeof(uint32_t)) || triangle_count > UINT32_MAX)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "triangle count %zu is too large", triangle_count);
+    for (size_t i = 0; i < 3 * triangle_count; i++)
+        if (indices[i] >= vertex_count)
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                           "triangle %zu: index %u >= vertex count %zu", i / 3, indices[i],
+                           vertex_count);
+    for (size_t i = 0; i < 3 * vertex_count; i++)
+        if (!isfinite(coordinate(scalar, positions, i)))
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                           "vertex %zu has a non-finite coordinate", i / 3);
+    return RSMOOTH_OK;
+}
+
+bool rs_mean_edge_length(const double *xyz, const uint32_t *indices, size_t triangle_count,
+                         double *out_length) {
+    *out_length = 0;
+    size_t edge_count = 3 * triangle_count;
+    uint64_t *keys = rs_alloc_array(edge_count, sizeof *keys);
+    uint32_t *unused = rs_alloc_array(edge_count, sizeof *unused);
+    if (!keys || !unused) {
+        rs_free(keys);
+        rs_free(unused);
+        return false;
+    }
+    size_t n = 0;
+    for (size_t t = 0; t < triangle_count; t++) {
+        for (int e = 0; e < 3; e++) {
+            uint32_t a = indices[3 * t + e], b = indices[3 * t + (e + 1) % 3];
+            if (a == b)
+                continue; /* a repeated index is no edge */
+            uint64_t lo = a < b ? a : b, hi = a < b ? b : a;
+            keys[n] = lo << 32 | hi;
+            unused[n] = 0;
+            n++;
+        }
+    }
+    bool ok = rs_radix_sort_u64(keys, unused, n);
+    if (ok) {
+        double sum = 0;
+        size_t unique = 0;
+        for (size_t i = 0; i < n; i++) {
+            if (i > 0 && keys[i] == keys[i - 1])
+                continue;
+            const double *a = xyz + 3 * (keys[i] >> 32), *b = xyz + 3 * (keys[i] & 0xffffffffu);
+            double d[3];
+            rs_sub3(a, b, d);
+            sum += sqrt(rs_dot3(d, d));
+            unique++;
+        }
+        *out_length = unique ? sum / (double)unique : 0;
+    }
+    rs_free(keys);
+    rs_free(unused);
+    return ok;
+}
+
+rsmooth_status rsmooth_mean_edge_length(rsmooth_scalar scalar, const void *positions,
+                                        size_t vertex_count, const uint32_t *indices,
+                                        size_t triangle_count, double *out_length,
+                                        rsmooth_error *error) {
+    static const char where[] = "rsmooth_mean_edge_length";
+    rs_error_clear(error);
+    if (!out_length)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_length is NULL");
+    rsmooth_status st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices,
+                                             triangle_count, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
+    double *xyz = rs_alloc_array(vertex_count, 3 * sizeof *xyz);
+    if (!xyz)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for positions");
+    for (size_t i = 0; i < 3 * vertex_count; i++)
+        xyz[i] = coordinate(scalar, positions, i);
+    bool ok = rs_mean_edge_length(xyz, indices, triangle_count, out_length);
+    rs_free(xyz);
+    return ok ? RSMOOTH_OK
+              : rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for edges");
+}
+
+void rs_store_position(rsmooth_scalar scalar, void *out_positions, size_t v, const double p[3]) {
+    for (int c = 0; c < 3; c++) {
+        if (scalar == RSMOOTH_FLOAT32)
+            ((float *)out_positions)[3 * v + c] = (float)p[c];
+        else
+            ((double *)out_positions)[3 * v + c] = p[c];
+    }
+}
+
+void rs_problem_free(rs_problem *problem) {
+    if (!problem)
+        return;
+    rs_free(problem->xyz);
+    rs_free(problem->facet_triangle);
+    rs_free(problem->centroid);
+    rs_free(problem->normal);
+    rs_free(problem->area);
+    memset(problem, 0, sizeof *problem);
+}
+
+/* Ranges overlap when neither ends before the other begins. */
+static bool overlaps(const void *a, size_t a_size, const void *b, size_t b_size) {
+    const char *pa = a, *pb = b;
+    return pa < pb + b_size && pb < pa + a_size;
+}
+
+rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
+                                  const void *positions, size_t vertex_count,
+                                  const uint32_t *indices, size_t triangle_count,
+                                  const rsmooth_params *params, const void *out_positions,
+                                  rsmooth_error *error, const char *where) {
+    memset(problem, 0, sizeof *problem);
+    rsmooth_params p;
+    rsmooth_status st = rs_params_resolve(params, &p, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
+    st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count, error,
+                              where);
+    if (st != RSMOOTH_OK)
+        return st;
+    if (!out_positions)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_positions is NULL");
+    size_t bytes = vertex_count * 3 * (scalar == RSMOOTH_FLOAT32 ? sizeof(float) : sizeof(double));
+    if (overlaps(positions, bytes, out_positions, bytes))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "out_positions overlaps positions: the filter reads all inputs while "
+                       "writing");
+
+    problem->vertex_count = vertex_count;
+    problem->indices = indices;
+    problem->triangle_count = triangle_count;
+    problem->xyz = rs_alloc_array(vertex_count, 3 * sizeof(double));
+    problem->facet_triangle = rs_alloc_array(triangle_count, sizeof(uint32_t));
+    problem->centroid = rs_alloc_array(triangle_count, 3 * sizeof(double));
+    problem->normal = rs_alloc_array(triangle_count, 3 * sizeof(double));
+    problem->area = rs_alloc_array(triangle_count, sizeof(double));
+    if (!problem->xyz || !problem->facet_triangle || !problem->centroid || !problem->normal ||
+        !problem->area) {
+        rs_problem_free(problem);
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for facet data");
+    }
+    for (size_t i = 0; i < 3 * vertex_count; i++)
+        problem->xyz[i] = coordinate(scalar, positions, i);
+
+    size_t f = 0;
+    for (size_t t = 0; t < triangle_count; t++) {
+        const double *a = problem->xyz + 3 * (size_t)indices[3 * t];
+        const double *b = problem->xyz + 3 * (size_t)indices[3 * t + 1];
+        const double *c = problem->xyz + 3 * (size_t)indices[3 * t + 2];
+        double e1[3], e2[3], n[3];
+        rs_sub3(b, a, e1);
+        rs_sub3(c, a, e2);
+        rs_cross3(e1, e2, n);
+        double len = sqrt(rs_dot3(n, n));
+        if (!(len > 0) || !isfinite(len))
+            continue; /* zero area: no weight, and no normal to divide by */
+        problem->facet_triangle[f] = (uint32_t)t;
+        for (int k = 0; k < 3; k++) {
+            problem->centroid[3 * f + k] = (a[k] + b[k] + c[k]) / 3.0;
+            problem->normal[3 * f + k] = n[k] / len;
+        }
+        problem->area[f] = 0.5 * len;
+        f++;
+    }
+    problem->facet_count = f;
+
+    if (!rs_mean_edge_length(problem->xyz, indices, triangle_count, &problem->mean_edge_length)) {
+        rs_problem_free(problem);
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for edges");
+    }
+    double unit = p.absolute ? 1.0 : problem->mean_edge_length;
+    problem->sigma_f = p.sigma_f * unit;
+    problem->sigma_g = isinf(p.sigma_g) ? INFINITY : p.sigma_g * unit;
+    problem->sigma_m = problem->sigma_f / 2;
+    problem->radius = p.cutoff * problem->sigma_f;
+    problem->mollify_radius =
+        (p.mollify_cutoff > 0 ? p.mollify_cutoff : p.cutoff) * problem->sigma_f;
+    problem->mollify = p.mollify != 0;
+    if (!(problem->sigma_f > 0) || !isfinite(problem->radius))
+        problem->facet_count = 0; /* no edge of non-zero length: nothing can move */
+    return RSMOOTH_OK;
+}
+
+void rs_store_unmoved(const rs_problem *problem, rsmooth_scalar scalar, void *out_positions,
+                      float *out_weight, float *out_confidence) {
+    for (size_t v = 0; v < problem->vertex_count; v++) {
+        rs_store_position(scalar, out_positions, v, problem->xyz + 3 * v);
+        if (out_weight)
+            out_weight[v] = 0;
+        if (out_confidence)
+            out_confidence[v] = 0;
+    }
+}
+
+void rs_report_problem(rsmooth_report *report, const rs_problem *problem, const rs_grid *grid,
+                       const char *device) {
+    memset(report, 0, sizeof *report);
+    report->vertex_count = problem->vertex_count;
+    report->triangle_count = problem->triangle_count;
+    report->facet_count = problem->facet_count;
+    report->mean_edge_length = problem->mean_edge_length;
+    report->sigma_f = problem->sigma_f;
+    report->sigma_g = problem->sigma_g;
+    report->radius = problem->radius;
+    report->grid_cell_count = grid ? grid->cell_count : 0;
+    snprintf(report->device, sizeof report->device, "%s", device);
+}

@@ -1,0 +1,57 @@
+/* Filter parameters: defaults, forward-compatible copying and range checks. */
+#include "rsmooth_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+/* The size of the first published rsmooth_params: callers built against it stay valid. */
+#define PARAMS_V0_SIZE (offsetof(rsmooth_params, mollify) + sizeof(int))
+
+rsmooth_status rsmooth_params_init(rsmooth_params *params) {
+    if (!params)
+        return RSMOOTH_ERROR_INVALID_ARGUMENT;
+    memset(params, 0, sizeof *params);
+    params->struct_size = sizeof *params;
+    params->sigma_f = 2.0;
+    params->sigma_g = 0.5;
+    params->absolute = 0;
+    params->cutoff = 2.0;
+    params->mollify_cutoff = 0.0;
+    params->mollify = 1;
+    return RSMOOTH_OK;
+}
+
+rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *out,
+                                 rsmooth_error *error, const char *where) {
+    rsmooth_params_init(out);
+    if (params) {
+        if (params->struct_size < PARAMS_V0_SIZE)
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                           "params.struct_size %zu is too small: call rsmooth_params_init first",
+                           params->struct_size);
+        size_t n = params->struct_size < sizeof *out ? params->struct_size : sizeof *out;
+        memcpy(out, params, n);
+        out->struct_size = sizeof *out;
+    }
+    if (!(out->sigma_f > 0) || !isfinite(out->sigma_f))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "sigma_f must be positive and finite (got %g)", out->sigma_f);
+    if (!(out->sigma_g > 0)) /* NaN fails too; +INFINITY turns the influence weight off */
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "sigma_g must be positive, or +infinity to turn the influence off (got %g)",
+                       out->sigma_g);
+    if (!(out->cutoff > 0) || !(out->cutoff <= 5))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "cutoff must be in (0, 5] sigma_f (got %g)", out->cutoff);
+    if (!(out->mollify_cutoff >= 0) || !(out->mollify_cutoff <= out->cutoff))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "mollify_cutoff must be in [0, cutoff = %g] (got %g)", out->cutoff,
+                       out->mollify_cutoff);
+    if (out->absolute != 0 && out->absolute != 1)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "absolute must be 0 or 1 (got %d)", out->absolute);
+    if (out->mollify != 0 && out->mollify != 1)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "mollify must be 0 or 1 (got %d)", out->mollify);
+    return RSMOOTH_OK;
+}

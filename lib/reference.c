@@ -1,0 +1,227 @@
+/* The reference path: Jones, Durand & Desbrun 2003 in double precision on one thread, written to be
+ * read beside the paper. Mollification (Sec. 3.2), then robust estimation (Eq. 3). It is the oracle
+ * the OpenCL path is tested against and the fallback when no OpenCL device exists. */
+#include "rsmooth_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+/* The facets whose centroid lies within `reach` of p (distance <= reach), with squared distances. */
+typedef struct neighbours {
+    size_t count, capacity;
+    uint32_t *facet;
+    double *dist2;
+} neighbours;
+
+static bool gather(const rs_problem *pb, const rs_grid *grid, const double p[3], double reach,
+                   neighbours *out) {
+    out->count = 0;
+    int32_t c[3];
+    rs_grid_cell_of(grid, p, c);
+    for (int dx = -1; dx <= 1; dx++)
+        for (int dy = -1; dy <= 1; dy++)
+            for (int dz = -1; dz <= 1; dz++) {
+                int32_t cell = rs_grid_find(grid, c[0] + dx, c[1] + dy, c[2] + dz);
+                if (cell < 0)
+                    continue;
+                for (uint32_t i = grid->cell_start[cell]; i < grid->cell_start[cell + 1]; i++) {
+                    uint32_t q = grid->facet_order[i];
+                    double d[3];
+                    rs_sub3(pb->centroid + 3 * (size_t)q, p, d);
+                    double d2 = rs_dot3(d, d);
+                    if (d2 > reach * reach)
+                        continue;
+                    if (out->count == out->capacity) {
+                        size_t cap = out->capacity ? 2 * out->capacity : 256;
+                        uint32_t *f = rs_realloc_array(out->facet, cap, sizeof *f);
+                        if (!f)
+                            return false;
+                        out->facet = f;
+                        double *dd = rs_realloc_array(out->dist2, cap, sizeof *dd);
+                        if (!dd)
+                            return false;
+                        out->dist2 = dd;
+                        out->capacity = cap;
+                    }
+                    out->facet[out->count] = q;
+                    out->dist2[out->count] = d2;
+                    out->count++;
+                }
+            }
+    return true;
+}
+
+/* Mollified position of p: sum c_q a_q f_m / sum a_q f_m, f_m of width sigma_m. */
+static void mollify_vertex(const rs_problem *pb, const neighbours *nb, const double p[3],
+                           double out[3]) {
+    double wsum = 0, acc[3] = {0, 0, 0};
+    for (size_t i = 0; i < nb->count; i++) {
+        uint32_t q = nb->facet[i];
+        double w = pb->area[q] * exp(-nb->dist2[i] / (2 * pb->sigma_m * pb->sigma_m));
+        for (int k = 0; k < 3; k++)
+            acc[k] += w * (pb->centroid[3 * (size_t)q + k] - p[k]);
+        wsum += w;
+    }
+    for (int k = 0; k < 3; k++)
+        out[k] = wsum > 0 ? p[k] + acc[k] / wsum : p[k];
+}
+
+/* Unit normal of the mollified facet, or the input normal if the mollified facet is degenerate. */
+static void mollified_normal(const rs_problem *pb, const double *mollified, size_t q,
+                             double out[3]) {
+    const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
+    double e1[3], e2[3], n[3];
+    rs_sub3(mollified + 3 * (size_t)tri[1], mollified + 3 * (size_t)tri[0], e1);
+    rs_sub3(mollified + 3 * (size_t)tri[2], mollified + 3 * (size_t)tri[0], e2);
+    rs_cross3(e1, e2, n);
+    double len = sqrt(rs_dot3(n, n));
+    if (!(len > RS_DEGENERATE_SINE * sqrt(rs_dot3(e1, e1) * rs_dot3(e2, e2)))) {
+        memcpy(out, pb->normal + 3 * q, 3 * sizeof(double));
+        return;
+    }
+    for (int k = 0; k < 3; k++)
+        out[k] = n[k] / len;
+}
+
+/* Robust estimate for p (Eq. 3). Writes the displacement p' - p, k(p) and sum a f. */
+static void estimate_vertex(const rs_problem *pb, const neighbours *nb, const double *normals,
+                            const double p[3], double disp[3], double *k_out, double *kf_out) {
+    const double inv_2sf2 = 1 / (2 * pb->sigma_f * pb->sigma_f);
+    const double inv_2sg2 = isinf(pb->sigma_g) ? 0 : 1 / (2 * pb->sigma_g * pb->sigma_g);
+    double k = 0, kf = 0, acc[3] = {0, 0, 0};
+    double e_min = INFINITY; /* smallest influence exponent, for the underflow rescue */
+    for (size_t i = 0; i < nb->count; i++) {
+        uint32_t q = nb->facet[i];
+        const double *n = normals + 3 * (size_t)q;
+        double d[3];
+        rs_sub3(pb->centroid + 3 * (size_t)q, p, d);
+        double t = rs_dot3(n, d); /* Pi_q(p) - p = t n */
+        double af = pb->area[q] * exp(-nb->dist2[i] * inv_2sf2);
+        double e = t * t * inv_2sg2;
+        double w = af * exp(-e);
+        for (int c = 0; c < 3; c++)
+            acc[c] += w * t * n[c];
+        k += w;
+        kf += af;
+        e_min = fmin(e_min, e);
+    }
+    if (kf > 0 && !(k > kf * RS_UNDERFLOW_RATIO)) {
+        /* Every influence weight is tiny: weigh by exp(e_min - e) instead, whose largest is 1. */
+        double ks = 0;
+        acc[0] = acc[1] = acc[2] = 0;
+        for (size_t i = 0; i < nb->count; i++) {
+            uint32_t q = nb->facet[i];
+            const double *n = normals + 3 * (size_t)q;
+            double d[3];
+            rs_sub3(pb->centroid + 3 * (size_t)q, p, d);
+            double t = rs_dot3(n, d);
+            double w = pb->area[q] * exp(-nb->dist2[i] * inv_2sf2) * exp(e_min - t * t * inv_2sg2);
+            for (int c = 0; c < 3; c++)
+                acc[c] += w * t * n[c];
+            ks += w;
+        }
+        k = ks * exp(-e_min);
+        for (int c = 0; c < 3; c++)
+            disp[c] = ks > 0 ? acc[c] / ks : 0;
+    } else {
+        for (int c = 0; c < 3; c++)
+            disp[c] = k > 0 ? acc[c] / k : 0;
+    }
+    *k_out = k;
+    *kf_out = kf;
+}
+
+rsmooth_status rsmooth_smooth_reference(rsmooth_scalar scalar, const void *positions,
+                                        size_t vertex_count, const uint32_t *indices,
+                                        size_t triangle_count, const rsmooth_params *params,
+                                        void *out_positions, float *out_weight,
+                                        float *out_confidence, rsmooth_report *report,
+                                        rsmooth_error *error) {
+    static const char where[] = "rsmooth_smooth_reference";
+    double t_start = rs_now_ms();
+    rs_error_clear(error);
+    rs_problem pb;
+    rsmooth_status st = rs_problem_prepare(&pb, scalar, positions, vertex_count, indices,
+                                           triangle_count, params, out_positions, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
+    double t_facets = rs_now_ms();
+
+    rs_grid grid;
+    memset(&grid, 0, sizeof grid);
+    neighbours nb = {0, 0, NULL, NULL};
+    double *mollified = NULL, *normals = NULL;
+    double t_grid = t_facets, t_mollify = t_facets, t_normals = t_facets;
+
+    if (pb.facet_count == 0) { /* nothing carries weight: every vertex stays */
+        rs_store_unmoved(&pb, scalar, out_positions, out_weight, out_confidence);
+        goto done;
+    }
+
+    st = rs_grid_build(&grid, pb.centroid, pb.facet_count, pb.radius, error);
+    if (st != RSMOOTH_OK)
+        goto fail;
+    t_grid = rs_now_ms();
+
+    normals = rs_alloc_array(pb.facet_count, 3 * sizeof(double));
+    if (!normals)
+        goto fail_memory;
+    if (pb.mollify) {
+        mollified = rs_alloc_array(vertex_count, 3 * sizeof(double));
+        if (!mollified)
+            goto fail_memory;
+        for (size_t v = 0; v < vertex_count; v++) {
+            if (!gather(&pb, &grid, pb.xyz + 3 * v, pb.mollify_radius, &nb))
+                goto fail_memory;
+            mollify_vertex(&pb, &nb, pb.xyz + 3 * v, mollified + 3 * v);
+        }
+        t_mollify = rs_now_ms();
+        for (size_t q = 0; q < pb.facet_count; q++)
+            mollified_normal(&pb, mollified, q, normals + 3 * q);
+    } else {
+        t_mollify = rs_now_ms();
+        memcpy(normals, pb.normal, pb.facet_count * 3 * sizeof(double));
+    }
+    t_normals = rs_now_ms();
+
+    for (size_t v = 0; v < vertex_count; v++) {
+        const double *p = pb.xyz + 3 * v;
+        if (!gather(&pb, &grid, p, pb.radius, &nb))
+            goto fail_memory;
+        double disp[3], k, kf;
+        estimate_vertex(&pb, &nb, normals, p, disp, &k, &kf);
+        double out[3] = {p[0] + disp[0], p[1] + disp[1], p[2] + disp[2]};
+        rs_store_position(scalar, out_positions, v, out);
+        if (out_weight)
+            out_weight[v] = (float)k;
+        if (out_confidence)
+            out_confidence[v] = kf > 0 ? (float)fmin(1.0, k / kf) : 0.0f;
+    }
+
+done:
+    if (report) {
+        double now = rs_now_ms();
+        rs_report_problem(report, &pb, &grid, "reference (double, 1 thread)");
+        report->ms_facets = t_facets - t_start;
+        report->ms_grid = t_grid - t_facets;
+        report->ms_mollify = t_mollify - t_grid;
+        report->ms_normals = t_normals - t_mollify;
+        report->ms_robust = now - t_normals;
+        report->ms_total = now - t_start;
+    }
+    st = RSMOOTH_OK;
+    goto cleanup;
+
+fail_memory:
+    st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "out of memory");
+fail:
+cleanup:
+    rs_free(nb.facet);
+    rs_free(nb.dist2);
+    rs_free(mollified);
+    rs_free(normals);
+    rs_grid_free(&grid);
+    rs_problem_free(&pb);
+    return st;
+}

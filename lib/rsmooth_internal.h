@@ -1,0 +1,208 @@
+/* Declarations shared by the library's own files (not installed). Prefix rs_. */
+#ifndef RSMOOTH_INTERNAL_H
+#define RSMOOTH_INTERNAL_H
+
+#include "rsmooth.h"
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+/* ---- status.c: error detail -------------------------------------------------------------------- */
+
+/* Resets `error` (if non-NULL) to success. */
+void rs_error_clear(rsmooth_error *error);
+
+/* Records a failure in `error` (if non-NULL) and returns `status`, so call sites read
+ * `return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_smooth", "sigma_f %g <= 0", s);` */
+rsmooth_status rs_fail(rsmooth_error *error, rsmooth_status status, const char *where,
+                       const char *format, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+
+/* As rs_fail, for parse errors: also records the line (-1 if unknown) and byte offset (-1). */
+rsmooth_status rs_fail_parse(rsmooth_error *error, int64_t line, int64_t byte_offset,
+                             const char *where, const char *format, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 5, 6)))
+#endif
+    ;
+
+/* ---- alloc.c: the one allocation pair (a per-object allocator can replace it later) ----------- */
+
+/* count * size bytes, NULL on overflow or failure. Never call with both 0 expecting non-NULL use. */
+void *rs_alloc_array(size_t count, size_t size);
+/* Same, zero-filled. */
+void *rs_calloc_array(size_t count, size_t size);
+void *rs_realloc_array(void *ptr, size_t count, size_t size);
+void rs_free(void *ptr);
+
+/* true when a * b overflows size_t. */
+static inline bool rs_mul_overflows(size_t a, size_t b) {
+    return b != 0 && a > SIZE_MAX / b;
+}
+
+/* Monotonic clock in milliseconds. */
+double rs_now_ms(void);
+
+#endif /* RSMOOTH_INTERNAL_H */
+
+/* ---- sort.c ------------------------------------------------------------------------------------ */
+
+/* Stable LSD radix sort of `keys` carrying `values` along. Returns false when scratch memory cannot
+ * be allocated (arrays unchanged then). */
+bool rs_radix_sort_u64(uint64_t *keys, uint32_t *values, size_t count);
+
+/* ---- params.c ---------------------------------------------------------------------------------- */
+
+/* Copies the caller's params (NULL: defaults) into `out`, filling fields newer than the caller's
+ * struct_size with defaults, and checks every value. */
+rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *out,
+                                 rsmooth_error *error, const char *where);
+
+/* ---- mesh.c: the validated problem both paths solve ------------------------------------------- */
+
+/* A facet is a triangle of non-zero area; zero-area triangles carry no weight and are left out. */
+typedef struct rs_problem {
+    size_t vertex_count;
+    double *xyz;                 /* 3 * vertex_count, the input converted to double (owned) */
+    size_t triangle_count;
+    const uint32_t *indices;     /* borrowed from the caller */
+    size_t facet_count;
+    uint32_t *facet_triangle;    /* triangle index of each facet */
+    double *centroid;            /* 3 per facet: c_q */
+    double *normal;              /* 3 per facet: unit n_q of the input */
+    double *area;                /* per facet: a_q > 0 */
+    double mean_edge_length;
+    /* absolute parameters, mesh units */
+    double sigma_f, sigma_g;     /* sigma_g is +INFINITY when the influence weight is off */
+    double sigma_m;              /* mollification width: sigma_f / 2 */
+    double radius;               /* cutoff * sigma_f: reach of the robust pass */
+    double mollify_radius;       /* reach of the mollification pass (<= radius) */
+    bool mollify;
+} rs_problem;
+
+/* Checks every argument of a smoothing call (nothing is written on failure), converts positions to
+ * double, computes facet data, the mean edge length and the absolute parameters. */
+rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
+                                  const void *positions, size_t vertex_count,
+                                  const uint32_t *indices, size_t triangle_count,
+                                  const rsmooth_params *params, const void *out_positions,
+                                  rsmooth_error *error, const char *where);
+void rs_problem_free(rs_problem *problem);
+
+/* Checks the arrays only (shared with rsmooth_mean_edge_length). */
+rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions,
+                                    size_t vertex_count, const uint32_t *indices,
+                                    size_t triangle_count, rsmooth_error *error,
+                                    const char *where);
+
+/* Mean length of unique undirected edges over `xyz` (double). false on allocation failure. */
+bool rs_mean_edge_length(const double *xyz, const uint32_t *indices, size_t triangle_count,
+                         double *out_length);
+
+/* Writes the result for vertex v (double xyz) into the caller's array of type `scalar`. */
+void rs_store_position(rsmooth_scalar scalar, void *out_positions, size_t v, const double p[3]);
+
+/* Geometry helpers shared by the reference path and the host side of the OpenCL path. */
+static inline double rs_dot3(const double a[3], const double b[3]) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+static inline void rs_sub3(const double a[3], const double b[3], double out[3]) {
+    out[0] = a[0] - b[0];
+    out[1] = a[1] - b[1];
+    out[2] = a[2] - b[2];
+}
+static inline void rs_cross3(const double a[3], const double b[3], double out[3]) {
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* A mollified facet whose sine of corner angle falls below this is degenerate: its input normal is
+ * used instead. Shared by both paths so they decide alike. */
+#define RS_DEGENERATE_SINE 1e-6
+
+/* When k(p) falls below this fraction of sum a f, the influence weights have underflowed (float32
+ * bottoms out near 1e-38): both paths then recompute the sums with the exponent shifted by its
+ * smallest value, so the result is the mathematically defined weighted average. */
+#define RS_UNDERFLOW_RATIO 1e-30
+
+/* ---- grid.c: uniform grid over facet centroids, facets sorted by cell ------------------------- */
+
+/* Occupied cells are found through an open-addressing hash on their integer coordinates, so far-apart
+ * components cost no empty cells. Cell edge >= the largest reach, so a vertex's neighbours lie in the
+ * 27 cells around its own. */
+typedef struct rs_grid {
+    double origin[3];        /* minimum corner of the centroids' bounding box */
+    double cell_size;        /* h >= reach */
+    int32_t dims[3];         /* cells per axis covering the centroids */
+    size_t cell_count;       /* occupied cells */
+    int32_t *cell_coord;     /* 4 per cell: x, y, z, 0 */
+    uint32_t *cell_start;    /* cell_count + 1: facets of cell i are facet_order[start[i]..start[i+1]) */
+    uint32_t *facet_order;   /* facet ids sorted by cell */
+    uint32_t table_mask;     /* hash table size - 1 (a power of two) */
+    int32_t *table;          /* table_mask + 1 slots: cell index or -1 */
+} rs_grid;
+
+/* Builds the grid over `count` points (3 doubles each) with cells at least `reach` wide. */
+rsmooth_status rs_grid_build(rs_grid *grid, const double *points, size_t count, double reach,
+                             rsmooth_error *error);
+void rs_grid_free(rs_grid *grid);
+
+/* Cell coordinates of a point, clamped to [-2, dims + 1]: a point clamped there is more than one cell
+ * away from every facet, so clamping never loses a neighbour. */
+void rs_grid_cell_of(const rs_grid *grid, const double p[3], int32_t cell[3]);
+
+/* Index of the occupied cell at (x, y, z), or -1. */
+int32_t rs_grid_find(const rs_grid *grid, int32_t x, int32_t y, int32_t z);
+
+/* The hash both host and kernels use to place a cell in the table. */
+static inline uint32_t rs_grid_hash(int32_t x, int32_t y, int32_t z) {
+    return ((uint32_t)x * 73856093u) ^ ((uint32_t)y * 19349663u) ^ ((uint32_t)z * 83492791u);
+}
+
+/* Orders `count` points (3 doubles each) by grid cell, for memory locality: order[i] is the index of
+ * the i-th point in that order. */
+rsmooth_status rs_grid_order_points(const rs_grid *grid, const double *points, size_t count,
+                                    uint32_t *order, rsmooth_error *error);
+
+/* ---- cl_device.c / cl_program.c: the OpenCL context object ------------------------------------ */
+
+#ifndef CL_TARGET_OPENCL_VERSION
+#define CL_TARGET_OPENCL_VERSION 120
+#endif
+#include <CL/cl.h>
+
+enum { RS_KERNEL_MOLLIFY, RS_KERNEL_NORMALS, RS_KERNEL_ROBUST, RS_KERNEL_COUNT };
+
+struct rsmooth_context {
+    cl_context context;
+    cl_device_id device;
+    cl_command_queue queue;
+    cl_program program;
+    cl_kernel kernels[RS_KERNEL_COUNT];
+    char device_name[256];
+    double build_ms;
+    size_t local_size;        /* work-group size used for every kernel */
+};
+
+/* Builds the program from the embedded kernels (or RSMOOTH_KERNEL_DIR) and creates the kernels. */
+rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error);
+
+/* Records an OpenCL failure: status RSMOOTH_ERROR_OPENCL with the raw code and failing call. */
+rsmooth_status rs_cl_fail(rsmooth_error *error, cl_int code, const char *call, const char *what);
+
+/* Symbolic name of an OpenCL error code, e.g. "CL_OUT_OF_RESOURCES". */
+const char *rs_cl_error_name(cl_int code);
+
+/* Writes every vertex unmoved, with zero weight and confidence: the result when no facet carries
+ * weight (no triangles, or all of zero area). */
+void rs_store_unmoved(const rs_problem *problem, rsmooth_scalar scalar, void *out_positions,
+                      float *out_weight, float *out_confidence);
+
+/* Fills the parts of a report both paths share. */
+void rs_report_problem(rsmooth_report *report, const rs_problem *problem, const rs_grid *grid,
+                       const char *device);

@@ -1,0 +1,434 @@
+/* OBJ reading and writing: index forms, errors with their line, round trips, truncation and
+ * garbage. */
+#define _POSIX_C_SOURCE 200809L
+#include "rsmooth_io.h"
+#include "test_util.h"
+
+#include <stdbool.h>
+#include <stdint.h>
+#include <string.h>
+#include <unistd.h>
+
+/* Parses `size` bytes of `text` from a buffer of exactly that size (ASan catches any over-read). */
+static rsmooth_status parse_n(const char *text, size_t size, rsmooth_mesh **mesh,
+                              rsmooth_error *err) {
+    char *copy = malloc(size ? size : 1);
+    CHECK(copy != NULL);
+    memcpy(copy, text, size);
+    rsmooth_status s = rsmooth_mesh_read_memory(copy, size, RSMOOTH_FORMAT_OBJ, mesh, err);
+    free(copy);
+    return s;
+}
+
+static rsmooth_mesh *parse_ok(const char *text) {
+    rsmooth_mesh *mesh = NULL;
+    rsmooth_error err;
+    rsmooth_status s = parse_n(text, strlen(text), &mesh, &err);
+    if (s != RSMOOTH_OK)
+        fprintf(stderr, "unexpected failure: %s (line %lld)\n", err.message, (long long)err.line);
+    CHECK_EQ_INT(s, RSMOOTH_OK);
+    CHECK(mesh != NULL);
+    CHECK_EQ_INT(mesh->source_format, RSMOOTH_FORMAT_OBJ);
+    CHECK_EQ_INT(mesh->precision, RSMOOTH_FLOAT64);
+    return mesh;
+}
+
+/* Expects a parse error at `line` whose message contains `needle`. */
+#define EXPECT_PARSE_ERROR(text, line, needle) expect_parse_error(__LINE__, text, line, needle)
+static void expect_parse_error(int at, const char *text, long long line, const char *needle) {
+    rsmooth_mesh *mesh = (rsmooth_mesh *)&mesh; /* must be reset to NULL */
+    rsmooth_error err;
+    rsmooth_status s = parse_n(text, strlen(text), &mesh, &err);
+    if (s != RSMOOTH_ERROR_PARSE || err.line != line || !strstr(err.message, needle)) {
+        fprintf(stderr,
+                "test_obj_io.c:%d: status %d line %lld message '%s'; expected status %d "
+                "line %lld message with '%s'\n",
+                at, (int)s, (long long)err.line, err.message, (int)RSMOOTH_ERROR_PARSE, line,
+                needle);
+        exit(1);
+    }
+    CHECK(mesh == NULL);
+    CHECK_EQ_INT(err.status, RSMOOTH_ERROR_PARSE);
+}
+
+static void check_face(const rsmooth_mesh *m, size_t f, const uint32_t *expected, size_t n) {
+    CHECK(f < m->face_count);
+    CHECK_EQ_INT(m->face_offsets[f + 1] - m->face_offsets[f], n);
+    for (size_t i = 0; i < n; i++)
+        CHECK_EQ_INT(m->face_indices[m->face_offsets[f] + i], expected[i]);
+}
+
+static void test_index_forms(void) {
+    const char *text = "# a comment\n"
+                       "mtllib things.mtl\n"
+                       "o thing\n"
+                       "g group one\n"
+                       "\n"
+                       "v 0 0 0\n"
+                       "v 1.5 -2 3e2\n"
+                       "   v\t1 1 0   \n"
+                       "v 0 1 0 1.0\n"        /* w */
+                       "v 2 2 2 0.5 0.25 1\n" /* r g b */
+                       "vt 0 0\n"
+                       "vn 0 0 1\n"
+                       "usemtl stone\n"
+                       "s off\n"
+                       "f 1 2 3\n"
+                       "f 1/1 3/1 4/1\n"
+                       "f 1//1 2//1 4//1 # trailing comment\n"
+                       "f 1/1/1 2/1/1 3/1/1 4/1/1\n"
+                       "f -5 -4 -1\n"
+                       "l 1 2\n"
+                       "p 1\n"
+                       "unknownstatement 1 2 3\n"
+                       "f 5 4 3"; /* no final newline */
+    rsmooth_mesh *m = parse_ok(text);
+    CHECK_EQ_INT(m->vertex_count, 5);
+    CHECK_NEAR(m->positions[3], 1.5, 0);
+    CHECK_NEAR(m->positions[4], -2, 0);
+    CHECK_NEAR(m->positions[5], 300, 0);
+    CHECK_NEAR(m->positions[12], 2, 0);
+    CHECK_EQ_INT(m->face_count, 6);
+    check_face(m, 0, (const uint32_t[]){0, 1, 2}, 3);
+    check_face(m, 1, (const uint32_t[]){0, 2, 3}, 3);
+    check_face(m, 2, (const uint32_t[]){0, 1, 3}, 3);
+    check_face(m, 3, (const uint32_t[]){0, 1, 2, 3}, 4);
+    check_face(m, 4, (const uint32_t[]){0, 1, 4}, 3);
+    check_face(m, 5, (const uint32_t[]){4, 3, 2}, 3);
+    /* the quad fans into two triangles */
+    CHECK_EQ_INT(m->triangle_count, 7);
+    const uint32_t quad[6] = {0, 1, 2, 0, 2, 3};
+    for (int i = 0; i < 6; i++)
+        CHECK_EQ_INT(m->triangles[9 + i], quad[i]);
+    CHECK(m->vertex_colors == NULL && m->vertex_quality == NULL);
+    rsmooth_mesh_destroy(m);
+}
+
+static void test_crlf_and_forward_references(void) {
+    rsmooth_mesh *m = parse_ok("f 1 2 3 4\r\nv 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\n# c\r\nv 0 1 0\r\n");
+    CHECK_EQ_INT(m->vertex_count, 4);
+    CHECK_NEAR(m->positions[11], 0, 0);
+    CHECK_NEAR(m->positions[10], 1, 0);
+    check_face(m, 0, (const uint32_t[]){0, 1, 2, 3}, 4);
+    CHECK_EQ_INT(m->triangle_count, 2);
+    rsmooth_mesh_destroy(m);
+
+    /* Vertices and no faces: a valid (point) mesh. */
+    m = parse_ok("v 1 2 3\nv 4 5 6\n");
+    CHECK_EQ_INT(m->vertex_count, 2);
+    CHECK_EQ_INT(m->face_count, 0);
+    CHECK_EQ_INT(m->triangle_count, 0);
+    CHECK(m->face_offsets != NULL && m->face_offsets[0] == 0);
+    rsmooth_mesh_destroy(m);
+
+    /* Exact decimal conversion: the fast path must agree with strtod. */
+    const char *numbers[] = {"0.1",
+                             "-0.30000000000000004",
+                             "123456789012345678901234",
+                             "1e-300",
+                             "4.9406564584124654e-324",
+                             "1.7976931348623157e308",
+                             ".5",
+                             "5.",
+                             "+2.5E+3",
+                             "0.000000000000000000000000123",
+                             "9007199254740993",
+                             "-0"};
+    for (size_t i = 0; i < sizeof numbers / sizeof numbers[0]; i++) {
+        char text[200];
+        snprintf(text, sizeof text, "v %s 0 0\n", numbers[i]);
+        m = parse_ok(text);
+        double expected = strtod(numbers[i], NULL);
+        if (memcmp(&m->positions[0], &expected, sizeof expected) != 0) {
+            fprintf(stderr, "test_obj_io.c:%d: '%s' parsed as %.17g, strtod gives %.17g\n",
+                    __LINE__, numbers[i], m->positions[0], expected);
+            exit(1);
+        }
+        rsmooth_mesh_destroy(m);
+    }
+}
+
+static void test_errors(void) {
+    EXPECT_PARSE_ERROR("", -1, "no vertices");
+    EXPECT_PARSE_ERROR("# only a comment\n\ng x\n", -1, "no vertices");
+    EXPECT_PARSE_ERROR("v 0 0 0\nv 1 nan 0\nv 0 0 0\n", 2, "vertex 2 has a non-finite coordinate");
+    EXPECT_PARSE_ERROR("v 0 0 0\nv 1 1 1\nv 0 0 inf\n", 3, "vertex 3 has a non-finite");
+    EXPECT_PARSE_ERROR("v 0 0 0\n\nv 1 1e999 1\n", 3, "vertex 2 has a non-finite");
+    EXPECT_PARSE_ERROR("v 0 0 0\nv 1 x 0\n", 2, "malformed number 'x'");
+    EXPECT_PARSE_ERROR("v 0 0 0\nv 1 1.5.2 0\n", 2, "malformed number");
+    EXPECT_PARSE_ERROR("v 0 0 0\nv 1 1\n", 2, "3 needed");
+    EXPECT_PARSE_ERROR("v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 0 2\n", 4, "face index 0");
+    /* forward references: the final count decides, the face's line is reported */
+    EXPECT_PARSE_ERROR("v 0 0 0\nf 1 2 3\nf 1 2 9\nv 1 1 1\nv 2 2 2\nv 3 3 3\n", 3,
+                       "face index 9 out of range (4 vertices)");
+    EXPECT_PARSE_ERROR("v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3\nf -1 -2 -4\n", 5,
+                       "face index -4 out of range (3 vertices)");
+    EXPECT_PARSE_ERROR("v 0 0 0\nv 1 1 1\nf 1 2\nv 2 2 2\n", 3, "face has 2 vertices");
+    EXPECT_PARSE_ERROR("v 0 0 0\nv 1 1 1\nv 2 2 2\nf\n", 4, "face has 0 vertices");
+    EXPECT_PARSE_ERROR("v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3x\n", 4, "malformed face index '3x'");
+    EXPECT_PARSE_ERROR("v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3/1/1/1\n", 4, "malformed face index");
+    EXPECT_PARSE_ERROR("v 0 0 0\r\nv 1 1 1\r\nv 2 2 2\r\nf 1 2 99999999999999999999\r\n", 4,
+                       "out of range");
+
+    /* The byte offset points at the offending token. */
+    const char *text = "v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 7\n";
+    rsmooth_mesh *mesh = NULL;
+    rsmooth_error err;
+    CHECK_EQ_INT(parse_n(text, strlen(text), &mesh, &err), RSMOOTH_ERROR_PARSE);
+    CHECK_EQ_INT(err.byte_offset, strstr(text, "7\n") - text);
+    CHECK_EQ_INT(err.line, 4);
+    CHECK(mesh == NULL);
+
+    /* A NULL error pointer is fine. */
+    CHECK_EQ_INT(parse_n("", 0, &mesh, NULL), RSMOOTH_ERROR_PARSE);
+    CHECK_EQ_INT(rsmooth_mesh_read_memory(NULL, 0, RSMOOTH_FORMAT_OBJ, NULL, &err),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+}
+
+/* Same counts, faces and triangles; positions bit-identical (as floats when `as_float`). */
+static bool meshes_equal(const rsmooth_mesh *a, const rsmooth_mesh *b, bool as_float) {
+    if (a->vertex_count != b->vertex_count || a->face_count != b->face_count ||
+        a->triangle_count != b->triangle_count)
+        return false;
+    for (size_t i = 0; i < 3 * a->vertex_count; i++) {
+        bool same = as_float ? (float)a->positions[i] == (float)b->positions[i]
+                             : memcmp(&a->positions[i], &b->positions[i], sizeof(double)) == 0;
+        if (!same) {
+            fprintf(stderr, "position %zu: %.17g written, %.17g read\n", i, a->positions[i],
+                    b->positions[i]);
+            return false;
+        }
+    }
+    if (memcmp(a->face_offsets, b->face_offsets, (a->face_count + 1) * sizeof(uint32_t)) != 0)
+        return false;
+    return memcmp(a->face_indices, b->face_indices,
+                  a->face_offsets[a->face_count] * sizeof(uint32_t)) == 0 &&
+           memcmp(a->triangles, b->triangles, 3 * a->triangle_count * sizeof(uint32_t)) == 0;
+}
+
+/* 10^e without libm (the test links only rsmooth::io). */
+static double power_of_ten(int e) {
+    double v = 1;
+    for (int i = 0; i < (e < 0 ? -e : e); i++)
+        v *= 10;
+    return e < 0 ? 1 / v : v;
+}
+
+static uint32_t lcg_state = 12345;
+static uint32_t lcg(void) {
+    lcg_state = lcg_state * 1664525u + 1013904223u;
+    return lcg_state >> 8;
+}
+
+/* A mesh with awkward coordinates and faces of 3..6 vertices. */
+static rsmooth_mesh *make_mesh(size_t nv, size_t nf) {
+    rsmooth_mesh *m = NULL;
+    rsmooth_error err;
+    CHECK_EQ_INT(rsmooth_mesh_create(nv, nf, 6 * nf, &m, &err), RSMOOTH_OK);
+    for (size_t i = 0; i < 3 * nv; i++) {
+        double v = ((double)lcg() / (1 << 24) - 0.5) * power_of_ten((int)(lcg() % 40) - 20);
+        m->positions[i] = i % 7 == 0 ? 1.0 / 3.0 : v;
+    }
+    m->positions[0] = -0.0;
+    m->positions[1] = 1e-300;
+    m->positions[2] = -1.7976931348623157e308;
+    uint32_t k = 0;
+    for (size_t f = 0; f < nf; f++) {
+        uint32_t n = 3 + lcg() % 4;
+        for (uint32_t i = 0; i < n; i++)
+            m->face_indices[k++] = lcg() % (uint32_t)nv;
+        m->face_offsets[f + 1] = k;
+    }
+    CHECK_EQ_INT(rsmooth_mesh_triangulate(m, &err), RSMOOTH_OK);
+    return m;
+}
+
+static rsmooth_mesh *read_stream_back(FILE *f) {
+    long size = ftell(f);
+    CHECK(size > 0);
+    rewind(f);
+    char *data = malloc((size_t)size);
+    CHECK(data != NULL);
+    CHECK_EQ_INT(fread(data, 1, (size_t)size, f), size);
+    rsmooth_mesh *m = NULL;
+    rsmooth_error err;
+    rsmooth_status s = rsmooth_mesh_read_memory(data, (size_t)size, RSMOOTH_FORMAT_AUTO, &m, &err);
+    if (s != RSMOOTH_OK)
+        fprintf(stderr, "read back: %s (line %lld)\n", err.message, (long long)err.line);
+    CHECK_EQ_INT(s, RSMOOTH_OK);
+    free(data);
+    return m;
+}
+
+static void test_round_trip(void) {
+    rsmooth_mesh *m = make_mesh(50, 80);
+    rsmooth_error err;
+    FILE *f = tmpfile();
+    CHECK(f != NULL);
+    CHECK_EQ_INT(rsmooth_mesh_write_stream(m, f, RSMOOTH_FORMAT_OBJ, &err), RSMOOTH_OK);
+    rsmooth_mesh *back = read_stream_back(f);
+    fclose(f);
+    CHECK(meshes_equal(m, back, false));
+    rsmooth_mesh_destroy(back);
+
+    /* float32 precision and colours: %.9g restores every float exactly; colours are skipped. */
+    for (size_t i = 0; i < 3 * m->vertex_count; i++)
+        m->positions[i] = (float)m->positions[i];
+    m->positions[2] = 1e30;
+    m->precision = RSMOOTH_FLOAT32;
+    m->vertex_colors = calloc(3 * m->vertex_count, 1);
+    CHECK(m->vertex_colors != NULL);
+    m->vertex_colors[4] = 255;
+    m->vertex_colors[5] = 17;
+
+    char path[] = "/tmp/rsmooth_test_obj_XXXXXX";
+    int fd = mkstemp(path);
+    CHECK(fd >= 0);
+    close(fd);
+    CHECK_EQ_INT(rsmooth_mesh_write_file(m, path, RSMOOTH_FORMAT_OBJ, &err), RSMOOTH_OK);
+    CHECK_EQ_INT(rsmooth_mesh_read_file(path, &back, &err), RSMOOTH_OK);
+    CHECK(meshes_equal(m, back, true));
+    CHECK_EQ_INT(back->precision, RSMOOTH_FLOAT64); /* text is read as double */
+    rsmooth_mesh_destroy(back);
+    FILE *text = fopen(path, "rb");
+    CHECK(text != NULL);
+    char line[256];
+    CHECK(fgets(line, sizeof line, text) != NULL);
+    CHECK(strcmp(line, "# written by rsmooth\n") == 0);
+    CHECK(fgets(line, sizeof line, text) != NULL);
+    CHECK(fgets(line, sizeof line, text) != NULL); /* first vertex, black */
+    CHECK(strstr(line, " 0 0 0\n") != NULL);
+    CHECK(fgets(line, sizeof line, text) != NULL); /* second vertex: 0 1 0.06667 */
+    CHECK(strstr(line, " 0 1 0.06667\n") != NULL);
+    fclose(text);
+    remove(path);
+
+    /* AUTO picks the format from the extension; unknown extensions are refused. */
+    CHECK_EQ_INT(rsmooth_mesh_write_file(m, "/tmp/rsmooth_test_noext", RSMOOTH_FORMAT_AUTO, &err),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK_EQ_INT(rsmooth_mesh_write_file(m, "/nonexistent-dir/x.obj", RSMOOTH_FORMAT_AUTO, &err),
+                 RSMOOTH_ERROR_IO);
+    CHECK(strstr(err.message, "/nonexistent-dir/x.obj") != NULL);
+    rsmooth_mesh_destroy(m);
+}
+
+static const char small_obj[] = "# cube corner\r\n"
+                                "v 0 0 0\n"
+                                "v 1.25 0 0\n"
+                                "v 1 1 -0.5\n"
+                                "v 0 1 0 \n"
+                                "vn 0 0 1\n"
+                                "f 1//1 2//1 3//1 4//1\n"
+                                "f -4 -2 -1\n"
+                                "f 1/1 3/1 4/1\n";
+
+static void test_truncated_prefixes(void) {
+    size_t n = strlen(small_obj);
+    for (size_t len = 0; len < n; len++) {
+        rsmooth_mesh *m = NULL;
+        rsmooth_error err;
+        rsmooth_status s = parse_n(small_obj, len, &m, &err);
+        if (s != RSMOOTH_OK && s != RSMOOTH_ERROR_PARSE) {
+            fprintf(stderr, "test_obj_io.c:%d: prefix %zu: status %d\n", __LINE__, len, (int)s);
+            exit(1);
+        }
+        CHECK((s == RSMOOTH_OK) == (m != NULL));
+        rsmooth_mesh_destroy(m);
+    }
+}
+
+static void test_garbage(void) {
+    static const char *const words[] = {"v",   "f",    "vt",  "#",   "1",  "-1",   "0",
+                                        "2/3", "1//2", "nan", "1e5", "\n", "\r\n", " ",
+                                        "\t",  "/",    "-",   ".",   "9",  "e"};
+    lcg_state = 2024;
+    for (int round = 0; round < 3000; round++) {
+        size_t len = lcg() % 400;
+        char *buf = malloc(len ? len : 1);
+        CHECK(buf != NULL);
+        if (round % 2 == 0) {
+            for (size_t i = 0; i < len; i++)
+                buf[i] = (char)(lcg() & 0xff);
+        } else { /* plausible tokens in random order reach deeper into the parser */
+            size_t i = 0;
+            while (i < len) {
+                const char *w = words[lcg() % (sizeof words / sizeof words[0])];
+                for (size_t j = 0; w[j] && i < len; j++)
+                    buf[i++] = w[j];
+                if (i < len && lcg() % 2)
+                    buf[i++] = ' ';
+            }
+        }
+        rsmooth_mesh *m = NULL;
+        rsmooth_error err;
+        rsmooth_status s = rsmooth_mesh_read_memory(buf, len, RSMOOTH_FORMAT_OBJ, &m, &err);
+        CHECK(s == RSMOOTH_OK || s == RSMOOTH_ERROR_PARSE);
+        if (s == RSMOOTH_OK) {
+            CHECK(m->vertex_count > 0);
+            for (size_t t = 0; t < 3 * m->triangle_count; t++)
+                CHECK(m->triangles[t] < m->vertex_count);
+        }
+        rsmooth_mesh_destroy(m);
+        free(buf);
+    }
+}
+
+static void test_files(void) {
+    rsmooth_mesh *m = (rsmooth_mesh *)&m;
+    rsmooth_error err;
+    CHECK_EQ_INT(rsmooth_mesh_read_file("/tmp", &m, &err), RSMOOTH_ERROR_IO);
+    CHECK(m == NULL);
+    CHECK(strstr(err.message, "'/tmp'") != NULL);
+    CHECK_EQ_INT(rsmooth_mesh_read_file("/nonexistent/mesh.obj", &m, &err), RSMOOTH_ERROR_IO);
+    CHECK(strstr(err.message, "/nonexistent/mesh.obj") != NULL);
+    CHECK(strstr(err.message, "No such file") != NULL);
+
+    CHECK_EQ_INT(rsmooth_format_from_path("a/b/Scan.OBJ"), RSMOOTH_FORMAT_OBJ);
+    CHECK_EQ_INT(rsmooth_format_from_path("x.ply"), RSMOOTH_FORMAT_PLY_BINARY);
+    CHECK_EQ_INT(rsmooth_format_from_path("x.stl"), RSMOOTH_FORMAT_AUTO);
+    CHECK_EQ_INT(rsmooth_format_from_path("obj"), RSMOOTH_FORMAT_AUTO);
+    CHECK_EQ_INT(rsmooth_format_from_path(NULL), RSMOOTH_FORMAT_AUTO);
+}
+
+static void test_create_and_triangulate(void) {
+    rsmooth_mesh *m = NULL;
+    rsmooth_error err;
+    CHECK_EQ_INT(rsmooth_mesh_create(5, 2, 8, &m, &err), RSMOOTH_OK);
+    CHECK_EQ_INT(m->face_offsets[0], 0);
+    const uint32_t faces[8] = {0, 1, 2, 3, 4, 1, 2, 3};
+    memcpy(m->face_indices, faces, sizeof faces);
+    m->face_offsets[1] = 5;
+    m->face_offsets[2] = 8;
+    CHECK_EQ_INT(rsmooth_mesh_triangulate(m, &err), RSMOOTH_OK);
+    CHECK_EQ_INT(m->triangle_count, 4);
+    const uint32_t fan[12] = {0, 1, 2, 0, 2, 3, 0, 3, 4, 1, 2, 3};
+    for (int i = 0; i < 12; i++)
+        CHECK_EQ_INT(m->triangles[i], fan[i]);
+    m->face_indices[7] = 5; /* out of range */
+    CHECK_EQ_INT(rsmooth_mesh_triangulate(m, &err), RSMOOTH_ERROR_INVALID_ARGUMENT);
+    m->face_indices[7] = 4;
+    m->face_offsets[1] = 6; /* leaves a face of 2 */
+    CHECK_EQ_INT(rsmooth_mesh_triangulate(m, &err), RSMOOTH_ERROR_INVALID_ARGUMENT);
+    FILE *f = tmpfile();
+    CHECK(f != NULL);
+    CHECK_EQ_INT(rsmooth_mesh_write_stream(m, f, RSMOOTH_FORMAT_OBJ, &err),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    fclose(f);
+    rsmooth_mesh_destroy(m);
+    rsmooth_mesh_destroy(NULL);
+    CHECK_EQ_INT(rsmooth_mesh_create(SIZE_MAX, 0, 0, &m, &err), RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK(m == NULL);
+}
+
+int main(void) {
+    test_index_forms();
+    test_crlf_and_forward_references();
+    test_errors();
+    test_round_trip();
+    test_truncated_prefixes();
+    test_garbage();
+    test_files();
+    test_create_and_triangulate();
+    printf("obj_io: all checks passed\n");
+    return 0;
+}
