@@ -39,12 +39,8 @@ rsmooth_status rsmooth_mesh_create(size_t vertex_count, size_t face_count, size_
     return RSMOOTH_OK;
 }
 
-rsmooth_status rsmooth_mesh_triangulate(rsmooth_mesh *mesh, rsmooth_error *error) {
-    static const char where[] = "rsmooth_mesh_triangulate";
-    rs_error_clear(error);
-    rsmooth_status status = rs_io_mesh_check(mesh, where, error);
-    if (status != RSMOOTH_OK)
-        return status;
+/* Fans the faces of a checked mesh into `triangles`. */
+static rsmooth_status fan_faces(rsmooth_mesh *mesh, const char *where, rsmooth_error *error) {
     /* The check bounds every face by 2^32 indices in all, so the sum cannot overflow size_t / 3. */
     size_t triangle_count = 0;
     for (size_t f = 0; f < mesh->face_count; f++)
@@ -74,6 +70,15 @@ rsmooth_status rsmooth_mesh_triangulate(rsmooth_mesh *mesh, rsmooth_error *error
     mesh->triangles = triangles;
     mesh->triangle_count = triangle_count;
     return RSMOOTH_OK;
+}
+
+rsmooth_status rsmooth_mesh_triangulate(rsmooth_mesh *mesh, rsmooth_error *error) {
+    static const char where[] = "rsmooth_mesh_triangulate";
+    rs_error_clear(error);
+    rsmooth_status status = rs_io_mesh_check(mesh, where, error);
+    if (status != RSMOOTH_OK)
+        return status;
+    return fan_faces(mesh, where, error);
 }
 
 void rsmooth_mesh_destroy(rsmooth_mesh *mesh) {
@@ -163,7 +168,8 @@ rsmooth_status rs_io_mesh_adopt(double *positions, size_t vertex_count, rsmooth_
         rsmooth_mesh_destroy(m);
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_mesh_read", "face offsets");
     }
-    rsmooth_status status = rsmooth_mesh_triangulate(m, error);
+    /* The parsers checked every face as they read it. */
+    rsmooth_status status = fan_faces(m, "rsmooth_mesh_read", error);
     if (status != RSMOOTH_OK) {
         rsmooth_mesh_destroy(m);
         return status;

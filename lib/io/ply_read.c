@@ -294,41 +294,59 @@ static rsmooth_status face_index(ply_reader *r, double v, int64_t line, int64_t 
 /* ---- data: binary ------------------------------------------------------------------------------
  */
 
+/* Fixed-size loads: compilers turn these into one load (and a byte swap where needed). */
+static inline uint16_t load_u16(const unsigned char *p, bool big_endian) {
+    return big_endian ? (uint16_t)(p[0] << 8 | p[1]) : (uint16_t)(p[1] << 8 | p[0]);
+}
+
+static inline uint32_t load_u32(const unsigned char *p, bool big_endian) {
+    return big_endian ? (uint32_t)p[0] << 24 | (uint32_t)p[1] << 16 | (uint32_t)p[2] << 8 | p[3]
+                      : (uint32_t)p[3] << 24 | (uint32_t)p[2] << 16 | (uint32_t)p[1] << 8 | p[0];
+}
+
+static inline uint64_t load_u64(const unsigned char *p, bool big_endian) {
+    uint64_t a = load_u32(p, big_endian), b = load_u32(p + 4, big_endian);
+    return big_endian ? a << 32 | b : b << 32 | a;
+}
+
+/* An unsigned integer of an integer type's size (list counts). */
 static inline uint64_t load_uint(const unsigned char *p, size_t size, bool big_endian) {
-    uint64_t v = 0;
-    if (big_endian)
-        for (size_t i = 0; i < size; i++)
-            v = v << 8 | p[i];
-    else
-        for (size_t i = size; i-- > 0;)
-            v = v << 8 | p[i];
-    return v;
+    switch (size) {
+    case 1:
+        return p[0];
+    case 2:
+        return load_u16(p, big_endian);
+    case 4:
+        return load_u32(p, big_endian);
+    default:
+        return load_u64(p, big_endian);
+    }
 }
 
 static inline double load_value(const unsigned char *p, ply_type type, bool big_endian) {
-    uint64_t u = load_uint(p, type_size[type], big_endian);
     switch (type) {
     case PLY_INT8:
-        return (double)(int8_t)(uint8_t)u;
+        return (double)(int8_t)p[0];
     case PLY_UINT8:
-        return (double)(uint8_t)u;
+        return (double)p[0];
     case PLY_INT16:
-        return (double)(int16_t)(uint16_t)u;
+        return (double)(int16_t)load_u16(p, big_endian);
     case PLY_UINT16:
-        return (double)(uint16_t)u;
+        return (double)load_u16(p, big_endian);
     case PLY_INT32:
-        return (double)(int32_t)(uint32_t)u;
+        return (double)(int32_t)load_u32(p, big_endian);
     case PLY_UINT32:
-        return (double)(uint32_t)u;
+        return (double)load_u32(p, big_endian);
     case PLY_FLOAT32: {
-        uint32_t bits = (uint32_t)u;
+        uint32_t bits = load_u32(p, big_endian);
         float f;
         memcpy(&f, &bits, sizeof f);
         return (double)f;
     }
     case PLY_FLOAT64: {
+        uint64_t bits = load_u64(p, big_endian);
         double d;
-        memcpy(&d, &u, sizeof d);
+        memcpy(&d, &bits, sizeof d);
         return d;
     }
     case PLY_NONE:
@@ -342,6 +360,46 @@ static rsmooth_status truncated(const ply_reader *r, const element_plan *plan, u
     return rs_fail_parse(
         error, -1, (int64_t)r->pos, where, "data ends inside element '%.*s' item %llu (byte %zu)",
         (int)plan->element->name_len, plan->element->name, (unsigned long long)item, r->pos);
+}
+
+/* The common face layout (the list alone, 32-bit indices), decoded without going through double. */
+static rsmooth_status read_binary_faces(ply_reader *r, const element_plan *plan,
+                                        rsmooth_error *error) {
+    const bool be = r->encoding == PLY_BINARY_BE;
+    const unsigned char *data = (const unsigned char *)r->data;
+    const ply_type count_type = plan->props[0].count_type;
+    const size_t count_size = type_size[count_type];
+    const bool count_signed =
+        count_type == PLY_INT8 || count_type == PLY_INT16 || count_type == PLY_INT32;
+    const bool index_signed = plan->props[0].type == PLY_INT32;
+    for (uint64_t i = 0; i < plan->element->count; i++) {
+        r->face_offsets[i] = (uint32_t)r->indices.count;
+        if (r->size - r->pos < count_size)
+            return truncated(r, plan, i, error);
+        size_t count_offset = r->pos;
+        uint64_t n = load_uint(data + r->pos, count_size, be);
+        r->pos += count_size;
+        if (count_signed && n >> (8 * count_size - 1))
+            return rs_fail_parse(error, -1, (int64_t)count_offset, where,
+                                 "negative list count in face %llu", (unsigned long long)i);
+        if (n > (r->size - r->pos) / 4)
+            return truncated(r, plan, i, error);
+        rsmooth_status status = face_begin(r, n, i, -1, (int64_t)count_offset, error);
+        if (status != RSMOOTH_OK)
+            return status;
+        uint32_t *out = r->indices.data + r->indices.count;
+        for (uint64_t j = 0; j < n; j++, r->pos += 4) {
+            uint32_t v = load_u32(data + r->pos, be);
+            if (v >= r->vertex_count || (index_signed && v > INT32_MAX))
+                return rs_fail_parse(error, -1, (int64_t)r->pos, where,
+                                     "face index %lld out of range (%zu vertices)",
+                                     index_signed ? (long long)(int32_t)v : (long long)v,
+                                     r->vertex_count);
+            out[j] = v;
+        }
+        r->indices.count += (size_t)n;
+    }
+    return RSMOOTH_OK;
 }
 
 static rsmooth_status read_binary_element(ply_reader *r, const element_plan *plan,
@@ -379,6 +437,9 @@ static rsmooth_status read_binary_element(ply_reader *r, const element_plan *pla
         r->pos += (size_t)e->count * item_size;
         return RSMOOTH_OK;
     }
+    if (plan->is_face && e->property_count == 1 &&
+        (plan->props[0].type == PLY_INT32 || plan->props[0].type == PLY_UINT32))
+        return read_binary_faces(r, plan, error);
     for (uint64_t i = 0; i < e->count; i++) {
         const size_t item_start = r->pos;
         if (plan->is_face)

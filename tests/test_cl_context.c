@@ -1,0 +1,166 @@
+/* The OpenCL context: device choice by spec, a caller's own queue (retained, never owned), bit-identical
+ * repeated runs, and argument errors that leave the output untouched. */
+#define _POSIX_C_SOURCE 200809L
+#include "mesh_shapes.h"
+#include "rsmooth_cl.h"
+#include "test_cl_util.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+static void smooth_cube(rsmooth_context *ctx, const shape_mesh *m, double *out) {
+    rsmooth_error err;
+    rsmooth_params p;
+    rsmooth_params_init(&p);
+    float *conf = malloc(m->vertex_count * sizeof *conf);
+    CHECK(conf);
+    CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                m->triangle_count, &p, out, NULL, conf, NULL, &err),
+                 RSMOOTH_OK);
+    free(conf);
+}
+
+int main(void) {
+    rsmooth_context *ctx = open_test_context();
+    shape_mesh cube;
+    CHECK(shape_cube(&cube, 16, 1.0) == 0);
+    CHECK(shape_add_normal_noise(&cube, 0.3, 3) == 0);
+    size_t n = 3 * cube.vertex_count;
+    double *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b), *c = malloc(n * sizeof *c);
+    CHECK(a && b && c);
+
+    /* Two runs on one device: bit-identical. */
+    smooth_cube(ctx, &cube, a);
+    smooth_cube(ctx, &cube, b);
+    CHECK(memcmp(a, b, n * sizeof *a) == 0);
+    printf("two runs: bit-identical\n");
+
+    /* Device specs: "cpu" and "0:0" name PoCL's device here; a name that matches nothing fails. */
+    rsmooth_error err;
+    rsmooth_context *other = NULL;
+    CHECK_STATUS(rsmooth_context_create("0:0", &other, &err), RSMOOTH_OK);
+    printf("device 0:0 is %s\n", rsmooth_context_device_name(other));
+    smooth_cube(other, &cube, c);
+    rsmooth_context_destroy(other);
+    other = NULL;
+    CHECK_STATUS(rsmooth_context_create("no such device anywhere", &other, &err),
+                 RSMOOTH_ERROR_NO_DEVICE);
+    CHECK(other == NULL && strstr(err.message, "no such device anywhere"));
+    CHECK_STATUS(rsmooth_context_create("99:0", &other, &err), RSMOOTH_ERROR_NO_DEVICE);
+    printf("unknown device: %s\n", err.message);
+
+    /* A caller's queue: the context derives context and device from it and retains it. The
+     * caller may drop its own reference while the rsmooth context lives. PoCL releases its own
+     * internal references to a queue lazily, so the count is polled back to where it started. */
+    {
+        cl_command_queue base = rsmooth_context_queue(ctx);
+        cl_context cl_ctx = NULL;
+        cl_device_id device = NULL;
+        clGetCommandQueueInfo(base, CL_QUEUE_CONTEXT, sizeof cl_ctx, &cl_ctx, NULL);
+        clGetCommandQueueInfo(base, CL_QUEUE_DEVICE, sizeof device, &device, NULL);
+        cl_int cl_err = CL_SUCCESS;
+        cl_command_queue queue = clCreateCommandQueue(cl_ctx, device, 0, &cl_err);
+        CHECK(cl_err == CL_SUCCESS);
+        cl_uint refs_before = 0, refs_during = 0, refs_after = 0;
+        clGetCommandQueueInfo(queue, CL_QUEUE_REFERENCE_COUNT, sizeof refs_before, &refs_before,
+                              NULL);
+        CHECK_STATUS(rsmooth_context_create_from_queue(queue, &other, &err), RSMOOTH_OK);
+        clGetCommandQueueInfo(queue, CL_QUEUE_REFERENCE_COUNT, sizeof refs_during, &refs_during,
+                              NULL);
+        CHECK_EQ_INT(refs_during, refs_before + 1);
+        CHECK(rsmooth_context_queue(other) == queue);
+        smooth_cube(other, &cube, c);
+        CHECK(memcmp(a, c, n * sizeof *a) == 0); /* same device, same program: same bits */
+        rsmooth_context_destroy(other);
+        clFinish(queue);
+        for (int i = 0; i < 200; i++) {
+            clGetCommandQueueInfo(queue, CL_QUEUE_REFERENCE_COUNT, sizeof refs_after, &refs_after,
+                                  NULL);
+            if (refs_after == refs_before)
+                break;
+            nanosleep(&(struct timespec){0, 10000000}, NULL);
+        }
+        CHECK_EQ_INT(refs_after, refs_before);
+        clReleaseCommandQueue(queue);
+        CHECK_STATUS(rsmooth_context_create_from_queue(NULL, &other, &err),
+                     RSMOOTH_ERROR_INVALID_ARGUMENT);
+        printf("caller's queue: retained (%u -> %u) and released (%u), same result\n",
+               refs_before, refs_during, refs_after);
+    }
+
+    /* Argument errors: status, message, and the output left as it was. */
+    rsmooth_params p;
+    rsmooth_params_init(&p);
+    memset(c, 0x5a, n * sizeof *c);
+    memcpy(b, c, n * sizeof *c);
+    uint32_t bad = cube.indices[5];
+    cube.indices[5] = (uint32_t)cube.vertex_count;
+    CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count, cube.indices,
+                                cube.triangle_count, &p, c, NULL, NULL, NULL, &err),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    printf("index out of range: %s\n", err.message);
+    cube.indices[5] = bad;
+    p.sigma_f = NAN;
+    CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count, cube.indices,
+                                cube.triangle_count, &p, c, NULL, NULL, NULL, &err),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    printf("sigma_f NaN: %s\n", err.message);
+    rsmooth_params_init(&p);
+    double saved = cube.xyz[7];
+    cube.xyz[7] = INFINITY;
+    CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count, cube.indices,
+                                cube.triangle_count, &p, c, NULL, NULL, NULL, &err),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    printf("infinite coordinate: %s\n", err.message);
+    cube.xyz[7] = saved;
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count, cube.indices,
+                                cube.triangle_count, &p, c, NULL, NULL, NULL, &err),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count, cube.indices,
+                                cube.triangle_count, &p, cube.xyz, NULL, NULL, NULL, &err),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK(memcmp(b, c, n * sizeof *c) == 0);
+    printf("bad arguments: output untouched\n");
+
+    /* Developer override: kernels from a directory. The source tree's copies give the same bits;
+     * a broken kernel gives a build error with the compiler's log; a missing directory an I/O error. */
+    setenv("RSMOOTH_KERNEL_DIR", RSMOOTH_KERNEL_SOURCE_DIR, 1);
+    CHECK_STATUS(rsmooth_context_create(NULL, &other, &err), RSMOOTH_OK);
+    smooth_cube(other, &cube, c);
+    CHECK(memcmp(a, c, n * sizeof *a) == 0);
+    rsmooth_context_destroy(other);
+    char broken_dir[] = "/tmp/rsmooth-broken-kernels-XXXXXX";
+    CHECK(mkdtemp(broken_dir) != NULL);
+    static const char *const names[] = {"common.cl", "mollify.cl", "estimate.cl"};
+    for (int i = 0; i < 3; i++) {
+        char path[256];
+        snprintf(path, sizeof path, "%s/%s", broken_dir, names[i]);
+        FILE *f = fopen(path, "w");
+        CHECK(f);
+        fputs(i == 2 ? "__kernel void robust_vertex(void) { this is not C; }\n" : "\n", f);
+        fclose(f);
+    }
+    setenv("RSMOOTH_KERNEL_DIR", broken_dir, 1);
+    CHECK_STATUS(rsmooth_context_create(NULL, &other, &err), RSMOOTH_ERROR_KERNEL_BUILD);
+    CHECK(other == NULL && err.build_log[0] != '\0');
+    printf("broken kernel: %s; log starts: %.60s\n", err.message, err.build_log);
+    for (int i = 0; i < 3; i++) {
+        char path[256];
+        snprintf(path, sizeof path, "%s/%s", broken_dir, names[i]);
+        remove(path);
+    }
+    CHECK_STATUS(rsmooth_context_create(NULL, &other, &err), RSMOOTH_ERROR_IO);
+    printf("missing kernel directory: %s\n", err.message);
+    rmdir(broken_dir);
+    unsetenv("RSMOOTH_KERNEL_DIR");
+
+    free(a);
+    free(b);
+    free(c);
+    shape_free(&cube);
+    rsmooth_context_destroy(ctx);
+    return 0;
+}
