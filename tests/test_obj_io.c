@@ -1,5 +1,4 @@
-/* OBJ reading and writing: index forms, errors with their line, round trips, truncation and
- * garbage. */
+/* OBJ reading and writing: index forms, errors and their lines, round trips, truncation. */
 #define _POSIX_C_SOURCE 200809L
 #include "rsmooth_io.h"
 #include "test_util.h"

@@ -1,5 +1,4 @@
-/* PLY reading and writing: ascii and both binary byte orders, skipped properties and elements,
- * errors, round trips, truncation and counts larger than the data. */
+/* PLY reading and writing: all encodings, skipped data, errors, round trips, truncation. */
 #define _POSIX_C_SOURCE 200809L
 #include "rsmooth_io.h"
 #include "test_util.h"
@@ -10,8 +9,7 @@
 #include <time.h>
 #include <unistd.h>
 
-/* ---- a byte buffer the tests build files in ----------------------------------------------------
- */
+/* ---- a byte buffer the tests build files in */
 
 typedef struct bytes {
     unsigned char *data;
@@ -57,8 +55,7 @@ static void put_f64(bytes *b, double d) {
     put_uint(b, u, 8);
 }
 
-/* ---- parsing helpers
- * ----------------------------------------------------------------------------- */
+/* ---- parsing helpers */
 
 /* Parses from a buffer of exactly `size` bytes (ASan catches any over-read). */
 static rsmooth_status parse_n(const void *data, size_t size, rsmooth_mesh **mesh,
@@ -123,8 +120,7 @@ static void check_square(const rsmooth_mesh *m) {
     CHECK(m->vertex_colors == NULL && m->vertex_quality == NULL);
 }
 
-/* ---- reading the three encodings
- * ----------------------------------------------------------------- */
+/* ---- reading the three encodings */
 
 static bytes ascii_square(void) {
     bytes b = {0};
@@ -223,6 +219,28 @@ static bytes binary_square(bool big_endian, bool doubles) {
     return b;
 }
 
+/* float x y z only, then "list uchar int" faces: what most tools write. */
+static bytes common_square(bool big_endian) {
+    bytes b = {.big_endian = big_endian};
+    put_text(&b, "ply\n");
+    put_text(&b,
+             big_endian ? "format binary_big_endian 1.0\n" : "format binary_little_endian 1.0\n");
+    put_text(&b, "element vertex 5\nproperty float x\n"
+                 "property float y\nproperty float z\nelement face 2\n"
+                 "property list uchar int vertex_indices\nend_header\n");
+    for (int i = 0; i < 5; i++)
+        for (int c = 0; c < 3; c++)
+            put_f32(&b, (float)square[i][c]);
+    put_u8(&b, 4);
+    for (int v = 0; v < 4; v++)
+        put_i32(&b, v);
+    put_u8(&b, 3);
+    put_i32(&b, 0);
+    put_i32(&b, 1);
+    put_i32(&b, 4);
+    return b;
+}
+
 static void set_f32_le(unsigned char *p, float f) {
     uint32_t u;
     memcpy(&u, &f, 4);
@@ -244,22 +262,14 @@ static void test_binary(void) {
         }
     }
 
-    /* The common layout: float x y z only, then "list uchar int" faces (the direct path). */
-    bytes b = {0};
-    put_text(&b, "ply\nformat binary_little_endian 1.0\nelement vertex 5\nproperty float x\n"
-                 "property float y\nproperty float z\nelement face 2\n"
-                 "property list uchar int vertex_indices\nend_header\n");
-    for (int i = 0; i < 5; i++)
-        for (int c = 0; c < 3; c++)
-            put_f32(&b, (float)square[i][c]);
-    put_u8(&b, 4);
-    for (int v = 0; v < 4; v++)
-        put_i32(&b, v);
-    put_u8(&b, 3);
-    put_i32(&b, 0);
-    put_i32(&b, 1);
-    put_i32(&b, 4);
+    /* The common layout (the direct path), in both byte orders. */
+    bytes b = common_square(true);
     rsmooth_mesh *m = parse_ok(&b);
+    check_square(m);
+    rsmooth_mesh_destroy(m);
+    free(b.data);
+    b = common_square(false);
+    m = parse_ok(&b);
     check_square(m);
     rsmooth_mesh_destroy(m);
 
@@ -289,8 +299,7 @@ static void test_binary(void) {
     free(b.data);
 }
 
-/* ---- errors
- * -------------------------------------------------------------------------------------- */
+/* ---- errors */
 
 static void expect_header_error(int at, const char *header, const char *needle) {
     bytes b = {0};
@@ -426,8 +435,7 @@ static void test_huge_counts(void) {
     }
 }
 
-/* ---- round trips
- * --------------------------------------------------------------------------------- */
+/* ---- round trips */
 
 /* 10^e without libm (the test links only rsmooth::io). */
 static double power_of_ten(int e) {
@@ -552,8 +560,7 @@ static void test_round_trip(void) {
     rsmooth_mesh_destroy(m);
 }
 
-/* ---- truncation
- * ---------------------------------------------------------------------------------- */
+/* ---- truncation */
 
 static void check_prefixes(const bytes *b) {
     for (size_t len = 0; len < b->size; len++) {
@@ -576,6 +583,9 @@ static void test_truncated_prefixes(void) {
     b = binary_square(true, false);
     check_prefixes(&b);
     free(b.data);
+    b = common_square(true);
+    check_prefixes(&b);
+    free(b.data);
     b = ascii_square();
     check_prefixes(&b);
     free(b.data);
@@ -583,9 +593,10 @@ static void test_truncated_prefixes(void) {
 
 /* Random corruption of a valid binary file: an error or a valid mesh, never a crash. */
 static void test_corruption(void) {
-    bytes good = binary_square(false, false);
+    bytes goods[2] = {binary_square(false, false), common_square(true)};
     lcg_state = 7;
-    for (int round = 0; round < 3000; round++) {
+    for (int round = 0; round < 4000; round++) {
+        const bytes good = goods[round % 2];
         bytes b = {0};
         put(&b, good.data, good.size);
         int flips = 1 + (int)(lcg() % 4);
@@ -601,7 +612,8 @@ static void test_corruption(void) {
         rsmooth_mesh_destroy(m);
         free(b.data);
     }
-    free(good.data);
+    free(goods[0].data);
+    free(goods[1].data);
 }
 
 int main(void) {

@@ -52,8 +52,8 @@ typedef struct rsmooth_mesh {
     uint8_t *vertex_colors;     /* 3 * vertex_count RGB bytes: PLY red/green/blue, OBJ "v x y z r g b" */
 } rsmooth_mesh;
 
-/* Parses a whole file held in memory. `name` (may be NULL) is only used to pick the format when
- * `format` is AUTO and the content is ambiguous. On failure *mesh is NULL and `error` holds the line
+/* Parses a whole file held in memory. With `format` AUTO, content starting with "ply" is PLY and
+ * anything else OBJ; any PLY value reads every PLY encoding (the header decides). On failure *mesh is NULL and `error` holds the line
  * (text) or byte offset (binary) and what is wrong; status RSMOOTH_ERROR_PARSE for malformed content
  * (truncation, bad numbers, indices out of range, faces with fewer than 3 vertices, non-finite
  * coordinates, counts larger than the data can hold), RSMOOTH_ERROR_OUT_OF_MEMORY. Thread-safe. */

@@ -1,5 +1,4 @@
-/* Public entry points of the mesh file library: format dispatch, whole-file reads and file writes.
- */
+/* Public entry points of the mesh file library: format dispatch, whole-file reads, file writes. */
 #define _POSIX_C_SOURCE 200809L
 #include "io/io_internal.h"
 

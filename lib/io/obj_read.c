@@ -1,5 +1,4 @@
-/* Wavefront OBJ parser over a memory buffer: v and f statements, everything else accepted and
- * skipped. */
+/* Wavefront OBJ parser over a memory buffer: v and f statements; all else accepted and skipped. */
 #include "io/io_internal.h"
 
 #include <math.h>

@@ -1,5 +1,4 @@
-/* Stanford PLY parser over a memory buffer: ascii, binary little- and big-endian; vertex x/y/z and
- * face lists. */
+/* Stanford PLY parser over a memory buffer (ascii, binary LE and BE): vertex x/y/z, face lists. */
 #include "io/io_internal.h"
 
 #include <limits.h>
@@ -86,8 +85,7 @@ static ply_type parse_type(const char *token, size_t len) {
     return PLY_NONE;
 }
 
-/* ---- header ------------------------------------------------------------------------------------
- */
+/* ---- header */
 
 #define MAX_HEADER_TOKENS 8
 
@@ -254,8 +252,7 @@ static rsmooth_status parse_header(ply_reader *r, rsmooth_error *error) {
     }
 }
 
-/* ---- data: shared ------------------------------------------------------------------------------
- */
+/* ---- data: shared */
 
 /* Roles of the properties the reader keeps. */
 typedef struct element_plan {
@@ -291,8 +288,7 @@ static rsmooth_status face_index(ply_reader *r, double v, int64_t line, int64_t 
     return RSMOOTH_OK;
 }
 
-/* ---- data: binary ------------------------------------------------------------------------------
- */
+/* ---- data: binary */
 
 /* Fixed-size loads: compilers turn these into one load (and a byte swap where needed). */
 static inline uint16_t load_u16(const unsigned char *p, bool big_endian) {
@@ -497,8 +493,7 @@ static rsmooth_status read_binary_element(ply_reader *r, const element_plan *pla
     return RSMOOTH_OK;
 }
 
-/* ---- data: ascii -------------------------------------------------------------------------------
- */
+/* ---- data: ascii */
 
 /* Next whitespace-separated token; counts lines. False at the end of the data. */
 static bool next_token(ply_reader *r, const char **token, size_t *len) {
@@ -598,14 +593,13 @@ static rsmooth_status read_ascii_element(ply_reader *r, const element_plan *plan
     return RSMOOTH_OK;
 }
 
-/* ---- data: driver ------------------------------------------------------------------------------
- */
+/* ---- data: driver */
 
 static rsmooth_status plan_element(ply_reader *r, const ply_element *e, element_plan *plan,
                                    rsmooth_error *error) {
     memset(plan, 0, sizeof *plan);
     plan->element = e;
-    plan->props = r->properties + e->first_property;
+    plan->props = r->properties ? r->properties + e->first_property : NULL;
     plan->xyz[0] = plan->xyz[1] = plan->xyz[2] = -1;
     plan->face_list = -1;
     plan->is_vertex = e == r->vertex_element;

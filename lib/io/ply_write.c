@@ -1,5 +1,4 @@
-/* Stanford PLY writer: ascii or binary little-endian (bytes laid out explicitly, right on any
- * host). */
+/* Stanford PLY writer: ascii or binary little-endian (bytes laid out explicitly for any host). */
 #include "io/io_internal.h"
 
 #include <errno.h>

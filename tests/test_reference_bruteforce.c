@@ -1,0 +1,431 @@
+/* The reference path equals an independent O(V * F) evaluation of the filter's equations. */
+#include "mesh_shapes.h"
+#include "rsmooth.h"
+#include "test_util.h"
+
+#include <stdint.h>
+#include <string.h>
+
+/* ---- the brute force: plain loops over every triangle, double precision ----------------------- */
+
+typedef struct bf_stats {
+    size_t facets;          /* triangles of non-zero area */
+    size_t fallback;        /* mollified facets that fell back to the input normal */
+    size_t unreached;       /* vertices with no facet within reach */
+    double mean_edge;
+} bf_stats;
+
+static int compare_u64(const void *a, const void *b) {
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+static double dot(const double *a, const double *b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void cross(const double *a, const double *b, double *out) {
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static double dist2(const double *a, const double *b) {
+    double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+    return dot(d, d);
+}
+
+/* Mean length of unique undirected edges (pairs of distinct indices). */
+static double bf_mean_edge(const double *xyz, const uint32_t *idx, size_t tc) {
+    uint64_t *keys = malloc((3 * tc + 1) * sizeof *keys);
+    CHECK(keys);
+    size_t n = 0;
+    for (size_t t = 0; t < tc; t++)
+        for (int e = 0; e < 3; e++) {
+            uint64_t a = idx[3 * t + e], b = idx[3 * t + (e + 1) % 3];
+            if (a != b)
+                keys[n++] = a < b ? a << 32 | b : b << 32 | a;
+        }
+    qsort(keys, n, sizeof *keys, compare_u64);
+    double sum = 0;
+    size_t unique = 0;
+    for (size_t i = 0; i < n; i++)
+        if (i == 0 || keys[i] != keys[i - 1]) {
+            sum += sqrt(dist2(xyz + 3 * (keys[i] >> 32), xyz + 3 * (keys[i] & 0xffffffffu)));
+            unique++;
+        }
+    free(keys);
+    return unique ? sum / (double)unique : 0;
+}
+
+static void brute_force(const double *xyz, size_t vc, const uint32_t *idx, size_t tc,
+                        const rsmooth_params *prm, double *out, double *k_out, double *conf_out,
+                        unsigned char *unreached, bf_stats *st) {
+    memset(st, 0, sizeof *st);
+    /* facet data */
+    uint32_t *tri = malloc((tc + 1) * sizeof *tri);
+    double *cen = malloc((3 * tc + 1) * sizeof *cen), *nrm = malloc((3 * tc + 1) * sizeof *nrm);
+    double *area = malloc((tc + 1) * sizeof *area), *mnrm = malloc((3 * tc + 1) * sizeof *mnrm);
+    double *moll = malloc(3 * vc * sizeof *moll);
+    CHECK(tri && cen && nrm && area && mnrm && moll);
+    size_t fc = 0;
+    for (size_t t = 0; t < tc; t++) {
+        const double *a = xyz + 3 * (size_t)idx[3 * t], *b = xyz + 3 * (size_t)idx[3 * t + 1],
+                     *c = xyz + 3 * (size_t)idx[3 * t + 2];
+        double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        double n[3];
+        cross(e1, e2, n);
+        double len = sqrt(dot(n, n));
+        if (!(len > 0))
+            continue;
+        tri[fc] = (uint32_t)t;
+        for (int k = 0; k < 3; k++) {
+            cen[3 * fc + k] = (a[k] + b[k] + c[k]) / 3;
+            nrm[3 * fc + k] = n[k] / len;
+        }
+        area[fc] = len / 2;
+        fc++;
+    }
+    st->facets = fc;
+    st->mean_edge = bf_mean_edge(xyz, idx, tc);
+
+    double unit = prm->absolute ? 1 : st->mean_edge;
+    double sf = prm->sigma_f * unit;
+    double sg = isinf(prm->sigma_g) ? INFINITY : prm->sigma_g * unit;
+    double sm = sf / 2;
+    double reach = prm->cutoff * sf;
+    double mreach = (prm->mollify_cutoff > 0 ? prm->mollify_cutoff : prm->cutoff) * sf;
+
+    /* mollification: sum c a f_m / sum a f_m over facets within mreach */
+    for (size_t v = 0; v < vc; v++) {
+        const double *p = xyz + 3 * v;
+        double acc[3] = {0, 0, 0}, ws = 0;
+        size_t count = 0, last = 0;
+        for (size_t q = 0; q < fc; q++) {
+            double d2 = dist2(cen + 3 * q, p);
+            if (!(d2 <= mreach * mreach))
+                continue;
+            double w = area[q] * exp(-d2 / (2 * sm * sm));
+            for (int k = 0; k < 3; k++)
+                acc[k] += w * cen[3 * q + k];
+            ws += w;
+            count++;
+            last = q;
+        }
+        for (int k = 0; k < 3; k++)
+            moll[3 * v + k] = ws > 0 ? acc[k] / ws : p[k];
+        /* One facet within reach: the average is that centroid exactly (c w / w may round). So an
+         * isolated triangle's mollified copy collapses to exactly one point and falls back to the
+         * input normal, as the equations say. */
+        if (count == 1)
+            memcpy(moll + 3 * v, cen + 3 * last, 3 * sizeof(double));
+    }
+    /* normals of the mollified facets, or the input ones */
+    for (size_t q = 0; q < fc; q++) {
+        const uint32_t *t = idx + 3 * (size_t)tri[q];
+        const double *m0 = moll + 3 * (size_t)t[0], *m1 = moll + 3 * (size_t)t[1],
+                     *m2 = moll + 3 * (size_t)t[2];
+        double e1[3] = {m1[0] - m0[0], m1[1] - m0[1], m1[2] - m0[2]};
+        double e2[3] = {m2[0] - m0[0], m2[1] - m0[1], m2[2] - m0[2]};
+        double n[3];
+        cross(e1, e2, n);
+        double len = sqrt(dot(n, n));
+        int degenerate = !(len > 1e-6 * sqrt(dot(e1, e1)) * sqrt(dot(e2, e2)));
+        if (!prm->mollify || degenerate) {
+            memcpy(mnrm + 3 * q, nrm + 3 * q, 3 * sizeof(double));
+            st->fallback += prm->mollify != 0;
+        } else {
+            for (int k = 0; k < 3; k++)
+                mnrm[3 * q + k] = n[k] / len;
+        }
+    }
+    /* robust estimate, with the influence exponents shifted by their smallest (log-sum-exp) so no
+     * weight underflows: p' = p + sum w t n / sum w is unchanged by the shift. */
+    for (size_t v = 0; v < vc; v++) {
+        const double *p = xyz + 3 * v;
+        double e_min = INFINITY;
+        size_t count = 0;
+        for (size_t q = 0; q < fc; q++) {
+            double d2 = dist2(cen + 3 * q, p);
+            if (!(d2 <= reach * reach))
+                continue;
+            double d[3] = {cen[3 * q] - p[0], cen[3 * q + 1] - p[1], cen[3 * q + 2] - p[2]};
+            double t = dot(mnrm + 3 * q, d);
+            double e = isinf(sg) ? 0 : t * t / (2 * sg * sg);
+            e_min = fmin(e_min, e);
+            count++;
+        }
+        double acc[3] = {0, 0, 0}, ws = 0, kf = 0;
+        for (size_t q = 0; count && q < fc; q++) {
+            double d2 = dist2(cen + 3 * q, p);
+            if (!(d2 <= reach * reach))
+                continue;
+            double d[3] = {cen[3 * q] - p[0], cen[3 * q + 1] - p[1], cen[3 * q + 2] - p[2]};
+            const double *n = mnrm + 3 * q;
+            double t = dot(n, d);
+            double e = isinf(sg) ? 0 : t * t / (2 * sg * sg);
+            double af = area[q] * exp(-d2 / (2 * sf * sf));
+            double w = af * exp(-(e - e_min));
+            for (int k = 0; k < 3; k++)
+                acc[k] += w * t * n[k];
+            ws += w;
+            kf += af;
+        }
+        if (count == 0 || !(ws > 0)) {
+            memcpy(out + 3 * v, p, 3 * sizeof(double));
+            k_out[v] = 0;
+            conf_out[v] = 0;
+            unreached[v] = 1;
+            st->unreached++;
+            continue;
+        }
+        unreached[v] = 0;
+        for (int k = 0; k < 3; k++)
+            out[3 * v + k] = p[k] + acc[k] / ws;
+        k_out[v] = ws * exp(-e_min);
+        conf_out[v] = fmin(1.0, k_out[v] / kf);
+    }
+    free(tri);
+    free(cen);
+    free(nrm);
+    free(area);
+    free(mnrm);
+    free(moll);
+}
+
+/* ---- comparison -------------------------------------------------------------------------------- */
+
+static double rel_float_dev(float got, double want) {
+    double diff = fabs((double)got - want);
+    if (diff <= 1e-37) /* below float's normal range: both underflowed */
+        return 0;
+    return diff / fmax(fabs(want), 1e-300);
+}
+
+/* Soft check: prints and counts a failure, so every case reports before the program fails. */
+static int g_failures;
+
+#define EXPECT_LE(name, a, b)                                                                      \
+    do {                                                                                           \
+        if (!((a) <= (b))) {                                                                       \
+            fprintf(stderr, "%s:%d: %s: FAILED %s = %.9g > %s = %.9g\n", __FILE__, __LINE__, name,  \
+                    #a, (double)(a), #b, (double)(b));                                             \
+            g_failures++;                                                                          \
+        }                                                                                          \
+    } while (0)
+
+static void run_case(const char *name, const double *xyz, size_t vc, const uint32_t *idx,
+                     size_t tc, const rsmooth_params *prm, size_t expect_unreached_min) {
+    double *ref = malloc(3 * vc * sizeof *ref), *bf = malloc(3 * vc * sizeof *bf);
+    double *bk = malloc(vc * sizeof *bk), *bc = malloc(vc * sizeof *bc);
+    float *rk = malloc(vc * sizeof *rk), *rc = malloc(vc * sizeof *rc);
+    unsigned char *unreached = malloc(vc);
+    CHECK(ref && bf && bk && bc && rk && rc && unreached);
+    rsmooth_report report;
+    rsmooth_error err;
+    rsmooth_status s = rsmooth_smooth_reference(RSMOOTH_FLOAT64, xyz, vc, idx, tc, prm, ref, rk,
+                                                rc, &report, &err);
+    if (s != RSMOOTH_OK)
+        fprintf(stderr, "%s: %s\n", name, err.message);
+    CHECK_STATUS(s, RSMOOTH_OK);
+    bf_stats st;
+    brute_force(xyz, vc, idx, tc, prm, bf, bk, bc, unreached, &st);
+
+    double max_dev = 0, max_move = 0, max_k = 0, max_c = 0;
+    size_t worst = 0, kept_exactly = 0;
+    for (size_t v = 0; v < vc; v++) {
+        double dev = sqrt(dist2(ref + 3 * v, bf + 3 * v));
+        if (dev > max_dev) {
+            max_dev = dev;
+            worst = v;
+        }
+        max_move = fmax(max_move, sqrt(dist2(bf + 3 * v, xyz + 3 * v)));
+        max_k = fmax(max_k, rel_float_dev(rk[v], bk[v]));
+        max_c = fmax(max_c, rel_float_dev(rc[v], bc[v]));
+        if (unreached[v]) /* no facet within reach: kept bit for bit, weight and confidence 0 */
+            kept_exactly += memcmp(ref + 3 * v, xyz + 3 * v, 3 * sizeof(double)) == 0 &&
+                            rc[v] == 0.0f && rk[v] == 0.0f;
+    }
+    double mel = st.mean_edge;
+    printf("%-38s V %5zu T %5zu facets %5zu fallback normals %2zu unreached %zu (kept %zu) | max "
+           "move %.3g edges, max |ref - brute| %.3g edges, k rel %.3g, confidence rel %.3g\n",
+           name, vc, tc, st.facets, st.fallback, st.unreached, kept_exactly, max_move / mel,
+           max_dev / mel, max_k, max_c);
+    if (max_dev / mel > 1e-9)
+        printf("    worst vertex %zu at (%.9g, %.9g, %.9g): reference (%.9g, %.9g, %.9g), brute "
+               "force (%.9g, %.9g, %.9g), confidence %.6g vs %.6g\n",
+               worst, xyz[3 * worst], xyz[3 * worst + 1], xyz[3 * worst + 2], ref[3 * worst],
+               ref[3 * worst + 1], ref[3 * worst + 2], bf[3 * worst], bf[3 * worst + 1],
+               bf[3 * worst + 2], rc[worst], bc[worst]);
+    CHECK_EQ_INT(report.facet_count, st.facets);
+    CHECK_NEAR(report.mean_edge_length, mel, 1e-12 * mel);
+    CHECK(max_move > 0); /* the case does something */
+    CHECK(st.unreached >= expect_unreached_min);
+    EXPECT_LE(name, max_dev / mel, 1e-9);
+    EXPECT_LE(name, max_k, 1e-6);
+    EXPECT_LE(name, max_c, 1e-6);
+    EXPECT_LE(name, st.unreached, kept_exactly);
+    free(ref);
+    free(bf);
+    free(bk);
+    free(bc);
+    free(rk);
+    free(rc);
+    free(unreached);
+}
+
+/* ---- the meshes -------------------------------------------------------------------------------- */
+
+static uint64_t next_u64(uint64_t *s) {
+    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+static double uniform(uint64_t *s, double lo, double hi) {
+    return lo + (hi - lo) * ((double)(next_u64(s) >> 11) * 0x1.0p-53);
+}
+
+/* A soup: clustered random triangles sharing some vertices, duplicated vertices, zero-area
+ * triangles (repeated index, coincident duplicates, exactly collinear), isolated small triangles
+ * (whose mollified copies collapse to a point: the fallback normal), unreferenced vertices near the
+ * soup and far from everything. */
+static void make_soup(shape_mesh *m, uint64_t seed, size_t isolated) {
+    const size_t base_tris = 500, dups = 30, extra_near = 25, extra_far = 4;
+    size_t vmax = 3 * base_tris + 3 * isolated + dups + 3 + extra_near + extra_far;
+    size_t tmax = base_tris + isolated + 2 * dups + 3 + 5;
+    m->xyz = malloc(3 * vmax * sizeof(double));
+    m->indices = malloc(3 * tmax * sizeof(uint32_t));
+    CHECK(m->xyz && m->indices);
+    uint64_t s = seed;
+    size_t v = 0, t = 0;
+#define ADD_V(x, y, z)                                                                             \
+    (m->xyz[3 * v] = (x), m->xyz[3 * v + 1] = (y), m->xyz[3 * v + 2] = (z), (uint32_t)v++)
+#define ADD_T(a, b, c)                                                                             \
+    (m->indices[3 * t] = (a), m->indices[3 * t + 1] = (b), m->indices[3 * t + 2] = (c), t++)
+    for (size_t i = 0; i < base_tris; i++) {
+        double c[3];
+        for (int k = 0; k < 3; k++)
+            c[k] = uniform(&s, 0, 3);
+        uint32_t corner[3];
+        for (int j = 0; j < 3; j++) {
+            if (v > 10 && next_u64(&s) % 4 == 0) { /* share an existing vertex */
+                corner[j] = (uint32_t)(next_u64(&s) % v);
+            } else {
+                corner[j] = ADD_V(c[0] + uniform(&s, -0.3, 0.3), c[1] + uniform(&s, -0.3, 0.3),
+                                  c[2] + uniform(&s, -0.3, 0.3));
+            }
+        }
+        if (corner[0] == corner[1] || corner[1] == corner[2] || corner[0] == corner[2])
+            corner[2] = ADD_V(c[0], c[1], c[2] + 0.2);
+        ADD_T(corner[0], corner[1], corner[2]);
+    }
+    for (size_t i = 0; i < isolated; i++) {
+        double x = 40 + 15 * (double)i;
+        uint32_t a = ADD_V(x, 0, 0), b = ADD_V(x + 0.3, 0.05, 0), c = ADD_V(x, 0.3, 0.1);
+        ADD_T(a, b, c);
+    }
+    for (size_t i = 0; i < dups; i++) { /* duplicates used by real and by zero-area triangles */
+        uint32_t src = (uint32_t)(next_u64(&s) % 300);
+        uint32_t d = ADD_V(m->xyz[3 * src], m->xyz[3 * src + 1], m->xyz[3 * src + 2]);
+        uint32_t w = (uint32_t)(next_u64(&s) % 300);
+        if (i % 2)
+            ADD_T(src, d, w); /* src and d coincide: zero area */
+        if (w != src)
+            ADD_T(d, w, (uint32_t)((w + 1) % 300)); /* a real triangle through the duplicate */
+    }
+    {
+        uint32_t a = ADD_V(1, 1, 1), b = ADD_V(1.25, 1.25, 1.25), c = ADD_V(1.5, 1.5, 1.5);
+        ADD_T(a, b, c); /* exactly collinear */
+        ADD_T(a, a, b); /* repeated index */
+        ADD_T(c, c, c);
+    }
+    for (size_t i = 0; i < extra_near; i++)
+        ADD_V(uniform(&s, 0, 3), uniform(&s, 0, 3), uniform(&s, 0, 3));
+    for (size_t i = 0; i < extra_far; i++)
+        ADD_V(1000 + 100 * (double)i, -500, 7);
+#undef ADD_V
+#undef ADD_T
+    m->vertex_count = v;
+    m->triangle_count = t;
+}
+
+int main(void) {
+    rsmooth_params def;
+    rsmooth_params_init(&def);
+
+    enum { MESHES = 4 };
+    shape_mesh meshes[MESHES];
+    memset(meshes, 0, sizeof meshes);
+    CHECK(shape_cube(&meshes[0], 12, 2.0) == 0);
+    CHECK(shape_add_normal_noise(&meshes[0], 0.3, 12345) == 0);
+    CHECK(shape_sphere(&meshes[1], 3, 1.0) == 0);
+    CHECK(shape_add_normal_noise(&meshes[1], 0.25, 777) == 0);
+    make_soup(&meshes[2], 4242, 0);
+    make_soup(&meshes[3], 4242, 6);
+    const char *names[MESHES] = {"noisy cube", "noisy sphere", "soup", "soup + isolated triangles"};
+    const size_t unreached[MESHES] = {0, 0, 4, 4};
+    const double absolute_sigma_f[MESHES] = {0.25, 0.25, 0.4, 0.4};
+
+    for (int i = 0; i < MESHES; i++) {
+        const shape_mesh *m = &meshes[i];
+        char name[96];
+        for (int variant = 0; variant < 8; variant++) {
+            rsmooth_params p = def;
+            const char *what = "";
+            switch (variant) {
+            case 0:
+                what = "defaults";
+                break;
+            case 1:
+                what = "mollify off";
+                p.mollify = 0;
+                break;
+            case 2:
+                what = "sigma_g inf";
+                p.sigma_g = INFINITY;
+                break;
+            case 3:
+                what = "sigma_g inf, mollify off";
+                p.sigma_g = INFINITY;
+                p.mollify = 0;
+                break;
+            case 4:
+                what = "absolute";
+                p.absolute = 1;
+                p.sigma_f = absolute_sigma_f[i];
+                p.sigma_g = 0.06;
+                break;
+            case 5:
+                what = "cutoff 3.5, mollify 1.2";
+                p.sigma_f = 1.5;
+                p.sigma_g = 0.7;
+                p.cutoff = 3.5;
+                p.mollify_cutoff = 1.2;
+                break;
+            case 6:
+                what = "cutoff 1, mollify 0.5";
+                p.cutoff = 1.0;
+                p.mollify_cutoff = 0.5;
+                break;
+            case 7: /* so narrow that every influence weight underflows: the rescue path */
+                what = "sigma_g 0.004 (underflow)";
+                p.sigma_g = 0.004;
+                break;
+            }
+            snprintf(name, sizeof name, "%s, %s", names[i], what);
+            run_case(name, m->xyz, m->vertex_count, m->indices, m->triangle_count, &p,
+                     unreached[i]);
+        }
+    }
+    for (int i = 0; i < MESHES; i++)
+        shape_free(&meshes[i]);
+    if (g_failures) {
+        fprintf(stderr, "reference_bruteforce: %d comparisons FAILED\n", g_failures);
+        return 1;
+    }
+    printf("reference_bruteforce: the reference path equals the brute force\n");
+    return 0;
+}
