@@ -9,7 +9,7 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-/* ---- small helpers ---------------------------------------------------------------------------- */
+/* ---- small helpers --------------------------------------------------------------------------- */
 
 static int mesh_alloc(shape_mesh *mesh, size_t vertex_count, size_t triangle_count) {
     memset(mesh, 0, sizeof *mesh);
@@ -98,7 +98,7 @@ static uint32_t key_map_get_or_insert(key_map *map, uint64_t key, uint32_t value
     return value;
 }
 
-/* ---- noise ------------------------------------------------------------------------------------ */
+/* ---- noise ----------------------------------------------------------------------------------- */
 
 static uint64_t splitmix64(uint64_t *state) {
     *state += 0x9E3779B97F4A7C15ull;
@@ -112,7 +112,7 @@ double shape_gaussian(uint64_t *state) {
     return sqrt(-2.0 * log(u1)) * cos(2.0 * M_PI * u2);
 }
 
-/* ---- plane ------------------------------------------------------------------------------------ */
+/* ---- plane ----------------------------------------------------------------------------------- */
 
 int shape_plane(shape_mesh *mesh, int nx, int ny, double spacing) {
     if (!mesh)
@@ -137,7 +137,7 @@ int shape_plane(shape_mesh *mesh, int nx, int ny, double spacing) {
     return 0;
 }
 
-/* ---- cube ------------------------------------------------------------------------------------- */
+/* ---- cube ------------------------------------------------------------------------------------ */
 
 int shape_cube(shape_mesh *mesh, int n, double size) {
     if (!mesh)
@@ -200,7 +200,7 @@ int shape_cube(shape_mesh *mesh, int n, double size) {
     return 0;
 }
 
-/* ---- sphere ----------------------------------------------------------------------------------- */
+/* ---- sphere ---------------------------------------------------------------------------------- */
 
 static void normalize3(double *p) {
     double len = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
@@ -216,9 +216,9 @@ int shape_sphere(shape_mesh *mesh, int levels, double radius) {
     if (levels < 0 || levels > 12 || !(radius > 0) || !isfinite(radius))
         return -1;
     static const uint32_t ico_f[20][3] = {
-        {0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+        {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
         {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-        {3, 8, 9},  {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+        {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
     size_t final_v = 12, final_t = 20;
     for (int l = 0; l < levels; l++) {
         final_v += final_t * 3 / 2; /* one new vertex per edge; E = 3F/2 */
@@ -233,9 +233,9 @@ int shape_sphere(shape_mesh *mesh, int levels, double radius) {
     }
     /* The icosahedron: cyclic permutations of (+-1, +-t, 0), t the golden ratio. */
     const double g = (1.0 + sqrt(5.0)) / 2.0;
-    const double ico_v[12][3] = {{-1, g, 0}, {1, g, 0},  {-1, -g, 0}, {1, -g, 0},
-                                 {0, -1, g}, {0, 1, g},  {0, -1, -g}, {0, 1, -g},
-                                 {g, 0, -1}, {g, 0, 1},  {-g, 0, -1}, {-g, 0, 1}};
+    const double ico_v[12][3] = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0},
+                                 {0, -1, g}, {0, 1, g}, {0, -1, -g}, {0, 1, -g},
+                                 {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
     for (size_t i = 0; i < 12; i++) {
         double p[3] = {ico_v[i][0], ico_v[i][1], ico_v[i][2]};
         normalize3(p);
@@ -285,7 +285,7 @@ int shape_sphere(shape_mesh *mesh, int levels, double radius) {
     return 0;
 }
 
-/* ---- capped cylinder -------------------------------------------------------------------------- */
+/* ---- capped cylinder ------------------------------------------------------------------------- */
 
 /* Stitches ring A (na vertices from a0, angles offset_a + 2 pi i / na) to ring B (nb vertices from
  * b0) with na + nb triangles, walking both by increasing angle. Unflipped, (B_j, B_j+1, A_i) is
@@ -340,9 +340,10 @@ int shape_capped_cylinder(shape_mesh *mesh, double radius, double height, size_t
     size_t cap_vertices = 1, cap_triangles = 0;
     ring_n[0] = 1;
     for (size_t j = 1; j <= cap_rings; j++) {
-        ring_n[j] = j == cap_rings ? segments
-                                   : (size_t)fmax(3.0, round((double)segments * (double)j /
-                                                             (double)cap_rings));
+        ring_n[j] =
+            j == cap_rings
+                ? segments
+                : (size_t)fmax(3.0, round((double)segments * (double)j / (double)cap_rings));
         if (j < cap_rings)
             cap_vertices += ring_n[j];
         cap_triangles += j == 1 ? ring_n[1] : ring_n[j - 1] + ring_n[j];
@@ -417,7 +418,7 @@ int shape_capped_cylinder(shape_mesh *mesh, double radius, double height, size_t
     return 0;
 }
 
-/* ---- measures and transforms ------------------------------------------------------------------ */
+/* ---- measures and transforms ----------------------------------------------------------------- */
 
 static void face_cross(const double *xyz, const uint32_t *tri, double n[3]) {
     const double *a = xyz + 3 * (size_t)tri[0], *b = xyz + 3 * (size_t)tri[1],

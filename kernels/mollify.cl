@@ -4,7 +4,9 @@
  * mollify_vertex: one work-item per vertex (grid order) writes its displacement, in cell units, to
  *   vertex_shift[v] (float4; 0 where no facet is within reach).
  * mollified_facet_normal: one work-item per facet writes the unit normal of the mollified triangle
- *   (or its input normal when the mollified triangle is degenerate) to mollified_normal[q].
+ *   (or its input normal when the mollified triangle is degenerate: a corner sine below
+ *   RS_DEGENERATE_SINE, or an area below RS_DEGENERATE_AREA_RATIO of the input's) to
+ *   mollified_normal[q].
  *   facet_vertices[q] = (v0, v1, v2, 0) in grid order; facet_edge1/2[q] = v1 - v0, v2 - v0 (cell units).
  */
 
@@ -54,12 +56,15 @@ __kernel void mollified_facet_normal(uint facet_count, __global const uint4 *fac
     if (q >= facet_count)
         return;
     uint4 t = facet_vertices[q];
+    float3 input_e1 = facet_edge1[q].xyz, input_e2 = facet_edge2[q].xyz;
+    float3 input_n = cross(input_e1, input_e2);
     float3 s0 = vertex_shift[t.x].xyz;
-    float3 e1 = facet_edge1[q].xyz + vertex_shift[t.y].xyz - s0;
-    float3 e2 = facet_edge2[q].xyz + vertex_shift[t.z].xyz - s0;
+    float3 e1 = input_e1 + vertex_shift[t.y].xyz - s0;
+    float3 e2 = input_e2 + vertex_shift[t.z].xyz - s0;
     float3 n = cross(e1, e2);
     float len = sqrt(dot(n, n));
-    if (len > RS_DEGENERATE_SINE * sqrt(dot(e1, e1) * dot(e2, e2)))
+    if (len > RS_DEGENERATE_SINE * sqrt(dot(e1, e1) * dot(e2, e2)) &&
+        len > RS_DEGENERATE_AREA_RATIO * sqrt(dot(input_n, input_n)))
         mollified_normal[q] = (float4)(n / len, 0.0f);
     else
         mollified_normal[q] = facet_normal[q];

@@ -12,8 +12,11 @@ extern const size_t rs_kernel_common_size, rs_kernel_mollify_size, rs_kernel_est
 
 /* Constants the host and kernels must agree on. Runtime values (sigmas, counts) are kernel
  * arguments, so changing them never rebuilds the program. */
-static const char prelude[] = "#define RS_DEGENERATE_SINE 1e-6f\n"
-                              "#define RS_RESCUE_EXPONENT 40.0f\n";
+#define STRINGIFY(x) #x
+#define FLOAT_DEFINE(name, value) "#define " #name " " STRINGIFY(value) "f\n"
+static const char prelude[] = FLOAT_DEFINE(RS_DEGENERATE_SINE, RS_DEGENERATE_SINE)
+    FLOAT_DEFINE(RS_DEGENERATE_AREA_RATIO, RS_DEGENERATE_AREA_RATIO)
+    "#define RS_RESCUE_EXPONENT 40.0f\n";
 
 /* Default options: relaxed math lets PoCL vectorize exp(); precision is checked against the
  * double-precision reference path by the tests. */

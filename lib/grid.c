@@ -60,7 +60,9 @@ rsmooth_status rs_grid_build(rs_grid *grid, const double *points, size_t count, 
         }
     if (count == 0)
         lo[0] = lo[1] = lo[2] = hi[0] = hi[1] = hi[2] = 0;
-    double h = reach > 0 ? reach : 1;
+    /* A hair wider than the reach: a point and a centroid exactly `reach` apart must never round
+     * into cells two apart. */
+    double h = reach > 0 ? reach * (1 + 1e-6) : 1;
     for (int k = 0; k < 3; k++)
         if ((hi[k] - lo[k]) / h > MAX_CELLS_PER_AXIS - 2)
             h = (hi[k] - lo[k]) / (MAX_CELLS_PER_AXIS - 2);

@@ -39,10 +39,16 @@ rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                            "triangle %zu: index %u >= vertex count %zu", i / 3, indices[i],
                            vertex_count);
-    for (size_t i = 0; i < 3 * vertex_count; i++)
-        if (!isfinite(coordinate(scalar, positions, i)))
+    for (size_t i = 0; i < 3 * vertex_count; i++) {
+        double x = coordinate(scalar, positions, i);
+        if (!isfinite(x))
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                            "vertex %zu has a non-finite coordinate", i / 3);
+        if (fabs(x) > RS_MAX_COORDINATE)
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                           "vertex %zu has coordinate %g beyond the supported magnitude %g", i / 3,
+                           x, RS_MAX_COORDINATE);
+    }
     return RSMOOTH_OK;
 }
 

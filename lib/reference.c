@@ -76,7 +76,8 @@ static void mollified_normal(const rs_problem *pb, const double *mollified, size
     rs_sub3(mollified + 3 * (size_t)tri[2], mollified + 3 * (size_t)tri[0], e2);
     rs_cross3(e1, e2, n);
     double len = sqrt(rs_dot3(n, n));
-    if (!(len > RS_DEGENERATE_SINE * sqrt(rs_dot3(e1, e1) * rs_dot3(e2, e2)))) {
+    if (!(len > RS_DEGENERATE_SINE * sqrt(rs_dot3(e1, e1) * rs_dot3(e2, e2))) ||
+        !(len > RS_DEGENERATE_AREA_RATIO * 2 * pb->area[q])) {
         memcpy(out, pb->normal + 3 * q, 3 * sizeof(double));
         return;
     }

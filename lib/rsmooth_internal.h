@@ -47,7 +47,6 @@ static inline bool rs_mul_overflows(size_t a, size_t b) {
 /* Monotonic clock in milliseconds. */
 double rs_now_ms(void);
 
-#endif /* RSMOOTH_INTERNAL_H */
 
 /* ---- sort.c ------------------------------------------------------------------------------------ */
 
@@ -121,9 +120,15 @@ static inline void rs_cross3(const double a[3], const double b[3], double out[3]
     out[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-/* A mollified facet whose sine of corner angle falls below this is degenerate: its input normal is
- * used instead. Shared by both paths so they decide alike. */
+/* A mollified facet is degenerate, and its input normal is used instead, when the sine of its corner
+ * angle falls below RS_DEGENERATE_SINE or its area shrank below RS_DEGENERATE_AREA_RATIO of the
+ * input facet's (an isolated triangle collapses onto its centroid; what remains of its edges is
+ * rounding noise, float32's included). Shared by both paths so they decide alike. */
 #define RS_DEGENERATE_SINE 1e-6
+#define RS_DEGENERATE_AREA_RATIO 1e-5
+
+/* Coordinates beyond this magnitude are refused: squared distances must not overflow a double. */
+#define RS_MAX_COORDINATE 1e150
 
 /* When k(p) falls below this fraction of sum a f, the influence weights have underflowed (float32
  * bottoms out near 1e-38): both paths then recompute the sums with the exponent shifted by its
@@ -206,3 +211,5 @@ void rs_store_unmoved(const rs_problem *problem, rsmooth_scalar scalar, void *ou
 /* Fills the parts of a report both paths share. */
 void rs_report_problem(rsmooth_report *report, const rs_problem *problem, const rs_grid *grid,
                        const char *device);
+
+#endif /* RSMOOTH_INTERNAL_H */

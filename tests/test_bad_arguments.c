@@ -1,4 +1,4 @@
-/* Every bad argument is refused with RSMOOTH_ERROR_INVALID_ARGUMENT, a message, and no output written. */
+/* Every bad argument is refused: RSMOOTH_ERROR_INVALID_ARGUMENT, a message, nothing written. */
 #include "mesh_shapes.h"
 #include "rsmooth.h"
 #include "test_util.h"
@@ -35,7 +35,7 @@ typedef struct call {
     rsmooth_report *report;
 } call;
 
-/* Output buffers, big enough for the base mesh in float64, filled with a sentinel before each call. */
+/* Output buffers, big enough for the base mesh in float64, set to a sentinel before each call. */
 #define OUT_DOUBLES 512
 static double g_out[OUT_DOUBLES];
 static float g_weight[OUT_DOUBLES], g_confidence[OUT_DOUBLES];
@@ -101,8 +101,8 @@ static void test_smooth_arguments(void) {
     rsmooth_params params;
     rsmooth_params_init(&params);
 
-    const call base = {RSMOOTH_FLOAT64, pos, vc, idx, tc, &params,
-                       g_out, g_weight, g_confidence, &g_report};
+    const call base = {RSMOOTH_FLOAT64, pos,   vc,       idx,          tc,
+                       &params,         g_out, g_weight, g_confidence, &g_report};
     /* the base call is valid and writes its outputs */
     for (size_t e = 0; e < sizeof entry_points / sizeof entry_points[0]; e++) {
         rsmooth_error err;
@@ -231,7 +231,7 @@ static void test_smooth_arguments(void) {
         c = base, c.scalar = RSMOOTH_FLOAT32, c.positions = bad32;
         expect_invalid(what, c);
     }
-    {   /* an unreferenced vertex counts too */
+    { /* an unreferenced vertex counts too */
         double extra[3 * 26];
         memcpy(extra, pos, 3 * vc * sizeof(double));
         extra[3 * 25] = 1;
@@ -276,7 +276,8 @@ static void test_smooth_arguments(void) {
         CHECK(memcmp(shared, pristine, sizeof shared) == 0);
         float shared32[3 * 25 + 3];
         memcpy(shared32, pos32, sizeof pos32);
-        c = base, c.scalar = RSMOOTH_FLOAT32, c.positions = shared32, c.out_positions = shared32 + 1;
+        c = base, c.scalar = RSMOOTH_FLOAT32, c.positions = shared32,
+        c.out_positions = shared32 + 1;
         expect_invalid("float32 out_positions = positions + 1", c);
         CHECK(memcmp(shared32, pos32, sizeof pos32) == 0);
     }
@@ -310,8 +311,8 @@ static void test_mean_edge_length(void) {
     float xyz32[3 * 20];
     for (size_t i = 0; i < 3 * plane.vertex_count; i++)
         xyz32[i] = (float)plane.xyz[i];
-    CHECK_STATUS(rsmooth_mean_edge_length(RSMOOTH_FLOAT32, xyz32, plane.vertex_count,
-                                          plane.indices, plane.triangle_count, &got32, &err),
+    CHECK_STATUS(rsmooth_mean_edge_length(RSMOOTH_FLOAT32, xyz32, plane.vertex_count, plane.indices,
+                                          plane.triangle_count, &got32, &err),
                  RSMOOTH_OK);
     printf("mean edge length of the %dx%d unit plane: %.15f (float32 %.15f), expected (31 + 12 "
            "sqrt 2) / 43 = %.15f\n",
@@ -337,8 +338,8 @@ static void test_mean_edge_length(void) {
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     CHECK(err.message[0]);
     got = 42;
-    CHECK_STATUS(rsmooth_mean_edge_length(RSMOOTH_FLOAT64, NULL, plane.vertex_count,
-                                          plane.indices, plane.triangle_count, &got, &err),
+    CHECK_STATUS(rsmooth_mean_edge_length(RSMOOTH_FLOAT64, NULL, plane.vertex_count, plane.indices,
+                                          plane.triangle_count, &got, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     CHECK(err.message[0] && err.status == RSMOOTH_ERROR_INVALID_ARGUMENT);
     tri[2] = 3;

@@ -1,4 +1,5 @@
-/* The facet grid: neighbour queries through the 27 cells around a point equal a brute-force scan. */
+/* The facet grid: neighbour queries through the 27 cells around a point equal a brute-force scan.
+ */
 #include "rsmooth_internal.h"
 #include "test_util.h"
 
@@ -154,8 +155,7 @@ static void draw_far(uint64_t *s, const double *points, size_t count, double rea
         p[k] = (next_u64(s) & 1) ? uniform(s, g_box_lo, g_box_hi) : far[next_u64(s) % 4];
 }
 
-static void draw_mixed(uint64_t *s, const double *points, size_t count, double reach,
-                       double p[3]) {
+static void draw_mixed(uint64_t *s, const double *points, size_t count, double reach, double p[3]) {
     uint64_t r = next_u64(s) % 10;
     if (r < 5)
         draw_near_point(s, points, count, reach, p);
@@ -234,9 +234,9 @@ int main(void) {
         CHECK(found > 0);
     }
 
-    /* 4. Rounding at a cell boundary. The grid puts c and p (exactly 1 - 2.8e-17 apart, reach 1) two
-     * cells apart: floor((c - o) / h) = 0 but floor((p - o) / h) = 2, because p - o rounds up to
-     * exactly 2 while c - o stays below 1. A facet the filter counts as within reach
+    /* 4. Rounding at a cell boundary. The grid puts c and p (exactly 1 - 2.8e-17 apart, reach 1)
+     * two cells apart: floor((c - o) / h) = 0 but floor((p - o) / h) = 2, because p - o rounds up
+     * to exactly 2 while c - o stays below 1. A facet the filter counts as within reach
      * (|c - p|^2 <= reach^2, and also exactly) is missed by the 27-cell search: the cell size needs
      * a margin over the reach that covers rounding. */
     {

@@ -1,4 +1,4 @@
-// The public headers compile as C++ (test_header.c checks C11).
+// The public headers compile as C++ (test_header_c.c checks C11).
 #include "rsmooth.h"
 #include "rsmooth_cl.h"
 #include "rsmooth_io.h"

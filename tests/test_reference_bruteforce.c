@@ -6,12 +6,12 @@
 #include <stdint.h>
 #include <string.h>
 
-/* ---- the brute force: plain loops over every triangle, double precision ----------------------- */
+/* ---- the brute force: plain loops over every triangle, double precision ---------------------- */
 
 typedef struct bf_stats {
-    size_t facets;          /* triangles of non-zero area */
-    size_t fallback;        /* mollified facets that fell back to the input normal */
-    size_t unreached;       /* vertices with no facet within reach */
+    size_t facets;    /* triangles of non-zero area */
+    size_t fallback;  /* mollified facets that fell back to the input normal */
+    size_t unreached; /* vertices with no facet within reach */
     double mean_edge;
 } bf_stats;
 
@@ -194,7 +194,7 @@ static void brute_force(const double *xyz, size_t vc, const uint32_t *idx, size_
     free(moll);
 }
 
-/* ---- comparison -------------------------------------------------------------------------------- */
+/* ---- comparison ------------------------------------------------------------------------------ */
 
 static double rel_float_dev(float got, double want) {
     double diff = fabs((double)got - want);
@@ -209,14 +209,14 @@ static int g_failures;
 #define EXPECT_LE(name, a, b)                                                                      \
     do {                                                                                           \
         if (!((a) <= (b))) {                                                                       \
-            fprintf(stderr, "%s:%d: %s: FAILED %s = %.9g > %s = %.9g\n", __FILE__, __LINE__, name,  \
+            fprintf(stderr, "%s:%d: %s: FAILED %s = %.9g > %s = %.9g\n", __FILE__, __LINE__, name, \
                     #a, (double)(a), #b, (double)(b));                                             \
             g_failures++;                                                                          \
         }                                                                                          \
     } while (0)
 
-static void run_case(const char *name, const double *xyz, size_t vc, const uint32_t *idx,
-                     size_t tc, const rsmooth_params *prm, size_t expect_unreached_min) {
+static void run_case(const char *name, const double *xyz, size_t vc, const uint32_t *idx, size_t tc,
+                     const rsmooth_params *prm, size_t expect_unreached_min) {
     double *ref = malloc(3 * vc * sizeof *ref), *bf = malloc(3 * vc * sizeof *bf);
     double *bk = malloc(vc * sizeof *bk), *bc = malloc(vc * sizeof *bc);
     float *rk = malloc(vc * sizeof *rk), *rc = malloc(vc * sizeof *rc);
@@ -224,8 +224,8 @@ static void run_case(const char *name, const double *xyz, size_t vc, const uint3
     CHECK(ref && bf && bk && bc && rk && rc && unreached);
     rsmooth_report report;
     rsmooth_error err;
-    rsmooth_status s = rsmooth_smooth_reference(RSMOOTH_FLOAT64, xyz, vc, idx, tc, prm, ref, rk,
-                                                rc, &report, &err);
+    rsmooth_status s = rsmooth_smooth_reference(RSMOOTH_FLOAT64, xyz, vc, idx, tc, prm, ref, rk, rc,
+                                                &report, &err);
     if (s != RSMOOTH_OK)
         fprintf(stderr, "%s: %s\n", name, err.message);
     CHECK_STATUS(s, RSMOOTH_OK);
@@ -275,7 +275,7 @@ static void run_case(const char *name, const double *xyz, size_t vc, const uint3
     free(unreached);
 }
 
-/* ---- the meshes -------------------------------------------------------------------------------- */
+/* ---- the meshes ------------------------------------------------------------------------------ */
 
 static uint64_t next_u64(uint64_t *s) {
     uint64_t z = (*s += 0x9E3779B97F4A7C15ull);

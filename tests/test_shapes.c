@@ -68,8 +68,9 @@ static double check_closed(const char *name, const shape_mesh *m, double *min_ed
     size_t unused = 0;
     for (size_t v = 0; v < m->vertex_count; v++)
         unused += !used[v];
-    printf("%-22s V %6zu T %6zu: bad edges %zu, unused vertices %zu, volume %.6f, edges %.4g..%.4g\n",
-           name, m->vertex_count, m->triangle_count, bad, unused, volume, *min_edge, *max_edge);
+    printf(
+        "%-22s V %6zu T %6zu: bad edges %zu, unused vertices %zu, volume %.6f, edges %.4g..%.4g\n",
+        name, m->vertex_count, m->triangle_count, bad, unused, volume, *min_edge, *max_edge);
     CHECK_EQ_INT(bad, 0);
     CHECK_EQ_INT(unused, 0);
     free(edges);
@@ -192,13 +193,13 @@ static void test_shape_generators(void) {
     shape_free(&u);
 }
 
-/* ---- the filter on the shapes ------------------------------------------------------------------ */
+/* ---- the filter on the shapes ---------------------------------------------------------------- */
 
 static void smooth(const shape_mesh *m, const rsmooth_params *p, double *out, float *confidence) {
     rsmooth_error err;
-    rsmooth_status s = rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count,
-                                                m->indices, m->triangle_count, p, out, NULL,
-                                                confidence, NULL, &err);
+    rsmooth_status s =
+        rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                 m->triangle_count, p, out, NULL, confidence, NULL, &err);
     if (s != RSMOOTH_OK)
         fprintf(stderr, "rsmooth_smooth_reference: %s\n", err.message);
     CHECK_STATUS(s, RSMOOTH_OK);
@@ -274,10 +275,11 @@ static void test_noisy_cube(void) {
     double after = shape_face_normal_error_deg(&clean, out);
     double corner_sum = 0, corner_max = 0, corner_before_sum = 0;
     int corners = 0;
-    printf("noisy cube n=%d, noise %.2f mean edges (seed %u), sigma_f %.2f, sigma_g %.2f: mean face "
-           "normal error %.2f -> %.2f degrees (ratio %.3f)\n  corner distance to the true corner "
-           "(mean edges) before -> after:",
-           n, noise, (unsigned)seed, sigma_f, sigma_g, before, after, after / before);
+    printf(
+        "noisy cube n=%d, noise %.2f mean edges (seed %u), sigma_f %.2f, sigma_g %.2f: mean face "
+        "normal error %.2f -> %.2f degrees (ratio %.3f)\n  corner distance to the true corner "
+        "(mean edges) before -> after:",
+        n, noise, (unsigned)seed, sigma_f, sigma_g, before, after, after / before);
     for (size_t v = 0; v < clean.vertex_count; v++) {
         const double *c = clean.xyz + 3 * v;
         if (fabs(fabs(c[0]) - 1) > 1e-12 || fabs(fabs(c[1]) - 1) > 1e-12 ||
@@ -360,8 +362,8 @@ static void test_unreferenced(void) {
     const double *f = out + 3 * (vc - 2), *g = out + 3 * (vc - 1);
     printf("unreferenced vertex 0.2 above the plane: -> (%.9g, %.9g, %.9g), confidence %.4f; far "
            "vertex: moved %s, weight %g, confidence %g\n",
-           f[0], f[1], f[2], conf[vc - 2], memcmp(g, far, sizeof far) ? "yes" : "no",
-           k[vc - 1], conf[vc - 1]);
+           f[0], f[1], f[2], conf[vc - 2], memcmp(g, far, sizeof far) ? "yes" : "no", k[vc - 1],
+           conf[vc - 1]);
     CHECK_NEAR(f[2], 0, 1e-9);
     CHECK_NEAR(f[0], floating[0], 1e-9);
     CHECK_NEAR(f[1], floating[1], 1e-9);

@@ -1,5 +1,6 @@
 /* Connectivity, placement and precision do not change the result: an unindexed soup equals its
- * indexed twin, a mesh far from the origin moves as it does at the origin, float32 matches float64. */
+ * indexed twin, a mesh far from the origin moves as it does at the origin, float32 matches float64,
+ * and coordinates near the largest double still work. */
 #include "mesh_shapes.h"
 #include "rsmooth.h"
 #include "test_util.h"
@@ -15,9 +16,9 @@ static double dist3(const double *a, const double *b) {
 static void smooth64(const shape_mesh *m, const rsmooth_params *p, double *out, float *k,
                      float *conf, rsmooth_report *report) {
     rsmooth_error err;
-    rsmooth_status s = rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count,
-                                                m->indices, m->triangle_count, p, out, k, conf,
-                                                report, &err);
+    rsmooth_status s =
+        rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                 m->triangle_count, p, out, k, conf, report, &err);
     if (s != RSMOOTH_OK)
         fprintf(stderr, "rsmooth_smooth_reference: %s\n", err.message);
     CHECK_STATUS(s, RSMOOTH_OK);
@@ -149,6 +150,37 @@ static void test_float32(const shape_mesh *mesh, const rsmooth_params *p) {
     free(k64);
 }
 
+/* Any finite coordinates are valid input. Two unit triangles in the planes x = -B and x = +B, and a
+ * vertex lying in the second: everything is flat, so nothing moves and every confidence is 1. Beyond
+ * 1e150 the library refuses the input (RSMOOTH_ERROR_INVALID_ARGUMENT, documented), which is fine;
+ * a wrong answer is not: (a + b + c) / 3 and the grid's extent hi - lo must not overflow. */
+static void test_extreme_coordinates(void) {
+    static const double extremes[] = {1e100, 1e150, 1e300, 1.7e308};
+    for (size_t i = 0; i < sizeof extremes / sizeof extremes[0]; i++) {
+        double b = extremes[i];
+        double xyz[21] = {-b, 0, 0, -b, 1, 0, -b, 0, 1, b, 0, 0, b, 1, 0, b, 0, 1, b, 0.2, 0.3};
+        uint32_t tri[6] = {0, 1, 2, 3, 4, 5};
+        double out[21];
+        float conf[7];
+        rsmooth_error err;
+        rsmooth_status s = rsmooth_smooth_reference(RSMOOTH_FLOAT64, xyz, 7, tri, 2, NULL, out,
+                                                    NULL, conf, NULL, &err);
+        if (s == RSMOOTH_ERROR_INVALID_ARGUMENT && b > 1e150) { /* documented limit */
+            printf("triangles at x = +-%g: refused (\"%s\")\n", b, err.message);
+            continue;
+        }
+        CHECK_STATUS(s, RSMOOTH_OK);
+        float min_conf = 1;
+        for (int v = 0; v < 7; v++)
+            min_conf = conf[v] < min_conf ? conf[v] : min_conf;
+        int kept = memcmp(out, xyz, sizeof xyz) == 0;
+        printf("triangles at x = +-%g: positions kept %s, smallest confidence %g (expected 1)\n", b,
+               kept ? "yes" : "no", min_conf);
+        CHECK(kept);
+        CHECK_NEAR(min_conf, 1, 1e-6);
+    }
+}
+
 int main(void) {
     shape_mesh cube;
     CHECK(shape_cube(&cube, 14, 2.0) == 0);
@@ -178,6 +210,7 @@ int main(void) {
 
     shape_free(&cube);
     shape_free(&cylinder);
+    test_extreme_coordinates();
     printf("soup: all checks passed\n");
     return 0;
 }

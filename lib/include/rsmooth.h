@@ -159,7 +159,8 @@ typedef struct rsmooth_report {
  * when no OpenCL device exists.
  *
  * scalar         type of `positions` and `out_positions`.
- * positions      3 * vertex_count floats or doubles (x, y, z per vertex), finite. Borrowed.
+ * positions      3 * vertex_count floats or doubles (x, y, z per vertex), finite, magnitude
+ *                <= 1e150. Borrowed.
  * vertex_count   >= 1 and < 2^32.
  * indices        3 * triangle_count vertex indices, each < vertex_count. May be NULL only when
  *                triangle_count is 0 (then nothing moves). Any soup is fine: duplicated, unreferenced

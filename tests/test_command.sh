@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# The rsmooth command end to end: results written, files never clobbered or half-written, and each
+# kind of failure with its exit status (2 usage/input, 3 device) and a message naming the file.
+set -uo pipefail
+rsmooth=$1
+shape=$2
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+cd "$dir"
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+# expect STATUS COMMAND...: runs it, checks the exit status, keeps stderr in err.txt
+expect() {
+  local want=$1; shift
+  "$@" >out.txt 2>err.txt
+  local got=$?
+  [ "$got" -eq "$want" ] || fail "exit $got (wanted $want): $* -- $(cat err.txt)"
+}
+
+expect 0 "$shape" make noisy.ply truth.ply --noise 0.3 --triangles 3000
+expect 0 "$rsmooth" noisy.ply -o smooth.ply --confidence conf.ply --json
+grep -q '"mollify":' out.txt || fail "--json printed no stage times: $(cat out.txt)"
+grep -q '"device":' out.txt || fail "--json printed no device"
+expect 0 "$shape" compare noisy.ply truth.ply
+before=$(sed -n 's/.*normal error \([0-9.]*\) deg.*/\1/p' out.txt)
+expect 0 "$shape" compare smooth.ply truth.ply
+after=$(sed -n 's/.*normal error \([0-9.]*\) deg.*/\1/p' out.txt)
+echo "normal error before $before, after $after degrees"
+awk -v a="$after" -v b="$before" 'BEGIN { exit !(a < b / 2) }' || fail "normal error not halved"
+head -c 400 conf.ply | grep -q "property float quality" || fail "confidence mesh has no quality"
+head -c 400 conf.ply | grep -q "property uchar red" || fail "confidence mesh has no colours"
+
+# OBJ out keeps the vertex and face counts; the reference path gives nearly the same result.
+expect 0 "$rsmooth" noisy.ply -o smooth.obj --device reference -q
+[ "$(grep -c '^v ' smooth.obj)" -eq "$(sed -n 's/^element vertex //p' noisy.ply)" ] ||
+  fail "vertex count changed in OBJ output"
+[ "$(grep -c '^f ' smooth.obj)" -eq "$(sed -n 's/^element face //p' noisy.ply)" ] ||
+  fail "face count changed in OBJ output"
+[ -s err.txt ] && fail "--quiet printed: $(cat err.txt)"
+
+# Nothing is replaced without --force, the input never, and failures leave no files behind.
+cp smooth.ply before.ply
+expect 2 "$rsmooth" noisy.ply -o smooth.ply
+grep -q "smooth.ply: already exists" err.txt || fail "no 'already exists' message: $(cat err.txt)"
+cmp -s smooth.ply before.ply || fail "existing output changed without --force"
+expect 0 "$rsmooth" noisy.ply -o smooth.ply --force -q --sigma-g inf
+cmp -s smooth.ply before.ply && fail "--force did not replace the output"
+expect 2 "$rsmooth" noisy.ply -o noisy.ply --force
+grep -q "refusing to overwrite the input" err.txt || fail "input overwrite not refused"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n' > bad.obj
+expect 2 "$rsmooth" bad.obj -o bad_out.ply
+grep -q "bad.obj:4" err.txt || fail "parse error does not name file and line: $(cat err.txt)"
+[ -e bad_out.ply ] && fail "output written for a bad input"
+expect 2 "$rsmooth" missing.obj -o x.ply
+grep -q "missing.obj" err.txt || fail "missing input not named"
+expect 2 "$rsmooth" . -o x.ply
+expect 2 "$rsmooth" noisy.ply -o x.xyz
+expect 2 "$rsmooth" noisy.ply -o x.ply --sigma-f -1
+expect 2 "$rsmooth" noisy.ply -o x.ply --sigma-g nan
+expect 2 "$rsmooth" noisy.ply -o x.ply --cutoff 9
+expect 2 "$rsmooth" noisy.ply -o x.ply --bogus
+expect 2 "$rsmooth" noisy.ply
+expect 3 "$rsmooth" noisy.ply -o x.ply --device "no such device"
+grep -q "no such device" err.txt || fail "device failure not explained: $(cat err.txt)"
+[ -e x.ply ] && fail "output written after a failure"
+ls ./*tmp-* >/dev/null 2>&1 && fail "temporary files left behind: $(ls ./*tmp-*)"
+
+# With no OpenCL platform at all, auto falls back to the reference path with a warning.
+OCL_ICD_VENDORS=/nonexistent OCL_ICD_FILENAMES= expect 0 "$rsmooth" noisy.ply -o fallback.ply
+grep -q "reference path" err.txt || fail "no fallback warning: $(cat err.txt)"
+
+expect 0 "$rsmooth" --help
+grep -q "sigma-g" out.txt || fail "--help does not explain sigma-g"
+expect 0 "$rsmooth" --version
+
+if [ "$failures" -ne 0 ]; then
+  echo "$failures failure(s)"
+  exit 1
+fi
+echo "command: all checks passed"
