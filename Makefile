@@ -5,7 +5,7 @@ BUILD_TYPE ?= Release
 WERROR ?= OFF
 DEMO ?= out/demo
 
-.PHONY: all deps configure build demo check install clean
+.PHONY: all deps configure build demo check sanitize install clean
 
 all: build
 
@@ -31,8 +31,15 @@ demo: build
 check: build
 	cd $(BUILD) && ctest --output-on-failure
 
+# The whole suite again under AddressSanitizer and UndefinedBehaviorSanitizer (Debug build).
+sanitize: deps
+	cmake -S . -B $(BUILD)-sanitize -DCMAKE_BUILD_TYPE=Debug -DRSMOOTH_SANITIZE=ON \
+	  -DRSMOOTH_INSTALL=OFF -DRSMOOTH_WERROR=$(WERROR)
+	cmake --build $(BUILD)-sanitize -j $(JOBS)
+	cd $(BUILD)-sanitize && ctest --output-on-failure
+
 install: build
 	cmake --install $(BUILD)
 
 clean:
-	rm -rf $(BUILD) out
+	rm -rf $(BUILD) $(BUILD)-sanitize out
