@@ -384,7 +384,9 @@ static void test_files(void) {
 
     CHECK_EQ_INT(rsmooth_format_from_path("a/b/Scan.OBJ"), RSMOOTH_FORMAT_OBJ);
     CHECK_EQ_INT(rsmooth_format_from_path("x.ply"), RSMOOTH_FORMAT_PLY_BINARY);
-    CHECK_EQ_INT(rsmooth_format_from_path("x.stl"), RSMOOTH_FORMAT_AUTO);
+    CHECK_EQ_INT(rsmooth_format_from_path("x.stl"), RSMOOTH_FORMAT_STL_BINARY);
+    CHECK_EQ_INT(rsmooth_format_from_path("x.Off"), RSMOOTH_FORMAT_OFF);
+    CHECK_EQ_INT(rsmooth_format_from_path("x.xyz"), RSMOOTH_FORMAT_AUTO);
     CHECK_EQ_INT(rsmooth_format_from_path("obj"), RSMOOTH_FORMAT_AUTO);
     CHECK_EQ_INT(rsmooth_format_from_path(NULL), RSMOOTH_FORMAT_AUTO);
 }

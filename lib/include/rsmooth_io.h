@@ -4,7 +4,15 @@
  *
  * Parsing from a memory buffer is the core (testable without a disk); the file functions are thin
  * wrappers. Formats: Wavefront OBJ, Stanford PLY (ascii, binary little- and big-endian on input;
- * ascii and binary little-endian on output).
+ * ascii and binary little-endian on output), OFF (with COFF/NOFF variants) and STL (ascii and
+ * binary; an unindexed soup, read as one and written back as one).
+ *
+ * Nothing is lost in a round trip through the same format: what a file carries beyond positions and
+ * faces (PLY properties, elements and comments; OBJ texture coordinates, groups, objects, materials
+ * and smoothing groups; OFF colours; STL header and attributes) is kept in `extras` and written back
+ * unchanged, except vertex normals, which writers recompute from the (filtered) positions.
+ * Converting to another format keeps what the target can hold (positions, faces, vertex colours,
+ * normals); rsmooth_mesh_conversion_losses() says what it drops.
  *
  *     rsmooth_mesh *mesh = NULL;
  *     rsmooth_error err;
@@ -30,7 +38,10 @@ typedef enum rsmooth_format {
     RSMOOTH_FORMAT_OBJ = 1,
     RSMOOTH_FORMAT_PLY_ASCII = 2,
     RSMOOTH_FORMAT_PLY_BINARY = 3, /* little-endian on output; either endianness on input */
-    RSMOOTH_FORMAT_PLY_BINARY_BE = 4 /* input only */
+    RSMOOTH_FORMAT_PLY_BINARY_BE = 4, /* input only */
+    RSMOOTH_FORMAT_OFF = 5,        /* OFF and its COFF / NOFF / CNOFF variants */
+    RSMOOTH_FORMAT_STL_ASCII = 6,
+    RSMOOTH_FORMAT_STL_BINARY = 7
 } rsmooth_format;
 
 /* A mesh read from a file. All arrays are owned by the mesh and freed by rsmooth_mesh_destroy. */
@@ -46,10 +57,19 @@ typedef struct rsmooth_mesh {
     size_t triangle_count;      /* the faces fanned into triangles (v0, vi, vi+1) */
     uint32_t *triangles;        /* 3 * triangle_count */
     rsmooth_format source_format; /* format it was read from */
+    int has_vertex_normals;     /* the file carried vertex normals: writers that can hold them write
+                                 * normals recomputed from `positions` (area-weighted face normals) */
 
-    /* Optional per-vertex extras written when non-NULL (the readers leave them NULL). */
+    /* Per-vertex attributes writers of every format that can hold them write when non-NULL.
+     * Readers fill vertex_colors when the file has vertex colours (PLY red/green/blue, OBJ
+     * "v x y z r g b", COFF); vertex_quality is for callers (the confidence output). */
     float *vertex_quality;      /* vertex_count values: PLY "quality" property */
-    uint8_t *vertex_colors;     /* 3 * vertex_count RGB bytes: PLY red/green/blue, OBJ "v x y z r g b" */
+    uint8_t *vertex_colors;     /* 3 * vertex_count RGB bytes */
+
+    /* What the file held beyond the fields above, kept by the reader so writing back to the same
+     * format loses nothing (opaque; NULL when there is nothing). Writers to the same format use it
+     * in place of vertex_colors / vertex_quality; set it to NULL to write only the fields above. */
+    struct rsmooth_mesh_extras *extras;
 } rsmooth_mesh;
 
 /* Parses a whole file held in memory. With `format` AUTO, content starting with "ply" is PLY and
@@ -66,6 +86,11 @@ RSMOOTH_API rsmooth_status rsmooth_mesh_read_memory(const void *data, size_t siz
 RSMOOTH_API rsmooth_status rsmooth_mesh_read_file(const char *path, rsmooth_mesh **mesh,
                                                   rsmooth_error *error);
 
+/* Reads a whole stream (to its end), then parses it as rsmooth_mesh_read_memory with AUTO.
+ * RSMOOTH_ERROR_IO when the stream fails. `name` (may be NULL) is used in messages. */
+RSMOOTH_API rsmooth_status rsmooth_mesh_read_stream(FILE *stream, const char *name,
+                                                    rsmooth_mesh **mesh, rsmooth_error *error);
+
 /* Writes `mesh` (its faces as polygons, not the fanned triangles) to an open stream. `format` must
  * not be AUTO. Returns RSMOOTH_ERROR_IO when the stream fails. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, FILE *stream,
@@ -77,7 +102,8 @@ RSMOOTH_API rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, F
 RSMOOTH_API rsmooth_status rsmooth_mesh_write_file(const rsmooth_mesh *mesh, const char *path,
                                                    rsmooth_format format, rsmooth_error *error);
 
-/* The format a path's extension names (case-insensitive .obj, .ply), or AUTO if none. */
+/* The format a path's extension names (case-insensitive .obj, .ply (binary), .off, .stl (binary)),
+ * or AUTO if none. */
 RSMOOTH_API rsmooth_format rsmooth_format_from_path(const char *path);
 
 /* Allocates an empty mesh with room for the given counts (arrays zeroed; face_offsets[0] = 0).
@@ -89,7 +115,18 @@ RSMOOTH_API rsmooth_status rsmooth_mesh_create(size_t vertex_count, size_t face_
 /* Recomputes `triangles` by fanning the faces. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_triangulate(rsmooth_mesh *mesh, rsmooth_error *error);
 
-/* Frees the mesh and everything it owns. Accepts NULL. */
+/* Describes what writing `mesh` in `format` would drop (e.g. "texture coordinates, groups"), as
+ * one comma-separated line in `buffer` (always NUL-terminated when size > 0). Returns the number of
+ * kinds of data dropped (0: nothing is lost). */
+RSMOOTH_API size_t rsmooth_mesh_conversion_losses(const rsmooth_mesh *mesh, rsmooth_format format,
+                                                  char *buffer, size_t size);
+
+/* Area-weighted vertex normals of the mesh's triangles (unit length; 0 for vertices no triangle
+ * uses), 3 * vertex_count doubles. What writers emit for files that carried normals. */
+RSMOOTH_API rsmooth_status rsmooth_mesh_vertex_normals(const rsmooth_mesh *mesh, double *normals,
+                                                       rsmooth_error *error);
+
+/* Frees the mesh and everything it owns (extras included). Accepts NULL. */
 RSMOOTH_API void rsmooth_mesh_destroy(rsmooth_mesh *mesh);
 
 #ifdef __cplusplus

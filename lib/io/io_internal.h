@@ -48,9 +48,66 @@ rsmooth_status rs_io_obj_read(const char *data, size_t size, rsmooth_mesh **mesh
 rsmooth_status rs_io_ply_read(const char *data, size_t size, rsmooth_mesh **mesh,
                               rsmooth_error *error);
 
-/* Format writers (obj_write.c, ply_write.c); the mesh is already checked. */
+/* Format writers; the mesh is already checked. Each writes faithfully from its own format's extras
+ * when the mesh has them, else the generic fields (positions, faces, vertex_colors, vertex_quality,
+ * has_vertex_normals) it can hold. */
 rsmooth_status rs_io_obj_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_error *error);
 rsmooth_status rs_io_ply_write(const rsmooth_mesh *mesh, FILE *stream, bool binary,
                                rsmooth_error *error);
+rsmooth_status rs_io_off_read(const char *data, size_t size, rsmooth_mesh **mesh,
+                              rsmooth_error *error);
+rsmooth_status rs_io_off_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_error *error);
+rsmooth_status rs_io_stl_read(const char *data, size_t size, rsmooth_mesh **mesh,
+                              rsmooth_error *error);
+rsmooth_status rs_io_stl_write(const rsmooth_mesh *mesh, FILE *stream, bool binary,
+                               rsmooth_error *error);
+
+/* ---- extras: what a format keeps beyond positions and faces ---------------------------------- */
+
+/* Each format defines its own record in its own files (ply_extras.c, obj_extras.c, off_*.c,
+ * stl_*.c); a mesh holds at most one of them, the one its reader made. */
+typedef struct rs_ply_extras rs_ply_extras;
+typedef struct rs_obj_extras rs_obj_extras;
+typedef struct rs_off_extras rs_off_extras;
+typedef struct rs_stl_extras rs_stl_extras;
+
+struct rsmooth_mesh_extras {
+    rs_ply_extras *ply;
+    rs_obj_extras *obj;
+    rs_off_extras *off;
+    rs_stl_extras *stl;
+};
+
+/* Each frees its record (accepts NULL). */
+void rs_io_ply_extras_free(rs_ply_extras *extras);
+void rs_io_obj_extras_free(rs_obj_extras *extras);
+void rs_io_off_extras_free(rs_off_extras *extras);
+void rs_io_stl_extras_free(rs_stl_extras *extras);
+
+/* Appends to `list` (a comma-separated line, capacity `size`) each kind of data in `extras` that
+ * `target` cannot hold, returning how many it appended. Helper for the list: rs_io_loss_add. */
+size_t rs_io_ply_losses(const rs_ply_extras *extras, rsmooth_format target, char *list,
+                        size_t size);
+size_t rs_io_obj_losses(const rs_obj_extras *extras, rsmooth_format target, char *list,
+                        size_t size);
+size_t rs_io_off_losses(const rs_off_extras *extras, rsmooth_format target, char *list,
+                        size_t size);
+size_t rs_io_stl_losses(const rs_stl_extras *extras, rsmooth_format target, char *list,
+                        size_t size);
+
+/* Appends ", what" (or "what" to an empty list) to `list`; returns 1 for counting. */
+size_t rs_io_loss_add(char *list, size_t size, const char *what);
+
+/* A mesh's extras record, created empty on first use (NULL when out of memory). */
+struct rsmooth_mesh_extras *rs_io_mesh_extras(rsmooth_mesh *mesh);
+
+/* true when `format` is one of the PLY / STL encodings. */
+static inline bool rs_io_is_ply(rsmooth_format f) {
+    return f == RSMOOTH_FORMAT_PLY_ASCII || f == RSMOOTH_FORMAT_PLY_BINARY ||
+           f == RSMOOTH_FORMAT_PLY_BINARY_BE;
+}
+static inline bool rs_io_is_stl(rsmooth_format f) {
+    return f == RSMOOTH_FORMAT_STL_ASCII || f == RSMOOTH_FORMAT_STL_BINARY;
+}
 
 #endif /* RSMOOTH_IO_INTERNAL_H */

@@ -1,8 +1,10 @@
 /* The rsmooth_mesh record (create, fan triangulation, destroy) and helpers the parsers share. */
+#define _POSIX_C_SOURCE 200809L
 #include "io/io_internal.h"
 
 #include <ctype.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -90,7 +92,54 @@ void rsmooth_mesh_destroy(rsmooth_mesh *mesh) {
     rs_free(mesh->triangles);
     rs_free(mesh->vertex_quality);
     rs_free(mesh->vertex_colors);
+    if (mesh->extras) {
+        rs_io_ply_extras_free(mesh->extras->ply);
+        rs_io_obj_extras_free(mesh->extras->obj);
+        rs_io_off_extras_free(mesh->extras->off);
+        rs_io_stl_extras_free(mesh->extras->stl);
+        rs_free(mesh->extras);
+    }
     rs_free(mesh);
+}
+
+struct rsmooth_mesh_extras *rs_io_mesh_extras(rsmooth_mesh *mesh) {
+    if (!mesh->extras)
+        mesh->extras = rs_calloc_array(1, sizeof *mesh->extras);
+    return mesh->extras;
+}
+
+size_t rs_io_loss_add(char *list, size_t size, const char *what) {
+    size_t used = strnlen(list, size);
+    if (used + 1 < size)
+        snprintf(list + used, size - used, "%s%s", used ? ", " : "", what);
+    return 1;
+}
+
+size_t rsmooth_mesh_conversion_losses(const rsmooth_mesh *mesh, rsmooth_format format,
+                                      char *buffer, size_t size) {
+    char scratch[1];
+    if (!buffer || size == 0) {
+        buffer = scratch;
+        size = sizeof scratch;
+    }
+    buffer[0] = '\0';
+    if (!mesh)
+        return 0;
+    size_t lost = 0;
+    bool stl = rs_io_is_stl(format);
+    if (mesh->vertex_colors && (stl || format == RSMOOTH_FORMAT_AUTO))
+        lost += rs_io_loss_add(buffer, size, "vertex colours");
+    if (mesh->has_vertex_normals && stl)
+        lost += rs_io_loss_add(buffer, size, "vertex normals");
+    if (mesh->vertex_quality && !rs_io_is_ply(format))
+        lost += rs_io_loss_add(buffer, size, "vertex quality");
+    if (mesh->extras) {
+        lost += rs_io_ply_losses(mesh->extras->ply, format, buffer, size);
+        lost += rs_io_obj_losses(mesh->extras->obj, format, buffer, size);
+        lost += rs_io_off_losses(mesh->extras->off, format, buffer, size);
+        lost += rs_io_stl_losses(mesh->extras->stl, format, buffer, size);
+    }
+    return lost;
 }
 
 static bool ends_with_ci(const char *s, size_t len, const char *suffix) {
@@ -111,6 +160,10 @@ rsmooth_format rsmooth_format_from_path(const char *path) {
         return RSMOOTH_FORMAT_OBJ;
     if (ends_with_ci(path, len, ".ply"))
         return RSMOOTH_FORMAT_PLY_BINARY;
+    if (ends_with_ci(path, len, ".off"))
+        return RSMOOTH_FORMAT_OFF;
+    if (ends_with_ci(path, len, ".stl"))
+        return RSMOOTH_FORMAT_STL_BINARY;
     return RSMOOTH_FORMAT_AUTO;
 }
 

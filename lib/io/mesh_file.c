@@ -10,6 +10,35 @@ static bool has_ply_magic(const char *data, size_t size) {
     return size >= 4 && memcmp(data, "ply", 3) == 0 && (data[3] == '\n' || data[3] == '\r');
 }
 
+/* OFF files open with a keyword ending in "OFF" (OFF, COFF, NOFF, CNOFF, STOFF...). */
+static bool has_off_magic(const char *data, size_t size) {
+    size_t n = 0;
+    while (n < size && n < 16 && data[n] >= 'A' && data[n] <= 'Z')
+        n++;
+    return n >= 3 && memcmp(data + n - 3, "OFF", 3) == 0 &&
+           (n == size || data[n] == ' ' || data[n] == '\t' || data[n] == '\r' || data[n] == '\n');
+}
+
+/* Binary STL: an 80-byte header, a little-endian triangle count, then exactly 50 bytes a triangle.
+ * The size test comes first because many binary headers also start with "solid". */
+static bool is_binary_stl(const char *data, size_t size) {
+    if (size < 84)
+        return false;
+    const unsigned char *c = (const unsigned char *)data + 80;
+    uint64_t count = (uint64_t)c[0] | (uint64_t)c[1] << 8 | (uint64_t)c[2] << 16 |
+                     (uint64_t)c[3] << 24;
+    return 84 + 50 * count == (uint64_t)size;
+}
+
+static bool has_ascii_stl_magic(const char *data, size_t size) {
+    size_t i = 0;
+    while (i < size && (data[i] == ' ' || data[i] == '\t' || data[i] == '\r' || data[i] == '\n'))
+        i++;
+    return size - i >= 6 && memcmp(data + i, "solid", 5) == 0 &&
+           (data[i + 5] == ' ' || data[i + 5] == '\t' || data[i + 5] == '\r' ||
+            data[i + 5] == '\n');
+}
+
 rsmooth_status rsmooth_mesh_read_memory(const void *data, size_t size, rsmooth_format format,
                                         rsmooth_mesh **mesh, rsmooth_error *error) {
     static const char where[] = "rsmooth_mesh_read_memory";
@@ -22,8 +51,18 @@ rsmooth_status rsmooth_mesh_read_memory(const void *data, size_t size, rsmooth_f
     const char *bytes = data ? (const char *)data : "";
     switch (format) {
     case RSMOOTH_FORMAT_AUTO:
-        return has_ply_magic(bytes, size) ? rs_io_ply_read(bytes, size, mesh, error)
-                                          : rs_io_obj_read(bytes, size, mesh, error);
+        if (has_ply_magic(bytes, size))
+            return rs_io_ply_read(bytes, size, mesh, error);
+        if (has_off_magic(bytes, size))
+            return rs_io_off_read(bytes, size, mesh, error);
+        if (is_binary_stl(bytes, size) || has_ascii_stl_magic(bytes, size))
+            return rs_io_stl_read(bytes, size, mesh, error);
+        return rs_io_obj_read(bytes, size, mesh, error);
+    case RSMOOTH_FORMAT_OFF:
+        return rs_io_off_read(bytes, size, mesh, error);
+    case RSMOOTH_FORMAT_STL_ASCII:
+    case RSMOOTH_FORMAT_STL_BINARY: /* the content decides */
+        return rs_io_stl_read(bytes, size, mesh, error);
     case RSMOOTH_FORMAT_OBJ:
         return rs_io_obj_read(bytes, size, mesh, error);
     case RSMOOTH_FORMAT_PLY_ASCII:
@@ -114,6 +153,25 @@ rsmooth_status rsmooth_mesh_read_file(const char *path, rsmooth_mesh **mesh, rsm
     return status;
 }
 
+rsmooth_status rsmooth_mesh_read_stream(FILE *stream, const char *name, rsmooth_mesh **mesh,
+                                        rsmooth_error *error) {
+    static const char where[] = "rsmooth_mesh_read_stream";
+    rs_error_clear(error);
+    if (!mesh)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "mesh is NULL");
+    *mesh = NULL;
+    if (!stream)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "stream is NULL");
+    char *data = NULL;
+    size_t size = 0;
+    rsmooth_status status = read_all(stream, name ? name : "stream", 0, &data, &size, error);
+    if (status != RSMOOTH_OK)
+        return status;
+    status = rsmooth_mesh_read_memory(data, size, RSMOOTH_FORMAT_AUTO, mesh, error);
+    rs_free(data);
+    return status;
+}
+
 rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, FILE *stream,
                                          rsmooth_format format, rsmooth_error *error) {
     static const char where[] = "rsmooth_mesh_write_stream";
@@ -133,11 +191,17 @@ rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, FILE *stream,
     case RSMOOTH_FORMAT_PLY_BINARY_BE:
         return rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, where,
                        "big-endian PLY output is not supported");
+    case RSMOOTH_FORMAT_OFF:
+        return rs_io_off_write(mesh, stream, error);
+    case RSMOOTH_FORMAT_STL_ASCII:
+        return rs_io_stl_write(mesh, stream, false, error);
+    case RSMOOTH_FORMAT_STL_BINARY:
+        return rs_io_stl_write(mesh, stream, true, error);
     case RSMOOTH_FORMAT_AUTO:
         break;
     }
-    return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "format %d: give OBJ or PLY",
-                   (int)format);
+    return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                   "format %d: give OBJ, PLY, OFF or STL", (int)format);
 }
 
 rsmooth_status rsmooth_mesh_write_file(const rsmooth_mesh *mesh, const char *path,
@@ -150,7 +214,7 @@ rsmooth_status rsmooth_mesh_write_file(const rsmooth_mesh *mesh, const char *pat
         format = rsmooth_format_from_path(path);
         if (format == RSMOOTH_FORMAT_AUTO)
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                           "cannot tell the format of '%s' (use .obj or .ply)", path);
+                           "cannot tell the format of '%s' (use .obj, .ply, .off or .stl)", path);
     }
     /* Check before creating the file, so a bad mesh leaves no file behind. */
     rsmooth_status status = rs_io_mesh_check(mesh, where, error);
