@@ -2,6 +2,8 @@
  * writes the result atomically: a temporary file beside the output, renamed when complete. */
 #define _POSIX_C_SOURCE 200809L
 #include "rsmooth.h"
+#include "cli_files.h"
+#include "cli_progress.h"
 #include "rsmooth_io.h"
 
 #include <errno.h>
@@ -11,15 +13,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <time.h>
-#include <unistd.h>
-
-/* Exit statuses. */
-enum { EXIT_OK = 0, EXIT_OTHER = 1, EXIT_USAGE = 2, EXIT_DEVICE = 3 };
 
 static const char usage_text[] =
     "usage: rsmooth INPUT -o OUTPUT [options]\n"
+    "       rsmooth INPUT --in-place [options]\n"
+    "       rsmooth --list-devices\n"
     "\n"
     "Removes noise from a triangle mesh while keeping its sharp edges and corners, with the\n"
     "non-iterative filter of Jones, Durand & Desbrun (SIGGRAPH 2003). Each vertex moves to a\n"
@@ -27,7 +25,11 @@ static const char usage_text[] =
     "plane would pull the vertex far (across a sharp edge) get little weight. One pass, and no\n"
     "connectivity needed: triangle soups, cracked and non-manifold scans work.\n"
     "\n"
-    "Files: OBJ and PLY (ascii or binary), chosen by extension. Vertex order and faces are kept.\n"
+    "Files: OBJ, PLY (ascii, binary), OFF and STL, by content on input and by extension on "
+    "output.\n"
+    "Vertex order, faces and everything else the file holds (colours, texture coordinates,\n"
+    "groups, materials, other PLY properties and elements) are kept when the output has the\n"
+    "input's format; vertex normals are recomputed. Converting says on stderr what it drops.\n"
     "\n"
     "The two widths, in mean edge lengths of the input (a scan's point spacing):\n"
     "  --sigma-f X     spatial width: how far around a vertex triangles are consulted (they are\n"
@@ -41,7 +43,9 @@ static const char usage_text[] =
     "  --sigma-g until the sharp features come back.\n"
     "\n"
     "Options:\n"
-    "  -o, --output FILE     result mesh (.obj or .ply); refuses to replace a file without --force\n"
+    "  -o, --output FILE     result mesh (.obj, .ply, .off, .stl); refuses to replace an existing\n"
+    "                        file without --force, and never writes the input\n"
+    "  --in-place            replace the input with the result (atomically; instead of -o)\n"
     "  --absolute            read --sigma-f and --sigma-g in the mesh's own units\n"
     "  --cutoff C            ignore triangles farther than C * sigma-f (default 2, range (0, 5])\n"
     "  --no-mollify          predict with the raw (noisy) normals: the paper's ablation, worse\n"
@@ -52,19 +56,27 @@ static const char usage_text[] =
     "  --confidence FILE     also write the mesh coloured by confidence k(p) / sum a f in [0, 1]\n"
     "                        (PLY: 'quality' property plus colours; OBJ: vertex colours). Low\n"
     "                        confidence (red) marks vertices few triangles agreed on.\n"
-    "  --ascii               write PLY as ascii (default binary little-endian)\n"
+    "  --ascii               write PLY and STL as ascii (default binary little-endian)\n"
+    "  --list-devices        list the OpenCL devices and how --device names them, then exit\n"
+    "  --stats               print statistics of the mesh and of what the filter did\n"
     "  --json                print one JSON object of counts, sigmas, device and stage times (ms)\n"
+    "                        on stdout\n"
     "  -f, --force           replace existing output files\n"
-    "  -q, --quiet           print nothing but errors\n"
+    "  -q, --quiet           print nothing but errors (no summary, warnings or progress bar)\n"
     "  --version             print the version\n"
     "  -h, --help            print this help\n"
+    "\n"
+    "Examples:\n"
+    "  rsmooth scan.ply -o smooth.ply\n"
+    "  rsmooth part.stl -o part-smooth.stl --sigma-f 3 --sigma-g 0.4 --confidence conf.ply\n"
+    "  rsmooth scan.obj --in-place --device gpu --stats\n"
     "\n"
     "Exit status: 0 success, 2 bad usage or bad input file, 3 OpenCL device failure, 1 other.\n";
 
 typedef struct options {
     const char *input, *output, *confidence, *device;
     rsmooth_params params;
-    bool ascii, json, force, quiet;
+    bool ascii, json, force, quiet, in_place, stats, list_devices;
 } options;
 
 __attribute__((format(printf, 1, 2))) static int usage_error(const char *fmt, ...) {
@@ -81,13 +93,13 @@ static bool parse_number(const char *text, double *out) {
     char *end = NULL;
     errno = 0;
     double v = strtod(text, &end);
-    if (end == text || *end != '\0' || errno == ERANGE)
+    if (end == text || *end != '\0' || errno == ERANGE || isnan(v))
         return false;
     *out = v;
     return true;
 }
 
-/* Returns -1 when parsing succeeded and the program should go on, else an exit status. */
+/* Returns -1 when the program should go on, else the exit status. */
 static int parse_args(int argc, char **argv, options *opt) {
     memset(opt, 0, sizeof *opt);
     rsmooth_params_init(&opt->params);
@@ -106,9 +118,9 @@ static int parse_args(int argc, char **argv, options *opt) {
                    !strcmp(a, "--device")) {
             if (!value)
                 return usage_error("%s needs a value", a);
-            if (a[2] == 'c')
+            if (!strcmp(a, "--confidence"))
                 opt->confidence = value;
-            else if (a[2] == 'd')
+            else if (!strcmp(a, "--device"))
                 opt->device = value;
             else
                 opt->output = value;
@@ -116,8 +128,8 @@ static int parse_args(int argc, char **argv, options *opt) {
         } else if (!strcmp(a, "--sigma-f") || !strcmp(a, "--sigma-g") || !strcmp(a, "--cutoff")) {
             if (!value)
                 return usage_error("%s needs a value", a);
-            if (!parse_number(value, &x) || isnan(x))
-                return usage_error("not a number: '%s'", value);
+            if (!parse_number(value, &x))
+                return usage_error("%s: not a number: '%s'", a, value);
             if (!strcmp(a, "--sigma-f"))
                 opt->params.sigma_f = x;
             else if (!strcmp(a, "--sigma-g"))
@@ -133,6 +145,12 @@ static int parse_args(int argc, char **argv, options *opt) {
             opt->ascii = true;
         } else if (!strcmp(a, "--json")) {
             opt->json = true;
+        } else if (!strcmp(a, "--stats")) {
+            opt->stats = true;
+        } else if (!strcmp(a, "--in-place")) {
+            opt->in_place = true;
+        } else if (!strcmp(a, "--list-devices")) {
+            opt->list_devices = true;
         } else if (!strcmp(a, "-f") || !strcmp(a, "--force")) {
             opt->force = true;
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
@@ -145,12 +163,18 @@ static int parse_args(int argc, char **argv, options *opt) {
             return usage_error("unexpected argument '%s' (one input file only)", a);
         }
     }
+    if (opt->list_devices)
+        return -1;
     if (!opt->input)
-        return usage_error("%s", "no input file");
+        return usage_error("no input file");
+    if (opt->in_place && opt->output)
+        return usage_error("give either -o OUTPUT or --in-place, not both");
+    if (opt->in_place)
+        opt->output = opt->input;
     if (!opt->output)
-        return usage_error("%s", "no output file (-o OUTPUT)");
-    /* Check the sigmas here so a typo is a usage error before any file is read. */
-    rsmooth_params *p = &opt->params;
+        return usage_error("no output file (-o OUTPUT, or --in-place)");
+    /* Checked here so a typo is a usage error before any file is read. */
+    const rsmooth_params *p = &opt->params;
     if (!(p->sigma_f > 0) || !isfinite(p->sigma_f))
         return usage_error("--sigma-f must be a positive number (got %g)", p->sigma_f);
     if (!(p->sigma_g > 0))
@@ -160,79 +184,25 @@ static int parse_args(int argc, char **argv, options *opt) {
     return -1;
 }
 
-static bool same_file(const char *a, const char *b) {
-    struct stat sa, sb;
-    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev &&
-           sa.st_ino == sb.st_ino;
-}
-
-/* Refuses to touch the input or, without --force, an existing file. */
-static int check_output_path(const options *opt, const char *path) {
-    if (same_file(path, opt->input)) {
-        fprintf(stderr, "rsmooth: %s: refusing to overwrite the input file\n", path);
-        return EXIT_USAGE;
+static int list_devices(void) {
+    rsmooth_device_info devices[64];
+    size_t n = rsmooth_list_devices(devices, 64);
+    if (n == 0) {
+        printf("no OpenCL device (install an OpenCL driver, e.g. pocl-opencl-icd); "
+               "--device reference still works\n");
+        return EXIT_OK;
     }
-    struct stat st;
-    if (!opt->force && stat(path, &st) == 0) {
-        fprintf(stderr, "rsmooth: %s: already exists (use --force to replace it)\n", path);
-        return EXIT_USAGE;
+    printf("%-5s %-5s %-60s %6s %9s  %s\n", "P:D", "type", "name", "units", "memory", "version");
+    for (size_t i = 0; i < n && i < 64; i++) {
+        char pd[16];
+        snprintf(pd, sizeof pd, "%d:%d", devices[i].platform_index, devices[i].device_index);
+        printf("%-5s %-5s %-60s %6u %6.1f GiB  %s\n", pd, devices[i].type, devices[i].name,
+               devices[i].compute_units, (double)devices[i].global_memory / (1u << 30),
+               devices[i].version);
     }
-    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) {
-        fprintf(stderr, "rsmooth: %s: is a directory\n", path);
-        return EXIT_USAGE;
-    }
-    rsmooth_format f = rsmooth_format_from_path(path);
-    if (f == RSMOOTH_FORMAT_AUTO) {
-        fprintf(stderr, "rsmooth: %s: unknown output format (use .obj or .ply)\n", path);
-        return EXIT_USAGE;
-    }
-    return -1;
-}
-
-/* Writes through a temporary file beside `path`, renamed into place only when complete. */
-static int write_atomically(const rsmooth_mesh *mesh, const char *path, bool ascii) {
-    rsmooth_format format = rsmooth_format_from_path(path);
-    if (format == RSMOOTH_FORMAT_PLY_BINARY && ascii)
-        format = RSMOOTH_FORMAT_PLY_ASCII;
-    size_t n = strlen(path) + 16;
-    char *tmp = malloc(n);
-    if (!tmp)
-        return EXIT_OTHER;
-    snprintf(tmp, n, "%s.tmp-XXXXXX", path);
-    int fd = mkstemp(tmp);
-    if (fd < 0) {
-        fprintf(stderr, "rsmooth: %s: cannot create a temporary file beside it: %s\n", path,
-                strerror(errno));
-        free(tmp);
-        return EXIT_OTHER;
-    }
-    FILE *f = fdopen(fd, "wb");
-    rsmooth_error err;
-    rsmooth_status st = f ? rsmooth_mesh_write_stream(mesh, f, format, &err) : RSMOOTH_ERROR_IO;
-    if (!f) {
-        snprintf(err.message, sizeof err.message, "%s", strerror(errno));
-        close(fd);
-    }
-    if (f && fclose(f) != 0 && st == RSMOOTH_OK) {
-        st = RSMOOTH_ERROR_IO;
-        snprintf(err.message, sizeof err.message, "%s", strerror(errno));
-    }
-    if (st == RSMOOTH_OK) {
-        /* mkstemp creates 0600; give the result the usual permissions. */
-        mode_t mask = umask(0);
-        umask(mask);
-        chmod(tmp, 0666 & ~mask);
-        if (rename(tmp, path) != 0) {
-            snprintf(err.message, sizeof err.message, "%s", strerror(errno));
-            st = RSMOOTH_ERROR_IO;
-        }
-    }
-    if (st != RSMOOTH_OK) {
-        fprintf(stderr, "rsmooth: %s: cannot write: %s\n", path, err.message);
-        remove(tmp);
-    }
-    free(tmp);
-    return st == RSMOOTH_OK ? EXIT_OK : EXIT_OTHER;
+    printf("--device auto picks the first GPU, else the first CPU device; --device reference runs "
+           "the double-precision C path.\n");
+    return EXIT_OK;
 }
 
 /* Red (low confidence) through yellow to blue (high): readable on white and for most colour-blind
@@ -260,34 +230,170 @@ static void print_json_string(const char *text) {
     putchar('"');
 }
 
-static void print_json(const rsmooth_report *r, const char *input, const char *output,
-                       double ms_read, double ms_write, double ms_setup) {
+static void print_json(const rsmooth_report *r, const options *opt, double ms_read,
+                       double ms_write) {
     printf("{\"input\":");
-    print_json_string(input);
+    print_json_string(opt->input);
     printf(",\"output\":");
-    print_json_string(output);
-    printf(",\"vertices\":%zu,\"triangles\":%zu,"
-           "\"facets\":%zu,\"mean_edge_length\":%.9g,\"sigma_f\":%.9g,",
-           r->vertex_count, r->triangle_count, r->facet_count,
-           r->mean_edge_length, r->sigma_f);
+    print_json_string(opt->output);
+    printf(",\"vertices\":%zu,\"triangles\":%zu,\"facets\":%zu,\"mean_edge_length\":%.9g,"
+           "\"sigma_f\":%.9g,",
+           r->vertex_count, r->triangle_count, r->facet_count, r->mean_edge_length, r->sigma_f);
     if (isinf(r->sigma_g))
         printf("\"sigma_g\":null,");
     else
         printf("\"sigma_g\":%.9g,", r->sigma_g);
     printf("\"radius\":%.9g,\"grid_cells\":%zu,\"device\":", r->radius, r->grid_cell_count);
     print_json_string(r->device);
-    printf(",\"ms\":{\"read\":%.3f,"
-           "\"setup\":%.3f,\"facets\":%.3f,\"grid\":%.3f,\"upload\":%.3f,\"mollify\":%.3f,"
-           "\"normals\":%.3f,\"robust\":%.3f,\"download\":%.3f,\"filter\":%.3f,\"write\":%.3f}}\n",
-           ms_read, ms_setup, r->ms_facets, r->ms_grid,
-           r->ms_upload, r->ms_mollify, r->ms_normals, r->ms_robust, r->ms_download, r->ms_total,
-           ms_write);
+    printf(",\"ms\":{\"read\":%.3f,\"setup\":%.3f,\"facets\":%.3f,\"grid\":%.3f,\"upload\":%.3f,"
+           "\"mollify\":%.3f,\"normals\":%.3f,\"robust\":%.3f,\"download\":%.3f,\"filter\":%.3f,"
+           "\"write\":%.3f}}\n",
+           ms_read, r->ms_setup, r->ms_facets, r->ms_grid, r->ms_upload, r->ms_mollify,
+           r->ms_normals, r->ms_robust, r->ms_download, r->ms_total, ms_write);
 }
 
-static double now_ms(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+static int compare_double(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* --stats: what the mesh is and what the filter did to it, in mean edge lengths. */
+static void print_stats(const rsmooth_mesh *mesh, const double *out, const float *confidence,
+                        const rsmooth_report *r) {
+    size_t nv = mesh->vertex_count;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    unsigned char *used = calloc(nv, 1);
+    double *moved = malloc(nv * sizeof *moved);
+    if (!used || !moved) {
+        free(used);
+        free(moved);
+        return;
+    }
+    for (size_t i = 0; i < 3 * mesh->triangle_count; i++)
+        used[mesh->triangles[i]] = 1;
+    size_t unreferenced = 0, low = 0;
+    double conf_sum = 0, conf_min = 1;
+    for (size_t v = 0; v < nv; v++) {
+        double d2 = 0;
+        for (int k = 0; k < 3; k++) {
+            double x = mesh->positions[3 * v + k], d = out[3 * v + k] - x;
+            lo[k] = fmin(lo[k], x);
+            hi[k] = fmax(hi[k], x);
+            d2 += d * d;
+        }
+        moved[v] = r->mean_edge_length > 0 ? sqrt(d2) / r->mean_edge_length : 0;
+        unreferenced += !used[v];
+        conf_sum += confidence[v];
+        conf_min = fmin(conf_min, confidence[v]);
+        low += confidence[v] < 0.5f;
+    }
+    qsort(moved, nv, sizeof *moved, compare_double);
+    double moved_sum = 0;
+    for (size_t v = 0; v < nv; v++)
+        moved_sum += moved[v];
+    fprintf(stderr,
+            "mesh:        %zu vertices (%zu referenced by no triangle), %zu faces, %zu triangles "
+            "(%zu of zero area)\n"
+            "size:        %.6g x %.6g x %.6g, mean edge %.6g\n"
+            "filter:      sigma_f %.6g, sigma_g %.6g, reach %.6g (mesh units), %zu grid cells\n"
+            "moved:       mean %.4f, median %.4f, max %.4f mean edge lengths\n"
+            "confidence:  mean %.3f, min %.3f, %zu vertices (%.1f%%) below 0.5\n",
+            nv, unreferenced, mesh->face_count, mesh->triangle_count,
+            r->triangle_count - r->facet_count, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2],
+            r->mean_edge_length, r->sigma_f, r->sigma_g, r->radius, r->grid_cell_count,
+            moved_sum / (double)nv, moved[nv / 2], moved[nv - 1], conf_sum / (double)nv, conf_min,
+            low, 100.0 * (double)low / (double)nv);
+    free(used);
+    free(moved);
+}
+
+/* Says on stderr what writing `mesh` as `format` drops. */
+static void warn_losses(const rsmooth_mesh *mesh, const char *path, rsmooth_format format,
+                        bool quiet) {
+    char lost[512];
+    if (!quiet && rsmooth_mesh_conversion_losses(mesh, format, lost, sizeof lost) > 0)
+        fprintf(stderr, "rsmooth: %s: this format cannot hold, so drops: %s\n", path, lost);
+}
+
+/* Runs the filter on the chosen device; prints what fails. */
+static int smooth(const options *opt, const rsmooth_mesh *mesh, double *out, float *confidence,
+                  rsmooth_report *report, cli_progress *bar) {
+    const char *device = opt->device ? opt->device : getenv("RSMOOTH_DEVICE");
+    bool reference = device && strcmp(device, "reference") == 0;
+    rsmooth_context *ctx = NULL;
+    rsmooth_error err;
+    rsmooth_status st;
+    double ms_setup = 0;
+    if (!reference) {
+        double t = cli_now_ms();
+        st = rsmooth_context_create(device, &ctx, &err);
+        ms_setup = cli_now_ms() - t;
+        bool automatic = !device || strcmp(device, "auto") == 0;
+        if (st == RSMOOTH_ERROR_NO_DEVICE && automatic) {
+            if (!opt->quiet)
+                fprintf(stderr, "rsmooth: warning: %s; using the reference path (slower)\n",
+                        err.message);
+            reference = true;
+        } else if (st != RSMOOTH_OK) {
+            cli_progress_clear(bar);
+            fprintf(stderr, "rsmooth: device '%s': %s: %s\n", device ? device : "auto",
+                    rsmooth_status_str(st), err.message);
+            if (err.build_log[0])
+                fprintf(stderr, "%s\n", err.build_log);
+            return st == RSMOOTH_ERROR_OUT_OF_MEMORY ? EXIT_OTHER : EXIT_DEVICE;
+        }
+    }
+    rsmooth_params params = opt->params;
+    params.progress = cli_progress_callback;
+    params.progress_user = bar;
+    if (reference)
+        st = rsmooth_smooth_reference(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
+                                      mesh->triangles, mesh->triangle_count, &params, out, NULL,
+                                      confidence, report, &err);
+    else
+        st = rsmooth_smooth(ctx, RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
+                            mesh->triangles, mesh->triangle_count, &params, out, NULL, confidence,
+                            report, &err);
+    int code = EXIT_OK;
+    if (st != RSMOOTH_OK) {
+        cli_progress_clear(bar);
+        if (st == RSMOOTH_ERROR_OPENCL)
+            fprintf(stderr, "rsmooth: %s: device '%s': %s\n", opt->input,
+                    rsmooth_context_device_name(ctx), err.message);
+        else
+            fprintf(stderr, "rsmooth: %s: %s\n", opt->input, err.message);
+        code = st == RSMOOTH_ERROR_OPENCL             ? EXIT_DEVICE
+               : st == RSMOOTH_ERROR_INVALID_ARGUMENT ? EXIT_USAGE
+                                                      : EXIT_OTHER;
+    }
+    report->ms_setup = ms_setup;
+    rsmooth_context_destroy(ctx);
+    return code;
+}
+
+/* The confidence mesh: the result's surface, coloured, written without the input's extras. */
+static int write_confidence(rsmooth_mesh *mesh, const options *opt, float *confidence) {
+    size_t nv = mesh->vertex_count;
+    uint8_t *colours = malloc(nv * 3);
+    if (!colours) {
+        fprintf(stderr, "rsmooth: %s: out of memory\n", opt->confidence);
+        return EXIT_OTHER;
+    }
+    for (size_t v = 0; v < nv; v++)
+        confidence_colour(confidence[v], colours + 3 * v);
+    float *quality = mesh->vertex_quality;
+    uint8_t *input_colours = mesh->vertex_colors;
+    struct rsmooth_mesh_extras *extras = mesh->extras;
+    mesh->vertex_quality = confidence;
+    mesh->vertex_colors = colours;
+    mesh->extras = NULL;
+    int code =
+        cli_write_mesh(mesh, opt->confidence, cli_output_format(opt->confidence, opt->ascii));
+    mesh->vertex_quality = quality;
+    mesh->vertex_colors = input_colours;
+    mesh->extras = extras;
+    free(colours);
+    return code;
 }
 
 int main(int argc, char **argv) {
@@ -295,111 +401,64 @@ int main(int argc, char **argv) {
     int code = parse_args(argc, argv, &opt);
     if (code >= 0)
         return code;
-    if ((code = check_output_path(&opt, opt.output)) >= 0)
+    if (opt.list_devices)
+        return list_devices();
+    if ((code = cli_check_output(opt.output, opt.input, opt.force, opt.in_place)) >= 0)
         return code;
-    if (opt.confidence && (code = check_output_path(&opt, opt.confidence)) >= 0)
-        return code;
-    if (opt.confidence && strcmp(opt.confidence, opt.output) == 0) {
-        fprintf(stderr, "rsmooth: %s: the confidence mesh needs its own file\n", opt.confidence);
-        return EXIT_USAGE;
+    if (opt.confidence) {
+        if (!strcmp(opt.confidence, opt.output)) {
+            fprintf(stderr, "rsmooth: %s: the confidence mesh needs its own file\n",
+                    opt.confidence);
+            return EXIT_USAGE;
+        }
+        if ((code = cli_check_output(opt.confidence, opt.input, opt.force, false)) >= 0)
+            return code;
     }
 
-    double t0 = now_ms();
+    cli_progress bar;
+    cli_progress_init(&bar, opt.quiet);
+    cli_progress_stage(&bar, "reading", 0, 0.1);
     rsmooth_mesh *mesh = NULL;
-    rsmooth_error err;
-    rsmooth_status st = rsmooth_mesh_read_file(opt.input, &mesh, &err);
-    if (st != RSMOOTH_OK) {
-        if (err.line >= 0)
-            fprintf(stderr, "rsmooth: %s:%lld: %s\n", opt.input, (long long)err.line, err.message);
-        else if (err.byte_offset >= 0)
-            fprintf(stderr, "rsmooth: %s: byte %lld: %s\n", opt.input, (long long)err.byte_offset,
-                    err.message);
-        else
-            fprintf(stderr, "rsmooth: %s: %s\n", opt.input, err.message);
-        return st == RSMOOTH_ERROR_OUT_OF_MEMORY ? EXIT_OTHER : EXIT_USAGE;
-    }
-    double ms_read = now_ms() - t0;
+    double t0 = cli_now_ms();
+    if ((code = cli_read_mesh(opt.input, &bar, &mesh)) != EXIT_OK)
+        return code;
+    double ms_read = cli_now_ms() - t0;
 
     size_t nv = mesh->vertex_count;
     double *out = malloc(nv * 3 * sizeof *out);
-    float *confidence = opt.confidence ? malloc(nv * sizeof *confidence) : NULL;
-    rsmooth_context *ctx = NULL;
+    bool want_confidence = opt.confidence || opt.stats;
+    float *confidence = want_confidence ? malloc(nv * sizeof *confidence) : NULL;
     rsmooth_report report;
+    memset(&report, 0, sizeof report);
     code = EXIT_OTHER;
-    if (!out || (opt.confidence && !confidence)) {
+    if (!out || (want_confidence && !confidence)) {
         fprintf(stderr, "rsmooth: %s: out of memory\n", opt.input);
         goto cleanup;
     }
-
-    const char *device = opt.device ? opt.device : getenv("RSMOOTH_DEVICE");
-    bool reference = device && strcmp(device, "reference") == 0;
-    double ms_setup = 0;
-    if (!reference) {
-        double t1 = now_ms();
-        st = rsmooth_context_create(device, &ctx, &err);
-        ms_setup = now_ms() - t1;
-        bool automatic = !device || strcmp(device, "auto") == 0;
-        if (st == RSMOOTH_ERROR_NO_DEVICE && automatic) {
-            if (!opt.quiet)
-                fprintf(stderr, "rsmooth: warning: %s; using the reference path (slower)\n",
-                        err.message);
-            reference = true;
-        } else if (st != RSMOOTH_OK) {
-            fprintf(stderr, "rsmooth: device %s: %s: %s\n", device ? device : "auto",
-                    rsmooth_status_str(st), err.message);
-            if (err.build_log[0])
-                fprintf(stderr, "%s\n", err.build_log);
-            code = st == RSMOOTH_ERROR_OUT_OF_MEMORY ? EXIT_OTHER : EXIT_DEVICE;
-            goto cleanup;
-        }
-    }
-    if (reference)
-        st = rsmooth_smooth_reference(RSMOOTH_FLOAT64, mesh->positions, nv, mesh->triangles,
-                                      mesh->triangle_count, &opt.params, out, NULL, confidence,
-                                      &report, &err);
-    else
-        st = rsmooth_smooth(ctx, RSMOOTH_FLOAT64, mesh->positions, nv, mesh->triangles,
-                            mesh->triangle_count, &opt.params, out, NULL, confidence, &report,
-                            &err);
-    if (st != RSMOOTH_OK) {
-        if (st == RSMOOTH_ERROR_OPENCL)
-            fprintf(stderr, "rsmooth: %s: device %s: %s\n", opt.input,
-                    rsmooth_context_device_name(ctx), err.message);
-        else
-            fprintf(stderr, "rsmooth: %s: %s\n", opt.input, err.message);
-        code = st == RSMOOTH_ERROR_OPENCL        ? EXIT_DEVICE
-               : st == RSMOOTH_ERROR_INVALID_ARGUMENT ? EXIT_USAGE
-                                                      : EXIT_OTHER;
+    cli_progress_stage(&bar, "smoothing", 0.1, 0.95);
+    if ((code = smooth(&opt, mesh, out, confidence, &report, &bar)) != EXIT_OK)
         goto cleanup;
-    }
-    report.ms_setup = ms_setup;
 
-    double t2 = now_ms();
+    cli_progress_stage(&bar, "writing", 0.95, 1);
+    double t1 = cli_now_ms();
     double *input_positions = mesh->positions;
     mesh->positions = out;
-    code = write_atomically(mesh, opt.output, opt.ascii);
-    if (code == EXIT_OK && opt.confidence) {
-        uint8_t *colours = malloc(nv * 3);
-        if (!colours) {
-            code = EXIT_OTHER;
-        } else {
-            for (size_t v = 0; v < nv; v++)
-                confidence_colour(confidence[v], colours + 3 * v);
-            mesh->vertex_quality = confidence;
-            mesh->vertex_colors = colours;
-            code = write_atomically(mesh, opt.confidence, opt.ascii);
-            mesh->vertex_quality = NULL;
-            mesh->vertex_colors = NULL;
-            free(colours);
-        }
-    }
+    rsmooth_format format = cli_output_format(opt.output, opt.ascii);
+    cli_progress_clear(&bar);
+    warn_losses(mesh, opt.output, format, opt.quiet);
+    code = cli_write_mesh(mesh, opt.output, format);
+    if (code == EXIT_OK && opt.confidence)
+        code = write_confidence(mesh, &opt, confidence);
     mesh->positions = input_positions;
-    double ms_write = now_ms() - t2;
+    double ms_write = cli_now_ms() - t1;
+    cli_progress_clear(&bar);
     if (code != EXIT_OK)
         goto cleanup;
 
     if (opt.json)
-        print_json(&report, opt.input, opt.output, ms_read, ms_write, ms_setup);
+        print_json(&report, &opt, ms_read, ms_write);
+    if (opt.stats)
+        print_stats(mesh, out, confidence, &report);
     if (!opt.quiet)
         fprintf(stderr,
                 "rsmooth: %s: %zu vertices, %zu triangles, mean edge %.6g; sigma_f %.6g, "
@@ -407,10 +466,9 @@ int main(int argc, char **argv) {
                 opt.input, report.vertex_count, report.triangle_count, report.mean_edge_length,
                 report.sigma_f, report.sigma_g, report.device, report.ms_total, opt.output,
                 opt.confidence ? " and " : "", opt.confidence ? opt.confidence : "");
-    code = EXIT_OK;
 
 cleanup:
-    rsmooth_context_destroy(ctx);
+    cli_progress_clear(&bar);
     rsmooth_mesh_destroy(mesh);
     free(out);
     free(confidence);

@@ -1,7 +1,7 @@
 /* Choosing an OpenCL device and owning (or sharing) its context and queue. */
 #define _POSIX_C_SOURCE 200809L
-#include "rsmooth_internal.h"
 #include "rsmooth_cl.h"
+#include "rsmooth_internal.h"
 
 #include <ctype.h>
 #include <stdio.h>
@@ -12,9 +12,9 @@
 #define MAX_DEVICES 64
 
 rsmooth_status rs_cl_fail(rsmooth_error *error, cl_int code, const char *call, const char *what) {
-    rsmooth_status st = rs_fail(error, RSMOOTH_ERROR_OPENCL, call, "%s failed with %s (%d)%s%s",
-                                call, rs_cl_error_name(code), (int)code, what ? ": " : "",
-                                what ? what : "");
+    rsmooth_status st =
+        rs_fail(error, RSMOOTH_ERROR_OPENCL, call, "%s failed with %s (%d)%s%s", call,
+                rs_cl_error_name(code), (int)code, what ? ": " : "", what ? what : "");
     if (error)
         error->cl_error = code;
     return st;
@@ -109,6 +109,31 @@ static int list_devices(candidate *out, int capacity) {
     return n;
 }
 
+size_t rsmooth_list_devices(rsmooth_device_info *devices, size_t capacity) {
+    candidate all[MAX_DEVICES];
+    int n = list_devices(all, MAX_DEVICES);
+    for (int i = 0; i < n && devices && (size_t)i < capacity; i++) {
+        rsmooth_device_info *d = &devices[i];
+        memset(d, 0, sizeof *d);
+        d->platform_index = all[i].platform_index;
+        d->device_index = all[i].device_index;
+        snprintf(d->name, sizeof d->name, "%s", all[i].name);
+        const char *type = (all[i].type & CL_DEVICE_TYPE_GPU)           ? "gpu"
+                           : (all[i].type & CL_DEVICE_TYPE_CPU)         ? "cpu"
+                           : (all[i].type & CL_DEVICE_TYPE_ACCELERATOR) ? "accel"
+                                                                        : "other";
+        snprintf(d->type, sizeof d->type, "%s", type);
+        clGetDeviceInfo(all[i].device, CL_DEVICE_VERSION, sizeof d->version - 1, d->version, NULL);
+        cl_uint units = 0;
+        cl_ulong memory = 0;
+        clGetDeviceInfo(all[i].device, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof units, &units, NULL);
+        clGetDeviceInfo(all[i].device, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof memory, &memory, NULL);
+        d->compute_units = units;
+        d->global_memory = memory;
+    }
+    return (size_t)n;
+}
+
 static rsmooth_status pick_device(const char *spec, candidate *chosen, rsmooth_error *error) {
     static const char where[] = "rsmooth_context_create";
     candidate all[MAX_DEVICES];
@@ -148,8 +173,8 @@ static rsmooth_status pick_device(const char *spec, candidate *chosen, rsmooth_e
                 *chosen = all[i];
                 return RSMOOTH_OK;
             }
-        return rs_fail(error, RSMOOTH_ERROR_NO_DEVICE, where,
-                       "no OpenCL device %d on platform %d", di, pi);
+        return rs_fail(error, RSMOOTH_ERROR_NO_DEVICE, where, "no OpenCL device %d on platform %d",
+                       di, pi);
     } else {
         for (int i = 0; i < n; i++) {
             char name[256];

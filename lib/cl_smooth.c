@@ -136,18 +136,37 @@ static void arg(arg_setter *s, size_t size, const void *value) {
     s->index++;
 }
 
-static cl_int run_1d(rsmooth_context *ctx, cl_kernel kernel, size_t count) {
+/* Slices a kernel launch takes when the caller wants progress reports. Every work-item computes
+ * its own vertex alone, so slicing never changes the result. */
+#define PROGRESS_SLICES 32
+#define MOLLIFY_SHARE 0.45
+
+/* Runs `kernel` over `count` work-items and waits; with progress requested, in slices, reporting
+ * fractions from `from` to `to` of the whole filter. */
+static cl_int run_1d(rsmooth_context *ctx, const rs_problem *pb, cl_kernel kernel, size_t count,
+                     double from, double to) {
     size_t local = ctx->local_size;
-    size_t global = (count + local - 1) / local * local;
-    cl_int err = clEnqueueNDRangeKernel(ctx->queue, kernel, 1, NULL, &global, &local, 0, NULL, NULL);
-    return err == CL_SUCCESS ? clFinish(ctx->queue) : err;
+    size_t slices = pb->progress && count > PROGRESS_SLICES * local ? PROGRESS_SLICES : 1;
+    size_t slice = (count + slices - 1) / slices;
+    slice = (slice + local - 1) / local * local;
+    for (size_t start = 0; start < count; start += slice) {
+        size_t n = count - start < slice ? count - start : slice;
+        size_t global = (n + local - 1) / local * local;
+        cl_int err =
+            clEnqueueNDRangeKernel(ctx->queue, kernel, 1, &start, &global, &local, 0, NULL, NULL);
+        if (err == CL_SUCCESS)
+            err = clFinish(ctx->queue);
+        if (err != CL_SUCCESS)
+            return err;
+        rs_progress(pb, from + (to - from) * (double)(start + n) / (double)count);
+    }
+    return CL_SUCCESS;
 }
 
 rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const void *positions,
-                              size_t vertex_count, const uint32_t *indices,
-                              size_t triangle_count, const rsmooth_params *params,
-                              void *out_positions, float *out_weight, float *out_confidence,
-                              rsmooth_report *report, rsmooth_error *error) {
+                              size_t vertex_count, const uint32_t *indices, size_t triangle_count,
+                              const rsmooth_params *params, void *out_positions, float *out_weight,
+                              float *out_confidence, rsmooth_report *report, rsmooth_error *error) {
     static const char where[] = "rsmooth_smooth";
     double t_start = rs_now_ms();
     rs_error_clear(error);
@@ -206,8 +225,8 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
         cl_int err = CL_SUCCESS;
         buf[b] = clCreateBuffer(ctx->context, spec[b].flags, spec[b].size, NULL, &err);
         if (err == CL_SUCCESS && spec[b].host)
-            err = clEnqueueWriteBuffer(ctx->queue, buf[b], CL_FALSE, 0, spec[b].size,
-                                       spec[b].host, 0, NULL, NULL);
+            err = clEnqueueWriteBuffer(ctx->queue, buf[b], CL_FALSE, 0, spec[b].size, spec[b].host,
+                                       0, NULL, NULL);
         if (err != CL_SUCCESS) {
             st = rs_cl_fail(error, err, "clCreateBuffer/clEnqueueWriteBuffer", ctx->device_name);
             goto cleanup;
@@ -227,7 +246,8 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     cl_float mollify_reach2 = (cl_float)((pb.mollify_radius / h) * (pb.mollify_radius / h));
     cl_float inv_2sm2 = (cl_float)(h * h / (2 * pb.sigma_m * pb.sigma_m));
     cl_float inv_2sf2 = (cl_float)(h * h / (2 * pb.sigma_f * pb.sigma_f));
-    cl_float inv_2sg2 = isinf(pb.sigma_g) ? 0.0f : (cl_float)(h * h / (2 * pb.sigma_g * pb.sigma_g));
+    cl_float inv_2sg2 =
+        isinf(pb.sigma_g) ? 0.0f : (cl_float)(h * h / (2 * pb.sigma_g * pb.sigma_g));
     cl_int want_confidence = out_confidence != NULL;
 
     cl_mem normals = buf[BUF_FACET_NORMAL];
@@ -244,7 +264,7 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
         arg(&s, sizeof(cl_mem), &buf[BUF_TABLE]);
         arg(&s, sizeof mask, &mask);
         arg(&s, sizeof(cl_mem), &buf[BUF_VERTEX_SHIFT]);
-        err = s.err != CL_SUCCESS ? s.err : run_1d(ctx, s.kernel, nv);
+        err = s.err != CL_SUCCESS ? s.err : run_1d(ctx, &pb, s.kernel, nv, 0, MOLLIFY_SHARE);
         if (err != CL_SUCCESS) {
             st = rs_cl_fail(error, err, "mollify_vertex", ctx->device_name);
             goto cleanup;
@@ -259,7 +279,8 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
         arg(&s, sizeof(cl_mem), &buf[BUF_FACET_NORMAL]);
         arg(&s, sizeof(cl_mem), &buf[BUF_VERTEX_SHIFT]);
         arg(&s, sizeof(cl_mem), &buf[BUF_MOLLIFIED_NORMAL]);
-        err = s.err != CL_SUCCESS ? s.err : run_1d(ctx, s.kernel, nf);
+        err = s.err != CL_SUCCESS ? s.err
+                                  : run_1d(ctx, &pb, s.kernel, nf, MOLLIFY_SHARE, MOLLIFY_SHARE);
         if (err != CL_SUCCESS) {
             st = rs_cl_fail(error, err, "mollified_facet_normal", ctx->device_name);
             goto cleanup;
@@ -286,7 +307,8 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     arg(&s, sizeof mask, &mask);
     arg(&s, sizeof(cl_mem), &buf[BUF_VERTEX_RESULT]);
     arg(&s, sizeof(cl_mem), &buf[BUF_VERTEX_EXTRA]);
-    err = s.err != CL_SUCCESS ? s.err : run_1d(ctx, s.kernel, nv);
+    err = s.err != CL_SUCCESS ? s.err
+                              : run_1d(ctx, &pb, s.kernel, nv, pb.mollify ? MOLLIFY_SHARE : 0, 1);
     if (err != CL_SUCCESS) {
         st = rs_cl_fail(error, err, "robust_vertex", ctx->device_name);
         goto cleanup;
@@ -324,6 +346,7 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     }
 
 done:
+    rs_progress(&pb, 1.0);
     if (report) {
         double now = rs_now_ms();
         rs_report_problem(report, &pb, &grid, ctx->device_name);

@@ -216,6 +216,8 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
     problem->mollify_radius =
         (p.mollify_cutoff > 0 ? p.mollify_cutoff : p.cutoff) * problem->sigma_f;
     problem->mollify = p.mollify != 0;
+    problem->progress = p.progress;
+    problem->progress_user = p.progress_user;
     if (!(problem->sigma_f > 0) || !isfinite(problem->radius))
         problem->facet_count = 0; /* no edge of non-zero length: nothing can move */
     return RSMOOTH_OK;

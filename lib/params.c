@@ -18,6 +18,8 @@ rsmooth_status rsmooth_params_init(rsmooth_params *params) {
     params->cutoff = 2.0;
     params->mollify_cutoff = 0.0;
     params->mollify = 1;
+    params->progress = NULL;
+    params->progress_user = NULL;
     return RSMOOTH_OK;
 }
 

@@ -7,7 +7,13 @@
 #include <stdio.h>
 #include <string.h>
 
-/* The facets whose centroid lies within `reach` of p (distance <= reach), with squared distances. */
+/* Progress: reported every PROGRESS_STEP vertices; mollification is about this share of the work.
+ */
+#define PROGRESS_STEP 4096
+#define MOLLIFY_SHARE 0.45
+
+/* The facets whose centroid lies within `reach` of p (distance <= reach), with squared distances.
+ */
 typedef struct neighbours {
     size_t count, capacity;
     uint32_t *facet;
@@ -176,6 +182,8 @@ rsmooth_status rsmooth_smooth_reference(rsmooth_scalar scalar, const void *posit
             if (!gather(&pb, &grid, pb.xyz + 3 * v, pb.mollify_radius, &nb))
                 goto fail_memory;
             mollify_vertex(&pb, &nb, pb.xyz + 3 * v, mollified + 3 * v);
+            if (v % PROGRESS_STEP == 0)
+                rs_progress(&pb, MOLLIFY_SHARE * (double)v / (double)vertex_count);
         }
         t_mollify = rs_now_ms();
         for (size_t q = 0; q < pb.facet_count; q++)
@@ -186,10 +194,13 @@ rsmooth_status rsmooth_smooth_reference(rsmooth_scalar scalar, const void *posit
     }
     t_normals = rs_now_ms();
 
+    double robust_start = pb.mollify ? MOLLIFY_SHARE : 0;
     for (size_t v = 0; v < vertex_count; v++) {
         const double *p = pb.xyz + 3 * v;
         if (!gather(&pb, &grid, p, pb.radius, &nb))
             goto fail_memory;
+        if (v % PROGRESS_STEP == 0)
+            rs_progress(&pb, robust_start + (1 - robust_start) * (double)v / (double)vertex_count);
         double disp[3], k, kf;
         estimate_vertex(&pb, &nb, normals, p, disp, &k, &kf);
         double out[3] = {p[0] + disp[0], p[1] + disp[1], p[2] + disp[2]};
@@ -201,6 +212,7 @@ rsmooth_status rsmooth_smooth_reference(rsmooth_scalar scalar, const void *posit
     }
 
 done:
+    rs_progress(&pb, 1.0);
     if (report) {
         double now = rs_now_ms();
         rs_report_problem(report, &pb, &grid, "reference (double, 1 thread)");

@@ -81,7 +81,15 @@ typedef struct rs_problem {
     double radius;               /* cutoff * sigma_f: reach of the robust pass */
     double mollify_radius;       /* reach of the mollification pass (<= radius) */
     bool mollify;
+    rsmooth_progress_fn progress; /* optional, from the params */
+    void *progress_user;
 } rs_problem;
+
+/* Reports progress `fraction` if the caller asked for it. */
+static inline void rs_progress(const rs_problem *problem, double fraction) {
+    if (problem->progress)
+        problem->progress(problem->progress_user, fraction);
+}
 
 /* Checks every argument of a smoothing call (nothing is written on failure), converts positions to
  * double, computes facet data, the mean edge length and the absolute parameters. */

@@ -23,6 +23,47 @@ static void smooth_cube(rsmooth_context *ctx, const shape_mesh *m, double *out) 
     free(conf);
 }
 
+/* Records progress reports: count, last fraction, and whether they ever went backwards. */
+typedef struct progress_log {
+    int calls;
+    double last;
+    int backwards;
+} progress_log;
+
+static void record_progress(void *user, double fraction) {
+    progress_log *log = user;
+    if (fraction < log->last || fraction < 0 || fraction > 1)
+        log->backwards = 1;
+    log->last = fraction;
+    log->calls++;
+}
+
+/* Progress reports arrive in order, end at 1, and slicing the kernels changes nothing. */
+static void check_progress(rsmooth_context *ctx, const shape_mesh *m, const double *expected) {
+    size_t n = 3 * m->vertex_count;
+    double *out = malloc(n * sizeof *out);
+    CHECK(out);
+    rsmooth_params p;
+    rsmooth_params_init(&p);
+    progress_log log = {0, 0, 0};
+    p.progress = record_progress;
+    p.progress_user = &log;
+    rsmooth_error err;
+    CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                m->triangle_count, &p, out, NULL, NULL, NULL, &err),
+                 RSMOOTH_OK);
+    printf("progress (OpenCL): %d reports, last %.3f\n", log.calls, log.last);
+    CHECK(log.calls >= 10 && !log.backwards && log.last == 1.0);
+    CHECK(memcmp(out, expected, n * sizeof *out) == 0);
+    log = (progress_log){0, 0, 0};
+    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                          m->triangle_count, &p, out, NULL, NULL, NULL, &err),
+                 RSMOOTH_OK);
+    printf("progress (reference): %d reports, last %.3f\n", log.calls, log.last);
+    CHECK(log.calls >= 3 && !log.backwards && log.last == 1.0);
+    free(out);
+}
+
 int main(void) {
     rsmooth_context *ctx = open_test_context();
     shape_mesh cube;
@@ -37,12 +78,35 @@ int main(void) {
     smooth_cube(ctx, &cube, b);
     CHECK(memcmp(a, b, n * sizeof *a) == 0);
     printf("two runs: bit-identical\n");
+    {
+        shape_mesh big;
+        CHECK(shape_sphere(&big, 6, 1.0) == 0); /* 40962 vertices: enough to slice */
+        CHECK(shape_add_normal_noise(&big, 0.2, 5) == 0);
+        double *plain = malloc(3 * big.vertex_count * sizeof *plain);
+        CHECK(plain);
+        rsmooth_params p;
+        rsmooth_params_init(&p);
+        CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, big.xyz, big.vertex_count, big.indices,
+                                    big.triangle_count, &p, plain, NULL, NULL, NULL, NULL),
+                     RSMOOTH_OK);
+        check_progress(ctx, &big, plain);
+        free(plain);
+        shape_free(&big);
+    }
 
     /* Device specs: "cpu" and "0:0" name PoCL's device here; a name that matches nothing fails. */
     rsmooth_error err;
     rsmooth_context *other = NULL;
     CHECK_STATUS(rsmooth_context_create("0:0", &other, &err), RSMOOTH_OK);
     printf("device 0:0 is %s\n", rsmooth_context_device_name(other));
+    rsmooth_device_info devices[8];
+    size_t device_count = rsmooth_list_devices(devices, 8);
+    CHECK(device_count >= 1);
+    CHECK(devices[0].platform_index == 0 && devices[0].device_index == 0);
+    CHECK(strcmp(devices[0].name, rsmooth_context_device_name(other)) == 0);
+    CHECK(devices[0].compute_units >= 1 && devices[0].global_memory > 0);
+    printf("devices: %zu, first %s (%s, %u compute units)\n", device_count, devices[0].name,
+           devices[0].type, devices[0].compute_units);
     smooth_cube(other, &cube, c);
     rsmooth_context_destroy(other);
     other = NULL;

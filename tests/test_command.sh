@@ -69,6 +69,29 @@ ls ./*tmp-* >/dev/null 2>&1 && fail "temporary files left behind: $(ls ./*tmp-*)
 OCL_ICD_VENDORS=/nonexistent OCL_ICD_FILENAMES= expect 0 "$rsmooth" noisy.ply -o fallback.ply
 grep -q "reference path" err.txt || fail "no fallback warning: $(cat err.txt)"
 
+# --in-place replaces the input atomically; with -o it is a usage error.
+cp noisy.ply inplace.ply
+expect 0 "$rsmooth" inplace.ply --in-place -q
+cmp -s inplace.ply noisy.ply && fail "--in-place left the input unchanged"
+expect 0 "$shape" compare inplace.ply truth.ply
+expect 2 "$rsmooth" inplace.ply --in-place -o other.ply
+
+# --stats and --list-devices
+expect 0 "$rsmooth" noisy.ply -o stats.ply --stats
+grep -q "^moved:" err.txt && grep -q "^confidence:" err.txt || fail "--stats printed: $(cat err.txt)"
+expect 0 "$rsmooth" --list-devices
+grep -q "P:D" out.txt || fail "--list-devices printed: $(cat out.txt)"
+
+# A progress bar appears on a terminal for work over a second (script(1) provides the terminal).
+if command -v script >/dev/null; then
+  expect 0 "$shape" make big.ply bigtruth.ply --triangles 150000
+  script -qec "'$rsmooth' big.ply -o bigout.ply --device reference --sigma-f 4" /dev/null >tty.txt 2>&1 ||
+    fail "rsmooth under script failed: $(cat tty.txt)"
+  grep -q "smoothing" tty.txt || fail "no progress bar on a terminal: $(head -c 300 tty.txt)"
+  expect 0 "$rsmooth" big.ply -o bigout2.ply --device reference
+  grep -q "smoothing" err.txt && fail "progress bar drawn when stderr is not a terminal"
+fi
+
 expect 0 "$rsmooth" --help
 grep -q "sigma-g" out.txt || fail "--help does not explain sigma-g"
 expect 0 "$rsmooth" --version

@@ -100,6 +100,11 @@ typedef enum rsmooth_scalar {
     RSMOOTH_FLOAT64 = 1  /* positions are double[3] per vertex (georeferenced scans, CAD in mm...) */
 } rsmooth_scalar;
 
+/* Progress of a long filter call: `fraction` of the work done, in [0, 1], non-decreasing. Called on
+ * the calling thread between pieces of work (the OpenCL path then launches its kernels in slices,
+ * which does not change the result). */
+typedef void (*rsmooth_progress_fn)(void *user, double fraction);
+
 /* Filter parameters. Fill with rsmooth_params_init() first, then change fields: struct_size lets
  * later versions add fields without breaking callers compiled against this one. */
 typedef struct rsmooth_params {
@@ -115,6 +120,8 @@ typedef struct rsmooth_params {
                             * means the same radius as `cutoff` (the published setting) */
     int mollify;           /* 1 (default): predict with mollified normals; 0: with the input's own
                             * (the paper's Fig. 4 ablation) */
+    rsmooth_progress_fn progress; /* optional (NULL, default): progress reports */
+    void *progress_user;          /* passed to `progress` unchanged */
 } rsmooth_params;
 
 /* Fills `params` with the defaults above. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if params is NULL. */
@@ -204,6 +211,22 @@ typedef struct rsmooth_context rsmooth_context;
  * set to NULL on failure. Thread-safe; the context itself must be used by one thread at a time. */
 RSMOOTH_API rsmooth_status rsmooth_context_create(const char *device, rsmooth_context **ctx,
                                                   rsmooth_error *error);
+
+/* One OpenCL device as rsmooth_list_devices reports it. */
+typedef struct rsmooth_device_info {
+    int platform_index;      /* the P of a "P:D" device choice */
+    int device_index;        /* the D */
+    char name[256];          /* "platform name / device name", what a name choice matches */
+    char type[8];            /* "gpu", "cpu", "accel" or "other" */
+    char version[64];        /* CL_DEVICE_VERSION, e.g. "OpenCL 3.0 PoCL ..." */
+    unsigned compute_units;
+    uint64_t global_memory;  /* bytes */
+} rsmooth_device_info;
+
+/* Fills up to `capacity` entries of `devices` (may be NULL when capacity is 0) with every OpenCL
+ * device of every platform, in the order "P:D" choices count them, and returns how many there are
+ * (0 when no OpenCL platform exists). Thread-safe. */
+RSMOOTH_API size_t rsmooth_list_devices(rsmooth_device_info *devices, size_t capacity);
 
 /* Releases everything the context holds. Accepts NULL. */
 RSMOOTH_API void rsmooth_context_destroy(rsmooth_context *ctx);

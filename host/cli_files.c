@@ -1,0 +1,181 @@
+/* The rsmooth command's file handling (see cli_files.h). */
+#define _POSIX_C_SOURCE 200809L
+#include "cli_files.h"
+
+#include <errno.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#define READ_CHUNK (8u << 20)
+
+int cli_read_mesh(const char *path, cli_progress *bar, rsmooth_mesh **mesh) {
+    *mesh = NULL;
+    FILE *f = fopen(path, "rb");
+    struct stat st;
+    if (!f || fstat(fileno(f), &st) != 0) {
+        fprintf(stderr, "rsmooth: %s: cannot open: %s\n", path, strerror(errno));
+        if (f)
+            fclose(f);
+        return EXIT_USAGE;
+    }
+    if (S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "rsmooth: %s: is a directory, not a mesh file\n", path);
+        fclose(f);
+        return EXIT_USAGE;
+    }
+    size_t expected = S_ISREG(st.st_mode) ? (size_t)st.st_size : 0;
+    size_t capacity = expected + 1 > READ_CHUNK ? expected + 1 : READ_CHUNK;
+    size_t size = 0;
+    char *data = malloc(capacity);
+    int code = EXIT_OK;
+    while (data) {
+        if (size == capacity) {
+            char *bigger = realloc(data, capacity * 2);
+            if (!bigger) {
+                free(data);
+                data = NULL;
+                break;
+            }
+            data = bigger;
+            capacity *= 2;
+        }
+        size_t want = capacity - size < READ_CHUNK ? capacity - size : READ_CHUNK;
+        size_t got = fread(data + size, 1, want, f);
+        size += got;
+        if (expected)
+            cli_progress_update(bar, (double)size / (double)expected);
+        if (got < want) {
+            if (ferror(f)) {
+                fprintf(stderr, "rsmooth: %s: read error: %s\n", path, strerror(errno));
+                code = EXIT_USAGE;
+            }
+            break;
+        }
+    }
+    fclose(f);
+    if (!data) {
+        fprintf(stderr, "rsmooth: %s: out of memory reading it\n", path);
+        return EXIT_OTHER;
+    }
+    if (code != EXIT_OK) {
+        free(data);
+        return code;
+    }
+    rsmooth_error err;
+    rsmooth_status status = rsmooth_mesh_read_memory(data, size, RSMOOTH_FORMAT_AUTO, mesh, &err);
+    free(data);
+    if (status == RSMOOTH_OK)
+        return EXIT_OK;
+    cli_progress_clear(bar);
+    if (err.line >= 0)
+        fprintf(stderr, "rsmooth: %s:%lld: %s\n", path, (long long)err.line, err.message);
+    else if (err.byte_offset >= 0)
+        fprintf(stderr, "rsmooth: %s: byte %lld: %s\n", path, (long long)err.byte_offset,
+                err.message);
+    else
+        fprintf(stderr, "rsmooth: %s: %s\n", path, err.message);
+    return status == RSMOOTH_ERROR_OUT_OF_MEMORY ? EXIT_OTHER : EXIT_USAGE;
+}
+
+rsmooth_format cli_output_format(const char *path, bool ascii) {
+    rsmooth_format format = rsmooth_format_from_path(path);
+    if (ascii && format == RSMOOTH_FORMAT_PLY_BINARY)
+        return RSMOOTH_FORMAT_PLY_ASCII;
+    if (ascii && format == RSMOOTH_FORMAT_STL_BINARY)
+        return RSMOOTH_FORMAT_STL_ASCII;
+    return format;
+}
+
+static bool same_file(const char *a, const char *b) {
+    struct stat sa, sb;
+    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev &&
+           sa.st_ino == sb.st_ino;
+}
+
+int cli_check_output(const char *path, const char *input, bool force, bool in_place) {
+    struct stat st;
+    bool exists = stat(path, &st) == 0;
+    if (!in_place && same_file(path, input)) {
+        fprintf(stderr, "rsmooth: %s: refusing to overwrite the input file (use --in-place)\n",
+                path);
+        return EXIT_USAGE;
+    }
+    if (exists && S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "rsmooth: %s: is a directory\n", path);
+        return EXIT_USAGE;
+    }
+    if (exists && !force && !in_place) {
+        fprintf(stderr, "rsmooth: %s: already exists (use --force to replace it)\n", path);
+        return EXIT_USAGE;
+    }
+    if (rsmooth_format_from_path(path) == RSMOOTH_FORMAT_AUTO) {
+        fprintf(stderr, "rsmooth: %s: unknown output format (use .obj, .ply, .off or .stl)\n",
+                path);
+        return EXIT_USAGE;
+    }
+    return -1;
+}
+
+/* The temporary file being written, removed if a signal interrupts the command. */
+static volatile sig_atomic_t have_temporary;
+static char temporary[4096];
+
+static void remove_temporary_and_exit(int signal_number) {
+    if (have_temporary)
+        unlink(temporary);
+    signal(signal_number, SIG_DFL);
+    raise(signal_number);
+}
+
+int cli_write_mesh(const rsmooth_mesh *mesh, const char *path, rsmooth_format format) {
+    if (strlen(path) + 16 > sizeof temporary) {
+        fprintf(stderr, "rsmooth: %s: path too long\n", path);
+        return EXIT_OTHER;
+    }
+    snprintf(temporary, sizeof temporary, "%s.tmp-XXXXXX", path);
+    int fd = mkstemp(temporary);
+    if (fd < 0) {
+        fprintf(stderr, "rsmooth: %s: cannot create a temporary file beside it: %s\n", path,
+                strerror(errno));
+        return EXIT_OTHER;
+    }
+    have_temporary = 1;
+    signal(SIGINT, remove_temporary_and_exit);
+    signal(SIGTERM, remove_temporary_and_exit);
+    signal(SIGHUP, remove_temporary_and_exit);
+    FILE *f = fdopen(fd, "wb");
+    rsmooth_error err;
+    rsmooth_status status = RSMOOTH_ERROR_IO;
+    if (f) {
+        status = rsmooth_mesh_write_stream(mesh, f, format, &err);
+        if (fclose(f) != 0 && status == RSMOOTH_OK) {
+            status = RSMOOTH_ERROR_IO;
+            snprintf(err.message, sizeof err.message, "%s", strerror(errno));
+        }
+    } else {
+        snprintf(err.message, sizeof err.message, "%s", strerror(errno));
+        close(fd);
+    }
+    if (status == RSMOOTH_OK) {
+        mode_t mask = umask(0); /* mkstemp makes 0600 files; give the usual permissions */
+        umask(mask);
+        chmod(temporary, 0666 & ~mask);
+        if (rename(temporary, path) != 0) {
+            snprintf(err.message, sizeof err.message, "%s", strerror(errno));
+            status = RSMOOTH_ERROR_IO;
+        }
+    }
+    if (status != RSMOOTH_OK) {
+        fprintf(stderr, "rsmooth: %s: cannot write: %s\n", path, err.message);
+        unlink(temporary);
+    }
+    have_temporary = 0;
+    signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
+    signal(SIGHUP, SIG_DFL);
+    return status == RSMOOTH_OK ? EXIT_OK : EXIT_OTHER;
+}

@@ -1,0 +1,65 @@
+/* The rsmooth command's progress bar (see cli_progress.h). */
+#define _POSIX_C_SOURCE 200809L
+#include "cli_progress.h"
+
+#include <stdio.h>
+#include <time.h>
+#include <unistd.h>
+
+#define SHOW_AFTER_MS 1000.0 /* quick runs never show a bar */
+#define REDRAW_MS 100.0
+#define WIDTH 30
+
+double cli_now_ms(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+void cli_progress_init(cli_progress *bar, bool quiet) {
+    bar->enabled = !quiet && isatty(STDERR_FILENO);
+    bar->drawn = false;
+    bar->start_ms = cli_now_ms();
+    bar->last_draw_ms = 0;
+    bar->stage_from = 0;
+    bar->stage_to = 0;
+    bar->stage = "";
+}
+
+void cli_progress_stage(cli_progress *bar, const char *stage, double from, double to) {
+    bar->stage = stage;
+    bar->stage_from = from;
+    bar->stage_to = to;
+    cli_progress_update(bar, 0);
+}
+
+void cli_progress_update(cli_progress *bar, double fraction) {
+    if (!bar->enabled)
+        return;
+    double now = cli_now_ms();
+    if (now - bar->start_ms < SHOW_AFTER_MS || now - bar->last_draw_ms < REDRAW_MS)
+        return;
+    bar->last_draw_ms = now;
+    double whole = bar->stage_from + (bar->stage_to - bar->stage_from) * fraction;
+    int filled = (int)(whole * WIDTH + 0.5);
+    char cells[WIDTH + 1];
+    for (int i = 0; i < WIDTH; i++)
+        cells[i] = i < filled ? '#' : '.';
+    cells[WIDTH] = '\0';
+    fprintf(stderr, "\r[%s] %3d%% %-9s %5.1f s", cells, (int)(whole * 100 + 0.5), bar->stage,
+            (now - bar->start_ms) / 1e3);
+    fflush(stderr);
+    bar->drawn = true;
+}
+
+void cli_progress_callback(void *user, double fraction) {
+    cli_progress_update(user, fraction);
+}
+
+void cli_progress_clear(cli_progress *bar) {
+    if (bar->drawn) {
+        fputs("\r\033[K", stderr);
+        fflush(stderr);
+        bar->drawn = false;
+    }
+}

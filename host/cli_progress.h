@@ -1,0 +1,33 @@
+/* A progress bar on stderr for the rsmooth command: shown only when stderr is a terminal and the
+ * work has taken more than a second, so scripts and quick runs see nothing. */
+#ifndef RSMOOTH_CLI_PROGRESS_H
+#define RSMOOTH_CLI_PROGRESS_H
+
+#include <stdbool.h>
+
+typedef struct cli_progress {
+    bool enabled;    /* stderr is a terminal and the user did not ask for quiet */
+    bool drawn;      /* something is on the line, to be cleared */
+    double start_ms; /* when the work began */
+    double last_draw_ms;
+    double stage_from, stage_to; /* the current stage's share of the whole bar */
+    const char *stage;           /* "reading", "smoothing", "writing" */
+} cli_progress;
+
+void cli_progress_init(cli_progress *bar, bool quiet);
+
+/* Enters a stage that covers [from, to] of the bar. */
+void cli_progress_stage(cli_progress *bar, const char *stage, double from, double to);
+
+/* Reports `fraction` of the current stage done. */
+void cli_progress_update(cli_progress *bar, double fraction);
+
+/* rsmooth_progress_fn adapter: `user` is a cli_progress. */
+void cli_progress_callback(void *user, double fraction);
+
+/* Clears the bar's line (before printing anything else, and at the end). */
+void cli_progress_clear(cli_progress *bar);
+
+double cli_now_ms(void);
+
+#endif
