@@ -32,6 +32,16 @@ static rsmooth_mesh *parse_ok(const char *text) {
     return mesh;
 }
 
+static rsmooth_mesh *parse_n_ok(const char *text, size_t size) {
+    rsmooth_mesh *mesh = NULL;
+    rsmooth_error err;
+    rsmooth_status s = parse_n(text, size, &mesh, &err);
+    if (s != RSMOOTH_OK)
+        fprintf(stderr, "unexpected failure: %s (line %lld)\n", err.message, (long long)err.line);
+    CHECK_EQ_INT(s, RSMOOTH_OK);
+    return mesh;
+}
+
 /* Expects a parse error at `line` whose message contains `needle`. */
 #define EXPECT_PARSE_ERROR(text, line, needle) expect_parse_error(__LINE__, text, line, needle)
 static void expect_parse_error(int at, const char *text, long long line, const char *needle) {
@@ -99,7 +109,19 @@ static void test_index_forms(void) {
     const uint32_t quad[6] = {0, 1, 2, 0, 2, 3};
     for (int i = 0; i < 6; i++)
         CHECK_EQ_INT(m->triangles[9 + i], quad[i]);
-    CHECK(m->vertex_colors == NULL && m->vertex_quality == NULL);
+    /* "v x y z r g b" colours the vertex; the others show white */
+    CHECK(m->vertex_colors != NULL && m->vertex_quality == NULL);
+    const uint8_t colors[15] = {255, 255, 255, 255, 255, 255, 255, 255,
+                                255, 255, 255, 255, 128, 64,  255};
+    for (int i = 0; i < 15; i++)
+        CHECK_EQ_INT(m->vertex_colors[i], colors[i]);
+    CHECK(m->has_vertex_normals);
+    CHECK(m->extras != NULL);
+    rsmooth_mesh_destroy(m);
+
+    /* Nothing beyond v and f: no extras, no colours, no normals. */
+    m = parse_ok("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2//1 3//1\n");
+    CHECK(m->extras == NULL && m->vertex_colors == NULL && !m->has_vertex_normals);
     rsmooth_mesh_destroy(m);
 }
 
@@ -168,6 +190,9 @@ static void test_errors(void) {
     EXPECT_PARSE_ERROR("v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3/1/1/1\n", 4, "malformed face index");
     EXPECT_PARSE_ERROR("v 0 0 0\r\nv 1 1 1\r\nv 2 2 2\r\nf 1 2 99999999999999999999\r\n", 4,
                        "out of range");
+    EXPECT_PARSE_ERROR("v 0 0 0\nv 1 1 1\nv 2 2 2\nvt 0 0\nf 1/1 2/-1 3/-2\n", 5,
+                       "texture index -2 out of range (1 texture coordinates)");
+    EXPECT_PARSE_ERROR("v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1/0 2/1 3/1\n", 4, "malformed face index");
 
     /* The byte offset points at the offending token. */
     const char *text = "v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 7\n";
@@ -270,7 +295,8 @@ static void test_round_trip(void) {
     CHECK(meshes_equal(m, back, false));
     rsmooth_mesh_destroy(back);
 
-    /* float32 precision and colours: %.9g restores every float exactly; colours are skipped. */
+    /* float32 precision and colours: every float comes back exactly, and so does every colour
+     * byte (4 significant digits of c / 255 are within 0.013 of c after scaling back). */
     for (size_t i = 0; i < 3 * m->vertex_count; i++)
         m->positions[i] = (float)m->positions[i];
     m->positions[2] = 1e30;
@@ -287,6 +313,8 @@ static void test_round_trip(void) {
     CHECK_EQ_INT(rsmooth_mesh_write_file(m, path, RSMOOTH_FORMAT_OBJ, &err), RSMOOTH_OK);
     CHECK_EQ_INT(rsmooth_mesh_read_file(path, &back, &err), RSMOOTH_OK);
     CHECK(meshes_equal(m, back, true));
+    CHECK(back->vertex_colors != NULL);
+    CHECK(memcmp(back->vertex_colors, m->vertex_colors, 3 * m->vertex_count) == 0);
     CHECK_EQ_INT(back->precision, RSMOOTH_FLOAT64); /* text is read as double */
     rsmooth_mesh_destroy(back);
     FILE *text = fopen(path, "rb");
@@ -421,6 +449,265 @@ static void test_create_and_triangulate(void) {
     CHECK(m == NULL);
 }
 
+
+/* ---- lossless OBJ: the faithful writer -------------------------------------------------------- */
+
+static const char rich_obj[] = "# exported by hand\n"
+                               "mtllib scene.mtl\n"
+                               "o thing\n"
+                               "v 0 0 0 1 0 0\n"
+                               "v 1 0 0 0 1 0\n"
+                               "v 1 1 0 0 0 1 # blue\n"
+                               "v 0 1 0 0.5 0.5 0.5\n"
+                               "v 0.5 0.5 1 1 1 1\n"
+                               "vt 0 0\n"
+                               "vt 1 0\n"
+                               "vt 1 1\n"
+                               "vt 0 1\n"
+                               "vn 0 0 1\n"
+                               "vn 0 0 -1\n"
+                               "g side\n"
+                               "usemtl red\n"
+                               "s 1\n"
+                               "f 1/1/1 2/2/1 3/3/1 4/4/1\n"
+                               "\n"
+                               "f 1 2 5\n"
+                               "s off\n"
+                               "g top\n"
+                               "usemtl blue\n"
+                               "f -4/-3 -3/-2 -1/-1\n"
+                               "f 3//2 4//2 5//2\n"
+                               "# a polyline\n"
+                               "l 1 2 3\n"
+                               "f -2/1/2 -1/2/1 1/3/2 # trailing\n";
+
+/* Writes `mesh` as OBJ into a malloc'd string (NUL-terminated; *size without the NUL). */
+static char *write_to_string(const rsmooth_mesh *mesh, rsmooth_format format, size_t *size) {
+    FILE *f = tmpfile();
+    CHECK(f != NULL);
+    rsmooth_error err;
+    rsmooth_status s = rsmooth_mesh_write_stream(mesh, f, format, &err);
+    if (s != RSMOOTH_OK)
+        fprintf(stderr, "write: %s\n", err.message);
+    CHECK_EQ_INT(s, RSMOOTH_OK);
+    long n = ftell(f);
+    CHECK(n > 0);
+    rewind(f);
+    char *text = malloc((size_t)n + 1);
+    CHECK(text != NULL);
+    CHECK_EQ_INT(fread(text, 1, (size_t)n, f), n);
+    text[n] = '\0';
+    fclose(f);
+    *size = (size_t)n;
+    return text;
+}
+
+/* What the test reads of an OBJ text by itself: the lines other than v, vn and f (in order), the
+ * vt and vn lines' values, and per face corner the vt and vn indices (absolute, 0-based, -1 none). */
+typedef struct obj_text {
+    char other[64][128];
+    size_t other_count;
+    double vt[64][3];
+    size_t vt_count;
+    double vn[64][3];
+    size_t vn_count;
+    long corner_vt[256], corner_vn[256];
+    size_t corner_count;
+} obj_text;
+
+static long resolve(long index, size_t count) {
+    return index < 0 ? (long)count + index : index - 1;
+}
+
+static void scan_obj(const char *text, obj_text *out) {
+    memset(out, 0, sizeof *out);
+    const char *p = text;
+    while (*p) {
+        size_t len = strcspn(p, "\n");
+        char line[256];
+        CHECK(len < sizeof line);
+        memcpy(line, p, len);
+        line[len] = '\0';
+        p += len + (p[len] == '\n');
+        if (len && line[len - 1] == '\r')
+            line[len - 1] = '\0';
+        char *save = NULL;
+        char copy[256];
+        strcpy(copy, line);
+        char *kw = strtok_r(copy, " \t", &save);
+        if (kw && (strcmp(kw, "vt") == 0 || strcmp(kw, "vn") == 0)) {
+            bool vt = kw[1] == 't';
+            double *dst = vt ? out->vt[out->vt_count++] : out->vn[out->vn_count++];
+            CHECK(out->vt_count <= 64 && out->vn_count <= 64);
+            for (int k = 0; k < 3; k++) {
+                char *t = strtok_r(NULL, " \t", &save);
+                dst[k] = t ? strtod(t, NULL) : 0;
+            }
+            if (vt) { /* vt lines are kept verbatim: list them with the others */
+                CHECK(out->other_count < 64);
+                strcpy(out->other[out->other_count++], line);
+            }
+        } else if (kw && strcmp(kw, "f") == 0) {
+            char *t;
+            while ((t = strtok_r(NULL, " \t", &save)) != NULL && t[0] != '#') {
+                CHECK(out->corner_count < 256);
+                long vt = -1, vn = -1;
+                char *slash = strchr(t, '/');
+                if (slash) {
+                    if (slash[1] != '/')
+                        vt = resolve(strtol(slash + 1, NULL, 10), out->vt_count);
+                    char *second = strchr(slash + 1, '/');
+                    if (second)
+                        vn = resolve(strtol(second + 1, NULL, 10), out->vn_count);
+                }
+                out->corner_vt[out->corner_count] = vt;
+                out->corner_vn[out->corner_count++] = vn;
+            }
+        } else if (!kw || strcmp(kw, "v") != 0) {
+            CHECK(out->other_count < 64);
+            strcpy(out->other[out->other_count++], line);
+        }
+    }
+}
+
+/* The text of every v line after its three coordinates. */
+static size_t vertex_tails(const char *text, char tails[][64], size_t max) {
+    size_t n = 0;
+    for (const char *p = text; *p; p += strcspn(p, "\n"), p += *p == '\n') {
+        if (p[0] != 'v' || p[1] != ' ')
+            continue;
+        const char *q = p + 1;
+        for (int k = 0; k < 3; k++) {
+            q += strspn(q, " \t");
+            q += strcspn(q, " \t\r\n");
+        }
+        size_t len = strcspn(q, "\r\n");
+        CHECK(n < max && len < 64);
+        memcpy(tails[n], q, len);
+        tails[n++][len] = '\0';
+    }
+    return n;
+}
+
+static void check_faithful_round_trip(const char *input) {
+    rsmooth_mesh *m = parse_ok(input);
+    CHECK(m->extras != NULL && m->has_vertex_normals && m->vertex_colors != NULL);
+    for (size_t i = 0; i < 3 * m->vertex_count; i++) /* digits that need all 17 to round-trip */
+        m->positions[i] += (double)(i + 1) / 3.0;
+    m->positions[4] = 0.1; /* and a short one */
+    rsmooth_error err;
+    CHECK_EQ_INT(rsmooth_mesh_triangulate(m, &err), RSMOOTH_OK);
+    size_t size;
+    char *out = write_to_string(m, RSMOOTH_FORMAT_OBJ, &size);
+    CHECK(strstr(out, "written by rsmooth") == NULL); /* not the generic path */
+    CHECK(strstr(out, " 0.1 ") != NULL);
+
+    /* Every line other than v, vn and f (vt included) comes back identical and in order. */
+    static obj_text a, b;
+    scan_obj(input, &a);
+    scan_obj(out, &b);
+    CHECK_EQ_INT(a.other_count, b.other_count);
+    for (size_t i = 0; i < a.other_count; i++)
+        if (strcmp(a.other[i], b.other[i]) != 0) {
+            fprintf(stderr, "line '%s' written as '%s'\n", a.other[i], b.other[i]);
+            exit(1);
+        }
+    /* CRLF input gives CRLF output. */
+    CHECK((strstr(input, "\r\n") != NULL) == (strstr(out, "\r\n") != NULL));
+
+    /* Read back: the new positions, the same faces, each corner on the same vt coordinates. */
+    rsmooth_mesh *back = parse_n_ok(out, size);
+    CHECK(meshes_equal(m, back, false));
+    CHECK_EQ_INT(a.corner_count, b.corner_count);
+    CHECK_EQ_INT(a.corner_count, m->face_offsets[m->face_count]);
+    for (size_t k = 0; k < a.corner_count; k++) {
+        CHECK_EQ_INT(a.corner_vt[k] < 0, b.corner_vt[k] < 0);
+        if (a.corner_vt[k] >= 0)
+            for (int c = 0; c < 3; c++)
+                CHECK_NEAR(a.vt[a.corner_vt[k]][c], b.vt[b.corner_vt[k]][c], 0);
+        CHECK_EQ_INT(b.corner_vn[k], m->face_indices[k]); /* the vertex's own normal */
+    }
+    /* One recomputed normal per vertex. */
+    CHECK_EQ_INT(b.vn_count, m->vertex_count);
+    double normals[3 * 64];
+    CHECK(m->vertex_count <= 64);
+    CHECK_EQ_INT(rsmooth_mesh_vertex_normals(m, normals, &err), RSMOOTH_OK);
+    for (size_t i = 0; i < 3 * m->vertex_count; i++)
+        CHECK_NEAR(b.vn[i / 3][i % 3], normals[i], 1e-8);
+    /* Colours: the same bytes, and the v lines' trailing fields verbatim. */
+    CHECK(back->vertex_colors != NULL);
+    CHECK(memcmp(back->vertex_colors, m->vertex_colors, 3 * m->vertex_count) == 0);
+    char tails_a[64][64], tails_b[64][64];
+    size_t na = vertex_tails(input, tails_a, 64);
+    CHECK_EQ_INT(na, vertex_tails(out, tails_b, 64));
+    for (size_t i = 0; i < na; i++)
+        CHECK(strcmp(tails_a[i], tails_b[i]) == 0);
+
+    /* Writing the read-back mesh again changes nothing: the output is a fixed point. */
+    size_t size2;
+    char *out2 = write_to_string(back, RSMOOTH_FORMAT_OBJ, &size2);
+    CHECK(size2 == size && memcmp(out, out2, size) == 0);
+    free(out2);
+
+    /* Conversion losses name the OBJ-only content, not colours or normals (PLY holds them). */
+    char losses[512];
+    size_t lost = rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_PLY_BINARY, losses,
+                                                 sizeof losses);
+    CHECK_EQ_INT(lost, 6);
+    CHECK(strstr(losses, "OBJ texture coordinates") != NULL);
+    CHECK(strstr(losses, "OBJ groups and objects") != NULL);
+    CHECK(strstr(losses, "OBJ materials") != NULL);
+    CHECK(strstr(losses, "OBJ smoothing groups") != NULL);
+    CHECK(strstr(losses, "OBJ lines and points") != NULL);
+    CHECK(strstr(losses, "OBJ comments") != NULL);
+    CHECK(strstr(losses, "colour") == NULL && strstr(losses, "normal") == NULL);
+    CHECK_EQ_INT(rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_OBJ, losses, sizeof losses), 0);
+    CHECK_EQ_INT(losses[0], '\0');
+
+    /* A changed face structure falls back to the generic writer: positions, colours, normals. */
+    m->face_count--;
+    char *generic = write_to_string(m, RSMOOTH_FORMAT_OBJ, &size2);
+    m->face_count++;
+    CHECK(strncmp(generic, "# written by rsmooth\n", 21) == 0);
+    CHECK(strstr(generic, "usemtl") == NULL && strstr(generic, "vt ") == NULL);
+    CHECK(strstr(generic, "\nvn ") != NULL && strstr(generic, "\nf 1//1 ") != NULL);
+    rsmooth_mesh *g = parse_n_ok(generic, size2);
+    CHECK_EQ_INT(g->face_count, m->face_count - 1);
+    CHECK(memcmp(g->vertex_colors, m->vertex_colors, 3 * m->vertex_count) == 0);
+    CHECK(g->has_vertex_normals);
+    rsmooth_mesh_destroy(g);
+    free(generic);
+
+    rsmooth_mesh_destroy(back);
+    free(out);
+    rsmooth_mesh_destroy(m);
+}
+
+static void test_faithful(void) {
+    check_faithful_round_trip(rich_obj);
+    /* The same with CRLF line ends. */
+    char crlf[sizeof rich_obj * 2];
+    size_t n = 0;
+    for (const char *p = rich_obj; *p; p++) {
+        if (*p == '\n')
+            crlf[n++] = '\r';
+        crlf[n++] = *p;
+    }
+    crlf[n] = '\0';
+    check_faithful_round_trip(crlf);
+
+    /* Without vn lines: faces keep their vt, gain no vn; no vn lines appear. */
+    rsmooth_mesh *m = parse_ok("g a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 1\n"
+                               "f 1/1 2/-1 3\nf 3 2//7 1/2\n");
+    CHECK(!m->has_vertex_normals);
+    size_t size;
+    char *out = write_to_string(m, RSMOOTH_FORMAT_OBJ, &size);
+    CHECK(strstr(out, "f 1/1 2/2 3\nf 3 2 1/2\n") != NULL);
+    CHECK(strstr(out, "vn") == NULL);
+    free(out);
+    rsmooth_mesh_destroy(m);
+}
+
 int main(void) {
     test_index_forms();
     test_crlf_and_forward_references();
@@ -430,6 +717,7 @@ int main(void) {
     test_garbage();
     test_files();
     test_create_and_triangulate();
+    test_faithful();
     printf("obj_io: all checks passed\n");
     return 0;
 }

@@ -528,7 +528,7 @@ static void test_round_trip(void) {
             for (int extras = 0; extras < 2; extras++) {
                 rsmooth_mesh *m = make_mesh(40, 70, extras);
                 m->precision = precision ? RSMOOTH_FLOAT64 : RSMOOTH_FLOAT32;
-                if (extras) { /* written, then skipped by the reader */
+                if (extras) { /* written, then read back (colours) and kept (quality) */
                     m->vertex_quality = calloc(m->vertex_count, sizeof(float));
                     m->vertex_colors = calloc(3 * m->vertex_count, 1);
                     CHECK(m->vertex_quality != NULL && m->vertex_colors != NULL);
@@ -537,6 +537,10 @@ static void test_round_trip(void) {
                 }
                 rsmooth_mesh *back = write_and_read(m, formats[fi]);
                 check_same(m, back);
+                CHECK((back->vertex_colors != NULL) == extras);
+                if (extras)
+                    CHECK(memcmp(back->vertex_colors, m->vertex_colors, 3 * m->vertex_count) == 0);
+                CHECK((back->extras != NULL) == extras); /* a plain file keeps no extras */
                 rsmooth_mesh_destroy(back);
                 rsmooth_mesh_destroy(m);
             }

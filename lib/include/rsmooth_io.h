@@ -81,7 +81,8 @@ RSMOOTH_API rsmooth_status rsmooth_mesh_read_memory(const void *data, size_t siz
                                                     rsmooth_format format, rsmooth_mesh **mesh,
                                                     rsmooth_error *error);
 
-/* Reads a file: format from the content (PLY magic) else OBJ. RSMOOTH_ERROR_IO when the path cannot
+/* Reads a file, its format told by the content: "ply" magic, an OFF keyword, a binary STL's exact
+ * size or ascii "solid", else OBJ. RSMOOTH_ERROR_IO when the path cannot
  * be opened or read (a directory, missing, unreadable), else as rsmooth_mesh_read_memory. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_read_file(const char *path, rsmooth_mesh **mesh,
                                                   rsmooth_error *error);
@@ -91,13 +92,14 @@ RSMOOTH_API rsmooth_status rsmooth_mesh_read_file(const char *path, rsmooth_mesh
 RSMOOTH_API rsmooth_status rsmooth_mesh_read_stream(FILE *stream, const char *name,
                                                     rsmooth_mesh **mesh, rsmooth_error *error);
 
-/* Writes `mesh` (its faces as polygons, not the fanned triangles) to an open stream. `format` must
- * not be AUTO. Returns RSMOOTH_ERROR_IO when the stream fails. */
+/* Writes `mesh` (its faces as polygons, not the fanned triangles; STL: the triangles) to an open
+ * stream. `format` must not be AUTO; big-endian PLY output is RSMOOTH_ERROR_UNSUPPORTED. Returns
+ * RSMOOTH_ERROR_IO when the stream fails. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, FILE *stream,
                                                      rsmooth_format format, rsmooth_error *error);
 
 /* Writes `mesh` to `path` (created or truncated). AUTO picks the format from the extension: .obj,
- * .ply (binary little-endian). Callers that must never leave a partial file write to a temporary
+ * .ply (binary little-endian), .off, .stl (binary). Callers that must never leave a partial file write to a temporary
  * path and rename it (the rsmooth command does). */
 RSMOOTH_API rsmooth_status rsmooth_mesh_write_file(const rsmooth_mesh *mesh, const char *path,
                                                    rsmooth_format format, rsmooth_error *error);

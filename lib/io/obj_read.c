@@ -1,5 +1,5 @@
-/* Wavefront OBJ parser over a memory buffer: v and f statements; all else accepted and skipped. */
-#include "io/io_internal.h"
+/* Wavefront OBJ parser over a memory buffer: v (with colours) and f; everything else kept as text. */
+#include "io/obj_format.h"
 
 #include <math.h>
 #include <string.h>
@@ -19,19 +19,30 @@ typedef struct obj_state {
     rs_io_u32vec offsets;
     rs_io_u32vec indices;
     uint64_t max_index; /* largest 0-based positive index seen */
+    size_t vt_count;    /* vt lines so far: negative vt indices count back from it */
+    /* vt index of each face corner, kept in step with `indices` once any corner names one. */
+    rs_io_u32vec corner_vt;
+    bool any_vt;
+    uint8_t *colors; /* 3 per vertex, position_capacity long once any vertex has r g b */
+    unsigned kinds;  /* RS_OBJ_* seen */
+    /* The line structure for the extras; TEXT runs' start is an offset into `data` until kept. */
+    rs_obj_run *runs;
+    size_t run_count, run_capacity;
+    bool crlf;
 } obj_state;
 
 static bool is_space(char c) {
     return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
 }
 
-/* Next whitespace-separated token of [*p, end); false at the end of the line or at a comment. */
+/* Next whitespace-separated token of [*p, end); false at the end of the line or at a comment,
+ * leaving *p at the '#' of a comment (so callers can tell one was there). */
 static bool next_token(const char **p, const char *end, const char **token, size_t *len) {
     const char *s = *p;
     while (s < end && is_space(*s))
         s++;
     if (s == end || *s == '#') {
-        *p = end;
+        *p = s;
         return false;
     }
     const char *t = s;
@@ -53,12 +64,42 @@ static bool grow_positions(obj_state *st) {
     if (!p)
         return false;
     st->positions = p;
+    if (st->colors) {
+        uint8_t *c = rs_realloc_array(st->colors, capacity, 3);
+        if (!c)
+            return false;
+        st->colors = c;
+    }
     st->position_capacity = capacity;
     return true;
 }
 
+/* A colour component in [0, 1] as a byte (out of range and NaN clamp). */
+static uint8_t color_byte(double c) {
+    if (!(c > 0))
+        return 0;
+    return c >= 1 ? 255 : (uint8_t)(c * 255 + 0.5);
+}
+
+/* Stores vertex st->vertex_count's colour, creating the array on the first coloured vertex. */
+static bool store_color(obj_state *st, const double rgb[3]) {
+    if (!st->colors) {
+        st->colors = rs_alloc_array(st->position_capacity, 3);
+        if (!st->colors)
+            return false;
+        /* vertices before the first coloured one show as white, the usual default */
+        memset(st->colors, 255, 3 * st->vertex_count);
+        st->kinds |= RS_OBJ_COLORS;
+    }
+    uint8_t *c = st->colors + 3 * st->vertex_count;
+    for (int k = 0; k < 3; k++)
+        c[k] = color_byte(rgb[k]);
+    return true;
+}
+
+/* *plain: nothing follows the coordinates (so the writer can make the line from the mesh alone). */
 static rsmooth_status parse_vertex(obj_state *st, const char *p, const char *end, int64_t line,
-                                   const char *statement, rsmooth_error *error) {
+                                   const char *statement, bool *plain, rsmooth_error *error) {
     if ((uint64_t)st->vertex_count + 1 >= RS_IO_MAX_VERTICES)
         return rs_fail_parse(error, line, statement - st->data, where,
                              "too many vertices (indices are 32-bit)");
@@ -70,7 +111,8 @@ static rsmooth_status parse_vertex(obj_state *st, const char *p, const char *end
     size_t len;
     int n = 0;
     bool finite = true;
-    /* x y z, then optionally w or r g b (accepted, ignored, but they must be numbers). */
+    double rgb[3] = {0, 0, 0};
+    /* x y z, then optionally w, or r g b (colours); any others must be numbers too. */
     while (next_token(&p, end, &token, &len)) {
         double v;
         if (!rs_io_parse_double(token, len, &v))
@@ -79,21 +121,37 @@ static rsmooth_status parse_vertex(obj_state *st, const char *p, const char *end
         if (n < 3) {
             xyz[n] = v;
             finite = finite && isfinite(v);
+        } else if (n < 6) {
+            rgb[n - 3] = v;
         }
         n++;
     }
+    if (p < end)
+        st->kinds |= RS_OBJ_COMMENTS;
+    *plain = n == 3 && p == end;
     if (n < 3)
         return rs_fail_parse(error, line, statement - st->data, where,
                              "vertex %zu has %d coordinates (3 needed)", st->vertex_count + 1, n);
     if (!finite) /* numbered as f statements refer to it: 1-based */
         return rs_fail_parse(error, line, statement - st->data, where,
                              "vertex %zu has a non-finite coordinate", st->vertex_count + 1);
+    if (n == 6) {
+        if (!store_color(st, rgb))
+            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "vertex colours");
+    } else {
+        if (n > 3)
+            st->kinds |= RS_OBJ_VERTEX_W;
+        if (st->colors)
+            memset(st->colors + 3 * st->vertex_count, 255, 3);
+    }
     st->vertex_count++;
     return RSMOOTH_OK;
 }
 
-/* Parses the vertex part of "v", "v/vt", "v//vn" or "v/vt/vn" (the others must be integers too). */
-static bool parse_index(const char *s, size_t len, int64_t *out) {
+/* Parses "v", "v/vt", "v//vn" or "v/vt/vn": the vertex index into *out, the vt index (0 when there
+ * is none) into *vt; the vn part must be an integer but is not kept (writers recompute normals). */
+static bool parse_index(const char *s, size_t len, int64_t *out, int64_t *vt) {
+    *vt = 0;
     size_t i = 0;
     int part = 0;
     while (part < 3) {
@@ -114,6 +172,10 @@ static bool parse_index(const char *s, size_t len, int64_t *out) {
             *out = negative ? -v : v;
         } else if (empty && (negative || part == 2)) {
             return false; /* "v/-" or "v/vt/" */
+        } else if (part == 1 && !empty) {
+            *vt = negative ? -v : v;
+            if (*vt == 0)
+                return false; /* "v/0": OBJ indices start at 1 */
         }
         if (i == len)
             return true;
@@ -125,14 +187,48 @@ static bool parse_index(const char *s, size_t len, int64_t *out) {
     return false; /* a third slash */
 }
 
+/* Records the vt index (as in the file, 0: none) of the corner about to be appended to st->indices,
+ * made absolute so the writer never depends on how many vt lines came before. */
+static rsmooth_status record_vt(obj_state *st, int64_t vt, int64_t line, const char *token,
+                                rsmooth_error *error) {
+    uint32_t value = RS_OBJ_NO_VT;
+    if (vt < 0) {
+        int64_t absolute = (int64_t)st->vt_count + vt;
+        if (absolute < 0)
+            return rs_fail_parse(error, line, token - st->data, where,
+                                 "texture index %lld out of range (%zu texture coordinates)",
+                                 (long long)vt, st->vt_count);
+        value = (uint32_t)absolute;
+    } else if (vt > 0) {
+        if (vt > (int64_t)UINT32_MAX - 1) /* not checked against the count: vt may come later */
+            return rs_fail_parse(error, line, token - st->data, where,
+                                 "texture index %lld out of range", (long long)vt);
+        value = (uint32_t)(vt - 1);
+    }
+    size_t corner = st->indices.count;
+    if (!rs_io_u32vec_reserve(&st->corner_vt, corner + 1 - st->corner_vt.count))
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "%zu texture indices",
+                       corner + 1);
+    if (!st->any_vt) { /* the corners before the first one that names a vt have none */
+        for (size_t i = 0; i < corner; i++)
+            st->corner_vt.data[i] = RS_OBJ_NO_VT;
+        st->corner_vt.count = corner;
+        st->any_vt = true;
+        st->kinds |= RS_OBJ_TEXCOORDS;
+    }
+    st->corner_vt.data[st->corner_vt.count++] = value;
+    return RSMOOTH_OK;
+}
+
+/* *plain: no trailing comment. */
 static rsmooth_status parse_face(obj_state *st, const char *p, const char *end, int64_t line,
-                                 const char *statement, rsmooth_error *error) {
+                                 const char *statement, bool *plain, rsmooth_error *error) {
     const char *token;
     size_t len;
     size_t first = st->indices.count;
     while (next_token(&p, end, &token, &len)) {
-        int64_t index;
-        if (!parse_index(token, len, &index))
+        int64_t index, vt;
+        if (!parse_index(token, len, &index, &vt))
             return rs_fail_parse(error, line, token - st->data, where,
                                  "malformed face index '%.*s'", (int)(len > 40 ? 40 : len), token);
         int64_t zero_based;
@@ -160,10 +256,18 @@ static rsmooth_status parse_face(obj_state *st, const char *p, const char *end, 
         if (!rs_io_u32vec_reserve(&st->indices, 1))
             return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "%zu face indices",
                            st->indices.count + 1);
+        if (vt != 0 || st->any_vt) {
+            rsmooth_status status = record_vt(st, vt, line, token, error);
+            if (status != RSMOOTH_OK)
+                return status;
+        }
         /* Out-of-range values are caught after the pass; UINT32_MAX is never a valid index. */
         st->indices.data[st->indices.count++] =
             zero_based >= (int64_t)UINT32_MAX ? UINT32_MAX : (uint32_t)zero_based;
     }
+    if (p < end)
+        st->kinds |= RS_OBJ_COMMENTS;
+    *plain = p == end;
     size_t n = st->indices.count - first;
     if (n < 3)
         return rs_fail_parse(error, line, statement - st->data, where,
@@ -174,6 +278,53 @@ static rsmooth_status parse_face(obj_state *st, const char *p, const char *end, 
     return RSMOOTH_OK;
 }
 
+/* The RS_OBJ_* kind of a statement other than v and f (counting vt lines on the way). */
+static unsigned classify(obj_state *st, const char *s, size_t len) {
+    if (len == 1) {
+        switch (s[0]) {
+        case 'g':
+        case 'o':
+            return RS_OBJ_GROUPS;
+        case 's':
+            return RS_OBJ_SMOOTHING;
+        case 'l':
+        case 'p':
+            return RS_OBJ_LINES;
+        default:
+            return RS_OBJ_OTHER;
+        }
+    }
+    if (len == 2 && s[0] == 'v' && s[1] == 't') {
+        st->vt_count++;
+        return RS_OBJ_TEXCOORDS;
+    }
+    if (len == 2 && s[0] == 'v' && s[1] == 'n')
+        return RS_OBJ_NORMALS;
+    if (len == 6 && (memcmp(s, "mtllib", 6) == 0 || memcmp(s, "usemtl", 6) == 0))
+        return RS_OBJ_MATERIALS;
+    return RS_OBJ_OTHER;
+}
+
+/* Adds the line [start, start + bytes) to the run structure as a line of `kind`. */
+static bool add_line(obj_state *st, int kind, size_t start, size_t bytes) {
+    rs_obj_run *last = st->run_count ? st->runs + st->run_count - 1 : NULL;
+    if (last && last->kind == kind) {
+        last->count += kind == RS_OBJ_RUN_TEXT ? bytes : 1;
+        return true;
+    }
+    if (st->run_count == st->run_capacity) {
+        size_t capacity = st->run_capacity ? 2 * st->run_capacity : 16;
+        rs_obj_run *runs = rs_realloc_array(st->runs, capacity, sizeof *runs);
+        if (!runs)
+            return false;
+        st->runs = runs;
+        st->run_capacity = capacity;
+    }
+    st->runs[st->run_count++] =
+        (rs_obj_run){.start = start, .count = kind == RS_OBJ_RUN_TEXT ? bytes : 1, .kind = kind};
+    return true;
+}
+
 static rsmooth_status parse_all(obj_state *st, rsmooth_error *error) {
     const char *p = st->data, *end = st->data + st->size;
     if (!rs_io_u32vec_reserve(&st->offsets, 1))
@@ -182,19 +333,36 @@ static rsmooth_status parse_all(obj_state *st, rsmooth_error *error) {
     for (int64_t line = 1; p < end; line++) {
         const char *eol = memchr(p, '\n', (size_t)(end - p));
         const char *line_end = eol ? eol : end;
+        bool crlf = line_end > p && line_end[-1] == '\r';
+        if (line == 1)
+            st->crlf = crlf; /* the first line's end is the one plain lines are written with */
         const char *statement;
         size_t len;
-        const char *q = p;
+        const char *q = p, *start = p;
         p = eol ? eol + 1 : end;
-        if (!next_token(&q, line_end, &statement, &len) || len != 1)
-            continue; /* blank, comment, or a statement we skip (vt, vn, g, o, usemtl, ...) */
-        rsmooth_status status = RSMOOTH_OK;
-        if (statement[0] == 'v')
-            status = parse_vertex(st, q, line_end, line, statement, error);
-        else if (statement[0] == 'f')
-            status = parse_face(st, q, line_end, line, statement, error);
-        if (status != RSMOOTH_OK)
-            return status;
+        int kind = RS_OBJ_RUN_TEXT;
+        if (!next_token(&q, line_end, &statement, &len)) {
+            if (q < line_end)
+                st->kinds |= RS_OBJ_COMMENTS;
+        } else {
+            rsmooth_status status = RSMOOTH_OK;
+            bool plain = false;
+            if (len == 1 && statement[0] == 'v') {
+                status = parse_vertex(st, q, line_end, line, statement, &plain, error);
+                kind = RS_OBJ_RUN_V;
+            } else if (len == 1 && statement[0] == 'f') {
+                status = parse_face(st, q, line_end, line, statement, &plain, error);
+                kind = RS_OBJ_RUN_F;
+            } else {
+                st->kinds |= classify(st, statement, len);
+            }
+            if (status != RSMOOTH_OK)
+                return status;
+            if (!plain || !eol || crlf != st->crlf)
+                kind = RS_OBJ_RUN_TEXT;
+        }
+        if (!add_line(st, kind, (size_t)(start - st->data), (size_t)(p - start)))
+            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "line structure");
     }
     return RSMOOTH_OK;
 }
@@ -203,6 +371,56 @@ static void free_state(obj_state *st) {
     rs_free(st->positions);
     rs_free(st->offsets.data);
     rs_free(st->indices.data);
+    rs_free(st->corner_vt.data);
+    rs_free(st->colors);
+    rs_free(st->runs);
+}
+
+/* Hands the colours, the normals flag and (when the file held anything beyond v and f) the extras
+ * record to the new mesh; frees what it does not hand over. */
+static rsmooth_status attach_extras(obj_state *st, rsmooth_mesh *mesh, rsmooth_error *error) {
+    mesh->has_vertex_normals = (st->kinds & RS_OBJ_NORMALS) != 0;
+    if (st->colors) {
+        uint8_t *colors = rs_realloc_array(st->colors, st->vertex_count, 3);
+        mesh->vertex_colors = colors ? colors : st->colors;
+        st->colors = NULL;
+    }
+    if (st->kinds == 0)
+        return RSMOOTH_OK;
+    size_t text_size = 0;
+    for (size_t i = 0; i < st->run_count; i++)
+        if (st->runs[i].kind == RS_OBJ_RUN_TEXT)
+            text_size += st->runs[i].count;
+    rs_obj_extras *x = rs_calloc_array(1, sizeof *x);
+    struct rsmooth_mesh_extras *holder = x ? rs_io_mesh_extras(mesh) : NULL;
+    if (x)
+        x->text = rs_alloc_array(text_size, 1);
+    if (!x || !holder || !x->text) {
+        rs_io_obj_extras_free(x);
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "%zu bytes of OBJ extras",
+                       text_size);
+    }
+    for (size_t i = 0; i < st->run_count; i++) {
+        rs_obj_run *run = st->runs + i;
+        if (run->kind == RS_OBJ_RUN_TEXT) {
+            memcpy(x->text + x->size, st->data + run->start, run->count);
+            run->start = x->size;
+            x->size += run->count;
+        }
+    }
+    rs_obj_run *runs = rs_realloc_array(st->runs, st->run_count, sizeof *runs);
+    x->runs = runs ? runs : st->runs;
+    x->run_count = st->run_count;
+    st->runs = NULL;
+    x->crlf = st->crlf;
+    x->vertex_count = mesh->vertex_count;
+    x->face_count = mesh->face_count;
+    x->offsets_hash = rs_obj_offsets_hash(mesh->face_offsets, mesh->face_count);
+    x->corner_vt = st->corner_vt.data;
+    st->corner_vt.data = NULL;
+    x->kinds = st->kinds;
+    holder->obj = x;
+    return RSMOOTH_OK;
 }
 
 rsmooth_status rs_io_obj_read(const char *data, size_t size, rsmooth_mesh **mesh,
@@ -238,6 +456,19 @@ rsmooth_status rs_io_obj_read(const char *data, size_t size, rsmooth_mesh **mesh
     double *positions = rs_realloc_array(st.positions, st.vertex_count, 3 * sizeof(double));
     if (!positions)
         positions = st.positions;
-    return rs_io_mesh_adopt(positions, st.vertex_count, RSMOOTH_FLOAT64, st.offsets.data,
-                            face_count, indices, RSMOOTH_FORMAT_OBJ, mesh, error);
+    st.positions = NULL; /* adopted (or freed) below */
+    uint32_t *offsets = st.offsets.data;
+    st.offsets.data = NULL;
+    st.indices.data = NULL;
+    status = rs_io_mesh_adopt(positions, st.vertex_count, RSMOOTH_FLOAT64, offsets, face_count,
+                              indices, RSMOOTH_FORMAT_OBJ, mesh, error);
+    if (status == RSMOOTH_OK) {
+        status = attach_extras(&st, *mesh, error);
+        if (status != RSMOOTH_OK) {
+            rsmooth_mesh_destroy(*mesh);
+            *mesh = NULL;
+        }
+    }
+    free_state(&st);
+    return status;
 }

@@ -1,40 +1,242 @@
-/* Wavefront OBJ writer: v lines (with r g b when the mesh has colours) and f lines of polygons. */
-#include "io/io_internal.h"
+/* Wavefront OBJ writer: faithful to the file the mesh was read from, else v (r g b), vn and f. */
+#include "io/obj_format.h"
 
 #include <errno.h>
 #include <string.h>
 
-rsmooth_status rs_io_obj_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_error *error) {
-    /* %.9g and %.17g are the shortest fixed widths that round-trip float and double exactly. */
-    const char *vertex_format =
-        mesh->precision == RSMOOTH_FLOAT32 ? "v %.9g %.9g %.9g" : "v %.17g %.17g %.17g";
-    errno = 0;
+static const char where[] = "rsmooth_mesh_write_stream";
+
+/* Writes " v" so that it reads back as the same value (the same float when `as_float`): with 15
+ * significant digits when they suffice (unchanged coordinates keep their short form), else 17. */
+static bool put_coord(FILE *stream, double v, bool as_float) {
+    char buf[40];
+    int short_digits = as_float ? 6 : 15, full_digits = as_float ? 9 : 17;
+    double value = as_float ? (double)(float)v : v;
+    int n = snprintf(buf, sizeof buf, " %.*g", short_digits, value);
+    double back;
+    if (!(n > 1 && rs_io_parse_double(buf + 1, (size_t)n - 1, &back) &&
+          (as_float ? (float)back == (float)value : back == value)))
+        n = snprintf(buf, sizeof buf, " %.*g", full_digits, value);
+    return n > 0 && fwrite(buf, 1, (size_t)n, stream) == (size_t)n;
+}
+
+static bool put_position(FILE *stream, const rsmooth_mesh *mesh, size_t v) {
+    const double *p = mesh->positions + 3 * v;
+    bool as_float = mesh->precision == RSMOOTH_FLOAT32;
+    return putc('v', stream) != EOF && put_coord(stream, p[0], as_float) &&
+           put_coord(stream, p[1], as_float) && put_coord(stream, p[2], as_float);
+}
+
+/* The recomputed normals, 3 * vertex_count doubles, into *out. */
+static rsmooth_status compute_normals(const rsmooth_mesh *mesh, double **out,
+                                      rsmooth_error *error) {
+    *out = NULL;
+    double *normals = rs_mul_overflows(mesh->vertex_count, 3 * sizeof(double))
+                          ? NULL
+                          : rs_alloc_array(mesh->vertex_count, 3 * sizeof(double));
+    if (!normals)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "normals of %zu vertices",
+                       mesh->vertex_count);
+    rsmooth_status status = rsmooth_mesh_vertex_normals(mesh, normals, error);
+    if (status != RSMOOTH_OK) {
+        rs_free(normals);
+        return status;
+    }
+    *out = normals;
+    return RSMOOTH_OK;
+}
+
+/* vertex_count vn lines, each ended by `eol`. */
+static bool put_normals(FILE *stream, const double *normals, size_t count, const char *eol,
+                        size_t eol_len) {
+    bool ok = true;
+    for (size_t i = 0; ok && i < count; i++) {
+        const double *n = normals + 3 * i;
+        ok = fprintf(stream, "vn %.9g %.9g %.9g", n[0], n[1], n[2]) >= 0 &&
+             fwrite(eol, 1, eol_len, stream) == eol_len;
+    }
+    return ok;
+}
+
+/* Appends the decimal digits of v to *p. */
+static void append_u64(char **p, uint64_t v) {
+    char digits[20];
+    int n = 0;
+    do {
+        digits[n++] = (char)('0' + v % 10);
+        v /= 10;
+    } while (v);
+    while (n)
+        *(*p)++ = digits[--n];
+}
+
+/* The corners of face f: "v", "v/vt", "v//vn" or "v/vt/vn", absolute and 1-based; a vertex's
+ * normal has the vertex's index. Formatted by hand in chunks: faces are most of a file. */
+static bool put_face(FILE *stream, const rsmooth_mesh *mesh, size_t f, const uint32_t *corner_vt,
+                     bool normals) {
+    char buf[1024];
+    char *p = buf;
+    *p++ = 'f';
+    for (uint32_t k = mesh->face_offsets[f]; k < mesh->face_offsets[f + 1]; k++) {
+        if (p - buf > (ptrdiff_t)sizeof buf - 70) { /* room for one corner: 3 numbers, 4 marks */
+            if (fwrite(buf, 1, (size_t)(p - buf), stream) != (size_t)(p - buf))
+                return false;
+            p = buf;
+        }
+        uint64_t v = (uint64_t)mesh->face_indices[k] + 1;
+        *p++ = ' ';
+        append_u64(&p, v);
+        bool vt = corner_vt && corner_vt[k] != RS_OBJ_NO_VT;
+        if (vt) {
+            *p++ = '/';
+            append_u64(&p, (uint64_t)corner_vt[k] + 1);
+        }
+        if (normals) {
+            *p++ = '/';
+            if (!vt)
+                *p++ = '/';
+            append_u64(&p, v);
+        }
+    }
+    return fwrite(buf, 1, (size_t)(p - buf), stream) == (size_t)(p - buf);
+}
+
+static bool is_space(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+
+/* As the reader's tokenizer: false at the line's end or at a '#', leaving *p there. */
+static bool next_token(const char **p, const char *end, const char **token, size_t *len) {
+    const char *s = *p;
+    while (s < end && is_space(*s))
+        s++;
+    *p = s;
+    if (s == end || *s == '#')
+        return false;
+    *token = s;
+    while (s < end && !is_space(*s))
+        s++;
+    *len = (size_t)(s - *token);
+    *p = s;
+    return true;
+}
+
+/* Where the faithful writer stands in the mesh while it walks the runs. */
+typedef struct faithful_cursor {
+    size_t v, f;
+    bool normals_written;
+} faithful_cursor;
+
+/* Writes the text lines [p, end): v gets the new position (what follows its coordinates kept), the
+ * vn lines give way to the recomputed normals, f gets absolute indices (a trailing comment kept);
+ * every other line is copied. */
+static bool write_text(const rsmooth_mesh *mesh, const rs_obj_extras *x, const double *normals,
+                       const char *p, const char *end, faithful_cursor *at, FILE *stream) {
+    bool ok = true;
+    while (ok && p < end) {
+        const char *eol = memchr(p, '\n', (size_t)(end - p));
+        const char *next = eol ? eol + 1 : end;
+        const char *content_end = eol ? eol : end;
+        if (content_end > p && content_end[-1] == '\r')
+            content_end--;
+        const char *ending = content_end; /* "\r\n", "\n" or nothing, as the line had */
+        size_t ending_len = (size_t)(next - content_end);
+        const char *q = p, *token;
+        size_t len;
+        bool keyword = next_token(&q, content_end, &token, &len);
+        if (keyword && len == 1 && token[0] == 'v' && at->v < mesh->vertex_count) {
+            for (int k = 0; k < 3; k++) /* the reader accepted the line: three numbers follow */
+                next_token(&q, content_end, &token, &len);
+            ok = put_position(stream, mesh, at->v++) &&
+                 fwrite(q, 1, (size_t)(content_end - q), stream) == (size_t)(content_end - q);
+        } else if (keyword && len == 2 && token[0] == 'v' && token[1] == 'n') {
+            if (!at->normals_written && normals)
+                ok = put_normals(stream, normals, mesh->vertex_count,
+                                 ending_len ? ending : (x->crlf ? "\r\n" : "\n"),
+                                 ending_len ? ending_len : (x->crlf ? 2 : 1));
+            at->normals_written = true;
+            p = next;
+            continue;
+        } else if (keyword && len == 1 && token[0] == 'f' && at->f < mesh->face_count) {
+            ok = put_face(stream, mesh, at->f++, x->corner_vt, normals != NULL);
+            while (next_token(&q, content_end, &token, &len)) {
+            }
+            if (ok && q < content_end) /* a trailing comment */
+                ok = putc(' ', stream) != EOF && fwrite(q, 1, (size_t)(content_end - q), stream) ==
+                                                     (size_t)(content_end - q);
+        } else {
+            ok = fwrite(p, 1, (size_t)(content_end - p), stream) == (size_t)(content_end - p);
+        }
+        ok = ok && fwrite(ending, 1, ending_len, stream) == ending_len;
+        p = next;
+    }
+    return ok;
+}
+
+/* Writes the file the mesh was read from, run by run. */
+static bool write_faithful(const rsmooth_mesh *mesh, const rs_obj_extras *x, const double *normals,
+                           FILE *stream) {
+    faithful_cursor at = {0, 0, false};
+    const char *eol = x->crlf ? "\r\n" : "\n";
+    size_t eol_len = x->crlf ? 2 : 1;
+    bool ok = true;
+    for (size_t r = 0; ok && r < x->run_count; r++) {
+        const rs_obj_run *run = x->runs + r;
+        if (run->kind == RS_OBJ_RUN_TEXT) {
+            ok = write_text(mesh, x, normals, x->text + run->start,
+                            x->text + run->start + run->count, &at, stream);
+        } else if (run->kind == RS_OBJ_RUN_V) {
+            for (size_t i = 0; ok && i < run->count && at.v < mesh->vertex_count; i++)
+                ok = put_position(stream, mesh, at.v++) &&
+                     fwrite(eol, 1, eol_len, stream) == eol_len;
+        } else {
+            for (size_t i = 0; ok && i < run->count && at.f < mesh->face_count; i++)
+                ok = put_face(stream, mesh, at.f++, x->corner_vt, normals != NULL) &&
+                     fwrite(eol, 1, eol_len, stream) == eol_len;
+        }
+    }
+    return ok;
+}
+
+static bool write_generic(const rsmooth_mesh *mesh, const double *normals, FILE *stream) {
     bool ok = fprintf(stream, "# written by rsmooth\n# %zu vertices, %zu faces\n",
                       mesh->vertex_count, mesh->face_count) >= 0;
     for (size_t i = 0; ok && i < mesh->vertex_count; i++) {
-        const double *p = mesh->positions + 3 * i;
-        double x = p[0], y = p[1], z = p[2];
-        if (mesh->precision == RSMOOTH_FLOAT32) { /* what a float file would hold */
-            x = (float)x;
-            y = (float)y;
-            z = (float)z;
-        }
-        ok = fprintf(stream, vertex_format, x, y, z) >= 0;
+        ok = put_position(stream, mesh, i);
         if (ok && mesh->vertex_colors) {
             const uint8_t *c = mesh->vertex_colors + 3 * i;
             ok = fprintf(stream, " %.4g %.4g %.4g", c[0] / 255.0, c[1] / 255.0, c[2] / 255.0) >= 0;
         }
         ok = ok && putc('\n', stream) != EOF;
     }
-    for (size_t f = 0; ok && f < mesh->face_count; f++) {
-        ok = putc('f', stream) != EOF;
-        for (uint32_t k = mesh->face_offsets[f]; ok && k < mesh->face_offsets[f + 1]; k++)
-            ok = fprintf(stream, " %lu", (unsigned long)mesh->face_indices[k] + 1) >= 0;
-        ok = ok && putc('\n', stream) != EOF;
+    if (ok && normals)
+        ok = put_normals(stream, normals, mesh->vertex_count, "\n", 1);
+    for (size_t f = 0; ok && f < mesh->face_count; f++)
+        ok = put_face(stream, mesh, f, NULL, normals != NULL) && putc('\n', stream) != EOF;
+    return ok;
+}
+
+rsmooth_status rs_io_obj_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_error *error) {
+    const rs_obj_extras *x = mesh->extras ? mesh->extras->obj : NULL;
+    /* The extras describe the mesh as read: they apply while its vertices and face structure are
+     * unchanged (positions may differ: that is what smoothing does). */
+    bool faithful = x && x->vertex_count == mesh->vertex_count &&
+                    x->face_count == mesh->face_count && mesh->face_offsets &&
+                    x->offsets_hash == rs_obj_offsets_hash(mesh->face_offsets, mesh->face_count);
+    bool want_normals = faithful ? (x->kinds & RS_OBJ_NORMALS) != 0 : mesh->has_vertex_normals;
+    double *normals = NULL;
+    if (want_normals) {
+        rsmooth_status status = compute_normals(mesh, &normals, error);
+        if (status != RSMOOTH_OK)
+            return status;
     }
+    errno = 0;
+    bool ok = faithful ? write_faithful(mesh, x, normals, stream)
+                       : write_generic(mesh, normals, stream);
+    rs_free(normals);
     ok = ok && fflush(stream) == 0 && !ferror(stream);
     if (!ok)
-        return rs_fail(error, RSMOOTH_ERROR_IO, "rsmooth_mesh_write_stream", "writing OBJ: %s",
+        return rs_fail(error, RSMOOTH_ERROR_IO, where, "writing OBJ: %s",
                        errno ? strerror(errno) : "stream error");
     return RSMOOTH_OK;
 }

@@ -1,18 +1,451 @@
-/* OFF reader (OFF, COFF, NOFF, CNOFF). */
-#include "io/io_internal.h"
+/* OFF reader (OFF, COFF, NOFF, CNOFF, STOFF and their combinations), its extras and their losses. */
+#include "io/off_format.h"
 
-rsmooth_status rs_io_off_read(const char *data, size_t size, rsmooth_mesh **mesh,
-                              rsmooth_error *error) {
-    (void)data, (void)size, (void)mesh;
-    return rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, "rs_io_off_read", "OFF is not supported yet");
+#include <math.h>
+#include <string.h>
+
+static const char where[] = "rsmooth_mesh_read (OFF)";
+
+/* Lines hold whitespace-separated tokens; '#' starts a comment. */
+typedef struct off_reader {
+    const char *data, *p, *end;
+    int64_t line;   /* of the line last returned by next_line */
+} off_reader;
+
+static bool is_space(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+
+/* The next line holding a token, as [*begin, *stop) with any comment cut off; false at the end. */
+static bool next_line(off_reader *r, const char **begin, const char **stop) {
+    while (r->p < r->end) {
+        const char *eol = memchr(r->p, '\n', (size_t)(r->end - r->p));
+        const char *line_end = eol ? eol : r->end;
+        const char *s = r->p;
+        r->p = eol ? eol + 1 : r->end;
+        r->line++;
+        const char *hash = memchr(s, '#', (size_t)(line_end - s));
+        if (hash)
+            line_end = hash;
+        while (s < line_end && is_space(*s))
+            s++;
+        if (s < line_end) {
+            *begin = s;
+            *stop = line_end;
+            return true;
+        }
+    }
+    r->line++; /* the errors for a missing line name the one after the last */
+    return false;
+}
+
+static bool next_token(const char **p, const char *end, const char **token, size_t *len) {
+    const char *s = *p;
+    while (s < end && is_space(*s))
+        s++;
+    if (s == end)
+        return false;
+    *token = s;
+    while (s < end && !is_space(*s))
+        s++;
+    *len = (size_t)(s - *token);
+    *p = s;
+    return true;
+}
+
+/* A decimal integer (optional sign), saturating far beyond any valid count or index. */
+static bool parse_int(const char *s, size_t len, int64_t *out) {
+    size_t i = 0;
+    bool negative = false;
+    if (i < len && (s[i] == '-' || s[i] == '+')) {
+        negative = s[i] == '-';
+        i++;
+    }
+    if (i == len)
+        return false;
+    int64_t v = 0;
+    for (; i < len; i++) {
+        if (s[i] < '0' || s[i] > '9')
+            return false;
+        if (v < INT64_MAX / 100)
+            v = v * 10 + (s[i] - '0');
+    }
+    *out = negative ? -v : v;
+    return true;
+}
+
+#define TOKEN_TEXT(t, len) (int)((len) > 40 ? 40 : (len)), (t)
+
+static bool texts_append(rs_off_texts *texts, size_t index, size_t count, const char *s,
+                         size_t len) {
+    if (!texts->offsets) {
+        if (len == 0)
+            return true;
+        texts->offsets = rs_calloc_array(count + 1, sizeof(size_t)); /* earlier ones: empty */
+        if (!texts->offsets)
+            return false;
+    }
+    if (texts->capacity - texts->size < len) {
+        size_t capacity = texts->capacity ? texts->capacity : 256;
+        while (capacity - texts->size < len) {
+            if (capacity > SIZE_MAX / 2)
+                return false;
+            capacity *= 2;
+        }
+        char *text = rs_realloc_array(texts->text, capacity, 1);
+        if (!text)
+            return false;
+        texts->text = text;
+        texts->capacity = capacity;
+    }
+    if (len)
+        memcpy(texts->text + texts->size, s, len);
+    texts->size += len;
+    texts->offsets[index + 1] = texts->size;
+    return true;
+}
+
+static void texts_free(rs_off_texts *texts) {
+    rs_free(texts->text);
+    rs_free(texts->offsets);
 }
 
 void rs_io_off_extras_free(rs_off_extras *extras) {
-    (void)extras;
+    if (!extras)
+        return;
+    texts_free(&extras->vertex);
+    texts_free(&extras->face);
+    rs_free(extras);
 }
 
 size_t rs_io_off_losses(const rs_off_extras *extras, rsmooth_format target, char *list,
                         size_t size) {
-    (void)extras, (void)target, (void)list, (void)size;
-    return 0;
+    if (!extras || target == RSMOOTH_FORMAT_OFF)
+        return 0;
+    size_t lost = 0;
+    if (extras->face.offsets)
+        lost += rs_io_loss_add(list, size, "OFF face colours");
+    if (extras->texcoords)
+        lost += rs_io_loss_add(list, size, "OFF texture coordinates");
+    if (extras->alpha)
+        lost += rs_io_loss_add(list, size, "OFF colour alpha");
+    return lost;
+}
+
+/* What the header says. */
+typedef struct off_header {
+    char keyword[16];
+    bool st, c, n;
+    uint64_t vertex_count, face_count, edge_count;
+} off_header;
+
+/* Parses "vertices faces [edges]" from [p, stop). */
+static rsmooth_status parse_counts(off_reader *r, const char *p, const char *stop, off_header *h,
+                                   rsmooth_error *error) {
+    const char *token;
+    size_t len;
+    uint64_t counts[3] = {0, 0, 0};
+    int n = 0;
+    while (next_token(&p, stop, &token, &len)) {
+        int64_t v;
+        if (n == 3)
+            return rs_fail_parse(error, r->line, token - r->data, where,
+                                 "unexpected '%.*s' after the vertex, face and edge counts",
+                                 TOKEN_TEXT(token, len));
+        if (!parse_int(token, len, &v) || v < 0)
+            return rs_fail_parse(error, r->line, token - r->data, where,
+                                 "malformed count '%.*s' (a non-negative integer expected)",
+                                 TOKEN_TEXT(token, len));
+        counts[n++] = (uint64_t)v;
+    }
+    if (n < 2)
+        return rs_fail_parse(error, r->line, p - r->data, where,
+                             "expected the vertex and face counts");
+    h->vertex_count = counts[0];
+    h->face_count = counts[1];
+    h->edge_count = counts[2];
+    return RSMOOTH_OK;
+}
+
+static rsmooth_status parse_header(off_reader *r, off_header *h, rsmooth_error *error) {
+    const char *p, *stop, *token;
+    size_t len;
+    if (!next_line(r, &p, &stop) || !next_token(&p, stop, &token, &len))
+        return rs_fail_parse(error, r->line, -1, where, "missing OFF header (empty file)");
+    /* [ST][C][N][4][n]OFF */
+    size_t i = 0;
+    bool four = false, dim = false;
+    if (len >= 2 && token[0] == 'S' && token[1] == 'T') {
+        h->st = true;
+        i = 2;
+    }
+    if (i < len && token[i] == 'C') {
+        h->c = true;
+        i++;
+    }
+    if (i < len && token[i] == 'N') {
+        h->n = true;
+        i++;
+    }
+    if (i < len && token[i] == '4') {
+        four = true;
+        i++;
+    }
+    if (i < len && token[i] == 'n') {
+        dim = true;
+        i++;
+    }
+    if (len - i != 3 || memcmp(token + i, "OFF", 3) != 0)
+        return rs_fail_parse(error, r->line, token - r->data, where,
+                             "missing OFF header: the file starts with '%.*s', not OFF, COFF, "
+                             "NOFF, CNOFF, STOFF or a combination",
+                             TOKEN_TEXT(token, len));
+    if (four || dim)
+        return rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, where,
+                       "line %lld: %.*s: %s vertices are not supported (only 3D OFF)",
+                       (long long)r->line, TOKEN_TEXT(token, len),
+                       dim ? "n-dimensional" : "4-dimensional");
+    memcpy(h->keyword, token, len);
+    h->keyword[len] = '\0';
+    const char *rest = p;
+    if (next_token(&p, stop, &token, &len)) {
+        if (len == 6 && memcmp(token, "BINARY", 6) == 0)
+            return rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, where,
+                           "line %lld: binary OFF is not supported", (long long)r->line);
+        return parse_counts(r, rest, stop, h, error); /* the counts on the keyword's line */
+    }
+    if (!next_line(r, &p, &stop))
+        return rs_fail_parse(error, r->line, -1, where,
+                             "the file ends before the vertex and face counts");
+    return parse_counts(r, p, stop, h, error);
+}
+
+/* The parse in progress; freed whole on failure. */
+typedef struct off_state {
+    double *positions;
+    float *raw_colors;  /* 3 per vertex as written; bytes once the file's convention is known */
+    bool color_above_one;
+    uint32_t *offsets;
+    rs_io_u32vec indices;
+    rs_off_extras *extras;
+} off_state;
+
+static void free_state(off_state *st) {
+    rs_free(st->positions);
+    rs_free(st->raw_colors);
+    rs_free(st->offsets);
+    rs_free(st->indices.data);
+    rs_io_off_extras_free(st->extras);
+}
+
+/* The tokens of a vertex line this reader looks at; the rest are counted. */
+#define MAX_TOKENS 16
+
+static rsmooth_status parse_vertex(off_reader *r, const off_header *h, off_state *st, size_t v,
+                                   rsmooth_error *error) {
+    const char *p, *stop;
+    if (!next_line(r, &p, &stop))
+        return rs_fail_parse(error, r->line, -1, where,
+                             "the file ends after %zu of %llu vertices (fewer than declared)", v,
+                             (unsigned long long)h->vertex_count);
+    const char *tokens[MAX_TOKENS];
+    size_t lens[MAX_TOKENS];
+    const char *token, *last_end = p;
+    size_t len;
+    int count = 0;
+    while (next_token(&p, stop, &token, &len)) {
+        if (count < MAX_TOKENS) {
+            tokens[count] = token;
+            lens[count] = len;
+        }
+        count = count < INT32_MAX ? count + 1 : count;
+        last_end = token + len;
+    }
+    int base = h->n ? 6 : 3; /* x y z [nx ny nz], then [r g b [a]] [s t] */
+    int need = base + (h->c ? 3 : 0) + (h->st ? 2 : 0);
+    if (count < need)
+        return rs_fail_parse(error, r->line, tokens[0] - r->data, where,
+                             "vertex %zu has %d values (%s needs %d)", v, count, h->keyword,
+                             need);
+    double values[MAX_TOKENS];
+    int checked = count < MAX_TOKENS ? count : MAX_TOKENS;
+    for (int k = 0; k < checked; k++)
+        if (!rs_io_parse_double(tokens[k], lens[k], &values[k]))
+            return rs_fail_parse(error, r->line, tokens[k] - r->data, where,
+                                 "vertex %zu: malformed number '%.*s'", v,
+                                 TOKEN_TEXT(tokens[k], lens[k]));
+    if (!isfinite(values[0]) || !isfinite(values[1]) || !isfinite(values[2]))
+        return rs_fail_parse(error, r->line, tokens[0] - r->data, where,
+                             "vertex %zu has a non-finite coordinate", v);
+    memcpy(st->positions + 3 * v, values, 3 * sizeof(double));
+    if (h->c) {
+        int components = count - base - (h->st ? 2 : 0);
+        if (components >= 4) {
+            st->extras->alpha = true;
+            if (values[base + 3] > 1) /* "r g b 255": integer colours */
+                st->color_above_one = true;
+        }
+        for (int k = 0; k < 3; k++) {
+            double c = values[base + k];
+            if (c > 1)
+                st->color_above_one = true;
+            st->raw_colors[3 * v + (size_t)k] = (float)(isfinite(c) ? c : 0);
+        }
+    }
+    if (count > base) { /* colour, texture coordinates (and anything else) kept as written */
+        const char *from = tokens[base];
+        if (!texts_append(&st->extras->vertex, v, h->vertex_count, from,
+                          (size_t)(last_end - from)))
+            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "OFF vertex extras");
+    } else if (st->extras->vertex.offsets) {
+        texts_append(&st->extras->vertex, v, h->vertex_count, "", 0);
+    }
+    return RSMOOTH_OK;
+}
+
+static rsmooth_status parse_face(off_reader *r, const off_header *h, off_state *st, size_t f,
+                                 rsmooth_error *error) {
+    const char *p, *stop, *token = NULL;
+    size_t len = 0;
+    if (!next_line(r, &p, &stop))
+        return rs_fail_parse(error, r->line, -1, where,
+                             "the file ends after %zu of %llu faces (fewer than declared)", f,
+                             (unsigned long long)h->face_count);
+    int64_t n;
+    if (!next_token(&p, stop, &token, &len) || !parse_int(token, len, &n))
+        return rs_fail_parse(error, r->line, token - r->data, where,
+                             "face %zu: malformed vertex count '%.*s'", f, TOKEN_TEXT(token, len));
+    if (n < 3)
+        return rs_fail_parse(error, r->line, token - r->data, where,
+                             "face %zu has %lld vertices (at least 3 needed)", f, (long long)n);
+    for (int64_t k = 0; k < n; k++) {
+        if (!next_token(&p, stop, &token, &len))
+            return rs_fail_parse(error, r->line, p - r->data, where,
+                                 "face %zu lists %lld of its %lld vertices", f, (long long)k,
+                                 (long long)n);
+        int64_t index;
+        if (!parse_int(token, len, &index))
+            return rs_fail_parse(error, r->line, token - r->data, where,
+                                 "face %zu: malformed index '%.*s'", f, TOKEN_TEXT(token, len));
+        if (index < 0 || (uint64_t)index >= h->vertex_count)
+            return rs_fail_parse(error, r->line, token - r->data, where,
+                                 "face %zu: index %lld out of range (%llu vertices)", f,
+                                 (long long)index, (unsigned long long)h->vertex_count);
+        if (st->indices.count + 1 >= RS_IO_MAX_FACE_INDICES)
+            return rs_fail_parse(error, r->line, token - r->data, where,
+                                 "too many face indices (offsets are 32-bit)");
+        if (!rs_io_u32vec_reserve(&st->indices, 1))
+            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "%zu face indices",
+                           st->indices.count + 1);
+        st->indices.data[st->indices.count++] = (uint32_t)index;
+    }
+    st->offsets[f + 1] = (uint32_t)st->indices.count;
+    /* A face colour (r g b [a] or a colormap index), kept as written. */
+    const char *from = NULL, *last_end = NULL;
+    while (next_token(&p, stop, &token, &len)) {
+        if (!from)
+            from = token;
+        last_end = token + len;
+    }
+    bool ok = from ? texts_append(&st->extras->face, f, h->face_count, from,
+                                  (size_t)(last_end - from))
+                   : texts_append(&st->extras->face, f, h->face_count, "", 0);
+    if (!ok)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "OFF face colours");
+    return RSMOOTH_OK;
+}
+
+/* Colours as bytes: integers 0..255 when any value exceeds 1 (whether written "255" or "255.0"),
+ * else floats in [0, 1]; a file of only 0 and 1 reads as floats, as Geomview defines colours. */
+static uint8_t *color_bytes(const off_state *st, size_t vertex_count) {
+    uint8_t *bytes = rs_alloc_array(vertex_count, 3);
+    if (!bytes)
+        return NULL;
+    bool integers = st->color_above_one;
+    for (size_t i = 0; i < 3 * vertex_count; i++) {
+        double c = st->raw_colors[i];
+        if (!integers)
+            c *= 255;
+        bytes[i] = !(c > 0) ? 0 : c >= 255 ? 255 : (uint8_t)(c + 0.5);
+    }
+    return bytes;
+}
+
+rsmooth_status rs_io_off_read(const char *data, size_t size, rsmooth_mesh **mesh,
+                              rsmooth_error *error) {
+    off_reader r = {.data = data, .p = data, .end = data + size, .line = 0};
+    off_header h = {.keyword = {0}};
+    rsmooth_status status = parse_header(&r, &h, error);
+    if (status != RSMOOTH_OK)
+        return status;
+    if (h.vertex_count == 0)
+        return rs_fail_parse(error, r.line, -1, where, "no vertices (an empty mesh)");
+    /* Every vertex takes at least "0 0 0\n" and every face "3 0 1 2\n": refuse counts the rest of
+     * the file cannot hold before allocating for them (the last line may lack its newline). */
+    uint64_t remaining = (uint64_t)(r.end - r.p) + 1;
+    if (h.vertex_count >= RS_IO_MAX_VERTICES || h.vertex_count > remaining / 6 ||
+        h.face_count > (remaining - 6 * h.vertex_count) / 8)
+        return rs_fail_parse(error, r.line, -1, where,
+                             "%llu vertices and %llu faces declared, more than the remaining "
+                             "%llu bytes can hold",
+                             (unsigned long long)h.vertex_count, (unsigned long long)h.face_count,
+                             (unsigned long long)(remaining - 1));
+    size_t nv = (size_t)h.vertex_count, nf = (size_t)h.face_count;
+    off_state st = {0};
+    st.positions = rs_alloc_array(nv, 3 * sizeof(double));
+    st.offsets = rs_calloc_array(nf + 1, sizeof(uint32_t));
+    st.extras = rs_calloc_array(1, sizeof *st.extras);
+    if (h.c)
+        st.raw_colors = rs_alloc_array(nv, 3 * sizeof(float));
+    if (!st.positions || !st.offsets || !st.extras || (h.c && !st.raw_colors) ||
+        !rs_io_u32vec_reserve(&st.indices, nf < SIZE_MAX / 3 ? 3 * nf : nf)) {
+        free_state(&st);
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "%zu vertices, %zu faces", nv,
+                       nf);
+    }
+    for (size_t v = 0; status == RSMOOTH_OK && v < nv; v++)
+        status = parse_vertex(&r, &h, &st, v, error);
+    for (size_t f = 0; status == RSMOOTH_OK && f < nf; f++)
+        status = parse_face(&r, &h, &st, f, error);
+    /* Anything after the faces (some writers add edges) is ignored. */
+    uint8_t *colors = NULL;
+    if (status == RSMOOTH_OK && h.c && !(colors = color_bytes(&st, nv)))
+        status = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "vertex colours");
+    if (status != RSMOOTH_OK) {
+        free_state(&st);
+        return status;
+    }
+    rs_off_extras *x = st.extras;
+    st.extras = NULL;
+    memcpy(x->keyword, h.keyword, sizeof x->keyword);
+    x->normals = h.n;
+    x->texcoords = h.st;
+    x->vertex_count = nv;
+    x->face_count = nf;
+    x->edge_count = h.edge_count;
+    uint32_t *indices = st.indices.data ? st.indices.data : rs_alloc_array(1, sizeof(uint32_t));
+    rs_free(st.raw_colors);
+    status = rs_io_mesh_adopt(st.positions, nv, RSMOOTH_FLOAT64, st.offsets, nf, indices,
+                              RSMOOTH_FORMAT_OFF, mesh, error);
+    if (status != RSMOOTH_OK) {
+        rs_free(colors);
+        rs_io_off_extras_free(x);
+        return status;
+    }
+    (*mesh)->vertex_colors = colors;
+    (*mesh)->has_vertex_normals = h.n;
+    /* Kept only when there is something the generic writer would not reproduce. */
+    if (x->vertex.offsets || x->face.offsets) {
+        struct rsmooth_mesh_extras *holder = rs_io_mesh_extras(*mesh);
+        if (!holder) {
+            rs_io_off_extras_free(x);
+            rsmooth_mesh_destroy(*mesh);
+            *mesh = NULL;
+            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "OFF extras");
+        }
+        holder->off = x;
+    } else {
+        rs_io_off_extras_free(x);
+    }
+    return RSMOOTH_OK;
 }

@@ -1,5 +1,5 @@
-/* Stanford PLY parser over a memory buffer (ascii, binary LE and BE): vertex x/y/z, face lists. */
-#include "io/io_internal.h"
+/* Stanford PLY parser (ascii, binary LE and BE): the mesh, and all else into the PLY extras. */
+#include "io/ply_format.h"
 
 #include <limits.h>
 #include <math.h>
@@ -7,36 +7,6 @@
 #include <string.h>
 
 static const char where[] = "rsmooth_mesh_read (PLY)";
-
-typedef enum ply_type {
-    PLY_NONE = 0,
-    PLY_INT8,
-    PLY_UINT8,
-    PLY_INT16,
-    PLY_UINT16,
-    PLY_INT32,
-    PLY_UINT32,
-    PLY_FLOAT32,
-    PLY_FLOAT64
-} ply_type;
-
-static const size_t type_size[] = {0, 1, 1, 2, 2, 4, 4, 4, 8};
-
-typedef struct ply_property {
-    const char *name; /* into the buffer, not NUL-terminated */
-    size_t name_len;
-    ply_type type;       /* scalar type, or the item type of a list */
-    ply_type count_type; /* PLY_NONE for scalars */
-} ply_property;
-
-typedef struct ply_element {
-    const char *name;
-    size_t name_len;
-    uint64_t count;
-    size_t first_property;
-    size_t property_count;
-    int64_t header_line;
-} ply_element;
 
 typedef enum ply_encoding { PLY_ASCII, PLY_BINARY_LE, PLY_BINARY_BE } ply_encoding;
 
@@ -46,18 +16,19 @@ typedef struct ply_reader {
     size_t pos;   /* read position in data */
     int64_t line; /* ascii: current line, 1-based */
     ply_encoding encoding;
-    ply_property *properties;
-    size_t property_count, property_capacity;
-    ply_element *elements;
-    size_t element_count, element_capacity;
+    bool swap;        /* binary data in the other byte order than the host's */
+    rs_ply_extras *x; /* the header, and the values kept */
     /* results */
-    const ply_element *vertex_element, *face_element;
+    rs_ply_element *vertex_element, *face_element;
     size_t vertex_count;
     double *positions;
     rsmooth_scalar precision;
     uint32_t *face_offsets;
     size_t face_count;
     rs_io_u32vec indices;
+    bool normals;
+    size_t color[3]; /* property index of red, green, blue in the vertex element; SIZE_MAX: none */
+    uint8_t *colors;
 } ply_reader;
 
 static bool is_space(char c) {
@@ -69,20 +40,25 @@ static bool token_is(const char *token, size_t len, const char *word) {
     return len == n && memcmp(token, word, n) == 0;
 }
 
-static ply_type parse_type(const char *token, size_t len) {
-    static const struct {
-        const char *name;
-        ply_type type;
-    } names[] = {{"char", PLY_INT8},      {"int8", PLY_INT8},       {"uchar", PLY_UINT8},
-                 {"uint8", PLY_UINT8},    {"short", PLY_INT16},     {"int16", PLY_INT16},
-                 {"ushort", PLY_UINT16},  {"uint16", PLY_UINT16},   {"int", PLY_INT32},
-                 {"int32", PLY_INT32},    {"uint", PLY_UINT32},     {"uint32", PLY_UINT32},
-                 {"float", PLY_FLOAT32},  {"float32", PLY_FLOAT32}, {"double", PLY_FLOAT64},
-                 {"float64", PLY_FLOAT64}};
-    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
-        if (token_is(token, len, names[i].name))
-            return names[i].type;
-    return PLY_NONE;
+/* The spelling index of a type word, or -1. */
+static int parse_type(const char *token, size_t len) {
+    for (unsigned s = 0; s < RS_PLY_SPELLING_COUNT; s++)
+        if (token_is(token, len, rs_ply_spelling(s)))
+            return (int)s;
+    return -1;
+}
+
+static bool is_signed_int(rs_ply_type t) {
+    return t == RS_PLY_INT8 || t == RS_PLY_INT16 || t == RS_PLY_INT32;
+}
+
+static char *copy_text(const char *s, size_t len) {
+    char *copy = rs_alloc_array(len + 1, 1);
+    if (copy) {
+        memcpy(copy, s, len);
+        copy[len] = '\0';
+    }
+    return copy;
 }
 
 /* ---- header */
@@ -95,53 +71,90 @@ static rsmooth_status header_error(const ply_reader *r, size_t offset, rsmooth_e
                          (int)(len > 40 ? 40 : len), token);
 }
 
+static rsmooth_status header_oom(rsmooth_error *error) {
+    return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "PLY header");
+}
+
+static rsmooth_status add_comment(ply_reader *r, const char *start, const char *eol,
+                                  bool have_format, rsmooth_error *error) {
+    rs_ply_extras *x = r->x;
+    if (x->comment_count == x->comment_capacity) {
+        size_t capacity = x->comment_capacity ? 2 * x->comment_capacity : 8;
+        rs_ply_comment *c = rs_realloc_array(x->comments, capacity, sizeof *c);
+        if (!c)
+            return header_oom(error);
+        x->comments = c;
+        x->comment_capacity = capacity;
+    }
+    while (eol > start && eol[-1] == '\r')
+        eol--;
+    char *text = copy_text(start, (size_t)(eol - start));
+    if (!text)
+        return header_oom(error);
+    x->comments[x->comment_count++] = (rs_ply_comment){
+        .text = text, .before_element = x->element_count, .before_format = !have_format};
+    return RSMOOTH_OK;
+}
+
 static rsmooth_status add_property(ply_reader *r, const char *const *tok, const size_t *len, int n,
                                    size_t offset, rsmooth_error *error) {
-    if (r->element_count == 0)
+    rs_ply_extras *x = r->x;
+    if (x->element_count == 0)
         return header_error(r, offset, error, "property before any element:", tok[0], len[0]);
-    ply_property prop = {0};
+    rs_ply_property prop = {0};
+    const char *name;
+    size_t name_len;
     if (n >= 2 && token_is(tok[1], len[1], "list")) {
         if (n != 5)
             return header_error(r, offset, error,
                                 "expected 'property list COUNTTYPE TYPE NAME':", tok[0], len[0]);
-        prop.count_type = parse_type(tok[2], len[2]);
-        prop.type = parse_type(tok[3], len[3]);
-        if (prop.count_type == PLY_NONE)
+        int count_spelling = parse_type(tok[2], len[2]), spelling = parse_type(tok[3], len[3]);
+        if (count_spelling < 0)
             return header_error(r, (size_t)(tok[2] - r->data), error, "unknown type", tok[2],
                                 len[2]);
-        if (prop.type == PLY_NONE)
+        if (spelling < 0)
             return header_error(r, (size_t)(tok[3] - r->data), error, "unknown type", tok[3],
                                 len[3]);
-        if (prop.count_type == PLY_FLOAT32 || prop.count_type == PLY_FLOAT64)
+        prop.count_spelling = (uint8_t)count_spelling;
+        prop.count_type = rs_ply_spelling_type((unsigned)count_spelling);
+        prop.spelling = (uint8_t)spelling;
+        prop.type = rs_ply_spelling_type((unsigned)spelling);
+        if (rs_ply_type_is_float(prop.count_type))
             return header_error(r, (size_t)(tok[2] - r->data), error,
                                 "list count type must be an integer:", tok[2], len[2]);
-        prop.name = tok[4];
-        prop.name_len = len[4];
+        name = tok[4];
+        name_len = len[4];
     } else {
         if (n != 3)
             return header_error(r, offset, error, "expected 'property TYPE NAME':", tok[0], len[0]);
-        prop.type = parse_type(tok[1], len[1]);
-        if (prop.type == PLY_NONE)
+        int spelling = parse_type(tok[1], len[1]);
+        if (spelling < 0)
             return header_error(r, (size_t)(tok[1] - r->data), error, "unknown type", tok[1],
                                 len[1]);
-        prop.name = tok[2];
-        prop.name_len = len[2];
+        prop.spelling = (uint8_t)spelling;
+        prop.type = rs_ply_spelling_type((unsigned)spelling);
+        name = tok[2];
+        name_len = len[2];
     }
-    if (r->property_count == r->property_capacity) {
-        size_t capacity = r->property_capacity ? 2 * r->property_capacity : 16;
-        ply_property *p = rs_realloc_array(r->properties, capacity, sizeof *p);
+    rs_ply_element *e = &x->elements[x->element_count - 1];
+    if (e->property_count == e->property_capacity) {
+        size_t capacity = e->property_capacity ? 2 * e->property_capacity : 8;
+        rs_ply_property *p = rs_realloc_array(e->properties, capacity, sizeof *p);
         if (!p)
-            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "header properties");
-        r->properties = p;
-        r->property_capacity = capacity;
+            return header_oom(error);
+        e->properties = p;
+        e->property_capacity = capacity;
     }
-    r->properties[r->property_count++] = prop;
-    r->elements[r->element_count - 1].property_count++;
+    prop.name = copy_text(name, name_len);
+    if (!prop.name)
+        return header_oom(error);
+    e->properties[e->property_count++] = prop;
     return RSMOOTH_OK;
 }
 
 static rsmooth_status add_element(ply_reader *r, const char *const *tok, const size_t *len, int n,
                                   size_t offset, rsmooth_error *error) {
+    rs_ply_extras *x = r->x;
     if (n != 3)
         return header_error(r, offset, error, "expected 'element NAME COUNT':", tok[0], len[0]);
     char digits[32];
@@ -157,20 +170,19 @@ static rsmooth_status add_element(ply_reader *r, const char *const *tok, const s
     if (count == ULLONG_MAX || count > UINT64_MAX / 2)
         return header_error(r, (size_t)(tok[2] - r->data), error, "element count out of range",
                             tok[2], len[2]);
-    if (r->element_count == r->element_capacity) {
-        size_t capacity = r->element_capacity ? 2 * r->element_capacity : 8;
-        ply_element *e = rs_realloc_array(r->elements, capacity, sizeof *e);
+    if (x->element_count == x->element_capacity) {
+        size_t capacity = x->element_capacity ? 2 * x->element_capacity : 8;
+        rs_ply_element *e = rs_realloc_array(x->elements, capacity, sizeof *e);
         if (!e)
-            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "header elements");
-        r->elements = e;
-        r->element_capacity = capacity;
+            return header_oom(error);
+        x->elements = e;
+        x->element_capacity = capacity;
     }
-    ply_element e = {.name = tok[1],
-                     .name_len = len[1],
-                     .count = count,
-                     .first_property = r->property_count,
-                     .header_line = r->line};
-    r->elements[r->element_count++] = e;
+    char *name = copy_text(tok[1], len[1]);
+    if (!name)
+        return header_oom(error);
+    x->elements[x->element_count++] =
+        (rs_ply_element){.name = name, .count = count, .header_line = r->line};
     return RSMOOTH_OK;
 }
 
@@ -215,7 +227,7 @@ static rsmooth_status parse_header(ply_reader *r, rsmooth_error *error) {
             continue; /* tolerate blank header lines */
         rsmooth_status status = RSMOOTH_OK;
         if (token_is(tok[0], len[0], "comment") || token_is(tok[0], len[0], "obj_info")) {
-            continue;
+            status = add_comment(r, tok[0], eol, have_format, error);
         } else if (token_is(tok[0], len[0], "end_header")) {
             if (n != 1)
                 return header_error(r, offset, error, "bad header line:", tok[0], len[0]);
@@ -239,6 +251,8 @@ static rsmooth_status parse_header(ply_reader *r, rsmooth_error *error) {
             if (!token_is(tok[2], len[2], "1.0") && !token_is(tok[2], len[2], "1"))
                 return header_error(r, (size_t)(tok[2] - data), error, "unsupported PLY version",
                                     tok[2], len[2]);
+            r->swap = r->encoding != PLY_ASCII &&
+                      (r->encoding == PLY_BINARY_LE) != rs_ply_host_is_le();
             have_format = true;
         } else if (token_is(tok[0], len[0], "element")) {
             status = add_element(r, tok, len, n, offset, error);
@@ -252,17 +266,111 @@ static rsmooth_status parse_header(ply_reader *r, rsmooth_error *error) {
     }
 }
 
-/* ---- data: shared */
+/* ---- roles: what each property's values are to the mesh */
 
-/* Roles of the properties the reader keeps. */
-typedef struct element_plan {
-    const ply_element *element;
-    const ply_property *props;
-    int xyz[3];     /* property index of x, y, z in a vertex element, else -1 */
-    int face_list;  /* property index of vertex_indices in the face element, else -1 */
-    bool is_vertex; /* the element whose coordinates are kept */
-    bool is_face;
-} element_plan;
+static size_t find_scalar(const rs_ply_element *e, const char *name) {
+    for (size_t k = 0; k < e->property_count; k++)
+        if (e->properties[k].count_type == RS_PLY_NONE && !strcmp(e->properties[k].name, name))
+            return k;
+    return SIZE_MAX;
+}
+
+static rsmooth_status assign_roles(ply_reader *r, rsmooth_error *error) {
+    r->color[0] = r->color[1] = r->color[2] = SIZE_MAX;
+    rs_ply_element *v = r->vertex_element;
+    static const char *const axis[3] = {"x", "y", "z"};
+    for (int c = 0; c < 3; c++) {
+        size_t k = SIZE_MAX;
+        for (size_t i = 0; i < v->property_count && k == SIZE_MAX; i++)
+            if (!strcmp(v->properties[i].name, axis[c]))
+                k = i;
+        if (k == SIZE_MAX)
+            return rs_fail_parse(error, v->header_line, -1, where,
+                                 "vertex element has no '%s' property", axis[c]);
+        if (v->properties[k].count_type != RS_PLY_NONE)
+            return rs_fail_parse(error, v->header_line, -1, where,
+                                 "vertex property '%s' is a list", axis[c]);
+        v->properties[k].role = (uint8_t)(RS_PLY_X + c);
+        if (v->properties[k].type == RS_PLY_FLOAT64)
+            r->precision = RSMOOTH_FLOAT64;
+    }
+    /* Normals only as floating-point triples: integer ones stay opaque values, kept as read. */
+    size_t n[3] = {find_scalar(v, "nx"), find_scalar(v, "ny"), find_scalar(v, "nz")};
+    if (n[0] != SIZE_MAX && n[1] != SIZE_MAX && n[2] != SIZE_MAX &&
+        rs_ply_type_is_float(v->properties[n[0]].type) &&
+        rs_ply_type_is_float(v->properties[n[1]].type) &&
+        rs_ply_type_is_float(v->properties[n[2]].type)) {
+        for (int c = 0; c < 3; c++)
+            v->properties[n[c]].role = (uint8_t)(RS_PLY_NX + c);
+        r->normals = true;
+    }
+    static const char *const channel[2][3] = {{"red", "green", "blue"},
+                                             {"diffuse_red", "diffuse_green", "diffuse_blue"}};
+    for (int naming = 0; naming < 2 && r->color[0] == SIZE_MAX; naming++) {
+        size_t k[3];
+        bool all = true;
+        for (int c = 0; c < 3; c++) {
+            k[c] = find_scalar(v, channel[naming][c]);
+            all = all && k[c] != SIZE_MAX && v->properties[k[c]].role == RS_PLY_STORED;
+        }
+        for (int c = 0; all && c < 3; c++) {
+            r->color[c] = k[c];
+            v->properties[k[c]].color = true;
+        }
+    }
+    rs_ply_element *f = r->face_element;
+    if (f) {
+        size_t k = SIZE_MAX;
+        for (size_t i = 0; i < f->property_count && k == SIZE_MAX; i++)
+            if (f->properties[i].count_type != RS_PLY_NONE &&
+                (!strcmp(f->properties[i].name, "vertex_indices") ||
+                 !strcmp(f->properties[i].name, "vertex_index")))
+                k = i;
+        if (k == SIZE_MAX)
+            return rs_fail_parse(error, f->header_line, -1, where,
+                                 "face element has no 'vertex_indices' list property");
+        f->properties[k].role = RS_PLY_FACE_LIST;
+    }
+    /* Rows: the stored scalars and list counts of each element, in property order. */
+    for (size_t ei = 0; ei < r->x->element_count; ei++) {
+        rs_ply_element *e = &r->x->elements[ei];
+        for (size_t k = 0; k < e->property_count; k++) {
+            rs_ply_property *p = &e->properties[k];
+            if (p->role != RS_PLY_STORED)
+                continue;
+            p->row_offset = e->row_size;
+            e->row_size += rs_ply_type_size(p->count_type != RS_PLY_NONE ? p->count_type : p->type);
+        }
+    }
+    return RSMOOTH_OK;
+}
+
+/* The layout the generic writer produces (x y z of one float type, then "list uchar int
+ * vertex_indices" faces, no comment but rsmooth's): nothing for extras to keep. */
+static bool is_plain(const ply_reader *r) {
+    const rs_ply_extras *x = r->x;
+    for (size_t c = 0; c < x->comment_count; c++)
+        if (strcmp(x->comments[c].text, "comment written by rsmooth") != 0)
+            return false;
+    if (x->element_count != 2 || x->vertex_element != 0 || x->face_element != 1 || r->normals)
+        return false;
+    const rs_ply_element *v = &x->elements[0], *f = &x->elements[1];
+    if (v->property_count != 3 || f->property_count != 1)
+        return false;
+    for (int c = 0; c < 3; c++) {
+        const rs_ply_property *p = &v->properties[c];
+        if (p->role != RS_PLY_X + c || p->type != v->properties[0].type ||
+            (strcmp(rs_ply_spelling(p->spelling), "float") != 0 &&
+             strcmp(rs_ply_spelling(p->spelling), "double") != 0))
+            return false;
+    }
+    const rs_ply_property *list = &f->properties[0];
+    return !strcmp(list->name, "vertex_indices") &&
+           !strcmp(rs_ply_spelling(list->count_spelling), "uchar") &&
+           !strcmp(rs_ply_spelling(list->spelling), "int");
+}
+
+/* ---- data: shared */
 
 static rsmooth_status face_begin(ply_reader *r, uint64_t n, uint64_t item, int64_t line,
                                  int64_t offset, rsmooth_error *error) {
@@ -286,6 +394,29 @@ static rsmooth_status face_index(ply_reader *r, double v, int64_t line, int64_t 
                              "face index %.17g out of range (%zu vertices)", v, r->vertex_count);
     r->indices.data[r->indices.count++] = (uint32_t)v;
     return RSMOOTH_OK;
+}
+
+/* Room for `extra` more bytes of list items (geometric growth). */
+static bool list_reserve(rs_ply_element *e, size_t extra) {
+    if (e->list_capacity - e->list_bytes >= extra)
+        return true;
+    if (extra > SIZE_MAX / 2 - e->list_bytes)
+        return false;
+    size_t need = e->list_bytes + extra;
+    size_t capacity = e->list_capacity ? e->list_capacity : 256;
+    while (capacity < need)
+        capacity = capacity > SIZE_MAX / 4 ? need : 2 * capacity;
+    unsigned char *items = rs_realloc_array(e->list_items, capacity, 1);
+    if (!items)
+        return false;
+    e->list_items = items;
+    e->list_capacity = capacity;
+    return true;
+}
+
+static rsmooth_status list_oom(const rs_ply_element *e, rsmooth_error *error) {
+    return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "list values of element '%.40s'",
+                   e->name);
 }
 
 /* ---- data: binary */
@@ -319,59 +450,70 @@ static inline uint64_t load_uint(const unsigned char *p, size_t size, bool big_e
     }
 }
 
-static inline double load_value(const unsigned char *p, ply_type type, bool big_endian) {
+static inline double load_value(const unsigned char *p, rs_ply_type type, bool big_endian) {
     switch (type) {
-    case PLY_INT8:
+    case RS_PLY_INT8:
         return (double)(int8_t)p[0];
-    case PLY_UINT8:
+    case RS_PLY_UINT8:
         return (double)p[0];
-    case PLY_INT16:
+    case RS_PLY_INT16:
         return (double)(int16_t)load_u16(p, big_endian);
-    case PLY_UINT16:
+    case RS_PLY_UINT16:
         return (double)load_u16(p, big_endian);
-    case PLY_INT32:
+    case RS_PLY_INT32:
         return (double)(int32_t)load_u32(p, big_endian);
-    case PLY_UINT32:
+    case RS_PLY_UINT32:
         return (double)load_u32(p, big_endian);
-    case PLY_FLOAT32: {
+    case RS_PLY_FLOAT32: {
         uint32_t bits = load_u32(p, big_endian);
         float f;
         memcpy(&f, &bits, sizeof f);
         return (double)f;
     }
-    case PLY_FLOAT64: {
+    case RS_PLY_FLOAT64: {
         uint64_t bits = load_u64(p, big_endian);
         double d;
         memcpy(&d, &bits, sizeof d);
         return d;
     }
-    case PLY_NONE:
+    case RS_PLY_NONE:
         break;
     }
     return 0;
 }
 
-static rsmooth_status truncated(const ply_reader *r, const element_plan *plan, uint64_t item,
+/* Copies `count` values of `size` bytes, reversing each one's bytes when `swap`. */
+static void copy_values(unsigned char *dst, const unsigned char *src, size_t count, size_t size,
+                        bool swap) {
+    if (!swap || size == 1) {
+        memcpy(dst, src, count * size);
+        return;
+    }
+    for (size_t i = 0; i < count; i++, dst += size, src += size)
+        for (size_t b = 0; b < size; b++)
+            dst[b] = src[size - 1 - b];
+}
+
+static rsmooth_status truncated(const ply_reader *r, const rs_ply_element *e, uint64_t item,
                                 rsmooth_error *error) {
-    return rs_fail_parse(
-        error, -1, (int64_t)r->pos, where, "data ends inside element '%.*s' item %llu (byte %zu)",
-        (int)plan->element->name_len, plan->element->name, (unsigned long long)item, r->pos);
+    return rs_fail_parse(error, -1, (int64_t)r->pos, where,
+                         "data ends inside element '%.40s' item %llu (byte %zu)", e->name,
+                         (unsigned long long)item, r->pos);
 }
 
 /* The common face layout (the list alone, 32-bit indices), decoded without going through double. */
-static rsmooth_status read_binary_faces(ply_reader *r, const element_plan *plan,
+static rsmooth_status read_binary_faces(ply_reader *r, const rs_ply_element *e,
                                         rsmooth_error *error) {
     const bool be = r->encoding == PLY_BINARY_BE;
     const unsigned char *data = (const unsigned char *)r->data;
-    const ply_type count_type = plan->props[0].count_type;
-    const size_t count_size = type_size[count_type];
-    const bool count_signed =
-        count_type == PLY_INT8 || count_type == PLY_INT16 || count_type == PLY_INT32;
-    const bool index_signed = plan->props[0].type == PLY_INT32;
-    for (uint64_t i = 0; i < plan->element->count; i++) {
+    const rs_ply_type count_type = e->properties[0].count_type;
+    const size_t count_size = rs_ply_type_size(count_type);
+    const bool count_signed = is_signed_int(count_type);
+    const bool index_signed = e->properties[0].type == RS_PLY_INT32;
+    for (uint64_t i = 0; i < e->count; i++) {
         r->face_offsets[i] = (uint32_t)r->indices.count;
         if (r->size - r->pos < count_size)
-            return truncated(r, plan, i, error);
+            return truncated(r, e, i, error);
         size_t count_offset = r->pos;
         uint64_t n = load_uint(data + r->pos, count_size, be);
         r->pos += count_size;
@@ -379,7 +521,7 @@ static rsmooth_status read_binary_faces(ply_reader *r, const element_plan *plan,
             return rs_fail_parse(error, -1, (int64_t)count_offset, where,
                                  "negative list count in face %llu", (unsigned long long)i);
         if (n > (r->size - r->pos) / 4)
-            return truncated(r, plan, i, error);
+            return truncated(r, e, i, error);
         rsmooth_status status = face_begin(r, n, i, -1, (int64_t)count_offset, error);
         if (status != RSMOOTH_OK)
             return status;
@@ -398,27 +540,74 @@ static rsmooth_status read_binary_faces(ply_reader *r, const element_plan *plan,
     return RSMOOTH_OK;
 }
 
-static rsmooth_status read_binary_element(ply_reader *r, const element_plan *plan,
-                                          rsmooth_error *error) {
+/* A run of stored values copied from each fixed-size item to its row. */
+typedef struct copy_run {
+    size_t src, dst, len; /* byte offsets in the item and in the row; bytes */
+    size_t unit;          /* size of the values to byte-swap, or 0 to copy as they are */
+} copy_run;
+
+/* Copies the stored values of an all-scalar element's `count` items of `item_size` bytes (already
+ * bounds-checked) into its rows: a memcpy per run of adjacent values. */
+static rsmooth_status copy_rows(ply_reader *r, rs_ply_element *e, size_t item_size,
+                                rsmooth_error *error) {
+    copy_run *runs = rs_alloc_array(e->property_count, sizeof *runs);
+    if (!runs)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "element '%.40s'", e->name);
+    size_t run_count = 0, src = 0;
+    for (size_t k = 0; k < e->property_count; k++) {
+        const rs_ply_property *p = &e->properties[k];
+        size_t size = rs_ply_type_size(p->type);
+        if (p->role == RS_PLY_STORED) {
+            size_t unit = r->swap && size > 1 ? size : 0;
+            copy_run *last = run_count ? &runs[run_count - 1] : NULL;
+            if (last && last->unit == unit && last->src + last->len == src &&
+                last->dst + last->len == p->row_offset)
+                last->len += size;
+            else
+                runs[run_count++] = (copy_run){src, p->row_offset, size, unit};
+        }
+        src += size;
+    }
+    const unsigned char *data = (const unsigned char *)r->data + r->pos;
+    for (size_t i = 0; i < (size_t)e->count; i++) {
+        const unsigned char *item = data + i * item_size;
+        unsigned char *row = e->rows + i * e->row_size;
+        for (size_t k = 0; k < run_count; k++) {
+            const copy_run *run = &runs[k];
+            if (run->unit == 0)
+                memcpy(row + run->dst, item + run->src, run->len);
+            else
+                copy_values(row + run->dst, item + run->src, run->len / run->unit, run->unit, true);
+        }
+    }
+    rs_free(runs);
+    return RSMOOTH_OK;
+}
+
+static rsmooth_status read_binary_element(ply_reader *r, rs_ply_element *e, rsmooth_error *error) {
     const bool be = r->encoding == PLY_BINARY_BE;
-    const ply_element *e = plan->element;
+    const bool is_vertex = e == r->vertex_element, is_face = e == r->face_element;
     const unsigned char *data = (const unsigned char *)r->data;
     bool all_scalar = true;
     size_t item_size = 0;
     for (size_t k = 0; k < e->property_count; k++) {
-        all_scalar = all_scalar && plan->props[k].count_type == PLY_NONE;
-        item_size += plan->props[k].count_type == PLY_NONE ? type_size[plan->props[k].type]
-                                                           : type_size[plan->props[k].count_type];
+        const rs_ply_property *p = &e->properties[k];
+        all_scalar = all_scalar && p->count_type == RS_PLY_NONE;
+        item_size += rs_ply_type_size(p->count_type != RS_PLY_NONE ? p->count_type : p->type);
     }
     /* item_size is the minimum size of an item, checked for every element in read_data. */
     if (all_scalar) {
-        size_t offsets[3] = {0, 0, 0};
-        ply_type types[3] = {PLY_NONE, PLY_NONE, PLY_NONE};
-        if (plan->is_vertex) {
-            for (int c = 0; c < 3; c++) {
-                for (int k = 0; k < plan->xyz[c]; k++)
-                    offsets[c] += type_size[plan->props[k].type];
-                types[c] = plan->props[plan->xyz[c]].type;
+        if (is_vertex) {
+            size_t offsets[3] = {0, 0, 0};
+            rs_ply_type types[3] = {RS_PLY_NONE, RS_PLY_NONE, RS_PLY_NONE};
+            size_t at = 0;
+            for (size_t k = 0; k < e->property_count; k++) {
+                const rs_ply_property *p = &e->properties[k];
+                if (p->role >= RS_PLY_X && p->role <= RS_PLY_Z) {
+                    offsets[p->role - RS_PLY_X] = at;
+                    types[p->role - RS_PLY_X] = p->type;
+                }
+                at += rs_ply_type_size(p->type);
             }
             for (size_t i = 0; i < e->count; i++) {
                 const unsigned char *item = data + r->pos + i * item_size;
@@ -430,59 +619,73 @@ static rsmooth_status read_binary_element(ply_reader *r, const element_plan *pla
                                          "vertex %zu has a non-finite coordinate", i);
             }
         }
+        if (e->row_size > 0) {
+            rsmooth_status status = copy_rows(r, e, item_size, error);
+            if (status != RSMOOTH_OK)
+                return status;
+        }
         r->pos += (size_t)e->count * item_size;
         return RSMOOTH_OK;
     }
-    if (plan->is_face && e->property_count == 1 &&
-        (plan->props[0].type == PLY_INT32 || plan->props[0].type == PLY_UINT32))
-        return read_binary_faces(r, plan, error);
+    if (is_face && e->property_count == 1 &&
+        (e->properties[0].type == RS_PLY_INT32 || e->properties[0].type == RS_PLY_UINT32))
+        return read_binary_faces(r, e, error);
     for (uint64_t i = 0; i < e->count; i++) {
         const size_t item_start = r->pos;
-        if (plan->is_face)
+        unsigned char *row = e->rows ? e->rows + (size_t)i * e->row_size : NULL;
+        if (is_face)
             r->face_offsets[i] = (uint32_t)r->indices.count;
         for (size_t k = 0; k < e->property_count; k++) {
-            const ply_property *prop = &plan->props[k];
-            if (prop->count_type == PLY_NONE) {
-                size_t size = type_size[prop->type];
+            const rs_ply_property *p = &e->properties[k];
+            if (p->count_type == RS_PLY_NONE) {
+                size_t size = rs_ply_type_size(p->type);
                 if (r->size - r->pos < size)
-                    return truncated(r, plan, i, error);
-                if (plan->is_vertex &&
-                    ((int)k == plan->xyz[0] || (int)k == plan->xyz[1] || (int)k == plan->xyz[2])) {
-                    int c = (int)k == plan->xyz[0] ? 0 : (int)k == plan->xyz[1] ? 1 : 2;
-                    r->positions[3 * i + (uint64_t)c] = load_value(data + r->pos, prop->type, be);
-                }
+                    return truncated(r, e, i, error);
+                const unsigned char *src = data + r->pos;
+                if (p->role == RS_PLY_STORED)
+                    copy_values(row + p->row_offset, src, 1, size, r->swap);
+                else if (p->role >= RS_PLY_X && p->role <= RS_PLY_Z)
+                    r->positions[3 * i + (uint64_t)(p->role - RS_PLY_X)] =
+                        load_value(src, p->type, be);
                 r->pos += size;
                 continue;
             }
-            size_t count_size = type_size[prop->count_type];
+            size_t count_size = rs_ply_type_size(p->count_type);
             if (r->size - r->pos < count_size)
-                return truncated(r, plan, i, error);
-            double count = load_value(data + r->pos, prop->count_type, be);
+                return truncated(r, e, i, error);
             size_t count_offset = r->pos;
+            uint64_t n = load_uint(data + r->pos, count_size, be);
+            if (is_signed_int(p->count_type) && n >> (8 * count_size - 1))
+                return rs_fail_parse(error, -1, (int64_t)count_offset, where,
+                                     "negative list count in element '%.40s' item %llu", e->name,
+                                     (unsigned long long)i);
             r->pos += count_size;
-            size_t size = type_size[prop->type];
-            if (count < 0 || count > (double)((r->size - r->pos) / size)) {
-                if (count < 0)
-                    return rs_fail_parse(error, -1, (int64_t)count_offset, where,
-                                         "negative list count %.0f", count);
-                return truncated(r, plan, i, error);
-            }
-            uint64_t n = (uint64_t)count;
-            if (plan->is_face && (int)k == plan->face_list) {
+            size_t size = rs_ply_type_size(p->type);
+            if (n > (r->size - r->pos) / size)
+                return truncated(r, e, i, error);
+            if (p->role == RS_PLY_FACE_LIST) {
                 rsmooth_status status = face_begin(r, n, i, -1, (int64_t)count_offset, error);
                 if (status != RSMOOTH_OK)
                     return status;
                 for (uint64_t j = 0; j < n; j++, r->pos += size) {
-                    status = face_index(r, load_value(data + r->pos, prop->type, be), -1,
+                    status = face_index(r, load_value(data + r->pos, p->type, be), -1,
                                         (int64_t)r->pos, error);
                     if (status != RSMOOTH_OK)
                         return status;
                 }
-            } else {
-                r->pos += (size_t)n * size;
+                continue;
             }
+            copy_values(row + p->row_offset, data + count_offset, 1, count_size, r->swap);
+            size_t bytes = (size_t)n * size; /* n * size <= the bytes left */
+            if (bytes == 0)
+                continue; /* list_items may still be NULL */
+            if (!list_reserve(e, bytes))
+                return list_oom(e, error);
+            copy_values(e->list_items + e->list_bytes, data + r->pos, (size_t)n, size, r->swap);
+            e->list_bytes += bytes;
+            r->pos += bytes;
         }
-        if (plan->is_vertex) {
+        if (is_vertex) {
             const double *xyz = r->positions + 3 * i;
             if (!isfinite(xyz[0]) || !isfinite(xyz[1]) || !isfinite(xyz[2]))
                 return rs_fail_parse(error, -1, (int64_t)item_start, where,
@@ -514,14 +717,14 @@ static bool next_token(ply_reader *r, const char **token, size_t *len) {
     return true;
 }
 
-static rsmooth_status read_ascii_value(ply_reader *r, const element_plan *plan, uint64_t item,
+static rsmooth_status read_ascii_value(ply_reader *r, const rs_ply_element *e, uint64_t item,
                                        double *value, size_t *offset, rsmooth_error *error) {
     const char *token;
     size_t len;
     if (!next_token(r, &token, &len))
-        return rs_fail_parse(
-            error, r->line, (int64_t)r->size, where, "data ends inside element '%.*s' item %llu",
-            (int)plan->element->name_len, plan->element->name, (unsigned long long)item);
+        return rs_fail_parse(error, r->line, (int64_t)r->size, where,
+                             "data ends inside element '%.40s' item %llu", e->name,
+                             (unsigned long long)item);
     *offset = (size_t)(token - r->data);
     if (!rs_io_parse_double(token, len, value))
         return rs_fail_parse(error, r->line, (int64_t)*offset, where, "malformed number '%.*s'",
@@ -529,60 +732,139 @@ static rsmooth_status read_ascii_value(ply_reader *r, const element_plan *plan, 
     return RSMOOTH_OK;
 }
 
-static rsmooth_status read_ascii_element(ply_reader *r, const element_plan *plan,
-                                         rsmooth_error *error) {
-    const ply_element *e = plan->element;
+/* Stores v as a value of type t (host order); false when t cannot hold it exactly (integers) —
+ * kept values must survive unchanged, so nothing is rounded. */
+static bool store_value(unsigned char *dst, rs_ply_type t, double v) {
+    if (!rs_ply_type_is_float(t) && v != floor(v))
+        return false; /* also NaN and infinities */
+    switch (t) {
+    case RS_PLY_INT8: {
+        if (v < INT8_MIN || v > INT8_MAX)
+            return false;
+        int8_t x = (int8_t)v;
+        memcpy(dst, &x, sizeof x);
+        return true;
+    }
+    case RS_PLY_UINT8: {
+        if (v < 0 || v > UINT8_MAX)
+            return false;
+        *dst = (uint8_t)v;
+        return true;
+    }
+    case RS_PLY_INT16: {
+        if (v < INT16_MIN || v > INT16_MAX)
+            return false;
+        int16_t x = (int16_t)v;
+        memcpy(dst, &x, sizeof x);
+        return true;
+    }
+    case RS_PLY_UINT16: {
+        if (v < 0 || v > UINT16_MAX)
+            return false;
+        uint16_t x = (uint16_t)v;
+        memcpy(dst, &x, sizeof x);
+        return true;
+    }
+    case RS_PLY_INT32: {
+        if (v < INT32_MIN || v > INT32_MAX)
+            return false;
+        int32_t x = (int32_t)v;
+        memcpy(dst, &x, sizeof x);
+        return true;
+    }
+    case RS_PLY_UINT32: {
+        if (v < 0 || v > UINT32_MAX)
+            return false;
+        uint32_t x = (uint32_t)v;
+        memcpy(dst, &x, sizeof x);
+        return true;
+    }
+    case RS_PLY_FLOAT32: {
+        float x = (float)v;
+        memcpy(dst, &x, sizeof x);
+        return true;
+    }
+    case RS_PLY_FLOAT64:
+        memcpy(dst, &v, sizeof v);
+        return true;
+    case RS_PLY_NONE:
+        break;
+    }
+    return false;
+}
+
+static rsmooth_status bad_value(const ply_reader *r, const rs_ply_element *e,
+                                const rs_ply_property *p, rs_ply_type type, double v, size_t offset,
+                                rsmooth_error *error) {
+    return rs_fail_parse(error, r->line, (int64_t)offset, where,
+                         "value %.17g does not fit the type '%s' of property '%.40s' (element "
+                         "'%.40s')",
+                         v, rs_ply_spelling(rs_ply_canonical_spelling(type)), p->name, e->name);
+}
+
+static rsmooth_status read_ascii_element(ply_reader *r, rs_ply_element *e, rsmooth_error *error) {
+    const bool is_vertex = e == r->vertex_element, is_face = e == r->face_element;
     rsmooth_status status;
     for (uint64_t i = 0; i < e->count; i++) {
         size_t item_start = 0;
         int64_t item_line = 0;
-        if (plan->is_face)
+        unsigned char *row = e->rows ? e->rows + (size_t)i * e->row_size : NULL;
+        if (is_face)
             r->face_offsets[i] = (uint32_t)r->indices.count;
         for (size_t k = 0; k < e->property_count; k++) {
-            const ply_property *prop = &plan->props[k];
+            const rs_ply_property *p = &e->properties[k];
             double v;
             size_t offset;
-            status = read_ascii_value(r, plan, i, &v, &offset, error);
+            status = read_ascii_value(r, e, i, &v, &offset, error);
             if (status != RSMOOTH_OK)
                 return status;
             if (k == 0) {
                 item_start = offset;
                 item_line = r->line;
             }
-            if (prop->count_type == PLY_NONE) {
-                if (plan->is_vertex) {
-                    for (int c = 0; c < 3; c++)
-                        if ((int)k == plan->xyz[c])
-                            /* as stored in binary: a float property holds a float */
-                            r->positions[3 * i + (uint64_t)c] =
-                                prop->type == PLY_FLOAT32 ? (double)(float)v : v;
-                }
+            if (p->count_type == RS_PLY_NONE) {
+                if (p->role >= RS_PLY_X && p->role <= RS_PLY_Z)
+                    /* as stored in binary: a float property holds a float */
+                    r->positions[3 * i + (uint64_t)(p->role - RS_PLY_X)] =
+                        p->type == RS_PLY_FLOAT32 ? (double)(float)v : v;
+                else if (p->role == RS_PLY_STORED && !store_value(row + p->row_offset, p->type, v))
+                    return bad_value(r, e, p, p->type, v, offset, error);
                 continue;
             }
             /* A list: every item takes at least 2 bytes ("1 "), which bounds the count. */
             if (!(v >= 0 && v == floor(v) && v <= (double)(r->size - r->pos)))
                 return rs_fail_parse(error, r->line, (int64_t)offset, where,
-                                     "bad list count %.17g in element '%.*s' item %llu", v,
-                                     (int)e->name_len, e->name, (unsigned long long)i);
+                                     "bad list count %.17g in element '%.40s' item %llu", v,
+                                     e->name, (unsigned long long)i);
             uint64_t n = (uint64_t)v;
-            bool is_face_list = plan->is_face && (int)k == plan->face_list;
-            if (is_face_list) {
+            if (p->role == RS_PLY_FACE_LIST) {
                 status = face_begin(r, n, i, r->line, (int64_t)offset, error);
                 if (status != RSMOOTH_OK)
                     return status;
-            }
-            for (uint64_t j = 0; j < n; j++) {
-                status = read_ascii_value(r, plan, i, &v, &offset, error);
-                if (status != RSMOOTH_OK)
-                    return status;
-                if (is_face_list) {
-                    status = face_index(r, v, r->line, (int64_t)offset, error);
+                for (uint64_t j = 0; j < n; j++) {
+                    status = read_ascii_value(r, e, i, &v, &offset, error);
+                    if (status == RSMOOTH_OK)
+                        status = face_index(r, v, r->line, (int64_t)offset, error);
                     if (status != RSMOOTH_OK)
                         return status;
                 }
+                continue;
+            }
+            if (!store_value(row + p->row_offset, p->count_type, v))
+                return bad_value(r, e, p, p->count_type, v, offset, error);
+            const size_t size = rs_ply_type_size(p->type);
+            for (uint64_t j = 0; j < n; j++) {
+                status = read_ascii_value(r, e, i, &v, &offset, error);
+                if (status != RSMOOTH_OK)
+                    return status;
+                if (!list_reserve(e, size))
+                    return list_oom(e, error);
+                if (!store_value(e->list_items + e->list_bytes, p->type, v))
+                    return bad_value(r, e, p, p->type, v, offset, error);
+                e->list_bytes += size;
             }
         }
-        if (plan->is_vertex) {
+        if (is_vertex) {
             const double *xyz = r->positions + 3 * i;
             if (!isfinite(xyz[0]) || !isfinite(xyz[1]) || !isfinite(xyz[2]))
                 return rs_fail_parse(error, item_line, (int64_t)item_start, where,
@@ -595,65 +877,55 @@ static rsmooth_status read_ascii_element(ply_reader *r, const element_plan *plan
 
 /* ---- data: driver */
 
-static rsmooth_status plan_element(ply_reader *r, const ply_element *e, element_plan *plan,
-                                   rsmooth_error *error) {
-    memset(plan, 0, sizeof *plan);
-    plan->element = e;
-    plan->props = r->properties ? r->properties + e->first_property : NULL;
-    plan->xyz[0] = plan->xyz[1] = plan->xyz[2] = -1;
-    plan->face_list = -1;
-    plan->is_vertex = e == r->vertex_element;
-    plan->is_face = e == r->face_element;
-    static const char *const axis[3] = {"x", "y", "z"};
-    for (size_t k = 0; k < e->property_count; k++) {
-        const ply_property *prop = &plan->props[k];
-        if (plan->is_vertex) {
-            for (int c = 0; c < 3; c++) {
-                if (plan->xyz[c] < 0 && token_is(prop->name, prop->name_len, axis[c])) {
-                    if (prop->count_type != PLY_NONE)
-                        return rs_fail_parse(error, e->header_line, -1, where,
-                                             "vertex property '%s' is a list", axis[c]);
-                    plan->xyz[c] = (int)k;
-                }
-            }
-        }
-        if (plan->is_face && plan->face_list < 0 && prop->count_type != PLY_NONE &&
-            (token_is(prop->name, prop->name_len, "vertex_indices") ||
-             token_is(prop->name, prop->name_len, "vertex_index")))
-            plan->face_list = (int)k;
-    }
-    if (plan->is_vertex) {
+/* A colour channel as a byte: floats span [0, 1], 16-bit integers their range, other integers
+ * are taken as bytes (clamped). */
+static uint8_t color_byte(double v, rs_ply_type t) {
+    if (rs_ply_type_is_float(t))
+        v *= 255;
+    else if (t == RS_PLY_UINT16 || t == RS_PLY_INT16)
+        v /= 257;
+    if (!(v > 0))
+        return 0; /* NaN too */
+    return v >= 255 ? 255 : (uint8_t)(v + 0.5);
+}
+
+static rsmooth_status fill_colors(ply_reader *r, rsmooth_error *error) {
+    const rs_ply_element *v = r->vertex_element;
+    if (rs_mul_overflows(r->vertex_count, 3))
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "%zu vertex colours",
+                       r->vertex_count);
+    r->colors = rs_alloc_array(r->vertex_count, 3);
+    if (!r->colors)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "%zu vertex colours",
+                       r->vertex_count);
+    const rs_ply_property *p[3];
+    for (int c = 0; c < 3; c++)
+        p[c] = &v->properties[r->color[c]];
+    for (size_t i = 0; i < r->vertex_count; i++) {
+        const unsigned char *row = v->rows + i * v->row_size;
         for (int c = 0; c < 3; c++)
-            if (plan->xyz[c] < 0)
-                return rs_fail_parse(error, e->header_line, -1, where,
-                                     "vertex element has no '%s' property", axis[c]);
-        for (int c = 0; c < 3; c++)
-            if (plan->props[plan->xyz[c]].type == PLY_FLOAT64)
-                r->precision = RSMOOTH_FLOAT64;
+            r->colors[3 * i + (size_t)c] =
+                p[c]->type == RS_PLY_UINT8 ? row[p[c]->row_offset]
+                                           : color_byte(rs_ply_host_value(row + p[c]->row_offset, p[c]->type),
+                                                        p[c]->type);
     }
-    if (plan->is_face && plan->face_list < 0)
-        return rs_fail_parse(error, e->header_line, -1, where,
-                             "face element has no 'vertex_indices' list property");
     return RSMOOTH_OK;
 }
 
 static rsmooth_status read_data(ply_reader *r, rsmooth_error *error) {
-    for (size_t ei = 0; ei < r->element_count; ei++) {
-        const ply_element *e = &r->elements[ei];
-        element_plan plan;
-        rsmooth_status status = plan_element(r, e, &plan, error);
-        if (status != RSMOOTH_OK)
-            return status;
+    for (size_t ei = 0; ei < r->x->element_count; ei++) {
+        rs_ply_element *e = &r->x->elements[ei];
+        const bool is_vertex = e == r->vertex_element, is_face = e == r->face_element;
         if (e->count == 0 || e->property_count == 0)
             continue; /* nothing stored */
         /* Reject counts the remaining bytes cannot hold before allocating anything for them. */
         size_t min_item = 0;
         for (size_t k = 0; k < e->property_count; k++) {
-            const ply_property *prop = &plan.props[k];
+            const rs_ply_property *p = &e->properties[k];
             if (r->encoding == PLY_ASCII)
                 min_item += 2; /* a digit and a separator */
             else
-                min_item += type_size[prop->count_type != PLY_NONE ? prop->count_type : prop->type];
+                min_item += rs_ply_type_size(p->count_type != RS_PLY_NONE ? p->count_type : p->type);
         }
         size_t remaining = r->size - r->pos;
         if (r->encoding == PLY_ASCII)
@@ -661,15 +933,26 @@ static rsmooth_status read_data(ply_reader *r, rsmooth_error *error) {
         if (e->count > remaining / min_item)
             return rs_fail_parse(
                 error, r->encoding == PLY_ASCII ? r->line : -1, (int64_t)r->pos, where,
-                "element '%.*s' declares %llu items but only %zu bytes remain", (int)e->name_len,
-                e->name, (unsigned long long)e->count, r->size - r->pos);
-        if (plan.is_vertex) {
+                "element '%.40s' declares %llu items but only %zu bytes remain", e->name,
+                (unsigned long long)e->count, r->size - r->pos);
+        /* Now count <= the bytes left, and a row is at most 8 bytes per property. */
+        if (e->row_size > 0) {
+            if (rs_mul_overflows((size_t)e->count, e->row_size))
+                return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "element '%.40s'",
+                               e->name);
+            e->rows = rs_alloc_array((size_t)e->count, e->row_size);
+            if (!e->rows)
+                return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where,
+                               "%llu items of element '%.40s'", (unsigned long long)e->count,
+                               e->name);
+        }
+        if (is_vertex) {
             r->positions = rs_alloc_array(r->vertex_count, 3 * sizeof(double));
             if (!r->positions)
                 return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "%zu vertices",
                                r->vertex_count);
         }
-        if (plan.is_face) {
+        if (is_face) {
             r->face_count = (size_t)e->count;
             r->face_offsets = rs_alloc_array(r->face_count + 1, sizeof(uint32_t));
             if (!r->face_offsets)
@@ -682,28 +965,45 @@ static rsmooth_status read_data(ply_reader *r, rsmooth_error *error) {
                 return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "%zu face indices",
                                guess);
         }
-        status = r->encoding == PLY_ASCII ? read_ascii_element(r, &plan, error)
-                                          : read_binary_element(r, &plan, error);
+        rsmooth_status status = r->encoding == PLY_ASCII ? read_ascii_element(r, e, error)
+                                                         : read_binary_element(r, e, error);
         if (status != RSMOOTH_OK)
             return status;
-        if (plan.is_face)
+        if (is_face)
             r->face_offsets[r->face_count] = (uint32_t)r->indices.count;
+        if (e->list_items && e->list_capacity > e->list_bytes) {
+            unsigned char *fit = rs_realloc_array(e->list_items, e->list_bytes, 1);
+            if (fit) { /* else keep the larger block */
+                e->list_items = fit;
+                e->list_capacity = e->list_bytes;
+            }
+        }
+        if (is_vertex && r->color[0] != SIZE_MAX) {
+            status = fill_colors(r, error);
+            if (status != RSMOOTH_OK)
+                return status;
+        }
     }
     return RSMOOTH_OK;
 }
 
 static rsmooth_status find_elements(ply_reader *r, rsmooth_error *error) {
-    for (size_t ei = 0; ei < r->element_count; ei++) {
-        const ply_element *e = &r->elements[ei];
-        bool vertex = token_is(e->name, e->name_len, "vertex");
-        bool face = token_is(e->name, e->name_len, "face");
+    rs_ply_extras *x = r->x;
+    for (size_t ei = 0; ei < x->element_count; ei++) {
+        rs_ply_element *e = &x->elements[ei];
+        bool vertex = !strcmp(e->name, "vertex");
+        bool face = !strcmp(e->name, "face");
         if ((vertex && r->vertex_element) || (face && r->face_element))
             return rs_fail_parse(error, e->header_line, -1, where, "a second '%s' element",
                                  vertex ? "vertex" : "face");
-        if (vertex)
+        if (vertex) {
             r->vertex_element = e;
-        if (face)
+            x->vertex_element = ei;
+        }
+        if (face) {
             r->face_element = e;
+            x->face_element = ei;
+        }
     }
     if (!r->vertex_element || r->vertex_element->count == 0)
         return rs_fail_parse(error, -1, -1, where, "no vertices");
@@ -718,30 +1018,56 @@ static rsmooth_status find_elements(ply_reader *r, rsmooth_error *error) {
 rsmooth_status rs_io_ply_read(const char *data, size_t size, rsmooth_mesh **mesh,
                               rsmooth_error *error) {
     ply_reader r = {.data = data, .size = size, .precision = RSMOOTH_FLOAT32};
+    r.x = rs_calloc_array(1, sizeof *r.x);
+    if (!r.x)
+        return header_oom(error);
+    r.x->vertex_element = r.x->face_element = SIZE_MAX;
     rsmooth_status status = parse_header(&r, error);
     if (status == RSMOOTH_OK)
         status = find_elements(&r, error);
     if (status == RSMOOTH_OK)
+        status = assign_roles(&r, error);
+    if (status == RSMOOTH_OK)
         status = read_data(&r, error);
-    rs_free(r.properties);
-    rs_free(r.elements);
+    uint32_t *indices = r.indices.data;
+    if (status == RSMOOTH_OK && !indices) {
+        indices = rs_alloc_array(1, sizeof(uint32_t));
+        if (!indices)
+            status = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "face indices");
+    }
     if (status != RSMOOTH_OK) {
         rs_free(r.positions);
         rs_free(r.face_offsets);
         rs_free(r.indices.data);
+        rs_free(r.colors);
+        rs_io_ply_extras_free(r.x);
         return status;
-    }
-    uint32_t *indices = r.indices.data;
-    if (!indices)
-        indices = rs_alloc_array(1, sizeof(uint32_t));
-    if (!indices) {
-        rs_free(r.positions);
-        rs_free(r.face_offsets);
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "face indices");
     }
     rsmooth_format format = r.encoding == PLY_ASCII       ? RSMOOTH_FORMAT_PLY_ASCII
                             : r.encoding == PLY_BINARY_LE ? RSMOOTH_FORMAT_PLY_BINARY
                                                           : RSMOOTH_FORMAT_PLY_BINARY_BE;
-    return rs_io_mesh_adopt(r.positions, r.vertex_count, r.precision, r.face_offsets, r.face_count,
-                            indices, format, mesh, error);
+    bool plain = is_plain(&r);
+    rsmooth_mesh *m = NULL;
+    status = rs_io_mesh_adopt(r.positions, r.vertex_count, r.precision, r.face_offsets,
+                              r.face_count, indices, format, &m, error);
+    if (status != RSMOOTH_OK) {
+        rs_free(r.colors);
+        rs_io_ply_extras_free(r.x);
+        return status;
+    }
+    m->has_vertex_normals = r.normals;
+    m->vertex_colors = r.colors;
+    if (plain) {
+        rs_io_ply_extras_free(r.x);
+    } else {
+        struct rsmooth_mesh_extras *extras = rs_io_mesh_extras(m);
+        if (!extras) {
+            rsmooth_mesh_destroy(m);
+            rs_io_ply_extras_free(r.x);
+            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "extras record");
+        }
+        extras->ply = r.x;
+    }
+    *mesh = m;
+    return RSMOOTH_OK;
 }

@@ -1,8 +1,21 @@
 /* Stanford PLY writer: ascii or binary little-endian (bytes laid out explicitly for any host). */
-#include "io/io_internal.h"
+#include "io/ply_format.h"
 
 #include <errno.h>
+#include <inttypes.h>
+#include <math.h>
 #include <string.h>
+
+/* Faithful path: a mesh whose PLY extras (ply_format.h) still match it (same vertex and face counts)
+ * is written with the input's header (comments, obj_info, elements, properties and their type
+ * words, in order) and every kept value as read; positions come from mesh->positions in the x/y/z
+ * types, normals are recomputed from them in the nx/ny/nz types, faces come from mesh->face_* in the
+ * list's types (widened when a value does not fit). There the extras win: caller-set
+ * vertex_quality and vertex_colors are ignored (set mesh->extras to NULL to write them instead).
+ * Otherwise the generic path writes positions, faces, recomputed normals when has_vertex_normals,
+ * vertex_quality and vertex_colors. */
+
+static const char where[] = "rsmooth_mesh_write_stream";
 
 typedef struct out_buffer {
     FILE *stream;
@@ -24,11 +37,31 @@ static unsigned char *out_reserve(out_buffer *out, size_t n) {
     return out->bytes + out->used;
 }
 
+static out_buffer *out_open(FILE *stream) {
+    out_buffer *out = rs_alloc_array(1, sizeof *out);
+    if (out) {
+        out->stream = stream;
+        out->used = 0;
+        out->ok = true;
+    }
+    return out;
+}
+
+/* Flushes and frees; false when any write failed. */
+static bool out_close(out_buffer *out) {
+    out_flush(out);
+    bool ok = out->ok;
+    rs_free(out);
+    return ok;
+}
+
+static void put_le(unsigned char *p, uint64_t v, size_t size) {
+    for (size_t b = 0; b < size; b++)
+        p[b] = (unsigned char)(v >> (8 * b));
+}
+
 static void put_u32(unsigned char *p, uint32_t v) {
-    p[0] = (unsigned char)v;
-    p[1] = (unsigned char)(v >> 8);
-    p[2] = (unsigned char)(v >> 16);
-    p[3] = (unsigned char)(v >> 24);
+    put_le(p, v, 4);
 }
 
 static void put_f32(unsigned char *p, float f) {
@@ -40,9 +73,38 @@ static void put_f32(unsigned char *p, float f) {
 static void put_f64(unsigned char *p, double d) {
     uint64_t bits;
     memcpy(&bits, &d, sizeof bits);
-    put_u32(p, (uint32_t)bits);
-    put_u32(p + 4, (uint32_t)(bits >> 32));
+    put_le(p, bits, 8);
 }
+
+/* The normals writers emit: recomputed from the positions (3 * vertex_count doubles). */
+static rsmooth_status compute_normals(const rsmooth_mesh *mesh, double **normals,
+                                      rsmooth_error *error) {
+    if (mesh->triangle_count > 0 && !mesh->triangles)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "%zu triangles but triangles is NULL", mesh->triangle_count);
+    if (rs_mul_overflows(mesh->vertex_count, 3 * sizeof(double)))
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "normals of %zu vertices",
+                       mesh->vertex_count);
+    *normals = rs_alloc_array(mesh->vertex_count, 3 * sizeof(double));
+    if (!*normals)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "normals of %zu vertices",
+                       mesh->vertex_count);
+    rsmooth_error inner;
+    if (rsmooth_mesh_vertex_normals(mesh, *normals, &inner) != RSMOOTH_OK) {
+        rs_free(*normals);
+        *normals = NULL;
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "normals: %s",
+                       inner.message);
+    }
+    return RSMOOTH_OK;
+}
+
+static rsmooth_status io_failure(rsmooth_error *error) {
+    return rs_fail(error, RSMOOTH_ERROR_IO, where, "writing PLY: %s",
+                   errno ? strerror(errno) : "stream error or out of memory");
+}
+
+/* ---- generic path: the mesh's own fields */
 
 static bool write_header(const rsmooth_mesh *mesh, FILE *stream, bool binary, bool wide_count,
                          bool unsigned_index) {
@@ -52,6 +114,9 @@ static bool write_header(const rsmooth_mesh *mesh, FILE *stream, bool binary, bo
                       "property %s x\nproperty %s y\nproperty %s z\n",
                       binary ? "binary_little_endian" : "ascii", mesh->vertex_count, scalar, scalar,
                       scalar) >= 0;
+    if (ok && mesh->has_vertex_normals)
+        ok = fprintf(stream, "property %s nx\nproperty %s ny\nproperty %s nz\n", scalar, scalar,
+                     scalar) >= 0;
     if (ok && mesh->vertex_quality)
         ok = fputs("property float quality\n", stream) >= 0;
     if (ok && mesh->vertex_colors)
@@ -62,24 +127,24 @@ static bool write_header(const rsmooth_mesh *mesh, FILE *stream, bool binary, bo
     return ok;
 }
 
-static bool write_binary(const rsmooth_mesh *mesh, FILE *stream, bool wide_count) {
-    out_buffer *out = rs_alloc_array(1, sizeof *out);
+static bool write_binary(const rsmooth_mesh *mesh, const double *normals, FILE *stream,
+                         bool wide_count) {
+    out_buffer *out = out_open(stream);
     if (!out)
         return false;
-    out->stream = stream;
-    out->used = 0;
-    out->ok = true;
     const bool f32 = mesh->precision == RSMOOTH_FLOAT32;
     for (size_t i = 0; out->ok && i < mesh->vertex_count; i++) {
-        unsigned char *p = out_reserve(out, 3 * 8 + 4 + 3);
-        const double *xyz = mesh->positions + 3 * i;
-        for (int c = 0; c < 3; c++) {
-            if (f32) {
-                put_f32(p, (float)xyz[c]);
-                p += 4;
-            } else {
-                put_f64(p, xyz[c]);
-                p += 8;
+        unsigned char *p = out_reserve(out, 6 * 8 + 4 + 3);
+        for (int set = 0; set < (normals ? 2 : 1); set++) {
+            const double *xyz = (set == 0 ? mesh->positions : normals) + 3 * i;
+            for (int c = 0; c < 3; c++) {
+                if (f32) {
+                    put_f32(p, (float)xyz[c]);
+                    p += 4;
+                } else {
+                    put_f64(p, xyz[c]);
+                    p += 8;
+                }
             }
         }
         if (mesh->vertex_quality) {
@@ -108,22 +173,22 @@ static bool write_binary(const rsmooth_mesh *mesh, FILE *stream, bool wide_count
             out->used += 4;
         }
     }
-    out_flush(out);
-    bool ok = out->ok;
-    rs_free(out);
-    return ok;
+    return out_close(out);
 }
 
-static bool write_ascii(const rsmooth_mesh *mesh, FILE *stream) {
+static bool write_ascii(const rsmooth_mesh *mesh, const double *normals, FILE *stream) {
     const bool f32 = mesh->precision == RSMOOTH_FLOAT32;
     bool ok = true;
     for (size_t i = 0; ok && i < mesh->vertex_count; i++) {
-        const double *xyz = mesh->positions + 3 * i;
-        if (f32)
-            ok = fprintf(stream, "%.9g %.9g %.9g", (double)(float)xyz[0], (double)(float)xyz[1],
-                         (double)(float)xyz[2]) >= 0;
-        else
-            ok = fprintf(stream, "%.17g %.17g %.17g", xyz[0], xyz[1], xyz[2]) >= 0;
+        for (int set = 0; ok && set < (normals ? 2 : 1); set++) {
+            const double *xyz = (set == 0 ? mesh->positions : normals) + 3 * i;
+            if (f32)
+                ok = fprintf(stream, "%s%.9g %.9g %.9g", set ? " " : "", (double)(float)xyz[0],
+                             (double)(float)xyz[1], (double)(float)xyz[2]) >= 0;
+            else
+                ok = fprintf(stream, "%s%.17g %.17g %.17g", set ? " " : "", xyz[0], xyz[1],
+                             xyz[2]) >= 0;
+        }
         if (ok && mesh->vertex_quality)
             ok = fprintf(stream, " %.9g", (double)mesh->vertex_quality[i]) >= 0;
         if (ok && mesh->vertex_colors) {
@@ -142,20 +207,294 @@ static bool write_ascii(const rsmooth_mesh *mesh, FILE *stream) {
     return ok;
 }
 
-rsmooth_status rs_io_ply_write(const rsmooth_mesh *mesh, FILE *stream, bool binary,
-                               rsmooth_error *error) {
+static rsmooth_status write_generic(const rsmooth_mesh *mesh, FILE *stream, bool binary,
+                                    rsmooth_error *error) {
     bool wide_count = false;
     for (size_t f = 0; f < mesh->face_count && !wide_count; f++)
         wide_count = mesh->face_offsets[f + 1] - mesh->face_offsets[f] > 255;
     /* "int" indices, as most tools expect, unless a vertex index would not fit in one. */
     bool unsigned_index = mesh->vertex_count > (size_t)INT32_MAX;
+    double *normals = NULL;
+    if (mesh->has_vertex_normals) {
+        rsmooth_status status = compute_normals(mesh, &normals, error);
+        if (status != RSMOOTH_OK)
+            return status;
+    }
     errno = 0;
     bool ok = write_header(mesh, stream, binary, wide_count, unsigned_index);
     if (ok)
-        ok = binary ? write_binary(mesh, stream, wide_count) : write_ascii(mesh, stream);
+        ok = binary ? write_binary(mesh, normals, stream, wide_count)
+                    : write_ascii(mesh, normals, stream);
+    rs_free(normals);
     ok = ok && fflush(stream) == 0 && !ferror(stream);
-    if (!ok)
-        return rs_fail(error, RSMOOTH_ERROR_IO, "rsmooth_mesh_write_stream", "writing PLY: %s",
-                       errno ? strerror(errno) : "stream error or out of memory");
+    return ok ? RSMOOTH_OK : io_failure(error);
+}
+
+/* ---- faithful path: the input's header and kept values */
+
+/* true when the integer or floating-point type t holds v exactly (v integral for integers). */
+static bool type_holds(rs_ply_type t, double v) {
+    switch (t) {
+    case RS_PLY_INT8:
+        return v >= INT8_MIN && v <= INT8_MAX;
+    case RS_PLY_UINT8:
+        return v >= 0 && v <= UINT8_MAX;
+    case RS_PLY_INT16:
+        return v >= INT16_MIN && v <= INT16_MAX;
+    case RS_PLY_UINT16:
+        return v >= 0 && v <= UINT16_MAX;
+    case RS_PLY_INT32:
+        return v >= INT32_MIN && v <= INT32_MAX;
+    case RS_PLY_UINT32:
+        return v >= 0 && v <= UINT32_MAX;
+    case RS_PLY_FLOAT32:
+        return fabs(v) <= 16777216.0; /* integers up to 2^24 are exact in a float */
+    case RS_PLY_FLOAT64:
+        return true;
+    case RS_PLY_NONE:
+        break;
+    }
+    return false;
+}
+
+/* Writes v (integral and in range for integer types) as a value of type t. */
+static void emit_double(out_buffer *out, bool binary, rs_ply_type t, double v) {
+    unsigned char *p = out_reserve(out, 40);
+    if (binary) {
+        size_t size = rs_ply_type_size(t);
+        if (t == RS_PLY_FLOAT32)
+            put_f32(p, (float)v);
+        else if (t == RS_PLY_FLOAT64)
+            put_f64(p, v);
+        else
+            put_le(p, (uint64_t)(int64_t)v, size);
+        out->used += size;
+        return;
+    }
+    int n;
+    if (t == RS_PLY_FLOAT32)
+        n = snprintf((char *)p, 40, "%.9g ", (double)(float)v);
+    else if (t == RS_PLY_FLOAT64)
+        n = snprintf((char *)p, 40, "%.17g ", v);
+    else
+        n = snprintf((char *)p, 40, "%" PRId64 " ", (int64_t)v);
+    if (n > 0 && n < 40)
+        out->used += (size_t)n;
+    else
+        out->ok = false;
+}
+
+/* Writes a kept value (host order) of type t. */
+static void emit_stored(out_buffer *out, bool binary, rs_ply_type t, const unsigned char *value) {
+    if (!binary) {
+        emit_double(out, false, t, rs_ply_host_value(value, t));
+        return;
+    }
+    size_t size = rs_ply_type_size(t);
+    unsigned char *p = out_reserve(out, size);
+    if (rs_ply_host_is_le() || size == 1)
+        memcpy(p, value, size);
+    else
+        for (size_t b = 0; b < size; b++)
+            p[b] = value[size - 1 - b];
+    out->used += size;
+}
+
+/* ascii: each value is followed by a space; the item's last one becomes the line end. */
+static void end_item(out_buffer *out, bool binary) {
+    if (!binary && out->used > 0)
+        out->bytes[out->used - 1] = '\n';
+}
+
+/* The face list's types as written: the input's, widened where the mesh's faces do not fit. */
+typedef struct face_types {
+    rs_ply_type count_type, index_type;
+    uint8_t count_spelling, spelling;
+} face_types;
+
+static face_types choose_face_types(const rsmooth_mesh *mesh, const rs_ply_property *list) {
+    face_types ft = {list->count_type, list->type, list->count_spelling, list->spelling};
+    uint32_t max_count = 0, max_index = 0;
+    for (size_t f = 0; f < mesh->face_count; f++) {
+        uint32_t n = mesh->face_offsets[f + 1] - mesh->face_offsets[f];
+        if (n > max_count)
+            max_count = n;
+    }
+    size_t index_count = mesh->face_count ? mesh->face_offsets[mesh->face_count] : 0;
+    for (size_t k = 0; k < index_count; k++)
+        if (mesh->face_indices[k] > max_index)
+            max_index = mesh->face_indices[k];
+    if (!type_holds(ft.count_type, max_count)) {
+        ft.count_type = RS_PLY_UINT32;
+        ft.count_spelling = rs_ply_canonical_spelling(RS_PLY_UINT32);
+    }
+    if (!type_holds(ft.index_type, max_index)) {
+        ft.index_type = max_index <= INT32_MAX ? RS_PLY_INT32 : RS_PLY_UINT32;
+        ft.spelling = rs_ply_canonical_spelling(ft.index_type);
+    }
+    return ft;
+}
+
+/* Integer-typed coordinates must hold the (rounded) filtered positions. */
+static rsmooth_status check_positions(const rsmooth_mesh *mesh, const rs_ply_element *v,
+                                      rsmooth_error *error) {
+    for (size_t k = 0; k < v->property_count; k++) {
+        const rs_ply_property *p = &v->properties[k];
+        if (p->role < RS_PLY_X || p->role > RS_PLY_Z || rs_ply_type_is_float(p->type))
+            continue;
+        int c = p->role - RS_PLY_X;
+        for (size_t i = 0; i < mesh->vertex_count; i++) {
+            double value = round(mesh->positions[3 * i + (size_t)c]);
+            if (!type_holds(p->type, value))
+                return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                               "vertex %zu: %s = %.17g does not fit the file's '%s' type", i,
+                               p->name, mesh->positions[3 * i + (size_t)c],
+                               rs_ply_spelling(p->spelling));
+        }
+    }
     return RSMOOTH_OK;
+}
+
+static bool write_faithful_header(const rs_ply_extras *x, FILE *stream, bool binary,
+                                  const face_types *ft) {
+    bool ok = fputs("ply\n", stream) >= 0;
+    for (size_t c = 0; ok && c < x->comment_count; c++)
+        if (x->comments[c].before_format)
+            ok = fprintf(stream, "%s\n", x->comments[c].text) >= 0;
+    ok = ok && fprintf(stream, "format %s 1.0\n", binary ? "binary_little_endian" : "ascii") >= 0;
+    size_t next_comment = 0;
+    for (size_t ei = 0; ok && ei <= x->element_count; ei++) {
+        for (; ok && next_comment < x->comment_count &&
+               x->comments[next_comment].before_element <= ei;
+             next_comment++)
+            if (!x->comments[next_comment].before_format)
+                ok = fprintf(stream, "%s\n", x->comments[next_comment].text) >= 0;
+        if (ei == x->element_count)
+            break;
+        const rs_ply_element *e = &x->elements[ei];
+        ok = ok && fprintf(stream, "element %s %" PRIu64 "\n", e->name, e->count) >= 0;
+        for (size_t k = 0; ok && k < e->property_count; k++) {
+            const rs_ply_property *p = &e->properties[k];
+            if (p->count_type == RS_PLY_NONE)
+                ok = fprintf(stream, "property %s %s\n", rs_ply_spelling(p->spelling), p->name) >= 0;
+            else if (p->role == RS_PLY_FACE_LIST)
+                ok = fprintf(stream, "property list %s %s %s\n",
+                             rs_ply_spelling(ft->count_spelling), rs_ply_spelling(ft->spelling),
+                             p->name) >= 0;
+            else
+                ok = fprintf(stream, "property list %s %s %s\n",
+                             rs_ply_spelling(p->count_spelling), rs_ply_spelling(p->spelling),
+                             p->name) >= 0;
+        }
+    }
+    return ok && fputs("end_header\n", stream) >= 0;
+}
+
+static rsmooth_status inconsistent(const rs_ply_element *e, rsmooth_error *error) {
+    return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                   "PLY extras of element '%.40s' are inconsistent", e->name);
+}
+
+static rsmooth_status write_element(const rsmooth_mesh *mesh, const rs_ply_extras *x, size_t ei,
+                                    const double *normals, const face_types *ft, out_buffer *out,
+                                    bool binary, rsmooth_error *error) {
+    const rs_ply_element *e = &x->elements[ei];
+    const bool is_face = ei == x->face_element;
+    size_t list_at = 0;
+    for (size_t i = 0; out->ok && i < (size_t)e->count; i++) {
+        const unsigned char *row = e->rows ? e->rows + i * e->row_size : NULL;
+        for (size_t k = 0; k < e->property_count; k++) {
+            const rs_ply_property *p = &e->properties[k];
+            switch ((rs_ply_role)p->role) {
+            case RS_PLY_X:
+            case RS_PLY_Y:
+            case RS_PLY_Z: {
+                double v = mesh->positions[3 * i + (size_t)(p->role - RS_PLY_X)];
+                emit_double(out, binary, p->type, rs_ply_type_is_float(p->type) ? v : round(v));
+                break;
+            }
+            case RS_PLY_NX:
+            case RS_PLY_NY:
+            case RS_PLY_NZ:
+                emit_double(out, binary, p->type, normals[3 * i + (size_t)(p->role - RS_PLY_NX)]);
+                break;
+            case RS_PLY_FACE_LIST: {
+                if (!is_face)
+                    return inconsistent(e, error);
+                uint32_t begin = mesh->face_offsets[i], end = mesh->face_offsets[i + 1];
+                emit_double(out, binary, ft->count_type, end - begin);
+                for (uint32_t j = begin; j < end; j++)
+                    emit_double(out, binary, ft->index_type, mesh->face_indices[j]);
+                break;
+            }
+            case RS_PLY_STORED:
+                if (!row || p->row_offset >= e->row_size)
+                    return inconsistent(e, error);
+                if (p->count_type == RS_PLY_NONE) {
+                    emit_stored(out, binary, p->type, row + p->row_offset);
+                    break;
+                }
+                double n = rs_ply_host_value(row + p->row_offset, p->count_type);
+                size_t size = rs_ply_type_size(p->type);
+                if (!(n >= 0 && n <= (double)((e->list_bytes - list_at) / size)))
+                    return inconsistent(e, error);
+                emit_stored(out, binary, p->count_type, row + p->row_offset);
+                for (size_t j = 0; j < (size_t)n; j++, list_at += size)
+                    emit_stored(out, binary, p->type, e->list_items + list_at);
+                break;
+            }
+        }
+        end_item(out, binary);
+    }
+    return RSMOOTH_OK;
+}
+
+static rsmooth_status write_faithful(const rsmooth_mesh *mesh, const rs_ply_extras *x, FILE *stream,
+                                     bool binary, rsmooth_error *error) {
+    const rs_ply_element *v = &x->elements[x->vertex_element];
+    rsmooth_status status = check_positions(mesh, v, error);
+    if (status != RSMOOTH_OK)
+        return status;
+    face_types ft = {RS_PLY_NONE, RS_PLY_NONE, 0, 0};
+    if (x->face_element != SIZE_MAX) {
+        const rs_ply_element *f = &x->elements[x->face_element];
+        for (size_t k = 0; k < f->property_count; k++)
+            if (f->properties[k].role == RS_PLY_FACE_LIST)
+                ft = choose_face_types(mesh, &f->properties[k]);
+    }
+    double *normals = NULL;
+    for (size_t k = 0; k < v->property_count && !normals; k++) {
+        if (v->properties[k].role >= RS_PLY_NX && v->properties[k].role <= RS_PLY_NZ) {
+            status = compute_normals(mesh, &normals, error);
+            if (status != RSMOOTH_OK)
+                return status;
+        }
+    }
+    errno = 0;
+    out_buffer *out = NULL;
+    bool ok = write_faithful_header(x, stream, binary, &ft);
+    if (ok)
+        ok = (out = out_open(stream)) != NULL;
+    for (size_t ei = 0; ok && status == RSMOOTH_OK && ei < x->element_count; ei++)
+        if (x->elements[ei].property_count > 0) /* else no data, whatever the count */
+            status = write_element(mesh, x, ei, normals, &ft, out, binary, error);
+    if (out)
+        ok = out_close(out) && ok;
+    rs_free(normals);
+    if (status != RSMOOTH_OK)
+        return status;
+    ok = ok && fflush(stream) == 0 && !ferror(stream);
+    return ok ? RSMOOTH_OK : io_failure(error);
+}
+
+rsmooth_status rs_io_ply_write(const rsmooth_mesh *mesh, FILE *stream, bool binary,
+                               rsmooth_error *error) {
+    const rs_ply_extras *x = mesh->extras ? mesh->extras->ply : NULL;
+    if (x && x->vertex_element < x->element_count &&
+        x->elements[x->vertex_element].count == mesh->vertex_count &&
+        (x->face_element < x->element_count
+             ? x->elements[x->face_element].count == mesh->face_count
+             : mesh->face_count == 0))
+        return write_faithful(mesh, x, stream, binary, error);
+    return write_generic(mesh, stream, binary, error);
 }
