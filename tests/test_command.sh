@@ -69,6 +69,44 @@ ls ./*tmp-* >/dev/null 2>&1 && fail "temporary files left behind: $(ls ./*tmp-*)
 OCL_ICD_VENDORS=/nonexistent OCL_ICD_FILENAMES= expect 0 "$rsmooth" noisy.ply -o fallback.ply
 grep -q "reference path" err.txt || fail "no fallback warning: $(cat err.txt)"
 
+# Same format in and out keeps every property; converting says what it drops.
+cat > rich.ply <<'PLY'
+ply
+format ascii 1.0
+comment made by hand
+element vertex 4
+property float x
+property float y
+property float z
+property uchar red
+property uchar green
+property uchar blue
+property float quality
+element face 2
+property list uchar int vertex_indices
+property uchar flags
+end_header
+0 0 0 255 0 0 0.5
+1 0 0 0 255 0 0.25
+0 1 0 0 0 255 1
+1 1 0.1 10 20 30 0
+3 0 1 2 7
+3 1 3 2 9
+PLY
+expect 0 "$rsmooth" rich.ply -o rich_out.ply --ascii
+grep -q "comment made by hand" rich_out.ply || fail "PLY comment lost"
+grep -q "property float quality" rich_out.ply || fail "PLY quality property lost"
+grep -q "property uchar flags" rich_out.ply || fail "PLY face property lost"
+grep -q "^3 1 3 2 9" rich_out.ply || fail "PLY face flags changed: $(tail -2 rich_out.ply)"
+grep -q "drops" err.txt && fail "PLY to PLY claims to drop something: $(cat err.txt)"
+expect 0 "$rsmooth" rich.ply -o rich_out.obj
+grep -q "rich_out.obj: this format cannot hold, so drops: PLY vertex property 'quality', PLY face property 'flags', PLY comments" err.txt ||
+  fail "conversion losses not reported: $(cat err.txt)"
+expect 0 "$rsmooth" rich.ply -o rich_out.stl
+grep -q "drops: vertex colours" err.txt || fail "STL colour loss not reported: $(cat err.txt)"
+expect 0 "$rsmooth" rich_out.stl -o rich_stl.off
+[ "$(sed -n 2p rich_stl.off)" = "6 2 0" ] || fail "STL is not read back as a soup: $(head -2 rich_stl.off)"
+
 # --in-place replaces the input atomically; with -o it is a usage error.
 cp noisy.ply inplace.ply
 expect 0 "$rsmooth" inplace.ply --in-place -q

@@ -25,8 +25,8 @@ static bool is_binary_stl(const char *data, size_t size) {
     if (size < 84)
         return false;
     const unsigned char *c = (const unsigned char *)data + 80;
-    uint64_t count = (uint64_t)c[0] | (uint64_t)c[1] << 8 | (uint64_t)c[2] << 16 |
-                     (uint64_t)c[3] << 24;
+    uint64_t count =
+        (uint64_t)c[0] | (uint64_t)c[1] << 8 | (uint64_t)c[2] << 16 | (uint64_t)c[3] << 24;
     return 84 + 50 * count == (uint64_t)size;
 }
 
@@ -34,8 +34,13 @@ static bool has_ascii_stl_magic(const char *data, size_t size) {
     size_t i = 0;
     while (i < size && (data[i] == ' ' || data[i] == '\t' || data[i] == '\r' || data[i] == '\n'))
         i++;
-    return size - i >= 6 && memcmp(data + i, "solid", 5) == 0 &&
-           (data[i + 5] == ' ' || data[i + 5] == '\t' || data[i + 5] == '\r' ||
+    static const char solid[] = "solid"; /* keywords are case-insensitive */
+    if (size - i < 6)
+        return false;
+    for (size_t k = 0; k < 5; k++)
+        if ((data[i + k] | 0x20) != solid[k])
+            return false;
+    return (data[i + 5] == ' ' || data[i + 5] == '\t' || data[i + 5] == '\r' ||
             data[i + 5] == '\n');
 }
 

@@ -206,6 +206,11 @@ static rsmooth_status parse_header(ply_reader *r, rsmooth_error *error) {
                                  "header ends without 'end_header'");
         size_t offset = r->pos;
         r->pos = (size_t)(eol - data) + 1;
+        /* A header is text: a NUL could never be written back (names and comments are strings). */
+        const char *nul = memchr(start, '\0', (size_t)(eol - start));
+        if (nul)
+            return rs_fail_parse(error, r->line, (int64_t)(nul - data), where,
+                                 "NUL byte in the header");
         const char *tok[MAX_HEADER_TOKENS];
         size_t len[MAX_HEADER_TOKENS];
         int n = 0;
