@@ -3,6 +3,7 @@
  * is removed afterwards (the ctest). */
 #define _POSIX_C_SOURCE 200809L
 #include "rsmooth_io.h"
+#include "test_io_util.h"
 
 #include <errno.h>
 #include <stdbool.h>
@@ -12,50 +13,6 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
-
-/* ---- a byte buffer the samples are built in, as the tests build theirs */
-
-typedef struct bytes {
-    unsigned char *data;
-    size_t size, capacity;
-    bool big_endian;
-} bytes;
-
-static void put(bytes *b, const void *p, size_t n) {
-    if (b->size + n > b->capacity) {
-        b->capacity = 2 * (b->size + n) + 64;
-        b->data = realloc(b->data, b->capacity);
-        if (!b->data) {
-            fprintf(stderr, "make_seed_corpus: out of memory\n");
-            exit(1);
-        }
-    }
-    memcpy(b->data + b->size, p, n);
-    b->size += n;
-}
-
-static void put_text(bytes *b, const char *s) {
-    put(b, s, strlen(s));
-}
-
-static void put_uint(bytes *b, uint64_t v, size_t n) {
-    unsigned char tmp[8];
-    for (size_t i = 0; i < n; i++)
-        tmp[b->big_endian ? n - 1 - i : i] = (unsigned char)(v >> (8 * i));
-    put(b, tmp, n);
-}
-
-static void put_f32(bytes *b, float f) {
-    uint32_t u;
-    memcpy(&u, &f, 4);
-    put_uint(b, u, 4);
-}
-
-static void put_f64(bytes *b, double d) {
-    uint64_t u;
-    memcpy(&u, &d, 8);
-    put_uint(b, u, 8);
-}
 
 /* The square 0-1-2-3 (a quad) plus the triangle 0 1 4, as the test files store it. */
 static const double square[5][3] = {
@@ -109,7 +66,7 @@ static void emit_text(corpus *c, const char *kind, const char *name, const char 
     bytes b = {0};
     put_text(&b, text);
     emit(c, kind, name, &b);
-    free(b.data);
+    bytes_free(&b);
 }
 
 /* ---- OBJ */
@@ -125,7 +82,7 @@ static void obj_seeds(corpus *c) {
     }
     put_text(&b, "f 1 2 3 4\nf 1 2 5\n");
     emit(c, "obj", "plain.obj", &b);
-    free(b.data);
+    bytes_free(&b);
 
     emit_text(c, "obj", "attributes.obj",
               "mtllib square.mtl\r\n"
@@ -175,7 +132,7 @@ static void ply_ascii_seeds(corpus *c) {
     }
     put_text(&b, "6 0 1 2 -1 3 4\r\n7 4 0 1 2 3 2 0.5 0.5\r\n1  3 0 1 4 0\n3 65 66 67 0.5\n");
     emit(c, "ply", "ascii_extras.ply", &b);
-    free(b.data);
+    bytes_free(&b);
 
     emit_text(c, "ply", "ascii_colours.ply",
               "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\n"
@@ -230,7 +187,7 @@ static void ply_binary_seed(corpus *c, const char *name, bool big_endian, bool d
         put_uint(&b, 7, 1);
     }
     emit(c, "ply", name, &b);
-    free(b.data);
+    bytes_free(&b);
 }
 
 /* What most tools write: float x y z, "list uchar int" faces. */
@@ -255,7 +212,7 @@ static void ply_common_seed(corpus *c, const char *name, bool big_endian) {
     put_uint(&b, 1, 4);
     put_uint(&b, 4, 4);
     emit(c, "ply", name, &b);
-    free(b.data);
+    bytes_free(&b);
 }
 
 static void ply_seeds(corpus *c) {
@@ -315,7 +272,7 @@ static void stl_binary_seed(corpus *c, const char *name, const char *header,
         put_uint(&b, attributes ? attributes[t] : 0, 2);
     }
     emit(c, "stl", name, &b);
-    free(b.data);
+    bytes_free(&b);
 }
 
 static void stl_seeds(corpus *c) {
@@ -334,7 +291,7 @@ static void stl_seeds(corpus *c) {
     }
     put_text(&b, "endsolid part one\r\n");
     emit(c, "stl", "ascii.stl", &b);
-    free(b.data);
+    bytes_free(&b);
 
     emit_text(c, "stl", "solids.stl",
               "solid a\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"

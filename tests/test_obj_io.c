@@ -1,7 +1,7 @@
 /* OBJ reading and writing: index forms, errors and their lines, round trips, truncation. */
 #define _POSIX_C_SOURCE 200809L
 #include "rsmooth_io.h"
-#include "test_util.h"
+#include "test_io_util.h"
 
 #include <stdbool.h>
 #include <stdint.h>
@@ -58,13 +58,6 @@ static void expect_parse_error(int at, const char *text, long long line, const c
     }
     CHECK(mesh == NULL);
     CHECK_EQ_INT(err.status, RSMOOTH_ERROR_PARSE);
-}
-
-static void check_face(const rsmooth_mesh *m, size_t f, const uint32_t *expected, size_t n) {
-    CHECK(f < m->face_count);
-    CHECK_EQ_INT(m->face_offsets[f + 1] - m->face_offsets[f], n);
-    for (size_t i = 0; i < n; i++)
-        CHECK_EQ_INT(m->face_indices[m->face_offsets[f] + i], expected[i]);
 }
 
 static void test_index_forms(void) {
@@ -481,27 +474,6 @@ static const char rich_obj[] = "# exported by hand\n"
                                "l 1 2 3\n"
                                "f -2/1/2 -1/2/1 1/3/2 # trailing\n";
 
-/* Writes `mesh` as OBJ into a malloc'd string (NUL-terminated; *size without the NUL). */
-static char *write_to_string(const rsmooth_mesh *mesh, rsmooth_format format, size_t *size) {
-    FILE *f = tmpfile();
-    CHECK(f != NULL);
-    rsmooth_error err;
-    rsmooth_status s = rsmooth_mesh_write_stream(mesh, f, format, &err);
-    if (s != RSMOOTH_OK)
-        fprintf(stderr, "write: %s\n", err.message);
-    CHECK_EQ_INT(s, RSMOOTH_OK);
-    long n = ftell(f);
-    CHECK(n > 0);
-    rewind(f);
-    char *text = malloc((size_t)n + 1);
-    CHECK(text != NULL);
-    CHECK_EQ_INT(fread(text, 1, (size_t)n, f), n);
-    text[n] = '\0';
-    fclose(f);
-    *size = (size_t)n;
-    return text;
-}
-
 /* What the test reads of an OBJ text by itself: the lines other than v, vn and f (in order), the
  * vt and vn lines' values, and per face corner the vt and vn indices (absolute, 0-based, -1 none). */
 typedef struct obj_text {
@@ -598,7 +570,7 @@ static void check_faithful_round_trip(const char *input) {
     rsmooth_error err;
     CHECK_EQ_INT(rsmooth_mesh_triangulate(m, &err), RSMOOTH_OK);
     size_t size;
-    char *out = write_to_string(m, RSMOOTH_FORMAT_OBJ, &size);
+    char *out = mesh_to_memory(m, RSMOOTH_FORMAT_OBJ, &size);
     CHECK(strstr(out, "written by rsmooth") == NULL); /* not the generic path */
     CHECK(strstr(out, " 0.1 ") != NULL);
 
@@ -645,7 +617,7 @@ static void check_faithful_round_trip(const char *input) {
 
     /* Writing the read-back mesh again changes nothing: the output is a fixed point. */
     size_t size2;
-    char *out2 = write_to_string(back, RSMOOTH_FORMAT_OBJ, &size2);
+    char *out2 = mesh_to_memory(back, RSMOOTH_FORMAT_OBJ, &size2);
     CHECK(size2 == size && memcmp(out, out2, size) == 0);
     free(out2);
 
@@ -666,7 +638,7 @@ static void check_faithful_round_trip(const char *input) {
 
     /* A changed face structure falls back to the generic writer: positions, colours, normals. */
     m->face_count--;
-    char *generic = write_to_string(m, RSMOOTH_FORMAT_OBJ, &size2);
+    char *generic = mesh_to_memory(m, RSMOOTH_FORMAT_OBJ, &size2);
     m->face_count++;
     CHECK(strncmp(generic, "# written by rsmooth\n", 21) == 0);
     CHECK(strstr(generic, "usemtl") == NULL && strstr(generic, "vt ") == NULL);
@@ -701,7 +673,7 @@ static void test_faithful(void) {
                                "f 1/1 2/-1 3\nf 3 2//7 1/2\n");
     CHECK(!m->has_vertex_normals);
     size_t size;
-    char *out = write_to_string(m, RSMOOTH_FORMAT_OBJ, &size);
+    char *out = mesh_to_memory(m, RSMOOTH_FORMAT_OBJ, &size);
     CHECK(strstr(out, "f 1/1 2/2 3\nf 3 2 1/2\n") != NULL);
     CHECK(strstr(out, "vn") == NULL);
     free(out);

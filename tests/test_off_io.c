@@ -1,7 +1,7 @@
 /* OFF reading and writing: the variants, errors and their lines, round trips, truncation. */
 #define _POSIX_C_SOURCE 200809L
 #include "rsmooth_io.h"
-#include "test_util.h"
+#include "test_io_util.h"
 
 #include <stdbool.h>
 #include <stdint.h>
@@ -53,39 +53,11 @@ static void expect_error(int at, const char *text, rsmooth_status status, long l
     CHECK_EQ_INT(err.status, status);
 }
 
-static void check_face(const rsmooth_mesh *m, size_t f, const uint32_t *expected, size_t n) {
-    CHECK(f < m->face_count);
-    CHECK_EQ_INT(m->face_offsets[f + 1] - m->face_offsets[f], n);
-    for (size_t i = 0; i < n; i++)
-        CHECK_EQ_INT(m->face_indices[m->face_offsets[f] + i], expected[i]);
-}
-
 static void check_color(const rsmooth_mesh *m, size_t v, int r, int g, int b) {
     CHECK(m->vertex_colors != NULL);
     CHECK_EQ_INT(m->vertex_colors[3 * v], r);
     CHECK_EQ_INT(m->vertex_colors[3 * v + 1], g);
     CHECK_EQ_INT(m->vertex_colors[3 * v + 2], b);
-}
-
-/* Writes `mesh` into a malloc'd NUL-terminated string. */
-static char *write_to_string(const rsmooth_mesh *mesh, rsmooth_format format, size_t *size) {
-    FILE *f = tmpfile();
-    CHECK(f != NULL);
-    rsmooth_error err;
-    rsmooth_status s = rsmooth_mesh_write_stream(mesh, f, format, &err);
-    if (s != RSMOOTH_OK)
-        fprintf(stderr, "write: %s\n", err.message);
-    CHECK_EQ_INT(s, RSMOOTH_OK);
-    long n = ftell(f);
-    CHECK(n > 0);
-    rewind(f);
-    char *text = malloc((size_t)n + 1);
-    CHECK(text != NULL);
-    CHECK_EQ_INT(fread(text, 1, (size_t)n, f), n);
-    text[n] = '\0';
-    fclose(f);
-    *size = (size_t)n;
-    return text;
 }
 
 static void test_variants(void) {
@@ -205,7 +177,7 @@ static void test_round_trips(void) {
 
     /* Faithful: keyword, vertex extras and face colours verbatim, normals recomputed. */
     size_t size;
-    char *out = write_to_string(m, RSMOOTH_FORMAT_OFF, &size);
+    char *out = mesh_to_memory(m, RSMOOTH_FORMAT_OFF, &size);
     CHECK(strncmp(out, "STCNOFF\n5 3 9\n", 14) == 0);
     CHECK(strstr(out, " 1.0 0.5 0 0.25  0 0\n") != NULL);
     CHECK(strstr(out, "\n4 0 1 2 3 0.9 0.1 0.1 1\n") != NULL);
@@ -229,7 +201,7 @@ static void test_round_trips(void) {
         CHECK_NEAR(read_normals[i], normals[i], 1e-8);
     /* Writing what was read back gives the same bytes. */
     size_t size2;
-    char *out2 = write_to_string(back, RSMOOTH_FORMAT_OFF, &size2);
+    char *out2 = mesh_to_memory(back, RSMOOTH_FORMAT_OFF, &size2);
     CHECK(size == size2 && memcmp(out, out2, size) == 0);
     free(out2);
     rsmooth_mesh_destroy(back);
@@ -238,7 +210,7 @@ static void test_round_trips(void) {
     /* Generic: CNOFF with integer colours, "nv nf 0", then positions, normals, colours. */
     struct rsmooth_mesh_extras *extras = m->extras;
     m->extras = NULL;
-    out = write_to_string(m, RSMOOTH_FORMAT_OFF, &size);
+    out = mesh_to_memory(m, RSMOOTH_FORMAT_OFF, &size);
     m->extras = extras;
     CHECK(strncmp(out, "CNOFF\n5 3 0\n", 12) == 0);
     CHECK(strstr(out, " 255 128 0 255\n") != NULL);
@@ -252,7 +224,7 @@ static void test_round_trips(void) {
 
     /* A changed count falls back to the generic writer. */
     m->face_count--;
-    out = write_to_string(m, RSMOOTH_FORMAT_OFF, &size);
+    out = mesh_to_memory(m, RSMOOTH_FORMAT_OFF, &size);
     m->face_count++;
     CHECK(strncmp(out, "CNOFF\n5 2 0\n", 12) == 0);
     free(out);
@@ -262,7 +234,7 @@ static void test_round_trips(void) {
     m->vertex_colors = NULL;
     m->has_vertex_normals = 0;
     m->extras = NULL;
-    out = write_to_string(m, RSMOOTH_FORMAT_OFF, &size);
+    out = mesh_to_memory(m, RSMOOTH_FORMAT_OFF, &size);
     m->extras = extras;
     CHECK(strncmp(out, "OFF\n5 3 0\n", 10) == 0);
     back = parse_size_ok(out, size);
@@ -275,7 +247,7 @@ static void test_round_trips(void) {
     rsmooth_mesh *obj = NULL;
     const char *obj_text = "v 0 0 0 1 0 0\nv 1 0 0 0 1 0\nv 0 1 0 0 0 1\nvn 0 0 1\nf 1 2 3\n";
     CHECK_EQ_INT(parse_n(obj_text, strlen(obj_text), RSMOOTH_FORMAT_OBJ, &obj, &err), RSMOOTH_OK);
-    out = write_to_string(obj, RSMOOTH_FORMAT_OFF, &size);
+    out = mesh_to_memory(obj, RSMOOTH_FORMAT_OFF, &size);
     CHECK(strncmp(out, "CNOFF\n3 1 0\n", 12) == 0);
     back = parse_size_ok(out, size);
     check_same_geometry(obj, back);

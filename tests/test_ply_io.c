@@ -1,59 +1,13 @@
 /* PLY reading and writing: all encodings, skipped data, errors, round trips, truncation. */
 #define _POSIX_C_SOURCE 200809L
 #include "rsmooth_io.h"
-#include "test_util.h"
+#include "test_io_util.h"
 
 #include <stdbool.h>
 #include <stdint.h>
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
-
-/* ---- a byte buffer the tests build files in */
-
-typedef struct bytes {
-    unsigned char *data;
-    size_t size, capacity;
-    bool big_endian;
-} bytes;
-
-static void put(bytes *b, const void *p, size_t n) {
-    if (b->size + n > b->capacity) {
-        b->capacity = 2 * (b->size + n) + 64;
-        b->data = realloc(b->data, b->capacity);
-        CHECK(b->data != NULL);
-    }
-    memcpy(b->data + b->size, p, n);
-    b->size += n;
-}
-
-static void put_text(bytes *b, const char *s) {
-    put(b, s, strlen(s));
-}
-
-static void put_uint(bytes *b, uint64_t v, size_t n) {
-    unsigned char tmp[8];
-    for (size_t i = 0; i < n; i++)
-        tmp[b->big_endian ? n - 1 - i : i] = (unsigned char)(v >> (8 * i));
-    put(b, tmp, n);
-}
-
-static void put_u8(bytes *b, unsigned v) {
-    put_uint(b, v, 1);
-}
-static void put_i32(bytes *b, int32_t v) {
-    put_uint(b, (uint32_t)v, 4);
-}
-static void put_f32(bytes *b, float f) {
-    uint32_t u;
-    memcpy(&u, &f, 4);
-    put_uint(b, u, 4);
-}
-static void put_f64(bytes *b, double d) {
-    uint64_t u;
-    memcpy(&u, &d, 8);
-    put_uint(b, u, 8);
-}
 
 /* ---- parsing helpers */
 
@@ -92,13 +46,6 @@ static rsmooth_error expect_parse_error(int at, const void *data, size_t size, c
     }
     CHECK(mesh == NULL);
     return err;
-}
-
-static void check_face(const rsmooth_mesh *m, size_t f, const uint32_t *expected, size_t n) {
-    CHECK(f < m->face_count);
-    CHECK_EQ_INT(m->face_offsets[f + 1] - m->face_offsets[f], n);
-    for (size_t i = 0; i < n; i++)
-        CHECK_EQ_INT(m->face_indices[m->face_offsets[f] + i], expected[i]);
 }
 
 /* The square 0-1-2-3 (a quad) plus the triangle 0 1 4, as every test file below stores it. */
@@ -166,7 +113,7 @@ static void test_ascii(void) {
     CHECK_EQ_INT(m->precision, RSMOOTH_FLOAT32);
     CHECK_EQ_INT(m->source_format, RSMOOTH_FORMAT_PLY_ASCII);
     rsmooth_mesh_destroy(m);
-    free(b.data);
+    bytes_free(&b);
 }
 
 /* Faces first, double coordinates, uint indices, an extra element with a list before them. */
@@ -258,7 +205,7 @@ static void test_binary(void) {
             CHECK_EQ_INT(m->source_format,
                          be ? RSMOOTH_FORMAT_PLY_BINARY_BE : RSMOOTH_FORMAT_PLY_BINARY);
             rsmooth_mesh_destroy(m);
-            free(b.data);
+            bytes_free(&b);
         }
     }
 
@@ -267,7 +214,7 @@ static void test_binary(void) {
     rsmooth_mesh *m = parse_ok(&b);
     check_square(m);
     rsmooth_mesh_destroy(m);
-    free(b.data);
+    bytes_free(&b);
     b = common_square(false);
     m = parse_ok(&b);
     check_square(m);
@@ -296,7 +243,7 @@ static void test_binary(void) {
     CHECK_EQ_INT(err.byte_offset, y3 - 4);
     set_f32_le(b.data + y3, -INFINITY);
     EXPECT_PARSE_ERROR(b.data, b.size, "vertex 3 has a non-finite coordinate");
-    free(b.data);
+    bytes_free(&b);
 }
 
 /* ---- errors */
@@ -306,7 +253,7 @@ static void expect_header_error(int at, const char *header, const char *needle) 
     put_text(&b, header);
     put_text(&b, "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
     expect_parse_error(at, b.data, b.size, needle);
-    free(b.data);
+    bytes_free(&b);
 }
 #define EXPECT_HEADER_ERROR(header, needle) expect_header_error(__LINE__, header, needle)
 
@@ -393,7 +340,7 @@ static void test_errors(void) {
     bytes b = binary_square(false, false);
     err = EXPECT_PARSE_ERROR(b.data, b.size - 1, "only");
     CHECK(err.byte_offset > 0);
-    free(b.data);
+    bytes_free(&b);
 }
 
 /* Declared counts far beyond the data are refused before anything that size is allocated. */
@@ -583,16 +530,16 @@ static void check_prefixes(const bytes *b) {
 static void test_truncated_prefixes(void) {
     bytes b = binary_square(false, true);
     check_prefixes(&b);
-    free(b.data);
+    bytes_free(&b);
     b = binary_square(true, false);
     check_prefixes(&b);
-    free(b.data);
+    bytes_free(&b);
     b = common_square(true);
     check_prefixes(&b);
-    free(b.data);
+    bytes_free(&b);
     b = ascii_square();
     check_prefixes(&b);
-    free(b.data);
+    bytes_free(&b);
 }
 
 /* Random corruption of a valid binary file: an error or a valid mesh, never a crash. */
@@ -614,10 +561,10 @@ static void test_corruption(void) {
             for (size_t t = 0; t < 3 * m->triangle_count; t++)
                 CHECK(m->triangles[t] < m->vertex_count);
         rsmooth_mesh_destroy(m);
-        free(b.data);
+        bytes_free(&b);
     }
-    free(goods[0].data);
-    free(goods[1].data);
+    bytes_free(&goods[0]);
+    bytes_free(&goods[1]);
 }
 
 int main(void) {

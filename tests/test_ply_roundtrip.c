@@ -1,32 +1,11 @@
 /* PLY round trips that keep everything: comments, every property and element, types, polygons. */
 #define _POSIX_C_SOURCE 200809L
 #include "rsmooth_io.h"
-#include "test_util.h"
+#include "test_io_util.h"
 
 #include <stdbool.h>
 #include <stdint.h>
 #include <string.h>
-
-/* ---- a byte buffer the tests build files in */
-
-typedef struct bytes {
-    unsigned char *data;
-    size_t size, capacity;
-} bytes;
-
-static void put(bytes *b, const void *p, size_t n) {
-    if (b->size + n > b->capacity) {
-        b->capacity = 2 * (b->size + n) + 64;
-        b->data = realloc(b->data, b->capacity);
-        CHECK(b->data != NULL);
-    }
-    memcpy(b->data + b->size, p, n);
-    b->size += n;
-}
-
-static void put_text(bytes *b, const char *s) {
-    put(b, s, strlen(s));
-}
 
 /* ---- a small independent PLY reader: header lines, and every value as a double */
 
@@ -314,24 +293,6 @@ static rsmooth_mesh *read_ok(const void *data, size_t size) {
     return mesh;
 }
 
-static bytes write_mem(const rsmooth_mesh *m, rsmooth_format format) {
-    rsmooth_error err;
-    FILE *f = tmpfile();
-    CHECK(f != NULL);
-    rsmooth_status s = rsmooth_mesh_write_stream(m, f, format, &err);
-    if (s != RSMOOTH_OK)
-        fprintf(stderr, "write: %s\n", err.message);
-    CHECK_EQ_INT(s, RSMOOTH_OK);
-    long size = ftell(f);
-    CHECK(size > 0);
-    rewind(f);
-    bytes b = {malloc((size_t)size), (size_t)size, (size_t)size};
-    CHECK(b.data != NULL);
-    CHECK_EQ_INT(fread(b.data, 1, (size_t)size, f), size);
-    fclose(f);
-    return b;
-}
-
 static bool same_bits(double a, double b) {
     return memcmp(&a, &b, sizeof a) == 0;
 }
@@ -433,7 +394,8 @@ static void test_rich_round_trip(void) {
             m->positions[i] = (float)(m->positions[i] + 0.5 + 0.001 * (double)i); /* see below */
         const rsmooth_format outputs[2] = {RSMOOTH_FORMAT_PLY_ASCII, RSMOOTH_FORMAT_PLY_BINARY};
         for (int o = 0; o < 2; o++) {
-            bytes written = write_mem(m, outputs[o]);
+            bytes written = {0};
+            written.data = mesh_to_memory(m, outputs[o], &written.size);
             tply *out = tparse(written.data, written.size);
             CHECK_EQ_INT(out->format, o == 0 ? T_ASCII : T_LE);
             check_faithful(in, out, m);
@@ -450,28 +412,30 @@ static void test_rich_round_trip(void) {
             CHECK_EQ_INT(memcmp(back->vertex_colors, m->vertex_colors, 3 * NV), 0);
             /* Writing the re-read mesh again gives the same bytes (the positions were floats, so
              * the normals come out the same). */
-            bytes again = write_mem(back, outputs[o]);
+            bytes again = {0};
+            again.data = mesh_to_memory(back, outputs[o], &again.size);
             CHECK_EQ_INT(again.size, written.size);
             CHECK_EQ_INT(memcmp(again.data, written.data, written.size), 0);
-            free(again.data);
+            bytes_free(&again);
             rsmooth_mesh_destroy(back);
             tfree(out);
-            free(written.data);
+            bytes_free(&written);
         }
 
         /* Caller fields do not override the extras; without extras they are written. */
         m->vertex_quality = calloc(NV, sizeof(float));
         CHECK(m->vertex_quality != NULL);
-        bytes written = write_mem(m, RSMOOTH_FORMAT_PLY_BINARY);
+        bytes written = {0};
+        written.data = mesh_to_memory(m, RSMOOTH_FORMAT_PLY_BINARY, &written.size);
         tply *out = tparse(written.data, written.size);
         check_faithful(in, out, m);
         tfree(out);
-        free(written.data);
+        bytes_free(&written);
 
         /* Fewer faces than the file had: the generic layout, with recomputed normals. */
         m->face_count--;
         m->triangle_count--;
-        written = write_mem(m, RSMOOTH_FORMAT_PLY_ASCII);
+        written.data = mesh_to_memory(m, RSMOOTH_FORMAT_PLY_ASCII, &written.size);
         out = tparse(written.data, written.size);
         CHECK(!strcmp(out->lines[2], "comment written by rsmooth"));
         const telem *v = &out->elems[0];
@@ -479,13 +443,13 @@ static void test_rich_round_trip(void) {
               tprop_index(v, "red") != SIZE_MAX && tprop_index(v, "label") == SIZE_MAX);
         CHECK_EQ_INT(out->elems[1].count, NF - 1);
         tfree(out);
-        free(written.data);
+        bytes_free(&written);
         m->face_count++;
         m->triangle_count++;
 
         rsmooth_mesh_destroy(m);
         tfree(in);
-        free(file.data);
+        bytes_free(&file);
     }
 }
 
@@ -493,7 +457,9 @@ static void test_rich_round_trip(void) {
 static void test_big_endian_as_little(void) {
     bytes le = rich_file(T_LE), be = rich_file(T_BE);
     rsmooth_mesh *a = read_ok(le.data, le.size), *b = read_ok(be.data, be.size);
-    bytes wa = write_mem(a, RSMOOTH_FORMAT_PLY_BINARY), wb = write_mem(b, RSMOOTH_FORMAT_PLY_BINARY);
+    bytes wa = {0}, wb = {0};
+    wa.data = mesh_to_memory(a, RSMOOTH_FORMAT_PLY_BINARY, &wa.size);
+    wb.data = mesh_to_memory(b, RSMOOTH_FORMAT_PLY_BINARY, &wb.size);
     CHECK_EQ_INT(wa.size, wb.size);
     CHECK_EQ_INT(memcmp(wa.data, wb.data, wa.size), 0);
     /* And that is the little-endian input itself (normals recomputed from these positions). */
@@ -501,12 +467,12 @@ static void test_big_endian_as_little(void) {
     check_faithful(in, out, b);
     tfree(in);
     tfree(out);
-    free(wa.data);
-    free(wb.data);
+    bytes_free(&wa);
+    bytes_free(&wb);
     rsmooth_mesh_destroy(a);
     rsmooth_mesh_destroy(b);
-    free(le.data);
-    free(be.data);
+    bytes_free(&le);
+    bytes_free(&be);
 }
 
 static void test_plain(void) {
@@ -523,10 +489,11 @@ static void test_plain(void) {
     CHECK_EQ_INT(rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_STL_BINARY, lost, sizeof lost),
                  0);
     /* The generic writer reproduces it exactly. */
-    bytes w = write_mem(m, RSMOOTH_FORMAT_PLY_ASCII);
+    bytes w = {0};
+    w.data = mesh_to_memory(m, RSMOOTH_FORMAT_PLY_ASCII, &w.size);
     CHECK_EQ_INT(w.size, strlen(text));
     CHECK_EQ_INT(memcmp(w.data, text, w.size), 0);
-    free(w.data);
+    bytes_free(&w);
     rsmooth_mesh_destroy(m);
 }
 
@@ -551,7 +518,7 @@ static void test_many_losses(void) {
     CHECK(strstr(lost, "'p5'") != NULL && strstr(lost, "'p6'") == NULL);
     CHECK(strstr(lost, "and 5 more PLY properties") != NULL);
     rsmooth_mesh_destroy(m);
-    free(b.data);
+    bytes_free(&b);
 }
 
 /* Faces that no longer fit the file's list types widen them; integer coordinates round and must fit. */
@@ -571,7 +538,8 @@ static void test_widening_and_integer_positions(void) {
     m->face_indices[2] = 299;
     m->positions[0] = 3.4;
     m->positions[1] = -2.6;
-    bytes w = write_mem(m, RSMOOTH_FORMAT_PLY_BINARY);
+    bytes w = {0};
+    w.data = mesh_to_memory(m, RSMOOTH_FORMAT_PLY_BINARY, &w.size);
     tply *out = tparse(w.data, w.size);
     CHECK(!strcmp(out->elems[1].props[0].count_type, "uchar"));
     CHECK(!strcmp(out->elems[1].props[0].type, "int"));
@@ -580,7 +548,7 @@ static void test_widening_and_integer_positions(void) {
     CHECK_EQ_INT(out->elems[0].values[0], 3);
     CHECK_EQ_INT(out->elems[0].values[1], -3);
     tfree(out);
-    free(w.data);
+    bytes_free(&w);
     m->positions[5] = 40000; /* beyond a short */
     rsmooth_error err;
     FILE *f = tmpfile();
@@ -590,7 +558,7 @@ static void test_widening_and_integer_positions(void) {
     CHECK(strstr(err.message, "short") != NULL);
     fclose(f);
     rsmooth_mesh_destroy(m);
-    free(b.data);
+    bytes_free(&b);
 }
 
 /* The generic path with normals: recomputed, in the positions' precision. */
@@ -608,7 +576,9 @@ static void test_generic_normals(void) {
     double normals[12];
     CHECK_EQ_INT(rsmooth_mesh_vertex_normals(m, normals, &err), RSMOOTH_OK);
     for (int o = 0; o < 2; o++) {
-        bytes w = write_mem(m, o ? RSMOOTH_FORMAT_PLY_BINARY : RSMOOTH_FORMAT_PLY_ASCII);
+        bytes w = {0};
+        w.data =
+            mesh_to_memory(m, o ? RSMOOTH_FORMAT_PLY_BINARY : RSMOOTH_FORMAT_PLY_ASCII, &w.size);
         tply *out = tparse(w.data, w.size);
         const telem *v = &out->elems[0];
         size_t nx = tprop_index(v, "nx");
@@ -623,7 +593,7 @@ static void test_generic_normals(void) {
         check_faithful(out, out, back); /* its own normals again on a second write */
         rsmooth_mesh_destroy(back);
         tfree(out);
-        free(w.data);
+        bytes_free(&w);
     }
     rsmooth_mesh_destroy(m);
 }
@@ -683,15 +653,17 @@ static void test_empty_lists(void) {
     rsmooth_mesh *m = read_ok(b.data, b.size);
     tply *in = tparse(b.data, b.size);
     for (int o = 0; o < 2; o++) {
-        bytes w = write_mem(m, o ? RSMOOTH_FORMAT_PLY_BINARY : RSMOOTH_FORMAT_PLY_ASCII);
+        bytes w = {0};
+        w.data =
+            mesh_to_memory(m, o ? RSMOOTH_FORMAT_PLY_BINARY : RSMOOTH_FORMAT_PLY_ASCII, &w.size);
         tply *out = tparse(w.data, w.size);
         check_faithful(in, out, m);
         tfree(out);
-        free(w.data);
+        bytes_free(&w);
     }
     tfree(in);
     rsmooth_mesh_destroy(m);
-    free(b.data);
+    bytes_free(&b);
 }
 
 /* Every prefix of the rich files: an error or a mesh, never an over-read (exact-size buffers). */
@@ -712,7 +684,7 @@ static void test_prefixes(void) {
                 CHECK_EQ_INT(s, RSMOOTH_OK);
             rsmooth_mesh_destroy(m);
         }
-        free(b.data);
+        bytes_free(&b);
     }
 }
 
@@ -741,7 +713,7 @@ static void test_corruption(void) {
             fclose(f);
         }
         rsmooth_mesh_destroy(m);
-        free(good.data);
+        bytes_free(&good);
     }
 }
 

@@ -1,44 +1,11 @@
 /* STL reading and writing: ascii and binary, soups, extras, errors, round trips, truncation. */
 #define _POSIX_C_SOURCE 200809L
 #include "rsmooth_io.h"
-#include "test_util.h"
+#include "test_io_util.h"
 
 #include <stdbool.h>
 #include <stdint.h>
 #include <string.h>
-
-/* ---- a byte buffer the tests build files in */
-
-typedef struct bytes {
-    unsigned char *data;
-    size_t size, capacity;
-} bytes;
-
-static void put(bytes *b, const void *p, size_t n) {
-    if (b->size + n > b->capacity) {
-        b->capacity = 2 * (b->size + n) + 64;
-        b->data = realloc(b->data, b->capacity);
-        CHECK(b->data != NULL);
-    }
-    memcpy(b->data + b->size, p, n);
-    b->size += n;
-}
-
-static void put_text(bytes *b, const char *s) {
-    put(b, s, strlen(s));
-}
-
-static void put_u32(bytes *b, uint32_t v) {
-    unsigned char tmp[4] = {(unsigned char)v, (unsigned char)(v >> 8), (unsigned char)(v >> 16),
-                            (unsigned char)(v >> 24)};
-    put(b, tmp, 4);
-}
-
-static void put_f32(bytes *b, float f) {
-    uint32_t u;
-    memcpy(&u, &f, 4);
-    put_u32(b, u);
-}
 
 static uint32_t get_u32(const unsigned char *p) {
     return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
@@ -171,29 +138,13 @@ static rsmooth_error expect_ascii_error(int at, const char *body, const char *ne
     put_text(&b, body);
     put_text(&b, "endsolid t\n");
     rsmooth_error err = expect_parse_error(at, b.data, b.size, RSMOOTH_FORMAT_AUTO, needle);
-    free(b.data);
+    bytes_free(&b);
     return err;
 }
 #define EXPECT_ASCII_ERROR(body, needle) expect_ascii_error(__LINE__, body, needle)
 
 #define GOOD_FACET                                                                                 \
     "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
-
-/* Writes `mesh` in `format` into a malloc'd buffer. */
-static bytes write_mem(const rsmooth_mesh *mesh, rsmooth_format format) {
-    char *data = NULL;
-    size_t size = 0;
-    FILE *f = open_memstream(&data, &size);
-    CHECK(f != NULL);
-    rsmooth_error err;
-    rsmooth_status s = rsmooth_mesh_write_stream(mesh, f, format, &err);
-    if (s != RSMOOTH_OK)
-        fprintf(stderr, "write failed: %s\n", err.message);
-    CHECK_EQ_INT(s, RSMOOTH_OK);
-    CHECK(fclose(f) == 0);
-    bytes b = {(unsigned char *)data, size, size};
-    return b;
-}
 
 static bool contains(const bytes *b, const char *needle) {
     size_t n = strlen(needle);
@@ -222,7 +173,7 @@ static void test_ascii(void) {
     m = parse_ok(b.data, b.size, RSMOOTH_FORMAT_STL_BINARY);
     check_soup(m, 3, 0);
     rsmooth_mesh_destroy(m);
-    free(b.data);
+    bytes_free(&b);
 
     /* Unnamed: nothing to keep. */
     const char *plain = "solid\n" GOOD_FACET "endsolid\n";
@@ -238,21 +189,23 @@ static void test_ascii(void) {
     CHECK_EQ_INT(m->triangle_count, 3);
     CHECK_EQ_INT(m->vertex_count, 9);
     CHECK_NEAR(m->positions[3 * 8 + 1], 1, 0);
-    bytes out = write_mem(m, RSMOOTH_FORMAT_STL_ASCII);
+    bytes out = {0};
+    out.data = mesh_to_memory(m, RSMOOTH_FORMAT_STL_ASCII, &out.size);
     CHECK(contains(&out, "solid a\n") && contains(&out, "endsolid a\n"));
     CHECK(contains(&out, "solid\nendsolid\n"));
     CHECK(contains(&out, "solid c d\n") && contains(&out, "endsolid c d\n"));
     rsmooth_mesh *back = parse_ok(out.data, out.size, RSMOOTH_FORMAT_AUTO);
-    bytes again = write_mem(back, RSMOOTH_FORMAT_STL_ASCII);
+    bytes again = {0};
+    again.data = mesh_to_memory(back, RSMOOTH_FORMAT_STL_ASCII, &again.size);
     CHECK(again.size == out.size && memcmp(again.data, out.data, out.size) == 0);
-    free(again.data);
+    bytes_free(&again);
     rsmooth_mesh_destroy(back);
-    free(out.data);
+    bytes_free(&out);
     /* To binary: the first name is the header. */
-    out = write_mem(m, RSMOOTH_FORMAT_STL_BINARY);
+    out.data = mesh_to_memory(m, RSMOOTH_FORMAT_STL_BINARY, &out.size);
     CHECK_EQ_INT(out.size, 84 + 3 * 50);
     CHECK(memcmp(out.data, "a ", 2) == 0);
-    free(out.data);
+    bytes_free(&out);
     rsmooth_mesh_destroy(m);
 }
 
@@ -273,7 +226,8 @@ static void test_binary(void) {
                  0);
 
     /* Written back: the same header and attributes, normals recomputed. */
-    bytes out = write_mem(m, RSMOOTH_FORMAT_STL_BINARY);
+    bytes out = {0};
+    out.data = mesh_to_memory(m, RSMOOTH_FORMAT_STL_BINARY, &out.size);
     CHECK_EQ_INT(out.size, b.size);
     CHECK(memcmp(out.data, b.data, 84) == 0);
     for (size_t t = 0; t < 3; t++) {
@@ -288,52 +242,52 @@ static void test_binary(void) {
     const double n1[3] = {-0.625, 0.75, 1.875}, len1 = sqrt(4.46875);
     for (int k = 0; k < 3; k++)
         CHECK_NEAR(get_f32(out.data + 84 + 50 + 4 * k), n1[k] / len1, 1e-7);
-    free(out.data);
+    bytes_free(&out);
 
     /* Once the triangles change, the details no longer apply. */
     m->triangle_count = 2;
-    out = write_mem(m, RSMOOTH_FORMAT_STL_BINARY);
+    out.data = mesh_to_memory(m, RSMOOTH_FORMAT_STL_BINARY, &out.size);
     CHECK_EQ_INT(out.size, 84 + 2 * 50);
     CHECK(memcmp(out.data, "rsmooth ", 8) == 0 && out.data[79] == ' ');
     CHECK_EQ_INT(get_u32(out.data + 80), 2);
     CHECK(out.data[84 + 50 + 48] == 0 && out.data[84 + 50 + 49] == 0);
-    free(out.data);
+    bytes_free(&out);
     m->triangle_count = 3;
 
     /* To ascii: the header as the solid name. */
-    out = write_mem(m, RSMOOTH_FORMAT_STL_ASCII);
+    out.data = mesh_to_memory(m, RSMOOTH_FORMAT_STL_ASCII, &out.size);
     CHECK(contains(&out, "solid made by test_stl_io\n"));
     CHECK(contains(&out, "endsolid made by test_stl_io\n"));
     rsmooth_mesh_destroy(m);
-    free(out.data);
-    free(b.data);
+    bytes_free(&out);
+    bytes_free(&b);
 
     /* Blank header, no attributes: nothing kept; written back with the default header. */
     b = binary_sample("", NULL);
     m = parse_ok(b.data, b.size, RSMOOTH_FORMAT_AUTO);
     CHECK(m->extras == NULL);
-    out = write_mem(m, RSMOOTH_FORMAT_STL_ASCII);
+    out.data = mesh_to_memory(m, RSMOOTH_FORMAT_STL_ASCII, &out.size);
     CHECK(memcmp(out.data, "solid rsmooth\n", 14) == 0);
     CHECK(contains(&out, "endsolid rsmooth\n"));
     /* float32 data written at float precision */
     CHECK(contains(&out, "vertex 0.25 1 3.125\n"));
-    free(out.data);
+    bytes_free(&out);
     rsmooth_mesh_destroy(m);
-    free(b.data);
+    bytes_free(&b);
 
     /* A header that starts with "solid": the exact size makes it binary. */
     b = binary_sample("solid cube exported by a CAD tool", NULL);
     m = parse_ok(b.data, b.size, RSMOOTH_FORMAT_AUTO);
     CHECK_EQ_INT(m->source_format, RSMOOTH_FORMAT_STL_BINARY);
     check_soup(m, 3, 0);
-    out = write_mem(m, RSMOOTH_FORMAT_STL_ASCII);
+    out.data = mesh_to_memory(m, RSMOOTH_FORMAT_STL_ASCII, &out.size);
     CHECK(memcmp(out.data, "solid cube exported by a CAD tool\n", 34) == 0);
-    free(out.data);
+    bytes_free(&out);
     rsmooth_mesh_destroy(m);
     /* The same with one byte more: its size is what is wrong, though it starts like ascii. */
     put(&b, "", 1);
     EXPECT_PARSE_ERROR(b.data, b.size, "binary STL of 3 triangles needs 234 bytes, file has 235");
-    free(b.data);
+    bytes_free(&b);
 }
 
 static void test_errors(void) {
@@ -364,7 +318,7 @@ static void test_errors(void) {
     set_f32(b.data + 84 + 50 + 12 + 12 + 4, 1);
     set_f32(b.data + 84, NAN);
     rsmooth_mesh_destroy(parse_ok(b.data, b.size, RSMOOTH_FORMAT_STL_BINARY));
-    free(b.data);
+    bytes_free(&b);
 
     /* ascii: keywords, vertex counts, numbers, with their line */
     err = EXPECT_ASCII_ERROR(GOOD_FACET "facet normal 0 0 1\nouter loop\nvertex nan 0 0\n"
@@ -468,7 +422,8 @@ static void test_round_trip(void) {
     /* ascii -> binary -> ascii: positions at float precision, the triangle count. */
     bytes b = ascii_sample();
     rsmooth_mesh *m = parse_ok(b.data, b.size, RSMOOTH_FORMAT_AUTO);
-    bytes bin = write_mem(m, RSMOOTH_FORMAT_STL_BINARY);
+    bytes bin = {0};
+    bin.data = mesh_to_memory(m, RSMOOTH_FORMAT_STL_BINARY, &bin.size);
     CHECK_EQ_INT(bin.size, 84 + 3 * 50);
     CHECK(memcmp(bin.data, "part one ", 9) == 0);
     rsmooth_mesh *m2 = parse_ok(bin.data, bin.size, RSMOOTH_FORMAT_AUTO);
@@ -476,7 +431,8 @@ static void test_round_trip(void) {
     check_soup(m2, 3, 1e-6);
     for (size_t i = 0; i < 9 * 3; i++)
         CHECK_NEAR(m2->positions[i], (double)(float)m->positions[i], 0);
-    bytes text = write_mem(m2, RSMOOTH_FORMAT_STL_ASCII);
+    bytes text = {0};
+    text.data = mesh_to_memory(m2, RSMOOTH_FORMAT_STL_ASCII, &text.size);
     CHECK(contains(&text, "solid part one\n"));
     rsmooth_mesh *m3 = parse_ok(text.data, text.size, RSMOOTH_FORMAT_AUTO);
     CHECK_EQ_INT(m3->triangle_count, 3);
@@ -484,18 +440,18 @@ static void test_round_trip(void) {
         CHECK_NEAR(m3->positions[i], m2->positions[i], 0);
     rsmooth_mesh_destroy(m3);
     rsmooth_mesh_destroy(m2);
-    free(text.data);
-    free(bin.data);
+    bytes_free(&text);
+    bytes_free(&bin);
 
     /* double data stays exact through ascii (%.17g). */
     m->positions[4] = 0.1;
     m->positions[5] = -1.0 / 3.0;
-    text = write_mem(m, RSMOOTH_FORMAT_STL_ASCII);
+    text.data = mesh_to_memory(m, RSMOOTH_FORMAT_STL_ASCII, &text.size);
     m2 = parse_ok(text.data, text.size, RSMOOTH_FORMAT_AUTO);
     for (size_t i = 0; i < 9 * 3; i++)
         CHECK_NEAR(m2->positions[i], m->positions[i], 0);
     rsmooth_mesh_destroy(m2);
-    free(text.data);
+    bytes_free(&text);
 
     /* What cannot be written is refused before anything is. */
     rsmooth_error err;
@@ -522,7 +478,7 @@ static void test_round_trip(void) {
     m->triangle_count = t;
     fclose(sink);
     rsmooth_mesh_destroy(m);
-    free(b.data);
+    bytes_free(&b);
 }
 
 /* An indexed mesh (a quad and a triangle sharing vertices, one degenerate triangle) is written as
@@ -540,7 +496,9 @@ static void test_indexed(void) {
     CHECK_STATUS(rsmooth_mesh_triangulate(m, &err), RSMOOTH_OK);
     CHECK_EQ_INT(m->triangle_count, 4);
     for (int binary = 0; binary < 2; binary++) {
-        bytes out = write_mem(m, binary ? RSMOOTH_FORMAT_STL_BINARY : RSMOOTH_FORMAT_STL_ASCII);
+        bytes out = {0};
+        out.data = mesh_to_memory(m, binary ? RSMOOTH_FORMAT_STL_BINARY : RSMOOTH_FORMAT_STL_ASCII,
+                                  &out.size);
         rsmooth_mesh *s = parse_ok(out.data, out.size, RSMOOTH_FORMAT_AUTO);
         CHECK_EQ_INT(s->source_format,
                      binary ? RSMOOTH_FORMAT_STL_BINARY : RSMOOTH_FORMAT_STL_ASCII);
@@ -555,7 +513,7 @@ static void test_indexed(void) {
         else
             CHECK(contains(&out, "facet normal 0 0 0\n"));
         rsmooth_mesh_destroy(s);
-        free(out.data);
+        bytes_free(&out);
     }
     rsmooth_mesh_destroy(m);
 }
