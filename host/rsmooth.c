@@ -344,8 +344,10 @@ static int smooth(const options *opt, const rsmooth_mesh *mesh, double *out, flo
         }
     }
     rsmooth_params params = opt->params;
-    params.progress = cli_progress_callback;
-    params.progress_user = bar;
+    if (bar->enabled) { /* progress slices the kernel launches: only when a bar can show */
+        params.progress = cli_progress_callback;
+        params.progress_user = bar;
+    }
     if (reference)
         st = rsmooth_smooth_reference(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
                                       mesh->triangles, mesh->triangle_count, &params, out, NULL,

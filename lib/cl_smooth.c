@@ -141,26 +141,37 @@ static void arg(arg_setter *s, size_t size, const void *value) {
 #define PROGRESS_SLICES 32
 #define MOLLIFY_SHARE 0.45
 
-/* Runs `kernel` over `count` work-items and waits; with progress requested, in slices, reporting
- * fractions from `from` to `to` of the whole filter. */
+/* Runs `kernel` over `count` work-items and waits; with progress requested, in slices enqueued
+ * together (the device never idles between them) and reported as each completes, as fractions
+ * from `from` to `to` of the whole filter. */
 static cl_int run_1d(rsmooth_context *ctx, const rs_problem *pb, cl_kernel kernel, size_t count,
                      double from, double to) {
     size_t local = ctx->local_size;
     size_t slices = pb->progress && count > PROGRESS_SLICES * local ? PROGRESS_SLICES : 1;
     size_t slice = (count + slices - 1) / slices;
     slice = (slice + local - 1) / local * local;
-    for (size_t start = 0; start < count; start += slice) {
+    cl_event done[PROGRESS_SLICES];
+    size_t ends[PROGRESS_SLICES];
+    size_t enqueued = 0;
+    cl_int err = CL_SUCCESS;
+    for (size_t start = 0; start < count && err == CL_SUCCESS; start += slice) {
         size_t n = count - start < slice ? count - start : slice;
         size_t global = (n + local - 1) / local * local;
-        cl_int err =
-            clEnqueueNDRangeKernel(ctx->queue, kernel, 1, &start, &global, &local, 0, NULL, NULL);
+        err = clEnqueueNDRangeKernel(ctx->queue, kernel, 1, &start, &global, &local, 0, NULL,
+                                     &done[enqueued]);
         if (err == CL_SUCCESS)
-            err = clFinish(ctx->queue);
-        if (err != CL_SUCCESS)
-            return err;
-        rs_progress(pb, from + (to - from) * (double)(start + n) / (double)count);
+            ends[enqueued++] = start + n;
     }
-    return CL_SUCCESS;
+    if (err == CL_SUCCESS)
+        err = clFlush(ctx->queue);
+    for (size_t i = 0; i < enqueued; i++) {
+        if (err == CL_SUCCESS)
+            err = clWaitForEvents(1, &done[i]);
+        if (err == CL_SUCCESS)
+            rs_progress(pb, from + (to - from) * (double)ends[i] / (double)count);
+        clReleaseEvent(done[i]);
+    }
+    return err == CL_SUCCESS ? clFinish(ctx->queue) : err;
 }
 
 rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const void *positions,
