@@ -8,9 +8,9 @@
 
 typedef struct shape_mesh {
     size_t vertex_count;
-    double *xyz;           /* 3 * vertex_count */
+    double *xyz; /* 3 * vertex_count */
     size_t triangle_count;
-    uint32_t *indices;     /* 3 * triangle_count, counter-clockwise seen from outside */
+    uint32_t *indices; /* 3 * triangle_count, counter-clockwise seen from outside */
 } shape_mesh;
 
 /* All return 0 on success, -1 on bad arguments or allocation failure (mesh then empty). */

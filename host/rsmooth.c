@@ -2,6 +2,7 @@
  * writes the result atomically: a temporary file beside the output, renamed when complete. */
 #define _POSIX_C_SOURCE 200809L
 #include "rsmooth.h"
+#include "cli_commands.h"
 #include "cli_files.h"
 #include "cli_progress.h"
 #include "rsmooth_io.h"
@@ -18,6 +19,8 @@ static const char usage_text[] =
     "usage: rsmooth INPUT -o OUTPUT [options]\n"
     "       rsmooth INPUT --in-place [options]\n"
     "       rsmooth --list-devices\n"
+    "       rsmooth compare RESULT TRUTH [--json]       (errors against a ground truth)\n"
+    "       rsmooth noise IN OUT --sigma S [options]    (reproducible noise for experiments)\n"
     "\n"
     "Removes noise from a triangle mesh while keeping its sharp edges and corners, with the\n"
     "non-iterative filter of Jones, Durand & Desbrun (SIGGRAPH 2003). Each vertex moves to a\n"
@@ -399,6 +402,10 @@ static int write_confidence(rsmooth_mesh *mesh, const options *opt, float *confi
 }
 
 int main(int argc, char **argv) {
+    if (argc >= 2 && !strcmp(argv[1], "compare"))
+        return cli_compare_main(argc - 1, argv + 1);
+    if (argc >= 2 && !strcmp(argv[1], "noise"))
+        return cli_noise_main(argc - 1, argv + 1);
     options opt;
     int code = parse_args(argc, argv, &opt);
     if (code >= 0)

@@ -156,7 +156,8 @@ static int bench_io(int argc, char **argv) {
 int main(int argc, char **argv) {
     if (argc >= 2 && !strcmp(argv[1], "io"))
         return bench_io(argc, argv);
-    fprintf(stderr, "usage: rsmooth-bench io [--triangles N] [--repeat R] [--dir DIR]\n"
-                    "  prints mesh-file read/write speed beside raw I/O of the same bytes (JSON)\n");
+    fprintf(stderr,
+            "usage: rsmooth-bench io [--triangles N] [--repeat R] [--dir DIR]\n"
+            "  prints mesh-file read/write speed beside raw I/O of the same bytes (JSON)\n");
     return argc >= 2 && (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help")) ? 0 : 2;
 }

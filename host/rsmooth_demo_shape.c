@@ -22,8 +22,8 @@ static const char usage_text[] =
 
 static int to_io_mesh(const shape_mesh *s, rsmooth_mesh **out) {
     rsmooth_error err;
-    if (rsmooth_mesh_create(s->vertex_count, s->triangle_count, 3 * s->triangle_count, out,
-                            &err) != RSMOOTH_OK)
+    if (rsmooth_mesh_create(s->vertex_count, s->triangle_count, 3 * s->triangle_count, out, &err) !=
+        RSMOOTH_OK)
         return -1;
     rsmooth_mesh *m = *out;
     memcpy(m->positions, s->xyz, s->vertex_count * 3 * sizeof(double));
@@ -111,8 +111,7 @@ static int compare(const char *result_path, const char *truth_path) {
                 result_path, truth_path);
         goto done;
     }
-    shape_mesh t = {truth->vertex_count, truth->positions, truth->triangle_count,
-                    truth->triangles};
+    shape_mesh t = {truth->vertex_count, truth->positions, truth->triangle_count, truth->triangles};
     double edge = shape_mean_edge_length(&t), sum2 = 0, max = 0;
     for (size_t v = 0; v < truth->vertex_count; v++) {
         double d2 = 0;
@@ -138,8 +137,7 @@ int main(int argc, char **argv) {
         return make(argc, argv);
     if (argc == 4 && !strcmp(argv[1], "compare"))
         return compare(argv[2], argv[3]);
-    fputs(usage_text, argc > 1 && (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help"))
-                          ? stdout
-                          : stderr);
+    fputs(usage_text,
+          argc > 1 && (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help")) ? stdout : stderr);
     return argc > 1 && (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help")) ? 0 : 2;
 }

@@ -130,6 +130,19 @@ if command -v script >/dev/null; then
   grep -q "smoothing" err.txt && fail "progress bar drawn when stderr is not a terminal"
 fi
 
+# The instruments: reproducible noise, and the errors against the ground truth.
+expect 0 "$rsmooth" noise truth.ply noise_a.ply --sigma 0.3 --seed 5
+expect 0 "$rsmooth" noise truth.ply noise_b.ply --sigma 0.3 --seed 5
+cmp -s noise_a.ply noise_b.ply || fail "the same seed gave different noise"
+expect 0 "$rsmooth" noise_a.ply -o noise_smooth.ply -q
+expect 0 "$rsmooth" compare noise_a.ply truth.ply --json
+ev_before=$(sed -n 's/.*"ev": *\([0-9.eE+-]*\).*/\1/p' out.txt)
+expect 0 "$rsmooth" compare noise_smooth.ply truth.ply --json
+ev_after=$(sed -n 's/.*"ev": *\([0-9.eE+-]*\).*/\1/p' out.txt)
+echo "ev before $ev_before, after $ev_after"
+awk -v a="$ev_after" -v b="$ev_before" 'BEGIN { exit !(a > 0 && a < b) }' || fail "ev did not fall"
+expect 2 "$rsmooth" compare noise_a.ply big.ply
+
 expect 0 "$rsmooth" --help
 grep -q "sigma-g" out.txt || fail "--help does not explain sigma-g"
 expect 0 "$rsmooth" --version

@@ -1,0 +1,168 @@
+/* rsmooth compare: the denoising error of a result mesh against its ground truth. */
+#include "cli_commands.h"
+#include "mesh_metrics.h"
+#include "rsmooth_io.h"
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <string.h>
+
+static const char compare_usage[] =
+    "usage: rsmooth compare RESULT TRUTH [--json]\n"
+    "\n"
+    "Measures how far a denoised mesh RESULT is from its ground truth TRUTH. Both must have the\n"
+    "same vertices in the same order and the same faces (a filter's output against the clean\n"
+    "mesh the noisy input was made from). Files: OBJ, PLY, OFF, STL; polygons count as the\n"
+    "triangles of their fans.\n"
+    "\n"
+    "Metrics (lower is better; 0 for identical meshes):\n"
+    "  theta      mean angle between corresponding face normals, in degrees (faces with zero\n"
+    "             area in either mesh are left out). Measures how well features and flat parts\n"
+    "             are restored.\n"
+    "  ev         area-weighted RMS distance from the result's vertices to the truth's surface\n"
+    "             (Sun et al. 2007 E_v; exact closest points on the triangles, each vertex\n"
+    "             weighted by the area of the result's faces around it), in thousandths of the\n"
+    "             truth's bounding-box diagonal.\n"
+    "  rms_v      RMS distance between corresponding vertices, in mean edge lengths of the\n"
+    "             truth (it also counts sliding along the surface, which ev does not).\n"
+    "  hausdorff  symmetric Hausdorff distance between the two surfaces sampled at their\n"
+    "             vertices: the farthest any result vertex is from the truth's surface or any\n"
+    "             truth vertex from the result's surface, in thousandths of the truth's\n"
+    "             bounding-box diagonal.\n"
+    "  mean_edge  mean length of the truth's unique edges, in its units (the unit of rms_v).\n"
+    "  bbox_diag  diagonal of the truth's bounding box, in its units (the unit of ev and\n"
+    "             hausdorff, times 1/1000).\n"
+    "\n"
+    "Options:\n"
+    "  --json      print one JSON object with the keys theta, ev, rms_v, hausdorff, mean_edge,\n"
+    "              bbox_diag, vertices and faces (triangles), in the units above; a figure\n"
+    "              that does not exist (no face with area) is null\n"
+    "  -h, --help  print this help\n"
+    "\n"
+    "The figures agree with ../shared/tools/meshmetrics.py, except that ev there tries only the\n"
+    "24 triangles with the nearest centroids, so it can be slightly larger.\n"
+    "\n"
+    "Exit status: 0 success, 2 bad usage or unreadable, malformed or mismatched files, 1 other.\n";
+
+static int compare_usage_error(const char *message, const char *arg) {
+    fprintf(stderr, "rsmooth compare: %s%s\nTry 'rsmooth compare --help'.\n", message,
+            arg ? arg : "");
+    return 2;
+}
+
+/* Reads `path`; on failure prints why and returns the exit status, else 0. */
+static int read_mesh(const char *path, rsmooth_mesh **mesh) {
+    rsmooth_error err;
+    rsmooth_status st = rsmooth_mesh_read_file(path, mesh, &err);
+    if (st == RSMOOTH_OK)
+        return 0;
+    if (err.line > 0)
+        fprintf(stderr, "rsmooth compare: %s:%lld: %s\n", path, (long long)err.line, err.message);
+    else if (err.byte_offset >= 0)
+        fprintf(stderr, "rsmooth compare: %s: byte %lld: %s\n", path, (long long)err.byte_offset,
+                err.message);
+    else
+        fprintf(stderr, "rsmooth compare: %s: %s\n", path,
+                err.message[0] ? err.message : rsmooth_status_str(st));
+    return st == RSMOOTH_ERROR_OUT_OF_MEMORY ? 1 : 2;
+}
+
+/* A figure as JSON: NAN and infinities have no JSON spelling. */
+static void print_json_number(const char *key, double value, bool last) {
+    if (isfinite(value))
+        printf("\"%s\": %.17g%s", key, value, last ? "" : ", ");
+    else
+        printf("\"%s\": null%s", key, last ? "" : ", ");
+}
+
+int cli_compare_main(int argc, char **argv) {
+    const char *paths[2] = {NULL, NULL};
+    size_t path_count = 0;
+    bool json = false;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            fputs(compare_usage, stdout);
+            return 0;
+        } else if (!strcmp(a, "--json")) {
+            json = true;
+        } else if (a[0] == '-' && a[1] != '\0') {
+            return compare_usage_error("unknown option: ", a);
+        } else if (path_count < 2) {
+            paths[path_count++] = a;
+        } else {
+            return compare_usage_error("too many files: ", a);
+        }
+    }
+    if (path_count != 2)
+        return compare_usage_error("needs two files, RESULT and TRUTH", NULL);
+
+    rsmooth_mesh *result = NULL, *truth = NULL;
+    int status = read_mesh(paths[0], &result);
+    if (status == 0)
+        status = read_mesh(paths[1], &truth);
+    if (status != 0)
+        goto done;
+    if (result->vertex_count != truth->vertex_count) {
+        fprintf(stderr,
+                "rsmooth compare: %s has %zu vertices but %s has %zu: they must be the same mesh "
+                "with moved vertices\n",
+                paths[0], result->vertex_count, paths[1], truth->vertex_count);
+        status = 2;
+        goto done;
+    }
+    if (result->triangle_count != truth->triangle_count) {
+        fprintf(stderr,
+                "rsmooth compare: %s has %zu triangles but %s has %zu: they must have the same "
+                "faces\n",
+                paths[0], result->triangle_count, paths[1], truth->triangle_count);
+        status = 2;
+        goto done;
+    }
+    for (size_t i = 0; i < 3 * result->triangle_count; i++) {
+        if (result->triangles[i] != truth->triangles[i]) {
+            fprintf(stderr,
+                    "rsmooth compare: %s and %s differ at triangle %zu (of their faces fanned "
+                    "into triangles): vertex or face order was changed\n",
+                    paths[0], paths[1], i / 3 + 1);
+            status = 2;
+            goto done;
+        }
+    }
+    if (result->triangle_count == 0) {
+        fprintf(stderr, "rsmooth compare: %s and %s have no faces: nothing to compare\n", paths[0],
+                paths[1]);
+        status = 2;
+        goto done;
+    }
+    mesh_metrics m;
+    if (mesh_metrics_compute(result->positions, truth->positions, result->vertex_count,
+                             result->triangles, result->triangle_count, &m) != 0) {
+        /* The reader already checked indices and finiteness: what is left is memory. */
+        fprintf(stderr, "rsmooth compare: %s, %s: out of memory\n", paths[0], paths[1]);
+        status = 1;
+        goto done;
+    }
+    if (json) {
+        printf("{");
+        print_json_number("theta", m.theta, false);
+        print_json_number("ev", m.ev, false);
+        print_json_number("rms_v", m.rms_v, false);
+        print_json_number("hausdorff", m.hausdorff, false);
+        print_json_number("mean_edge", m.mean_edge, false);
+        print_json_number("bbox_diag", m.bbox_diag, false);
+        printf("\"vertices\": %zu, \"faces\": %zu}\n", m.vertex_count, m.triangle_count);
+    } else {
+        printf("theta=%.6g ev=%.6g rms_v=%.6g hausdorff=%.6g mean_edge=%.6g bbox_diag=%.6g\n",
+               m.theta, m.ev, m.rms_v, m.hausdorff, m.mean_edge, m.bbox_diag);
+    }
+    if (fflush(stdout) != 0 || ferror(stdout)) {
+        fprintf(stderr, "rsmooth compare: cannot write the figures\n");
+        status = 1;
+    }
+done:
+    rsmooth_mesh_destroy(result);
+    rsmooth_mesh_destroy(truth);
+    return status;
+}
