@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Installs what rsmooth builds and tests with, from Debian's packages, when any of it is missing:
-# compiler, CMake, the OpenCL ICD loader and headers, and PoCL (an OpenCL implementation on the CPU).
+# compiler, CMake, the OpenCL ICD loader and headers, PoCL (an OpenCL implementation on the CPU) and
+# libpng (the pictures of `rsmooth render`).
 # `install-deps.sh fuzz` (or FUZZ=1) also installs clang and its libFuzzer runtime, for `make fuzz`.
 set -euo pipefail
-packages=(build-essential cmake pkg-config ocl-icd-opencl-dev opencl-c-headers pocl-opencl-icd clinfo)
+packages=(build-essential cmake pkg-config ocl-icd-opencl-dev opencl-c-headers pocl-opencl-icd clinfo libpng-dev)
 fuzz_packages=(clang libclang-rt-14-dev) # Debian 12: libFuzzer for its clang 14
 if [ "${1:-}" = fuzz ] || [ "${FUZZ:-0}" = 1 ]; then
   packages+=("${fuzz_packages[@]}")

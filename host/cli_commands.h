@@ -9,4 +9,7 @@ int cli_compare_main(int argc, char **argv);
 /* rsmooth noise IN OUT --sigma S [...]: reproducible Gaussian or impulsive noise. */
 int cli_noise_main(int argc, char **argv);
 
+/* rsmooth render IN... -o OUT.png [...]: flat-shaded pictures of meshes side by side (PNG). */
+int cli_render_main(int argc, char **argv);
+
 #endif

@@ -21,6 +21,7 @@ static const char usage_text[] =
     "       rsmooth --list-devices\n"
     "       rsmooth compare RESULT TRUTH [--json]       (errors against a ground truth)\n"
     "       rsmooth noise IN OUT --sigma S [options]    (reproducible noise for experiments)\n"
+    "       rsmooth render IN... -o OUT.png [options]   (flat-shaded pictures side by side)\n"
     "\n"
     "Removes noise from a triangle mesh while keeping its sharp edges and corners, with the\n"
     "non-iterative filter of Jones, Durand & Desbrun (SIGGRAPH 2003). Each vertex moves to a\n"
@@ -406,6 +407,8 @@ int main(int argc, char **argv) {
         return cli_compare_main(argc - 1, argv + 1);
     if (argc >= 2 && !strcmp(argv[1], "noise"))
         return cli_noise_main(argc - 1, argv + 1);
+    if (argc >= 2 && !strcmp(argv[1], "render"))
+        return cli_render_main(argc - 1, argv + 1);
     options opt;
     int code = parse_args(argc, argv, &opt);
     if (code >= 0)

@@ -143,6 +143,18 @@ echo "ev before $ev_before, after $ev_after"
 awk -v a="$ev_after" -v b="$ev_before" 'BEGIN { exit !(a > 0 && a < b) }' || fail "ev did not fall"
 expect 2 "$rsmooth" compare noise_a.ply big.ply
 
+# Pictures: the input, the result and its confidence side by side, as PNG, never clobbered.
+expect 0 "$rsmooth" render noisy.ply smooth.ply conf.ply -o pair.png --size 480x160
+[ "$(head -c 8 pair.png | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] ||
+  fail "render did not write a PNG: $(head -c 8 pair.png | od -An -tx1)"
+expect 2 "$rsmooth" render noisy.ply smooth.ply -o pair.png
+grep -q "pair.png: already exists" err.txt || fail "render replaced a file without --force"
+expect 0 "$rsmooth" render noisy.ply -o pair.png --force --azimuth 200 --elevation -10
+expect 2 "$rsmooth" render missing.ply -o missing.png
+[ -e missing.png ] && fail "render wrote a picture of a missing mesh"
+expect 2 "$rsmooth" render noisy.ply -o bad.png --elevation 90
+ls pair.png.tmp-* >/dev/null 2>&1 && fail "render left a temporary file"
+
 expect 0 "$rsmooth" --help
 grep -q "sigma-g" out.txt || fail "--help does not explain sigma-g"
 expect 0 "$rsmooth" --version

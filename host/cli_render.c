@@ -1,0 +1,266 @@
+/* rsmooth render: flat-shaded PNG pictures of meshes side by side, to judge smoothing by eye. */
+#define _POSIX_C_SOURCE 200809L
+#include "cli_commands.h"
+#include "mesh_render.h"
+#include "png_write.h"
+#include "rsmooth_io.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#define DEFAULT_PANEL 800
+#define MAX_SIDE 16384 /* keeps the supersampled buffers within a few GiB */
+
+static const char render_usage[] =
+    "usage: rsmooth render IN... -o OUT.png [options]\n"
+    "\n"
+    "Draws each mesh IN (OBJ, PLY, OFF, STL) in its own panel, side by side, all from the same\n"
+    "camera fitted to every mesh together, so a mesh and its smoothed copy appear at the same\n"
+    "place and size. Faces are flat-shaded (one shade per triangle), which shows sharp edges and\n"
+    "residual noise plainly. Meshes with vertex colours (such as the file `rsmooth --confidence`\n"
+    "writes) are drawn in them; others in light grey. Up is +y.\n"
+    "\n"
+    "Options:\n"
+    "  -o, --output FILE   the PNG to write (required)\n"
+    "  --size WxH          picture size in pixels (default 800 x 800 per panel)\n"
+    "  --azimuth DEG       camera angle about the up axis; 0 looks along -z (default 35)\n"
+    "  --elevation DEG     camera angle above the horizon, in (-90, 90) (default 25)\n"
+    "  --orthographic      parallel projection instead of perspective\n"
+    "  -f, --force         replace OUT if it exists\n"
+    "  -h, --help          print this help\n"
+    "\n"
+    "Example:\n"
+    "  rsmooth render noisy.ply smooth.ply conf.ply -o compare.png\n"
+    "\n"
+    "Exit status: 0 success, 2 bad usage or an unreadable or malformed input, 1 other.\n";
+
+static int render_usage_error(const char *message, const char *arg) {
+    fprintf(stderr, "rsmooth render: %s%s\nTry 'rsmooth render --help'.\n", message,
+            arg ? arg : "");
+    return 2;
+}
+
+/* Reads `path`; on failure prints why and returns the exit status, else 0. */
+static int read_mesh(const char *path, rsmooth_mesh **mesh) {
+    rsmooth_error err;
+    rsmooth_status st = rsmooth_mesh_read_file(path, mesh, &err);
+    if (st == RSMOOTH_OK)
+        return 0;
+    if (err.line > 0)
+        fprintf(stderr, "rsmooth render: %s:%lld: %s\n", path, (long long)err.line, err.message);
+    else if (err.byte_offset >= 0)
+        fprintf(stderr, "rsmooth render: %s: byte %lld: %s\n", path, (long long)err.byte_offset,
+                err.message);
+    else
+        fprintf(stderr, "rsmooth render: %s: %s\n", path,
+                err.message[0] ? err.message : rsmooth_status_str(st));
+    return st == RSMOOTH_ERROR_OUT_OF_MEMORY ? 1 : 2;
+}
+
+static bool parse_double(const char *s, double *out) {
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (end == s || *end != '\0' || errno != 0 || !isfinite(v))
+        return false;
+    *out = v;
+    return true;
+}
+
+static bool parse_size(const char *s, int *w, int *h) {
+    char *end;
+    errno = 0;
+    long a = strtol(s, &end, 10);
+    if (end == s || (*end != 'x' && *end != 'X') || errno != 0)
+        return false;
+    const char *rest = end + 1;
+    long b = strtol(rest, &end, 10);
+    if (end == rest || *end != '\0' || errno != 0)
+        return false;
+    if (a < 1 || b < 1 || a > MAX_SIDE || b > MAX_SIDE)
+        return false;
+    *w = (int)a;
+    *h = (int)b;
+    return true;
+}
+
+/* Writes the picture to a temporary file beside `path` and renames it into place, so a failure
+ * never leaves a partial PNG under the name asked for. Returns an exit status. */
+static int write_png(const char *path, const uint8_t *rgb, int width, int height) {
+    size_t len = strlen(path);
+    char *temporary = malloc(len + 16);
+    if (!temporary) {
+        fprintf(stderr, "rsmooth render: %s: out of memory\n", path);
+        return 1;
+    }
+    snprintf(temporary, len + 16, "%s.tmp-XXXXXX", path);
+    int fd = mkstemp(temporary);
+    if (fd < 0) {
+        fprintf(stderr, "rsmooth render: %s: cannot create a temporary file beside it: %s\n", path,
+                strerror(errno));
+        free(temporary);
+        return 1;
+    }
+    char message[256] = "";
+    int status = -1;
+    FILE *f = fdopen(fd, "wb");
+    if (f) {
+        status = png_write_rgb(f, rgb, width, height, message, sizeof message);
+        if (fclose(f) != 0 && status == 0) {
+            snprintf(message, sizeof message, "%s", strerror(errno));
+            status = -1;
+        }
+    } else {
+        snprintf(message, sizeof message, "%s", strerror(errno));
+        close(fd);
+    }
+    if (status == 0) {
+        mode_t mask = umask(0); /* mkstemp makes 0600 files; give the usual permissions */
+        umask(mask);
+        chmod(temporary, 0666 & ~mask);
+        if (rename(temporary, path) != 0) {
+            snprintf(message, sizeof message, "%s", strerror(errno));
+            status = -1;
+        }
+    }
+    if (status != 0) {
+        fprintf(stderr, "rsmooth render: %s: cannot write: %s\n", path, message);
+        unlink(temporary);
+    }
+    free(temporary);
+    return status == 0 ? 0 : 1;
+}
+
+int cli_render_main(int argc, char **argv) {
+    const char *output = NULL;
+    bool force = false;
+    int width = 0, height = 0;
+    render_options options;
+    render_options_default(&options);
+    const char **inputs = calloc((size_t)(argc > 0 ? argc : 1), sizeof *inputs);
+    if (!inputs) {
+        fprintf(stderr, "rsmooth render: out of memory\n");
+        return 1;
+    }
+    size_t input_count = 0;
+    int status = 0;
+    for (int i = 1; i < argc && status == 0; i++) {
+        const char *a = argv[i];
+        bool takes_value = !strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--size") ||
+                           !strcmp(a, "--azimuth") || !strcmp(a, "--elevation");
+        if (takes_value && i + 1 >= argc) {
+            status = render_usage_error("missing value after ", a);
+            break;
+        }
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            fputs(render_usage, stdout);
+            free(inputs);
+            return 0;
+        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
+            output = argv[++i];
+        } else if (!strcmp(a, "--size")) {
+            if (!parse_size(argv[++i], &width, &height))
+                status = render_usage_error("--size wants WxH, each 1 to 16384: ", argv[i]);
+        } else if (!strcmp(a, "--azimuth")) {
+            if (!parse_double(argv[++i], &options.azimuth_deg))
+                status = render_usage_error("--azimuth wants degrees: ", argv[i]);
+        } else if (!strcmp(a, "--elevation")) {
+            if (!parse_double(argv[++i], &options.elevation_deg) ||
+                !(options.elevation_deg > -90 && options.elevation_deg < 90))
+                status = render_usage_error("--elevation wants degrees in (-90, 90): ", argv[i]);
+        } else if (!strcmp(a, "--orthographic")) {
+            options.orthographic = true;
+        } else if (!strcmp(a, "-f") || !strcmp(a, "--force")) {
+            force = true;
+        } else if (a[0] == '-' && a[1] != '\0') {
+            status = render_usage_error("unknown option: ", a);
+        } else {
+            inputs[input_count++] = a;
+        }
+    }
+    if (status == 0 && input_count == 0)
+        status = render_usage_error("needs at least one mesh file", NULL);
+    if (status == 0 && !output)
+        status = render_usage_error("needs -o OUT.png", NULL);
+    if (status != 0) {
+        free(inputs);
+        return status;
+    }
+    if (width == 0) { /* default: square panels side by side */
+        width = (int)(input_count * DEFAULT_PANEL + (input_count - 1) * (size_t)options.gap);
+        height = DEFAULT_PANEL;
+        if (input_count > MAX_SIDE / DEFAULT_PANEL)
+            width = MAX_SIDE;
+    }
+    if ((size_t)width < input_count * 8 + (input_count - 1) * (size_t)options.gap) {
+        free(inputs);
+        return render_usage_error("--size is too narrow for that many panels", NULL);
+    }
+    struct stat st;
+    if (stat(output, &st) == 0) {
+        if (S_ISDIR(st.st_mode)) {
+            fprintf(stderr, "rsmooth render: %s: is a directory\n", output);
+            free(inputs);
+            return 2;
+        }
+        if (!force) {
+            fprintf(stderr, "rsmooth render: %s: already exists (use --force to replace it)\n",
+                    output);
+            free(inputs);
+            return 2;
+        }
+        for (size_t i = 0; i < input_count; i++) {
+            struct stat in;
+            if (stat(inputs[i], &in) == 0 && in.st_dev == st.st_dev && in.st_ino == st.st_ino) {
+                fprintf(stderr, "rsmooth render: %s: refusing to overwrite an input file\n",
+                        output);
+                free(inputs);
+                return 2;
+            }
+        }
+    }
+
+    rsmooth_mesh **meshes = calloc(input_count, sizeof *meshes);
+    render_mesh *views = calloc(input_count, sizeof *views);
+    uint8_t *rgb = NULL;
+    if (!meshes || !views) {
+        fprintf(stderr, "rsmooth render: out of memory\n");
+        status = 1;
+        goto done;
+    }
+    for (size_t i = 0; i < input_count && status == 0; i++) {
+        status = read_mesh(inputs[i], &meshes[i]);
+        if (status == 0) {
+            views[i].xyz = meshes[i]->positions;
+            views[i].vertex_count = meshes[i]->vertex_count;
+            views[i].triangles = meshes[i]->triangles;
+            views[i].triangle_count = meshes[i]->triangle_count;
+            views[i].colors = meshes[i]->vertex_colors;
+        }
+    }
+    if (status != 0)
+        goto done;
+    rgb = malloc(3 * (size_t)width * (size_t)height);
+    if (!rgb || mesh_render(views, input_count, &options, rgb, width, height) != 0) {
+        /* The arguments were checked above; what is left is memory. */
+        fprintf(stderr, "rsmooth render: out of memory for a %d x %d picture\n", width, height);
+        status = 1;
+        goto done;
+    }
+    status = write_png(output, rgb, width, height);
+done:
+    if (meshes)
+        for (size_t i = 0; i < input_count; i++)
+            rsmooth_mesh_destroy(meshes[i]);
+    free(meshes);
+    free(views);
+    free(rgb);
+    free(inputs);
+    return status;
+}
