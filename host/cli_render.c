@@ -1,6 +1,7 @@
 /* rsmooth render: flat-shaded PNG pictures of meshes side by side, to judge smoothing by eye. */
 #define _POSIX_C_SOURCE 200809L
 #include "cli_commands.h"
+#include "cli_files.h"
 #include "mesh_render.h"
 #include "png_write.h"
 #include "rsmooth_io.h"
@@ -46,21 +47,12 @@ static int render_usage_error(const char *message, const char *arg) {
     return 2;
 }
 
-/* Reads `path`; on failure prints why and returns the exit status, else 0. */
+/* Reads `path` (no progress bar); on failure cli_read_mesh has said why. Returns 0 or the exit
+ * status. */
 static int read_mesh(const char *path, rsmooth_mesh **mesh) {
-    rsmooth_error err;
-    rsmooth_status st = rsmooth_mesh_read_file(path, mesh, &err);
-    if (st == RSMOOTH_OK)
-        return 0;
-    if (err.line > 0)
-        fprintf(stderr, "rsmooth render: %s:%lld: %s\n", path, (long long)err.line, err.message);
-    else if (err.byte_offset >= 0)
-        fprintf(stderr, "rsmooth render: %s: byte %lld: %s\n", path, (long long)err.byte_offset,
-                err.message);
-    else
-        fprintf(stderr, "rsmooth render: %s: %s\n", path,
-                err.message[0] ? err.message : rsmooth_status_str(st));
-    return st == RSMOOTH_ERROR_OUT_OF_MEMORY ? 1 : 2;
+    cli_progress quiet;
+    cli_progress_init(&quiet, true);
+    return cli_read_mesh(path, &quiet, mesh);
 }
 
 static bool parse_double(const char *s, double *out) {
