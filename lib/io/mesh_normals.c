@@ -11,6 +11,9 @@ rsmooth_status rsmooth_mesh_vertex_normals(const rsmooth_mesh *mesh, double *nor
     rs_error_clear(error);
     if (!mesh || !normals)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "mesh or normals is NULL");
+    if (mesh->triangle_count > 0 && !mesh->triangles)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "%zu triangles but triangles is NULL", mesh->triangle_count);
     memset(normals, 0, mesh->vertex_count * 3 * sizeof *normals);
     for (size_t t = 0; t < mesh->triangle_count; t++) {
         const uint32_t *tri = mesh->triangles + 3 * t;
@@ -35,6 +38,22 @@ rsmooth_status rsmooth_mesh_vertex_normals(const rsmooth_mesh *mesh, double *nor
         double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
         for (int k = 0; k < 3; k++)
             n[k] = len > 0 ? n[k] / len : 0;
+    }
+    return RSMOOTH_OK;
+}
+
+rsmooth_status rs_io_vertex_normals(const rsmooth_mesh *mesh, double **normals, const char *where,
+                                    rsmooth_error *error) {
+    *normals = rs_alloc_array(mesh->vertex_count, 3 * sizeof(double));
+    if (!*normals)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "normals of %zu vertices",
+                       mesh->vertex_count);
+    rsmooth_error inner;
+    if (rsmooth_mesh_vertex_normals(mesh, *normals, &inner) != RSMOOTH_OK) {
+        rs_free(*normals);
+        *normals = NULL;
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "normals: %s",
+                       inner.message);
     }
     return RSMOOTH_OK;
 }

@@ -27,25 +27,6 @@ static bool put_position(FILE *stream, const rsmooth_mesh *mesh, size_t v) {
            put_coord(stream, p[1], as_float) && put_coord(stream, p[2], as_float);
 }
 
-/* The recomputed normals, 3 * vertex_count doubles, into *out. */
-static rsmooth_status compute_normals(const rsmooth_mesh *mesh, double **out,
-                                      rsmooth_error *error) {
-    *out = NULL;
-    double *normals = rs_mul_overflows(mesh->vertex_count, 3 * sizeof(double))
-                          ? NULL
-                          : rs_alloc_array(mesh->vertex_count, 3 * sizeof(double));
-    if (!normals)
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "normals of %zu vertices",
-                       mesh->vertex_count);
-    rsmooth_status status = rsmooth_mesh_vertex_normals(mesh, normals, error);
-    if (status != RSMOOTH_OK) {
-        rs_free(normals);
-        return status;
-    }
-    *out = normals;
-    return RSMOOTH_OK;
-}
-
 /* vertex_count vn lines, each ended by `eol`. */
 static bool put_normals(FILE *stream, const double *normals, size_t count, const char *eol,
                         size_t eol_len) {
@@ -226,7 +207,7 @@ rsmooth_status rs_io_obj_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_e
     bool want_normals = faithful ? (x->kinds & RS_OBJ_NORMALS) != 0 : mesh->has_vertex_normals;
     double *normals = NULL;
     if (want_normals) {
-        rsmooth_status status = compute_normals(mesh, &normals, error);
+        rsmooth_status status = rs_io_vertex_normals(mesh, &normals, where, error);
         if (status != RSMOOTH_OK)
             return status;
     }

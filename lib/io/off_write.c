@@ -87,17 +87,9 @@ rsmooth_status rs_io_off_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_e
     bool want_normals = faithful ? x->normals : mesh->has_vertex_normals;
     double *normals = NULL;
     if (want_normals) {
-        normals = rs_mul_overflows(mesh->vertex_count, 3 * sizeof(double))
-                      ? NULL
-                      : rs_alloc_array(mesh->vertex_count, 3 * sizeof(double));
-        if (!normals)
-            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "normals of %zu vertices",
-                           mesh->vertex_count);
-        rsmooth_status status = rsmooth_mesh_vertex_normals(mesh, normals, error);
-        if (status != RSMOOTH_OK) {
-            rs_free(normals);
+        rsmooth_status status = rs_io_vertex_normals(mesh, &normals, where, error);
+        if (status != RSMOOTH_OK)
             return status;
-        }
     }
     errno = 0;
     bool ok;

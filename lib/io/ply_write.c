@@ -76,29 +76,6 @@ static void put_f64(unsigned char *p, double d) {
     put_le(p, bits, 8);
 }
 
-/* The normals writers emit: recomputed from the positions (3 * vertex_count doubles). */
-static rsmooth_status compute_normals(const rsmooth_mesh *mesh, double **normals,
-                                      rsmooth_error *error) {
-    if (mesh->triangle_count > 0 && !mesh->triangles)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "%zu triangles but triangles is NULL", mesh->triangle_count);
-    if (rs_mul_overflows(mesh->vertex_count, 3 * sizeof(double)))
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "normals of %zu vertices",
-                       mesh->vertex_count);
-    *normals = rs_alloc_array(mesh->vertex_count, 3 * sizeof(double));
-    if (!*normals)
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "normals of %zu vertices",
-                       mesh->vertex_count);
-    rsmooth_error inner;
-    if (rsmooth_mesh_vertex_normals(mesh, *normals, &inner) != RSMOOTH_OK) {
-        rs_free(*normals);
-        *normals = NULL;
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "normals: %s",
-                       inner.message);
-    }
-    return RSMOOTH_OK;
-}
-
 static rsmooth_status io_failure(rsmooth_error *error) {
     return rs_fail(error, RSMOOTH_ERROR_IO, where, "writing PLY: %s",
                    errno ? strerror(errno) : "stream error or out of memory");
@@ -216,7 +193,7 @@ static rsmooth_status write_generic(const rsmooth_mesh *mesh, FILE *stream, bool
     bool unsigned_index = mesh->vertex_count > (size_t)INT32_MAX;
     double *normals = NULL;
     if (mesh->has_vertex_normals) {
-        rsmooth_status status = compute_normals(mesh, &normals, error);
+        rsmooth_status status = rs_io_vertex_normals(mesh, &normals, where, error);
         if (status != RSMOOTH_OK)
             return status;
     }
@@ -465,7 +442,7 @@ static rsmooth_status write_faithful(const rsmooth_mesh *mesh, const rs_ply_extr
     double *normals = NULL;
     for (size_t k = 0; k < v->property_count && !normals; k++) {
         if (v->properties[k].role >= RS_PLY_NX && v->properties[k].role <= RS_PLY_NZ) {
-            status = compute_normals(mesh, &normals, error);
+            status = rs_io_vertex_normals(mesh, &normals, where, error);
             if (status != RSMOOTH_OK)
                 return status;
         }
