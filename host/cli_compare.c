@@ -1,4 +1,5 @@
 /* rsmooth compare: the denoising error of a result mesh against its ground truth. */
+#include "cli_args.h"
 #include "cli_commands.h"
 #include "cli_files.h"
 #include "mesh_metrics.h"
@@ -46,20 +47,6 @@ static const char compare_usage[] =
     "\n"
     "Exit status: 0 success, 2 bad usage or unreadable, malformed or mismatched files, 1 other.\n";
 
-static int compare_usage_error(const char *message, const char *arg) {
-    fprintf(stderr, "rsmooth compare: %s%s\nTry 'rsmooth compare --help'.\n", message,
-            arg ? arg : "");
-    return 2;
-}
-
-/* Reads `path` (no progress bar); on failure cli_read_mesh has said why. Returns 0 or the exit
- * status. */
-static int read_mesh(const char *path, rsmooth_mesh **mesh) {
-    cli_progress quiet;
-    cli_progress_init(&quiet, true);
-    return cli_read_mesh(path, &quiet, mesh);
-}
-
 /* A figure as JSON: NAN and infinities have no JSON spelling. */
 static void print_json_number(const char *key, double value, bool last) {
     if (isfinite(value))
@@ -80,20 +67,20 @@ int cli_compare_main(int argc, char **argv) {
         } else if (!strcmp(a, "--json")) {
             json = true;
         } else if (a[0] == '-' && a[1] != '\0') {
-            return compare_usage_error("unknown option: ", a);
+            return cli_usage_error("compare", "unknown option: %s", a);
         } else if (path_count < 2) {
             paths[path_count++] = a;
         } else {
-            return compare_usage_error("too many files: ", a);
+            return cli_usage_error("compare", "too many files: %s", a);
         }
     }
     if (path_count != 2)
-        return compare_usage_error("needs two files, RESULT and TRUTH", NULL);
+        return cli_usage_error("compare", "needs two files, RESULT and TRUTH");
 
     rsmooth_mesh *result = NULL, *truth = NULL;
-    int status = read_mesh(paths[0], &result);
+    int status = cli_read_mesh(paths[0], NULL, &result);
     if (status == 0)
-        status = read_mesh(paths[1], &truth);
+        status = cli_read_mesh(paths[1], NULL, &truth);
     if (status != 0)
         goto done;
     if (result->vertex_count != truth->vertex_count) {

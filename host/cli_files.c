@@ -46,7 +46,7 @@ int cli_read_mesh(const char *path, cli_progress *bar, rsmooth_mesh **mesh) {
         size_t want = capacity - size < READ_CHUNK ? capacity - size : READ_CHUNK;
         size_t got = fread(data + size, 1, want, f);
         size += got;
-        if (expected)
+        if (expected && bar)
             cli_progress_update(bar, (double)size / (double)expected);
         if (got < want) {
             if (ferror(f)) {
@@ -70,7 +70,8 @@ int cli_read_mesh(const char *path, cli_progress *bar, rsmooth_mesh **mesh) {
     free(data);
     if (status == RSMOOTH_OK)
         return EXIT_OK;
-    cli_progress_clear(bar);
+    if (bar)
+        cli_progress_clear(bar);
     if (err.line >= 0)
         fprintf(stderr, "rsmooth: %s:%lld: %s\n", path, (long long)err.line, err.message);
     else if (err.byte_offset >= 0)

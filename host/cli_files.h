@@ -11,8 +11,9 @@
 /* Exit statuses of the command. */
 enum { EXIT_OK = 0, EXIT_OTHER = 1, EXIT_USAGE = 2, EXIT_DEVICE = 3 };
 
-/* Reads and parses `path`, reporting bytes read to `bar`. On failure prints "rsmooth: PATH:LINE:
- * message" (or the byte offset) and returns EXIT_USAGE (bad or unreadable file) or EXIT_OTHER. */
+/* Reads and parses `path`, reporting bytes read to `bar` (may be NULL: no progress). On failure
+ * prints "rsmooth: PATH:LINE: message" (or the byte offset) and returns EXIT_USAGE (bad or
+ * unreadable file) or EXIT_OTHER. */
 int cli_read_mesh(const char *path, cli_progress *bar, rsmooth_mesh **mesh);
 
 /* The output format for `path` (by extension), ascii variants when `ascii`; AUTO if unknown. */

@@ -1,7 +1,7 @@
 /* `rsmooth noise`: corrupts a mesh with reproducible Gaussian or impulsive noise (experiments). */
+#include "cli_args.h"
 #include "cli_commands.h"
 #include "cli_files.h"
-#include "cli_progress.h"
 #include "mesh_noise.h"
 #include "rsmooth_io.h"
 
@@ -58,26 +58,6 @@ typedef struct noise_args {
     bool have_sigma, impulsive, ascii, force, quiet;
 } noise_args;
 
-__attribute__((format(printf, 1, 2))) static int noise_usage_error(const char *fmt, ...) {
-    va_list args;
-    va_start(args, fmt);
-    fprintf(stderr, "rsmooth noise: ");
-    vfprintf(stderr, fmt, args);
-    fprintf(stderr, "\nTry 'rsmooth noise --help'.\n");
-    va_end(args);
-    return EXIT_USAGE;
-}
-
-static bool parse_double(const char *text, double *out) {
-    char *end = NULL;
-    errno = 0;
-    double v = strtod(text, &end);
-    if (end == text || *end != '\0' || errno == ERANGE || isnan(v))
-        return false;
-    *out = v;
-    return true;
-}
-
 /* Decimal digits only: strtoull would take "-1" as 2^64 - 1, and a seed must be typed exactly. */
 static bool parse_seed(const char *text, uint64_t *out) {
     if (!isdigit((unsigned char)text[0]))
@@ -109,40 +89,42 @@ static int parse_noise_args(int argc, char **argv, noise_args *a) {
         } else if (!strcmp(arg, "--sigma") || !strcmp(arg, "--impulsive")) {
             double x;
             if (!value)
-                return noise_usage_error("%s needs a value", arg);
-            if (!parse_double(value, &x))
-                return noise_usage_error("%s: not a number: '%s'", arg, value);
+                return cli_usage_error("noise", "%s needs a value", arg);
+            if (!cli_parse_number(value, &x))
+                return cli_usage_error("noise", "%s: not a number: '%s'", arg, value);
             if (!strcmp(arg, "--sigma")) {
                 if (!(x >= 0) || !isfinite(x))
-                    return noise_usage_error("--sigma must be a number >= 0 (got '%s')", value);
+                    return cli_usage_error("noise", "--sigma must be a number >= 0 (got '%s')",
+                                           value);
                 a->noise.sigma = x;
                 a->have_sigma = true;
             } else {
                 /* 0 would mean "every vertex" to mesh_add_noise: a surprise for someone who asked
                  * for impulsive noise, so it is refused here. */
                 if (!(x > 0 && x <= 1))
-                    return noise_usage_error("--impulsive must be a fraction in (0, 1] (got '%s'); "
-                                             "leave it out to move every vertex",
-                                             value);
+                    return cli_usage_error("noise",
+                                           "--impulsive must be a fraction in (0, 1] (got '%s'); "
+                                           "leave it out to move every vertex",
+                                           value);
                 a->noise.impulsive_fraction = x;
                 a->impulsive = true;
             }
             i++;
         } else if (!strcmp(arg, "--direction")) {
             if (!value)
-                return noise_usage_error("--direction needs a value (normal or random)");
+                return cli_usage_error("noise", "--direction needs a value (normal or random)");
             if (!strcmp(value, "normal"))
                 a->noise.direction = MESH_NOISE_NORMAL;
             else if (!strcmp(value, "random"))
                 a->noise.direction = MESH_NOISE_RANDOM;
             else
-                return noise_usage_error("--direction: '%s' is not normal or random", value);
+                return cli_usage_error("noise", "--direction: '%s' is not normal or random", value);
             i++;
         } else if (!strcmp(arg, "--seed")) {
             if (!value)
-                return noise_usage_error("--seed needs a value");
+                return cli_usage_error("noise", "--seed needs a value");
             if (!parse_seed(value, &a->noise.seed))
-                return noise_usage_error("--seed: not an integer in [0, 2^64): '%s'", value);
+                return cli_usage_error("noise", "--seed: not an integer in [0, 2^64): '%s'", value);
             i++;
         } else if (!strcmp(arg, "--ascii")) {
             a->ascii = true;
@@ -151,21 +133,23 @@ static int parse_noise_args(int argc, char **argv, noise_args *a) {
         } else if (!strcmp(arg, "-q") || !strcmp(arg, "--quiet")) {
             a->quiet = true;
         } else if (arg[0] == '-' && arg[1] != '\0') {
-            return noise_usage_error("unknown option '%s'", arg);
+            return cli_usage_error("noise", "unknown option '%s'", arg);
         } else if (!a->input) {
             a->input = arg;
         } else if (!a->output) {
             a->output = arg;
         } else {
-            return noise_usage_error("unexpected argument '%s' (INPUT and OUTPUT only)", arg);
+            return cli_usage_error("noise", "unexpected argument '%s' (INPUT and OUTPUT only)",
+                                   arg);
         }
     }
     if (!a->input)
-        return noise_usage_error("no input file");
+        return cli_usage_error("noise", "no input file");
     if (!a->output)
-        return noise_usage_error("no output file");
+        return cli_usage_error("noise", "no output file");
     if (!a->have_sigma)
-        return noise_usage_error("--sigma is required (in mean edge lengths, e.g. --sigma 0.3)");
+        return cli_usage_error("noise",
+                               "--sigma is required (in mean edge lengths, e.g. --sigma 0.3)");
     return -1;
 }
 
@@ -178,10 +162,8 @@ int cli_noise_main(int argc, char **argv) {
     if ((code = cli_check_output(a.output, a.input, a.force, false)) >= 0)
         return code;
 
-    cli_progress bar;
-    cli_progress_init(&bar, true);
     rsmooth_mesh *mesh = NULL;
-    if ((code = cli_read_mesh(a.input, &bar, &mesh)) != EXIT_OK)
+    if ((code = cli_read_mesh(a.input, NULL, &mesh)) != EXIT_OK)
         return code;
 
     size_t nv = mesh->vertex_count;

@@ -1,5 +1,6 @@
 /* rsmooth render: flat-shaded PNG pictures of meshes side by side, to judge smoothing by eye. */
 #define _POSIX_C_SOURCE 200809L
+#include "cli_args.h"
 #include "cli_commands.h"
 #include "cli_files.h"
 #include "mesh_render.h"
@@ -40,30 +41,6 @@ static const char render_usage[] =
     "  rsmooth render noisy.ply smooth.ply conf.ply -o compare.png\n"
     "\n"
     "Exit status: 0 success, 2 bad usage or an unreadable or malformed input, 1 other.\n";
-
-static int render_usage_error(const char *message, const char *arg) {
-    fprintf(stderr, "rsmooth render: %s%s\nTry 'rsmooth render --help'.\n", message,
-            arg ? arg : "");
-    return 2;
-}
-
-/* Reads `path` (no progress bar); on failure cli_read_mesh has said why. Returns 0 or the exit
- * status. */
-static int read_mesh(const char *path, rsmooth_mesh **mesh) {
-    cli_progress quiet;
-    cli_progress_init(&quiet, true);
-    return cli_read_mesh(path, &quiet, mesh);
-}
-
-static bool parse_double(const char *s, double *out) {
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (end == s || *end != '\0' || errno != 0 || !isfinite(v))
-        return false;
-    *out = v;
-    return true;
-}
 
 static bool parse_size(const char *s, int *w, int *h) {
     char *end;
@@ -147,7 +124,7 @@ int cli_render_main(int argc, char **argv) {
         bool takes_value = !strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--size") ||
                            !strcmp(a, "--azimuth") || !strcmp(a, "--elevation");
         if (takes_value && i + 1 >= argc) {
-            status = render_usage_error("missing value after ", a);
+            status = cli_usage_error("render", "missing value after %s", a);
             break;
         }
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
@@ -158,28 +135,31 @@ int cli_render_main(int argc, char **argv) {
             output = argv[++i];
         } else if (!strcmp(a, "--size")) {
             if (!parse_size(argv[++i], &width, &height))
-                status = render_usage_error("--size wants WxH, each 1 to 16384: ", argv[i]);
+                status =
+                    cli_usage_error("render", "--size wants WxH, each 1 to 16384: %s", argv[i]);
         } else if (!strcmp(a, "--azimuth")) {
-            if (!parse_double(argv[++i], &options.azimuth_deg))
-                status = render_usage_error("--azimuth wants degrees: ", argv[i]);
+            if (!cli_parse_number(argv[++i], &options.azimuth_deg) ||
+                !isfinite(options.azimuth_deg))
+                status = cli_usage_error("render", "--azimuth wants degrees: %s", argv[i]);
         } else if (!strcmp(a, "--elevation")) {
-            if (!parse_double(argv[++i], &options.elevation_deg) ||
+            if (!cli_parse_number(argv[++i], &options.elevation_deg) ||
                 !(options.elevation_deg > -90 && options.elevation_deg < 90))
-                status = render_usage_error("--elevation wants degrees in (-90, 90): ", argv[i]);
+                status = cli_usage_error("render", "--elevation wants degrees in (-90, 90): %s",
+                                         argv[i]);
         } else if (!strcmp(a, "--orthographic")) {
             options.orthographic = true;
         } else if (!strcmp(a, "-f") || !strcmp(a, "--force")) {
             force = true;
         } else if (a[0] == '-' && a[1] != '\0') {
-            status = render_usage_error("unknown option: ", a);
+            status = cli_usage_error("render", "unknown option: %s", a);
         } else {
             inputs[input_count++] = a;
         }
     }
     if (status == 0 && input_count == 0)
-        status = render_usage_error("needs at least one mesh file", NULL);
+        status = cli_usage_error("render", "needs at least one mesh file");
     if (status == 0 && !output)
-        status = render_usage_error("needs -o OUT.png", NULL);
+        status = cli_usage_error("render", "needs -o OUT.png");
     if (status != 0) {
         free(inputs);
         return status;
@@ -192,7 +172,7 @@ int cli_render_main(int argc, char **argv) {
     }
     if ((size_t)width < input_count * 8 + (input_count - 1) * (size_t)options.gap) {
         free(inputs);
-        return render_usage_error("--size is too narrow for that many panels", NULL);
+        return cli_usage_error("render", "--size is too narrow for that many panels");
     }
     struct stat st;
     if (stat(output, &st) == 0) {
@@ -227,7 +207,7 @@ int cli_render_main(int argc, char **argv) {
         goto done;
     }
     for (size_t i = 0; i < input_count && status == 0; i++) {
-        status = read_mesh(inputs[i], &meshes[i]);
+        status = cli_read_mesh(inputs[i], NULL, &meshes[i]);
         if (status == 0) {
             views[i].xyz = meshes[i]->positions;
             views[i].vertex_count = meshes[i]->vertex_count;

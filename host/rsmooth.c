@@ -2,6 +2,7 @@
  * writes the result atomically: a temporary file beside the output, renamed when complete. */
 #define _POSIX_C_SOURCE 200809L
 #include "rsmooth.h"
+#include "cli_args.h"
 #include "cli_commands.h"
 #include "cli_files.h"
 #include "cli_progress.h"
@@ -83,26 +84,6 @@ typedef struct options {
     bool ascii, json, force, quiet, in_place, stats, list_devices;
 } options;
 
-__attribute__((format(printf, 1, 2))) static int usage_error(const char *fmt, ...) {
-    va_list args;
-    va_start(args, fmt);
-    fprintf(stderr, "rsmooth: ");
-    vfprintf(stderr, fmt, args);
-    fprintf(stderr, "\nTry 'rsmooth --help'.\n");
-    va_end(args);
-    return EXIT_USAGE;
-}
-
-static bool parse_number(const char *text, double *out) {
-    char *end = NULL;
-    errno = 0;
-    double v = strtod(text, &end);
-    if (end == text || *end != '\0' || errno == ERANGE || isnan(v))
-        return false;
-    *out = v;
-    return true;
-}
-
 /* Returns -1 when the program should go on, else the exit status. */
 static int parse_args(int argc, char **argv, options *opt) {
     memset(opt, 0, sizeof *opt);
@@ -121,7 +102,7 @@ static int parse_args(int argc, char **argv, options *opt) {
         } else if (!strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--confidence") ||
                    !strcmp(a, "--device")) {
             if (!value)
-                return usage_error("%s needs a value", a);
+                return cli_usage_error(NULL, "%s needs a value", a);
             if (!strcmp(a, "--confidence"))
                 opt->confidence = value;
             else if (!strcmp(a, "--device"))
@@ -131,9 +112,9 @@ static int parse_args(int argc, char **argv, options *opt) {
             i++;
         } else if (!strcmp(a, "--sigma-f") || !strcmp(a, "--sigma-g") || !strcmp(a, "--cutoff")) {
             if (!value)
-                return usage_error("%s needs a value", a);
-            if (!parse_number(value, &x))
-                return usage_error("%s: not a number: '%s'", a, value);
+                return cli_usage_error(NULL, "%s needs a value", a);
+            if (!cli_parse_number(value, &x))
+                return cli_usage_error(NULL, "%s: not a number: '%s'", a, value);
             if (!strcmp(a, "--sigma-f"))
                 opt->params.sigma_f = x;
             else if (!strcmp(a, "--sigma-g"))
@@ -160,31 +141,31 @@ static int parse_args(int argc, char **argv, options *opt) {
         } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
             opt->quiet = true;
         } else if (a[0] == '-' && a[1] != '\0') {
-            return usage_error("unknown option '%s'", a);
+            return cli_usage_error(NULL, "unknown option '%s'", a);
         } else if (!opt->input) {
             opt->input = a;
         } else {
-            return usage_error("unexpected argument '%s' (one input file only)", a);
+            return cli_usage_error(NULL, "unexpected argument '%s' (one input file only)", a);
         }
     }
     if (opt->list_devices)
         return -1;
     if (!opt->input)
-        return usage_error("no input file");
+        return cli_usage_error(NULL, "no input file");
     if (opt->in_place && opt->output)
-        return usage_error("give either -o OUTPUT or --in-place, not both");
+        return cli_usage_error(NULL, "give either -o OUTPUT or --in-place, not both");
     if (opt->in_place)
         opt->output = opt->input;
     if (!opt->output)
-        return usage_error("no output file (-o OUTPUT, or --in-place)");
+        return cli_usage_error(NULL, "no output file (-o OUTPUT, or --in-place)");
     /* Checked here so a typo is a usage error before any file is read. */
     const rsmooth_params *p = &opt->params;
     if (!(p->sigma_f > 0) || !isfinite(p->sigma_f))
-        return usage_error("--sigma-f must be a positive number (got %g)", p->sigma_f);
+        return cli_usage_error(NULL, "--sigma-f must be a positive number (got %g)", p->sigma_f);
     if (!(p->sigma_g > 0))
-        return usage_error("--sigma-g must be positive, or 'inf' (got %g)", p->sigma_g);
+        return cli_usage_error(NULL, "--sigma-g must be positive, or 'inf' (got %g)", p->sigma_g);
     if (!(p->cutoff > 0 && p->cutoff <= 5))
-        return usage_error("--cutoff must be in (0, 5] (got %g)", p->cutoff);
+        return cli_usage_error(NULL, "--cutoff must be in (0, 5] (got %g)", p->cutoff);
     return -1;
 }
 

@@ -1,0 +1,31 @@
+/* Argument helpers shared by the rsmooth command and its subcommands (see cli_args.h). */
+#include "cli_args.h"
+#include "cli_files.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+int cli_usage_error(const char *command, const char *format, ...) {
+    const char *space = command ? " " : "";
+    command = command ? command : "";
+    va_list args;
+    va_start(args, format);
+    fprintf(stderr, "rsmooth%s%s: ", space, command);
+    vfprintf(stderr, format, args);
+    fprintf(stderr, "\nTry 'rsmooth%s%s --help'.\n", space, command);
+    va_end(args);
+    return EXIT_USAGE;
+}
+
+bool cli_parse_number(const char *text, double *out) {
+    char *end = NULL;
+    errno = 0;
+    double v = strtod(text, &end);
+    if (end == text || *end != '\0' || errno == ERANGE || isnan(v))
+        return false;
+    *out = v;
+    return true;
+}

@@ -1,0 +1,17 @@
+/* Argument helpers shared by the rsmooth command and its subcommands. */
+#ifndef RSMOOTH_CLI_ARGS_H
+#define RSMOOTH_CLI_ARGS_H
+
+#include <stdbool.h>
+
+/* Prints "rsmooth[ COMMAND]: message" and the --help hint to stderr; returns the usage exit status
+ * (2). `command` is NULL for the main command. */
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+int cli_usage_error(const char *command, const char *format, ...);
+
+/* Parses the whole of `text` as a number; false for junk, NaN or out of range. Accepts "inf". */
+bool cli_parse_number(const char *text, double *out);
+
+#endif
