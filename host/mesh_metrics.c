@@ -1,6 +1,7 @@
 /* Denoising error metrics (face-normal angle, Sun et al. 2007 E_v, RMS displacement, Hausdorff) and
  * the exact closest-point-on-surface grid they rest on. */
 #include "mesh_metrics.h"
+#include "mesh_shapes.h"
 
 #include <float.h>
 #include <math.h>
@@ -404,39 +405,6 @@ double surface_index_query(const surface_index *index, const double point[3], do
 
 /* ---- metrics --------------------------------------------------------------------------------- */
 
-static int compare_u64(const void *a, const void *b) {
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
-    return (x > y) - (x < y);
-}
-
-/* Mean length of unique undirected edges, as rsmooth_mean_edge_length (the unit of the filter's
- * sigmas) counts them. -1 when out of memory. */
-static double mean_edge_length(const double *xyz, const uint32_t *triangles,
-                               size_t triangle_count) {
-    uint64_t *keys = malloc(3 * triangle_count * sizeof *keys);
-    if (!keys)
-        return -1;
-    size_t n = 0;
-    for (size_t t = 0; t < triangle_count; t++) {
-        for (int e = 0; e < 3; e++) {
-            uint64_t a = triangles[3 * t + e], b = triangles[3 * t + (e + 1) % 3];
-            if (a != b)
-                keys[n++] = a < b ? a << 32 | b : b << 32 | a;
-        }
-    }
-    qsort(keys, n, sizeof *keys, compare_u64);
-    double sum = 0;
-    size_t unique = 0;
-    for (size_t i = 0; i < n; i++) {
-        if (i > 0 && keys[i] == keys[i - 1])
-            continue;
-        sum += sqrt(dist2_3(xyz + 3 * (keys[i] >> 32), xyz + 3 * (keys[i] & 0xffffffffu)));
-        unique++;
-    }
-    free(keys);
-    return unique ? sum / (double)unique : 0;
-}
-
 int mesh_metrics_compute(const double *result_xyz, const double *truth_xyz, size_t vertex_count,
                          const uint32_t *triangles, size_t triangle_count, mesh_metrics *out) {
     if (!result_xyz || !truth_xyz || !triangles || !out || vertex_count == 0 ||
@@ -459,8 +427,11 @@ int mesh_metrics_compute(const double *result_xyz, const double *truth_xyz, size
     out->vertex_count = vertex_count;
     out->triangle_count = triangle_count;
 
-    out->mean_edge = mean_edge_length(truth_xyz, triangles, triangle_count);
-    if (out->mean_edge < 0)
+    /* A read-only view: shape_mean_edge_length writes nothing through it. It counts edges as
+     * rsmooth_mean_edge_length does (the unit of the filter's sigmas). */
+    shape_mesh truth = {vertex_count, (double *)truth_xyz, triangle_count, (uint32_t *)triangles};
+    out->mean_edge = shape_mean_edge_length(&truth);
+    if (isnan(out->mean_edge))
         goto done;
     double lo[3], hi[3];
     for (int k = 0; k < 3; k++) {
