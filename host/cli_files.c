@@ -132,7 +132,7 @@ static void remove_temporary_and_exit(int signal_number) {
     raise(signal_number);
 }
 
-int cli_write_mesh(const rsmooth_mesh *mesh, const char *path, rsmooth_format format) {
+int cli_write_atomically(const char *path, cli_writer write, void *user) {
     if (strlen(path) + 16 > sizeof temporary) {
         fprintf(stderr, "rsmooth: %s: path too long\n", path);
         return EXIT_OTHER;
@@ -149,34 +149,53 @@ int cli_write_mesh(const rsmooth_mesh *mesh, const char *path, rsmooth_format fo
     signal(SIGTERM, remove_temporary_and_exit);
     signal(SIGHUP, remove_temporary_and_exit);
     FILE *f = fdopen(fd, "wb");
-    rsmooth_error err;
-    rsmooth_status status = RSMOOTH_ERROR_IO;
+    char message[256] = "";
+    bool ok = false;
     if (f) {
-        status = rsmooth_mesh_write_stream(mesh, f, format, &err);
-        if (fclose(f) != 0 && status == RSMOOTH_OK) {
-            status = RSMOOTH_ERROR_IO;
-            snprintf(err.message, sizeof err.message, "%s", strerror(errno));
+        ok = write(f, user, message, sizeof message) == 0;
+        if (fclose(f) != 0 && ok) {
+            ok = false;
+            snprintf(message, sizeof message, "%s", strerror(errno));
         }
     } else {
-        snprintf(err.message, sizeof err.message, "%s", strerror(errno));
+        snprintf(message, sizeof message, "%s", strerror(errno));
         close(fd);
     }
-    if (status == RSMOOTH_OK) {
+    if (ok) {
         mode_t mask = umask(0); /* mkstemp makes 0600 files; give the usual permissions */
         umask(mask);
         chmod(temporary, 0666 & ~mask);
         if (rename(temporary, path) != 0) {
-            snprintf(err.message, sizeof err.message, "%s", strerror(errno));
-            status = RSMOOTH_ERROR_IO;
+            snprintf(message, sizeof message, "%s", strerror(errno));
+            ok = false;
         }
     }
-    if (status != RSMOOTH_OK) {
-        fprintf(stderr, "rsmooth: %s: cannot write: %s\n", path, err.message);
+    if (!ok) {
+        fprintf(stderr, "rsmooth: %s: cannot write: %s\n", path, message);
         unlink(temporary);
     }
     have_temporary = 0;
     signal(SIGINT, SIG_DFL);
     signal(SIGTERM, SIG_DFL);
     signal(SIGHUP, SIG_DFL);
-    return status == RSMOOTH_OK ? EXIT_OK : EXIT_OTHER;
+    return ok ? EXIT_OK : EXIT_OTHER;
+}
+
+typedef struct mesh_write {
+    const rsmooth_mesh *mesh;
+    rsmooth_format format;
+} mesh_write;
+
+static int write_mesh_stream(FILE *f, void *user, char *message, size_t size) {
+    const mesh_write *w = user;
+    rsmooth_error err;
+    if (rsmooth_mesh_write_stream(w->mesh, f, w->format, &err) == RSMOOTH_OK)
+        return 0;
+    snprintf(message, size, "%s", err.message);
+    return -1;
+}
+
+int cli_write_mesh(const rsmooth_mesh *mesh, const char *path, rsmooth_format format) {
+    mesh_write w = {mesh, format};
+    return cli_write_atomically(path, write_mesh_stream, &w);
 }

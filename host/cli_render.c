@@ -59,51 +59,14 @@ static bool parse_size(const char *s, int *w, int *h) {
     return true;
 }
 
-/* Writes the picture to a temporary file beside `path` and renames it into place, so a failure
- * never leaves a partial PNG under the name asked for. Returns an exit status. */
-static int write_png(const char *path, const uint8_t *rgb, int width, int height) {
-    size_t len = strlen(path);
-    char *temporary = malloc(len + 16);
-    if (!temporary) {
-        fprintf(stderr, "rsmooth render: %s: out of memory\n", path);
-        return 1;
-    }
-    snprintf(temporary, len + 16, "%s.tmp-XXXXXX", path);
-    int fd = mkstemp(temporary);
-    if (fd < 0) {
-        fprintf(stderr, "rsmooth render: %s: cannot create a temporary file beside it: %s\n", path,
-                strerror(errno));
-        free(temporary);
-        return 1;
-    }
-    char message[256] = "";
-    int status = -1;
-    FILE *f = fdopen(fd, "wb");
-    if (f) {
-        status = png_write_rgb(f, rgb, width, height, message, sizeof message);
-        if (fclose(f) != 0 && status == 0) {
-            snprintf(message, sizeof message, "%s", strerror(errno));
-            status = -1;
-        }
-    } else {
-        snprintf(message, sizeof message, "%s", strerror(errno));
-        close(fd);
-    }
-    if (status == 0) {
-        mode_t mask = umask(0); /* mkstemp makes 0600 files; give the usual permissions */
-        umask(mask);
-        chmod(temporary, 0666 & ~mask);
-        if (rename(temporary, path) != 0) {
-            snprintf(message, sizeof message, "%s", strerror(errno));
-            status = -1;
-        }
-    }
-    if (status != 0) {
-        fprintf(stderr, "rsmooth render: %s: cannot write: %s\n", path, message);
-        unlink(temporary);
-    }
-    free(temporary);
-    return status == 0 ? 0 : 1;
+typedef struct picture {
+    const uint8_t *rgb;
+    int width, height;
+} picture;
+
+static int write_picture(FILE *stream, void *user, char *message, size_t size) {
+    const picture *p = user;
+    return png_write_rgb(stream, p->rgb, p->width, p->height, message, size);
 }
 
 int cli_render_main(int argc, char **argv) {
@@ -225,7 +188,8 @@ int cli_render_main(int argc, char **argv) {
         status = 1;
         goto done;
     }
-    status = write_png(output, rgb, width, height);
+    picture pic = {rgb, width, height};
+    status = cli_write_atomically(output, write_picture, &pic);
 done:
     if (meshes)
         for (size_t i = 0; i < input_count; i++)
