@@ -54,6 +54,17 @@ static const char usage_text[] =
     "  --absolute            read --sigma-f and --sigma-g in the mesh's own units\n"
     "  --cutoff C            ignore triangles farther than C * sigma-f (default 2, range (0, 5])\n"
     "  --no-mollify          predict with the raw (noisy) normals: the paper's ablation, worse\n"
+    "  --method M            robust (default): the filter above. For comparison, the isotropic\n"
+    "                        smoothers it improves on, which round sharp edges:\n"
+    "                          gaussian   Gaussian-weighted average of triangle centroids\n"
+    "                                     (width --sigma-f; no influence weight, one pass)\n"
+    "                          laplacian  --iterations steps towards the mean of the edge\n"
+    "                                     neighbours, by --lambda (default 0.5); shrinks\n"
+    "                          taubin     Taubin's lambda|mu: each step followed by one back\n"
+    "                                     by --mu (default -0.53); keeps the size\n"
+    "                        laplacian and taubin need connected faces (a soup does not move),\n"
+    "                        run on the CPU and write no --confidence.\n"
+    "  --iterations N        laplacian and taubin steps (default 10)\n"
     "  --device D            auto (default: first GPU, else CPU; falls back to the reference path\n"
     "                        with a warning when no OpenCL exists), gpu, cpu, reference (double\n"
     "                        precision on one CPU thread), P:D (platform and device index), or a\n"
@@ -81,6 +92,10 @@ static const char usage_text[] =
 typedef struct options {
     const char *input, *output, *confidence, *device;
     rsmooth_params params;
+    enum { METHOD_ROBUST, METHOD_GAUSSIAN, METHOD_LAPLACIAN, METHOD_TAUBIN } method;
+    double lambda, mu;
+    unsigned iterations;
+    bool sigma_g_given, umbrella_given; /* for consistency checks against --method */
     bool ascii, json, force, quiet, in_place, stats, list_devices;
 } options;
 
@@ -88,6 +103,9 @@ typedef struct options {
 static int parse_args(int argc, char **argv, options *opt) {
     memset(opt, 0, sizeof *opt);
     rsmooth_params_init(&opt->params);
+    opt->lambda = 0.5;
+    opt->mu = -0.53;
+    opt->iterations = 10;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *value = i + 1 < argc ? argv[i + 1] : NULL;
@@ -110,6 +128,37 @@ static int parse_args(int argc, char **argv, options *opt) {
             else
                 opt->output = value;
             i++;
+        } else if (!strcmp(a, "--method")) {
+            if (!value)
+                return cli_usage_error(NULL, "%s needs a value", a);
+            if (!strcmp(value, "robust"))
+                opt->method = METHOD_ROBUST;
+            else if (!strcmp(value, "gaussian"))
+                opt->method = METHOD_GAUSSIAN;
+            else if (!strcmp(value, "laplacian"))
+                opt->method = METHOD_LAPLACIAN;
+            else if (!strcmp(value, "taubin"))
+                opt->method = METHOD_TAUBIN;
+            else
+                return cli_usage_error(
+                    NULL, "--method: '%s' is not robust, gaussian, laplacian or taubin", value);
+            i++;
+        } else if (!strcmp(a, "--lambda") || !strcmp(a, "--mu") || !strcmp(a, "--iterations")) {
+            if (!value)
+                return cli_usage_error(NULL, "%s needs a value", a);
+            if (!cli_parse_number(value, &x))
+                return cli_usage_error(NULL, "%s: not a number: '%s'", a, value);
+            if (!strcmp(a, "--lambda"))
+                opt->lambda = x;
+            else if (!strcmp(a, "--mu"))
+                opt->mu = x;
+            else if (!(x >= 0 && x <= 1e6 && x == floor(x)))
+                return cli_usage_error(NULL, "--iterations must be a whole number in [0, 1e6] "
+                                             "(got '%s')", value);
+            else
+                opt->iterations = (unsigned)x;
+            opt->umbrella_given = true;
+            i++;
         } else if (!strcmp(a, "--sigma-f") || !strcmp(a, "--sigma-g") || !strcmp(a, "--cutoff")) {
             if (!value)
                 return cli_usage_error(NULL, "%s needs a value", a);
@@ -118,7 +167,7 @@ static int parse_args(int argc, char **argv, options *opt) {
             if (!strcmp(a, "--sigma-f"))
                 opt->params.sigma_f = x;
             else if (!strcmp(a, "--sigma-g"))
-                opt->params.sigma_g = x;
+                opt->params.sigma_g = x, opt->sigma_g_given = true;
             else
                 opt->params.cutoff = x;
             i++;
@@ -166,6 +215,26 @@ static int parse_args(int argc, char **argv, options *opt) {
         return cli_usage_error(NULL, "--sigma-g must be positive, or 'inf' (got %g)", p->sigma_g);
     if (!(p->cutoff > 0 && p->cutoff <= 5))
         return cli_usage_error(NULL, "--cutoff must be in (0, 5] (got %g)", p->cutoff);
+    bool umbrella = opt->method == METHOD_LAPLACIAN || opt->method == METHOD_TAUBIN;
+    if (opt->umbrella_given && !umbrella)
+        return cli_usage_error(NULL, "--lambda, --mu and --iterations need --method laplacian "
+                                     "or taubin");
+    if (umbrella && opt->confidence)
+        return cli_usage_error(NULL, "--method %s has no confidence to write",
+                               opt->method == METHOD_TAUBIN ? "taubin" : "laplacian");
+    if (opt->method == METHOD_GAUSSIAN) {
+        if (opt->sigma_g_given)
+            return cli_usage_error(NULL, "--method gaussian has no influence weight: drop "
+                                         "--sigma-g");
+        opt->params.predictor = RSMOOTH_PREDICT_CENTROID;
+        opt->params.sigma_g = INFINITY;
+    }
+    if (opt->method == METHOD_LAPLACIAN)
+        opt->mu = 0;
+    if (umbrella && !(opt->lambda > 0 && opt->lambda <= 1))
+        return cli_usage_error(NULL, "--lambda must be in (0, 1] (got %g)", opt->lambda);
+    if (opt->method == METHOD_TAUBIN && !(opt->mu >= -1 && opt->mu < 0))
+        return cli_usage_error(NULL, "--mu must be in [-1, 0) (got %g)", opt->mu);
     return -1;
 }
 
@@ -221,6 +290,11 @@ static void print_json(const rsmooth_report *r, const options *opt, double ms_re
     print_json_string(opt->input);
     printf(",\"output\":");
     print_json_string(opt->output);
+    static const char *const method_names[] = {"robust", "gaussian", "laplacian", "taubin"};
+    printf(",\"method\":\"%s\"", method_names[opt->method]);
+    if (opt->method == METHOD_LAPLACIAN || opt->method == METHOD_TAUBIN)
+        printf(",\"lambda\":%.9g,\"mu\":%.9g,\"iterations\":%u", opt->lambda, opt->mu,
+               opt->iterations);
     printf(",\"vertices\":%zu,\"triangles\":%zu,\"facets\":%zu,\"mean_edge_length\":%.9g,"
            "\"sigma_f\":%.9g,",
            r->vertex_count, r->triangle_count, r->facet_count, r->mean_edge_length, r->sigma_f);
@@ -268,26 +342,34 @@ static void print_stats(const rsmooth_mesh *mesh, const double *out, const float
         }
         moved[v] = r->mean_edge_length > 0 ? sqrt(d2) / r->mean_edge_length : 0;
         unreferenced += !used[v];
-        conf_sum += confidence[v];
-        conf_min = fmin(conf_min, confidence[v]);
-        low += confidence[v] < 0.5f;
+        if (confidence) {
+            conf_sum += confidence[v];
+            conf_min = fmin(conf_min, confidence[v]);
+            low += confidence[v] < 0.5f;
+        }
     }
     qsort(moved, nv, sizeof *moved, compare_double);
     double moved_sum = 0;
     for (size_t v = 0; v < nv; v++)
         moved_sum += moved[v];
     fprintf(stderr,
-            "mesh:        %zu vertices (%zu referenced by no triangle), %zu faces, %zu triangles "
-            "(%zu of zero area)\n"
-            "size:        %.6g x %.6g x %.6g, mean edge %.6g\n"
-            "filter:      sigma_f %.6g, sigma_g %.6g, reach %.6g (mesh units), %zu grid cells\n"
-            "moved:       mean %.4f, median %.4f, max %.4f mean edge lengths\n"
-            "confidence:  mean %.3f, min %.3f, %zu vertices (%.1f%%) below 0.5\n",
-            nv, unreferenced, mesh->face_count, mesh->triangle_count,
-            r->triangle_count - r->facet_count, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2],
-            r->mean_edge_length, r->sigma_f, r->sigma_g, r->radius, r->grid_cell_count,
-            moved_sum / (double)nv, moved[nv / 2], moved[nv - 1], conf_sum / (double)nv, conf_min,
-            low, 100.0 * (double)low / (double)nv);
+            "mesh:        %zu vertices (%zu referenced by no triangle), %zu faces, %zu triangles\n"
+            "size:        %.6g x %.6g x %.6g, mean edge %.6g\n",
+            nv, unreferenced, mesh->face_count, mesh->triangle_count, hi[0] - lo[0],
+            hi[1] - lo[1], hi[2] - lo[2], r->mean_edge_length);
+    if (confidence) /* the robust filter and the Gaussian; the umbrella methods have neither */
+        fprintf(stderr,
+                "filter:      sigma_f %.6g, sigma_g %.6g, reach %.6g (mesh units), %zu grid "
+                "cells, %zu triangles of zero area\n",
+                r->sigma_f, r->sigma_g, r->radius, r->grid_cell_count,
+                r->triangle_count - r->facet_count);
+    else
+        fprintf(stderr, "filter:      %s\n", r->device);
+    fprintf(stderr, "moved:       mean %.4f, median %.4f, max %.4f mean edge lengths\n",
+            moved_sum / (double)nv, moved[nv / 2], moved[nv - 1]);
+    if (confidence)
+        fprintf(stderr, "confidence:  mean %.3f, min %.3f, %zu vertices (%.1f%%) below 0.5\n",
+                conf_sum / (double)nv, conf_min, low, 100.0 * (double)low / (double)nv);
     free(used);
     free(moved);
 }
@@ -300,9 +382,35 @@ static void warn_losses(const rsmooth_mesh *mesh, const char *path, rsmooth_form
         fprintf(stderr, "rsmooth: %s: this format cannot hold, so drops: %s\n", path, lost);
 }
 
+/* Laplacian or Taubin smoothing (always on the CPU); fills the report's counts and time. */
+static int smooth_umbrella(const options *opt, const rsmooth_mesh *mesh, double *out,
+                           rsmooth_report *report) {
+    rsmooth_error err;
+    double t = cli_now_ms();
+    rsmooth_status st = rsmooth_smooth_taubin(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
+                                              mesh->triangles, mesh->triangle_count, opt->lambda,
+                                              opt->mu, opt->iterations, out, &err);
+    if (st == RSMOOTH_OK)
+        st = rsmooth_mean_edge_length(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
+                                      mesh->triangles, mesh->triangle_count,
+                                      &report->mean_edge_length, &err);
+    if (st != RSMOOTH_OK) {
+        fprintf(stderr, "rsmooth: %s: %s\n", opt->input, err.message);
+        return st == RSMOOTH_ERROR_INVALID_ARGUMENT ? EXIT_USAGE : EXIT_OTHER;
+    }
+    report->ms_total = cli_now_ms() - t;
+    report->vertex_count = mesh->vertex_count;
+    report->triangle_count = mesh->triangle_count;
+    snprintf(report->device, sizeof report->device, "%s, %u iterations (double, 1 thread)",
+             opt->mu != 0 ? "taubin" : "laplacian", opt->iterations);
+    return EXIT_OK;
+}
+
 /* Runs the filter on the chosen device; prints what fails. */
 static int smooth(const options *opt, const rsmooth_mesh *mesh, double *out, float *confidence,
                   rsmooth_report *report, cli_progress *bar) {
+    if (opt->method == METHOD_LAPLACIAN || opt->method == METHOD_TAUBIN)
+        return smooth_umbrella(opt, mesh, out, report);
     const char *device = opt->device ? opt->device : getenv("RSMOOTH_DEVICE");
     bool reference = device && strcmp(device, "reference") == 0;
     rsmooth_context *ctx = NULL;
@@ -419,7 +527,8 @@ int main(int argc, char **argv) {
 
     size_t nv = mesh->vertex_count;
     double *out = malloc(nv * 3 * sizeof *out);
-    bool want_confidence = opt.confidence || opt.stats;
+    bool umbrella = opt.method == METHOD_LAPLACIAN || opt.method == METHOD_TAUBIN;
+    bool want_confidence = opt.confidence || (opt.stats && !umbrella);
     float *confidence = want_confidence ? malloc(nv * sizeof *confidence) : NULL;
     rsmooth_report report;
     memset(&report, 0, sizeof report);
@@ -452,7 +561,11 @@ int main(int argc, char **argv) {
         print_json(&report, &opt, ms_read, ms_write);
     if (opt.stats)
         print_stats(mesh, out, confidence, &report);
-    if (!opt.quiet)
+    if (!opt.quiet && umbrella)
+        fprintf(stderr, "rsmooth: %s: %zu vertices, %zu triangles; %s: %.1f ms; wrote %s\n",
+                opt.input, report.vertex_count, report.triangle_count, report.device,
+                report.ms_total, opt.output);
+    else if (!opt.quiet)
         fprintf(stderr,
                 "rsmooth: %s: %zu vertices, %zu triangles, mean edge %.6g; sigma_f %.6g, "
                 "sigma_g %.6g (mesh units) on %s: filter %.1f ms; wrote %s%s%s\n",

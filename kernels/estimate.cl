@@ -6,13 +6,14 @@
  *   vertex_extra[v]  = (sum a f, the exponent shift e_s, 0, 0): k(p) = k' exp(-e_s) in mean-area units.
  * When every influence exponent exceeds RS_RESCUE_EXPONENT, float32 weights would underflow; the
  * sums are then redone with the smallest exponent subtracted (e_s), as the reference path does.
- * `want_confidence` = 0 skips sum a f (one exp per pair instead of two).
+ * `want_confidence` = 0 skips sum a f (one exp per pair instead of two). `predict_centroid` = 1
+ * predicts c_q instead of Pi_q(p) (isotropic Gaussian smoothing when inv_2sg2 = 0).
  */
 
 /* Sums of Eq. 3 over the facets within reach of p, in the cells listed in `cells` (the 27 around
  * the vertex's own, -1 where empty), with influence exponents shifted down by `shift`. */
 inline void robust_sums(float3 p, const int *cells, float reach2, float inv_2sf2, float inv_2sg2,
-                        float shift, int want_confidence, __global const float4 *facet_centroid,
+                        float shift, int want_confidence, int predict_centroid, __global const float4 *facet_centroid,
                         __global const float4 *normal, __global const uint *cell_start,
                         float3 *acc_out, float *k_out, float *kf_out, float *e_min_out) {
     float k = 0.0f, kf = 0.0f, e_min = MAXFLOAT;
@@ -33,9 +34,11 @@ inline void robust_sums(float3 p, const int *cells, float reach2, float inv_2sf2
                     if (d2 <= reach2) {
                         float3 n = normal[q].xyz;
                         float t = dot(n, d);
-                        float e = t * t * inv_2sg2;
+                        /* prediction - p: Pi_q(p) - p = t n, or c_q - p = d (centroid) */
+                        float3 step = predict_centroid ? d : t * n;
+                        float e = (predict_centroid ? d2 : t * t) * inv_2sg2;
                         float w = exp(c.w - d2 * inv_2sf2 - (e - shift));
-                        acc += (w * t) * n;
+                        acc += w * step;
                         k += w;
                         e_min = fmin(e_min, e);
                         if (want_confidence)
@@ -50,7 +53,7 @@ inline void robust_sums(float3 p, const int *cells, float reach2, float inv_2sf2
 }
 
 __kernel void robust_vertex(uint vertex_count, float reach2, float inv_2sf2, float inv_2sg2,
-                            int want_confidence,
+                            int want_confidence, int predict_centroid,
                             __global const float4 *vertex_local, __global const int4 *vertex_cell,
                             __global const float4 *facet_centroid, __global const float4 *normal,
                             __global const int4 *cell_coord, __global const uint *cell_start,
@@ -70,13 +73,13 @@ __kernel void robust_vertex(uint vertex_count, float reach2, float inv_2sf2, flo
                                        home.z + dz);
     float3 acc;
     float k, kf, e_min, unused;
-    robust_sums(p, cells, reach2, inv_2sf2, inv_2sg2, 0.0f, want_confidence, facet_centroid,
-                normal, cell_start, &acc, &k, &kf, &e_min);
+    robust_sums(p, cells, reach2, inv_2sf2, inv_2sg2, 0.0f, want_confidence, predict_centroid,
+                facet_centroid, normal, cell_start, &acc, &k, &kf, &e_min);
     float shift = 0.0f;
     if (e_min > RS_RESCUE_EXPONENT && e_min < MAXFLOAT) {
         shift = e_min;
-        robust_sums(p, cells, reach2, inv_2sf2, inv_2sg2, shift, 0, facet_centroid, normal,
-                    cell_start, &acc, &k, &unused, &e_min);
+        robust_sums(p, cells, reach2, inv_2sf2, inv_2sg2, shift, 0, predict_centroid,
+                    facet_centroid, normal, cell_start, &acc, &k, &unused, &e_min);
     }
     vertex_result[v] = k > 0.0f ? (float4)(acc / k, k) : (float4)(0.0f);
     vertex_extra[v] = (float4)(kf, shift, 0.0f, 0.0f);

@@ -260,6 +260,7 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     cl_float inv_2sg2 =
         isinf(pb.sigma_g) ? 0.0f : (cl_float)(h * h / (2 * pb.sigma_g * pb.sigma_g));
     cl_int want_confidence = out_confidence != NULL;
+    cl_int predict_centroid = pb.predict_centroid;
 
     cl_mem normals = buf[BUF_FACET_NORMAL];
     if (pb.mollify) {
@@ -308,6 +309,7 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     arg(&s, sizeof inv_2sf2, &inv_2sf2);
     arg(&s, sizeof inv_2sg2, &inv_2sg2);
     arg(&s, sizeof want_confidence, &want_confidence);
+    arg(&s, sizeof predict_centroid, &predict_centroid);
     arg(&s, sizeof(cl_mem), &buf[BUF_VERTEX_LOCAL]);
     arg(&s, sizeof(cl_mem), &buf[BUF_VERTEX_CELL]);
     arg(&s, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);

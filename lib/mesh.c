@@ -215,7 +215,8 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
     problem->radius = p.cutoff * problem->sigma_f;
     problem->mollify_radius =
         (p.mollify_cutoff > 0 ? p.mollify_cutoff : p.cutoff) * problem->sigma_f;
-    problem->mollify = p.mollify != 0;
+    problem->predict_centroid = p.predictor == RSMOOTH_PREDICT_CENTROID;
+    problem->mollify = p.mollify != 0 && !problem->predict_centroid;
     problem->progress = p.progress;
     problem->progress_user = p.progress_user;
     if (!(problem->sigma_f > 0) || !isfinite(problem->radius))

@@ -20,6 +20,7 @@ rsmooth_status rsmooth_params_init(rsmooth_params *params) {
     params->mollify = 1;
     params->progress = NULL;
     params->progress_user = NULL;
+    params->predictor = RSMOOTH_PREDICT_PROJECTION;
     return RSMOOTH_OK;
 }
 
@@ -55,5 +56,9 @@ rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *o
     if (out->mollify != 0 && out->mollify != 1)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "mollify must be 0 or 1 (got %d)", out->mollify);
+    if (out->predictor != RSMOOTH_PREDICT_PROJECTION && out->predictor != RSMOOTH_PREDICT_CENTROID)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "predictor must be RSMOOTH_PREDICT_PROJECTION or RSMOOTH_PREDICT_CENTROID "
+                       "(got %d)", out->predictor);
     return RSMOOTH_OK;
 }

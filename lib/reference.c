@@ -91,6 +91,15 @@ static void mollified_normal(const rs_problem *pb, const double *mollified, size
         out[k] = n[k] / len;
 }
 
+/* What facet q predicts for p, as a step from p: the projection Pi_q(p) - p = (n . d) n, with
+ * d = c_q - p, or (centroid predictor) d itself. */
+static void prediction_step(const rs_problem *pb, const double n[3], const double d[3],
+                            double step[3]) {
+    double t = pb->predict_centroid ? 1 : rs_dot3(n, d);
+    for (int c = 0; c < 3; c++)
+        step[c] = pb->predict_centroid ? d[c] : t * n[c];
+}
+
 /* Robust estimate for p (Eq. 3). Writes the displacement p' - p, k(p) and sum a f. */
 static void estimate_vertex(const rs_problem *pb, const neighbours *nb, const double *normals,
                             const double p[3], double disp[3], double *k_out, double *kf_out) {
@@ -103,12 +112,13 @@ static void estimate_vertex(const rs_problem *pb, const neighbours *nb, const do
         const double *n = normals + 3 * (size_t)q;
         double d[3];
         rs_sub3(pb->centroid + 3 * (size_t)q, p, d);
-        double t = rs_dot3(n, d); /* Pi_q(p) - p = t n */
+        double step[3]; /* prediction - p: Pi_q(p) - p = t n, or c_q - p */
+        prediction_step(pb, n, d, step);
         double af = pb->area[q] * exp(-nb->dist2[i] * inv_2sf2);
-        double e = t * t * inv_2sg2;
+        double e = rs_dot3(step, step) * inv_2sg2;
         double w = af * exp(-e);
         for (int c = 0; c < 3; c++)
-            acc[c] += w * t * n[c];
+            acc[c] += w * step[c];
         k += w;
         kf += af;
         e_min = fmin(e_min, e);
@@ -122,10 +132,12 @@ static void estimate_vertex(const rs_problem *pb, const neighbours *nb, const do
             const double *n = normals + 3 * (size_t)q;
             double d[3];
             rs_sub3(pb->centroid + 3 * (size_t)q, p, d);
-            double t = rs_dot3(n, d);
-            double w = pb->area[q] * exp(-nb->dist2[i] * inv_2sf2) * exp(e_min - t * t * inv_2sg2);
+            double step[3];
+            prediction_step(pb, n, d, step);
+            double w = pb->area[q] * exp(-nb->dist2[i] * inv_2sf2) *
+                       exp(e_min - rs_dot3(step, step) * inv_2sg2);
             for (int c = 0; c < 3; c++)
-                acc[c] += w * t * n[c];
+                acc[c] += w * step[c];
             ks += w;
         }
         k = ks * exp(-e_min);

@@ -80,7 +80,8 @@ typedef struct rs_problem {
     double sigma_m;              /* mollification width: sigma_f / 2 */
     double radius;               /* cutoff * sigma_f: reach of the robust pass */
     double mollify_radius;       /* reach of the mollification pass (<= radius) */
-    bool mollify;
+    bool mollify;                /* false also when the predictor needs no normals (centroid) */
+    bool predict_centroid;       /* predict c_q instead of Pi_q(p) */
     rsmooth_progress_fn progress; /* optional, from the params */
     void *progress_user;
 } rs_problem;

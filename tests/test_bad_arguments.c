@@ -196,6 +196,9 @@ static void test_smooth_arguments(void) {
         p = params;
         p.mollify = -1;
         expect_invalid("mollify -1", c);
+        p = params;
+        p.predictor = 2;
+        expect_invalid("predictor 2", c);
         static const size_t small[] = {0, 1, sizeof(size_t) + sizeof(double),
                                        offsetof(rsmooth_params, mollify)};
         for (size_t i = 0; i < sizeof small / sizeof small[0]; i++) {

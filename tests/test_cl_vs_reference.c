@@ -131,6 +131,10 @@ int main(void) {
     compare_shape(ctx, "noisy cube, influence off", &cube, &p);
     p.sigma_g = 0.05; /* tiny influence width: exercises the underflow rescue */
     compare_shape(ctx, "noisy cube, sg=0.05", &cube, &p);
+    p.predictor = RSMOOTH_PREDICT_CENTROID;
+    compare_shape(ctx, "noisy cube, centroid predictor, sg=0.05", &cube, &p);
+    p.sigma_g = INFINITY;
+    compare_shape(ctx, "noisy sphere, isotropic Gaussian (centroid, influence off)", &sphere, &p);
     rsmooth_params_init(&p);
     p.cutoff = 3;
     p.mollify_cutoff = 1;

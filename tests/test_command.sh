@@ -58,6 +58,24 @@ expect 2 "$rsmooth" noisy.ply -o x.xyz
 expect 2 "$rsmooth" noisy.ply -o x.ply --sigma-f -1
 expect 2 "$rsmooth" noisy.ply -o x.ply --sigma-g nan
 expect 2 "$rsmooth" noisy.ply -o x.ply --cutoff 9
+
+# The comparison methods: each smooths (normal error drops), and misuse is a usage error.
+for method in gaussian "laplacian --iterations 3" "taubin --iterations 5 --lambda 0.4 --mu -0.45"; do
+  expect 0 "$rsmooth" noisy.ply -o method.ply --force -q --json --method $method
+  grep -q "\"method\":\"${method%% *}\"" out.txt || fail "--json does not name --method $method"
+  expect 0 "$shape" compare method.ply truth.ply
+  err=$(sed -n 's/.*normal error \([0-9.]*\) deg.*/\1/p' out.txt)
+  awk -v a="$err" -v b="$before" 'BEGIN { exit !(a < b) }' ||
+    fail "--method $method did not lower the normal error ($before -> $err)"
+done
+expect 2 "$rsmooth" noisy.ply -o x.ply --method median
+expect 2 "$rsmooth" noisy.ply -o x.ply --method gaussian --sigma-g 1
+expect 2 "$rsmooth" noisy.ply -o x.ply --iterations 3
+expect 2 "$rsmooth" noisy.ply -o x.ply --method taubin --iterations 2.5
+expect 2 "$rsmooth" noisy.ply -o x.ply --method taubin --mu 0.2
+expect 2 "$rsmooth" noisy.ply -o x.ply --method laplacian --lambda 0
+expect 2 "$rsmooth" noisy.ply -o x.ply --method laplacian --confidence c.ply
+[ -e x.ply ] && fail "a refused --method call wrote its output"
 expect 2 "$rsmooth" noisy.ply -o x.ply --bogus
 expect 2 "$rsmooth" noisy.ply
 expect 3 "$rsmooth" noisy.ply -o x.ply --device "no such device"

@@ -140,6 +140,7 @@ static void brute_force(const double *xyz, size_t vc, const uint32_t *idx, size_
                 mnrm[3 * q + k] = n[k] / len;
         }
     }
+    const int centroid = prm->predictor == RSMOOTH_PREDICT_CENTROID; /* predict c_q, not Pi_q(p) */
     /* robust estimate, with the influence exponents shifted by their smallest (log-sum-exp) so no
      * weight underflows: p' = p + sum w t n / sum w is unchanged by the shift. */
     for (size_t v = 0; v < vc; v++) {
@@ -152,7 +153,8 @@ static void brute_force(const double *xyz, size_t vc, const uint32_t *idx, size_
                 continue;
             double d[3] = {cen[3 * q] - p[0], cen[3 * q + 1] - p[1], cen[3 * q + 2] - p[2]};
             double t = dot(mnrm + 3 * q, d);
-            double e = isinf(sg) ? 0 : t * t / (2 * sg * sg);
+            double r2 = centroid ? d2 : t * t; /* |prediction - p|^2 */
+            double e = isinf(sg) ? 0 : r2 / (2 * sg * sg);
             e_min = fmin(e_min, e);
             count++;
         }
@@ -164,11 +166,12 @@ static void brute_force(const double *xyz, size_t vc, const uint32_t *idx, size_
             double d[3] = {cen[3 * q] - p[0], cen[3 * q + 1] - p[1], cen[3 * q + 2] - p[2]};
             const double *n = mnrm + 3 * q;
             double t = dot(n, d);
-            double e = isinf(sg) ? 0 : t * t / (2 * sg * sg);
+            double r2 = centroid ? d2 : t * t;
+            double e = isinf(sg) ? 0 : r2 / (2 * sg * sg);
             double af = area[q] * exp(-d2 / (2 * sf * sf));
             double w = af * exp(-(e - e_min));
             for (int k = 0; k < 3; k++)
-                acc[k] += w * t * n[k];
+                acc[k] += w * (centroid ? d[k] : t * n[k]);
             ws += w;
             kf += af;
         }
@@ -372,7 +375,7 @@ int main(void) {
     for (int i = 0; i < MESHES; i++) {
         const shape_mesh *m = &meshes[i];
         char name[96];
-        for (int variant = 0; variant < 8; variant++) {
+        for (int variant = 0; variant < 10; variant++) {
             rsmooth_params p = def;
             const char *what = "";
             switch (variant) {
@@ -413,6 +416,16 @@ int main(void) {
             case 7: /* so narrow that every influence weight underflows: the rescue path */
                 what = "sigma_g 0.004 (underflow)";
                 p.sigma_g = 0.004;
+                break;
+            case 8: /* the paper's isotropic Gaussian baseline */
+                what = "centroid predictor, sigma_g inf";
+                p.predictor = RSMOOTH_PREDICT_CENTROID;
+                p.sigma_g = INFINITY;
+                break;
+            case 9:
+                what = "centroid predictor, sigma_g 0.7";
+                p.predictor = RSMOOTH_PREDICT_CENTROID;
+                p.sigma_g = 0.7;
                 break;
             }
             snprintf(name, sizeof name, "%s, %s", names[i], what);

@@ -39,7 +39,7 @@
 #include <stdint.h>
 
 #define RSMOOTH_VERSION_MAJOR 0
-#define RSMOOTH_VERSION_MINOR 1
+#define RSMOOTH_VERSION_MINOR 2
 #define RSMOOTH_VERSION_PATCH 0
 
 #if defined(_WIN32)
@@ -105,6 +105,14 @@ typedef enum rsmooth_scalar {
  * which does not change the result). */
 typedef void (*rsmooth_progress_fn)(void *user, double fraction);
 
+/* What each nearby triangle q predicts for a vertex p. */
+typedef enum rsmooth_predictor {
+    RSMOOTH_PREDICT_PROJECTION = 0, /* Pi_q(p), p projected onto q's (mollified) plane: the paper */
+    RSMOOTH_PREDICT_CENTROID = 1    /* c_q, q's centroid: with sigma_g = +INFINITY this is plain
+                                     * isotropic Gaussian smoothing (the paper's Fig. 4 baseline);
+                                     * the influence, if on, weighs |c_q - p| */
+} rsmooth_predictor;
+
 /* Filter parameters. Fill with rsmooth_params_init() first, then change fields: struct_size lets
  * later versions add fields without breaking callers compiled against this one. */
 typedef struct rsmooth_params {
@@ -122,6 +130,8 @@ typedef struct rsmooth_params {
                             * (the paper's Fig. 4 ablation) */
     rsmooth_progress_fn progress; /* optional (NULL, default): progress reports */
     void *progress_user;          /* passed to `progress` unchanged */
+    int predictor;                /* an rsmooth_predictor; default RSMOOTH_PREDICT_PROJECTION. (Added
+                                   * in 0.2: callers with an older struct_size get the default.) */
 } rsmooth_params;
 
 /* Fills `params` with the defaults above. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if params is NULL. */
@@ -190,6 +200,19 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_reference(rsmooth_scalar scalar, const
                                                     void *out_positions, float *out_weight,
                                                     float *out_confidence, rsmooth_report *report,
                                                     rsmooth_error *error);
+
+/* The isotropic baselines people already use, for comparison only: `iterations` rounds of
+ * p += lambda * U(p), each followed, when mu != 0, by p += mu * U(p) (Taubin's lambda|mu smoothing,
+ * SIGGRAPH 1995; typical lambda 0.5, mu -0.53). mu = 0 gives plain Laplacian smoothing, which
+ * shrinks the mesh. U(p) is the uniform umbrella operator: the mean of p's edge neighbours minus p.
+ * Unlike the filter above these need connectivity (vertices without an edge stay) and round sharp
+ * edges. lambda in (0, 1], mu in [-1, 0]. Same arrays and argument errors as
+ * rsmooth_smooth_reference; double precision, one thread, thread-safe. */
+RSMOOTH_API rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const void *positions,
+                                                 size_t vertex_count, const uint32_t *indices,
+                                                 size_t triangle_count, double lambda, double mu,
+                                                 unsigned iterations, void *out_positions,
+                                                 rsmooth_error *error);
 
 /* ---------------------------------------------------------------------------------------------- */
 /* Layer 2: an OpenCL context object                                                                */
