@@ -8,7 +8,7 @@ FUZZ_SECONDS ?= 60
 FUZZ_BUILD ?= $(BUILD)-fuzz
 FUZZERS = obj ply off stl
 
-.PHONY: all deps configure build demo check sanitize fuzz install clean
+.PHONY: all deps configure build demo experiments check sanitize fuzz install clean
 
 all: build
 
@@ -30,6 +30,12 @@ demo: build
 	  -o $(DEMO)/smoothed.ply --confidence $(DEMO)/confidence.ply --force
 	@echo "error before:" && $(BUILD)/rsmooth-demo-shape compare $(DEMO)/noisy.ply $(DEMO)/truth.ply
 	@echo "error after: " && $(BUILD)/rsmooth-demo-shape compare $(DEMO)/smoothed.ply $(DEMO)/truth.ply
+
+# Regenerates docs/experiments.md, docs/img/ and the README's "How well does it work" from
+# ../shared/data (about 20 minutes on 2 cores; reruns reuse out/experiments/cache.json).
+experiments: build
+	@.ci/install-deps.sh experiments
+	POCL_CACHE_DIR=$(abspath $(BUILD))/pocl-cache python3 scripts/experiments.py
 
 check: build
 	cd $(BUILD) && ctest --output-on-failure

@@ -69,9 +69,10 @@ static const char usage_text[] =
     "                        with a warning when no OpenCL exists), gpu, cpu, reference (double\n"
     "                        precision on one CPU thread), P:D (platform and device index), or a\n"
     "                        part of the device name. Also read from RSMOOTH_DEVICE.\n"
-    "  --confidence FILE     also write the mesh coloured by confidence k(p) / sum a f in [0, 1]\n"
-    "                        (PLY: 'quality' property plus colours; OBJ: vertex colours). Low\n"
-    "                        confidence (red) marks vertices few triangles agreed on.\n"
+    "  --confidence FILE     also write the mesh with its confidence k(p) / sum a f in [0, 1]\n"
+    "                        (PLY: 'quality' property) and coloured by it, normalised to the\n"
+    "                        mesh's range: red its lowest (few triangles agreed: sharp edges,\n"
+    "                        outliers, sparse parts), blue its highest. OBJ: colours only.\n"
     "  --ascii               write PLY and STL as ascii (default binary little-endian)\n"
     "  --list-devices        list the OpenCL devices and how --device names them, then exit\n"
     "  --stats               print statistics of the mesh and of what the filter did\n"
@@ -474,8 +475,23 @@ static int write_confidence(rsmooth_mesh *mesh, const options *opt, float *confi
         fprintf(stderr, "rsmooth: %s: out of memory\n", opt->confidence);
         return EXIT_OTHER;
     }
+    /* Normalised: the ramp spans the mesh's own range of confidence among vertices some facet
+     * reached (those no facet reached, confidence 0, are red), so the lows show on any mesh;
+     * the raw value stays in the quality property. */
+    float lo = INFINITY, hi = 0;
     for (size_t v = 0; v < nv; v++)
-        confidence_colour(confidence[v], colours + 3 * v);
+        if (confidence[v] > 0) {
+            lo = fminf(lo, confidence[v]);
+            hi = fmaxf(hi, confidence[v]);
+        }
+    for (size_t v = 0; v < nv; v++) {
+        float c = confidence[v];
+        float x = !(c > 0) ? 0 : hi - lo > 1e-6f ? (c - lo) / (hi - lo) : 1;
+        confidence_colour(x, colours + 3 * v);
+    }
+    if (!opt->quiet)
+        fprintf(stderr, "rsmooth: %s: confidence from %.3g (red) to %.3g (blue)\n",
+                opt->confidence, lo < hi ? lo : hi, hi);
     float *quality = mesh->vertex_quality;
     uint8_t *input_colours = mesh->vertex_colors;
     struct rsmooth_mesh_extras *extras = mesh->extras;

@@ -29,6 +29,12 @@ echo "normal error before $before, after $after degrees"
 awk -v a="$after" -v b="$before" 'BEGIN { exit !(a < b / 2) }' || fail "normal error not halved"
 head -c 400 conf.ply | grep -q "property float quality" || fail "confidence mesh has no quality"
 head -c 400 conf.ply | grep -q "property uchar red" || fail "confidence mesh has no colours"
+# The colours are normalised to the mesh's range: both ends of the ramp appear.
+expect 0 "$rsmooth" noisy.ply -o smooth_a.ply --confidence conf_a.ply --ascii
+grep -q "conf_a.ply: confidence from" err.txt || fail "no confidence range printed: $(cat err.txt)"
+awk '/^end_header/ { body = 1; next } body && NF == 7 { c[$5 " " $6 " " $7]++ }
+     END { exit !(c["215 48 39"] > 0 && c["69 117 180"] > 0) }' conf_a.ply ||
+  fail "confidence colours do not span red to blue"
 
 # OBJ out keeps the vertex and face counts; the reference path gives nearly the same result.
 expect 0 "$rsmooth" noisy.ply -o smooth.obj --device reference -q
