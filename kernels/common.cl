@@ -1,4 +1,4 @@
-/* Shared by every phase: grid lookup and the layout conventions below.
+/* Shared by every phase: grid lookup, vertex blocks and the layout conventions below.
  *
  * Coordinates are float32 in units of the grid cell size h, relative to the origin of the cell that
  * holds the point (so a mesh far from the origin keeps full precision). A vertex in cell v seen from
@@ -6,14 +6,27 @@
  * Facet weights travel as log(area / mean area), so one exp() per pair gives area * Gaussian and no
  * area underflows.
  *
- * Buffers (facets sorted by cell, vertices in grid order):
+ * Vertices travel in blocks of up to RS_LANES vertices of one cell, one block per work-item and one
+ * vertex per vector lane: the 27 cells around the block are looked up once, and each facet is
+ * loaded once and evaluated against every lane at once (explicit vectors, which CPU devices run as
+ * SIMD instructions). A vertex's "slot" is block * RS_LANES + lane. Per-vertex arrays are stored
+ * per block, component by component: the x of every lane, then every y, and so on. Unused lanes
+ * repeat lane 0 and their results are never read.
+ *
+ * Buffers (facets sorted by cell):
  *   facet_centroid[q]  float4 (c_q local to its cell, log area)
  *   facet_normal[q]    float4 (unit normal, 0)
  *   cell_coord[c]      int4 (x, y, z, 0) of occupied cell c
  *   cell_start[c]      first facet of cell c; cell_start[cell_count] = facet count
  *   table[s]           open-addressing hash slot: occupied cell index or -1
- *   vertex_local[v]    float4 (p local to its cell, 0);  vertex_cell[v] int4 (its cell, 0)
+ *   block_cell[b]      int4 (x, y, z, 0): the cell of block b's vertices
+ *   block_pos          per block: x, y, z of each lane, local to the block's cell
  */
+
+typedef float8 lanef;
+typedef int8 lanei;
+#define load_lanes vload8
+#define store_lanes vstore8
 
 /* The hash the host uses to fill `table` (rs_grid_hash in lib/rsmooth_internal.h). */
 inline uint grid_hash(int x, int y, int z) {
@@ -33,4 +46,20 @@ inline int grid_find(__global const int4 *cell_coord, __global const int *table,
             return cell;
         slot = (slot + 1) & table_mask;
     }
+}
+
+/* The occupied cells around `home` (27 entries, -1 where empty), dx outermost, dz innermost. */
+inline void neighbour_cells(int4 home, __global const int4 *cell_coord,
+                            __global const int *table, uint table_mask, int *cells) {
+    int i = 0;
+    for (int dx = -1; dx <= 1; dx++)
+        for (int dy = -1; dy <= 1; dy++)
+            for (int dz = -1; dz <= 1; dz++)
+                cells[i++] = grid_find(cell_coord, table, table_mask, home.x + dx, home.y + dy,
+                                       home.z + dz);
+}
+
+/* Component k (0 = x) of the vertex in `slot` of a per-block array of `stride` components. */
+inline float slot_component(__global const float *blocks, uint slot, uint stride, uint k) {
+    return blocks[(slot / RS_LANES) * stride * RS_LANES + k * RS_LANES + slot % RS_LANES];
 }

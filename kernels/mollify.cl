@@ -1,56 +1,68 @@
 /* Mollification (Jones et al. 2003, Sec. 3.2): the predictors' normals come from a copy of the mesh
  * whose vertices moved to sum c_q a_q f_m / sum a_q f_m, f_m a Gaussian of width sigma_m = sigma_f/2.
  *
- * mollify_vertex: one work-item per vertex (grid order) writes its displacement, in cell units, to
- *   vertex_shift[v] (float4; 0 where no facet is within reach).
+ * mollify_block: one work-item per vertex block writes each lane's displacement, in cell units, to
+ *   block_shift (3 components per lane; 0 where no facet is within reach).
  * mollified_facet_normal: one work-item per facet writes the unit normal of the mollified triangle
  *   (or its input normal when the mollified triangle is degenerate: a corner sine below
  *   RS_DEGENERATE_SINE, or an area below RS_DEGENERATE_AREA_RATIO of the input's) to
  *   mollified_normal[q].
- *   facet_vertices[q] = (v0, v1, v2, 0) in grid order; facet_edge1/2[q] = v1 - v0, v2 - v0 (cell units).
+ *   facet_vertices[q] = the slots of its three vertices; facet_edge1/2[q] = v1 - v0, v2 - v0 (cell
+ *   units).
  */
 
-__kernel void mollify_vertex(uint vertex_count, float reach2, float inv_2sigma2,
-                             __global const float4 *vertex_local, __global const int4 *vertex_cell,
-                             __global const float4 *facet_centroid,
-                             __global const int4 *cell_coord, __global const uint *cell_start,
-                             __global const int *table, uint table_mask,
-                             __global float4 *vertex_shift) {
-    uint v = get_global_id(0);
-    if (v >= vertex_count)
+__kernel void mollify_block(uint block_count, float reach2, float inv_2sigma2,
+                            __global const float *block_pos, __global const int4 *block_cell,
+                            __global const float4 *facet_centroid,
+                            __global const int4 *cell_coord, __global const uint *cell_start,
+                            __global const int *table, uint table_mask,
+                            __global float *block_shift) {
+    uint b = get_global_id(0);
+    if (b >= block_count)
         return;
-    float3 p = vertex_local[v].xyz;
-    int4 home = vertex_cell[v];
-    float wsum = 0.0f;
-    float3 acc = (float3)(0.0f);
+    __global const float *pos = block_pos + 3 * RS_LANES * (size_t)b;
+    lanef px = load_lanes(0, pos), py = load_lanes(1, pos), pz = load_lanes(2, pos);
+    int cells[27];
+    neighbour_cells(block_cell[b], cell_coord, table, table_mask, cells);
+    lanef wsum = 0.0f, ax = 0.0f, ay = 0.0f, az = 0.0f;
+    int i = 0;
     for (int dx = -1; dx <= 1; dx++)
         for (int dy = -1; dy <= 1; dy++)
             for (int dz = -1; dz <= 1; dz++) {
-                int cell = grid_find(cell_coord, table, table_mask, home.x + dx, home.y + dy,
-                                     home.z + dz);
+                int cell = cells[i++];
                 if (cell < 0)
                     continue;
-                float3 pc = p - (float3)((float)dx, (float)dy, (float)dz);
+                lanef qx = px - (float)dx, qy = py - (float)dy, qz = pz - (float)dz;
                 uint end = cell_start[cell + 1];
                 for (uint q = cell_start[cell]; q < end; q++) {
                     float4 c = facet_centroid[q];
-                    float3 d = c.xyz - pc;
-                    float d2 = dot(d, d);
-                    if (d2 <= reach2) {
-                        float w = exp(c.w - d2 * inv_2sigma2);
-                        acc += w * d;
-                        wsum += w;
-                    }
+                    lanef ex = c.x - qx, ey = c.y - qy, ez = c.z - qz;
+                    lanef d2 = ex * ex + ey * ey + ez * ez;
+                    lanef w = select((lanef)0.0f, exp(c.w - d2 * inv_2sigma2), d2 <= reach2);
+                    ax += w * ex;
+                    ay += w * ey;
+                    az += w * ez;
+                    wsum += w;
                 }
             }
-    vertex_shift[v] = wsum > 0.0f ? (float4)(acc / wsum, 0.0f) : (float4)(0.0f);
+    lanei some = wsum > 0.0f;
+    __global float *out = block_shift + 3 * RS_LANES * (size_t)b;
+    store_lanes(select((lanef)0.0f, ax / wsum, some), 0, out);
+    store_lanes(select((lanef)0.0f, ay / wsum, some), 1, out);
+    store_lanes(select((lanef)0.0f, az / wsum, some), 2, out);
+}
+
+/* The displacement of the vertex in `slot` (from mollify_block). */
+inline float3 slot_shift(__global const float *block_shift, uint slot) {
+    return (float3)(slot_component(block_shift, slot, 3, 0), slot_component(block_shift, slot, 3, 1),
+                    slot_component(block_shift, slot, 3, 2));
 }
 
 __kernel void mollified_facet_normal(uint facet_count, __global const uint4 *facet_vertices,
                                      __global const float4 *facet_edge1,
                                      __global const float4 *facet_edge2,
                                      __global const float4 *facet_normal,
-                                     __global const float4 *vertex_shift,
+                                     __global const float *block_shift,
                                      __global float4 *mollified_normal) {
     uint q = get_global_id(0);
     if (q >= facet_count)
@@ -58,9 +70,9 @@ __kernel void mollified_facet_normal(uint facet_count, __global const uint4 *fac
     uint4 t = facet_vertices[q];
     float3 input_e1 = facet_edge1[q].xyz, input_e2 = facet_edge2[q].xyz;
     float3 input_n = cross(input_e1, input_e2);
-    float3 s0 = vertex_shift[t.x].xyz;
-    float3 e1 = input_e1 + vertex_shift[t.y].xyz - s0;
-    float3 e2 = input_e2 + vertex_shift[t.z].xyz - s0;
+    float3 s0 = slot_shift(block_shift, t.x);
+    float3 e1 = input_e1 + slot_shift(block_shift, t.y) - s0;
+    float3 e2 = input_e2 + slot_shift(block_shift, t.z) - s0;
     float3 n = cross(e1, e2);
     float len = sqrt(dot(n, n));
     if (len > RS_DEGENERATE_SINE * sqrt(dot(e1, e1) * dot(e2, e2)) &&

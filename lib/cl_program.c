@@ -13,10 +13,11 @@ extern const size_t rs_kernel_common_size, rs_kernel_mollify_size, rs_kernel_est
 /* Constants the host and kernels must agree on. Runtime values (sigmas, counts) are kernel
  * arguments, so changing them never rebuilds the program. */
 #define STRINGIFY(x) #x
+#define EXPANDED_STRING(x) STRINGIFY(x)
 #define FLOAT_DEFINE(name, value) "#define " #name " " STRINGIFY(value) "f\n"
 static const char prelude[] = FLOAT_DEFINE(RS_DEGENERATE_SINE, RS_DEGENERATE_SINE)
     FLOAT_DEFINE(RS_DEGENERATE_AREA_RATIO, RS_DEGENERATE_AREA_RATIO)
-    "#define RS_RESCUE_EXPONENT 40.0f\n";
+    "#define RS_RESCUE_EXPONENT 40.0f\n" "#define RS_LANES " EXPANDED_STRING(RS_LANES) "\n";
 
 /* Default options: relaxed math lets PoCL vectorize exp(); precision is checked against the
  * double-precision reference path by the tests. */
@@ -99,7 +100,7 @@ rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error) {
         goto done;
     }
     static const char *const kernel_names[RS_KERNEL_COUNT] = {
-        "mollify_vertex", "mollified_facet_normal", "robust_vertex"};
+        "mollify_block", "mollified_facet_normal", "robust_block"};
     for (int k = 0; k < RS_KERNEL_COUNT; k++) {
         ctx->kernels[k] = clCreateKernel(ctx->program, kernel_names[k], &err);
         if (err != CL_SUCCESS) {

@@ -13,11 +13,11 @@
 
 typedef struct packed {
     cl_float4 *facet_centroid, *facet_normal, *facet_edge1, *facet_edge2;
-    cl_uint4 *facet_vertices;
-    cl_float4 *vertex_local;
-    cl_int4 *vertex_cell;
-    uint32_t *order; /* grid position -> caller's vertex index */
-    uint32_t *rank;  /* caller's vertex index -> grid position */
+    cl_uint4 *facet_vertices; /* slots of the three vertices */
+    size_t block_count;
+    cl_int4 *block_cell;      /* per block: its cell */
+    cl_float *block_pos;      /* per block: RS_LANES x, then y, then z, local to the cell */
+    uint32_t *slot;           /* caller's vertex index -> block * RS_LANES + lane */
     double mean_area;
 } packed;
 
@@ -27,10 +27,9 @@ static void packed_free(packed *pk) {
     rs_free(pk->facet_edge1);
     rs_free(pk->facet_edge2);
     rs_free(pk->facet_vertices);
-    rs_free(pk->vertex_local);
-    rs_free(pk->vertex_cell);
-    rs_free(pk->order);
-    rs_free(pk->rank);
+    rs_free(pk->block_cell);
+    rs_free(pk->block_pos);
+    rs_free(pk->slot);
 }
 
 static cl_float4 local_point(const rs_grid *grid, const double p[3], const int32_t cell[3]) {
@@ -44,6 +43,58 @@ static cl_float4 local_point(const rs_grid *grid, const double p[3], const int32
     return out;
 }
 
+/* Vertices in grid order, cut into blocks of at most RS_LANES vertices of one cell. */
+static rsmooth_status pack_blocks(const rs_problem *pb, const rs_grid *grid, packed *pk,
+                                  rsmooth_error *error) {
+    size_t nv = pb->vertex_count;
+    uint32_t *order = rs_alloc_array(nv, sizeof *order); /* grid position -> vertex */
+    int32_t *cells = rs_alloc_array(nv, 3 * sizeof *cells);
+    rsmooth_status st = RSMOOTH_OK;
+    if (!order || !cells) {
+        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth", "no memory for blocks");
+        goto done;
+    }
+    if ((st = rs_grid_order_points(grid, pb->xyz, nv, order, error)) != RSMOOTH_OK)
+        goto done;
+    size_t blocks = 0;
+    for (size_t i = 0, lane = RS_LANES; i < nv; i++, lane++) {
+        int32_t *c = cells + 3 * i;
+        rs_grid_cell_of(grid, pb->xyz + 3 * (size_t)order[i], c);
+        if (lane == RS_LANES || memcmp(c, c - 3, 3 * sizeof *c) != 0) {
+            blocks++;
+            lane = 0;
+        }
+    }
+    pk->block_count = blocks;
+    pk->block_cell = rs_alloc_array(blocks, sizeof(cl_int4));
+    pk->block_pos = rs_alloc_array(blocks, 3 * RS_LANES * sizeof(cl_float));
+    if (!pk->block_cell || !pk->block_pos) {
+        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth", "no memory for blocks");
+        goto done;
+    }
+    size_t b = (size_t)-1, lane = RS_LANES;
+    for (size_t i = 0; i < nv; i++, lane++) {
+        const int32_t *c = cells + 3 * i;
+        if (lane == RS_LANES || memcmp(c, c - 3, 3 * sizeof *c) != 0) {
+            b++;
+            lane = 0;
+            pk->block_cell[b] = (cl_int4){{c[0], c[1], c[2], 0}};
+        }
+        uint32_t v = order[i];
+        pk->slot[v] = (uint32_t)(b * RS_LANES + lane);
+        cl_float4 local = local_point(grid, pb->xyz + 3 * (size_t)v, c);
+        cl_float *pos = pk->block_pos + 3 * RS_LANES * b;
+        /* lane 0 also fills the unused lanes, so they compute something harmless */
+        for (size_t l = lane; l < (lane == 0 ? RS_LANES : lane + 1); l++)
+            for (int k = 0; k < 3; k++)
+                pos[k * RS_LANES + l] = local.s[k];
+    }
+done:
+    rs_free(order);
+    rs_free(cells);
+    return st;
+}
+
 static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, packed *pk,
                            rsmooth_error *error) {
     size_t nf = pb->facet_count, nv = pb->vertex_count;
@@ -53,26 +104,14 @@ static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, packed *pk
     pk->facet_edge1 = rs_alloc_array(nf, sizeof(cl_float4));
     pk->facet_edge2 = rs_alloc_array(nf, sizeof(cl_float4));
     pk->facet_vertices = rs_alloc_array(nf, sizeof(cl_uint4));
-    pk->vertex_local = rs_alloc_array(nv, sizeof(cl_float4));
-    pk->vertex_cell = rs_alloc_array(nv, sizeof(cl_int4));
-    pk->order = rs_alloc_array(nv, sizeof(uint32_t));
-    pk->rank = rs_alloc_array(nv, sizeof(uint32_t));
+    pk->slot = rs_alloc_array(nv, sizeof(uint32_t));
     if (!pk->facet_centroid || !pk->facet_normal || !pk->facet_edge1 || !pk->facet_edge2 ||
-        !pk->facet_vertices || !pk->vertex_local || !pk->vertex_cell || !pk->order || !pk->rank)
+        !pk->facet_vertices || !pk->slot)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth",
                        "no memory for device staging arrays");
-
-    rsmooth_status st = rs_grid_order_points(grid, pb->xyz, nv, pk->order, error);
+    rsmooth_status st = pack_blocks(pb, grid, pk, error);
     if (st != RSMOOTH_OK)
         return st;
-    for (size_t i = 0; i < nv; i++) {
-        uint32_t v = pk->order[i];
-        pk->rank[v] = (uint32_t)i;
-        int32_t cell[3];
-        rs_grid_cell_of(grid, pb->xyz + 3 * (size_t)v, cell);
-        pk->vertex_local[i] = local_point(grid, pb->xyz + 3 * (size_t)v, cell);
-        pk->vertex_cell[i] = (cl_int4){{cell[0], cell[1], cell[2], 0}};
-    }
 
     double area_sum = 0;
     for (size_t q = 0; q < nf; q++)
@@ -99,7 +138,7 @@ static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, packed *pk
             }
             pk->facet_edge1[j].s[3] = pk->facet_edge2[j].s[3] = 0;
             pk->facet_vertices[j] =
-                (cl_uint4){{pk->rank[tri[0]], pk->rank[tri[1]], pk->rank[tri[2]], 0}};
+                (cl_uint4){{pk->slot[tri[0]], pk->slot[tri[1]], pk->slot[tri[2]], 0}};
         }
     }
     return RSMOOTH_OK;
@@ -114,12 +153,12 @@ enum {
     BUF_CELL_COORD,
     BUF_CELL_START,
     BUF_TABLE,
-    BUF_VERTEX_LOCAL,
-    BUF_VERTEX_CELL,
-    BUF_VERTEX_SHIFT,
+    BUF_BLOCK_POS,
+    BUF_BLOCK_CELL,
+    BUF_BLOCK_SHIFT,
     BUF_MOLLIFIED_NORMAL,
-    BUF_VERTEX_RESULT,
-    BUF_VERTEX_EXTRA,
+    BUF_BLOCK_RESULT,
+    BUF_BLOCK_EXTRA,
     BUF_COUNT
 };
 
@@ -197,7 +236,7 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     packed pk;
     memset(&pk, 0, sizeof pk);
     cl_mem buf[BUF_COUNT] = {0};
-    cl_float4 *result = NULL, *extra = NULL;
+    cl_float *result = NULL, *extra = NULL; /* per block, as block_result and block_extra */
 
     if (pb.facet_count == 0) {
         rs_store_unmoved(&pb, scalar, out_positions, out_weight, out_confidence);
@@ -211,6 +250,7 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     t_grid = rs_now_ms();
 
     size_t nv = vertex_count, nf = pb.facet_count, nc = grid.cell_count;
+    size_t nb = pk.block_count, ns = nb * RS_LANES; /* blocks and slots */
     size_t table_size = (size_t)grid.table_mask + 1;
     const struct {
         size_t size;
@@ -225,12 +265,12 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
         [BUF_CELL_COORD] = {nc * 4 * sizeof(cl_int), grid.cell_coord, CL_MEM_READ_ONLY},
         [BUF_CELL_START] = {(nc + 1) * sizeof(cl_uint), grid.cell_start, CL_MEM_READ_ONLY},
         [BUF_TABLE] = {table_size * sizeof(cl_int), grid.table, CL_MEM_READ_ONLY},
-        [BUF_VERTEX_LOCAL] = {nv * sizeof(cl_float4), pk.vertex_local, CL_MEM_READ_ONLY},
-        [BUF_VERTEX_CELL] = {nv * sizeof(cl_int4), pk.vertex_cell, CL_MEM_READ_ONLY},
-        [BUF_VERTEX_SHIFT] = {nv * sizeof(cl_float4), NULL, CL_MEM_READ_WRITE},
+        [BUF_BLOCK_POS] = {ns * 3 * sizeof(cl_float), pk.block_pos, CL_MEM_READ_ONLY},
+        [BUF_BLOCK_CELL] = {nb * sizeof(cl_int4), pk.block_cell, CL_MEM_READ_ONLY},
+        [BUF_BLOCK_SHIFT] = {ns * 3 * sizeof(cl_float), NULL, CL_MEM_READ_WRITE},
         [BUF_MOLLIFIED_NORMAL] = {nf * sizeof(cl_float4), NULL, CL_MEM_READ_WRITE},
-        [BUF_VERTEX_RESULT] = {nv * sizeof(cl_float4), NULL, CL_MEM_WRITE_ONLY},
-        [BUF_VERTEX_EXTRA] = {nv * sizeof(cl_float4), NULL, CL_MEM_WRITE_ONLY},
+        [BUF_BLOCK_RESULT] = {ns * 4 * sizeof(cl_float), NULL, CL_MEM_WRITE_ONLY},
+        [BUF_BLOCK_EXTRA] = {ns * 2 * sizeof(cl_float), NULL, CL_MEM_WRITE_ONLY},
     };
     for (int b = 0; b < BUF_COUNT; b++) {
         cl_int err = CL_SUCCESS;
@@ -252,7 +292,7 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
 
     /* Lengths in cell units (h), so every float the kernels see is of order one. */
     const double h = grid.cell_size;
-    cl_uint vcount = (cl_uint)nv, fcount = (cl_uint)nf, mask = grid.table_mask;
+    cl_uint bcount = (cl_uint)nb, fcount = (cl_uint)nf, mask = grid.table_mask;
     cl_float reach2 = (cl_float)((pb.radius / h) * (pb.radius / h));
     cl_float mollify_reach2 = (cl_float)((pb.mollify_radius / h) * (pb.mollify_radius / h));
     cl_float inv_2sm2 = (cl_float)(h * h / (2 * pb.sigma_m * pb.sigma_m));
@@ -265,20 +305,20 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     cl_mem normals = buf[BUF_FACET_NORMAL];
     if (pb.mollify) {
         arg_setter s = {ctx->kernels[RS_KERNEL_MOLLIFY], 0, CL_SUCCESS};
-        arg(&s, sizeof vcount, &vcount);
+        arg(&s, sizeof bcount, &bcount);
         arg(&s, sizeof mollify_reach2, &mollify_reach2);
         arg(&s, sizeof inv_2sm2, &inv_2sm2);
-        arg(&s, sizeof(cl_mem), &buf[BUF_VERTEX_LOCAL]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_VERTEX_CELL]);
+        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_POS]);
+        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_CELL]);
         arg(&s, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
         arg(&s, sizeof(cl_mem), &buf[BUF_CELL_COORD]);
         arg(&s, sizeof(cl_mem), &buf[BUF_CELL_START]);
         arg(&s, sizeof(cl_mem), &buf[BUF_TABLE]);
         arg(&s, sizeof mask, &mask);
-        arg(&s, sizeof(cl_mem), &buf[BUF_VERTEX_SHIFT]);
-        err = s.err != CL_SUCCESS ? s.err : run_1d(ctx, &pb, s.kernel, nv, 0, MOLLIFY_SHARE);
+        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_SHIFT]);
+        err = s.err != CL_SUCCESS ? s.err : run_1d(ctx, &pb, s.kernel, nb, 0, MOLLIFY_SHARE);
         if (err != CL_SUCCESS) {
-            st = rs_cl_fail(error, err, "mollify_vertex", ctx->device_name);
+            st = rs_cl_fail(error, err, "mollify_block", ctx->device_name);
             goto cleanup;
         }
         t_mollify = rs_now_ms();
@@ -289,7 +329,7 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
         arg(&s, sizeof(cl_mem), &buf[BUF_FACET_EDGE1]);
         arg(&s, sizeof(cl_mem), &buf[BUF_FACET_EDGE2]);
         arg(&s, sizeof(cl_mem), &buf[BUF_FACET_NORMAL]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_VERTEX_SHIFT]);
+        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_SHIFT]);
         arg(&s, sizeof(cl_mem), &buf[BUF_MOLLIFIED_NORMAL]);
         err = s.err != CL_SUCCESS ? s.err
                                   : run_1d(ctx, &pb, s.kernel, nf, MOLLIFY_SHARE, MOLLIFY_SHARE);
@@ -304,54 +344,55 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     t_normals = rs_now_ms();
 
     arg_setter s = {ctx->kernels[RS_KERNEL_ROBUST], 0, CL_SUCCESS};
-    arg(&s, sizeof vcount, &vcount);
+    arg(&s, sizeof bcount, &bcount);
     arg(&s, sizeof reach2, &reach2);
     arg(&s, sizeof inv_2sf2, &inv_2sf2);
     arg(&s, sizeof inv_2sg2, &inv_2sg2);
     arg(&s, sizeof want_confidence, &want_confidence);
     arg(&s, sizeof predict_centroid, &predict_centroid);
-    arg(&s, sizeof(cl_mem), &buf[BUF_VERTEX_LOCAL]);
-    arg(&s, sizeof(cl_mem), &buf[BUF_VERTEX_CELL]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_POS]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_CELL]);
     arg(&s, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
     arg(&s, sizeof(cl_mem), &normals);
     arg(&s, sizeof(cl_mem), &buf[BUF_CELL_COORD]);
     arg(&s, sizeof(cl_mem), &buf[BUF_CELL_START]);
     arg(&s, sizeof(cl_mem), &buf[BUF_TABLE]);
     arg(&s, sizeof mask, &mask);
-    arg(&s, sizeof(cl_mem), &buf[BUF_VERTEX_RESULT]);
-    arg(&s, sizeof(cl_mem), &buf[BUF_VERTEX_EXTRA]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_RESULT]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_EXTRA]);
     err = s.err != CL_SUCCESS ? s.err
-                              : run_1d(ctx, &pb, s.kernel, nv, pb.mollify ? MOLLIFY_SHARE : 0, 1);
+                              : run_1d(ctx, &pb, s.kernel, nb, pb.mollify ? MOLLIFY_SHARE : 0, 1);
     if (err != CL_SUCCESS) {
-        st = rs_cl_fail(error, err, "robust_vertex", ctx->device_name);
+        st = rs_cl_fail(error, err, "robust_block", ctx->device_name);
         goto cleanup;
     }
     t_robust = rs_now_ms();
 
-    result = rs_alloc_array(nv, sizeof(cl_float4));
-    extra = rs_alloc_array(nv, sizeof(cl_float4));
+    result = rs_alloc_array(ns, 4 * sizeof(cl_float));
+    extra = rs_alloc_array(ns, 2 * sizeof(cl_float));
     if (!result || !extra) {
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for results");
         goto cleanup;
     }
-    err = clEnqueueReadBuffer(ctx->queue, buf[BUF_VERTEX_RESULT], CL_TRUE, 0,
-                              nv * sizeof(cl_float4), result, 0, NULL, NULL);
+    err = clEnqueueReadBuffer(ctx->queue, buf[BUF_BLOCK_RESULT], CL_TRUE, 0,
+                              ns * 4 * sizeof(cl_float), result, 0, NULL, NULL);
     if (err == CL_SUCCESS)
-        err = clEnqueueReadBuffer(ctx->queue, buf[BUF_VERTEX_EXTRA], CL_TRUE, 0,
-                                  nv * sizeof(cl_float4), extra, 0, NULL, NULL);
+        err = clEnqueueReadBuffer(ctx->queue, buf[BUF_BLOCK_EXTRA], CL_TRUE, 0,
+                                  ns * 2 * sizeof(cl_float), extra, 0, NULL, NULL);
     if (err != CL_SUCCESS) {
         st = rs_cl_fail(error, err, "clEnqueueReadBuffer", ctx->device_name);
         goto cleanup;
     }
-    for (size_t i = 0; i < nv; i++) {
-        uint32_t v = pk.order[i];
-        const double *p = pb.xyz + 3 * (size_t)v;
+    for (size_t v = 0; v < nv; v++) {
+        size_t b = pk.slot[v] / RS_LANES, lane = pk.slot[v] % RS_LANES;
+        const cl_float *res = result + 4 * RS_LANES * b + lane, *ext = extra + 2 * RS_LANES * b + lane;
+        const double *p = pb.xyz + 3 * v;
         double out[3];
         for (int k = 0; k < 3; k++)
-            out[k] = p[k] + (double)result[i].s[k] * h;
+            out[k] = p[k] + (double)res[k * RS_LANES] * h;
         rs_store_position(scalar, out_positions, v, out);
-        double k = (double)result[i].s[3] * exp(-(double)extra[i].s[1]) * pk.mean_area;
-        double kf = (double)extra[i].s[0] * pk.mean_area;
+        double k = (double)res[3 * RS_LANES] * exp(-(double)ext[RS_LANES]) * pk.mean_area;
+        double kf = (double)ext[0] * pk.mean_area;
         if (out_weight)
             out_weight[v] = (float)k;
         if (out_confidence)

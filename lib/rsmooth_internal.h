@@ -190,6 +190,9 @@ rsmooth_status rs_grid_order_points(const rs_grid *grid, const double *points, s
 #endif
 #include <CL/cl.h>
 
+/* Vertices per block: the vector width the kernels use across vertices (float8, kernels/common.cl). */
+#define RS_LANES 8
+
 enum { RS_KERNEL_MOLLIFY, RS_KERNEL_NORMALS, RS_KERNEL_ROBUST, RS_KERNEL_COUNT };
 
 struct rsmooth_context {
