@@ -44,7 +44,7 @@ inline robust_acc robust_sums(lanef px, lanef py, lanef pz, const int *cells, fl
                     lanef t = n.x * ex + n.y * ey + n.z * ez;
                     /* |prediction - p|^2: t^2 for the projection, d2 for the centroid */
                     lanef e = (predict_centroid ? d2 : t * t) * inv_2sg2;
-                    lanef w = select((lanef)0.0f, exp(c.w - d2 * inv_2sf2 - (e - shift)), near);
+                    lanef w = select((lanef)0.0f, fast_exp(c.w - d2 * inv_2sf2 - (e - shift)), near);
                     if (predict_centroid) {
                         a.x += w * ex;
                         a.y += w * ey;
@@ -58,7 +58,7 @@ inline robust_acc robust_sums(lanef px, lanef py, lanef pz, const int *cells, fl
                     a.k += w;
                     a.e_min = select(a.e_min, fmin(a.e_min, e), near);
                     if (want_confidence)
-                        a.kf += select((lanef)0.0f, exp(c.w - d2 * inv_2sf2), near);
+                        a.kf += select((lanef)0.0f, fast_exp(c.w - d2 * inv_2sf2), near);
                 }
             }
     return a;
