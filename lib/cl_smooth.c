@@ -43,6 +43,12 @@ static cl_float4 local_point(const rs_grid *grid, const double p[3], const int32
     return out;
 }
 
+/* Whether the vertex with cell `c` (the previous vertex's is c - 3) starts a new block when the
+ * current block already holds `lane` vertices. */
+static bool starts_block(size_t lane, const int32_t *c) {
+    return lane == RS_LANES || memcmp(c, c - 3, 3 * sizeof *c) != 0;
+}
+
 /* Vertices in grid order, cut into blocks of at most RS_LANES vertices of one cell. */
 static rsmooth_status pack_blocks(const rs_problem *pb, const rs_grid *grid, packed *pk,
                                   rsmooth_error *error) {
@@ -54,13 +60,11 @@ static rsmooth_status pack_blocks(const rs_problem *pb, const rs_grid *grid, pac
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth", "no memory for blocks");
         goto done;
     }
-    if ((st = rs_grid_order_points(grid, pb->xyz, nv, order, error)) != RSMOOTH_OK)
+    if ((st = rs_grid_order_points(grid, pb->xyz, nv, order, cells, error)) != RSMOOTH_OK)
         goto done;
     size_t blocks = 0;
     for (size_t i = 0, lane = RS_LANES; i < nv; i++, lane++) {
-        int32_t *c = cells + 3 * i;
-        rs_grid_cell_of(grid, pb->xyz + 3 * (size_t)order[i], c);
-        if (lane == RS_LANES || memcmp(c, c - 3, 3 * sizeof *c) != 0) {
+        if (starts_block(lane, cells + 3 * i)) {
             blocks++;
             lane = 0;
         }
@@ -75,7 +79,7 @@ static rsmooth_status pack_blocks(const rs_problem *pb, const rs_grid *grid, pac
     size_t b = (size_t)-1, lane = RS_LANES;
     for (size_t i = 0; i < nv; i++, lane++) {
         const int32_t *c = cells + 3 * i;
-        if (lane == RS_LANES || memcmp(c, c - 3, 3 * sizeof *c) != 0) {
+        if (starts_block(lane, c)) {
             b++;
             lane = 0;
             pk->block_cell[b] = (cl_int4){{c[0], c[1], c[2], 0}};

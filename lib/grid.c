@@ -33,6 +33,15 @@ static uint64_t cell_key(const rs_grid *grid, const int32_t c[3]) {
     return (x * ny + y) * nz + z;
 }
 
+/* The cell whose cell_key is `key`. */
+static void cell_of_key(const rs_grid *grid, uint64_t key, int32_t c[3]) {
+    uint64_t ny = (uint64_t)grid->dims[1] + 4, nz = (uint64_t)grid->dims[2] + 4;
+    c[2] = (int32_t)(key % nz) - 2;
+    key /= nz;
+    c[1] = (int32_t)(key % ny) - 2;
+    c[0] = (int32_t)(key / ny) - 2;
+}
+
 int32_t rs_grid_find(const rs_grid *grid, int32_t x, int32_t y, int32_t z) {
     if (grid->cell_count == 0)
         return -1;
@@ -110,9 +119,7 @@ rsmooth_status rs_grid_build(rs_grid *grid, const double *points, size_t count, 
         if (i > 0 && keys[i] == keys[i - 1])
             continue;
         int32_t c[3];
-        rs_grid_cell_of(grid, points + 3 * (size_t)grid->facet_order[i], c);
-        for (int k = 0; k < 3; k++)
-            c[k] = c[k] < 0 ? 0 : c[k] >= grid->dims[k] ? grid->dims[k] - 1 : c[k];
+        cell_of_key(grid, keys[i], c); /* the clamped cell the key was made from */
         int32_t *coord = grid->cell_coord + 4 * cell;
         coord[0] = c[0];
         coord[1] = c[1];
@@ -137,7 +144,7 @@ fail_memory:
 }
 
 rsmooth_status rs_grid_order_points(const rs_grid *grid, const double *points, size_t count,
-                                    uint32_t *order, rsmooth_error *error) {
+                                    uint32_t *order, int32_t *cells, rsmooth_error *error) {
     uint64_t *keys = rs_alloc_array(count, sizeof *keys);
     if (!keys)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rs_grid_order_points",
@@ -149,6 +156,8 @@ rsmooth_status rs_grid_order_points(const rs_grid *grid, const double *points, s
         order[i] = (uint32_t)i;
     }
     bool ok = rs_radix_sort_u64(keys, order, count);
+    for (size_t i = 0; ok && i < count; i++)
+        cell_of_key(grid, keys[i], cells + 3 * i);
     rs_free(keys);
     return ok ? RSMOOTH_OK
               : rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rs_grid_order_points",

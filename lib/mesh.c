@@ -5,11 +5,6 @@
 #include <stdio.h>
 #include <string.h>
 
-static double coordinate(rsmooth_scalar scalar, const void *positions, size_t i) {
-    return scalar == RSMOOTH_FLOAT32 ? (double)((const float *)positions)[i]
-                                     : ((const double *)positions)[i];
-}
-
 rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions,
                                     size_t vertex_count, const uint32_t *indices,
                                     size_t triangle_count, rsmooth_error *error,
@@ -40,7 +35,7 @@ rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions
                            "triangle %zu: index %u >= vertex count %zu", i / 3, indices[i],
                            vertex_count);
     for (size_t i = 0; i < 3 * vertex_count; i++) {
-        double x = coordinate(scalar, positions, i);
+        double x = rs_coordinate(scalar, positions, i);
         if (!isfinite(x))
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                            "vertex %zu has a non-finite coordinate", i / 3);
@@ -111,7 +106,7 @@ rsmooth_status rsmooth_mean_edge_length(rsmooth_scalar scalar, const void *posit
     if (!xyz)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for positions");
     for (size_t i = 0; i < 3 * vertex_count; i++)
-        xyz[i] = coordinate(scalar, positions, i);
+        xyz[i] = rs_coordinate(scalar, positions, i);
     bool ok = rs_mean_edge_length(xyz, indices, triangle_count, out_length);
     rs_free(xyz);
     return ok ? RSMOOTH_OK
@@ -144,6 +139,19 @@ static bool overlaps(const void *a, size_t a_size, const void *b, size_t b_size)
     return pa < pb + b_size && pb < pa + a_size;
 }
 
+rsmooth_status rs_check_output_positions(rsmooth_scalar scalar, const void *positions,
+                                         size_t vertex_count, const void *out_positions,
+                                         rsmooth_error *error, const char *where) {
+    if (!out_positions)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_positions is NULL");
+    size_t bytes = vertex_count * 3 * (scalar == RSMOOTH_FLOAT32 ? sizeof(float) : sizeof(double));
+    if (overlaps(positions, bytes, out_positions, bytes))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "out_positions overlaps positions: smoothing reads all inputs while "
+                       "writing");
+    return RSMOOTH_OK;
+}
+
 rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
                                   const void *positions, size_t vertex_count,
                                   const uint32_t *indices, size_t triangle_count,
@@ -158,13 +166,9 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
                               where);
     if (st != RSMOOTH_OK)
         return st;
-    if (!out_positions)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_positions is NULL");
-    size_t bytes = vertex_count * 3 * (scalar == RSMOOTH_FLOAT32 ? sizeof(float) : sizeof(double));
-    if (overlaps(positions, bytes, out_positions, bytes))
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "out_positions overlaps positions: the filter reads all inputs while "
-                       "writing");
+    st = rs_check_output_positions(scalar, positions, vertex_count, out_positions, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
 
     problem->vertex_count = vertex_count;
     problem->indices = indices;
@@ -180,7 +184,7 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for facet data");
     }
     for (size_t i = 0; i < 3 * vertex_count; i++)
-        problem->xyz[i] = coordinate(scalar, positions, i);
+        problem->xyz[i] = rs_coordinate(scalar, positions, i);
 
     size_t f = 0;
     for (size_t t = 0; t < triangle_count; t++) {

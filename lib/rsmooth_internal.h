@@ -101,6 +101,18 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
                                   rsmooth_error *error, const char *where);
 void rs_problem_free(rs_problem *problem);
 
+/* Coordinate i (x, y, z of vertex i / 3) of the caller's positions, as a double. */
+static inline double rs_coordinate(rsmooth_scalar scalar, const void *positions, size_t i) {
+    return scalar == RSMOOTH_FLOAT32 ? (double)((const float *)positions)[i]
+                                     : ((const double *)positions)[i];
+}
+
+/* Checks the output array of a smoothing call: present, and not overlapping the positions it is
+ * computed from (every call reads all inputs while writing). */
+rsmooth_status rs_check_output_positions(rsmooth_scalar scalar, const void *positions,
+                                         size_t vertex_count, const void *out_positions,
+                                         rsmooth_error *error, const char *where);
+
 /* Checks the arrays only (shared with rsmooth_mean_edge_length). */
 rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions,
                                     size_t vertex_count, const uint32_t *indices,
@@ -179,9 +191,9 @@ static inline uint32_t rs_grid_hash(int32_t x, int32_t y, int32_t z) {
 }
 
 /* Orders `count` points (3 doubles each) by grid cell, for memory locality: order[i] is the index of
- * the i-th point in that order. */
+ * the i-th point in that order and cells[3 i .. 3 i + 2] its cell (as rs_grid_cell_of gives it). */
 rsmooth_status rs_grid_order_points(const rs_grid *grid, const double *points, size_t count,
-                                    uint32_t *order, rsmooth_error *error);
+                                    uint32_t *order, int32_t *cells, rsmooth_error *error);
 
 /* ---- cl_device.c / cl_program.c: the OpenCL context object ------------------------------------ */
 

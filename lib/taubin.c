@@ -84,15 +84,11 @@ rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const void *position
     rs_error_clear(error);
     rsmooth_status st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices,
                                              triangle_count, error, where);
+    if (st == RSMOOTH_OK)
+        st = rs_check_output_positions(scalar, positions, vertex_count, out_positions, error,
+                                       where);
     if (st != RSMOOTH_OK)
         return st;
-    if (!out_positions)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_positions is NULL");
-    size_t bytes = 3 * vertex_count * (scalar == RSMOOTH_FLOAT32 ? sizeof(float) : sizeof(double));
-    const char *in = positions, *out = out_positions;
-    if (in < out + bytes && out < in + bytes)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "out_positions overlaps positions");
     if (!(lambda > 0 && lambda <= 1))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "lambda must be in (0, 1] (got %g)", lambda);
@@ -109,8 +105,7 @@ rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const void *position
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "out of memory");
     }
     for (size_t i = 0; i < 3 * vertex_count; i++)
-        a[i] = scalar == RSMOOTH_FLOAT32 ? (double)((const float *)positions)[i]
-                                         : ((const double *)positions)[i];
+        a[i] = rs_coordinate(scalar, positions, i);
     double *cur = a, *next = b;
     for (unsigned it = 0; it < iterations; it++) {
         for (int pass = 0; pass < (mu != 0 ? 2 : 1); pass++) { /* shrink, then inflate back */
