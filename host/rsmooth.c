@@ -90,10 +90,20 @@ static const char usage_text[] =
     "\n"
     "Exit status: 0 success, 2 bad usage or bad input file, 3 OpenCL device failure, 1 other.\n";
 
+/* --method: the filter, or a baseline to compare it with. */
+typedef enum method { METHOD_ROBUST, METHOD_GAUSSIAN, METHOD_LAPLACIAN, METHOD_TAUBIN } method;
+static const char *const method_names[] = {"robust", "gaussian", "laplacian", "taubin"};
+
+/* Laplacian and Taubin iterate on the mesh's edges (rsmooth_smooth_taubin): no sigmas, no
+ * confidence. */
+static bool method_uses_edges(method m) {
+    return m == METHOD_LAPLACIAN || m == METHOD_TAUBIN;
+}
+
 typedef struct options {
     const char *input, *output, *confidence, *device;
     rsmooth_params params;
-    enum { METHOD_ROBUST, METHOD_GAUSSIAN, METHOD_LAPLACIAN, METHOD_TAUBIN } method;
+    method method;
     double lambda, mu;
     unsigned iterations;
     bool sigma_g_given, umbrella_given; /* for consistency checks against --method */
@@ -132,17 +142,13 @@ static int parse_args(int argc, char **argv, options *opt) {
         } else if (!strcmp(a, "--method")) {
             if (!value)
                 return cli_usage_error(NULL, "%s needs a value", a);
-            if (!strcmp(value, "robust"))
-                opt->method = METHOD_ROBUST;
-            else if (!strcmp(value, "gaussian"))
-                opt->method = METHOD_GAUSSIAN;
-            else if (!strcmp(value, "laplacian"))
-                opt->method = METHOD_LAPLACIAN;
-            else if (!strcmp(value, "taubin"))
-                opt->method = METHOD_TAUBIN;
-            else
+            int m = METHOD_TAUBIN;
+            while (m >= 0 && strcmp(value, method_names[m]) != 0)
+                m--;
+            if (m < 0)
                 return cli_usage_error(
                     NULL, "--method: '%s' is not robust, gaussian, laplacian or taubin", value);
+            opt->method = (method)m;
             i++;
         } else if (!strcmp(a, "--lambda") || !strcmp(a, "--mu") || !strcmp(a, "--iterations")) {
             if (!value)
@@ -216,13 +222,13 @@ static int parse_args(int argc, char **argv, options *opt) {
         return cli_usage_error(NULL, "--sigma-g must be positive, or 'inf' (got %g)", p->sigma_g);
     if (!(p->cutoff > 0 && p->cutoff <= 5))
         return cli_usage_error(NULL, "--cutoff must be in (0, 5] (got %g)", p->cutoff);
-    bool umbrella = opt->method == METHOD_LAPLACIAN || opt->method == METHOD_TAUBIN;
+    bool umbrella = method_uses_edges(opt->method);
     if (opt->umbrella_given && !umbrella)
         return cli_usage_error(NULL, "--lambda, --mu and --iterations need --method laplacian "
                                      "or taubin");
     if (umbrella && opt->confidence)
         return cli_usage_error(NULL, "--method %s has no confidence to write",
-                               opt->method == METHOD_TAUBIN ? "taubin" : "laplacian");
+                               method_names[opt->method]);
     if (opt->method == METHOD_GAUSSIAN) {
         if (opt->sigma_g_given)
             return cli_usage_error(NULL, "--method gaussian has no influence weight: drop "
@@ -291,9 +297,8 @@ static void print_json(const rsmooth_report *r, const options *opt, double ms_re
     print_json_string(opt->input);
     printf(",\"output\":");
     print_json_string(opt->output);
-    static const char *const method_names[] = {"robust", "gaussian", "laplacian", "taubin"};
     printf(",\"method\":\"%s\"", method_names[opt->method]);
-    if (opt->method == METHOD_LAPLACIAN || opt->method == METHOD_TAUBIN)
+    if (method_uses_edges(opt->method))
         printf(",\"lambda\":%.9g,\"mu\":%.9g,\"iterations\":%u", opt->lambda, opt->mu,
                opt->iterations);
     printf(",\"vertices\":%zu,\"triangles\":%zu,\"facets\":%zu,\"mean_edge_length\":%.9g,"
@@ -403,14 +408,14 @@ static int smooth_umbrella(const options *opt, const rsmooth_mesh *mesh, double 
     report->vertex_count = mesh->vertex_count;
     report->triangle_count = mesh->triangle_count;
     snprintf(report->device, sizeof report->device, "%s, %u iterations (double, 1 thread)",
-             opt->mu != 0 ? "taubin" : "laplacian", opt->iterations);
+             method_names[opt->method], opt->iterations);
     return EXIT_OK;
 }
 
 /* Runs the filter on the chosen device; prints what fails. */
 static int smooth(const options *opt, const rsmooth_mesh *mesh, double *out, float *confidence,
                   rsmooth_report *report, cli_progress *bar) {
-    if (opt->method == METHOD_LAPLACIAN || opt->method == METHOD_TAUBIN)
+    if (method_uses_edges(opt->method))
         return smooth_umbrella(opt, mesh, out, report);
     const char *device = opt->device ? opt->device : getenv("RSMOOTH_DEVICE");
     bool reference = device && strcmp(device, "reference") == 0;
@@ -543,7 +548,7 @@ int main(int argc, char **argv) {
 
     size_t nv = mesh->vertex_count;
     double *out = malloc(nv * 3 * sizeof *out);
-    bool umbrella = opt.method == METHOD_LAPLACIAN || opt.method == METHOD_TAUBIN;
+    bool umbrella = method_uses_edges(opt.method);
     bool want_confidence = opt.confidence || (opt.stats && !umbrella);
     float *confidence = want_confidence ? malloc(nv * sizeof *confidence) : NULL;
     rsmooth_report report;
