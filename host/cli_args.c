@@ -2,7 +2,9 @@
 #include "cli_args.h"
 #include "cli_files.h"
 
+#include <ctype.h>
 #include <errno.h>
+#include <string.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -27,5 +29,27 @@ bool cli_parse_number(const char *text, double *out) {
     if (end == text || *end != '\0' || errno == ERANGE || isnan(v))
         return false;
     *out = v;
+    return true;
+}
+
+bool cli_parse_bytes(const char *text, uint64_t *out) {
+    char *end = NULL;
+    double v = strtod(text, &end);
+    if (end == text || !(v >= 0))
+        return false;
+    static const char units[] = "KMGT";
+    const char *unit = *end ? strchr(units, toupper((unsigned char)*end)) : NULL;
+    if (unit && *unit) {
+        for (const char *u = units; u <= unit; u++)
+            v *= 1024;
+        end++;
+        if (*end == 'i') /* "MiB" */
+            end++;
+        if (*end == 'B' || *end == 'b')
+            end++;
+    }
+    if (*end != '\0' || !(v < 1.8e19))
+        return false;
+    *out = (uint64_t)v;
     return true;
 }

@@ -3,6 +3,7 @@
 #define RSMOOTH_CLI_ARGS_H
 
 #include <stdbool.h>
+#include <stdint.h>
 
 /* Prints "rsmooth[ COMMAND]: message" and the --help hint to stderr; returns the usage exit status
  * (2). `command` is NULL for the main command. */
@@ -13,5 +14,8 @@ int cli_usage_error(const char *command, const char *format, ...);
 
 /* Parses the whole of `text` as a number; false for junk, NaN or out of range. Accepts "inf". */
 bool cli_parse_number(const char *text, double *out);
+
+/* Parses a byte count: "268435456", "256M", "1.5G", "512KiB" (K, M, G, T are powers of 1024). */
+bool cli_parse_bytes(const char *text, uint64_t *out);
 
 #endif

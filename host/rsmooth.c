@@ -74,6 +74,10 @@ static const char usage_text[] =
     "                        mesh's range: red its lowest (few triangles agreed: sharp edges,\n"
     "                        outliers, sparse parts), blue its highest. OBJ: colours only.\n"
     "  --ascii               write PLY and STL as ascii (default binary little-endian)\n"
+    "  --memory-budget SIZE  device memory one run may hold (e.g. 256M, 2G; default: most of the\n"
+    "                        device's). A mesh that needs more is filtered in spatial tiles, with\n"
+    "                        the same result to float rounding. Also read from\n"
+    "                        RSMOOTH_MEMORY_BUDGET.\n"
     "  --list-devices        list the OpenCL devices and how --device names them, then exit\n"
     "  --stats               print statistics of the mesh and of what the filter did\n"
     "  --json                print one JSON object of counts, sigmas, device and stage times (ms)\n"
@@ -106,6 +110,7 @@ typedef struct options {
     method method;
     double lambda, mu;
     unsigned iterations;
+    uint64_t memory_budget; /* 0: the library's default */
     bool sigma_g_given, umbrella_given; /* for consistency checks against --method */
     bool ascii, json, force, quiet, in_place, stats, list_devices;
 } options;
@@ -138,6 +143,13 @@ static int parse_args(int argc, char **argv, options *opt) {
                 opt->device = value;
             else
                 opt->output = value;
+            i++;
+        } else if (!strcmp(a, "--memory-budget")) {
+            if (!value)
+                return cli_usage_error(NULL, "%s needs a value", a);
+            if (!cli_parse_bytes(value, &opt->memory_budget) || opt->memory_budget == 0)
+                return cli_usage_error(NULL, "--memory-budget: '%s' is not a byte count above 0 "
+                                             "(examples: 256M, 1.5G)", value);
             i++;
         } else if (!strcmp(a, "--method")) {
             if (!value)
@@ -308,7 +320,8 @@ static void print_json(const rsmooth_report *r, const options *opt, double ms_re
         printf("\"sigma_g\":null,");
     else
         printf("\"sigma_g\":%.9g,", r->sigma_g);
-    printf("\"radius\":%.9g,\"grid_cells\":%zu,\"device\":", r->radius, r->grid_cell_count);
+    printf("\"radius\":%.9g,\"grid_cells\":%zu,\"pairs_robust\":%llu,\"tiles\":%zu,\"device\":", r->radius,
+           r->grid_cell_count, (unsigned long long)r->pairs_robust, r->tiles);
     print_json_string(r->device);
     printf(",\"ms\":{\"read\":%.3f,\"setup\":%.3f,\"facets\":%.3f,\"grid\":%.3f,\"upload\":%.3f,"
            "\"mollify\":%.3f,\"normals\":%.3f,\"robust\":%.3f,\"download\":%.3f,\"filter\":%.3f,"
@@ -366,9 +379,9 @@ static void print_stats(const rsmooth_mesh *mesh, const double *out, const float
     if (confidence) /* the robust filter and the Gaussian; the umbrella methods have neither */
         fprintf(stderr,
                 "filter:      sigma_f %.6g, sigma_g %.6g, reach %.6g (mesh units), %zu grid "
-                "cells, %zu triangles of zero area\n",
-                r->sigma_f, r->sigma_g, r->radius, r->grid_cell_count,
-                r->triangle_count - r->facet_count);
+                "cells in %zu tile%s, %zu triangles of zero area\n",
+                r->sigma_f, r->sigma_g, r->radius, r->grid_cell_count, r->tiles,
+                r->tiles == 1 ? "" : "s", r->triangle_count - r->facet_count);
     else
         fprintf(stderr, "filter:      %s\n", r->device);
     fprintf(stderr, "moved:       mean %.4f, median %.4f, max %.4f mean edge lengths\n",
@@ -427,6 +440,8 @@ static int smooth(const options *opt, const rsmooth_mesh *mesh, double *out, flo
         double t = cli_now_ms();
         st = rsmooth_context_create(device, &ctx, &err);
         ms_setup = cli_now_ms() - t;
+        if (st == RSMOOTH_OK && opt->memory_budget)
+            rsmooth_context_set_memory_budget(ctx, opt->memory_budget);
         bool automatic = !device || strcmp(device, "auto") == 0;
         if (st == RSMOOTH_ERROR_NO_DEVICE && automatic) {
             if (!opt->quiet)

@@ -201,6 +201,61 @@ static size_t choose_local_size(cl_device_id device) {
     return local ? local : 1;
 }
 
+bool rs_parse_bytes(const char *text, uint64_t *bytes) {
+    char *end = NULL;
+    double value = strtod(text, &end);
+    if (end == text || !(value >= 0))
+        return false;
+    static const char suffixes[] = "KMGT";
+    double scale = 1;
+    if (*end) {
+        const char *s = strchr(suffixes, toupper((unsigned char)*end));
+        if (!s || !*s)
+            return false;
+        for (const char *k = suffixes; k <= s; k++)
+            scale *= 1024;
+        end++;
+        if (*end == 'i') /* "MiB" */
+            end++;
+        if (*end == 'B' || *end == 'b')
+            end++;
+    }
+    if (*end || !(value * scale < 1.8e19))
+        return false;
+    *bytes = (uint64_t)(value * scale);
+    return true;
+}
+
+/* Reads the device's memory limits and the RSMOOTH_MEMORY_BUDGET override. */
+static rsmooth_status read_memory_limits(rsmooth_context *ctx, rsmooth_error *error) {
+    cl_ulong global = 0, max_alloc = 0;
+    clGetDeviceInfo(ctx->device, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof global, &global, NULL);
+    clGetDeviceInfo(ctx->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof max_alloc, &max_alloc, NULL);
+    ctx->global_memory = global ? global : (uint64_t)1 << 30;
+    ctx->max_allocation = max_alloc ? max_alloc : ctx->global_memory / 4;
+    const char *budget = getenv("RSMOOTH_MEMORY_BUDGET");
+    if (budget && *budget && !rs_parse_bytes(budget, &ctx->memory_budget))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_context_create",
+                       "RSMOOTH_MEMORY_BUDGET='%s' is not a byte count (examples: 268435456, "
+                       "256M, 1.5G)", budget);
+    return RSMOOTH_OK;
+}
+
+uint64_t rs_cl_usable_memory(const rsmooth_context *ctx) {
+    /* most of the device: the driver and other programs keep some */
+    uint64_t device = ctx->global_memory / 4 * 3;
+    return ctx->memory_budget && ctx->memory_budget < device ? ctx->memory_budget : device;
+}
+
+void rsmooth_context_set_memory_budget(rsmooth_context *ctx, uint64_t bytes) {
+    if (ctx)
+        ctx->memory_budget = bytes;
+}
+
+uint64_t rsmooth_context_memory_budget(const rsmooth_context *ctx) {
+    return ctx ? rs_cl_usable_memory(ctx) : 0;
+}
+
 static rsmooth_context *new_context(void) {
     rsmooth_context *ctx = rs_calloc_array(1, sizeof *ctx);
     return ctx;
@@ -240,7 +295,9 @@ rsmooth_status rsmooth_context_create(const char *device, rsmooth_context **out,
         st = rs_cl_fail(error, err, "clCreateCommandQueue", chosen.name);
         goto fail;
     }
-    st = rs_cl_build_program(ctx, error);
+    st = read_memory_limits(ctx, error);
+    if (st == RSMOOTH_OK)
+        st = rs_cl_build_program(ctx, error);
     if (st != RSMOOTH_OK)
         goto fail;
     *out = ctx;
@@ -286,7 +343,9 @@ rsmooth_status rsmooth_context_create_from_queue(cl_command_queue queue, rsmooth
     clGetPlatformInfo(platform, CL_PLATFORM_NAME, sizeof platform_name - 1, platform_name, NULL);
     clGetDeviceInfo(device, CL_DEVICE_NAME, sizeof device_name - 1, device_name, NULL);
     snprintf(ctx->device_name, sizeof ctx->device_name, "%s / %s", platform_name, device_name);
-    rsmooth_status st = rs_cl_build_program(ctx, error);
+    rsmooth_status st = read_memory_limits(ctx, error);
+    if (st == RSMOOTH_OK)
+        st = rs_cl_build_program(ctx, error);
     if (st != RSMOOTH_OK) {
         rsmooth_context_destroy(ctx);
         return st;

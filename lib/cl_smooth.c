@@ -18,7 +18,7 @@ typedef struct packed {
     cl_int4 *block_cell;      /* per block: its cell */
     cl_float *block_pos;      /* per block: RS_LANES x, then y, then z, local to the cell */
     uint32_t *slot;           /* caller's vertex index -> block * RS_LANES + lane */
-    double mean_area;
+    uint64_t pairs;           /* vertex-facet pairs one pass over the blocks evaluates */
 } packed;
 
 static void packed_free(packed *pk) {
@@ -93,6 +93,18 @@ static rsmooth_status pack_blocks(const rs_problem *pb, const rs_grid *grid, pac
             for (int k = 0; k < 3; k++)
                 pos[k * RS_LANES + l] = local.s[k];
     }
+    pk->pairs = 0;
+    for (b = 0; b < blocks; b++) {
+        const cl_int *c = pk->block_cell[b].s;
+        for (int dx = -1; dx <= 1; dx++)
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dz = -1; dz <= 1; dz++) {
+                    int32_t cell = rs_grid_find(grid, c[0] + dx, c[1] + dy, c[2] + dz);
+                    if (cell >= 0)
+                        pk->pairs += (uint64_t)RS_LANES *
+                                     (grid->cell_start[cell + 1] - grid->cell_start[cell]);
+                }
+    }
 done:
     rs_free(order);
     rs_free(cells);
@@ -117,17 +129,13 @@ static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, packed *pk
     if (st != RSMOOTH_OK)
         return st;
 
-    double area_sum = 0;
-    for (size_t q = 0; q < nf; q++)
-        area_sum += pb->area[q];
-    pk->mean_area = area_sum / (double)nf;
     const double inv_h = 1 / grid->cell_size;
     for (size_t c = 0; c < grid->cell_count; c++) {
         const int32_t *cell = grid->cell_coord + 4 * c;
         for (uint32_t j = grid->cell_start[c]; j < grid->cell_start[c + 1]; j++) {
             uint32_t q = grid->facet_order[j];
             cl_float4 cen = local_point(grid, pb->centroid + 3 * (size_t)q, cell);
-            cen.s[3] = (float)log(pb->area[q] / pk->mean_area);
+            cen.s[3] = (float)log(pb->area[q] / pb->mean_area);
             pk->facet_centroid[j] = cen;
             for (int k = 0; k < 3; k++)
                 pk->facet_normal[j].s[k] = (float)pb->normal[3 * (size_t)q + k];
@@ -217,23 +225,12 @@ static cl_int run_1d(rsmooth_context *ctx, const rs_problem *pb, cl_kernel kerne
     return err == CL_SUCCESS ? clFinish(ctx->queue) : err;
 }
 
-rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const void *positions,
-                              size_t vertex_count, const uint32_t *indices, size_t triangle_count,
-                              const rsmooth_params *params, void *out_positions, float *out_weight,
-                              float *out_confidence, rsmooth_report *report, rsmooth_error *error) {
+rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_result_sink *sink,
+                         rs_run_stats *stats, uint64_t *needed, rsmooth_error *error) {
     static const char where[] = "rsmooth_smooth";
     double t_start = rs_now_ms();
-    rs_error_clear(error);
-    if (!ctx)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "ctx is NULL");
-    rs_problem pb;
-    rsmooth_status st = rs_problem_prepare(&pb, scalar, positions, vertex_count, indices,
-                                           triangle_count, params, out_positions, error, where);
-    if (st != RSMOOTH_OK)
-        return st;
-    double t_facets = rs_now_ms();
-    double t_grid = t_facets, t_upload = t_facets, t_mollify = t_facets, t_normals = t_facets;
-    double t_robust = t_facets;
+    double t_upload = t_start, t_mollify = t_start, t_normals = t_start, t_robust = t_start;
+    *needed = 0;
 
     rs_grid grid;
     memset(&grid, 0, sizeof grid);
@@ -242,18 +239,14 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     cl_mem buf[BUF_COUNT] = {0};
     cl_float *result = NULL, *extra = NULL; /* per block, as block_result and block_extra */
 
-    if (pb.facet_count == 0) {
-        rs_store_unmoved(&pb, scalar, out_positions, out_weight, out_confidence);
-        goto done;
-    }
-    st = rs_grid_build(&grid, pb.centroid, pb.facet_count, pb.radius, error);
+    rsmooth_status st = rs_grid_build(&grid, pb->centroid, pb->facet_count, pb->radius, error);
     if (st == RSMOOTH_OK)
-        st = pack(&pb, &grid, &pk, error);
+        st = pack(pb, &grid, &pk, error);
     if (st != RSMOOTH_OK)
         goto cleanup;
-    t_grid = rs_now_ms();
+    double t_grid = rs_now_ms();
 
-    size_t nv = vertex_count, nf = pb.facet_count, nc = grid.cell_count;
+    size_t nv = pb->vertex_count, nf = pb->facet_count, nc = grid.cell_count;
     size_t nb = pk.block_count, ns = nb * RS_LANES; /* blocks and slots */
     size_t table_size = (size_t)grid.table_mask + 1;
     const struct {
@@ -276,6 +269,21 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
         [BUF_BLOCK_RESULT] = {ns * 4 * sizeof(cl_float), NULL, CL_MEM_WRITE_ONLY},
         [BUF_BLOCK_EXTRA] = {ns * 2 * sizeof(cl_float), NULL, CL_MEM_WRITE_ONLY},
     };
+    uint64_t total = 0, largest = 0;
+    for (int b = 0; b < BUF_COUNT; b++) {
+        total += spec[b].size;
+        largest = spec[b].size > largest ? spec[b].size : largest;
+    }
+    if (total > rs_cl_usable_memory(ctx) || largest > ctx->max_allocation) {
+        *needed = total;
+        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where,
+                     "%zu facets need %llu bytes on %s (usable %llu, largest buffer %llu of at "
+                     "most %llu)",
+                     nf, (unsigned long long)total, ctx->device_name,
+                     (unsigned long long)rs_cl_usable_memory(ctx), (unsigned long long)largest,
+                     (unsigned long long)ctx->max_allocation);
+        goto cleanup;
+    }
     for (int b = 0; b < BUF_COUNT; b++) {
         cl_int err = CL_SUCCESS;
         buf[b] = clCreateBuffer(ctx->context, spec[b].flags, spec[b].size, NULL, &err);
@@ -297,17 +305,17 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     /* Lengths in cell units (h), so every float the kernels see is of order one. */
     const double h = grid.cell_size;
     cl_uint bcount = (cl_uint)nb, fcount = (cl_uint)nf, mask = grid.table_mask;
-    cl_float reach2 = (cl_float)((pb.radius / h) * (pb.radius / h));
-    cl_float mollify_reach2 = (cl_float)((pb.mollify_radius / h) * (pb.mollify_radius / h));
-    cl_float inv_2sm2 = (cl_float)(h * h / (2 * pb.sigma_m * pb.sigma_m));
-    cl_float inv_2sf2 = (cl_float)(h * h / (2 * pb.sigma_f * pb.sigma_f));
+    cl_float reach2 = (cl_float)((pb->radius / h) * (pb->radius / h));
+    cl_float mollify_reach2 = (cl_float)((pb->mollify_radius / h) * (pb->mollify_radius / h));
+    cl_float inv_2sm2 = (cl_float)(h * h / (2 * pb->sigma_m * pb->sigma_m));
+    cl_float inv_2sf2 = (cl_float)(h * h / (2 * pb->sigma_f * pb->sigma_f));
     cl_float inv_2sg2 =
-        isinf(pb.sigma_g) ? 0.0f : (cl_float)(h * h / (2 * pb.sigma_g * pb.sigma_g));
-    cl_int want_confidence = out_confidence != NULL;
-    cl_int predict_centroid = pb.predict_centroid;
+        isinf(pb->sigma_g) ? 0.0f : (cl_float)(h * h / (2 * pb->sigma_g * pb->sigma_g));
+    cl_int want_confidence = sink->confidence != NULL;
+    cl_int predict_centroid = pb->predict_centroid;
 
     cl_mem normals = buf[BUF_FACET_NORMAL];
-    if (pb.mollify) {
+    if (pb->mollify) {
         arg_setter s = {ctx->kernels[RS_KERNEL_MOLLIFY], 0, CL_SUCCESS};
         arg(&s, sizeof bcount, &bcount);
         arg(&s, sizeof mollify_reach2, &mollify_reach2);
@@ -320,7 +328,7 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
         arg(&s, sizeof(cl_mem), &buf[BUF_TABLE]);
         arg(&s, sizeof mask, &mask);
         arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_SHIFT]);
-        err = s.err != CL_SUCCESS ? s.err : run_1d(ctx, &pb, s.kernel, nb, 0, MOLLIFY_SHARE);
+        err = s.err != CL_SUCCESS ? s.err : run_1d(ctx, pb, s.kernel, nb, 0, MOLLIFY_SHARE);
         if (err != CL_SUCCESS) {
             st = rs_cl_fail(error, err, "mollify_block", ctx->device_name);
             goto cleanup;
@@ -336,7 +344,7 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
         arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_SHIFT]);
         arg(&s, sizeof(cl_mem), &buf[BUF_MOLLIFIED_NORMAL]);
         err = s.err != CL_SUCCESS ? s.err
-                                  : run_1d(ctx, &pb, s.kernel, nf, MOLLIFY_SHARE, MOLLIFY_SHARE);
+                                  : run_1d(ctx, pb, s.kernel, nf, MOLLIFY_SHARE, MOLLIFY_SHARE);
         if (err != CL_SUCCESS) {
             st = rs_cl_fail(error, err, "mollified_facet_normal", ctx->device_name);
             goto cleanup;
@@ -365,7 +373,7 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_RESULT]);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_EXTRA]);
     err = s.err != CL_SUCCESS ? s.err
-                              : run_1d(ctx, &pb, s.kernel, nb, pb.mollify ? MOLLIFY_SHARE : 0, 1);
+                              : run_1d(ctx, pb, s.kernel, nb, pb->mollify ? MOLLIFY_SHARE : 0, 1);
     if (err != CL_SUCCESS) {
         st = rs_cl_fail(error, err, "robust_block", ctx->device_name);
         goto cleanup;
@@ -387,37 +395,32 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
         st = rs_cl_fail(error, err, "clEnqueueReadBuffer", ctx->device_name);
         goto cleanup;
     }
-    for (size_t v = 0; v < nv; v++) {
+    for (size_t v = 0; v < sink->core_count && v < nv; v++) {
         size_t b = pk.slot[v] / RS_LANES, lane = pk.slot[v] % RS_LANES;
         const cl_float *res = result + 4 * RS_LANES * b + lane, *ext = extra + 2 * RS_LANES * b + lane;
-        const double *p = pb.xyz + 3 * v;
+        const double *p = pb->xyz + 3 * v;
+        size_t to = sink->target ? sink->target[v] : v;
         double out[3];
         for (int k = 0; k < 3; k++)
             out[k] = p[k] + (double)res[k * RS_LANES] * h;
-        rs_store_position(scalar, out_positions, v, out);
-        double k = (double)res[3 * RS_LANES] * exp(-(double)ext[RS_LANES]) * pk.mean_area;
-        double kf = (double)ext[0] * pk.mean_area;
-        if (out_weight)
-            out_weight[v] = (float)k;
-        if (out_confidence)
-            out_confidence[v] = kf > 0 ? (float)fmin(1.0, k / kf) : 0.0f;
+        rs_store_position(sink->scalar, sink->positions, to, out);
+        double k = (double)res[3 * RS_LANES] * exp(-(double)ext[RS_LANES]) * pb->mean_area;
+        double kf = (double)ext[0] * pb->mean_area;
+        if (sink->weight)
+            sink->weight[to] = (float)k;
+        if (sink->confidence)
+            sink->confidence[to] = kf > 0 ? (float)fmin(1.0, k / kf) : 0.0f;
     }
-
-done:
-    rs_progress(&pb, 1.0);
-    if (report) {
-        double now = rs_now_ms();
-        rs_report_problem(report, &pb, &grid, ctx->device_name);
-        report->ms_facets = t_facets - t_start;
-        report->ms_grid = t_grid - t_facets;
-        report->ms_upload = t_upload - t_grid;
-        report->ms_mollify = t_mollify - t_upload;
-        report->ms_normals = t_normals - t_mollify;
-        report->ms_robust = t_robust - t_normals;
-        report->ms_download = pb.facet_count ? now - t_robust : 0;
-        report->ms_total = now - t_start;
-    }
-    st = RSMOOTH_OK;
+    double t_end = rs_now_ms();
+    stats->ms_grid += t_grid - t_start;
+    stats->ms_upload += t_upload - t_grid;
+    stats->ms_mollify += t_mollify - t_upload;
+    stats->ms_normals += t_normals - t_mollify;
+    stats->ms_robust += t_robust - t_normals;
+    stats->ms_download += t_end - t_robust;
+    stats->pairs += pk.pairs;
+    stats->cells += grid.cell_count;
+    stats->tiles++;
 
 cleanup:
     for (int b = 0; b < BUF_COUNT; b++)
@@ -427,6 +430,51 @@ cleanup:
     rs_free(extra);
     packed_free(&pk);
     rs_grid_free(&grid);
+    return st;
+}
+
+rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const void *positions,
+                              size_t vertex_count, const uint32_t *indices, size_t triangle_count,
+                              const rsmooth_params *params, void *out_positions, float *out_weight,
+                              float *out_confidence, rsmooth_report *report, rsmooth_error *error) {
+    static const char where[] = "rsmooth_smooth";
+    double t_start = rs_now_ms();
+    rs_error_clear(error);
+    if (!ctx)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "ctx is NULL");
+    rs_problem pb;
+    rsmooth_status st = rs_problem_prepare(&pb, scalar, positions, vertex_count, indices,
+                                           triangle_count, params, out_positions, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
+    double t_facets = rs_now_ms();
+    rs_run_stats stats;
+    memset(&stats, 0, sizeof stats);
+    if (pb.facet_count == 0) {
+        rs_store_unmoved(&pb, scalar, out_positions, out_weight, out_confidence);
+    } else {
+        rs_result_sink sink = {scalar, out_positions, out_weight, out_confidence, NULL,
+                               vertex_count};
+        st = rs_cl_filter(ctx, &pb, &sink, &stats, error);
+    }
+    if (st == RSMOOTH_OK) {
+        rs_progress(&pb, 1.0);
+        if (report) {
+            rs_report_problem(report, &pb, NULL, ctx->device_name);
+            report->grid_cell_count = stats.cells;
+            report->ms_facets = t_facets - t_start;
+            report->ms_grid = stats.ms_grid;
+            report->ms_upload = stats.ms_upload;
+            report->ms_mollify = stats.ms_mollify;
+            report->ms_normals = stats.ms_normals;
+            report->ms_robust = stats.ms_robust;
+            report->ms_download = stats.ms_download;
+            report->ms_total = rs_now_ms() - t_start;
+            report->pairs_mollify = pb.mollify ? stats.pairs : 0;
+            report->pairs_robust = stats.pairs;
+            report->tiles = stats.tiles;
+        }
+    }
     rs_problem_free(&pb);
     return st;
 }

@@ -207,6 +207,10 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
         f++;
     }
     problem->facet_count = f;
+    double area_sum = 0;
+    for (size_t q = 0; q < f; q++)
+        area_sum += problem->area[q];
+    problem->mean_area = f ? area_sum / (double)f : 0;
 
     if (!rs_mean_edge_length(problem->xyz, indices, triangle_count, &problem->mean_edge_length)) {
         rs_problem_free(problem);
@@ -249,6 +253,7 @@ void rs_report_problem(rsmooth_report *report, const rs_problem *problem, const 
     report->sigma_f = problem->sigma_f;
     report->sigma_g = problem->sigma_g;
     report->radius = problem->radius;
+    report->mollify_radius = problem->mollify ? problem->mollify_radius : 0;
     report->grid_cell_count = grid ? grid->cell_count : 0;
     snprintf(report->device, sizeof report->device, "%s", device);
 }

@@ -228,6 +228,7 @@ done:
     if (report) {
         double now = rs_now_ms();
         rs_report_problem(report, &pb, &grid, "reference (double, 1 thread)");
+        report->tiles = 1;
         report->ms_facets = t_facets - t_start;
         report->ms_grid = t_grid - t_facets;
         report->ms_mollify = t_mollify - t_grid;

@@ -75,6 +75,7 @@ typedef struct rs_problem {
     double *normal;              /* 3 per facet: unit n_q of the input */
     double *area;                /* per facet: a_q > 0 */
     double mean_edge_length;
+    double mean_area;            /* of the facets (a tile keeps its whole mesh's) */
     /* absolute parameters, mesh units */
     double sigma_f, sigma_g;     /* sigma_g is +INFINITY when the influence weight is off */
     double sigma_m;              /* mollification width: sigma_f / 2 */
@@ -216,7 +217,52 @@ struct rsmooth_context {
     char device_name[256];
     double build_ms;
     size_t local_size;        /* work-group size used for every kernel */
+    uint64_t global_memory;   /* CL_DEVICE_GLOBAL_MEM_SIZE */
+    uint64_t max_allocation;  /* CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest one buffer may be */
+    uint64_t memory_budget;   /* caller's or RSMOOTH_MEMORY_BUDGET's limit; 0: the device's */
 };
+
+/* Bytes one run may hold on the device: the caller's budget, else most of the device's memory. */
+uint64_t rs_cl_usable_memory(const rsmooth_context *ctx);
+
+/* Reads a byte count such as "256M", "1.5G", "4096" (suffixes K, M, G, T: powers of 1024).
+ * false when `text` is not one. */
+bool rs_parse_bytes(const char *text, uint64_t *bytes);
+
+/* ---- cl_smooth.c / tiles.c: the OpenCL path ------------------------------------------------- */
+
+/* Where a run's results go: vertex v < core_count of the problem it solved is written to entry
+ * target[v] (v itself when target is NULL) of the caller's arrays; the others are a tile's halo. */
+typedef struct rs_result_sink {
+    rsmooth_scalar scalar;
+    void *positions;
+    float *weight, *confidence; /* optional */
+    const uint32_t *target;
+    size_t core_count;
+} rs_result_sink;
+
+/* Stage times and work, summed over the runs (tiles) of one call. */
+typedef struct rs_run_stats {
+    double ms_grid, ms_upload, ms_mollify, ms_normals, ms_robust, ms_download;
+    uint64_t pairs;    /* vertex-facet pairs one pass evaluated */
+    size_t cells;      /* occupied grid cells */
+    size_t tiles;
+} rs_run_stats;
+
+/* Device bytes a run needs at most, estimated before its grid exists (tiles.c plans with it). */
+#define RS_DEVICE_BYTES_PER_FACET 96
+#define RS_DEVICE_BYTES_PER_VERTEX 80
+
+/* One run of the whole pipeline on `problem` (facet_count > 0). When its buffers would exceed
+ * rs_cl_usable_memory or the device's largest allocation, returns RSMOOTH_ERROR_OUT_OF_MEMORY
+ * with `*needed` set to the bytes it wanted, having run nothing. */
+rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *problem, const rs_result_sink *sink,
+                         rs_run_stats *stats, uint64_t *needed, rsmooth_error *error);
+
+/* The filter on `problem`: one run when it fits the device, else spatial tiles, each with the
+ * facets within reach of its vertices' results (tiles.c). */
+rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *problem,
+                            const rs_result_sink *sink, rs_run_stats *stats, rsmooth_error *error);
 
 /* Builds the program from the embedded kernels (or RSMOOTH_KERNEL_DIR) and creates the kernels. */
 rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error);

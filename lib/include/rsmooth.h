@@ -39,7 +39,7 @@
 #include <stdint.h>
 
 #define RSMOOTH_VERSION_MAJOR 0
-#define RSMOOTH_VERSION_MINOR 2
+#define RSMOOTH_VERSION_MINOR 3
 #define RSMOOTH_VERSION_PATCH 0
 
 #if defined(_WIN32)
@@ -166,6 +166,13 @@ typedef struct rsmooth_report {
     double ms_robust;             /* robust estimation */
     double ms_download;
     double ms_total;              /* the whole filter call */
+    /* Work counts (0 where a path does not count them; the reference path does not). */
+    double mollify_radius;        /* reach of the mollification pass, mesh units */
+    uint64_t pairs_mollify;       /* vertex-facet pairs the mollification pass evaluated */
+    uint64_t pairs_robust;        /* vertex-facet pairs the robust pass evaluated (each of them,
+                                     within reach or not: the grid's waste is counted) */
+    size_t tiles;                 /* spatial tiles the mesh was cut into to fit the device (1 when
+                                     it fitted whole) */
 } rsmooth_report;
 
 /* ---------------------------------------------------------------------------------------------- */
@@ -259,6 +266,16 @@ RSMOOTH_API const char *rsmooth_context_device_name(const rsmooth_context *ctx);
 
 /* Milliseconds the context's creation spent building the OpenCL program. */
 RSMOOTH_API double rsmooth_context_build_ms(const rsmooth_context *ctx);
+
+/* Limits the device memory one filter call holds to `bytes` (0: most of the device's memory, the
+ * default; the environment variable RSMOOTH_MEMORY_BUDGET, e.g. "256M", sets it at creation).
+ * A mesh that needs more, or a buffer larger than the device's largest allocation, is cut into
+ * spatial tiles, each run with the facets within reach of its vertices: results agree with an
+ * untiled run to float32 rounding (rsmooth_report.tiles says how many ran). */
+RSMOOTH_API void rsmooth_context_set_memory_budget(rsmooth_context *ctx, uint64_t bytes);
+
+/* The bytes one filter call may hold on the device now: the budget, else the device's share. */
+RSMOOTH_API uint64_t rsmooth_context_memory_budget(const rsmooth_context *ctx);
 
 /* The filter on the context's device, float32 arithmetic in cell-local coordinates (so meshes far
  * from the origin lose nothing). Same arguments, outputs and argument errors as

@@ -1,0 +1,249 @@
+/* Spatial tiles: a mesh whose buffers exceed the device's memory (or the caller's budget) is cut
+ * into boxes of vertices, each run with every facet its vertices' results depend on.
+ *
+ * A vertex p moves by the facets whose centroids lie within `radius` of it. Their mollified normals
+ * come from their own vertices (within `reach`, the mesh's largest centroid-to-vertex distance),
+ * which moved by the facets within `mollify_radius` of them. So a tile holding the facets whose
+ * centroids lie within radius + reach + mollify_radius of its box computes its vertices as the
+ * whole mesh would, up to float32 rounding (coordinates are local to a different grid). Boxes are
+ * halved along their longest side until a tile fits. */
+#include "rsmooth_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+#define ABSENT UINT32_MAX
+/* Halvings before giving up: far more than any budget that can hold one vertex's halo needs. */
+#define MAX_DEPTH 96
+
+typedef struct tiler {
+    rsmooth_context *ctx;
+    const rs_problem *whole;
+    const rs_result_sink *sink; /* the whole call's (target NULL) */
+    rs_run_stats *stats;
+    double halo;
+    uint64_t budget;
+    uint32_t *sub_index; /* whole vertex -> its index in the current tile, ABSENT elsewhere */
+    size_t vertices_done;
+    rsmooth_error *error;
+} tiler;
+
+/* A tile's progress mapped into the whole call's. */
+typedef struct tile_progress {
+    rsmooth_progress_fn fn;
+    void *user;
+    double from, span;
+} tile_progress;
+
+static void report_tile_progress(void *user, double fraction) {
+    const tile_progress *tp = user;
+    tp->fn(tp->user, tp->from + tp->span * fraction);
+}
+
+/* Device bytes a tile of `vertices` core vertices and `facets` facets is expected to need (a
+ * facet brings about half a vertex of its own). */
+static uint64_t estimate_bytes(size_t vertices, size_t facets) {
+    size_t v = vertices > facets / 2 ? vertices : facets / 2;
+    return (uint64_t)facets * RS_DEVICE_BYTES_PER_FACET + (uint64_t)v * RS_DEVICE_BYTES_PER_VERTEX;
+}
+
+/* Runs the tile of core vertices `verts` with facets `facets` (indices into the whole problem):
+ * core vertices first, then the other vertices of those facets. */
+static rsmooth_status run_tile(tiler *t, const uint32_t *verts, size_t n, const uint32_t *facets,
+                               size_t m, uint64_t *needed) {
+    const rs_problem *w = t->whole;
+    rs_problem sub = *w;
+    sub.xyz = NULL;
+    sub.facet_triangle = NULL;
+    sub.centroid = sub.normal = sub.area = NULL;
+    uint32_t *list = rs_alloc_array(n + 3 * m, sizeof *list); /* tile vertex -> whole vertex */
+    uint32_t *indices = rs_alloc_array(m, 3 * sizeof *indices);
+    sub.facet_triangle = rs_alloc_array(m, sizeof(uint32_t));
+    sub.centroid = rs_alloc_array(m, 3 * sizeof(double));
+    sub.normal = rs_alloc_array(m, 3 * sizeof(double));
+    sub.area = rs_alloc_array(m, sizeof(double));
+    size_t count = 0;
+    rsmooth_status st = RSMOOTH_OK;
+    if (!list || !indices || !sub.facet_triangle || !sub.centroid || !sub.normal || !sub.area) {
+        st = rs_fail(t->error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth",
+                     "no memory for a tile of %zu facets", m);
+        goto done;
+    }
+    for (; count < n; count++) {
+        t->sub_index[verts[count]] = (uint32_t)count;
+        list[count] = verts[count];
+    }
+    for (size_t j = 0; j < m; j++) {
+        size_t q = facets[j];
+        const uint32_t *tri = w->indices + 3 * (size_t)w->facet_triangle[q];
+        for (int c = 0; c < 3; c++) {
+            if (t->sub_index[tri[c]] == ABSENT) {
+                t->sub_index[tri[c]] = (uint32_t)count;
+                list[count++] = tri[c];
+            }
+            indices[3 * j + c] = t->sub_index[tri[c]];
+        }
+        sub.facet_triangle[j] = (uint32_t)j;
+        memcpy(sub.centroid + 3 * j, w->centroid + 3 * q, 3 * sizeof(double));
+        memcpy(sub.normal + 3 * j, w->normal + 3 * q, 3 * sizeof(double));
+        sub.area[j] = w->area[q];
+    }
+    sub.xyz = rs_alloc_array(count, 3 * sizeof(double));
+    if (!sub.xyz) {
+        st = rs_fail(t->error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth",
+                     "no memory for a tile of %zu vertices", count);
+        goto done;
+    }
+    for (size_t v = 0; v < count; v++)
+        memcpy(sub.xyz + 3 * v, w->xyz + 3 * (size_t)list[v], 3 * sizeof(double));
+    sub.vertex_count = count;
+    sub.indices = indices;
+    sub.triangle_count = sub.facet_count = m;
+
+    tile_progress tp = {w->progress, w->progress_user,
+                        (double)t->vertices_done / (double)w->vertex_count,
+                        (double)n / (double)w->vertex_count};
+    if (w->progress) {
+        sub.progress = report_tile_progress;
+        sub.progress_user = &tp;
+    }
+    rs_result_sink sink = *t->sink;
+    sink.target = verts;
+    sink.core_count = n;
+    st = rs_cl_run(t->ctx, &sub, &sink, t->stats, needed, t->error);
+    if (st == RSMOOTH_OK)
+        t->vertices_done += n;
+
+done:
+    for (size_t v = 0; v < count; v++)
+        t->sub_index[list[v]] = ABSENT;
+    rs_free(list);
+    rs_free(indices);
+    sub.indices = NULL;
+    rs_problem_free(&sub);
+    return st;
+}
+
+/* Solves the vertices `verts` (reordered in place) with candidate facets `facets` (a superset of
+ * those within the halo of their box). */
+static rsmooth_status solve_region(tiler *t, uint32_t *verts, size_t n, const uint32_t *facets,
+                                   size_t facet_count, int depth) {
+    const rs_problem *w = t->whole;
+    if (n == 0)
+        return RSMOOTH_OK;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            lo[k] = fmin(lo[k], w->xyz[3 * (size_t)verts[i] + k]);
+            hi[k] = fmax(hi[k], w->xyz[3 * (size_t)verts[i] + k]);
+        }
+    uint32_t *near = rs_alloc_array(facet_count ? facet_count : 1, sizeof *near);
+    if (!near)
+        return rs_fail(t->error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth",
+                       "no memory to plan tiles");
+    size_t m = 0;
+    for (size_t j = 0; j < facet_count; j++) {
+        const double *c = w->centroid + 3 * (size_t)facets[j];
+        bool inside = true;
+        for (int k = 0; k < 3; k++)
+            inside = inside && c[k] >= lo[k] - t->halo && c[k] <= hi[k] + t->halo;
+        if (inside)
+            near[m++] = facets[j];
+    }
+    int axis = 0;
+    for (int k = 1; k < 3; k++)
+        if (hi[k] - lo[k] > hi[axis] - lo[axis])
+            axis = k;
+    double mid = 0.5 * (lo[axis] + hi[axis]);
+    bool can_split = n >= 2 && depth < MAX_DEPTH && mid > lo[axis];
+
+    rsmooth_status st = RSMOOTH_OK;
+    uint64_t needed = 0;
+    if (!can_split || estimate_bytes(n, m) <= t->budget) {
+        st = run_tile(t, verts, n, near, m, &needed);
+        if (st != RSMOOTH_ERROR_OUT_OF_MEMORY || needed == 0 || !can_split) {
+            if (st == RSMOOTH_ERROR_OUT_OF_MEMORY && needed > 0)
+                st = rs_fail(t->error, st, "rsmooth_smooth",
+                             "device memory budget of %llu bytes is too small: the %zu facets "
+                             "within reach of %zu vertices need %llu",
+                             (unsigned long long)t->budget, m, n, (unsigned long long)needed);
+            rs_free(near);
+            return st;
+        }
+        rs_error_clear(t->error);
+    }
+    size_t below = 0; /* vertices left of mid come first */
+    for (size_t i = 0; i < n; i++) {
+        if (w->xyz[3 * (size_t)verts[i] + axis] < mid) {
+            uint32_t v = verts[i];
+            verts[i] = verts[below];
+            verts[below++] = v;
+        }
+    }
+    st = solve_region(t, verts, below, near, m, depth + 1);
+    if (st == RSMOOTH_OK)
+        st = solve_region(t, verts + below, n - below, near, m, depth + 1);
+    rs_free(near);
+    return st;
+}
+
+rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *pb, const rs_result_sink *sink,
+                            rs_run_stats *stats, rsmooth_error *error) {
+    uint64_t budget = rs_cl_usable_memory(ctx);
+    if (estimate_bytes(pb->vertex_count, pb->facet_count) <= budget) {
+        uint64_t needed = 0;
+        rsmooth_status st = rs_cl_run(ctx, pb, sink, stats, &needed, error);
+        if (st != RSMOOTH_ERROR_OUT_OF_MEMORY || needed == 0)
+            return st;
+        rs_error_clear(error);
+    }
+    double reach = 0; /* largest centroid-to-vertex distance */
+    for (size_t q = 0; q < pb->facet_count; q++) {
+        const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
+        for (int c = 0; c < 3; c++) {
+            double d[3];
+            rs_sub3(pb->xyz + 3 * (size_t)tri[c], pb->centroid + 3 * q, d);
+            reach = fmax(reach, sqrt(rs_dot3(d, d)));
+        }
+    }
+    /* Tiles write to scratch first, so a tile that fails leaves the caller's arrays untouched. */
+    size_t nv = pb->vertex_count;
+    uint32_t *verts = rs_alloc_array(nv, sizeof *verts);
+    uint32_t *facets = rs_alloc_array(pb->facet_count, sizeof *facets);
+    uint32_t *sub_index = rs_alloc_array(nv, sizeof *sub_index);
+    double *positions = rs_alloc_array(nv, 3 * sizeof *positions);
+    float *weight = sink->weight ? rs_alloc_array(nv, sizeof *weight) : NULL;
+    float *confidence = sink->confidence ? rs_alloc_array(nv, sizeof *confidence) : NULL;
+    rsmooth_status st = RSMOOTH_OK;
+    if (!verts || !facets || !sub_index || !positions || (sink->weight && !weight) ||
+        (sink->confidence && !confidence)) {
+        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth",
+                     "no memory to plan tiles");
+    } else {
+        for (size_t v = 0; v < nv; v++) {
+            verts[v] = (uint32_t)v;
+            sub_index[v] = ABSENT;
+        }
+        for (size_t q = 0; q < pb->facet_count; q++)
+            facets[q] = (uint32_t)q;
+        /* a little extra: a facet exactly at the halo must not round out of it */
+        double halo = (pb->radius + (pb->mollify ? pb->mollify_radius + reach : 0)) * (1 + 1e-6);
+        rs_result_sink scratch = {RSMOOTH_FLOAT64, positions, weight, confidence, NULL, nv};
+        tiler t = {ctx, pb, &scratch, stats, halo, budget, sub_index, 0, error};
+        st = solve_region(&t, verts, nv, facets, pb->facet_count, 0);
+    }
+    for (size_t v = 0; st == RSMOOTH_OK && v < nv; v++) {
+        rs_store_position(sink->scalar, sink->positions, v, positions + 3 * v);
+        if (weight)
+            sink->weight[v] = weight[v];
+        if (confidence)
+            sink->confidence[v] = confidence[v];
+    }
+    rs_free(positions);
+    rs_free(weight);
+    rs_free(confidence);
+    rs_free(verts);
+    rs_free(facets);
+    rs_free(sub_index);
+    return st;
+}
