@@ -3,6 +3,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions,
@@ -47,47 +48,69 @@ rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions
     return RSMOOTH_OK;
 }
 
-bool rs_mean_edge_length(const double *xyz, const uint32_t *indices, size_t triangle_count,
-                         double *out_length) {
+static int compare_u32(const void *a, const void *b) {
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Buckets of more edges than this are sorted to find duplicates; smaller ones are scanned. */
+#define EDGE_SCAN_LIMIT 32
+
+bool rs_mean_edge_length(const double *xyz, size_t vertex_count, const uint32_t *indices,
+                         size_t triangle_count, double *out_length) {
+    /* Unique edges without a global sort: each edge goes to the bucket of its lower vertex (a
+     * counting sort, linear time), and duplicates are removed within a bucket (a handful). */
     *out_length = 0;
-    size_t edge_count = 3 * triangle_count;
-    uint64_t *keys = rs_alloc_array(edge_count, sizeof *keys);
-    uint32_t *unused = rs_alloc_array(edge_count, sizeof *unused);
-    if (!keys || !unused) {
-        rs_free(keys);
-        rs_free(unused);
+    size_t *start = rs_calloc_array(vertex_count + 1, sizeof *start);
+    uint32_t *upper = rs_alloc_array(triangle_count > 0 ? 3 * triangle_count : 1, sizeof *upper);
+    if (!start || !upper) {
+        rs_free(start);
+        rs_free(upper);
         return false;
     }
-    size_t n = 0;
-    for (size_t t = 0; t < triangle_count; t++) {
+    for (size_t t = 0; t < triangle_count; t++)
         for (int e = 0; e < 3; e++) {
             uint32_t a = indices[3 * t + e], b = indices[3 * t + (e + 1) % 3];
-            if (a == b)
-                continue; /* a repeated index is no edge */
-            uint64_t lo = a < b ? a : b, hi = a < b ? b : a;
-            keys[n] = lo << 32 | hi;
-            unused[n] = 0;
-            n++;
+            if (a != b) /* a repeated index is no edge */
+                start[(a < b ? a : b) + 1]++;
         }
-    }
-    bool ok = rs_radix_sort_u64(keys, unused, n);
-    if (ok) {
-        double sum = 0;
-        size_t unique = 0;
+    for (size_t v = 0; v < vertex_count; v++)
+        start[v + 1] += start[v];
+    for (size_t t = 0; t < triangle_count; t++)
+        for (int e = 0; e < 3; e++) {
+            uint32_t a = indices[3 * t + e], b = indices[3 * t + (e + 1) % 3];
+            if (a != b)
+                upper[start[a < b ? a : b]++] = a < b ? b : a;
+        }
+    for (size_t v = vertex_count; v > 0; v--) /* the fill moved each start to the next's */
+        start[v] = start[v - 1];
+    start[0] = 0;
+    double sum = 0;
+    size_t unique = 0;
+    for (size_t v = 0; v < vertex_count; v++) {
+        uint32_t *bucket = upper + start[v];
+        size_t n = start[v + 1] - start[v];
+        if (n > EDGE_SCAN_LIMIT)
+            qsort(bucket, n, sizeof *bucket, compare_u32);
         for (size_t i = 0; i < n; i++) {
-            if (i > 0 && keys[i] == keys[i - 1])
+            bool seen = false;
+            if (n > EDGE_SCAN_LIMIT)
+                seen = i > 0 && bucket[i] == bucket[i - 1];
+            else
+                for (size_t j = 0; j < i && !seen; j++)
+                    seen = bucket[j] == bucket[i];
+            if (seen)
                 continue;
-            const double *a = xyz + 3 * (keys[i] >> 32), *b = xyz + 3 * (keys[i] & 0xffffffffu);
             double d[3];
-            rs_sub3(a, b, d);
+            rs_sub3(xyz + 3 * v, xyz + 3 * (size_t)bucket[i], d);
             sum += sqrt(rs_dot3(d, d));
             unique++;
         }
-        *out_length = unique ? sum / (double)unique : 0;
     }
-    rs_free(keys);
-    rs_free(unused);
-    return ok;
+    *out_length = unique ? sum / (double)unique : 0;
+    rs_free(start);
+    rs_free(upper);
+    return true;
 }
 
 rsmooth_status rsmooth_mean_edge_length(rsmooth_scalar scalar, const void *positions,
@@ -107,7 +130,7 @@ rsmooth_status rsmooth_mean_edge_length(rsmooth_scalar scalar, const void *posit
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for positions");
     for (size_t i = 0; i < 3 * vertex_count; i++)
         xyz[i] = rs_coordinate(scalar, positions, i);
-    bool ok = rs_mean_edge_length(xyz, indices, triangle_count, out_length);
+    bool ok = rs_mean_edge_length(xyz, vertex_count, indices, triangle_count, out_length);
     rs_free(xyz);
     return ok ? RSMOOTH_OK
               : rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for edges");
@@ -212,7 +235,8 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
         area_sum += problem->area[q];
     problem->mean_area = f ? area_sum / (double)f : 0;
 
-    if (!rs_mean_edge_length(problem->xyz, indices, triangle_count, &problem->mean_edge_length)) {
+    if (!rs_mean_edge_length(problem->xyz, vertex_count, indices, triangle_count,
+                             &problem->mean_edge_length)) {
         rs_problem_free(problem);
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for edges");
     }

@@ -121,8 +121,8 @@ rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions
                                     const char *where);
 
 /* Mean length of unique undirected edges over `xyz` (double). false on allocation failure. */
-bool rs_mean_edge_length(const double *xyz, const uint32_t *indices, size_t triangle_count,
-                         double *out_length);
+bool rs_mean_edge_length(const double *xyz, size_t vertex_count, const uint32_t *indices,
+                         size_t triangle_count, double *out_length);
 
 /* Writes the result for vertex v (double xyz) into the caller's array of type `scalar`. */
 void rs_store_position(rsmooth_scalar scalar, void *out_positions, size_t v, const double p[3]);
