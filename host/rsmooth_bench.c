@@ -4,12 +4,26 @@
  *   rsmooth-bench io [--triangles N] [--repeat R] [--dir DIR]
  *     Mesh file speed: writes and reads a binary PLY (and an OBJ) of a generated N-triangle mesh,
  *     beside a raw write and read of the same number of bytes in the same process: the
- *     disk-bound limit. One JSON object on stdout with medians over R repetitions. */
+ *     disk-bound limit. One JSON object on stdout with medians over R repetitions.
+ *
+ *   rsmooth-bench filter [MESH] [--triangles N] [--noise S] [--sigma-f X] [--sigma-g Y]
+ *                        [--device D] [--repeat R] [--no-roofline]
+ *     The OpenCL filter (rsmooth_smooth, float32): program build (first and cached), the first
+ *     run, then median/min/max of each stage over R runs and whether they are bit-identical;
+ *     pairs each pass examined against the useful ones (within reach, counted apart in
+ *     bench_pairs.c), and useful pairs per second against a native roofline of the same
+ *     arithmetic on all cores (bench_roofline.c); peak memory over the input's. One JSON object.
+ */
 #define _POSIX_C_SOURCE 200809L
+#include "bench_pairs.h"
+#include "bench_roofline.h"
+#include "cli_args.h"
 #include "mesh_shapes.h"
 #include "rsmooth.h"
 #include "rsmooth_io.h"
 
+#include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -153,11 +167,453 @@ static int bench_io(int argc, char **argv) {
     return 0;
 }
 
+/* ---- filter ---------------------------------------------------------------------------------- */
+
+/* Exit statuses, as the rsmooth command's. */
+enum { EXIT_OK = 0, EXIT_OTHER = 1, EXIT_USAGE = 2, EXIT_DEVICE = 3 };
+
+static const char filter_usage[] =
+    "usage: rsmooth-bench filter [MESH] [--triangles N] [--noise S] [--sigma-f X] [--sigma-g Y]\n"
+    "                            [--device D] [--repeat R] [--no-roofline]\n"
+    "  times the OpenCL filter (float32 positions): program build (first and cached), the first\n"
+    "  run, then median/min/max of each stage over R runs and whether they are bit-identical;\n"
+    "  pairs each pass examined against the useful ones (within reach), useful pairs per second\n"
+    "  against a native roofline of the same arithmetic on all cores, and peak memory (JSON)\n"
+    "  MESH            any mesh file rsmooth reads; default: a generated closed cylinder\n"
+    "                  (radius 1, height 1.5: sharp rims, curved side, flat caps)\n"
+    "  --triangles N   generated mesh: about N triangles (default 200000)\n"
+    "  --noise S       generated mesh: normal noise of S mean edge lengths, seed 1 (default 0.2)\n"
+    "  --sigma-f X     spatial width in mean edge lengths (default 2)\n"
+    "  --sigma-g Y     influence width in mean edge lengths, or 'inf' (default 0.5)\n"
+    "  --device D      as rsmooth --device: auto, gpu, cpu, P:D or part of a name (default:\n"
+    "                  RSMOOTH_DEVICE, else auto)\n"
+    "  --repeat R      timed runs after the first, 1..99 (default 7)\n"
+    "  --no-roofline   skip the native roofline (several seconds)\n"
+    "  The first program build compiles from source only when PoCL's cache (POCL_CACHE_DIR)\n"
+    "  holds no binary of it yet; point POCL_CACHE_DIR at an empty folder to time that.\n";
+
+typedef struct filter_options {
+    const char *mesh_path; /* NULL: generated */
+    const char *device;
+    double triangles, noise;
+    bool shape_option_given; /* --triangles or --noise */
+    rsmooth_params params;
+    int repeat;
+    bool roofline;
+} filter_options;
+
+static int filter_usage_error(const char *message, const char *value) {
+    fprintf(stderr, "rsmooth-bench filter: %s%s%s%s\nTry 'rsmooth-bench filter --help'.\n", message,
+            value ? " '" : "", value ? value : "", value ? "'" : "");
+    return EXIT_USAGE;
+}
+
+/* Returns -1 when the program should go on, else the exit status. */
+static int parse_filter_args(int argc, char **argv, filter_options *opt) {
+    memset(opt, 0, sizeof *opt);
+    rsmooth_params_init(&opt->params);
+    opt->triangles = 200000;
+    opt->noise = 0.2;
+    opt->repeat = 7;
+    opt->roofline = true;
+    for (int i = 2; i < argc; i++) {
+        const char *a = argv[i], *value = i + 1 < argc ? argv[i + 1] : NULL;
+        double x = 0;
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            fputs(filter_usage, stdout);
+            return EXIT_OK;
+        } else if (!strcmp(a, "--no-roofline")) {
+            opt->roofline = false;
+        } else if (!strcmp(a, "--device")) {
+            if (!value)
+                return filter_usage_error("--device needs a value", NULL);
+            opt->device = argv[++i];
+        } else if (!strcmp(a, "--triangles") || !strcmp(a, "--noise") || !strcmp(a, "--sigma-f") ||
+                   !strcmp(a, "--sigma-g") || !strcmp(a, "--repeat")) {
+            if (!value)
+                return filter_usage_error("an option needs a value:", a);
+            if (!cli_parse_number(value, &x))
+                return filter_usage_error("not a number:", value);
+            i++;
+            if (!strcmp(a, "--triangles")) {
+                if (!(x >= 100 && x <= 1e9 && x == floor(x)))
+                    return filter_usage_error("--triangles must be a whole number in [100, 1e9]:",
+                                              value);
+                opt->triangles = x;
+                opt->shape_option_given = true;
+            } else if (!strcmp(a, "--noise")) {
+                if (!(x >= 0 && isfinite(x)))
+                    return filter_usage_error("--noise must be >= 0 and finite:", value);
+                opt->noise = x;
+                opt->shape_option_given = true;
+            } else if (!strcmp(a, "--sigma-f")) {
+                if (!(x > 0 && isfinite(x)))
+                    return filter_usage_error("--sigma-f must be a positive number:", value);
+                opt->params.sigma_f = x;
+            } else if (!strcmp(a, "--sigma-g")) {
+                if (!(x > 0))
+                    return filter_usage_error("--sigma-g must be positive, or 'inf':", value);
+                opt->params.sigma_g = x;
+            } else {
+                if (!(x >= 1 && x <= 99 && x == floor(x)))
+                    return filter_usage_error("--repeat must be a whole number in 1..99:", value);
+                opt->repeat = (int)x;
+            }
+        } else if (a[0] == '-' && a[1] != '\0') {
+            return filter_usage_error("unknown option", a);
+        } else if (!opt->mesh_path) {
+            opt->mesh_path = a;
+        } else {
+            return filter_usage_error("one mesh file only; unexpected", a);
+        }
+    }
+    if (opt->mesh_path && opt->shape_option_given)
+        return filter_usage_error("--triangles and --noise shape the generated mesh; not with",
+                                  opt->mesh_path);
+    return -1;
+}
+
+/* The mesh as rsmooth_smooth gets it: float32 positions, uint32 triangles (owned here). */
+typedef struct bench_input {
+    size_t vertex_count, triangle_count;
+    float *positions;
+    uint32_t *indices;
+} bench_input;
+
+static void bench_input_free(bench_input *in) {
+    free(in->positions);
+    free(in->indices);
+    memset(in, 0, sizeof *in);
+}
+
+/* Fills `in` from doubles; 0, or -1 when memory runs out. */
+static int bench_input_set(bench_input *in, const double *xyz, size_t vertex_count,
+                           const uint32_t *indices, size_t triangle_count) {
+    in->vertex_count = vertex_count;
+    in->triangle_count = triangle_count;
+    in->positions = malloc((vertex_count ? vertex_count : 1) * 3 * sizeof *in->positions);
+    in->indices = malloc((triangle_count ? triangle_count : 1) * 3 * sizeof *in->indices);
+    if (!in->positions || !in->indices)
+        return -1;
+    for (size_t i = 0; i < 3 * vertex_count; i++)
+        in->positions[i] = (float)xyz[i];
+    memcpy(in->indices, indices, triangle_count * 3 * sizeof *indices);
+    return 0;
+}
+
+/* Reads MESH or generates the cylinder; prints what fails and returns an exit status. */
+static int load_input(const filter_options *opt, bench_input *in) {
+    memset(in, 0, sizeof *in);
+    int failed;
+    if (opt->mesh_path) {
+        rsmooth_mesh *mesh = NULL;
+        rsmooth_error err;
+        rsmooth_status st = rsmooth_mesh_read_file(opt->mesh_path, &mesh, &err);
+        if (st != RSMOOTH_OK) {
+            if (err.line >= 0)
+                fprintf(stderr, "rsmooth-bench: %s:%lld: %s\n", opt->mesh_path, (long long)err.line,
+                        err.message);
+            else
+                fprintf(stderr, "rsmooth-bench: %s: %s\n", opt->mesh_path, err.message);
+            return st == RSMOOTH_ERROR_OUT_OF_MEMORY ? EXIT_OTHER : EXIT_USAGE;
+        }
+        if (mesh->triangle_count == 0) {
+            fprintf(stderr, "rsmooth-bench: %s: no triangles to smooth\n", opt->mesh_path);
+            rsmooth_mesh_destroy(mesh);
+            return EXIT_USAGE;
+        }
+        failed = bench_input_set(in, mesh->positions, mesh->vertex_count, mesh->triangles,
+                                 mesh->triangle_count);
+        rsmooth_mesh_destroy(mesh);
+    } else {
+        shape_mesh shape;
+        if (shape_capped_cylinder(&shape, 1.0, 1.5, (size_t)opt->triangles) != 0 ||
+            shape_add_normal_noise(&shape, opt->noise, 1) != 0) {
+            fprintf(stderr, "rsmooth-bench: cannot generate a %.0f-triangle cylinder\n",
+                    opt->triangles);
+            return EXIT_OTHER;
+        }
+        failed =
+            bench_input_set(in, shape.xyz, shape.vertex_count, shape.indices, shape.triangle_count);
+        shape_free(&shape);
+    }
+    if (failed) {
+        fprintf(stderr, "rsmooth-bench: out of memory for the mesh\n");
+        bench_input_free(in);
+        return EXIT_OTHER;
+    }
+    return EXIT_OK;
+}
+
+/* Creates a context, timed; prints what fails and returns an exit status. */
+static int create_context(const char *device, rsmooth_context **ctx, double *ms) {
+    rsmooth_error err;
+    double t0 = now_ms();
+    rsmooth_status st = rsmooth_context_create(device, ctx, &err);
+    *ms = now_ms() - t0;
+    if (st == RSMOOTH_OK)
+        return EXIT_OK;
+    fprintf(stderr, "rsmooth-bench: device '%s': %s: %s\n", device ? device : "auto",
+            rsmooth_status_str(st), err.message);
+    if (err.build_log[0])
+        fprintf(stderr, "%s\n", err.build_log);
+    return st == RSMOOTH_ERROR_OUT_OF_MEMORY ? EXIT_OTHER : EXIT_DEVICE;
+}
+
+/* Resident memory now, from /proc/self/statm; -1 when unreadable. */
+static double rss_bytes(void) {
+    long pages = -1, resident = -1;
+    FILE *f = fopen("/proc/self/statm", "r");
+    if (f) {
+        if (fscanf(f, "%ld %ld", &pages, &resident) != 2)
+            resident = -1;
+        fclose(f);
+    }
+    return resident < 0 ? -1 : (double)resident * (double)sysconf(_SC_PAGESIZE);
+}
+
+/* Resets the peak resident size getrusage reports to the current one (Linux 4.0+), so the peak
+ * read later is the filter's and not, say, the mesh generator's. False where refused. */
+static bool reset_peak_rss(void) {
+    FILE *f = fopen("/proc/self/clear_refs", "w");
+    if (!f)
+        return false;
+    bool ok = fputs("5", f) >= 0;
+    return fclose(f) == 0 && ok;
+}
+
+static void print_json_string(const char *text) {
+    putchar('"');
+    for (const unsigned char *c = (const unsigned char *)text; *c; c++) {
+        if (*c == '"' || *c == '\\')
+            printf("\\%c", *c);
+        else if (*c < 0x20)
+            printf("\\u%04x", *c);
+        else
+            putchar(*c);
+    }
+    putchar('"');
+}
+
+/* A number, or null where it does not exist (NaN, infinite). */
+static void print_json_number(const char *key, double value) {
+    if (isfinite(value))
+        printf("\"%s\":%.6g", key, value);
+    else
+        printf("\"%s\":null", key);
+}
+
+/* One pass's pair figures. */
+static void print_pass(const char *name, uint64_t examined, uint64_t useful, double median_ms,
+                       double roofline_pairs_per_s, bool roofline) {
+    double per_s = median_ms > 0 ? (double)useful / (median_ms / 1e3) : NAN;
+    printf(",\"%s\":{\"examined\":%llu,\"useful\":%llu,", name, (unsigned long long)examined,
+           (unsigned long long)useful);
+    print_json_number("useful_pairs_per_s", per_s);
+    putchar(',');
+    print_json_number("waste", examined > 0 ? 1 - (double)useful / (double)examined : NAN);
+    if (roofline) {
+        putchar(',');
+        print_json_number("roofline_pairs_per_s",
+                          roofline_pairs_per_s > 0 ? roofline_pairs_per_s : NAN);
+        putchar(',');
+        print_json_number("ratio", roofline_pairs_per_s > 0 ? per_s / roofline_pairs_per_s : NAN);
+    }
+    putchar('}');
+}
+
+/* The stages of rsmooth_report, in the order they run. */
+enum {
+    STAGE_FACETS,
+    STAGE_GRID,
+    STAGE_UPLOAD,
+    STAGE_MOLLIFY,
+    STAGE_NORMALS,
+    STAGE_ROBUST,
+    STAGE_DOWNLOAD,
+    STAGE_TOTAL,
+    STAGE_COUNT
+};
+static const char *const stage_names[STAGE_COUNT] = {"facets",  "grid",   "upload",   "mollify",
+                                                     "normals", "robust", "download", "total"};
+
+static void stage_times(const rsmooth_report *r, double ms[STAGE_COUNT]) {
+    const double v[STAGE_COUNT] = {r->ms_facets,  r->ms_grid,   r->ms_upload,   r->ms_mollify,
+                                   r->ms_normals, r->ms_robust, r->ms_download, r->ms_total};
+    memcpy(ms, v, sizeof v);
+}
+
+static int bench_filter(int argc, char **argv) {
+    filter_options opt;
+    int code = parse_filter_args(argc, argv, &opt);
+    if (code >= 0)
+        return code;
+    bench_input in;
+    if ((code = load_input(&opt, &in)) != EXIT_OK)
+        return code;
+    const size_t nv = in.vertex_count, nt = in.triangle_count;
+    rsmooth_context *ctx = NULL;
+    float *first = NULL, *out = NULL;
+    bench_grid grid;
+    memset(&grid, 0, sizeof grid);
+
+    /* The program build twice: from source, then (PoCL) from its on-disk binary cache. */
+    double ms_create_first, ms_create_cached, ms_build_first, ms_build_cached;
+    if ((code = create_context(opt.device, &ctx, &ms_create_first)) != EXIT_OK)
+        goto done;
+    ms_build_first = rsmooth_context_build_ms(ctx);
+    rsmooth_context_destroy(ctx);
+    ctx = NULL;
+    if ((code = create_context(opt.device, &ctx, &ms_create_cached)) != EXIT_OK)
+        goto done;
+    ms_build_cached = rsmooth_context_build_ms(ctx);
+
+    code = EXIT_OTHER;
+    first = malloc(nv * 3 * sizeof *first);
+    out = malloc(nv * 3 * sizeof *out);
+    if (!first || !out) {
+        fprintf(stderr, "rsmooth-bench: out of memory for the output\n");
+        goto done;
+    }
+    memset(first, 0, nv * 3 * sizeof *first); /* touched, so the baseline counts them */
+    memset(out, 0, nv * 3 * sizeof *out);
+    const bool peak_reset = reset_peak_rss();
+    const double baseline = rss_bytes();
+
+    /* The first run includes PoCL's one-time code generation for each kernel. */
+    rsmooth_report report;
+    memset(&report, 0, sizeof report);
+    rsmooth_error err;
+    rsmooth_status st = rsmooth_smooth(ctx, RSMOOTH_FLOAT32, in.positions, nv, in.indices, nt,
+                                       &opt.params, first, NULL, NULL, &report, &err);
+    const double first_run_ms = report.ms_total;
+    const double first_run_peak = (double)peak_rss_kib() * 1024;
+    double ms[STAGE_COUNT][99];
+    bool identical = true;
+    for (int i = 0; i < opt.repeat && st == RSMOOTH_OK; i++) {
+        st = rsmooth_smooth(ctx, RSMOOTH_FLOAT32, in.positions, nv, in.indices, nt, &opt.params,
+                            out, NULL, NULL, &report, &err);
+        double stage[STAGE_COUNT];
+        stage_times(&report, stage);
+        for (int s = 0; s < STAGE_COUNT; s++)
+            ms[s][i] = stage[s];
+        identical = identical && memcmp(first, out, nv * 3 * sizeof *out) == 0;
+    }
+    const double peak = (double)peak_rss_kib() * 1024;
+    if (st != RSMOOTH_OK) {
+        const char *name = opt.mesh_path ? opt.mesh_path : "generated mesh";
+        if (st == RSMOOTH_ERROR_OPENCL)
+            fprintf(stderr, "rsmooth-bench: %s: device '%s': %s\n", name,
+                    rsmooth_context_device_name(ctx), err.message);
+        else
+            fprintf(stderr, "rsmooth-bench: %s: %s\n", name, err.message);
+        code = st == RSMOOTH_ERROR_OPENCL             ? EXIT_DEVICE
+               : st == RSMOOTH_ERROR_INVALID_ARGUMENT ? EXIT_USAGE
+                                                      : EXIT_OTHER;
+        goto done;
+    }
+    double median_ms[STAGE_COUNT], min_ms[STAGE_COUNT], max_ms[STAGE_COUNT];
+    for (int s = 0; s < STAGE_COUNT; s++) {
+        median_ms[s] = median(ms[s], opt.repeat); /* sorts: min and max at the ends */
+        min_ms[s] = ms[s][0];
+        max_ms[s] = ms[s][opt.repeat - 1];
+    }
+
+    /* Counted after the peak was read: the grid and the roofline use memory of their own. */
+    uint64_t useful_mollify = 0, useful_robust = 0;
+    const double cell = fmax(report.radius, report.mollify_radius);
+    if (report.facet_count > 0) {
+        if (bench_grid_build(&grid, in.positions, in.indices, nt, cell) != 0) {
+            fprintf(stderr, "rsmooth-bench: cannot build the pair-counting grid (out of memory, "
+                            "or the mesh spans over 2^30 cells)\n");
+            goto done;
+        }
+        useful_robust = bench_pairs_within(&grid, in.positions, nv, report.radius);
+        if (report.mollify_radius > 0)
+            useful_mollify = bench_pairs_within(&grid, in.positions, nv, report.mollify_radius);
+    }
+    bench_roofline roof;
+    memset(&roof, 0, sizeof roof);
+    bool have_roofline = false;
+    if (opt.roofline && grid.facet_count > 0) {
+        const bench_roofline_setup setup = {
+            .sigma_f = report.sigma_f,
+            .sigma_g = report.sigma_g,
+            .sigma_m = report.sigma_f / 2, /* the library mollifies with sigma_f / 2 */
+            .radius = report.radius,
+            .mollify_radius = report.mollify_radius,
+        };
+        have_roofline = bench_roofline_run(&grid, in.positions, nv, &setup, &roof) == 0;
+        if (!have_roofline)
+            fprintf(stderr, "rsmooth-bench: roofline skipped: out of memory\n");
+    }
+
+    printf("{\"mode\":\"filter\",\"mesh\":");
+    print_json_string(opt.mesh_path ? opt.mesh_path : "generated");
+    if (!opt.mesh_path)
+        printf(",\"noise\":%.6g", opt.noise);
+    printf(",\"vertices\":%zu,\"triangles\":%zu,\"facets\":%zu,\"mean_edge_length\":%.6g,", nv, nt,
+           report.facet_count, report.mean_edge_length);
+    print_json_number("sigma_f", opt.params.sigma_f);
+    putchar(',');
+    print_json_number("sigma_g", opt.params.sigma_g); /* null: inf, the influence off */
+    putchar(',');
+    print_json_number("sigma_f_abs", report.sigma_f);
+    putchar(',');
+    print_json_number("sigma_g_abs", report.sigma_g);
+    printf(",\"radius\":%.6g,\"mollify_radius\":%.6g,\"grid_cell_count\":%zu,\"tiles\":%zu,"
+           "\"device\":",
+           report.radius, report.mollify_radius, report.grid_cell_count, report.tiles);
+    print_json_string(report.device);
+    printf(",\"repeat\":%d,\"context_create_first_ms\":%.1f,\"program_build_first_ms\":%.1f,"
+           "\"context_create_cached_ms\":%.1f,\"program_build_cached_ms\":%.1f,"
+           "\"first_run_ms\":%.2f,\"ms\":{",
+           opt.repeat, ms_create_first, ms_build_first, ms_create_cached, ms_build_cached,
+           first_run_ms);
+    for (int s = 0; s < STAGE_COUNT; s++)
+        printf("%s\"%s\":{\"median\":%.3f,\"min\":%.3f,\"max\":%.3f}", s ? "," : "", stage_names[s],
+               median_ms[s], min_ms[s], max_ms[s]);
+    printf("},\"bit_identical\":%s", identical ? "true" : "false");
+    print_pass("mollify", report.pairs_mollify, useful_mollify, median_ms[STAGE_MOLLIFY],
+               roof.mollify_pairs_per_s, have_roofline);
+    print_pass("robust", report.pairs_robust, useful_robust, median_ms[STAGE_ROBUST],
+               roof.robust_pairs_per_s, have_roofline);
+    if (have_roofline)
+        printf(",\"roofline\":{\"threads\":%d,\"openmp\":%s,\"lanes\":%d,\"window\":%zu,"
+               "\"seconds\":%.2f}",
+               roof.threads, roof.openmp ? "true" : "false", roof.lanes, roof.window, roof.seconds);
+    else
+        printf(",\"roofline\":null");
+    const double input_bytes = (double)nv * 3 * sizeof(float) + (double)nt * 3 * sizeof(uint32_t);
+    printf(",\"rss_baseline_MiB\":%.1f,\"peak_rss_MiB\":%.1f,\"first_run_peak_rss_MiB\":%.1f,"
+           "\"peak_rss_reset\":%s,\"input_MiB\":%.1f,",
+           baseline / 1048576, peak / 1048576, first_run_peak / 1048576,
+           peak_reset ? "true" : "false", input_bytes / 1048576);
+    print_json_number("filter_bytes_per_triangle",
+                      baseline >= 0 ? (peak - baseline) / (double)nt : NAN);
+    printf("}\n");
+    code = EXIT_OK;
+
+done:
+    bench_grid_free(&grid);
+    rsmooth_context_destroy(ctx);
+    free(first);
+    free(out);
+    bench_input_free(&in);
+    return code;
+}
+
 int main(int argc, char **argv) {
     if (argc >= 2 && !strcmp(argv[1], "io"))
         return bench_io(argc, argv);
-    fprintf(stderr,
+    if (argc >= 2 && !strcmp(argv[1], "filter"))
+        return bench_filter(argc, argv);
+    bool help = argc >= 2 && (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help"));
+    fprintf(help ? stdout : stderr,
             "usage: rsmooth-bench io [--triangles N] [--repeat R] [--dir DIR]\n"
-            "  prints mesh-file read/write speed beside raw I/O of the same bytes (JSON)\n");
-    return argc >= 2 && (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help")) ? 0 : 2;
+            "  prints mesh-file read/write speed beside raw I/O of the same bytes (JSON)\n"
+            "%s"
+            "Each prints one JSON object of figures on stdout, never a pass or fail.\n",
+            filter_usage);
+    return help ? 0 : 2;
 }

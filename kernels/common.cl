@@ -6,10 +6,11 @@
  * Facet weights travel as log(area / mean area), so one exp() per pair gives area * Gaussian and no
  * area underflows.
  *
- * Vertices travel in blocks of up to RS_LANES vertices of one cell, one block per work-item and one
- * vertex per vector lane: the 27 cells around the block are looked up once, and each facet is
- * loaded once and evaluated against every lane at once (explicit vectors, which CPU devices run as
- * SIMD instructions). A vertex's "slot" is block * RS_LANES + lane. Per-vertex arrays are stored
+ * Vertices travel in blocks of up to RS_LANES vertices spanning at most two cells per axis, one
+ * block per work-item and one vertex per vector lane: the cells within reach of the block are looked
+ * up once, and each facet is loaded once and evaluated against every lane at once (explicit
+ * vectors, which CPU devices run as SIMD instructions). Cells are a fraction of the reach wide
+ * (the host picks how many per reach), so the cells searched hug the ball of reach around the block. A vertex's "slot" is block * RS_LANES + lane. Per-vertex arrays are stored
  * per block, component by component: the x of every lane, then every y, and so on. Unused lanes
  * repeat lane 0 and their results are never read.
  *
@@ -18,9 +19,13 @@
  *   facet_normal[q]    float4 (unit normal, 0)
  *   cell_coord[c]      int4 (x, y, z, 0) of occupied cell c
  *   cell_start[c]      first facet of cell c; cell_start[cell_count] = facet count
- *   table[s]           open-addressing hash slot: occupied cell index or -1
- *   block_cell[b]      int4 (x, y, z, 0): the cell of block b's vertices
- *   block_pos          per block: x, y, z of each lane, local to the block's cell
+ *   column_first[j]    first cell of column j (the occupied cells of one x, y, by z); [j + 1]
+ *                      ends it
+ *   column_table[s]    open-addressing hash slot, on (x, y, 0): column index or -1
+ *   block_cell[b]      int4 (x, y, z, 0): block b's anchor, the lowest cell its vertices span
+ *   block_pos          per block: x, y, z of each lane, local to the anchor
+ *   block_pairs[2 b]   facets block b evaluated (times RS_LANES: pairs) in mollification, [2 b + 1]
+ *                      in the robust pass: the work done, within reach or not
  */
 
 typedef float8 lanef;
@@ -41,36 +46,82 @@ inline lanef fast_exp(lanef x) {
     return p * as_float8((n + 127) << 23);
 }
 
-/* The hash the host uses to fill `table` (rs_grid_hash in lib/rsmooth_internal.h). */
+/* The hash the host fills the tables with (rs_grid_hash in lib/rsmooth_internal.h). */
 inline uint grid_hash(int x, int y, int z) {
     return ((uint)x * 73856093u) ^ ((uint)y * 19349663u) ^ ((uint)z * 83492791u);
 }
 
-/* Index of the occupied cell at (x, y, z), or -1 (rs_grid_find). */
-inline int grid_find(__global const int4 *cell_coord, __global const int *table, uint table_mask,
-                     int x, int y, int z) {
-    uint slot = grid_hash(x, y, z) & table_mask;
+/* Index of the column of occupied cells at (x, y), or -1. */
+inline int column_find(__global const int4 *cell_coord, __global const uint *column_first,
+                       __global const int *column_table, uint column_mask, int x, int y) {
+    uint slot = grid_hash(x, y, 0) & column_mask;
     for (;;) {
-        int cell = table[slot];
-        if (cell < 0)
+        int column = column_table[slot];
+        if (column < 0)
             return -1;
-        int4 c = cell_coord[cell];
-        if (c.x == x && c.y == y && c.z == z)
-            return cell;
-        slot = (slot + 1) & table_mask;
+        int4 c = cell_coord[column_first[column]];
+        if (c.x == x && c.y == y)
+            return column;
+        slot = (slot + 1) & column_mask;
     }
 }
 
-/* The occupied cells around `home` (27 entries, -1 where empty), dx outermost, dz innermost. */
-inline void neighbour_cells(int4 home, __global const int4 *cell_coord,
-                            __global const int *table, uint table_mask, int *cells) {
-    int i = 0;
-    for (int dx = -1; dx <= 1; dx++)
-        for (int dy = -1; dy <= 1; dy++)
-            for (int dz = -1; dz <= 1; dz++)
-                cells[i++] = grid_find(cell_coord, table, table_mask, home.x + dx, home.y + dy,
-                                       home.z + dz);
+/* Smallest and largest value over the lanes. */
+inline float lane_min(lanef v) {
+    float4 m = fmin(v.lo, v.hi);
+    float2 n = fmin(m.lo, m.hi);
+    return fmin(n.x, n.y);
 }
+inline float lane_max(lanef v) {
+    float4 m = fmax(v.lo, v.hi);
+    float2 n = fmax(m.lo, m.hi);
+    return fmax(n.x, n.y);
+}
+
+/* Squared distance along one axis from the interval [lo, hi] to the cell [c, c + 1]. */
+inline float axis_gap2(float lo, float hi, int c) {
+    float g = fmax(0.0f, fmax((float)c - hi, lo - (float)(c + 1)));
+    return g * g;
+}
+
+/* Runs the block (the last argument) for every occupied cell whose box lies within sqrt(REACH2) of
+ * the box [LO, HI] (float3, in cells relative to the cell ANCHOR), with `cell` its index and
+ * (dx, dy, dz) its offset from ANCHOR. Columns (x, y) out of reach are skipped before they are
+ * looked up, and a column's cells follow each other in memory, so one lookup per column finds
+ * them: the search covers a ball around the block rather than a cube. */
+#define FOR_EACH_CELL_NEAR(ANCHOR, LO, HI, REACH2, cell_coord, column_first, column_table,         \
+                           column_mask, ...)                                                       \
+    {                                                                                              \
+        float reach_ = sqrt(REACH2);                                                               \
+        int x0_ = (int)floor((LO).x - reach_), x1_ = (int)floor((HI).x + reach_);                  \
+        int y0_ = (int)floor((LO).y - reach_), y1_ = (int)floor((HI).y + reach_);                  \
+        int z0_ = (ANCHOR).z + (int)floor((LO).z - reach_);                                        \
+        int z1_ = (ANCHOR).z + (int)floor((HI).z + reach_);                                        \
+        for (int dx = x0_; dx <= x1_; dx++) {                                                      \
+            float gx_ = axis_gap2((LO).x, (HI).x, dx);                                             \
+            if (gx_ > (REACH2))                                                                    \
+                continue;                                                                          \
+            for (int dy = y0_; dy <= y1_; dy++) {                                                  \
+                float gxy_ = gx_ + axis_gap2((LO).y, (HI).y, dy);                                  \
+                if (gxy_ > (REACH2))                                                               \
+                    continue;                                                                      \
+                int column_ = column_find(cell_coord, column_first, column_table, column_mask,     \
+                                          (ANCHOR).x + dx, (ANCHOR).y + dy);                       \
+                if (column_ < 0)                                                                   \
+                    continue;                                                                      \
+                uint last_ = column_first[column_ + 1];                                            \
+                for (uint cell = column_first[column_]; cell < last_; cell++) {                    \
+                    int z_ = cell_coord[cell].z;                                                   \
+                    if (z_ > z1_)                                                                  \
+                        break;                                                                     \
+                    int dz = z_ - (ANCHOR).z;                                                      \
+                    if (z_ < z0_ || gxy_ + axis_gap2((LO).z, (HI).z, dz) > (REACH2))               \
+                        continue;                                                                  \
+                    __VA_ARGS__                                                                    \
+                }                                                                                  \
+            }                                                                                      \
+        }                                                                                          \
+    }
 
 /* Component k (0 = x) of the vertex in `slot` of a per-block array of `stride` components. */
 inline float slot_component(__global const float *blocks, uint slot, uint stride, uint k) {

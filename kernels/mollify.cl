@@ -8,48 +8,48 @@
  *   RS_DEGENERATE_SINE, or an area below RS_DEGENERATE_AREA_RATIO of the input's) to
  *   mollified_normal[q].
  *   facet_vertices[q] = the slots of its three vertices; facet_edge1/2[q] = v1 - v0, v2 - v0 (cell
- *   units).
+ *   units), all in the caller's facet order; facet_place[q] = the facet's index in grid order,
+ *   where facet_normal and mollified_normal live.
  */
 
 __kernel void mollify_block(uint block_count, float reach2, float inv_2sigma2,
                             __global const float *block_pos, __global const int4 *block_cell,
                             __global const float4 *facet_centroid,
                             __global const int4 *cell_coord, __global const uint *cell_start,
-                            __global const int *table, uint table_mask,
-                            __global float *block_shift) {
+                            __global const uint *column_first,
+                           __global const int *column_table, uint column_mask,
+                            __global float *block_shift, __global uint *block_pairs) {
     uint b = get_global_id(0);
     if (b >= block_count)
         return;
     __global const float *pos = block_pos + 3 * RS_LANES * (size_t)b;
     lanef px = load_lanes(0, pos), py = load_lanes(1, pos), pz = load_lanes(2, pos);
-    int cells[27];
-    neighbour_cells(block_cell[b], cell_coord, table, table_mask, cells);
+    float3 lo = (float3)(lane_min(px), lane_min(py), lane_min(pz));
+    float3 hi = (float3)(lane_max(px), lane_max(py), lane_max(pz));
+    int4 anchor = block_cell[b];
     lanef wsum = 0.0f, ax = 0.0f, ay = 0.0f, az = 0.0f;
-    int i = 0;
-    for (int dx = -1; dx <= 1; dx++)
-        for (int dy = -1; dy <= 1; dy++)
-            for (int dz = -1; dz <= 1; dz++) {
-                int cell = cells[i++];
-                if (cell < 0)
-                    continue;
-                lanef qx = px - (float)dx, qy = py - (float)dy, qz = pz - (float)dz;
-                uint end = cell_start[cell + 1];
-                for (uint q = cell_start[cell]; q < end; q++) {
-                    float4 c = facet_centroid[q];
-                    lanef ex = c.x - qx, ey = c.y - qy, ez = c.z - qz;
-                    lanef d2 = ex * ex + ey * ey + ez * ez;
-                    lanef w = select((lanef)0.0f, fast_exp(c.w - d2 * inv_2sigma2), d2 <= reach2);
-                    ax += w * ex;
-                    ay += w * ey;
-                    az += w * ez;
-                    wsum += w;
-                }
-            }
+    uint pairs = 0;
+    FOR_EACH_CELL_NEAR(anchor, lo, hi, reach2, cell_coord, column_first, column_table, column_mask, {
+        lanef qx = px - (float)dx, qy = py - (float)dy, qz = pz - (float)dz;
+        uint begin = cell_start[cell], end = cell_start[cell + 1];
+        pairs += end - begin;
+        for (uint q = begin; q < end; q++) {
+            float4 c = facet_centroid[q];
+            lanef ex = c.x - qx, ey = c.y - qy, ez = c.z - qz;
+            lanef d2 = ex * ex + ey * ey + ez * ez;
+            lanef w = select((lanef)0.0f, fast_exp(c.w - d2 * inv_2sigma2), d2 <= reach2);
+            ax += w * ex;
+            ay += w * ey;
+            az += w * ez;
+            wsum += w;
+        }
+    })
     lanei some = wsum > 0.0f;
     __global float *out = block_shift + 3 * RS_LANES * (size_t)b;
     store_lanes(select((lanef)0.0f, ax / wsum, some), 0, out);
     store_lanes(select((lanef)0.0f, ay / wsum, some), 1, out);
     store_lanes(select((lanef)0.0f, az / wsum, some), 2, out);
+    block_pairs[2 * (size_t)b] = pairs;
 }
 
 /* The displacement of the vertex in `slot` (from mollify_block). */
@@ -59,14 +59,16 @@ inline float3 slot_shift(__global const float *block_shift, uint slot) {
 }
 
 __kernel void mollified_facet_normal(uint facet_count, __global const uint4 *facet_vertices,
+                                     __global const uint *facet_place,
                                      __global const float4 *facet_edge1,
                                      __global const float4 *facet_edge2,
                                      __global const float4 *facet_normal,
                                      __global const float *block_shift,
                                      __global float4 *mollified_normal) {
-    uint q = get_global_id(0);
+    uint q = get_global_id(0); /* the caller's facet order; j is its place in grid order */
     if (q >= facet_count)
         return;
+    uint j = facet_place[q];
     uint4 t = facet_vertices[q];
     float3 input_e1 = facet_edge1[q].xyz, input_e2 = facet_edge2[q].xyz;
     float3 input_n = cross(input_e1, input_e2);
@@ -77,7 +79,7 @@ __kernel void mollified_facet_normal(uint facet_count, __global const uint4 *fac
     float len = sqrt(dot(n, n));
     if (len > RS_DEGENERATE_SINE * sqrt(dot(e1, e1) * dot(e2, e2)) &&
         len > RS_DEGENERATE_AREA_RATIO * sqrt(dot(input_n, input_n)))
-        mollified_normal[q] = (float4)(n / len, 0.0f);
+        mollified_normal[j] = (float4)(n / len, 0.0f);
     else
-        mollified_normal[q] = facet_normal[q];
+        mollified_normal[j] = facet_normal[j];
 }

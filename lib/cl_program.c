@@ -17,7 +17,7 @@ extern const size_t rs_kernel_common_size, rs_kernel_mollify_size, rs_kernel_est
 #define FLOAT_DEFINE(name, value) "#define " #name " " STRINGIFY(value) "f\n"
 static const char prelude[] = FLOAT_DEFINE(RS_DEGENERATE_SINE, RS_DEGENERATE_SINE)
     FLOAT_DEFINE(RS_DEGENERATE_AREA_RATIO, RS_DEGENERATE_AREA_RATIO)
-    "#define RS_RESCUE_EXPONENT 40.0f\n" "#define RS_LANES " EXPANDED_STRING(RS_LANES) "\n";
+    "#define RS_RESCUE_WEIGHT 1e-20f\n" "#define RS_LANES " EXPANDED_STRING(RS_LANES) "\n";
 
 /* Default options: relaxed math lets PoCL vectorize exp(); precision is checked against the
  * double-precision reference path by the tests. */

@@ -5,6 +5,7 @@
 #include "rsmooth_internal.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -12,13 +13,14 @@
 #define LOCAL_CLAMP 1e6
 
 typedef struct packed {
-    cl_float4 *facet_centroid, *facet_normal, *facet_edge1, *facet_edge2;
+    cl_float4 *facet_centroid, *facet_normal; /* in grid order */
+    cl_float4 *facet_edge1, *facet_edge2; /* in the caller's facet order, like: */
     cl_uint4 *facet_vertices; /* slots of the three vertices */
+    cl_uint *facet_place;     /* caller's facet -> its place in grid order */
     size_t block_count;
     cl_int4 *block_cell;      /* per block: its cell */
     cl_float *block_pos;      /* per block: RS_LANES x, then y, then z, local to the cell */
     uint32_t *slot;           /* caller's vertex index -> block * RS_LANES + lane */
-    uint64_t pairs;           /* vertex-facet pairs one pass over the blocks evaluates */
 } packed;
 
 static void packed_free(packed *pk) {
@@ -27,6 +29,7 @@ static void packed_free(packed *pk) {
     rs_free(pk->facet_edge1);
     rs_free(pk->facet_edge2);
     rs_free(pk->facet_vertices);
+    rs_free(pk->facet_place);
     rs_free(pk->block_cell);
     rs_free(pk->block_pos);
     rs_free(pk->slot);
@@ -43,18 +46,56 @@ static cl_float4 local_point(const rs_grid *grid, const double p[3], const int32
     return out;
 }
 
-/* Whether the vertex with cell `c` (the previous vertex's is c - 3) starts a new block when the
- * current block already holds `lane` vertices. */
-static bool starts_block(size_t lane, const int32_t *c) {
-    return lane == RS_LANES || memcmp(c, c - 3, 3 * sizeof *c) != 0;
+/* Whether a vertex of cell `c` joins the block spanning cells [lo, hi] with `lanes` vertices: a
+ * block holds at most RS_LANES vertices and spans at most two cells per axis, so its lanes lie in a
+ * box of at most two cells and its neighbour search stays small. */
+static bool joins_block(size_t lanes, const int32_t lo[3], const int32_t hi[3], const int32_t *c) {
+    if (lanes == 0 || lanes == RS_LANES)
+        return false;
+    for (int k = 0; k < 3; k++) {
+        int32_t a = c[k] < lo[k] ? c[k] : lo[k], b = c[k] > hi[k] ? c[k] : hi[k];
+        if (b - a > 1)
+            return false;
+    }
+    return true;
 }
 
-/* Vertices in grid order, cut into blocks of at most RS_LANES vertices of one cell. */
+/* Cuts the vertices, in grid order (`cells` per position), into blocks: block b holds positions
+ * start[b] .. start[b + 1] - 1 and its anchor (the lowest cell it spans) is anchor[b]. With NULL
+ * arrays it only counts. Returns the block count. */
+static size_t cut_blocks(const int32_t *cells, size_t count, uint32_t *start, cl_int4 *anchor) {
+    size_t blocks = 0, lanes = 0;
+    int32_t lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    for (size_t i = 0; i < count; i++) {
+        const int32_t *c = cells + 3 * i;
+        if (!joins_block(lanes, lo, hi, c)) {
+            if (start)
+                start[blocks] = (uint32_t)i;
+            blocks++;
+            lanes = 0;
+            memcpy(lo, c, sizeof lo);
+            memcpy(hi, c, sizeof hi);
+        }
+        for (int k = 0; k < 3; k++) {
+            lo[k] = c[k] < lo[k] ? c[k] : lo[k];
+            hi[k] = c[k] > hi[k] ? c[k] : hi[k];
+        }
+        if (anchor)
+            anchor[blocks - 1] = (cl_int4){{lo[0], lo[1], lo[2], 0}};
+        lanes++;
+    }
+    if (start)
+        start[blocks] = (uint32_t)count;
+    return blocks;
+}
+
+/* Vertices in grid order, cut into blocks (cut_blocks), positions local to each block's anchor. */
 static rsmooth_status pack_blocks(const rs_problem *pb, const rs_grid *grid, packed *pk,
                                   rsmooth_error *error) {
     size_t nv = pb->vertex_count;
     uint32_t *order = rs_alloc_array(nv, sizeof *order); /* grid position -> vertex */
     int32_t *cells = rs_alloc_array(nv, 3 * sizeof *cells);
+    uint32_t *start = NULL;
     rsmooth_status st = RSMOOTH_OK;
     if (!order || !cells) {
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth", "no memory for blocks");
@@ -62,52 +103,33 @@ static rsmooth_status pack_blocks(const rs_problem *pb, const rs_grid *grid, pac
     }
     if ((st = rs_grid_order_points(grid, pb->xyz, nv, order, cells, error)) != RSMOOTH_OK)
         goto done;
-    size_t blocks = 0;
-    for (size_t i = 0, lane = RS_LANES; i < nv; i++, lane++) {
-        if (starts_block(lane, cells + 3 * i)) {
-            blocks++;
-            lane = 0;
-        }
-    }
+    size_t blocks = cut_blocks(cells, nv, NULL, NULL);
     pk->block_count = blocks;
     pk->block_cell = rs_alloc_array(blocks, sizeof(cl_int4));
     pk->block_pos = rs_alloc_array(blocks, 3 * RS_LANES * sizeof(cl_float));
-    if (!pk->block_cell || !pk->block_pos) {
+    start = rs_alloc_array(blocks + 1, sizeof *start);
+    if (!pk->block_cell || !pk->block_pos || !start) {
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth", "no memory for blocks");
         goto done;
     }
-    size_t b = (size_t)-1, lane = RS_LANES;
-    for (size_t i = 0; i < nv; i++, lane++) {
-        const int32_t *c = cells + 3 * i;
-        if (starts_block(lane, c)) {
-            b++;
-            lane = 0;
-            pk->block_cell[b] = (cl_int4){{c[0], c[1], c[2], 0}};
-        }
-        uint32_t v = order[i];
-        pk->slot[v] = (uint32_t)(b * RS_LANES + lane);
-        cl_float4 local = local_point(grid, pb->xyz + 3 * (size_t)v, c);
+    cut_blocks(cells, nv, start, pk->block_cell);
+    for (size_t b = 0; b < blocks; b++) {
         cl_float *pos = pk->block_pos + 3 * RS_LANES * b;
-        /* lane 0 also fills the unused lanes, so they compute something harmless */
-        for (size_t l = lane; l < (lane == 0 ? RS_LANES : lane + 1); l++)
-            for (int k = 0; k < 3; k++)
-                pos[k * RS_LANES + l] = local.s[k];
-    }
-    pk->pairs = 0;
-    for (b = 0; b < blocks; b++) {
-        const cl_int *c = pk->block_cell[b].s;
-        for (int dx = -1; dx <= 1; dx++)
-            for (int dy = -1; dy <= 1; dy++)
-                for (int dz = -1; dz <= 1; dz++) {
-                    int32_t cell = rs_grid_find(grid, c[0] + dx, c[1] + dy, c[2] + dz);
-                    if (cell >= 0)
-                        pk->pairs += (uint64_t)RS_LANES *
-                                     (grid->cell_start[cell + 1] - grid->cell_start[cell]);
-                }
+        const cl_int *anchor = pk->block_cell[b].s;
+        for (uint32_t i = start[b]; i < start[b + 1]; i++) {
+            uint32_t v = order[i], lane = i - start[b];
+            pk->slot[v] = (uint32_t)(b * RS_LANES + lane);
+            cl_float4 local = local_point(grid, pb->xyz + 3 * (size_t)v, anchor);
+            /* lane 0 also fills the unused lanes, so they compute something harmless */
+            for (size_t l = lane; l < (lane == 0 ? RS_LANES : lane + 1); l++)
+                for (int k = 0; k < 3; k++)
+                    pos[k * RS_LANES + l] = local.s[k];
+        }
     }
 done:
     rs_free(order);
     rs_free(cells);
+    rs_free(start);
     return st;
 }
 
@@ -120,38 +142,45 @@ static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, packed *pk
     pk->facet_edge1 = rs_alloc_array(nf, sizeof(cl_float4));
     pk->facet_edge2 = rs_alloc_array(nf, sizeof(cl_float4));
     pk->facet_vertices = rs_alloc_array(nf, sizeof(cl_uint4));
+    pk->facet_place = rs_alloc_array(nf, sizeof(cl_uint));
     pk->slot = rs_alloc_array(nv, sizeof(uint32_t));
     if (!pk->facet_centroid || !pk->facet_normal || !pk->facet_edge1 || !pk->facet_edge2 ||
-        !pk->facet_vertices || !pk->slot)
+        !pk->facet_vertices || !pk->facet_place || !pk->slot)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth",
                        "no memory for device staging arrays");
     rsmooth_status st = pack_blocks(pb, grid, pk, error);
     if (st != RSMOOTH_OK)
         return st;
 
+    /* Facets are read in the caller's order (mostly coherent in memory). What the pair loops read
+     * (centroid, normal) goes to its place in grid order; what only the per-facet normals kernel
+     * reads (edges, vertices) stays in the caller's order, with `place` to find the rest. */
+    uint32_t *place = pk->facet_place;
+    for (size_t j = 0; j < nf; j++)
+        place[grid->facet_order[j]] = (uint32_t)j;
     const double inv_h = 1 / grid->cell_size;
-    for (size_t c = 0; c < grid->cell_count; c++) {
-        const int32_t *cell = grid->cell_coord + 4 * c;
-        for (uint32_t j = grid->cell_start[c]; j < grid->cell_start[c + 1]; j++) {
-            uint32_t q = grid->facet_order[j];
-            cl_float4 cen = local_point(grid, pb->centroid + 3 * (size_t)q, cell);
-            cen.s[3] = (float)log(pb->area[q] / pb->mean_area);
-            pk->facet_centroid[j] = cen;
-            for (int k = 0; k < 3; k++)
-                pk->facet_normal[j].s[k] = (float)pb->normal[3 * (size_t)q + k];
-            pk->facet_normal[j].s[3] = 0;
-            const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
-            const double *a = pb->xyz + 3 * (size_t)tri[0];
-            const double *b = pb->xyz + 3 * (size_t)tri[1];
-            const double *d = pb->xyz + 3 * (size_t)tri[2];
-            for (int k = 0; k < 3; k++) {
-                pk->facet_edge1[j].s[k] = (float)((b[k] - a[k]) * inv_h);
-                pk->facet_edge2[j].s[k] = (float)((d[k] - a[k]) * inv_h);
-            }
-            pk->facet_edge1[j].s[3] = pk->facet_edge2[j].s[3] = 0;
-            pk->facet_vertices[j] =
-                (cl_uint4){{pk->slot[tri[0]], pk->slot[tri[1]], pk->slot[tri[2]], 0}};
-        }
+    const float inv_mean_area = (float)(1 / pb->mean_area);
+    for (size_t q = 0; q < nf; q++) {
+        uint32_t j = place[q];
+        int32_t cell[3];
+        rs_grid_facet_cell(grid, pb->centroid + 3 * q, cell);
+        cl_float4 cen = local_point(grid, pb->centroid + 3 * q, cell);
+        cen.s[3] = logf((float)pb->area[q] * inv_mean_area);
+        pk->facet_centroid[j] = cen;
+        const double *n = pb->normal + 3 * q;
+        pk->facet_normal[j] = (cl_float4){{(float)n[0], (float)n[1], (float)n[2], 0}};
+        const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
+        const double *a = pb->xyz + 3 * (size_t)tri[0];
+        const double *b = pb->xyz + 3 * (size_t)tri[1];
+        const double *d = pb->xyz + 3 * (size_t)tri[2];
+        pk->facet_edge1[q] = (cl_float4){{(float)((b[0] - a[0]) * inv_h),
+                                          (float)((b[1] - a[1]) * inv_h),
+                                          (float)((b[2] - a[2]) * inv_h), 0}};
+        pk->facet_edge2[q] = (cl_float4){{(float)((d[0] - a[0]) * inv_h),
+                                          (float)((d[1] - a[1]) * inv_h),
+                                          (float)((d[2] - a[2]) * inv_h), 0}};
+        pk->facet_vertices[q] =
+            (cl_uint4){{pk->slot[tri[0]], pk->slot[tri[1]], pk->slot[tri[2]], 0}};
     }
     return RSMOOTH_OK;
 }
@@ -162,17 +191,32 @@ enum {
     BUF_FACET_EDGE1,
     BUF_FACET_EDGE2,
     BUF_FACET_VERTICES,
+    BUF_FACET_PLACE,
     BUF_CELL_COORD,
     BUF_CELL_START,
-    BUF_TABLE,
+    BUF_COLUMN_FIRST,
+    BUF_COLUMN_TABLE,
     BUF_BLOCK_POS,
     BUF_BLOCK_CELL,
     BUF_BLOCK_SHIFT,
     BUF_MOLLIFIED_NORMAL,
     BUF_BLOCK_RESULT,
     BUF_BLOCK_EXTRA,
+    BUF_BLOCK_PAIRS,
     BUF_COUNT
 };
+
+/* Grid cells per reach: small cells hug the ball of reach around a block (less work wasted on
+ * facets out of reach), large ones hold more vertices per block; measured on PoCL's CPU device
+ * (rsmooth-bench filter), cells about two mean edges wide did best. RSMOOTH_CELLS_PER_REACH
+ * overrides it, for such measurements. */
+static int cells_per_reach(const rs_problem *pb) {
+    const char *forced = getenv("RSMOOTH_CELLS_PER_REACH");
+    if (forced && atoi(forced) >= 1 && atoi(forced) <= 8)
+        return atoi(forced);
+    double cells = floor(pb->radius / (2 * pb->mean_edge_length));
+    return cells < 1 || !isfinite(cells) ? 1 : cells > 3 ? 3 : (int)cells;
+}
 
 /* Sets kernel arguments in order; stops at the first failure. */
 typedef struct arg_setter {
@@ -238,8 +282,10 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     memset(&pk, 0, sizeof pk);
     cl_mem buf[BUF_COUNT] = {0};
     cl_float *result = NULL, *extra = NULL; /* per block, as block_result and block_extra */
+    cl_uint *pairs = NULL;                  /* per block, as block_pairs */
 
-    rsmooth_status st = rs_grid_build(&grid, pb->centroid, pb->facet_count, pb->radius, error);
+    rsmooth_status st = rs_grid_build_split(&grid, pb->centroid, pb->facet_count, pb->radius,
+                                            cells_per_reach(pb), error);
     if (st == RSMOOTH_OK)
         st = pack(pb, &grid, &pk, error);
     if (st != RSMOOTH_OK)
@@ -248,7 +294,6 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
 
     size_t nv = pb->vertex_count, nf = pb->facet_count, nc = grid.cell_count;
     size_t nb = pk.block_count, ns = nb * RS_LANES; /* blocks and slots */
-    size_t table_size = (size_t)grid.table_mask + 1;
     const struct {
         size_t size;
         void *host;
@@ -259,15 +304,20 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
         [BUF_FACET_EDGE1] = {nf * sizeof(cl_float4), pk.facet_edge1, CL_MEM_READ_ONLY},
         [BUF_FACET_EDGE2] = {nf * sizeof(cl_float4), pk.facet_edge2, CL_MEM_READ_ONLY},
         [BUF_FACET_VERTICES] = {nf * sizeof(cl_uint4), pk.facet_vertices, CL_MEM_READ_ONLY},
+        [BUF_FACET_PLACE] = {nf * sizeof(cl_uint), pk.facet_place, CL_MEM_READ_ONLY},
         [BUF_CELL_COORD] = {nc * 4 * sizeof(cl_int), grid.cell_coord, CL_MEM_READ_ONLY},
         [BUF_CELL_START] = {(nc + 1) * sizeof(cl_uint), grid.cell_start, CL_MEM_READ_ONLY},
-        [BUF_TABLE] = {table_size * sizeof(cl_int), grid.table, CL_MEM_READ_ONLY},
+        [BUF_COLUMN_FIRST] = {(grid.column_count + 1) * sizeof(cl_uint), grid.column_first,
+                              CL_MEM_READ_ONLY},
+        [BUF_COLUMN_TABLE] = {((size_t)grid.column_mask + 1) * sizeof(cl_int), grid.column_table,
+                              CL_MEM_READ_ONLY},
         [BUF_BLOCK_POS] = {ns * 3 * sizeof(cl_float), pk.block_pos, CL_MEM_READ_ONLY},
         [BUF_BLOCK_CELL] = {nb * sizeof(cl_int4), pk.block_cell, CL_MEM_READ_ONLY},
         [BUF_BLOCK_SHIFT] = {ns * 3 * sizeof(cl_float), NULL, CL_MEM_READ_WRITE},
         [BUF_MOLLIFIED_NORMAL] = {nf * sizeof(cl_float4), NULL, CL_MEM_READ_WRITE},
         [BUF_BLOCK_RESULT] = {ns * 4 * sizeof(cl_float), NULL, CL_MEM_WRITE_ONLY},
         [BUF_BLOCK_EXTRA] = {ns * 2 * sizeof(cl_float), NULL, CL_MEM_WRITE_ONLY},
+        [BUF_BLOCK_PAIRS] = {nb * 2 * sizeof(cl_uint), NULL, CL_MEM_WRITE_ONLY},
     };
     uint64_t total = 0, largest = 0;
     for (int b = 0; b < BUF_COUNT; b++) {
@@ -304,7 +354,7 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
 
     /* Lengths in cell units (h), so every float the kernels see is of order one. */
     const double h = grid.cell_size;
-    cl_uint bcount = (cl_uint)nb, fcount = (cl_uint)nf, mask = grid.table_mask;
+    cl_uint bcount = (cl_uint)nb, fcount = (cl_uint)nf, mask = grid.column_mask;
     cl_float reach2 = (cl_float)((pb->radius / h) * (pb->radius / h));
     cl_float mollify_reach2 = (cl_float)((pb->mollify_radius / h) * (pb->mollify_radius / h));
     cl_float inv_2sm2 = (cl_float)(h * h / (2 * pb->sigma_m * pb->sigma_m));
@@ -325,9 +375,11 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
         arg(&s, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
         arg(&s, sizeof(cl_mem), &buf[BUF_CELL_COORD]);
         arg(&s, sizeof(cl_mem), &buf[BUF_CELL_START]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_TABLE]);
+        arg(&s, sizeof(cl_mem), &buf[BUF_COLUMN_FIRST]);
+        arg(&s, sizeof(cl_mem), &buf[BUF_COLUMN_TABLE]);
         arg(&s, sizeof mask, &mask);
         arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_SHIFT]);
+        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_PAIRS]);
         err = s.err != CL_SUCCESS ? s.err : run_1d(ctx, pb, s.kernel, nb, 0, MOLLIFY_SHARE);
         if (err != CL_SUCCESS) {
             st = rs_cl_fail(error, err, "mollify_block", ctx->device_name);
@@ -338,6 +390,7 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
         s = (arg_setter){ctx->kernels[RS_KERNEL_NORMALS], 0, CL_SUCCESS};
         arg(&s, sizeof fcount, &fcount);
         arg(&s, sizeof(cl_mem), &buf[BUF_FACET_VERTICES]);
+        arg(&s, sizeof(cl_mem), &buf[BUF_FACET_PLACE]);
         arg(&s, sizeof(cl_mem), &buf[BUF_FACET_EDGE1]);
         arg(&s, sizeof(cl_mem), &buf[BUF_FACET_EDGE2]);
         arg(&s, sizeof(cl_mem), &buf[BUF_FACET_NORMAL]);
@@ -368,10 +421,12 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     arg(&s, sizeof(cl_mem), &normals);
     arg(&s, sizeof(cl_mem), &buf[BUF_CELL_COORD]);
     arg(&s, sizeof(cl_mem), &buf[BUF_CELL_START]);
-    arg(&s, sizeof(cl_mem), &buf[BUF_TABLE]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_COLUMN_FIRST]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_COLUMN_TABLE]);
     arg(&s, sizeof mask, &mask);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_RESULT]);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_EXTRA]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_PAIRS]);
     err = s.err != CL_SUCCESS ? s.err
                               : run_1d(ctx, pb, s.kernel, nb, pb->mollify ? MOLLIFY_SHARE : 0, 1);
     if (err != CL_SUCCESS) {
@@ -382,7 +437,8 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
 
     result = rs_alloc_array(ns, 4 * sizeof(cl_float));
     extra = rs_alloc_array(ns, 2 * sizeof(cl_float));
-    if (!result || !extra) {
+    pairs = rs_alloc_array(nb, 2 * sizeof(cl_uint));
+    if (!result || !extra || !pairs) {
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for results");
         goto cleanup;
     }
@@ -391,6 +447,9 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     if (err == CL_SUCCESS)
         err = clEnqueueReadBuffer(ctx->queue, buf[BUF_BLOCK_EXTRA], CL_TRUE, 0,
                                   ns * 2 * sizeof(cl_float), extra, 0, NULL, NULL);
+    if (err == CL_SUCCESS)
+        err = clEnqueueReadBuffer(ctx->queue, buf[BUF_BLOCK_PAIRS], CL_TRUE, 0,
+                                  nb * 2 * sizeof(cl_uint), pairs, 0, NULL, NULL);
     if (err != CL_SUCCESS) {
         st = rs_cl_fail(error, err, "clEnqueueReadBuffer", ctx->device_name);
         goto cleanup;
@@ -418,7 +477,10 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     stats->ms_normals += t_normals - t_mollify;
     stats->ms_robust += t_robust - t_normals;
     stats->ms_download += t_end - t_robust;
-    stats->pairs += pk.pairs;
+    for (size_t b = 0; b < nb; b++) {
+        stats->pairs_mollify += pb->mollify ? (uint64_t)pairs[2 * b] * RS_LANES : 0;
+        stats->pairs_robust += (uint64_t)pairs[2 * b + 1] * RS_LANES;
+    }
     stats->cells += grid.cell_count;
     stats->tiles++;
 
@@ -428,6 +490,7 @@ cleanup:
             clReleaseMemObject(buf[b]);
     rs_free(result);
     rs_free(extra);
+    rs_free(pairs);
     packed_free(&pk);
     rs_grid_free(&grid);
     return st;
@@ -470,8 +533,8 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
             report->ms_robust = stats.ms_robust;
             report->ms_download = stats.ms_download;
             report->ms_total = rs_now_ms() - t_start;
-            report->pairs_mollify = pb.mollify ? stats.pairs : 0;
-            report->pairs_robust = stats.pairs;
+            report->pairs_mollify = stats.pairs_mollify;
+            report->pairs_robust = stats.pairs_robust;
             report->tiles = stats.tiles;
         }
     }

@@ -15,31 +15,42 @@ void rs_grid_free(rs_grid *grid) {
     rs_free(grid->cell_start);
     rs_free(grid->facet_order);
     rs_free(grid->table);
+    rs_free(grid->column_first);
+    rs_free(grid->column_table);
     memset(grid, 0, sizeof *grid);
 }
 
 void rs_grid_cell_of(const rs_grid *grid, const double p[3], int32_t cell[3]) {
+    int32_t m = grid->split + 1;
     for (int k = 0; k < 3; k++) {
         double c = floor((p[k] - grid->origin[k]) / grid->cell_size);
-        double hi = (double)grid->dims[k] + 1;
-        cell[k] = (int32_t)(c < -2 ? -2 : c > hi ? hi : c);
+        double lo = -m, hi = (double)grid->dims[k] + m - 1;
+        cell[k] = (int32_t)(c < lo ? lo : c > hi ? hi : c);
     }
 }
 
-/* Linear key of a (clamped) cell; the +2 offsets make clamped vertex cells non-negative too. */
+void rs_grid_facet_cell(const rs_grid *grid, const double p[3], int32_t cell[3]) {
+    rs_grid_cell_of(grid, p, cell);
+    for (int k = 0; k < 3; k++) /* rounding can put the far edge one cell out */
+        cell[k] = cell[k] < 0 ? 0 : cell[k] >= grid->dims[k] ? grid->dims[k] - 1 : cell[k];
+}
+
+/* Linear key of a (clamped) cell; the offsets make clamped vertex cells non-negative too. */
 static uint64_t cell_key(const rs_grid *grid, const int32_t c[3]) {
-    uint64_t x = (uint64_t)(c[0] + 2), y = (uint64_t)(c[1] + 2), z = (uint64_t)(c[2] + 2);
-    uint64_t ny = (uint64_t)grid->dims[1] + 4, nz = (uint64_t)grid->dims[2] + 4;
+    int32_t m = grid->split + 1;
+    uint64_t x = (uint64_t)(c[0] + m), y = (uint64_t)(c[1] + m), z = (uint64_t)(c[2] + m);
+    uint64_t ny = (uint64_t)(grid->dims[1] + 2 * m), nz = (uint64_t)(grid->dims[2] + 2 * m);
     return (x * ny + y) * nz + z;
 }
 
 /* The cell whose cell_key is `key`. */
 static void cell_of_key(const rs_grid *grid, uint64_t key, int32_t c[3]) {
-    uint64_t ny = (uint64_t)grid->dims[1] + 4, nz = (uint64_t)grid->dims[2] + 4;
-    c[2] = (int32_t)(key % nz) - 2;
+    int32_t m = grid->split + 1;
+    uint64_t ny = (uint64_t)(grid->dims[1] + 2 * m), nz = (uint64_t)(grid->dims[2] + 2 * m);
+    c[2] = (int32_t)(key % nz) - m;
     key /= nz;
-    c[1] = (int32_t)(key % ny) - 2;
-    c[0] = (int32_t)(key / ny) - 2;
+    c[1] = (int32_t)(key % ny) - m;
+    c[0] = (int32_t)(key / ny) - m;
 }
 
 int32_t rs_grid_find(const rs_grid *grid, int32_t x, int32_t y, int32_t z) {
@@ -57,10 +68,54 @@ int32_t rs_grid_find(const rs_grid *grid, int32_t x, int32_t y, int32_t z) {
     }
 }
 
+/* Open-addressing table of at least twice `count` slots, all -1; its mask in *mask. */
+static int32_t *new_table(size_t count, uint32_t *mask) {
+    uint32_t size = 16;
+    while (size < 2 * count)
+        size *= 2;
+    *mask = size - 1;
+    int32_t *table = rs_alloc_array(size, sizeof *table);
+    for (uint32_t s = 0; table && s < size; s++)
+        table[s] = -1;
+    return table;
+}
+
+/* The columns of occupied cells (cells are sorted by x, then y, then z). */
+static bool build_columns(rs_grid *grid) {
+    size_t columns = 0;
+    const int32_t *c = grid->cell_coord;
+    for (size_t i = 0; i < grid->cell_count; i++)
+        if (i == 0 || c[4 * i] != c[4 * i - 4] || c[4 * i + 1] != c[4 * i - 3])
+            columns++;
+    grid->column_count = columns;
+    grid->column_first = rs_alloc_array(columns + 1, sizeof(uint32_t));
+    grid->column_table = new_table(columns, &grid->column_mask);
+    if (!grid->column_first || !grid->column_table)
+        return false;
+    size_t j = 0;
+    for (size_t i = 0; i < grid->cell_count; i++) {
+        if (!(i == 0 || c[4 * i] != c[4 * i - 4] || c[4 * i + 1] != c[4 * i - 3]))
+            continue;
+        grid->column_first[j] = (uint32_t)i;
+        uint32_t slot = rs_grid_hash(c[4 * i], c[4 * i + 1], 0) & grid->column_mask;
+        while (grid->column_table[slot] >= 0)
+            slot = (slot + 1) & grid->column_mask;
+        grid->column_table[slot] = (int32_t)j++;
+    }
+    grid->column_first[columns] = (uint32_t)grid->cell_count;
+    return true;
+}
+
 rsmooth_status rs_grid_build(rs_grid *grid, const double *points, size_t count, double reach,
                              rsmooth_error *error) {
+    return rs_grid_build_split(grid, points, count, reach, 1, error);
+}
+
+rsmooth_status rs_grid_build_split(rs_grid *grid, const double *points, size_t count, double reach,
+                                   int split, rsmooth_error *error) {
     static const char where[] = "rs_grid_build";
     memset(grid, 0, sizeof *grid);
+    grid->split = split;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t i = 0; i < count; i++)
         for (int k = 0; k < 3; k++) {
@@ -71,7 +126,7 @@ rsmooth_status rs_grid_build(rs_grid *grid, const double *points, size_t count, 
         lo[0] = lo[1] = lo[2] = hi[0] = hi[1] = hi[2] = 0;
     /* A hair wider than the reach: a point and a centroid exactly `reach` apart must never round
      * into cells two apart. */
-    double h = reach > 0 ? reach * (1 + 1e-6) : 1;
+    double h = reach > 0 ? reach * (1 + 1e-6) / split : 1;
     for (int k = 0; k < 3; k++)
         if ((hi[k] - lo[k]) / h > MAX_CELLS_PER_AXIS - 2)
             h = (hi[k] - lo[k]) / (MAX_CELLS_PER_AXIS - 2);
@@ -86,9 +141,7 @@ rsmooth_status rs_grid_build(rs_grid *grid, const double *points, size_t count, 
         goto fail_memory;
     for (size_t i = 0; i < count; i++) {
         int32_t c[3];
-        rs_grid_cell_of(grid, points + 3 * i, c);
-        for (int k = 0; k < 3; k++) /* rounding can put the far edge one cell out */
-            c[k] = c[k] < 0 ? 0 : c[k] >= grid->dims[k] ? grid->dims[k] - 1 : c[k];
+        rs_grid_facet_cell(grid, points + 3 * i, c);
         keys[i] = cell_key(grid, c);
         grid->facet_order[i] = (uint32_t)i;
     }
@@ -104,15 +157,9 @@ rsmooth_status rs_grid_build(rs_grid *grid, const double *points, size_t count, 
     grid->cell_start = rs_alloc_array(cells + 1, sizeof(uint32_t));
     if (cells > (1u << 30))
         goto fail_memory; /* the hash table's 32-bit slots would overflow */
-    uint32_t table_size = 16;
-    while (table_size < 2 * cells)
-        table_size *= 2;
-    grid->table_mask = table_size - 1;
-    grid->table = rs_alloc_array(table_size, sizeof(int32_t));
+    grid->table = new_table(cells, &grid->table_mask);
     if (!grid->cell_coord || !grid->cell_start || !grid->table)
         goto fail_memory;
-    for (uint32_t s = 0; s < table_size; s++)
-        grid->table[s] = -1;
 
     size_t cell = 0;
     for (size_t i = 0; i < count; i++) {
@@ -134,6 +181,8 @@ rsmooth_status rs_grid_build(rs_grid *grid, const double *points, size_t count, 
     }
     grid->cell_start[cells] = (uint32_t)count;
     rs_free(keys);
+    if (!build_columns(grid))
+        goto fail_memory;
     return RSMOOTH_OK;
 
 fail_memory:
@@ -143,21 +192,34 @@ fail_memory:
                    count);
 }
 
+/* Spreads the low 21 bits of x to every third bit (Morton order). */
+static uint64_t spread_bits(uint64_t x) {
+    x &= 0x1fffff;
+    x = (x | x << 32) & 0x1f00000000ffffull;
+    x = (x | x << 16) & 0x1f0000ff0000ffull;
+    x = (x | x << 8) & 0x100f00f00f00f00full;
+    x = (x | x << 4) & 0x10c30c30c30c30c3ull;
+    x = (x | x << 2) & 0x1249249249249249ull;
+    return x;
+}
+
 rsmooth_status rs_grid_order_points(const rs_grid *grid, const double *points, size_t count,
                                     uint32_t *order, int32_t *cells, rsmooth_error *error) {
     uint64_t *keys = rs_alloc_array(count, sizeof *keys);
     if (!keys)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rs_grid_order_points",
                        "no memory to order %zu vertices", count);
+    int32_t m = grid->split + 1; /* clamped cells start at -m */
     for (size_t i = 0; i < count; i++) {
-        int32_t c[3];
+        int32_t *c = cells + 3 * i;
         rs_grid_cell_of(grid, points + 3 * i, c);
-        keys[i] = cell_key(grid, c);
+        keys[i] = spread_bits((uint64_t)(c[0] + m)) << 2 | spread_bits((uint64_t)(c[1] + m)) << 1 |
+                  spread_bits((uint64_t)(c[2] + m));
         order[i] = (uint32_t)i;
     }
     bool ok = rs_radix_sort_u64(keys, order, count);
-    for (size_t i = 0; ok && i < count; i++)
-        cell_of_key(grid, keys[i], cells + 3 * i);
+    for (size_t i = 0; ok && i < count; i++) /* the cells in the new order */
+        rs_grid_cell_of(grid, points + 3 * (size_t)order[i], cells + 3 * i);
     rs_free(keys);
     return ok ? RSMOOTH_OK
               : rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rs_grid_order_points",

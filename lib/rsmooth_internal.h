@@ -160,11 +160,12 @@ static inline void rs_cross3(const double a[3], const double b[3], double out[3]
 /* ---- grid.c: uniform grid over facet centroids, facets sorted by cell ------------------------- */
 
 /* Occupied cells are found through an open-addressing hash on their integer coordinates, so far-apart
- * components cost no empty cells. Cell edge >= the largest reach, so a vertex's neighbours lie in the
- * 27 cells around its own. */
+ * components cost no empty cells. Cell edge >= reach / split, so a vertex's neighbours lie within
+ * `split` cells of its own (the 27 around it when split is 1). */
 typedef struct rs_grid {
     double origin[3];        /* minimum corner of the centroids' bounding box */
-    double cell_size;        /* h >= reach */
+    double cell_size;        /* h >= reach / split */
+    int32_t split;           /* cells per reach */
     int32_t dims[3];         /* cells per axis covering the centroids */
     size_t cell_count;       /* occupied cells */
     int32_t *cell_coord;     /* 4 per cell: x, y, z, 0 */
@@ -172,16 +173,27 @@ typedef struct rs_grid {
     uint32_t *facet_order;   /* facet ids sorted by cell */
     uint32_t table_mask;     /* hash table size - 1 (a power of two) */
     int32_t *table;          /* table_mask + 1 slots: cell index or -1 */
+    /* Columns: the occupied cells of one (x, y), consecutive in cell order (sorted by x, y, z). */
+    size_t column_count;
+    uint32_t *column_first;  /* column_count + 1: cells of column j are column_first[j] .. [j+1]-1 */
+    uint32_t column_mask;    /* column hash table size - 1 */
+    int32_t *column_table;   /* column_mask + 1 slots: column index or -1, hashed on (x, y, 0) */
 } rs_grid;
 
 /* Builds the grid over `count` points (3 doubles each) with cells at least `reach` wide. */
 rsmooth_status rs_grid_build(rs_grid *grid, const double *points, size_t count, double reach,
                              rsmooth_error *error);
+/* The same with cells at least reach / split wide (split >= 1). */
+rsmooth_status rs_grid_build_split(rs_grid *grid, const double *points, size_t count, double reach,
+                                   int split, rsmooth_error *error);
 void rs_grid_free(rs_grid *grid);
 
-/* Cell coordinates of a point, clamped to [-2, dims + 1]: a point clamped there is more than one cell
- * away from every facet, so clamping never loses a neighbour. */
+/* Cell coordinates of a point, clamped to [-split - 1, dims + split]: a point clamped there is more
+ * than `split` cells away from every facet, so clamping never loses a neighbour. */
 void rs_grid_cell_of(const rs_grid *grid, const double p[3], int32_t cell[3]);
+
+/* The cell the grid filed a point it was built over in (rs_grid_cell_of, within the grid). */
+void rs_grid_facet_cell(const rs_grid *grid, const double p[3], int32_t cell[3]);
 
 /* Index of the occupied cell at (x, y, z), or -1. */
 int32_t rs_grid_find(const rs_grid *grid, int32_t x, int32_t y, int32_t z);
@@ -191,8 +203,9 @@ static inline uint32_t rs_grid_hash(int32_t x, int32_t y, int32_t z) {
     return ((uint32_t)x * 73856093u) ^ ((uint32_t)y * 19349663u) ^ ((uint32_t)z * 83492791u);
 }
 
-/* Orders `count` points (3 doubles each) by grid cell, for memory locality: order[i] is the index of
- * the i-th point in that order and cells[3 i .. 3 i + 2] its cell (as rs_grid_cell_of gives it). */
+/* Orders `count` points (3 doubles each) by grid cell in Morton (Z) order, so points that follow
+ * each other are close in every direction: order[i] is the index of the i-th point in that order
+ * and cells[3 i .. 3 i + 2] its cell (as rs_grid_cell_of gives it). */
 rsmooth_status rs_grid_order_points(const rs_grid *grid, const double *points, size_t count,
                                     uint32_t *order, int32_t *cells, rsmooth_error *error);
 
@@ -244,7 +257,7 @@ typedef struct rs_result_sink {
 /* Stage times and work, summed over the runs (tiles) of one call. */
 typedef struct rs_run_stats {
     double ms_grid, ms_upload, ms_mollify, ms_normals, ms_robust, ms_download;
-    uint64_t pairs;    /* vertex-facet pairs one pass evaluated */
+    uint64_t pairs_mollify, pairs_robust; /* vertex-facet pairs each pass evaluated */
     size_t cells;      /* occupied grid cells */
     size_t tiles;
 } rs_run_stats;

@@ -56,7 +56,10 @@ static void compare(rsmooth_context *ctx, const char *name, const double *xyz, s
     CHECK(isfinite(dev[nv - 1]));
     CHECK_LE(dev[nv - 1], MAX_DEVIATION);
     CHECK_LE(max_conf, 1e-3);
-    CHECK_LE(max_k, 1e-3);
+    /* k is a sum of weights: a facet exactly at the cutoff may fall on either side of it in
+     * float32 and add up to e^-cutoff^2/2 of its area to k, a relative change that can reach a
+     * few 1e-3 where k is small (the positions still agree to 1e-4) */
+    CHECK_LE(max_k, 1e-2);
     free(ref);
     free(cl);
     free(ref_conf);
