@@ -174,7 +174,8 @@ enum { EXIT_OK = 0, EXIT_OTHER = 1, EXIT_USAGE = 2, EXIT_DEVICE = 3 };
 
 static const char filter_usage[] =
     "usage: rsmooth-bench filter [MESH] [--triangles N] [--noise S] [--sigma-f X] [--sigma-g Y]\n"
-    "                            [--device D] [--repeat R] [--no-roofline]\n"
+    "                            [--device D] [--repeat R] [--memory-budget SIZE] [--no-pairs]\n"
+    "                            [--no-roofline]\n"
     "  times the OpenCL filter (float32 positions): program build (first and cached), the first\n"
     "  run, then median/min/max of each stage over R runs and whether they are bit-identical;\n"
     "  pairs each pass examined against the useful ones (within reach), useful pairs per second\n"
@@ -188,6 +189,9 @@ static const char filter_usage[] =
     "  --device D      as rsmooth --device: auto, gpu, cpu, P:D or part of a name (default:\n"
     "                  RSMOOTH_DEVICE, else auto)\n"
     "  --repeat R      timed runs after the first, 1..99 (default 7)\n"
+    "  --memory-budget SIZE  device memory one run may hold (e.g. 256M): larger meshes run in\n"
+    "                  spatial tiles (\"tiles\" in the output)\n"
+    "  --no-pairs      skip counting the useful pairs (and the roofline): seconds on big meshes\n"
     "  --no-roofline   skip the native roofline (several seconds)\n"
     "  The first program build compiles from source only when PoCL's cache (POCL_CACHE_DIR)\n"
     "  holds no binary of it yet; point POCL_CACHE_DIR at an empty folder to time that.\n";
@@ -199,7 +203,8 @@ typedef struct filter_options {
     bool shape_option_given; /* --triangles or --noise */
     rsmooth_params params;
     int repeat;
-    bool roofline;
+    uint64_t memory_budget; /* 0: the library's default */
+    bool roofline, pairs;
 } filter_options;
 
 static int filter_usage_error(const char *message, const char *value) {
@@ -216,6 +221,7 @@ static int parse_filter_args(int argc, char **argv, filter_options *opt) {
     opt->noise = 0.2;
     opt->repeat = 7;
     opt->roofline = true;
+    opt->pairs = true;
     for (int i = 2; i < argc; i++) {
         const char *a = argv[i], *value = i + 1 < argc ? argv[i + 1] : NULL;
         double x = 0;
@@ -224,6 +230,14 @@ static int parse_filter_args(int argc, char **argv, filter_options *opt) {
             return EXIT_OK;
         } else if (!strcmp(a, "--no-roofline")) {
             opt->roofline = false;
+        } else if (!strcmp(a, "--no-pairs")) {
+            opt->pairs = opt->roofline = false;
+        } else if (!strcmp(a, "--memory-budget")) {
+            if (!value)
+                return filter_usage_error("--memory-budget needs a value", NULL);
+            if (!cli_parse_bytes(value, &opt->memory_budget) || opt->memory_budget == 0)
+                return filter_usage_error("--memory-budget: not a byte count above 0:", value);
+            i++;
         } else if (!strcmp(a, "--device")) {
             if (!value)
                 return filter_usage_error("--device needs a value", NULL);
@@ -404,14 +418,18 @@ static void print_json_number(const char *key, double value) {
 }
 
 /* One pass's pair figures. */
-static void print_pass(const char *name, uint64_t examined, uint64_t useful, double median_ms,
-                       double roofline_pairs_per_s, bool roofline) {
-    double per_s = median_ms > 0 ? (double)useful / (median_ms / 1e3) : NAN;
-    printf(",\"%s\":{\"examined\":%llu,\"useful\":%llu,", name, (unsigned long long)examined,
-           (unsigned long long)useful);
+static void print_pass(const char *name, uint64_t examined, uint64_t useful, bool counted,
+                       double median_ms, double roofline_pairs_per_s, bool roofline) {
+    double per_s = median_ms > 0 && counted ? (double)useful / (median_ms / 1e3) : NAN;
+    printf(",\"%s\":{\"examined\":%llu,", name, (unsigned long long)examined);
+    if (counted)
+        printf("\"useful\":%llu,", (unsigned long long)useful);
+    else
+        printf("\"useful\":null,");
     print_json_number("useful_pairs_per_s", per_s);
     putchar(',');
-    print_json_number("waste", examined > 0 ? 1 - (double)useful / (double)examined : NAN);
+    print_json_number("waste", examined > 0 && counted ? 1 - (double)useful / (double)examined
+                                                       : NAN);
     if (roofline) {
         putchar(',');
         print_json_number("roofline_pairs_per_s",
@@ -467,6 +485,8 @@ static int bench_filter(int argc, char **argv) {
     if ((code = create_context(opt.device, &ctx, &ms_create_cached)) != EXIT_OK)
         goto done;
     ms_build_cached = rsmooth_context_build_ms(ctx);
+    if (opt.memory_budget)
+        rsmooth_context_set_memory_budget(ctx, opt.memory_budget);
 
     code = EXIT_OTHER;
     first = malloc(nv * 3 * sizeof *first);
@@ -522,7 +542,7 @@ static int bench_filter(int argc, char **argv) {
     /* Counted after the peak was read: the grid and the roofline use memory of their own. */
     uint64_t useful_mollify = 0, useful_robust = 0;
     const double cell = fmax(report.radius, report.mollify_radius);
-    if (report.facet_count > 0) {
+    if (report.facet_count > 0 && opt.pairs) {
         if (bench_grid_build(&grid, in.positions, in.indices, nt, cell) != 0) {
             fprintf(stderr, "rsmooth-bench: cannot build the pair-counting grid (out of memory, "
                             "or the mesh spans over 2^30 cells)\n");
@@ -562,8 +582,9 @@ static int bench_filter(int argc, char **argv) {
     putchar(',');
     print_json_number("sigma_g_abs", report.sigma_g);
     printf(",\"radius\":%.6g,\"mollify_radius\":%.6g,\"grid_cell_count\":%zu,\"tiles\":%zu,"
-           "\"device\":",
-           report.radius, report.mollify_radius, report.grid_cell_count, report.tiles);
+           "\"memory_budget\":%llu,\"device\":",
+           report.radius, report.mollify_radius, report.grid_cell_count, report.tiles,
+           (unsigned long long)rsmooth_context_memory_budget(ctx));
     print_json_string(report.device);
     printf(",\"repeat\":%d,\"context_create_first_ms\":%.1f,\"program_build_first_ms\":%.1f,"
            "\"context_create_cached_ms\":%.1f,\"program_build_cached_ms\":%.1f,"
@@ -574,9 +595,9 @@ static int bench_filter(int argc, char **argv) {
         printf("%s\"%s\":{\"median\":%.3f,\"min\":%.3f,\"max\":%.3f}", s ? "," : "", stage_names[s],
                median_ms[s], min_ms[s], max_ms[s]);
     printf("},\"bit_identical\":%s", identical ? "true" : "false");
-    print_pass("mollify", report.pairs_mollify, useful_mollify, median_ms[STAGE_MOLLIFY],
+    print_pass("mollify", report.pairs_mollify, useful_mollify, opt.pairs, median_ms[STAGE_MOLLIFY],
                roof.mollify_pairs_per_s, have_roofline);
-    print_pass("robust", report.pairs_robust, useful_robust, median_ms[STAGE_ROBUST],
+    print_pass("robust", report.pairs_robust, useful_robust, opt.pairs, median_ms[STAGE_ROBUST],
                roof.robust_pairs_per_s, have_roofline);
     if (have_roofline)
         printf(",\"roofline\":{\"threads\":%d,\"openmp\":%s,\"lanes\":%d,\"window\":%zu,"
