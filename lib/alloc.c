@@ -11,6 +11,10 @@
 
 #define HUGE_PAGE (2u << 20)
 #define LARGE_ARRAY (16u << 20) /* bytes from which huge pages pay */
+/* Arrays from this size are aligned to DEVICE_ALIGNMENT, so OpenCL CPU devices can use them in
+ * place as buffers (CL_MEM_USE_HOST_PTR; PoCL copies unaligned ones). */
+#define DEVICE_ARRAY (64u << 10)
+#define DEVICE_ALIGNMENT 128
 
 static void *allocate(size_t bytes) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
@@ -22,6 +26,10 @@ static void *allocate(size_t bytes) {
         return p;
     }
 #endif
+    if (bytes >= DEVICE_ARRAY) {
+        void *p = NULL;
+        return posix_memalign(&p, DEVICE_ALIGNMENT, bytes) == 0 ? p : NULL;
+    }
     return malloc(bytes ? bytes : 1);
 }
 

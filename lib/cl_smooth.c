@@ -334,14 +334,15 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
                      (unsigned long long)ctx->max_allocation);
         goto cleanup;
     }
+    /* Inputs are handed over in place (CL_MEM_USE_HOST_PTR): a CPU device reads the staging
+     * arrays themselves (no copy, no second allocation; they are aligned for it, see alloc.c), a
+     * GPU copies them when first used. They stay alive until the buffers are released. */
     for (int b = 0; b < BUF_COUNT; b++) {
         cl_int err = CL_SUCCESS;
-        buf[b] = clCreateBuffer(ctx->context, spec[b].flags, spec[b].size, NULL, &err);
-        if (err == CL_SUCCESS && spec[b].host)
-            err = clEnqueueWriteBuffer(ctx->queue, buf[b], CL_FALSE, 0, spec[b].size, spec[b].host,
-                                       0, NULL, NULL);
+        cl_mem_flags flags = spec[b].flags | (spec[b].host ? CL_MEM_USE_HOST_PTR : 0);
+        buf[b] = clCreateBuffer(ctx->context, flags, spec[b].size, spec[b].host, &err);
         if (err != CL_SUCCESS) {
-            st = rs_cl_fail(error, err, "clCreateBuffer/clEnqueueWriteBuffer", ctx->device_name);
+            st = rs_cl_fail(error, err, "clCreateBuffer", ctx->device_name);
             goto cleanup;
         }
     }
