@@ -33,19 +33,20 @@ typedef struct roof {
     float reach2, inv_2sf2, inv_2sg2, mollify_reach2, inv_2sm2;
 } roof;
 
+#define LOG2E 1.4426950408889634
+
 /* The sums live on through this, so the compiler cannot drop them. */
 static volatile double sink;
 
-/* fast_exp of kernels/common.cl on one float: 2^n from the exponent bits times a degree-6
- * polynomial for e^f, |f| <= ln 2 / 2. */
-static inline float fast_exp(float x) {
-    float y = fminf(fmaxf(x, -87.0f), 88.0f) * 1.44269504089f;
+/* fast_exp2 of kernels/common.cl on one float: 2^n from the exponent bits times a degree-5
+ * minimax polynomial for 2^f, |f| <= 1/2 (exponents arrive in base 2, as in the kernels). */
+static inline float fast_exp2(float x) {
+    float y = fminf(fmaxf(x, -126.0f), 127.0f);
     int32_t n = (int32_t)(y + 128.5f) - 128;
-    float f = (y - (float)n) * 0.69314718056f;
-    float p = 1.0f + f * (1.0f + f * (0.5f + f * (0.166666667f +
-                                                  f * (0.0416666667f + f * (0.00833333333f +
-                                                                            f * 0.00138888889f)))));
-    int32_t bits = (n + 127) << 23; /* n >= -125 after the clamp: never negative */
+    float f = y - (float)n;
+    float p = 1.00000012f + f * (0.693146944f + f * (0.240221202f + f * (0.0555071346f +
+                                  f * (0.00967554096f + f * 0.00132764666f))));
+    int32_t bits = (n + 127) << 23; /* n >= -126 after the clamp: never negative */
     float scale;
     memcpy(&scale, &bits, sizeof scale);
     return p * scale;
@@ -62,15 +63,14 @@ static inline float masked(float w, int keep) {
     return w;
 }
 
-/* robust_sums of kernels/estimate.cl for one block: projection predictor, no rescue shift. */
+/* robust_sums of kernels/estimate.cl for one block: projection predictor, no confidence, no
+ * rescue (the kernel decides on a rescue from the sums, after the loop). */
 static double robust_block(const roof *r, size_t b) {
     float px[LANES], py[LANES], pz[LANES];
-    float ax[LANES] = {0}, ay[LANES] = {0}, az[LANES] = {0}, ak[LANES] = {0}, emin[LANES];
+    float ax[LANES] = {0}, ay[LANES] = {0}, az[LANES] = {0}, ak[LANES] = {0};
     memcpy(px, r->px + b * LANES, sizeof px);
     memcpy(py, r->py + b * LANES, sizeof py);
     memcpy(pz, r->pz + b * LANES, sizeof pz);
-    for (int l = 0; l < LANES; l++)
-        emin[l] = 3.4e38f;
     const float reach2 = r->reach2, inv_2sf2 = r->inv_2sf2, inv_2sg2 = r->inv_2sg2;
     const size_t end = r->window_start[b] + r->window;
     for (size_t q = r->window_start[b]; q < end; q++) {
@@ -82,18 +82,17 @@ static double robust_block(const roof *r, size_t b) {
             float t = nx * ex + ny * ey + nz * ez;
             float e = t * t * inv_2sg2;
             int near = d2 <= reach2;
-            float w = masked(fast_exp(la - d2 * inv_2sf2 - e), near);
+            float w = masked(fast_exp2(la - d2 * inv_2sf2 - e), near);
             float wt = w * t;
             ax[l] += wt * nx;
             ay[l] += wt * ny;
             az[l] += wt * nz;
             ak[l] += w;
-            emin[l] = near ? fminf(emin[l], e) : emin[l]; /* the kernel's underflow rescue test */
         }
     }
     double sum = 0;
     for (int l = 0; l < LANES; l++)
-        sum += (double)ax[l] + ay[l] + az[l] + ak[l] + emin[l];
+        sum += (double)ax[l] + ay[l] + az[l] + ak[l];
     return sum;
 }
 
@@ -111,7 +110,7 @@ static double mollify_block(const roof *r, size_t b) {
         for (int l = 0; l < LANES; l++) {
             float ex = cx - px[l], ey = cy - py[l], ez = cz - pz[l];
             float d2 = ex * ex + ey * ey + ez * ez;
-            float w = masked(fast_exp(la - d2 * inv_2sm2), d2 <= reach2);
+            float w = masked(fast_exp2(la - d2 * inv_2sm2), d2 <= reach2);
             ax[l] += w * ex;
             ay[l] += w * ey;
             az[l] += w * ez;
@@ -194,14 +193,14 @@ int bench_roofline_run(const bench_grid *grid, const float *positions, size_t ve
         goto done;
 
     /* As the kernels have them: coordinates in cell units (from the grid's corner rather than each
-     * cell's, as a window spans many cells), weights as log(area / mean area). */
+     * cell's, as a window spans many cells), weights as log2(area / mean area), exponents in base 2 like the kernels'. */
     const double h = grid->cell_size;
     for (size_t q = 0; q < nf; q++) {
         for (int k = 0; k < 3; k++) {
             facet_soa[k * nf + q] = (float)((grid->centroid[3 * q + k] - grid->origin[k]) / h);
             facet_soa[(3 + k) * nf + q] = (float)grid->normal[3 * q + k];
         }
-        facet_soa[6 * nf + q] = (float)log(grid->area[q] / grid->mean_area);
+        facet_soa[6 * nf + q] = (float)log2(grid->area[q] / grid->mean_area);
     }
     /* Vertices in the grid's cell order, so a block's window holds the facets around it. */
     for (size_t v = 0; v < vertex_count; v++) {
@@ -239,11 +238,12 @@ int bench_roofline_run(const bench_grid *grid, const float *positions, size_t ve
         .nz = facet_soa + 5 * nf,
         .logarea = facet_soa + 6 * nf,
         .reach2 = (float)((setup->radius / h) * (setup->radius / h)),
-        .inv_2sf2 = (float)(h * h / (2 * setup->sigma_f * setup->sigma_f)),
-        .inv_2sg2 =
-            isinf(setup->sigma_g) ? 0.0f : (float)(h * h / (2 * setup->sigma_g * setup->sigma_g)),
+        .inv_2sf2 = (float)(LOG2E * h * h / (2 * setup->sigma_f * setup->sigma_f)),
+        .inv_2sg2 = isinf(setup->sigma_g)
+                        ? 0.0f
+                        : (float)(LOG2E * h * h / (2 * setup->sigma_g * setup->sigma_g)),
         .mollify_reach2 = (float)((setup->mollify_radius / h) * (setup->mollify_radius / h)),
-        .inv_2sm2 = (float)(h * h / (2 * setup->sigma_m * setup->sigma_m)),
+        .inv_2sm2 = (float)(LOG2E * h * h / (2 * setup->sigma_m * setup->sigma_m)),
     };
     if (setup->mollify_radius > 0)
         result->mollify_pairs_per_s = pairs_per_s(&r, 0);

@@ -5,7 +5,7 @@
  *   block_result: the displacement p' - p in cell units (x, y, z) and k' = the sum of the weights
  *                 used (4 components per lane)
  *   block_extra:  sum a f and the exponent shift e_s (2 components per lane), so that
- *                 k(p) = k' exp(-e_s) in mean-area units.
+ *                 k(p) = k' 2^-e_s in mean-area units (exponents are in base 2 here).
  * When k' falls below RS_RESCUE_WEIGHT, float32 weights have (nearly) underflowed: the vertex's sums
  * are then redone with its smallest influence exponent subtracted (e_s), as the reference path
  * does. `want_confidence` = 0 skips sum a f (one exp per pair instead of two).
@@ -43,7 +43,7 @@ robust_sums(lanef px, lanef py, lanef pz, float3 lo, float3 hi, int4 anchor, flo
             lanef t = n.x * ex + n.y * ey + n.z * ez;
             /* |prediction - p|^2: t^2 for the projection, d2 for the centroid */
             lanef e = (predict_centroid ? d2 : t * t) * inv_2sg2;
-            lanef w = select((lanef)0.0f, fast_exp(c.w - d2 * inv_2sf2 - (e - shift)), near);
+            lanef w = select((lanef)0.0f, fast_exp2(c.w - d2 * inv_2sf2 - (e - shift)), near);
             if (predict_centroid) {
                 a.x += w * ex;
                 a.y += w * ey;
@@ -56,7 +56,7 @@ robust_sums(lanef px, lanef py, lanef pz, float3 lo, float3 hi, int4 anchor, flo
             }
             a.k += w;
             if (want_confidence)
-                a.kf += select((lanef)0.0f, fast_exp(c.w - d2 * inv_2sf2), near);
+                a.kf += select((lanef)0.0f, fast_exp2(c.w - d2 * inv_2sf2), near);
         }
     })
     return a;

@@ -37,7 +37,7 @@ __kernel void mollify_block(uint block_count, float reach2, float inv_2sigma2,
             float4 c = facet_centroid[q];
             lanef ex = c.x - qx, ey = c.y - qy, ez = c.z - qz;
             lanef d2 = ex * ex + ey * ey + ez * ez;
-            lanef w = select((lanef)0.0f, fast_exp(c.w - d2 * inv_2sigma2), d2 <= reach2);
+            lanef w = select((lanef)0.0f, fast_exp2(c.w - d2 * inv_2sigma2), d2 <= reach2);
             ax += w * ex;
             ay += w * ey;
             az += w * ez;

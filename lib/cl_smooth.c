@@ -165,7 +165,7 @@ static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, packed *pk
         int32_t cell[3];
         rs_grid_facet_cell(grid, pb->centroid + 3 * q, cell);
         cl_float4 cen = local_point(grid, pb->centroid + 3 * q, cell);
-        cen.s[3] = logf((float)pb->area[q] * inv_mean_area);
+        cen.s[3] = log2f((float)pb->area[q] * inv_mean_area);
         pk->facet_centroid[j] = cen;
         const double *n = pb->normal + 3 * q;
         pk->facet_normal[j] = (cl_float4){{(float)n[0], (float)n[1], (float)n[2], 0}};
@@ -358,10 +358,12 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     cl_uint bcount = (cl_uint)nb, fcount = (cl_uint)nf, mask = grid.column_mask;
     cl_float reach2 = (cl_float)((pb->radius / h) * (pb->radius / h));
     cl_float mollify_reach2 = (cl_float)((pb->mollify_radius / h) * (pb->mollify_radius / h));
-    cl_float inv_2sm2 = (cl_float)(h * h / (2 * pb->sigma_m * pb->sigma_m));
-    cl_float inv_2sf2 = (cl_float)(h * h / (2 * pb->sigma_f * pb->sigma_f));
+    /* Exponents in base 2 (the kernels' fast_exp2): 1 / 2 sigma^2 scaled by log2 e. */
+    const double log2e = 1.4426950408889634;
+    cl_float inv_2sm2 = (cl_float)(log2e * h * h / (2 * pb->sigma_m * pb->sigma_m));
+    cl_float inv_2sf2 = (cl_float)(log2e * h * h / (2 * pb->sigma_f * pb->sigma_f));
     cl_float inv_2sg2 =
-        isinf(pb->sigma_g) ? 0.0f : (cl_float)(h * h / (2 * pb->sigma_g * pb->sigma_g));
+        isinf(pb->sigma_g) ? 0.0f : (cl_float)(log2e * h * h / (2 * pb->sigma_g * pb->sigma_g));
     cl_int want_confidence = sink->confidence != NULL;
     cl_int predict_centroid = pb->predict_centroid;
 
@@ -464,7 +466,7 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
         for (int k = 0; k < 3; k++)
             out[k] = p[k] + (double)res[k * RS_LANES] * h;
         rs_store_position(sink->scalar, sink->positions, to, out);
-        double k = (double)res[3 * RS_LANES] * exp(-(double)ext[RS_LANES]) * pb->mean_area;
+        double k = (double)res[3 * RS_LANES] * exp2(-(double)ext[RS_LANES]) * pb->mean_area;
         double kf = (double)ext[0] * pb->mean_area;
         if (sink->weight)
             sink->weight[to] = (float)k;
