@@ -1,8 +1,9 @@
 /* Shared by every phase: grid lookup, vertex blocks and the layout conventions below.
  *
- * Coordinates are float32 in units of the grid cell size h, relative to the origin of the cell that
- * holds the point (so a mesh far from the origin keeps full precision). A vertex in cell v seen from
- * a neighbouring cell u is at p - (u - v), exact in float for the small integers involved.
+ * Coordinates are float32 in units of the grid cell size h, relative to the corner of a nearby cell
+ * (a facet's own cell, a vertex block's anchor), so a mesh far from the origin keeps full
+ * precision. A point local to cell v seen from cell u is at p - (u - v), exact in float for the
+ * small integers involved.
  * Facet weights travel as log2(area / mean area), so one exponential per pair gives area * Gaussian
  * and no area underflows; every exponent is in base 2 (see fast_exp2).
  *
