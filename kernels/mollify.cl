@@ -3,13 +3,12 @@
  *
  * mollify_block: one work-item per vertex block writes each lane's displacement, in cell units, to
  *   block_shift (3 components per lane; 0 where no facet is within reach).
- * mollified_facet_normal: one work-item per facet writes the unit normal of the mollified triangle
- *   (or its input normal when the mollified triangle is degenerate: a corner sine below
- *   RS_DEGENERATE_SINE, or an area below RS_DEGENERATE_AREA_RATIO of the input's) to
- *   mollified_normal[q].
- *   facet_vertices[q] = the slots of its three vertices; facet_edge1/2[q] = v1 - v0, v2 - v0 (cell
- *   units), all in the caller's facet order; facet_place[q] = the facet's index in grid order,
- *   where facet_normal and mollified_normal live.
+ * mollified_facet_normal: one work-item per facet replaces its input normal, in place, by the unit
+ *   normal of the mollified triangle (unless that triangle is degenerate: a corner sine below
+ *   RS_DEGENERATE_SINE, or an area below RS_DEGENERATE_AREA_RATIO of the input's). The triangle's
+ *   corners come from the vertex blocks (positions plus shifts); facet_vertices[q] = the slots of
+ *   its three vertices, in the caller's facet order; facet_place[q] = the facet's index in grid
+ *   order, where its normal lives.
  */
 
 __kernel void mollify_block(uint block_count, float reach2, float inv_2sigma2,
@@ -58,28 +57,38 @@ inline float3 slot_shift(__global const float *block_shift, uint slot) {
                     slot_component(block_shift, slot, 3, 2));
 }
 
+/* The position of the vertex in `slot`, in cells from the corner of cell `origin`: exact in its
+ * integer part, so differences between a facet's corners keep float32's full precision. */
+inline float3 slot_position(__global const float *block_pos, __global const int4 *block_cell,
+                            uint slot, int4 origin) {
+    int4 cell = block_cell[slot / RS_LANES] - origin;
+    return convert_float3(cell.xyz) +
+           (float3)(slot_component(block_pos, slot, 3, 0), slot_component(block_pos, slot, 3, 1),
+                    slot_component(block_pos, slot, 3, 2));
+}
+
 __kernel void mollified_facet_normal(uint facet_count, __global const uint4 *facet_vertices,
                                      __global const uint *facet_place,
-                                     __global const float4 *facet_edge1,
-                                     __global const float4 *facet_edge2,
-                                     __global const float4 *facet_normal,
-                                     __global const float *block_shift,
-                                     __global float4 *mollified_normal) {
+                                     __global const float *block_pos,
+                                     __global const int4 *block_cell, __global float4 *normal,
+                                     __global const float *block_shift) {
     uint q = get_global_id(0); /* the caller's facet order; j is its place in grid order */
     if (q >= facet_count)
         return;
     uint j = facet_place[q];
     uint4 t = facet_vertices[q];
-    float3 input_e1 = facet_edge1[q].xyz, input_e2 = facet_edge2[q].xyz;
+    int4 origin = block_cell[t.x / RS_LANES];
+    float3 p0 = slot_position(block_pos, block_cell, t.x, origin);
+    float3 input_e1 = slot_position(block_pos, block_cell, t.y, origin) - p0;
+    float3 input_e2 = slot_position(block_pos, block_cell, t.z, origin) - p0;
     float3 input_n = cross(input_e1, input_e2);
     float3 s0 = slot_shift(block_shift, t.x);
     float3 e1 = input_e1 + slot_shift(block_shift, t.y) - s0;
     float3 e2 = input_e2 + slot_shift(block_shift, t.z) - s0;
     float3 n = cross(e1, e2);
     float len = sqrt(dot(n, n));
+    /* each work-item reads and writes its own facet's normal only: replacing it is safe */
     if (len > RS_DEGENERATE_SINE * sqrt(dot(e1, e1) * dot(e2, e2)) &&
         len > RS_DEGENERATE_AREA_RATIO * sqrt(dot(input_n, input_n)))
-        mollified_normal[j] = (float4)(n / len, 0.0f);
-    else
-        mollified_normal[j] = facet_normal[j];
+        normal[j] = (float4)(n / len, 0.0f);
 }

@@ -5,6 +5,9 @@
 #include "rsmooth_internal.h"
 
 #include <stdlib.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 #include <string.h>
 #include <sys/mman.h>
 #include <time.h>
@@ -60,6 +63,12 @@ void *rs_realloc_array(void *ptr, size_t count, size_t size) {
 
 void rs_free(void *ptr) {
     free(ptr);
+}
+
+void rs_release_free_memory(void) {
+#if defined(__GLIBC__)
+    malloc_trim(0);
+#endif
 }
 
 double rs_now_ms(void) {

@@ -14,8 +14,7 @@
 
 typedef struct packed {
     cl_float4 *facet_centroid, *facet_normal; /* in grid order */
-    cl_float4 *facet_edge1, *facet_edge2; /* in the caller's facet order, like: */
-    cl_uint4 *facet_vertices; /* slots of the three vertices */
+    cl_uint4 *facet_vertices; /* in the caller's facet order: slots of the three vertices */
     cl_uint *facet_place;     /* caller's facet -> its place in grid order */
     size_t block_count;
     cl_int4 *block_cell;      /* per block: its cell */
@@ -26,8 +25,6 @@ typedef struct packed {
 static void packed_free(packed *pk) {
     rs_free(pk->facet_centroid);
     rs_free(pk->facet_normal);
-    rs_free(pk->facet_edge1);
-    rs_free(pk->facet_edge2);
     rs_free(pk->facet_vertices);
     rs_free(pk->facet_place);
     rs_free(pk->block_cell);
@@ -139,13 +136,11 @@ static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, packed *pk
     memset(pk, 0, sizeof *pk);
     pk->facet_centroid = rs_alloc_array(nf, sizeof(cl_float4));
     pk->facet_normal = rs_alloc_array(nf, sizeof(cl_float4));
-    pk->facet_edge1 = rs_alloc_array(nf, sizeof(cl_float4));
-    pk->facet_edge2 = rs_alloc_array(nf, sizeof(cl_float4));
     pk->facet_vertices = rs_alloc_array(nf, sizeof(cl_uint4));
     pk->facet_place = rs_alloc_array(nf, sizeof(cl_uint));
     pk->slot = rs_alloc_array(nv, sizeof(uint32_t));
-    if (!pk->facet_centroid || !pk->facet_normal || !pk->facet_edge1 || !pk->facet_edge2 ||
-        !pk->facet_vertices || !pk->facet_place || !pk->slot)
+    if (!pk->facet_centroid || !pk->facet_normal || !pk->facet_vertices || !pk->facet_place ||
+        !pk->slot)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth",
                        "no memory for device staging arrays");
     rsmooth_status st = pack_blocks(pb, grid, pk, error);
@@ -153,32 +148,23 @@ static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, packed *pk
         return st;
 
     /* Facets are read in the caller's order (mostly coherent in memory). What the pair loops read
-     * (centroid, normal) goes to its place in grid order; what only the per-facet normals kernel
-     * reads (edges, vertices) stays in the caller's order, with `place` to find the rest. */
+     * (centroid, normal) goes to its place in grid order; the vertex slots, which only the
+     * per-facet normals kernel reads, stay in the caller's order, with `place` to find the rest. */
     uint32_t *place = pk->facet_place;
     for (size_t j = 0; j < nf; j++)
         place[grid->facet_order[j]] = (uint32_t)j;
-    const double inv_h = 1 / grid->cell_size;
     const float inv_mean_area = (float)(1 / pb->mean_area);
     for (size_t q = 0; q < nf; q++) {
         uint32_t j = place[q];
+        double c[3], n[3], area;
+        rs_facet_geometry(pb, q, c, n, &area);
         int32_t cell[3];
-        rs_grid_facet_cell(grid, pb->centroid + 3 * q, cell);
-        cl_float4 cen = local_point(grid, pb->centroid + 3 * q, cell);
-        cen.s[3] = log2f((float)pb->area[q] * inv_mean_area);
+        rs_grid_facet_cell(grid, c, cell);
+        cl_float4 cen = local_point(grid, c, cell);
+        cen.s[3] = log2f((float)area * inv_mean_area);
         pk->facet_centroid[j] = cen;
-        const double *n = pb->normal + 3 * q;
         pk->facet_normal[j] = (cl_float4){{(float)n[0], (float)n[1], (float)n[2], 0}};
         const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
-        const double *a = pb->xyz + 3 * (size_t)tri[0];
-        const double *b = pb->xyz + 3 * (size_t)tri[1];
-        const double *d = pb->xyz + 3 * (size_t)tri[2];
-        pk->facet_edge1[q] = (cl_float4){{(float)((b[0] - a[0]) * inv_h),
-                                          (float)((b[1] - a[1]) * inv_h),
-                                          (float)((b[2] - a[2]) * inv_h), 0}};
-        pk->facet_edge2[q] = (cl_float4){{(float)((d[0] - a[0]) * inv_h),
-                                          (float)((d[1] - a[1]) * inv_h),
-                                          (float)((d[2] - a[2]) * inv_h), 0}};
         pk->facet_vertices[q] =
             (cl_uint4){{pk->slot[tri[0]], pk->slot[tri[1]], pk->slot[tri[2]], 0}};
     }
@@ -188,8 +174,6 @@ static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, packed *pk
 enum {
     BUF_FACET_CENTROID,
     BUF_FACET_NORMAL,
-    BUF_FACET_EDGE1,
-    BUF_FACET_EDGE2,
     BUF_FACET_VERTICES,
     BUF_FACET_PLACE,
     BUF_CELL_COORD,
@@ -199,7 +183,6 @@ enum {
     BUF_BLOCK_POS,
     BUF_BLOCK_CELL,
     BUF_BLOCK_SHIFT,
-    BUF_MOLLIFIED_NORMAL,
     BUF_BLOCK_RESULT,
     BUF_BLOCK_EXTRA,
     BUF_BLOCK_PAIRS,
@@ -216,6 +199,33 @@ static int cells_per_reach(const rs_problem *pb) {
         return atoi(forced);
     double cells = floor(pb->radius / (2 * pb->mean_edge_length));
     return cells < 1 || !isfinite(cells) ? 1 : cells > 3 ? 3 : (int)cells;
+}
+
+/* The grid over the facets' centroids, in a box that also holds every vertex of a facet, so the
+ * kernels can form each facet's edges from its vertices' block positions (no vertex is clamped).
+ * The centroids live only while the grid is built. */
+static rsmooth_status build_grid(const rs_problem *pb, rs_grid *grid, rsmooth_error *error) {
+    size_t nf = pb->facet_count;
+    double *centroid = rs_alloc_array(nf, 3 * sizeof *centroid);
+    if (!centroid)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth",
+                       "no memory for %zu centroids", nf);
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t q = 0; q < nf; q++) {
+        double n[3], area;
+        rs_facet_geometry(pb, q, centroid + 3 * q, n, &area);
+        const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
+        for (int c = 0; c < 3; c++)
+            for (int k = 0; k < 3; k++) {
+                double x = pb->xyz[3 * (size_t)tri[c] + k];
+                lo[k] = x < lo[k] ? x : lo[k];
+                hi[k] = x > hi[k] ? x : hi[k];
+            }
+    }
+    rsmooth_status st = rs_grid_build_in_box(grid, centroid, nf, pb->radius, cells_per_reach(pb),
+                                             lo, hi, error);
+    rs_free(centroid);
+    return st;
 }
 
 /* Sets kernel arguments in order; stops at the first failure. */
@@ -281,11 +291,11 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     packed pk;
     memset(&pk, 0, sizeof pk);
     cl_mem buf[BUF_COUNT] = {0};
-    cl_float *result = NULL, *extra = NULL; /* per block, as block_result and block_extra */
-    cl_uint *pairs = NULL;                  /* per block, as block_pairs */
+    /* mapped results, per block, as block_result, block_extra and block_pairs */
+    cl_float *result = NULL, *extra = NULL;
+    cl_uint *pairs = NULL;
 
-    rsmooth_status st = rs_grid_build_split(&grid, pb->centroid, pb->facet_count, pb->radius,
-                                            cells_per_reach(pb), error);
+    rsmooth_status st = build_grid(pb, &grid, error);
     if (st == RSMOOTH_OK)
         st = pack(pb, &grid, &pk, error);
     if (st != RSMOOTH_OK)
@@ -300,9 +310,8 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
         cl_mem_flags flags;
     } spec[BUF_COUNT] = {
         [BUF_FACET_CENTROID] = {nf * sizeof(cl_float4), pk.facet_centroid, CL_MEM_READ_ONLY},
-        [BUF_FACET_NORMAL] = {nf * sizeof(cl_float4), pk.facet_normal, CL_MEM_READ_ONLY},
-        [BUF_FACET_EDGE1] = {nf * sizeof(cl_float4), pk.facet_edge1, CL_MEM_READ_ONLY},
-        [BUF_FACET_EDGE2] = {nf * sizeof(cl_float4), pk.facet_edge2, CL_MEM_READ_ONLY},
+        /* the input normals, replaced in place by the mollified ones */
+        [BUF_FACET_NORMAL] = {nf * sizeof(cl_float4), pk.facet_normal, CL_MEM_READ_WRITE},
         [BUF_FACET_VERTICES] = {nf * sizeof(cl_uint4), pk.facet_vertices, CL_MEM_READ_ONLY},
         [BUF_FACET_PLACE] = {nf * sizeof(cl_uint), pk.facet_place, CL_MEM_READ_ONLY},
         [BUF_CELL_COORD] = {nc * 4 * sizeof(cl_int), grid.cell_coord, CL_MEM_READ_ONLY},
@@ -314,7 +323,6 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
         [BUF_BLOCK_POS] = {ns * 3 * sizeof(cl_float), pk.block_pos, CL_MEM_READ_ONLY},
         [BUF_BLOCK_CELL] = {nb * sizeof(cl_int4), pk.block_cell, CL_MEM_READ_ONLY},
         [BUF_BLOCK_SHIFT] = {ns * 3 * sizeof(cl_float), NULL, CL_MEM_READ_WRITE},
-        [BUF_MOLLIFIED_NORMAL] = {nf * sizeof(cl_float4), NULL, CL_MEM_READ_WRITE},
         [BUF_BLOCK_RESULT] = {ns * 4 * sizeof(cl_float), NULL, CL_MEM_WRITE_ONLY},
         [BUF_BLOCK_EXTRA] = {ns * 2 * sizeof(cl_float), NULL, CL_MEM_WRITE_ONLY},
         [BUF_BLOCK_PAIRS] = {nb * 2 * sizeof(cl_uint), NULL, CL_MEM_WRITE_ONLY},
@@ -367,7 +375,6 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     cl_int want_confidence = sink->confidence != NULL;
     cl_int predict_centroid = pb->predict_centroid;
 
-    cl_mem normals = buf[BUF_FACET_NORMAL];
     if (pb->mollify) {
         arg_setter s = {ctx->kernels[RS_KERNEL_MOLLIFY], 0, CL_SUCCESS};
         arg(&s, sizeof bcount, &bcount);
@@ -394,18 +401,16 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
         arg(&s, sizeof fcount, &fcount);
         arg(&s, sizeof(cl_mem), &buf[BUF_FACET_VERTICES]);
         arg(&s, sizeof(cl_mem), &buf[BUF_FACET_PLACE]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_FACET_EDGE1]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_FACET_EDGE2]);
+        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_POS]);
+        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_CELL]);
         arg(&s, sizeof(cl_mem), &buf[BUF_FACET_NORMAL]);
         arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_SHIFT]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_MOLLIFIED_NORMAL]);
         err = s.err != CL_SUCCESS ? s.err
                                   : run_1d(ctx, pb, s.kernel, nf, MOLLIFY_SHARE, MOLLIFY_SHARE);
         if (err != CL_SUCCESS) {
             st = rs_cl_fail(error, err, "mollified_facet_normal", ctx->device_name);
             goto cleanup;
         }
-        normals = buf[BUF_MOLLIFIED_NORMAL];
     } else {
         t_mollify = rs_now_ms();
     }
@@ -421,7 +426,7 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_POS]);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_CELL]);
     arg(&s, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
-    arg(&s, sizeof(cl_mem), &normals);
+    arg(&s, sizeof(cl_mem), &buf[BUF_FACET_NORMAL]);
     arg(&s, sizeof(cl_mem), &buf[BUF_CELL_COORD]);
     arg(&s, sizeof(cl_mem), &buf[BUF_CELL_START]);
     arg(&s, sizeof(cl_mem), &buf[BUF_COLUMN_FIRST]);
@@ -438,23 +443,17 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     }
     t_robust = rs_now_ms();
 
-    result = rs_alloc_array(ns, 4 * sizeof(cl_float));
-    extra = rs_alloc_array(ns, 2 * sizeof(cl_float));
-    pairs = rs_alloc_array(nb, 2 * sizeof(cl_uint));
-    if (!result || !extra || !pairs) {
-        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for results");
-        goto cleanup;
-    }
-    err = clEnqueueReadBuffer(ctx->queue, buf[BUF_BLOCK_RESULT], CL_TRUE, 0,
-                              ns * 4 * sizeof(cl_float), result, 0, NULL, NULL);
+    /* Results are mapped, not copied: a CPU device hands over its own memory. */
+    result = clEnqueueMapBuffer(ctx->queue, buf[BUF_BLOCK_RESULT], CL_TRUE, CL_MAP_READ, 0,
+                                ns * 4 * sizeof(cl_float), 0, NULL, NULL, &err);
     if (err == CL_SUCCESS)
-        err = clEnqueueReadBuffer(ctx->queue, buf[BUF_BLOCK_EXTRA], CL_TRUE, 0,
-                                  ns * 2 * sizeof(cl_float), extra, 0, NULL, NULL);
+        extra = clEnqueueMapBuffer(ctx->queue, buf[BUF_BLOCK_EXTRA], CL_TRUE, CL_MAP_READ, 0,
+                                   ns * 2 * sizeof(cl_float), 0, NULL, NULL, &err);
     if (err == CL_SUCCESS)
-        err = clEnqueueReadBuffer(ctx->queue, buf[BUF_BLOCK_PAIRS], CL_TRUE, 0,
-                                  nb * 2 * sizeof(cl_uint), pairs, 0, NULL, NULL);
+        pairs = clEnqueueMapBuffer(ctx->queue, buf[BUF_BLOCK_PAIRS], CL_TRUE, CL_MAP_READ, 0,
+                                   nb * 2 * sizeof(cl_uint), 0, NULL, NULL, &err);
     if (err != CL_SUCCESS) {
-        st = rs_cl_fail(error, err, "clEnqueueReadBuffer", ctx->device_name);
+        st = rs_cl_fail(error, err, "clEnqueueMapBuffer", ctx->device_name);
         goto cleanup;
     }
     for (size_t v = 0; v < sink->core_count && v < nv; v++) {
@@ -488,12 +487,17 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     stats->tiles++;
 
 cleanup:
+    if (result)
+        clEnqueueUnmapMemObject(ctx->queue, buf[BUF_BLOCK_RESULT], result, 0, NULL, NULL);
+    if (extra)
+        clEnqueueUnmapMemObject(ctx->queue, buf[BUF_BLOCK_EXTRA], extra, 0, NULL, NULL);
+    if (pairs)
+        clEnqueueUnmapMemObject(ctx->queue, buf[BUF_BLOCK_PAIRS], pairs, 0, NULL, NULL);
+    if (result || extra || pairs)
+        clFinish(ctx->queue);
     for (int b = 0; b < BUF_COUNT; b++)
         if (buf[b])
             clReleaseMemObject(buf[b]);
-    rs_free(result);
-    rs_free(extra);
-    rs_free(pairs);
     packed_free(&pk);
     rs_grid_free(&grid);
     return st;
@@ -510,7 +514,8 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "ctx is NULL");
     rs_problem pb;
     rsmooth_status st = rs_problem_prepare(&pb, scalar, positions, vertex_count, indices,
-                                           triangle_count, params, out_positions, error, where);
+                                           triangle_count, params, out_positions, false, error,
+                                           where);
     if (st != RSMOOTH_OK)
         return st;
     double t_facets = rs_now_ms();
@@ -542,5 +547,6 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
         }
     }
     rs_problem_free(&pb);
+    rs_release_free_memory();
     return st;
 }

@@ -113,24 +113,31 @@ rsmooth_status rs_grid_build(rs_grid *grid, const double *points, size_t count, 
 
 rsmooth_status rs_grid_build_split(rs_grid *grid, const double *points, size_t count, double reach,
                                    int split, rsmooth_error *error) {
-    static const char where[] = "rs_grid_build";
-    memset(grid, 0, sizeof *grid);
-    grid->split = split;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t i = 0; i < count; i++)
         for (int k = 0; k < 3; k++) {
-            lo[k] = fmin(lo[k], points[3 * i + k]);
-            hi[k] = fmax(hi[k], points[3 * i + k]);
+            double x = points[3 * i + k];
+            lo[k] = x < lo[k] ? x : lo[k];
+            hi[k] = x > hi[k] ? x : hi[k];
         }
     if (count == 0)
         lo[0] = lo[1] = lo[2] = hi[0] = hi[1] = hi[2] = 0;
+    return rs_grid_build_in_box(grid, points, count, reach, split, lo, hi, error);
+}
+
+rsmooth_status rs_grid_build_in_box(rs_grid *grid, const double *points, size_t count,
+                                    double reach, int split, const double lo[3],
+                                    const double hi[3], rsmooth_error *error) {
+    static const char where[] = "rs_grid_build";
+    memset(grid, 0, sizeof *grid);
+    grid->split = split;
     /* A hair wider than the reach: a point and a centroid exactly `reach` apart must never round
      * into cells two apart. */
     double h = reach > 0 ? reach * (1 + 1e-6) / split : 1;
     for (int k = 0; k < 3; k++)
         if ((hi[k] - lo[k]) / h > MAX_CELLS_PER_AXIS - 2)
             h = (hi[k] - lo[k]) / (MAX_CELLS_PER_AXIS - 2);
-    memcpy(grid->origin, lo, sizeof lo);
+    memcpy(grid->origin, lo, 3 * sizeof *lo);
     grid->cell_size = h;
     for (int k = 0; k < 3; k++)
         grid->dims[k] = (int32_t)floor((hi[k] - lo[k]) / h) + 1;

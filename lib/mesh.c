@@ -145,6 +145,25 @@ void rs_store_position(rsmooth_scalar scalar, void *out_positions, size_t v, con
     }
 }
 
+bool rs_triangle_geometry(const double *xyz, const uint32_t *tri, double centroid[3],
+                          double normal[3], double *area) {
+    const double *a = xyz + 3 * (size_t)tri[0], *b = xyz + 3 * (size_t)tri[1];
+    const double *c = xyz + 3 * (size_t)tri[2];
+    double e1[3], e2[3], n[3];
+    rs_sub3(b, a, e1);
+    rs_sub3(c, a, e2);
+    rs_cross3(e1, e2, n);
+    double len = sqrt(rs_dot3(n, n));
+    if (!(len > 0) || !isfinite(len))
+        return false;
+    for (int k = 0; k < 3; k++) {
+        centroid[k] = (a[k] + b[k] + c[k]) / 3.0;
+        normal[k] = n[k] / len;
+    }
+    *area = 0.5 * len;
+    return true;
+}
+
 void rs_problem_free(rs_problem *problem) {
     if (!problem)
         return;
@@ -179,7 +198,8 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
                                   const void *positions, size_t vertex_count,
                                   const uint32_t *indices, size_t triangle_count,
                                   const rsmooth_params *params, const void *out_positions,
-                                  rsmooth_error *error, const char *where) {
+                                  bool keep_facet_data, rsmooth_error *error,
+                                  const char *where) {
     memset(problem, 0, sizeof *problem);
     rsmooth_params p;
     rsmooth_status st = rs_params_resolve(params, &p, error, where);
@@ -198,11 +218,13 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
     problem->triangle_count = triangle_count;
     problem->xyz = rs_alloc_array(vertex_count, 3 * sizeof(double));
     problem->facet_triangle = rs_alloc_array(triangle_count, sizeof(uint32_t));
-    problem->centroid = rs_alloc_array(triangle_count, 3 * sizeof(double));
-    problem->normal = rs_alloc_array(triangle_count, 3 * sizeof(double));
-    problem->area = rs_alloc_array(triangle_count, sizeof(double));
-    if (!problem->xyz || !problem->facet_triangle || !problem->centroid || !problem->normal ||
-        !problem->area) {
+    if (keep_facet_data) {
+        problem->centroid = rs_alloc_array(triangle_count, 3 * sizeof(double));
+        problem->normal = rs_alloc_array(triangle_count, 3 * sizeof(double));
+        problem->area = rs_alloc_array(triangle_count, sizeof(double));
+    }
+    if (!problem->xyz || !problem->facet_triangle ||
+        (keep_facet_data && (!problem->centroid || !problem->normal || !problem->area))) {
         rs_problem_free(problem);
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for facet data");
     }
@@ -210,29 +232,21 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
         problem->xyz[i] = rs_coordinate(scalar, positions, i);
 
     size_t f = 0;
+    double area_sum = 0;
     for (size_t t = 0; t < triangle_count; t++) {
-        const double *a = problem->xyz + 3 * (size_t)indices[3 * t];
-        const double *b = problem->xyz + 3 * (size_t)indices[3 * t + 1];
-        const double *c = problem->xyz + 3 * (size_t)indices[3 * t + 2];
-        double e1[3], e2[3], n[3];
-        rs_sub3(b, a, e1);
-        rs_sub3(c, a, e2);
-        rs_cross3(e1, e2, n);
-        double len = sqrt(rs_dot3(n, n));
-        if (!(len > 0) || !isfinite(len))
+        double c[3], n[3], area;
+        if (!rs_triangle_geometry(problem->xyz, indices + 3 * t, c, n, &area))
             continue; /* zero area: no weight, and no normal to divide by */
         problem->facet_triangle[f] = (uint32_t)t;
-        for (int k = 0; k < 3; k++) {
-            problem->centroid[3 * f + k] = (a[k] + b[k] + c[k]) / 3.0;
-            problem->normal[3 * f + k] = n[k] / len;
+        if (keep_facet_data) {
+            memcpy(problem->centroid + 3 * f, c, sizeof c);
+            memcpy(problem->normal + 3 * f, n, sizeof n);
+            problem->area[f] = area;
         }
-        problem->area[f] = 0.5 * len;
+        area_sum += area;
         f++;
     }
     problem->facet_count = f;
-    double area_sum = 0;
-    for (size_t q = 0; q < f; q++)
-        area_sum += problem->area[q];
     problem->mean_area = f ? area_sum / (double)f : 0;
 
     if (!rs_mean_edge_length(problem->xyz, vertex_count, indices, triangle_count,

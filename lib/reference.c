@@ -162,7 +162,8 @@ rsmooth_status rsmooth_smooth_reference(rsmooth_scalar scalar, const void *posit
     rs_error_clear(error);
     rs_problem pb;
     rsmooth_status st = rs_problem_prepare(&pb, scalar, positions, vertex_count, indices,
-                                           triangle_count, params, out_positions, error, where);
+                                           triangle_count, params, out_positions, true, error,
+                                           where);
     if (st != RSMOOTH_OK)
         return st;
     double t_facets = rs_now_ms();

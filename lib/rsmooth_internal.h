@@ -38,6 +38,10 @@ void *rs_alloc_array(size_t count, size_t size);
 void *rs_calloc_array(size_t count, size_t size);
 void *rs_realloc_array(void *ptr, size_t count, size_t size);
 void rs_free(void *ptr);
+/* Hands memory freed inside the C library's heap back to the system (glibc keeps what it freed
+ * resident otherwise, so a program calling the filter repeatedly would grow by the arrays of its
+ * largest call). Called once at the end of each filter call. */
+void rs_release_free_memory(void);
 
 /* true when a * b overflows size_t. */
 static inline bool rs_mul_overflows(size_t a, size_t b) {
@@ -71,6 +75,8 @@ typedef struct rs_problem {
     const uint32_t *indices;     /* borrowed from the caller */
     size_t facet_count;
     uint32_t *facet_triangle;    /* triangle index of each facet */
+    /* Kept only when asked (the reference path); the OpenCL path computes them where it needs
+     * them (rs_facet_geometry), which saves 56 bytes per triangle. */
     double *centroid;            /* 3 per facet: c_q */
     double *normal;              /* 3 per facet: unit n_q of the input */
     double *area;                /* per facet: a_q > 0 */
@@ -94,12 +100,25 @@ static inline void rs_progress(const rs_problem *problem, double fraction) {
 }
 
 /* Checks every argument of a smoothing call (nothing is written on failure), converts positions to
- * double, computes facet data, the mean edge length and the absolute parameters. */
+ * double, finds the facets, computes the mean edge length and area and the absolute parameters,
+ * and with keep_facet_data the facets' centroids, normals and areas. */
 rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
                                   const void *positions, size_t vertex_count,
                                   const uint32_t *indices, size_t triangle_count,
                                   const rsmooth_params *params, const void *out_positions,
-                                  rsmooth_error *error, const char *where);
+                                  bool keep_facet_data, rsmooth_error *error, const char *where);
+
+/* Centroid, unit normal and area of the triangle with vertex indices tri[0..2] over `xyz`; false
+ * (outputs unset) when its area is zero or not finite. The one formula every path uses. */
+bool rs_triangle_geometry(const double *xyz, const uint32_t *tri, double centroid[3],
+                          double normal[3], double *area);
+
+/* The same for facet q of a problem. */
+static inline void rs_facet_geometry(const rs_problem *problem, size_t q, double centroid[3],
+                                     double normal[3], double *area) {
+    rs_triangle_geometry(problem->xyz, problem->indices + 3 * (size_t)problem->facet_triangle[q],
+                         centroid, normal, area);
+}
 void rs_problem_free(rs_problem *problem);
 
 /* Coordinate i (x, y, z of vertex i / 3) of the caller's positions, as a double. */
@@ -186,6 +205,11 @@ rsmooth_status rs_grid_build(rs_grid *grid, const double *points, size_t count, 
 /* The same with cells at least reach / split wide (split >= 1). */
 rsmooth_status rs_grid_build_split(rs_grid *grid, const double *points, size_t count, double reach,
                                    int split, rsmooth_error *error);
+/* The same over the box [lo, hi], which must hold every point (it may hold more: the OpenCL path
+ * makes it hold the vertices too, so none of them is clamped). */
+rsmooth_status rs_grid_build_in_box(rs_grid *grid, const double *points, size_t count,
+                                    double reach, int split, const double lo[3],
+                                    const double hi[3], rsmooth_error *error);
 void rs_grid_free(rs_grid *grid);
 
 /* Cell coordinates of a point, clamped to [-split - 1, dims + split]: a point clamped there is more
@@ -263,8 +287,8 @@ typedef struct rs_run_stats {
 } rs_run_stats;
 
 /* Device bytes a run needs at most, estimated before its grid exists (tiles.c plans with it). */
-#define RS_DEVICE_BYTES_PER_FACET 96
-#define RS_DEVICE_BYTES_PER_VERTEX 80
+#define RS_DEVICE_BYTES_PER_FACET 64
+#define RS_DEVICE_BYTES_PER_VERTEX 72
 
 /* One run of the whole pipeline on `problem` (facet_count > 0). When its buffers would exceed
  * rs_cl_usable_memory or the device's largest allocation, returns RSMOOTH_ERROR_OUT_OF_MEMORY

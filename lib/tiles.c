@@ -54,17 +54,13 @@ static rsmooth_status run_tile(tiler *t, const uint32_t *verts, size_t n, const 
     const rs_problem *w = t->whole;
     rs_problem sub = *w;
     sub.xyz = NULL;
-    sub.facet_triangle = NULL;
-    sub.centroid = sub.normal = sub.area = NULL;
+    sub.centroid = sub.normal = sub.area = NULL; /* computed from the vertices where needed */
     uint32_t *list = rs_alloc_array(n + 3 * m, sizeof *list); /* tile vertex -> whole vertex */
     uint32_t *indices = rs_alloc_array(m, 3 * sizeof *indices);
     sub.facet_triangle = rs_alloc_array(m, sizeof(uint32_t));
-    sub.centroid = rs_alloc_array(m, 3 * sizeof(double));
-    sub.normal = rs_alloc_array(m, 3 * sizeof(double));
-    sub.area = rs_alloc_array(m, sizeof(double));
     size_t count = 0;
     rsmooth_status st = RSMOOTH_OK;
-    if (!list || !indices || !sub.facet_triangle || !sub.centroid || !sub.normal || !sub.area) {
+    if (!list || !indices || !sub.facet_triangle) {
         st = rs_fail(t->error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth",
                      "no memory for a tile of %zu facets", m);
         goto done;
@@ -84,9 +80,6 @@ static rsmooth_status run_tile(tiler *t, const uint32_t *verts, size_t n, const 
             indices[3 * j + c] = t->sub_index[tri[c]];
         }
         sub.facet_triangle[j] = (uint32_t)j;
-        memcpy(sub.centroid + 3 * j, w->centroid + 3 * q, 3 * sizeof(double));
-        memcpy(sub.normal + 3 * j, w->normal + 3 * q, 3 * sizeof(double));
-        sub.area[j] = w->area[q];
     }
     sub.xyz = rs_alloc_array(count, 3 * sizeof(double));
     if (!sub.xyz) {
@@ -143,7 +136,8 @@ static rsmooth_status solve_region(tiler *t, uint32_t *verts, size_t n, const ui
                        "no memory to plan tiles");
     size_t m = 0;
     for (size_t j = 0; j < facet_count; j++) {
-        const double *c = w->centroid + 3 * (size_t)facets[j];
+        double c[3], normal[3], area;
+        rs_facet_geometry(w, facets[j], c, normal, &area);
         bool inside = true;
         for (int k = 0; k < 3; k++)
             inside = inside && c[k] >= lo[k] - t->halo && c[k] <= hi[k] + t->halo;
@@ -200,9 +194,11 @@ rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *pb, const rs
     double reach = 0; /* largest centroid-to-vertex distance */
     for (size_t q = 0; q < pb->facet_count; q++) {
         const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
+        double centroid[3], normal[3], area;
+        rs_facet_geometry(pb, q, centroid, normal, &area);
         for (int c = 0; c < 3; c++) {
             double d[3];
-            rs_sub3(pb->xyz + 3 * (size_t)tri[c], pb->centroid + 3 * q, d);
+            rs_sub3(pb->xyz + 3 * (size_t)tri[c], centroid, d);
             reach = fmax(reach, sqrt(rs_dot3(d, d)));
         }
     }
