@@ -9,6 +9,9 @@
 #include <stdio.h>
 #include <string.h>
 
+/* Elements per chunk below which a host loop is not worth a thread. */
+#define PARALLEL_GRAIN 4096
+
 /* Vertices clamped far outside the grid have no neighbours; keep their floats finite anyway. */
 #define LOCAL_CLAMP 1e6
 
@@ -86,6 +89,33 @@ static size_t cut_blocks(const int32_t *cells, size_t count, uint32_t *start, cl
     return blocks;
 }
 
+typedef struct block_job {
+    const rs_problem *pb;
+    const rs_grid *grid;
+    packed *pk;
+    const uint32_t *order, *start;
+} block_job;
+
+/* Slots and anchor-local positions of the vertices of blocks [begin, end). */
+static void fill_blocks(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const block_job *job = ctx;
+    packed *pk = job->pk;
+    (void)chunk;
+    for (size_t b = begin; b < end; b++) {
+        cl_float *pos = pk->block_pos + 3 * RS_LANES * b;
+        const cl_int *anchor = pk->block_cell[b].s;
+        for (uint32_t i = job->start[b]; i < job->start[b + 1]; i++) {
+            uint32_t v = job->order[i], lane = i - job->start[b];
+            pk->slot[v] = (uint32_t)(b * RS_LANES + lane);
+            cl_float4 local = local_point(job->grid, job->pb->xyz + 3 * (size_t)v, anchor);
+            /* lane 0 also fills the unused lanes, so they compute something harmless */
+            for (size_t l = lane; l < (lane == 0 ? RS_LANES : lane + 1); l++)
+                for (int k = 0; k < 3; k++)
+                    pos[k * RS_LANES + l] = local.s[k];
+        }
+    }
+}
+
 /* Vertices in grid order, cut into blocks (cut_blocks), positions local to each block's anchor. */
 static rsmooth_status pack_blocks(const rs_problem *pb, const rs_grid *grid, packed *pk,
                                   rsmooth_error *error) {
@@ -110,24 +140,48 @@ static rsmooth_status pack_blocks(const rs_problem *pb, const rs_grid *grid, pac
         goto done;
     }
     cut_blocks(cells, nv, start, pk->block_cell);
-    for (size_t b = 0; b < blocks; b++) {
-        cl_float *pos = pk->block_pos + 3 * RS_LANES * b;
-        const cl_int *anchor = pk->block_cell[b].s;
-        for (uint32_t i = start[b]; i < start[b + 1]; i++) {
-            uint32_t v = order[i], lane = i - start[b];
-            pk->slot[v] = (uint32_t)(b * RS_LANES + lane);
-            cl_float4 local = local_point(grid, pb->xyz + 3 * (size_t)v, anchor);
-            /* lane 0 also fills the unused lanes, so they compute something harmless */
-            for (size_t l = lane; l < (lane == 0 ? RS_LANES : lane + 1); l++)
-                for (int k = 0; k < 3; k++)
-                    pos[k * RS_LANES + l] = local.s[k];
-        }
-    }
+    block_job job = {pb, grid, pk, order, start};
+    rs_parallel_for(blocks, PARALLEL_GRAIN / RS_LANES, fill_blocks, &job);
 done:
     rs_free(order);
     rs_free(cells);
     rs_free(start);
     return st;
+}
+
+typedef struct facet_job {
+    const rs_problem *pb;
+    const rs_grid *grid;
+    packed *pk;
+    float inv_mean_area;
+} facet_job;
+
+static void place_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const facet_job *job = ctx;
+    (void)chunk;
+    for (size_t j = begin; j < end; j++)
+        job->pk->facet_place[job->grid->facet_order[j]] = (uint32_t)j;
+}
+
+static void pack_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const facet_job *job = ctx;
+    const rs_problem *pb = job->pb;
+    packed *pk = job->pk;
+    (void)chunk;
+    for (size_t q = begin; q < end; q++) {
+        uint32_t j = pk->facet_place[q];
+        double c[3], n[3], area;
+        rs_facet_geometry(pb, q, c, n, &area);
+        int32_t cell[3];
+        rs_grid_facet_cell(job->grid, c, cell);
+        cl_float4 cen = local_point(job->grid, c, cell);
+        cen.s[3] = log2f((float)area * job->inv_mean_area);
+        pk->facet_centroid[j] = cen;
+        pk->facet_normal[j] = (cl_float4){{(float)n[0], (float)n[1], (float)n[2], 0}};
+        const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
+        pk->facet_vertices[q] =
+            (cl_uint4){{pk->slot[tri[0]], pk->slot[tri[1]], pk->slot[tri[2]], 0}};
+    }
 }
 
 static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, packed *pk,
@@ -150,24 +204,9 @@ static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, packed *pk
     /* Facets are read in the caller's order (mostly coherent in memory). What the pair loops read
      * (centroid, normal) goes to its place in grid order; the vertex slots, which only the
      * per-facet normals kernel reads, stay in the caller's order, with `place` to find the rest. */
-    uint32_t *place = pk->facet_place;
-    for (size_t j = 0; j < nf; j++)
-        place[grid->facet_order[j]] = (uint32_t)j;
-    const float inv_mean_area = (float)(1 / pb->mean_area);
-    for (size_t q = 0; q < nf; q++) {
-        uint32_t j = place[q];
-        double c[3], n[3], area;
-        rs_facet_geometry(pb, q, c, n, &area);
-        int32_t cell[3];
-        rs_grid_facet_cell(grid, c, cell);
-        cl_float4 cen = local_point(grid, c, cell);
-        cen.s[3] = log2f((float)area * inv_mean_area);
-        pk->facet_centroid[j] = cen;
-        pk->facet_normal[j] = (cl_float4){{(float)n[0], (float)n[1], (float)n[2], 0}};
-        const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
-        pk->facet_vertices[q] =
-            (cl_uint4){{pk->slot[tri[0]], pk->slot[tri[1]], pk->slot[tri[2]], 0}};
-    }
+    facet_job job = {pb, grid, pk, (float)(1 / pb->mean_area)};
+    rs_parallel_for(nf, PARALLEL_GRAIN, place_facets, &job);
+    rs_parallel_for(nf, PARALLEL_GRAIN, pack_facets, &job);
     return RSMOOTH_OK;
 }
 
@@ -204,16 +243,19 @@ static int cells_per_reach(const rs_problem *pb) {
 /* The grid over the facets' centroids, in a box that also holds every vertex of a facet, so the
  * kernels can form each facet's edges from its vertices' block positions (no vertex is clamped).
  * The centroids live only while the grid is built. */
-static rsmooth_status build_grid(const rs_problem *pb, rs_grid *grid, rsmooth_error *error) {
-    size_t nf = pb->facet_count;
-    double *centroid = rs_alloc_array(nf, 3 * sizeof *centroid);
-    if (!centroid)
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth",
-                       "no memory for %zu centroids", nf);
+typedef struct centroid_job {
+    const rs_problem *pb;
+    double *centroid;
+    double (*box)[6]; /* per chunk: lo x, y, z, hi x, y, z */
+} centroid_job;
+
+static void centroids_and_box(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const centroid_job *job = ctx;
+    const rs_problem *pb = job->pb;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t q = 0; q < nf; q++) {
+    for (size_t q = begin; q < end; q++) {
         double n[3], area;
-        rs_facet_geometry(pb, q, centroid + 3 * q, n, &area);
+        rs_facet_geometry(pb, q, job->centroid + 3 * q, n, &area);
         const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
         for (int c = 0; c < 3; c++)
             for (int k = 0; k < 3; k++) {
@@ -222,9 +264,34 @@ static rsmooth_status build_grid(const rs_problem *pb, rs_grid *grid, rsmooth_er
                 hi[k] = x > hi[k] ? x : hi[k];
             }
     }
+    for (int k = 0; k < 3; k++) {
+        job->box[chunk][k] = lo[k];
+        job->box[chunk][3 + k] = hi[k];
+    }
+}
+
+static rsmooth_status build_grid(const rs_problem *pb, rs_grid *grid, rsmooth_error *error) {
+    size_t nf = pb->facet_count, chunks = rs_parallel_chunks(nf, PARALLEL_GRAIN);
+    double *centroid = rs_alloc_array(nf, 3 * sizeof *centroid);
+    double(*box)[6] = rs_alloc_array(chunks, sizeof *box);
+    if (!centroid || !box) {
+        rs_free(centroid);
+        rs_free(box);
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth",
+                       "no memory for %zu centroids", nf);
+    }
+    centroid_job job = {pb, centroid, box};
+    rs_parallel_for(nf, PARALLEL_GRAIN, centroids_and_box, &job);
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t c = 0; c < chunks; c++)
+        for (int k = 0; k < 3; k++) {
+            lo[k] = box[c][k] < lo[k] ? box[c][k] : lo[k];
+            hi[k] = box[c][3 + k] > hi[k] ? box[c][3 + k] : hi[k];
+        }
     rsmooth_status st = rs_grid_build_in_box(grid, centroid, nf, pb->radius, cells_per_reach(pb),
                                              lo, hi, error);
     rs_free(centroid);
+    rs_free(box);
     return st;
 }
 
@@ -277,6 +344,39 @@ static cl_int run_1d(rsmooth_context *ctx, const rs_problem *pb, cl_kernel kerne
         clReleaseEvent(done[i]);
     }
     return err == CL_SUCCESS ? clFinish(ctx->queue) : err;
+}
+
+typedef struct result_job {
+    const rs_problem *pb;
+    const rs_result_sink *sink;
+    const packed *pk;
+    const cl_float *result, *extra; /* mapped block_result and block_extra */
+    double h;
+} result_job;
+
+/* Positions (p + displacement, in double), k and confidence of vertices [begin, end). */
+static void store_results(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const result_job *job = ctx;
+    const rs_result_sink *sink = job->sink;
+    const double mean_area = job->pb->mean_area;
+    (void)chunk;
+    for (size_t v = begin; v < end; v++) {
+        size_t b = job->pk->slot[v] / RS_LANES, lane = job->pk->slot[v] % RS_LANES;
+        const cl_float *res = job->result + 4 * RS_LANES * b + lane;
+        const cl_float *ext = job->extra + 2 * RS_LANES * b + lane;
+        const double *p = job->pb->xyz + 3 * v;
+        size_t to = sink->target ? sink->target[v] : v;
+        double out[3];
+        for (int k = 0; k < 3; k++)
+            out[k] = p[k] + (double)res[k * RS_LANES] * job->h;
+        rs_store_position(sink->scalar, sink->positions, to, out);
+        double k = (double)res[3 * RS_LANES] * exp2(-(double)ext[RS_LANES]) * mean_area;
+        double kf = (double)ext[0] * mean_area;
+        if (sink->weight)
+            sink->weight[to] = (float)k;
+        if (sink->confidence)
+            sink->confidence[to] = kf > 0 ? (float)fmin(1.0, k / kf) : 0.0f;
+    }
 }
 
 rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_result_sink *sink,
@@ -456,22 +556,9 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
         st = rs_cl_fail(error, err, "clEnqueueMapBuffer", ctx->device_name);
         goto cleanup;
     }
-    for (size_t v = 0; v < sink->core_count && v < nv; v++) {
-        size_t b = pk.slot[v] / RS_LANES, lane = pk.slot[v] % RS_LANES;
-        const cl_float *res = result + 4 * RS_LANES * b + lane, *ext = extra + 2 * RS_LANES * b + lane;
-        const double *p = pb->xyz + 3 * v;
-        size_t to = sink->target ? sink->target[v] : v;
-        double out[3];
-        for (int k = 0; k < 3; k++)
-            out[k] = p[k] + (double)res[k * RS_LANES] * h;
-        rs_store_position(sink->scalar, sink->positions, to, out);
-        double k = (double)res[3 * RS_LANES] * exp2(-(double)ext[RS_LANES]) * pb->mean_area;
-        double kf = (double)ext[0] * pb->mean_area;
-        if (sink->weight)
-            sink->weight[to] = (float)k;
-        if (sink->confidence)
-            sink->confidence[to] = kf > 0 ? (float)fmin(1.0, k / kf) : 0.0f;
-    }
+    result_job rj = {pb, sink, &pk, result, extra, h};
+    rs_parallel_for(sink->core_count < nv ? sink->core_count : nv, PARALLEL_GRAIN, store_results,
+                    &rj);
     double t_end = rs_now_ms();
     stats->ms_grid += t_grid - t_start;
     stats->ms_upload += t_upload - t_grid;

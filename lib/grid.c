@@ -68,6 +68,28 @@ int32_t rs_grid_find(const rs_grid *grid, int32_t x, int32_t y, int32_t z) {
     }
 }
 
+/* Elements per chunk below which a key loop is not worth a thread. */
+#define KEY_GRAIN 8192
+
+typedef struct key_job {
+    const rs_grid *grid;
+    const double *points;
+    uint64_t *keys;
+    uint32_t *order;
+    int32_t *cells;
+} key_job;
+
+static void facet_keys(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const key_job *job = ctx;
+    (void)chunk;
+    for (size_t i = begin; i < end; i++) {
+        int32_t c[3];
+        rs_grid_facet_cell(job->grid, job->points + 3 * i, c);
+        job->keys[i] = cell_key(job->grid, c);
+        job->order[i] = (uint32_t)i;
+    }
+}
+
 /* Open-addressing table of at least twice `count` slots, all -1; its mask in *mask. */
 static int32_t *new_table(size_t count, uint32_t *mask) {
     uint32_t size = 16;
@@ -146,12 +168,8 @@ rsmooth_status rs_grid_build_in_box(rs_grid *grid, const double *points, size_t 
     grid->facet_order = rs_alloc_array(count, sizeof *grid->facet_order);
     if (!keys || !grid->facet_order)
         goto fail_memory;
-    for (size_t i = 0; i < count; i++) {
-        int32_t c[3];
-        rs_grid_facet_cell(grid, points + 3 * i, c);
-        keys[i] = cell_key(grid, c);
-        grid->facet_order[i] = (uint32_t)i;
-    }
+    key_job job = {grid, points, keys, grid->facet_order, NULL};
+    rs_parallel_for(count, KEY_GRAIN, facet_keys, &job);
     if (!rs_radix_sort_u64(keys, grid->facet_order, count))
         goto fail_memory;
 
@@ -210,23 +228,38 @@ static uint64_t spread_bits(uint64_t x) {
     return x;
 }
 
+static void morton_keys(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const key_job *job = ctx;
+    int32_t m = job->grid->split + 1; /* clamped cells start at -m */
+    (void)chunk;
+    for (size_t i = begin; i < end; i++) {
+        int32_t *c = job->cells + 3 * i;
+        rs_grid_cell_of(job->grid, job->points + 3 * i, c);
+        job->keys[i] = spread_bits((uint64_t)(c[0] + m)) << 2 |
+                       spread_bits((uint64_t)(c[1] + m)) << 1 | spread_bits((uint64_t)(c[2] + m));
+        job->order[i] = (uint32_t)i;
+    }
+}
+
+/* The cells of the points in their new order. */
+static void ordered_cells(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const key_job *job = ctx;
+    (void)chunk;
+    for (size_t i = begin; i < end; i++)
+        rs_grid_cell_of(job->grid, job->points + 3 * (size_t)job->order[i], job->cells + 3 * i);
+}
+
 rsmooth_status rs_grid_order_points(const rs_grid *grid, const double *points, size_t count,
                                     uint32_t *order, int32_t *cells, rsmooth_error *error) {
     uint64_t *keys = rs_alloc_array(count, sizeof *keys);
     if (!keys)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rs_grid_order_points",
                        "no memory to order %zu vertices", count);
-    int32_t m = grid->split + 1; /* clamped cells start at -m */
-    for (size_t i = 0; i < count; i++) {
-        int32_t *c = cells + 3 * i;
-        rs_grid_cell_of(grid, points + 3 * i, c);
-        keys[i] = spread_bits((uint64_t)(c[0] + m)) << 2 | spread_bits((uint64_t)(c[1] + m)) << 1 |
-                  spread_bits((uint64_t)(c[2] + m));
-        order[i] = (uint32_t)i;
-    }
+    key_job job = {grid, points, keys, order, cells};
+    rs_parallel_for(count, KEY_GRAIN, morton_keys, &job);
     bool ok = rs_radix_sort_u64(keys, order, count);
-    for (size_t i = 0; ok && i < count; i++) /* the cells in the new order */
-        rs_grid_cell_of(grid, points + 3 * (size_t)order[i], cells + 3 * i);
+    if (ok)
+        rs_parallel_for(count, KEY_GRAIN, ordered_cells, &job);
     rs_free(keys);
     return ok ? RSMOOTH_OK
               : rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rs_grid_order_points",

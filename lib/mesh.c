@@ -194,6 +194,61 @@ rsmooth_status rs_check_output_positions(rsmooth_scalar scalar, const void *posi
     return RSMOOTH_OK;
 }
 
+/* Triangles per chunk below which the facet loops are not worth a thread. */
+#define GEOMETRY_GRAIN 8192
+
+typedef struct geometry_job {
+    rs_problem *problem;
+    rsmooth_scalar scalar;
+    const void *positions;
+    const uint32_t *indices;
+    bool keep;
+    uint8_t *valid;   /* per triangle: non-zero area */
+    size_t *count;    /* per chunk: its facets, then where they start */
+    double *area_sum; /* per chunk */
+} geometry_job;
+
+static void convert_positions(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const geometry_job *job = ctx;
+    (void)chunk;
+    for (size_t i = 3 * begin; i < 3 * end; i++)
+        job->problem->xyz[i] = rs_coordinate(job->scalar, job->positions, i);
+}
+
+/* First pass: which triangles are facets, how many per chunk, their area. */
+static void find_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const geometry_job *job = ctx;
+    size_t n = 0;
+    double sum = 0;
+    for (size_t t = begin; t < end; t++) {
+        double c[3], normal[3], area;
+        job->valid[t] = rs_triangle_geometry(job->problem->xyz, job->indices + 3 * t, c, normal,
+                                             &area);
+        if (job->valid[t]) {
+            n++;
+            sum += area;
+        }
+    }
+    job->count[chunk] = n;
+    job->area_sum[chunk] = sum;
+}
+
+/* Second pass: each chunk writes its facets from where the chunks before it end. */
+static void store_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const geometry_job *job = ctx;
+    rs_problem *pb = job->problem;
+    size_t f = job->count[chunk];
+    for (size_t t = begin; t < end; t++) {
+        if (!job->valid[t])
+            continue;
+        pb->facet_triangle[f] = (uint32_t)t;
+        if (job->keep)
+            rs_triangle_geometry(pb->xyz, job->indices + 3 * t, pb->centroid + 3 * f,
+                                 pb->normal + 3 * f, &pb->area[f]);
+        f++;
+    }
+}
+
 rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
                                   const void *positions, size_t vertex_count,
                                   const uint32_t *indices, size_t triangle_count,
@@ -228,24 +283,32 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
         rs_problem_free(problem);
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for facet data");
     }
-    for (size_t i = 0; i < 3 * vertex_count; i++)
-        problem->xyz[i] = rs_coordinate(scalar, positions, i);
-
-    size_t f = 0;
-    double area_sum = 0;
-    for (size_t t = 0; t < triangle_count; t++) {
-        double c[3], n[3], area;
-        if (!rs_triangle_geometry(problem->xyz, indices + 3 * t, c, n, &area))
-            continue; /* zero area: no weight, and no normal to divide by */
-        problem->facet_triangle[f] = (uint32_t)t;
-        if (keep_facet_data) {
-            memcpy(problem->centroid + 3 * f, c, sizeof c);
-            memcpy(problem->normal + 3 * f, n, sizeof n);
-            problem->area[f] = area;
-        }
-        area_sum += area;
-        f++;
+    size_t chunks = rs_parallel_chunks(triangle_count, GEOMETRY_GRAIN);
+    geometry_job job = {problem, scalar, positions, indices, keep_facet_data, NULL, NULL, NULL};
+    job.valid = rs_alloc_array(triangle_count, 1);
+    job.count = rs_calloc_array(chunks, sizeof *job.count);
+    job.area_sum = rs_calloc_array(chunks, sizeof *job.area_sum);
+    if (!job.valid || !job.count || !job.area_sum) {
+        rs_free(job.valid);
+        rs_free(job.count);
+        rs_free(job.area_sum);
+        rs_problem_free(problem);
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for facet data");
     }
+    rs_parallel_for(vertex_count, GEOMETRY_GRAIN, convert_positions, &job);
+    rs_parallel_for(triangle_count, GEOMETRY_GRAIN, find_facets, &job);
+    size_t f = 0; /* chunk c's facets start at the sum of the counts before it */
+    double area_sum = 0;
+    for (size_t c = 0; c < chunks; c++) {
+        size_t n = job.count[c];
+        job.count[c] = f;
+        f += n;
+        area_sum += job.area_sum[c];
+    }
+    rs_parallel_for(triangle_count, GEOMETRY_GRAIN, store_facets, &job);
+    rs_free(job.valid);
+    rs_free(job.count);
+    rs_free(job.area_sum);
     problem->facet_count = f;
     problem->mean_area = f ? area_sum / (double)f : 0;
 

@@ -52,6 +52,22 @@ static inline bool rs_mul_overflows(size_t a, size_t b) {
 double rs_now_ms(void);
 
 
+/* ---- parallel.c: host loops on every core ------------------------------------------------------ */
+
+/* Elements [begin, end) of a loop, as chunk number `chunk` (chunks are contiguous and in order). */
+typedef void (*rs_range_fn)(void *ctx, size_t begin, size_t end, size_t chunk);
+
+/* Threads host loops use: the online cores, or RSMOOTH_HOST_THREADS; at most 64. */
+size_t rs_host_threads(void);
+
+/* How many chunks rs_parallel_for cuts `count` elements into (at least min_per_chunk each). */
+size_t rs_parallel_chunks(size_t count, size_t min_per_chunk);
+
+/* Runs fn over [0, count) in rs_parallel_chunks(count, min_per_chunk) chunks at once and returns
+ * when all are done. The split depends only on the count and the thread count, so per-chunk
+ * results combined in chunk order are the same on every run. */
+void rs_parallel_for(size_t count, size_t min_per_chunk, rs_range_fn fn, void *ctx);
+
 /* ---- sort.c ------------------------------------------------------------------------------------ */
 
 /* Stable LSD radix sort of `keys` carrying `values` along. Returns false when scratch memory cannot
