@@ -39,7 +39,7 @@ static cl_float4 local_point(const rs_grid *grid, const double p[3], const int32
     cl_float4 out;
     for (int k = 0; k < 3; k++) {
         double corner = grid->origin[k] + (double)cell[k] * grid->cell_size;
-        double x = (p[k] - corner) / grid->cell_size;
+        double x = (p[k] - corner) * grid->inv_cell_size;
         out.s[k] = (float)(x < -LOCAL_CLAMP ? -LOCAL_CLAMP : x > LOCAL_CLAMP ? LOCAL_CLAMP : x);
     }
     out.s[3] = 0;

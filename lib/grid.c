@@ -23,7 +23,7 @@ void rs_grid_free(rs_grid *grid) {
 void rs_grid_cell_of(const rs_grid *grid, const double p[3], int32_t cell[3]) {
     int32_t m = grid->split + 1;
     for (int k = 0; k < 3; k++) {
-        double c = floor((p[k] - grid->origin[k]) / grid->cell_size);
+        double c = floor((p[k] - grid->origin[k]) * grid->inv_cell_size);
         double lo = -m, hi = (double)grid->dims[k] + m - 1;
         cell[k] = (int32_t)(c < lo ? lo : c > hi ? hi : c);
     }
@@ -161,6 +161,7 @@ rsmooth_status rs_grid_build_in_box(rs_grid *grid, const double *points, size_t 
             h = (hi[k] - lo[k]) / (MAX_CELLS_PER_AXIS - 2);
     memcpy(grid->origin, lo, 3 * sizeof *lo);
     grid->cell_size = h;
+    grid->inv_cell_size = 1 / h;
     for (int k = 0; k < 3; k++)
         grid->dims[k] = (int32_t)floor((hi[k] - lo[k]) / h) + 1;
 

@@ -156,9 +156,10 @@ bool rs_triangle_geometry(const double *xyz, const uint32_t *tri, double centroi
     double len = sqrt(rs_dot3(n, n));
     if (!(len > 0) || !isfinite(len))
         return false;
+    double inv_len = 1 / len;
     for (int k = 0; k < 3; k++) {
-        centroid[k] = (a[k] + b[k] + c[k]) / 3.0;
-        normal[k] = n[k] / len;
+        centroid[k] = (a[k] + b[k] + c[k]) / 3.0; /* exact where the coordinates are equal */
+        normal[k] = n[k] * inv_len;
     }
     *area = 0.5 * len;
     return true;
@@ -221,7 +222,7 @@ static void find_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
     size_t n = 0;
     double sum = 0;
     for (size_t t = begin; t < end; t++) {
-        double c[3], normal[3], area;
+        double c[3], normal[3], area = 0;
         job->valid[t] = rs_triangle_geometry(job->problem->xyz, job->indices + 3 * t, c, normal,
                                              &area);
         if (job->valid[t]) {

@@ -200,6 +200,8 @@ static inline void rs_cross3(const double a[3], const double b[3], double out[3]
 typedef struct rs_grid {
     double origin[3];        /* minimum corner of the centroids' bounding box */
     double cell_size;        /* h >= reach / split */
+    double inv_cell_size;    /* 1 / h: cells are found by multiplying (the margin in h absorbs
+                                the rounding) */
     int32_t split;           /* cells per reach */
     int32_t dims[3];         /* cells per axis covering the centroids */
     size_t cell_count;       /* occupied cells */
