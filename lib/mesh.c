@@ -195,8 +195,9 @@ rsmooth_status rs_check_output_positions(rsmooth_scalar scalar, const void *posi
     return RSMOOTH_OK;
 }
 
-/* Triangles per chunk below which the facet loops are not worth a thread. */
-#define GEOMETRY_GRAIN 8192
+/* Triangles per block of the facet loops (and elements per chunk below which a loop is not worth
+ * a thread). */
+#define GEOMETRY_BLOCK 8192
 
 typedef struct geometry_job {
     rs_problem *problem;
@@ -204,9 +205,10 @@ typedef struct geometry_job {
     const void *positions;
     const uint32_t *indices;
     bool keep;
+    size_t triangle_count;
     uint8_t *valid;   /* per triangle: non-zero area */
-    size_t *count;    /* per chunk: its facets, then where they start */
-    double *area_sum; /* per chunk */
+    size_t *count;    /* per block of GEOMETRY_BLOCK triangles: its facets, then their start */
+    double *area_sum; /* per block */
 } geometry_job;
 
 static void convert_positions(void *ctx, size_t begin, size_t end, size_t chunk) {
@@ -216,37 +218,45 @@ static void convert_positions(void *ctx, size_t begin, size_t end, size_t chunk)
         job->problem->xyz[i] = rs_coordinate(job->scalar, job->positions, i);
 }
 
-/* First pass: which triangles are facets, how many per chunk, their area. */
+/* First pass, over blocks [begin, end): which triangles are facets, how many per block, their
+ * area. Blocks have a fixed size, so the area sum (and the mean area every weight is scaled by)
+ * does not depend on the thread count. */
 static void find_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
     const geometry_job *job = ctx;
-    size_t n = 0;
-    double sum = 0;
-    for (size_t t = begin; t < end; t++) {
-        double c[3], normal[3], area = 0;
-        job->valid[t] = rs_triangle_geometry(job->problem->xyz, job->indices + 3 * t, c, normal,
-                                             &area);
-        if (job->valid[t]) {
-            n++;
-            sum += area;
+    (void)chunk;
+    for (size_t b = begin; b < end; b++) {
+        size_t n = 0, last = (b + 1) * GEOMETRY_BLOCK;
+        double sum = 0;
+        for (size_t t = b * GEOMETRY_BLOCK; t < last && t < job->triangle_count; t++) {
+            double c[3], normal[3], area = 0;
+            job->valid[t] = rs_triangle_geometry(job->problem->xyz, job->indices + 3 * t, c,
+                                                 normal, &area);
+            if (job->valid[t]) {
+                n++;
+                sum += area;
+            }
         }
+        job->count[b] = n;
+        job->area_sum[b] = sum;
     }
-    job->count[chunk] = n;
-    job->area_sum[chunk] = sum;
 }
 
-/* Second pass: each chunk writes its facets from where the chunks before it end. */
+/* Second pass: each block writes its facets from where the blocks before it end. */
 static void store_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
     const geometry_job *job = ctx;
     rs_problem *pb = job->problem;
-    size_t f = job->count[chunk];
-    for (size_t t = begin; t < end; t++) {
-        if (!job->valid[t])
-            continue;
-        pb->facet_triangle[f] = (uint32_t)t;
-        if (job->keep)
-            rs_triangle_geometry(pb->xyz, job->indices + 3 * t, pb->centroid + 3 * f,
-                                 pb->normal + 3 * f, &pb->area[f]);
-        f++;
+    (void)chunk;
+    for (size_t b = begin; b < end; b++) {
+        size_t f = job->count[b], last = (b + 1) * GEOMETRY_BLOCK;
+        for (size_t t = b * GEOMETRY_BLOCK; t < last && t < job->triangle_count; t++) {
+            if (!job->valid[t])
+                continue;
+            pb->facet_triangle[f] = (uint32_t)t;
+            if (job->keep)
+                rs_triangle_geometry(pb->xyz, job->indices + 3 * t, pb->centroid + 3 * f,
+                                     pb->normal + 3 * f, &pb->area[f]);
+            f++;
+        }
     }
 }
 
@@ -284,11 +294,12 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
         rs_problem_free(problem);
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for facet data");
     }
-    size_t chunks = rs_parallel_chunks(triangle_count, GEOMETRY_GRAIN);
-    geometry_job job = {problem, scalar, positions, indices, keep_facet_data, NULL, NULL, NULL};
+    size_t blocks = (triangle_count + GEOMETRY_BLOCK - 1) / GEOMETRY_BLOCK;
+    geometry_job job = {problem, scalar, positions, indices, keep_facet_data, triangle_count,
+                        NULL, NULL, NULL};
     job.valid = rs_alloc_array(triangle_count, 1);
-    job.count = rs_calloc_array(chunks, sizeof *job.count);
-    job.area_sum = rs_calloc_array(chunks, sizeof *job.area_sum);
+    job.count = rs_calloc_array(blocks, sizeof *job.count);
+    job.area_sum = rs_calloc_array(blocks, sizeof *job.area_sum);
     if (!job.valid || !job.count || !job.area_sum) {
         rs_free(job.valid);
         rs_free(job.count);
@@ -296,17 +307,17 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
         rs_problem_free(problem);
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for facet data");
     }
-    rs_parallel_for(vertex_count, GEOMETRY_GRAIN, convert_positions, &job);
-    rs_parallel_for(triangle_count, GEOMETRY_GRAIN, find_facets, &job);
-    size_t f = 0; /* chunk c's facets start at the sum of the counts before it */
+    rs_parallel_for(vertex_count, GEOMETRY_BLOCK, convert_positions, &job);
+    rs_parallel_for(blocks, 1, find_facets, &job);
+    size_t f = 0; /* block b's facets start at the sum of the counts before it */
     double area_sum = 0;
-    for (size_t c = 0; c < chunks; c++) {
-        size_t n = job.count[c];
-        job.count[c] = f;
+    for (size_t b = 0; b < blocks; b++) {
+        size_t n = job.count[b];
+        job.count[b] = f;
         f += n;
-        area_sum += job.area_sum[c];
+        area_sum += job.area_sum[b];
     }
-    rs_parallel_for(triangle_count, GEOMETRY_GRAIN, store_facets, &job);
+    rs_parallel_for(blocks, 1, store_facets, &job);
     rs_free(job.valid);
     rs_free(job.count);
     rs_free(job.area_sum);

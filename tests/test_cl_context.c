@@ -78,6 +78,31 @@ int main(void) {
     smooth_cube(ctx, &cube, b);
     CHECK(memcmp(a, b, n * sizeof *a) == 0);
     printf("two runs: bit-identical\n");
+
+    /* One host thread or several: the same bits (static chunks, fixed-size partial sums). */
+    {
+        shape_mesh big;
+        CHECK(shape_capped_cylinder(&big, 1.0, 1.5, 60000) == 0);
+        CHECK(shape_add_normal_noise(&big, 0.3, 5) == 0);
+        size_t nb = 3 * big.vertex_count;
+        double *one = malloc(nb * sizeof *one), *many = malloc(nb * sizeof *many);
+        CHECK(one && many);
+        rsmooth_error err;
+        setenv("RSMOOTH_HOST_THREADS", "1", 1);
+        CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, big.xyz, big.vertex_count, big.indices,
+                                    big.triangle_count, NULL, one, NULL, NULL, NULL, &err),
+                     RSMOOTH_OK);
+        setenv("RSMOOTH_HOST_THREADS", "5", 1);
+        CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, big.xyz, big.vertex_count, big.indices,
+                                    big.triangle_count, NULL, many, NULL, NULL, NULL, &err),
+                     RSMOOTH_OK);
+        unsetenv("RSMOOTH_HOST_THREADS");
+        CHECK(memcmp(one, many, nb * sizeof *one) == 0);
+        printf("1 and 5 host threads (%zu triangles): bit-identical\n", big.triangle_count);
+        free(one);
+        free(many);
+        shape_free(&big);
+    }
     {
         shape_mesh big;
         CHECK(shape_sphere(&big, 6, 1.0) == 0); /* 40962 vertices: enough to slice */
