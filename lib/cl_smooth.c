@@ -1,7 +1,8 @@
-/* The OpenCL path: host-side facet data and grid, upload, mollify -> normals -> robust kernels,
- * download and scatter back to the caller's vertex order. Coordinates travel as float32 in units of
- * the cell size, relative to their own cell's corner (see kernels/common.cl), so precision does not
- * depend on where the mesh sits; displacements return to double before they are added. */
+/* The OpenCL path: host-side facet data and grid (on every core), buffers the device reads in
+ * place, mollify -> normals -> robust kernels, results mapped and scattered back to the caller's
+ * vertex order. Coordinates travel as float32 in units of the cell size, relative to a nearby
+ * cell's corner (see kernels/common.cl), so precision does not depend on where the mesh sits;
+ * displacements return to double before they are added. */
 #include "rsmooth_internal.h"
 
 #include <math.h>
@@ -20,8 +21,8 @@ typedef struct packed {
     cl_uint4 *facet_vertices; /* in the caller's facet order: slots of the three vertices */
     cl_uint *facet_place;     /* caller's facet -> its place in grid order */
     size_t block_count;
-    cl_int4 *block_cell;      /* per block: its cell */
-    cl_float *block_pos;      /* per block: RS_LANES x, then y, then z, local to the cell */
+    cl_int4 *block_cell;      /* per block: its anchor, the lowest cell it spans */
+    cl_float *block_pos;      /* per block: RS_LANES x, then y, then z, local to the anchor */
     uint32_t *slot;           /* caller's vertex index -> block * RS_LANES + lane */
 } packed;
 
