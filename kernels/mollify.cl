@@ -67,7 +67,7 @@ inline float3 slot_position(__global const float *block_pos, __global const int4
                     slot_component(block_pos, slot, 3, 2));
 }
 
-__kernel void mollified_facet_normal(uint facet_count, __global const uint4 *facet_vertices,
+__kernel void mollified_facet_normal(uint facet_count, __global const uint *facet_vertices,
                                      __global const uint *facet_place,
                                      __global const float *block_pos,
                                      __global const int4 *block_cell, __global float4 *normal,
@@ -76,7 +76,7 @@ __kernel void mollified_facet_normal(uint facet_count, __global const uint4 *fac
     if (q >= facet_count)
         return;
     uint j = facet_place[q];
-    uint4 t = facet_vertices[q];
+    uint3 t = vload3(q, facet_vertices);
     int4 origin = block_cell[t.x / RS_LANES];
     float3 p0 = slot_position(block_pos, block_cell, t.x, origin);
     float3 input_e1 = slot_position(block_pos, block_cell, t.y, origin) - p0;

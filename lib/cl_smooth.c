@@ -18,7 +18,7 @@
 
 typedef struct packed {
     cl_float4 *facet_centroid, *facet_normal; /* in grid order */
-    cl_uint4 *facet_vertices; /* in the caller's facet order: slots of the three vertices */
+    cl_uint *facet_vertices;  /* in the caller's facet order: slots of the three vertices */
     cl_uint *facet_place;     /* caller's facet -> its place in grid order */
     size_t block_count;
     cl_int4 *block_cell;      /* per block: its anchor, the lowest cell it spans */
@@ -180,8 +180,8 @@ static void pack_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
         pk->facet_centroid[j] = cen;
         pk->facet_normal[j] = (cl_float4){{(float)n[0], (float)n[1], (float)n[2], 0}};
         const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
-        pk->facet_vertices[q] =
-            (cl_uint4){{pk->slot[tri[0]], pk->slot[tri[1]], pk->slot[tri[2]], 0}};
+        for (int corner = 0; corner < 3; corner++)
+            pk->facet_vertices[3 * q + corner] = pk->slot[tri[corner]];
     }
 }
 
@@ -191,7 +191,7 @@ static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, packed *pk
     memset(pk, 0, sizeof *pk);
     pk->facet_centroid = rs_alloc_array(nf, sizeof(cl_float4));
     pk->facet_normal = rs_alloc_array(nf, sizeof(cl_float4));
-    pk->facet_vertices = rs_alloc_array(nf, sizeof(cl_uint4));
+    pk->facet_vertices = rs_alloc_array(nf, 3 * sizeof(cl_uint));
     pk->facet_place = rs_alloc_array(nf, sizeof(cl_uint));
     pk->slot = rs_alloc_array(nv, sizeof(uint32_t));
     if (!pk->facet_centroid || !pk->facet_normal || !pk->facet_vertices || !pk->facet_place ||
@@ -401,6 +401,8 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
         st = pack(pb, &grid, &pk, error);
     if (st != RSMOOTH_OK)
         goto cleanup;
+    rs_free(grid.facet_order); /* packing was its last use: 4 bytes per facet less at the peak */
+    grid.facet_order = NULL;
     double t_grid = rs_now_ms();
 
     size_t nv = pb->vertex_count, nf = pb->facet_count, nc = grid.cell_count;
@@ -413,7 +415,7 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
         [BUF_FACET_CENTROID] = {nf * sizeof(cl_float4), pk.facet_centroid, CL_MEM_READ_ONLY},
         /* the input normals, replaced in place by the mollified ones */
         [BUF_FACET_NORMAL] = {nf * sizeof(cl_float4), pk.facet_normal, CL_MEM_READ_WRITE},
-        [BUF_FACET_VERTICES] = {nf * sizeof(cl_uint4), pk.facet_vertices, CL_MEM_READ_ONLY},
+        [BUF_FACET_VERTICES] = {nf * 3 * sizeof(cl_uint), pk.facet_vertices, CL_MEM_READ_ONLY},
         [BUF_FACET_PLACE] = {nf * sizeof(cl_uint), pk.facet_place, CL_MEM_READ_ONLY},
         [BUF_CELL_COORD] = {nc * 4 * sizeof(cl_int), grid.cell_coord, CL_MEM_READ_ONLY},
         [BUF_CELL_START] = {(nc + 1) * sizeof(cl_uint), grid.cell_start, CL_MEM_READ_ONLY},
