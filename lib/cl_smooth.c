@@ -255,8 +255,7 @@ static void centroids_and_box(void *ctx, size_t begin, size_t end, size_t chunk)
     const rs_problem *pb = job->pb;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t q = begin; q < end; q++) {
-        double n[3], area;
-        rs_facet_geometry(pb, q, job->centroid + 3 * q, n, &area);
+        rs_facet_centroid(pb, q, job->centroid + 3 * q);
         const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
         for (int c = 0; c < 3; c++)
             for (int k = 0; k < 3; k++) {

@@ -156,11 +156,10 @@ bool rs_triangle_geometry(const double *xyz, const uint32_t *tri, double centroi
     double len = sqrt(rs_dot3(n, n));
     if (!(len > 0) || !isfinite(len))
         return false;
+    rs_triangle_centroid(xyz, tri, centroid);
     double inv_len = 1 / len;
-    for (int k = 0; k < 3; k++) {
-        centroid[k] = (a[k] + b[k] + c[k]) / 3.0; /* exact where the coordinates are equal */
+    for (int k = 0; k < 3; k++)
         normal[k] = n[k] * inv_len;
-    }
     *area = 0.5 * len;
     return true;
 }

@@ -129,11 +129,24 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
 bool rs_triangle_geometry(const double *xyz, const uint32_t *tri, double centroid[3],
                           double normal[3], double *area);
 
+/* The centroid alone, as rs_triangle_geometry computes it. */
+static inline void rs_triangle_centroid(const double *xyz, const uint32_t *tri,
+                                        double centroid[3]) {
+    const double *a = xyz + 3 * (size_t)tri[0], *b = xyz + 3 * (size_t)tri[1];
+    const double *c = xyz + 3 * (size_t)tri[2];
+    for (int k = 0; k < 3; k++)
+        centroid[k] = (a[k] + b[k] + c[k]) / 3.0; /* exact where the coordinates are equal */
+}
+
 /* The same for facet q of a problem. */
 static inline void rs_facet_geometry(const rs_problem *problem, size_t q, double centroid[3],
                                      double normal[3], double *area) {
     rs_triangle_geometry(problem->xyz, problem->indices + 3 * (size_t)problem->facet_triangle[q],
                          centroid, normal, area);
+}
+static inline void rs_facet_centroid(const rs_problem *problem, size_t q, double centroid[3]) {
+    rs_triangle_centroid(problem->xyz,
+                         problem->indices + 3 * (size_t)problem->facet_triangle[q], centroid);
 }
 void rs_problem_free(rs_problem *problem);
 

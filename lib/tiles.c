@@ -28,15 +28,6 @@ typedef struct tiler {
     rsmooth_error *error;
 } tiler;
 
-/* Facet q's centroid, as rs_triangle_geometry computes it (tiles need no normal or area). */
-static void facet_centroid(const rs_problem *pb, size_t q, double c[3]) {
-    const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
-    const double *a = pb->xyz + 3 * (size_t)tri[0], *b = pb->xyz + 3 * (size_t)tri[1];
-    const double *d = pb->xyz + 3 * (size_t)tri[2];
-    for (int k = 0; k < 3; k++)
-        c[k] = (a[k] + b[k] + d[k]) / 3.0;
-}
-
 /* A tile's progress mapped into the whole call's. */
 typedef struct tile_progress {
     rsmooth_progress_fn fn;
@@ -146,7 +137,7 @@ static rsmooth_status solve_region(tiler *t, uint32_t *verts, size_t n, const ui
     size_t m = 0;
     for (size_t j = 0; j < facet_count; j++) {
         double c[3];
-        facet_centroid(w, facets[j], c);
+        rs_facet_centroid(w, facets[j], c);
         bool inside = true;
         for (int k = 0; k < 3; k++)
             inside = inside && c[k] >= lo[k] - t->halo && c[k] <= hi[k] + t->halo;
@@ -204,7 +195,7 @@ rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *pb, const rs
     for (size_t q = 0; q < pb->facet_count; q++) {
         const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
         double centroid[3];
-        facet_centroid(pb, q, centroid);
+        rs_facet_centroid(pb, q, centroid);
         for (int c = 0; c < 3; c++) {
             double d[3];
             rs_sub3(pb->xyz + 3 * (size_t)tri[c], centroid, d);
