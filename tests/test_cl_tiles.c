@@ -71,7 +71,7 @@ static double max_float_diff(const float *a, const float *b, size_t n, bool rela
     return worst;
 }
 
-/* Untiled, tiled with a budget of a sixth of the need, and the reference: all agree. */
+/* Untiled, tiled with a budget far below the need, and the reference: all agree. */
 static void check_shape(rsmooth_context *ctx, const char *name, const shape_mesh *m,
                         const rsmooth_params *base) {
     size_t nv = m->vertex_count, nt = m->triangle_count;
