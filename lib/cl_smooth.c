@@ -632,7 +632,7 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
             report->ms_total = rs_now_ms() - t_start;
             report->pairs_mollify = stats.pairs_mollify;
             report->pairs_robust = stats.pairs_robust;
-            report->tiles = stats.tiles;
+            report->tiles = stats.tiles > 0 ? stats.tiles : 1; /* no facet: one trivial run */
         }
     }
     rs_problem_free(&pb);

@@ -49,9 +49,26 @@ static uint64_t estimate_bytes(size_t vertices, size_t facets) {
 
 /* Runs the tile of core vertices `verts` with facets `facets` (indices into the whole problem):
  * core vertices first, then the other vertices of those facets. */
+/* Vertices with no facet within reach of their tile stay where they are, with zero weight. */
+static void store_unmoved(tiler *t, const uint32_t *verts, size_t n) {
+    const rs_result_sink *sink = t->sink;
+    for (size_t i = 0; i < n; i++) {
+        rs_store_position(sink->scalar, sink->positions, verts[i], t->whole->xyz + 3 * verts[i]);
+        if (sink->weight)
+            sink->weight[verts[i]] = 0;
+        if (sink->confidence)
+            sink->confidence[verts[i]] = 0;
+    }
+    t->vertices_done += n;
+}
+
 static rsmooth_status run_tile(tiler *t, const uint32_t *verts, size_t n, const uint32_t *facets,
                                size_t m, uint64_t *needed) {
     const rs_problem *w = t->whole;
+    if (m == 0) { /* stray vertices far from every facet */
+        store_unmoved(t, verts, n);
+        return RSMOOTH_OK;
+    }
     rs_problem sub = *w;
     sub.xyz = NULL;
     sub.centroid = sub.normal = sub.area = NULL; /* computed from the vertices where needed */

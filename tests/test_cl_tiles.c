@@ -177,6 +177,20 @@ int main(void) {
     check_shape(ctx, "cylinder (3, inf), no mollification", &cylinder, &params);
     rsmooth_params_init(&params);
     check_shape(ctx, "unindexed soup (2, 0.5)", &soup, &params);
+    /* stray vertices far from every facet make tiles with no facet at all: they stay put */
+    shape_mesh stray;
+    CHECK(shape_copy(&cylinder, &stray) == 0);
+    size_t first = stray.vertex_count;
+    stray.vertex_count += 8;
+    stray.xyz = realloc(stray.xyz, stray.vertex_count * 3 * sizeof *stray.xyz);
+    CHECK(stray.xyz);
+    for (size_t v = first; v < stray.vertex_count; v++) {
+        stray.xyz[3 * v] = 100.0 * (double)(v - first + 1);
+        stray.xyz[3 * v + 1] = -50.0;
+        stray.xyz[3 * v + 2] = 3.0;
+    }
+    check_shape(ctx, "cylinder and 8 far stray vertices", &stray, &params);
+    shape_free(&stray);
     check_too_small(ctx, &cylinder);
     rsmooth_context_destroy(ctx);
     check_environment();
