@@ -53,3 +53,16 @@ bool cli_parse_bytes(const char *text, uint64_t *out) {
     *out = (uint64_t)v;
     return true;
 }
+
+void cli_print_json_string(const char *text) {
+    putchar('"');
+    for (const unsigned char *c = (const unsigned char *)text; *c; c++) {
+        if (*c == '"' || *c == '\\')
+            printf("\\%c", *c);
+        else if (*c < 0x20)
+            printf("\\u%04x", *c);
+        else
+            putchar(*c);
+    }
+    putchar('"');
+}

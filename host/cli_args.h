@@ -15,6 +15,10 @@ int cli_usage_error(const char *command, const char *format, ...);
 /* Parses the whole of `text` as a number; false for junk, NaN or out of range. Accepts "inf". */
 bool cli_parse_number(const char *text, double *out);
 
+/* Prints `text` on stdout as a JSON string literal (quotes, backslashes and control characters
+ * escaped). */
+void cli_print_json_string(const char *text);
+
 /* Parses a byte count: "268435456", "256M", "1.5G", "512KiB" (K, M, G, T are powers of 1024). */
 bool cli_parse_bytes(const char *text, uint64_t *out);
 

@@ -289,26 +289,12 @@ static void confidence_colour(float c, uint8_t rgb[3]) {
         rgb[k] = (uint8_t)lrintf(stops[i][k] + t * (stops[i + 1][k] - stops[i][k]));
 }
 
-/* A JSON string literal of `text` (quotes, backslashes and control characters escaped). */
-static void print_json_string(const char *text) {
-    putchar('"');
-    for (const unsigned char *c = (const unsigned char *)text; *c; c++) {
-        if (*c == '"' || *c == '\\')
-            printf("\\%c", *c);
-        else if (*c < 0x20)
-            printf("\\u%04x", *c);
-        else
-            putchar(*c);
-    }
-    putchar('"');
-}
-
 static void print_json(const rsmooth_report *r, const options *opt, double ms_read,
                        double ms_write) {
     printf("{\"input\":");
-    print_json_string(opt->input);
+    cli_print_json_string(opt->input);
     printf(",\"output\":");
-    print_json_string(opt->output);
+    cli_print_json_string(opt->output);
     printf(",\"method\":\"%s\"", method_names[opt->method]);
     if (method_uses_edges(opt->method))
         printf(",\"lambda\":%.9g,\"mu\":%.9g,\"iterations\":%u", opt->lambda, opt->mu,
@@ -322,7 +308,7 @@ static void print_json(const rsmooth_report *r, const options *opt, double ms_re
         printf("\"sigma_g\":%.9g,", r->sigma_g);
     printf("\"radius\":%.9g,\"grid_cells\":%zu,\"pairs_robust\":%llu,\"tiles\":%zu,\"device\":", r->radius,
            r->grid_cell_count, (unsigned long long)r->pairs_robust, r->tiles);
-    print_json_string(r->device);
+    cli_print_json_string(r->device);
     printf(",\"ms\":{\"read\":%.3f,\"setup\":%.3f,\"facets\":%.3f,\"grid\":%.3f,\"upload\":%.3f,"
            "\"mollify\":%.3f,\"normals\":%.3f,\"robust\":%.3f,\"download\":%.3f,\"filter\":%.3f,"
            "\"write\":%.3f}}\n",

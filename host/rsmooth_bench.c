@@ -396,19 +396,6 @@ static bool reset_peak_rss(void) {
     return fclose(f) == 0 && ok;
 }
 
-static void print_json_string(const char *text) {
-    putchar('"');
-    for (const unsigned char *c = (const unsigned char *)text; *c; c++) {
-        if (*c == '"' || *c == '\\')
-            printf("\\%c", *c);
-        else if (*c < 0x20)
-            printf("\\u%04x", *c);
-        else
-            putchar(*c);
-    }
-    putchar('"');
-}
-
 /* A number, or null where it does not exist (NaN, infinite). */
 static void print_json_number(const char *key, double value) {
     if (isfinite(value))
@@ -583,7 +570,7 @@ static int bench_filter(int argc, char **argv) {
     }
 
     printf("{\"mode\":\"filter\",\"mesh\":");
-    print_json_string(opt.mesh_path ? opt.mesh_path : "generated");
+    cli_print_json_string(opt.mesh_path ? opt.mesh_path : "generated");
     if (!opt.mesh_path)
         printf(",\"noise\":%.6g", opt.noise);
     printf(",\"vertices\":%zu,\"triangles\":%zu,\"facets\":%zu,\"mean_edge_length\":%.6g,", nv, nt,
@@ -599,7 +586,7 @@ static int bench_filter(int argc, char **argv) {
            "\"memory_budget\":%llu,\"device\":",
            report.radius, report.mollify_radius, report.grid_cell_count, report.tiles,
            (unsigned long long)rsmooth_context_memory_budget(ctx));
-    print_json_string(report.device);
+    cli_print_json_string(report.device);
     printf(",\"repeat\":%d,\"context_create_first_ms\":%.1f,\"program_build_first_ms\":%.1f,"
            "\"context_create_cached_ms\":%.1f,\"program_build_cached_ms\":%.1f,"
            "\"kernel_codegen_ms\":%.2f,\"first_run_ms\":%.2f,\"ms\":{",

@@ -288,8 +288,8 @@ static rsmooth_status build_grid(const rs_problem *pb, rs_grid *grid, rsmooth_er
             lo[k] = box[c][k] < lo[k] ? box[c][k] : lo[k];
             hi[k] = box[c][3 + k] > hi[k] ? box[c][3 + k] : hi[k];
         }
-    rsmooth_status st = rs_grid_build_in_box(grid, centroid, nf, pb->radius, cells_per_reach(pb),
-                                             lo, hi, error);
+    rsmooth_status st = rs_grid_build_columns(grid, centroid, nf, pb->radius, cells_per_reach(pb),
+                                              lo, hi, error);
     rs_free(centroid);
     rs_free(box);
     return st;

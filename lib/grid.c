@@ -128,13 +128,33 @@ static bool build_columns(rs_grid *grid) {
     return true;
 }
 
-rsmooth_status rs_grid_build(rs_grid *grid, const double *points, size_t count, double reach,
-                             rsmooth_error *error) {
-    return rs_grid_build_split(grid, points, count, reach, 1, error);
+/* The hash table of occupied cells (rs_grid_find). */
+static bool index_cells(rs_grid *grid) {
+    grid->table = new_table(grid->cell_count, &grid->table_mask);
+    if (!grid->table)
+        return false;
+    for (size_t cell = 0; cell < grid->cell_count; cell++) {
+        const int32_t *c = grid->cell_coord + 4 * cell;
+        uint32_t slot = rs_grid_hash(c[0], c[1], c[2]) & grid->table_mask;
+        while (grid->table[slot] >= 0)
+            slot = (slot + 1) & grid->table_mask;
+        grid->table[slot] = (int32_t)cell;
+    }
+    return true;
 }
 
-rsmooth_status rs_grid_build_split(rs_grid *grid, const double *points, size_t count, double reach,
-                                   int split, rsmooth_error *error) {
+static rsmooth_status sort_into_cells(rs_grid *grid, const double *points, size_t count,
+                                      double reach, int split, const double lo[3],
+                                      const double hi[3], rsmooth_error *error);
+
+static rsmooth_status out_of_memory(rs_grid *grid, size_t count, rsmooth_error *error) {
+    rs_grid_free(grid);
+    return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rs_grid_build",
+                   "no memory for the grid (%zu facets)", count);
+}
+
+rsmooth_status rs_grid_build(rs_grid *grid, const double *points, size_t count, double reach,
+                             rsmooth_error *error) {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t i = 0; i < count; i++)
         for (int k = 0; k < 3; k++) {
@@ -144,13 +164,26 @@ rsmooth_status rs_grid_build_split(rs_grid *grid, const double *points, size_t c
         }
     if (count == 0)
         lo[0] = lo[1] = lo[2] = hi[0] = hi[1] = hi[2] = 0;
-    return rs_grid_build_in_box(grid, points, count, reach, split, lo, hi, error);
+    rsmooth_status st = sort_into_cells(grid, points, count, reach, 1, lo, hi, error);
+    if (st == RSMOOTH_OK && !index_cells(grid))
+        return out_of_memory(grid, count, error);
+    return st;
 }
 
-rsmooth_status rs_grid_build_in_box(rs_grid *grid, const double *points, size_t count,
-                                    double reach, int split, const double lo[3],
-                                    const double hi[3], rsmooth_error *error) {
-    static const char where[] = "rs_grid_build";
+rsmooth_status rs_grid_build_columns(rs_grid *grid, const double *points, size_t count,
+                                     double reach, int split, const double lo[3],
+                                     const double hi[3], rsmooth_error *error) {
+    rsmooth_status st = sort_into_cells(grid, points, count, reach, split, lo, hi, error);
+    if (st == RSMOOTH_OK && !build_columns(grid))
+        return out_of_memory(grid, count, error);
+    return st;
+}
+
+/* Facets sorted by cell, and the occupied cells with their first facets: what both lookups
+ * (cells, columns) index. */
+static rsmooth_status sort_into_cells(rs_grid *grid, const double *points, size_t count,
+                                      double reach, int split, const double lo[3],
+                                      const double hi[3], rsmooth_error *error) {
     memset(grid, 0, sizeof *grid);
     grid->split = split;
     /* A hair wider than the reach: a point and a centroid exactly `reach` apart must never round
@@ -182,9 +215,8 @@ rsmooth_status rs_grid_build_in_box(rs_grid *grid, const double *points, size_t 
     grid->cell_coord = rs_alloc_array(cells, 4 * sizeof(int32_t));
     grid->cell_start = rs_alloc_array(cells + 1, sizeof(uint32_t));
     if (cells > (1u << 30))
-        goto fail_memory; /* the hash table's 32-bit slots would overflow */
-    grid->table = new_table(cells, &grid->table_mask);
-    if (!grid->cell_coord || !grid->cell_start || !grid->table)
+        goto fail_memory; /* the hash tables' 32-bit slots would overflow */
+    if (!grid->cell_coord || !grid->cell_start)
         goto fail_memory;
 
     size_t cell = 0;
@@ -199,23 +231,15 @@ rsmooth_status rs_grid_build_in_box(rs_grid *grid, const double *points, size_t 
         coord[2] = c[2];
         coord[3] = 0;
         grid->cell_start[cell] = (uint32_t)i;
-        uint32_t slot = rs_grid_hash(c[0], c[1], c[2]) & grid->table_mask;
-        while (grid->table[slot] >= 0)
-            slot = (slot + 1) & grid->table_mask;
-        grid->table[slot] = (int32_t)cell;
         cell++;
     }
     grid->cell_start[cells] = (uint32_t)count;
     rs_free(keys);
-    if (!build_columns(grid))
-        goto fail_memory;
     return RSMOOTH_OK;
 
 fail_memory:
     rs_free(keys);
-    rs_grid_free(grid);
-    return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the grid (%zu facets)",
-                   count);
+    return out_of_memory(grid, count, error);
 }
 
 /* Spreads the low 21 bits of x to every third bit (Morton order). */

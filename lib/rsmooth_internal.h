@@ -221,26 +221,27 @@ typedef struct rs_grid {
     int32_t *cell_coord;     /* 4 per cell: x, y, z, 0 */
     uint32_t *cell_start;    /* cell_count + 1: facets of cell i are facet_order[start[i]..start[i+1]) */
     uint32_t *facet_order;   /* facet ids sorted by cell */
+    /* rs_grid_build only: a hash table of the occupied cells */
     uint32_t table_mask;     /* hash table size - 1 (a power of two) */
     int32_t *table;          /* table_mask + 1 slots: cell index or -1 */
-    /* Columns: the occupied cells of one (x, y), consecutive in cell order (sorted by x, y, z). */
+    /* rs_grid_build_columns only. Columns: the occupied cells of one (x, y), consecutive in cell
+     * order (sorted by x, y, z). */
     size_t column_count;
     uint32_t *column_first;  /* column_count + 1: cells of column j are column_first[j] .. [j+1]-1 */
     uint32_t column_mask;    /* column hash table size - 1 */
     int32_t *column_table;   /* column_mask + 1 slots: column index or -1, hashed on (x, y, 0) */
 } rs_grid;
 
-/* Builds the grid over `count` points (3 doubles each) with cells at least `reach` wide. */
+/* Builds the grid over `count` points (3 doubles each) with cells at least `reach` wide, its
+ * occupied cells found through `table` (rs_grid_find): the reference path's grid. */
 rsmooth_status rs_grid_build(rs_grid *grid, const double *points, size_t count, double reach,
                              rsmooth_error *error);
-/* The same with cells at least reach / split wide (split >= 1). */
-rsmooth_status rs_grid_build_split(rs_grid *grid, const double *points, size_t count, double reach,
-                                   int split, rsmooth_error *error);
-/* The same over the box [lo, hi], which must hold every point (it may hold more: the OpenCL path
- * makes it hold the vertices too, so none of them is clamped). */
-rsmooth_status rs_grid_build_in_box(rs_grid *grid, const double *points, size_t count,
-                                    double reach, int split, const double lo[3],
-                                    const double hi[3], rsmooth_error *error);
+/* The OpenCL path's grid: cells at least reach / split wide (split >= 1) over the box [lo, hi],
+ * which must hold every point (it may hold more: the OpenCL path makes it hold the vertices too, so
+ * none of them is clamped), its occupied cells found by column (no `table`). */
+rsmooth_status rs_grid_build_columns(rs_grid *grid, const double *points, size_t count,
+                                     double reach, int split, const double lo[3],
+                                     const double hi[3], rsmooth_error *error);
 void rs_grid_free(rs_grid *grid);
 
 /* Cell coordinates of a point, clamped to [-split - 1, dims + split]: a point clamped there is more
@@ -250,7 +251,7 @@ void rs_grid_cell_of(const rs_grid *grid, const double p[3], int32_t cell[3]);
 /* The cell the grid filed a point it was built over in (rs_grid_cell_of, within the grid). */
 void rs_grid_facet_cell(const rs_grid *grid, const double p[3], int32_t cell[3]);
 
-/* Index of the occupied cell at (x, y, z), or -1. */
+/* Index of the occupied cell at (x, y, z), or -1 (a grid from rs_grid_build). */
 int32_t rs_grid_find(const rs_grid *grid, int32_t x, int32_t y, int32_t z);
 
 /* The hash both host and kernels use to place a cell in the table. */
