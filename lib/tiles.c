@@ -47,8 +47,6 @@ static uint64_t estimate_bytes(size_t vertices, size_t facets) {
     return (uint64_t)facets * RS_DEVICE_BYTES_PER_FACET + (uint64_t)v * RS_DEVICE_BYTES_PER_VERTEX;
 }
 
-/* Runs the tile of core vertices `verts` with facets `facets` (indices into the whole problem):
- * core vertices first, then the other vertices of those facets. */
 /* Vertices with no facet within reach of their tile stay where they are, with zero weight. */
 static void store_unmoved(tiler *t, const uint32_t *verts, size_t n) {
     const rs_result_sink *sink = t->sink;
@@ -62,6 +60,8 @@ static void store_unmoved(tiler *t, const uint32_t *verts, size_t n) {
     t->vertices_done += n;
 }
 
+/* Runs the tile of core vertices `verts` with facets `facets` (indices into the whole problem):
+ * core vertices first, then the other vertices of those facets. */
 static rsmooth_status run_tile(tiler *t, const uint32_t *verts, size_t n, const uint32_t *facets,
                                size_t m, uint64_t *needed) {
     const rs_problem *w = t->whole;
