@@ -35,6 +35,10 @@ static const char usage_text[] =
     "Vertex order, faces and everything else the file holds (colours, texture coordinates,\n"
     "groups, materials, other PLY properties and elements) are kept when the output has the\n"
     "input's format; vertex normals are recomputed. Converting says on stderr what it drops.\n"
+    "Point clouds: a file with vertex normals and no faces (PLY nx ny nz, NOFF, OBJ vn) is\n"
+    "filtered as points, each predicting with its tangent plane (sigmas in point spacings: the\n"
+    "mean distance to the 6 nearest points); the filtered positions and normals are written.\n"
+    "Reference path only (CPU) for now.\n"
     "\n"
     "The two widths, in mean edge lengths of the input (a scan's point spacing):\n"
     "  --sigma-f X     spatial width: how far around a vertex triangles are consulted (they are\n"
@@ -46,6 +50,22 @@ static const char usage_text[] =
     "                  (plain Gaussian-weighted smoothing). Default 0.5.\n"
     "  Rule of thumb (the paper's): raise both until the surface is smooth enough, then lower\n"
     "  --sigma-g until the sharp features come back.\n"
+    "\n"
+    "Beyond the paper (the defaults above are the paper's filter, unchanged):\n"
+    "  --best                the most accurate mode measured (docs/experiments.md): bilateral\n"
+    "                        normals, then 3 passes at sigma-f 1, sigma-g 0.3. Options after it\n"
+    "                        still apply, e.g. --best --passes 4\n"
+    "  --normals F           how the predicting planes' normals are smoothed: mollify (default,\n"
+    "                        the paper's) or bilateral (keeps creases the Gaussian rounds)\n"
+    "  --normal-sigma-s X    bilateral: spatial width, in the units of sigma-f (default 1)\n"
+    "  --normal-sigma-n X    bilateral: width on the difference of unit normals, (0, 2]; smaller\n"
+    "                        keeps more creases (default 0.35)\n"
+    "  --normal-iterations K bilateral: rounds (default 5)\n"
+    "  --influence G         the robust weight on a prediction's distance: gaussian (default),\n"
+    "                        tukey (zero beyond 2.24 sigma-g), lorentzian or huber (heavier tails)\n"
+    "  --passes N            run the filter N times, each from the previous result (default 1)\n"
+    "  --pass-confidence C   passes after the first move only vertices whose confidence was\n"
+    "                        below C in (0, 1]: more smoothing at features and outliers only\n"
     "\n"
     "Options:\n"
     "  -o, --output FILE     result mesh (.obj, .ply, .off, .stl); refuses to replace an existing\n"
@@ -98,6 +118,10 @@ static const char usage_text[] =
 typedef enum method { METHOD_ROBUST, METHOD_GAUSSIAN, METHOD_LAPLACIAN, METHOD_TAUBIN } method;
 static const char *const method_names[] = {"robust", "gaussian", "laplacian", "taubin"};
 
+/* --normals and --influence values, in enum order. */
+static const char *const normal_filter_names[] = {"mollify", "bilateral"};
+static const char *const influence_names[] = {"gaussian", "tukey", "lorentzian", "huber"};
+
 /* Laplacian and Taubin iterate on the mesh's edges (rsmooth_smooth_taubin): no sigmas, no
  * confidence. */
 static bool method_uses_edges(method m) {
@@ -112,7 +136,7 @@ typedef struct options {
     unsigned iterations;
     uint64_t memory_budget; /* 0: the library's default */
     bool sigma_g_given, umbrella_given; /* for consistency checks against --method */
-    bool ascii, json, force, quiet, in_place, stats, list_devices;
+    bool ascii, json, force, quiet, in_place, stats, list_devices, best;
 } options;
 
 /* Returns -1 when the program should go on, else the exit status. */
@@ -122,6 +146,11 @@ static int parse_args(int argc, char **argv, options *opt) {
     opt->lambda = 0.5;
     opt->mu = -0.53;
     opt->iterations = 10;
+    for (int i = 1; i < argc; i++)
+        if (!strcmp(argv[i], "--best")) {
+            rsmooth_params_init_best(&opt->params);
+            opt->best = true;
+        }
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *value = i + 1 < argc ? argv[i + 1] : NULL;
@@ -190,6 +219,50 @@ static int parse_args(int argc, char **argv, options *opt) {
             else
                 opt->params.cutoff = x;
             i++;
+        } else if (!strcmp(a, "--normals") || !strcmp(a, "--influence")) {
+            if (!value)
+                return cli_usage_error(NULL, "%s needs a value", a);
+            bool normals = !strcmp(a, "--normals");
+            const char *const *names = normals ? normal_filter_names : influence_names;
+            int count = normals ? 2 : 4, k = 0;
+            while (k < count && strcmp(value, names[k]) != 0)
+                k++;
+            if (k == count)
+                return cli_usage_error(NULL, normals ? "--normals: '%s' is not mollify or bilateral"
+                                                     : "--influence: '%s' is not gaussian, tukey, "
+                                                       "lorentzian or huber",
+                                       value);
+            if (normals)
+                opt->params.normal_filter = k;
+            else
+                opt->params.influence = k;
+            i++;
+        } else if (!strcmp(a, "--normal-sigma-s") || !strcmp(a, "--normal-sigma-n") ||
+                   !strcmp(a, "--pass-confidence")) {
+            if (!value)
+                return cli_usage_error(NULL, "%s needs a value", a);
+            if (!cli_parse_number(value, &x))
+                return cli_usage_error(NULL, "%s: not a number: '%s'", a, value);
+            if (!strcmp(a, "--normal-sigma-s"))
+                opt->params.normal_sigma_s = x;
+            else if (!strcmp(a, "--normal-sigma-n"))
+                opt->params.normal_sigma_n = x;
+            else
+                opt->params.pass_confidence = x;
+            i++;
+        } else if (!strcmp(a, "--normal-iterations") || !strcmp(a, "--passes")) {
+            if (!value)
+                return cli_usage_error(NULL, "%s needs a value", a);
+            if (!cli_parse_number(value, &x) || !(x >= 1 && x <= 100 && x == floor(x)))
+                return cli_usage_error(NULL, "%s must be a whole number in [1, 100] (got '%s')", a,
+                                       value);
+            if (!strcmp(a, "--passes"))
+                opt->params.passes = (int)x;
+            else
+                opt->params.normal_iterations = (int)x;
+            i++;
+        } else if (!strcmp(a, "--best")) {
+            /* applied before the loop, so the options after it can change its settings */
         } else if (!strcmp(a, "--absolute")) {
             opt->params.absolute = 1;
         } else if (!strcmp(a, "--no-mollify")) {
@@ -234,6 +307,15 @@ static int parse_args(int argc, char **argv, options *opt) {
         return cli_usage_error(NULL, "--sigma-g must be positive, or 'inf' (got %g)", p->sigma_g);
     if (!(p->cutoff > 0 && p->cutoff <= 5))
         return cli_usage_error(NULL, "--cutoff must be in (0, 5] (got %g)", p->cutoff);
+    if (!(p->normal_sigma_s > 0) || !isfinite(p->normal_sigma_s))
+        return cli_usage_error(NULL, "--normal-sigma-s must be a positive number (got %g)",
+                               p->normal_sigma_s);
+    if (!(p->normal_sigma_n > 0 && p->normal_sigma_n <= 2))
+        return cli_usage_error(NULL, "--normal-sigma-n must be in (0, 2] (got %g)",
+                               p->normal_sigma_n);
+    if (!(p->pass_confidence >= 0 && p->pass_confidence <= 1))
+        return cli_usage_error(NULL, "--pass-confidence must be in [0, 1] (got %g)",
+                               p->pass_confidence);
     bool umbrella = method_uses_edges(opt->method);
     if (opt->umbrella_given && !umbrella)
         return cli_usage_error(NULL, "--lambda, --mu and --iterations need --method laplacian "
@@ -299,6 +381,15 @@ static void print_json(const rsmooth_report *r, const options *opt, double ms_re
     if (method_uses_edges(opt->method))
         printf(",\"lambda\":%.9g,\"mu\":%.9g,\"iterations\":%u", opt->lambda, opt->mu,
                opt->iterations);
+    else {
+        const rsmooth_params *p = &opt->params;
+        printf(",\"normals\":\"%s\"", p->mollify ? normal_filter_names[p->normal_filter] : "input");
+        if (p->mollify && p->normal_filter == RSMOOTH_NORMALS_BILATERAL)
+            printf(",\"normal_sigma_s\":%.9g,\"normal_sigma_n\":%.9g,\"normal_iterations\":%d",
+                   p->normal_sigma_s, p->normal_sigma_n, p->normal_iterations);
+        printf(",\"influence\":\"%s\",\"passes\":%d,\"pass_confidence\":%.9g",
+               influence_names[p->influence], p->passes, p->pass_confidence);
+    }
     printf(",\"vertices\":%zu,\"triangles\":%zu,\"facets\":%zu,\"mean_edge_length\":%.9g,"
            "\"sigma_f\":%.9g,",
            r->vertex_count, r->triangle_count, r->facet_count, r->mean_edge_length, r->sigma_f);
@@ -473,6 +564,53 @@ static int smooth(const options *opt, const rsmooth_mesh *mesh, double *out, flo
     return code;
 }
 
+/* A mesh without triangles is a point cloud: it needs its normals, and a method without edges. */
+static int check_point_cloud(const options *opt, const rsmooth_mesh *mesh) {
+    if (!mesh->vertex_normals) {
+        fprintf(stderr, "rsmooth: %s has no faces and no vertex normals: a point cloud needs "
+                        "normals (nx, ny, nz)\n", opt->input);
+        return EXIT_USAGE;
+    }
+    if (method_uses_edges(opt->method)) {
+        fprintf(stderr, "rsmooth: %s is a point cloud (no faces): --method %s needs edges\n",
+                opt->input, method_names[opt->method]);
+        return EXIT_USAGE;
+    }
+    return EXIT_OK;
+}
+
+/* The point-cloud filter, on the reference path: the OpenCL path does not take points yet. */
+static int smooth_points(const options *opt, const rsmooth_mesh *mesh, double *out,
+                         double *out_normals, float *confidence, rsmooth_report *report,
+                         cli_progress *bar) {
+    const char *device = opt->device ? opt->device : getenv("RSMOOTH_DEVICE");
+    if (!opt->quiet) {
+        cli_progress_clear(bar);
+        if (device && strcmp(device, "reference") != 0 && strcmp(device, "auto") != 0)
+            fprintf(stderr, "rsmooth: note: %s is a point cloud, which the OpenCL path does not "
+                            "take yet: filtering on the reference path, not on device '%s'\n",
+                    opt->input, device);
+        else if (!device || strcmp(device, "reference") != 0)
+            fprintf(stderr, "rsmooth: note: %s is a point cloud (no faces): filtering its points "
+                            "and normals on the reference path (CPU)\n", opt->input);
+    }
+    rsmooth_params params = opt->params;
+    if (bar->enabled) {
+        params.progress = cli_progress_callback;
+        params.progress_user = bar;
+    }
+    rsmooth_error err;
+    rsmooth_status st = rsmooth_smooth_points_reference(
+        RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_normals, mesh->vertex_count, &params, out,
+        out_normals, confidence, report, &err);
+    if (st != RSMOOTH_OK) {
+        cli_progress_clear(bar);
+        fprintf(stderr, "rsmooth: %s: %s\n", opt->input, err.message);
+        return st == RSMOOTH_ERROR_INVALID_ARGUMENT ? EXIT_USAGE : EXIT_OTHER;
+    }
+    return EXIT_OK;
+}
+
 /* The confidence mesh: the result's surface, coloured, written without the input's extras. */
 static int write_confidence(rsmooth_mesh *mesh, const options *opt, float *confidence) {
     size_t nv = mesh->vertex_count;
@@ -546,27 +684,37 @@ int main(int argc, char **argv) {
     if ((code = cli_read_mesh(opt.input, &bar, &mesh)) != EXIT_OK)
         return code;
     double ms_read = cli_now_ms() - t0;
+    bool points = mesh->triangle_count == 0; /* a point cloud: its points and normals filtered */
+    if (points && (code = check_point_cloud(&opt, mesh)) != EXIT_OK) {
+        rsmooth_mesh_destroy(mesh);
+        return code;
+    }
 
     size_t nv = mesh->vertex_count;
     double *out = malloc(nv * 3 * sizeof *out);
+    double *out_normals = points ? malloc(nv * 3 * sizeof *out_normals) : NULL;
     bool umbrella = method_uses_edges(opt.method);
     bool want_confidence = opt.confidence || (opt.stats && !umbrella);
     float *confidence = want_confidence ? malloc(nv * sizeof *confidence) : NULL;
     rsmooth_report report;
     memset(&report, 0, sizeof report);
     code = EXIT_OTHER;
-    if (!out || (want_confidence && !confidence)) {
+    if (!out || (points && !out_normals) || (want_confidence && !confidence)) {
         fprintf(stderr, "rsmooth: %s: out of memory\n", opt.input);
         goto cleanup;
     }
     cli_progress_stage(&bar, "smoothing", 0.1, 0.95);
-    if ((code = smooth(&opt, mesh, out, confidence, &report, &bar)) != EXIT_OK)
+    code = points ? smooth_points(&opt, mesh, out, out_normals, confidence, &report, &bar)
+                  : smooth(&opt, mesh, out, confidence, &report, &bar);
+    if (code != EXIT_OK)
         goto cleanup;
 
     cli_progress_stage(&bar, "writing", 0.95, 1);
     double t1 = cli_now_ms();
-    double *input_positions = mesh->positions;
+    double *input_positions = mesh->positions, *input_normals = mesh->vertex_normals;
     mesh->positions = out;
+    if (points)
+        mesh->vertex_normals = out_normals; /* written in place of recomputed ones */
     rsmooth_format format = cli_output_format(opt.output, opt.ascii);
     cli_progress_clear(&bar);
     warn_losses(mesh, opt.output, format, opt.quiet);
@@ -574,6 +722,7 @@ int main(int argc, char **argv) {
     if (code == EXIT_OK && opt.confidence)
         code = write_confidence(mesh, &opt, confidence);
     mesh->positions = input_positions;
+    mesh->vertex_normals = input_normals;
     double ms_write = cli_now_ms() - t1;
     cli_progress_clear(&bar);
     if (code != EXIT_OK)
@@ -587,6 +736,13 @@ int main(int argc, char **argv) {
         fprintf(stderr, "rsmooth: %s: %zu vertices, %zu triangles; %s: %.1f ms; wrote %s\n",
                 opt.input, report.vertex_count, report.triangle_count, report.device,
                 report.ms_total, opt.output);
+    else if (!opt.quiet && points)
+        fprintf(stderr,
+                "rsmooth: %s: %zu points with normals, spacing %.6g; sigma_f %.6g, sigma_g "
+                "%.6g (cloud units) on %s: filter %.1f ms; wrote %s%s%s\n",
+                opt.input, report.vertex_count, report.mean_edge_length, report.sigma_f,
+                report.sigma_g, report.device, report.ms_total, opt.output,
+                opt.confidence ? " and " : "", opt.confidence ? opt.confidence : "");
     else if (!opt.quiet)
         fprintf(stderr,
                 "rsmooth: %s: %zu vertices, %zu triangles, mean edge %.6g; sigma_f %.6g, "
@@ -599,6 +755,7 @@ cleanup:
     cli_progress_clear(&bar);
     rsmooth_mesh_destroy(mesh);
     free(out);
+    free(out_normals);
     free(confidence);
     return code;
 }

@@ -11,11 +11,25 @@
  * does. `want_confidence` = 0 skips sum a f (one exp per pair instead of two).
  * `predict_centroid` = 1 predicts c_q instead of Pi_q(p) (isotropic Gaussian smoothing when
  * inv_2sg2 = 0).
+ * `influence` (an RS_INFLUENCE_ value) picks g; every one but the Gaussian is a function of
+ * u = x^2 / sigma_g^2 (x = |prediction - p|, inv_sg2 = h^2 / sigma_g^2) multiplying a f, and
+ * has no rescue: a lane they give no weight at all (Tukey's) stays where it is.
  */
 
 typedef struct robust_acc {
     lanef x, y, z, k, kf;
 } robust_acc;
+
+/* g(u) of the influence functions other than the Gaussian, u = x^2 / sigma_g^2. */
+inline __attribute__((always_inline)) lanef influence_weight(lanef u, int influence) {
+    if (influence == RS_INFLUENCE_TUKEY) { /* (1 - x^2 / c^2)^2 below c^2 = 5 sigma_g^2 */
+        lanef r = 1.0f - u * 0.2f;
+        return select((lanef)0.0f, r * r, u < 5.0f);
+    }
+    if (influence == RS_INFLUENCE_LORENTZIAN)
+        return 1.0f / (1.0f + u);
+    return select((lanef)1.0f, rsqrt(u), u > 1.0f); /* Huber: min(1, sigma_g / x) */
+}
 
 /* Sums of Eq. 3 for the lanes at (px, py, pz) (box [lo, hi]) over the facets within reach of the
  * block's anchor, with influence exponents shifted down by `shift`; *pairs counts the facets.
@@ -24,6 +38,7 @@ typedef struct robust_acc {
 inline __attribute__((always_inline)) robust_acc
 robust_sums(lanef px, lanef py, lanef pz, float3 lo, float3 hi, int4 anchor, float reach2,
             float inv_2sf2, float inv_2sg2, lanef shift, int want_confidence, int predict_centroid,
+            int influence, float inv_sg2,
             __global const float4 *facet_centroid, __global const float4 *normal,
             __global const int4 *cell_coord, __global const uint *cell_start,
             __global const uint *column_first, __global const int *column_table, uint column_mask,
@@ -42,8 +57,15 @@ robust_sums(lanef px, lanef py, lanef pz, float3 lo, float3 hi, int4 anchor, flo
             lanei near = d2 <= reach2;
             lanef t = n.x * ex + n.y * ey + n.z * ez;
             /* |prediction - p|^2: t^2 for the projection, d2 for the centroid */
-            lanef e = (predict_centroid ? d2 : t * t) * inv_2sg2;
-            lanef w = select((lanef)0.0f, fast_exp2(c.w - d2 * inv_2sf2 - (e - shift)), near);
+            lanef x2 = predict_centroid ? d2 : t * t;
+            lanef w, af = 0.0f;
+            if (influence == RS_INFLUENCE_GAUSSIAN) {
+                lanef e = x2 * inv_2sg2;
+                w = select((lanef)0.0f, fast_exp2(c.w - d2 * inv_2sf2 - (e - shift)), near);
+            } else {
+                af = select((lanef)0.0f, fast_exp2(c.w - d2 * inv_2sf2), near);
+                w = af * influence_weight(x2 * inv_sg2, influence);
+            }
             if (predict_centroid) {
                 a.x += w * ex;
                 a.y += w * ey;
@@ -55,7 +77,9 @@ robust_sums(lanef px, lanef py, lanef pz, float3 lo, float3 hi, int4 anchor, flo
                 a.z += wt * n.z;
             }
             a.k += w;
-            if (want_confidence)
+            if (influence != RS_INFLUENCE_GAUSSIAN)
+                a.kf += af; /* computed anyway */
+            else if (want_confidence)
                 a.kf += select((lanef)0.0f, fast_exp2(c.w - d2 * inv_2sf2), near);
         }
     })
@@ -87,7 +111,7 @@ lanef smallest_exponent(lanef px, lanef py, lanef pz, float3 lo, float3 hi, int4
 }
 
 __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float inv_2sg2,
-                           int want_confidence, int predict_centroid,
+                           int influence, float inv_sg2, int want_confidence, int predict_centroid,
                            __global const float *block_pos, __global const int4 *block_cell,
                            __global const float4 *facet_centroid, __global const float4 *normal,
                            __global const int4 *cell_coord, __global const uint *cell_start,
@@ -105,24 +129,43 @@ __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float
     int4 anchor = block_cell[b];
     uint pairs = 0, rescue_pairs = 0;
     robust_acc a;
-    /* one specialised copy of the loop per flag combination */
-    if (predict_centroid)
-        a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f,
-                        want_confidence, 1, facet_centroid, normal, cell_coord, cell_start,
+    /* one specialised copy of the loop per flag combination (the other influence functions
+     * always sum a f: it is part of their weight) */
+    if (influence != RS_INFLUENCE_GAUSSIAN && predict_centroid)
+        a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 1,
+                        influence, inv_sg2, facet_centroid, normal, cell_coord, cell_start,
                         column_first, column_table, column_mask, &pairs);
+    else if (influence == RS_INFLUENCE_TUKEY)
+        a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 0,
+                        RS_INFLUENCE_TUKEY, inv_sg2, facet_centroid, normal, cell_coord,
+                        cell_start, column_first, column_table, column_mask, &pairs);
+    else if (influence == RS_INFLUENCE_LORENTZIAN)
+        a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 0,
+                        RS_INFLUENCE_LORENTZIAN, inv_sg2, facet_centroid, normal, cell_coord,
+                        cell_start, column_first, column_table, column_mask, &pairs);
+    else if (influence == RS_INFLUENCE_HUBER)
+        a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 0,
+                        RS_INFLUENCE_HUBER, inv_sg2, facet_centroid, normal, cell_coord,
+                        cell_start, column_first, column_table, column_mask, &pairs);
+    else if (predict_centroid)
+        a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f,
+                        want_confidence, 1, RS_INFLUENCE_GAUSSIAN, inv_sg2, facet_centroid,
+                        normal, cell_coord, cell_start, column_first, column_table, column_mask,
+                        &pairs);
     else if (want_confidence)
         a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1,
-                        0, facet_centroid, normal, cell_coord, cell_start, column_first,
-                        column_table, column_mask, &pairs);
+                        0, RS_INFLUENCE_GAUSSIAN, inv_sg2, facet_centroid, normal, cell_coord,
+                        cell_start, column_first, column_table, column_mask, &pairs);
     else
         a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 0,
-                        0, facet_centroid, normal, cell_coord, cell_start, column_first,
-                        column_table, column_mask, &pairs);
+                        0, RS_INFLUENCE_GAUSSIAN, inv_sg2, facet_centroid, normal, cell_coord,
+                        cell_start, column_first, column_table, column_mask, &pairs);
     lanef kf = a.kf;
-    /* A lane whose weights (nearly) all underflowed: redo its sums with the exponents shifted
-     * by their smallest value, as the reference path does. Shifting never changes the weighted
-     * average, only how well float32 holds it. */
-    lanei rescue = a.k < RS_RESCUE_WEIGHT;
+    /* A lane whose Gaussian weights (nearly) all underflowed: redo its sums with the exponents
+     * shifted by their smallest value, as the reference path does. Shifting never changes the
+     * weighted average, only how well float32 holds it. The other influence functions keep
+     * their sums: a weight of zero there is a verdict, not an underflow. */
+    lanei rescue = influence == RS_INFLUENCE_GAUSSIAN ? a.k < RS_RESCUE_WEIGHT : (lanei)0;
     lanef shift = 0.0f;
     if (any(rescue)) {
         lanef e_min = smallest_exponent(px, py, pz, lo, hi, anchor, reach2, inv_2sg2,
@@ -132,9 +175,9 @@ __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float
     }
     if (any(shift != 0.0f)) {
         robust_acc r = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, shift,
-                                   0, predict_centroid, facet_centroid, normal, cell_coord,
-                                   cell_start, column_first, column_table, column_mask,
-                                   &rescue_pairs);
+                                   0, predict_centroid, RS_INFLUENCE_GAUSSIAN, inv_sg2,
+                                   facet_centroid, normal, cell_coord, cell_start, column_first,
+                                   column_table, column_mask, &rescue_pairs);
         lanei redo = shift != 0.0f;
         a.x = select(a.x, r.x, redo);
         a.y = select(a.y, r.y, redo);

@@ -7,8 +7,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-extern const unsigned char rs_kernel_common[], rs_kernel_mollify[], rs_kernel_estimate[];
-extern const size_t rs_kernel_common_size, rs_kernel_mollify_size, rs_kernel_estimate_size;
+extern const unsigned char rs_kernel_common[], rs_kernel_mollify[], rs_kernel_bilateral[],
+    rs_kernel_estimate[];
+extern const size_t rs_kernel_common_size, rs_kernel_mollify_size, rs_kernel_bilateral_size,
+    rs_kernel_estimate_size;
+
+/* The kernel files in the order they are compiled, after the prelude. */
+#define KERNEL_FILES 4
 
 /* Constants the host and kernels must agree on. Runtime values (sigmas, counts) are kernel
  * arguments, so changing them never rebuilds the program. */
@@ -17,7 +22,13 @@ extern const size_t rs_kernel_common_size, rs_kernel_mollify_size, rs_kernel_est
 #define FLOAT_DEFINE(name, value) "#define " #name " " STRINGIFY(value) "f\n"
 static const char prelude[] = FLOAT_DEFINE(RS_DEGENERATE_SINE, RS_DEGENERATE_SINE)
     FLOAT_DEFINE(RS_DEGENERATE_AREA_RATIO, RS_DEGENERATE_AREA_RATIO)
-    "#define RS_RESCUE_WEIGHT 1e-20f\n" "#define RS_LANES " EXPANDED_STRING(RS_LANES) "\n";
+    "#define RS_RESCUE_WEIGHT 1e-20f\n" "#define RS_LANES " EXPANDED_STRING(RS_LANES) "\n"
+    "#define RS_INFLUENCE_GAUSSIAN 0\n" "#define RS_INFLUENCE_TUKEY 1\n"
+    "#define RS_INFLUENCE_LORENTZIAN 2\n" "#define RS_INFLUENCE_HUBER 3\n";
+/* enum constants do not stringify: the values above are written out, and checked here */
+_Static_assert(RSMOOTH_INFLUENCE_GAUSSIAN == 0 && RSMOOTH_INFLUENCE_TUKEY == 1 &&
+                   RSMOOTH_INFLUENCE_LORENTZIAN == 2 && RSMOOTH_INFLUENCE_HUBER == 3,
+               "the kernels' RS_INFLUENCE_ values");
 
 /* Default options: relaxed math lets PoCL vectorize exp(); precision is checked against the
  * double-precision reference path by the tests. */
@@ -48,16 +59,19 @@ static char *read_text_file(const char *dir, const char *name, size_t *size) {
 }
 
 rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error) {
-    static const char *const names[] = {"common.cl", "mollify.cl", "estimate.cl"};
-    const char *sources[4] = {prelude, (const char *)rs_kernel_common,
-                              (const char *)rs_kernel_mollify, (const char *)rs_kernel_estimate};
-    size_t sizes[4] = {sizeof prelude - 1, rs_kernel_common_size, rs_kernel_mollify_size,
-                       rs_kernel_estimate_size};
-    char *loaded[3] = {NULL, NULL, NULL};
+    static const char *const names[KERNEL_FILES] = {"common.cl", "mollify.cl", "bilateral.cl",
+                                                    "estimate.cl"};
+    const char *sources[KERNEL_FILES + 1] = {
+        prelude, (const char *)rs_kernel_common, (const char *)rs_kernel_mollify,
+        (const char *)rs_kernel_bilateral, (const char *)rs_kernel_estimate};
+    size_t sizes[KERNEL_FILES + 1] = {sizeof prelude - 1, rs_kernel_common_size,
+                                      rs_kernel_mollify_size, rs_kernel_bilateral_size,
+                                      rs_kernel_estimate_size};
+    char *loaded[KERNEL_FILES] = {NULL};
     rsmooth_status st = RSMOOTH_OK;
     const char *dir = getenv("RSMOOTH_KERNEL_DIR");
     if (dir && *dir) {
-        for (int i = 0; i < 3; i++) {
+        for (int i = 0; i < KERNEL_FILES; i++) {
             loaded[i] = read_text_file(dir, names[i], &sizes[i + 1]);
             if (!loaded[i]) {
                 st = rs_fail(error, RSMOOTH_ERROR_IO, "RSMOOTH_KERNEL_DIR",
@@ -70,7 +84,7 @@ rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error) {
 
     double t0 = rs_now_ms();
     cl_int err = CL_SUCCESS;
-    ctx->program = clCreateProgramWithSource(ctx->context, 4, sources, sizes, &err);
+    ctx->program = clCreateProgramWithSource(ctx->context, KERNEL_FILES + 1, sources, sizes, &err);
     if (err != CL_SUCCESS) {
         st = rs_cl_fail(error, err, "clCreateProgramWithSource", ctx->device_name);
         goto done;
@@ -100,7 +114,10 @@ rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error) {
         goto done;
     }
     static const char *const kernel_names[RS_KERNEL_COUNT] = {
-        "mollify_block", "mollified_facet_normal", "robust_block"};
+        [RS_KERNEL_MOLLIFY] = "mollify_block",
+        [RS_KERNEL_NORMALS] = "mollified_facet_normal",
+        [RS_KERNEL_BILATERAL] = "bilateral_cell_normals",
+        [RS_KERNEL_ROBUST] = "robust_block"};
     for (int k = 0; k < RS_KERNEL_COUNT; k++) {
         ctx->kernels[k] = clCreateKernel(ctx->program, kernel_names[k], &err);
         if (err != CL_SUCCESS) {
@@ -110,7 +127,7 @@ rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error) {
     }
     ctx->build_ms = rs_now_ms() - t0;
 done:
-    for (int i = 0; i < 3; i++)
+    for (int i = 0; i < KERNEL_FILES; i++)
         rs_free(loaded[i]);
     return st;
 }

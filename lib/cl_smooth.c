@@ -1,14 +1,17 @@
 /* The OpenCL path: host-side facet data and grid (on every core), buffers the device reads in
- * place, mollify -> normals -> robust kernels, results mapped and scattered back to the caller's
- * vertex order. Coordinates travel as float32 in units of the cell size, relative to a nearby
- * cell's corner (see kernels/common.cl), so precision does not depend on where the mesh sits;
- * displacements return to double before they are added. */
+ * place, mollify -> normals (or the bilateral normal filter's rounds) -> robust kernels, results
+ * mapped and scattered back to the caller's vertex order. Coordinates travel as float32 in units
+ * of the cell size, relative to a nearby cell's corner (see kernels/common.cl), so precision does
+ * not depend on where the mesh sits; displacements return to double before they are added. */
 #include "rsmooth_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
+
+/* Exponents reach the kernels in base 2: natural ones times log2(e). */
+#define LOG2_E 1.4426950408889634
 
 /* Elements per chunk below which a host loop is not worth a thread. */
 #define PARALLEL_GRAIN 4096
@@ -226,6 +229,8 @@ enum {
     BUF_BLOCK_RESULT,
     BUF_BLOCK_EXTRA,
     BUF_BLOCK_PAIRS,
+    BUF_FACET_SCRATCH, /* bilateral: the normals of every other round */
+    BUF_CELL_PAIRS,    /* bilateral: facets each cell's groups evaluated in a round */
     BUF_COUNT
 };
 
@@ -346,6 +351,58 @@ static cl_int run_1d(rsmooth_context *ctx, const rs_problem *pb, cl_kernel kerne
     return err == CL_SUCCESS ? clFinish(ctx->queue) : err;
 }
 
+/* The bilateral normal filter's rounds (kernels/bilateral.cl), each reading the normals the
+ * previous one wrote: they alternate between the input normals' buffer and the scratch one.
+ * *normals is left at the buffer holding the last round's; *pairs counts the facet pairs
+ * evaluated (as vertex-facet pairs are: every lane of every facet looked at). */
+static cl_int run_bilateral(rsmooth_context *ctx, const rs_problem *pb, const rs_grid *grid,
+                            const cl_mem *buf, cl_mem *normals, uint64_t *pairs) {
+    const double h = grid->cell_size, s = pb->normal_sigma_s, t = pb->normal_sigma_n;
+    cl_uint cell_count = (cl_uint)grid->cell_count, mask = grid->column_mask;
+    cl_float reach2 = (cl_float)((pb->normal_radius / h) * (pb->normal_radius / h));
+    cl_float inv_2s2 = (cl_float)(LOG2_E * h * h / (2 * s * s));
+    cl_float inv_2t2 = (cl_float)(LOG2_E / (2 * t * t)); /* normals are unit: no length scale */
+    cl_mem from = buf[BUF_FACET_NORMAL], to = buf[BUF_FACET_SCRATCH];
+    double share = MOLLIFY_SHARE / pb->normal_iterations;
+    cl_int err = CL_SUCCESS;
+    for (int round = 0; round < pb->normal_iterations && err == CL_SUCCESS; round++) {
+        arg_setter a = {ctx->kernels[RS_KERNEL_BILATERAL], 0, CL_SUCCESS};
+        arg(&a, sizeof cell_count, &cell_count);
+        arg(&a, sizeof reach2, &reach2);
+        arg(&a, sizeof inv_2s2, &inv_2s2);
+        arg(&a, sizeof inv_2t2, &inv_2t2);
+        arg(&a, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
+        arg(&a, sizeof(cl_mem), &from);
+        arg(&a, sizeof(cl_mem), &buf[BUF_CELL_COORD]);
+        arg(&a, sizeof(cl_mem), &buf[BUF_CELL_START]);
+        arg(&a, sizeof(cl_mem), &buf[BUF_COLUMN_FIRST]);
+        arg(&a, sizeof(cl_mem), &buf[BUF_COLUMN_TABLE]);
+        arg(&a, sizeof mask, &mask);
+        arg(&a, sizeof(cl_mem), &to);
+        arg(&a, sizeof(cl_mem), &buf[BUF_CELL_PAIRS]);
+        err = a.err != CL_SUCCESS ? a.err
+                                  : run_1d(ctx, pb, a.kernel, cell_count, share * round,
+                                           share * (round + 1));
+        cl_mem written = to;
+        to = from;
+        from = written;
+    }
+    *normals = from;
+    if (err != CL_SUCCESS)
+        return err;
+    /* every round evaluates the same pairs: the last round's count stands for each */
+    cl_ulong *cell_pairs = clEnqueueMapBuffer(ctx->queue, buf[BUF_CELL_PAIRS], CL_TRUE,
+                                              CL_MAP_READ, 0, cell_count * sizeof(cl_ulong), 0,
+                                              NULL, NULL, &err);
+    if (err != CL_SUCCESS)
+        return err;
+    uint64_t sum = 0;
+    for (size_t c = 0; c < cell_count; c++)
+        sum += cell_pairs[c];
+    *pairs = sum * RS_LANES * (uint64_t)pb->normal_iterations;
+    return clEnqueueUnmapMemObject(ctx->queue, buf[BUF_CELL_PAIRS], cell_pairs, 0, NULL, NULL);
+}
+
 typedef struct result_job {
     const rs_problem *pb;
     const rs_result_sink *sink;
@@ -406,13 +463,15 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
 
     size_t nv = pb->vertex_count, nf = pb->facet_count, nc = grid.cell_count;
     size_t nb = pk.block_count, ns = nb * RS_LANES; /* blocks and slots */
+    bool paper_mollify = pb->mollify && !pb->bilateral;
     const struct {
         size_t size;
         void *host;
         cl_mem_flags flags;
     } spec[BUF_COUNT] = {
         [BUF_FACET_CENTROID] = {nf * sizeof(cl_float4), pk.facet_centroid, CL_MEM_READ_ONLY},
-        /* the input normals, replaced in place by the mollified ones */
+        /* the input normals, replaced in place by the mollified ones (bilateral: by the rounds
+         * that write here) */
         [BUF_FACET_NORMAL] = {nf * sizeof(cl_float4), pk.facet_normal, CL_MEM_READ_WRITE},
         [BUF_FACET_VERTICES] = {nf * 3 * sizeof(cl_uint), pk.facet_vertices, CL_MEM_READ_ONLY},
         [BUF_FACET_PLACE] = {nf * sizeof(cl_uint), pk.facet_place, CL_MEM_READ_ONLY},
@@ -424,10 +483,14 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
                               CL_MEM_READ_ONLY},
         [BUF_BLOCK_POS] = {ns * 3 * sizeof(cl_float), pk.block_pos, CL_MEM_READ_ONLY},
         [BUF_BLOCK_CELL] = {nb * sizeof(cl_int4), pk.block_cell, CL_MEM_READ_ONLY},
-        [BUF_BLOCK_SHIFT] = {ns * 3 * sizeof(cl_float), NULL, CL_MEM_READ_WRITE},
+        [BUF_BLOCK_SHIFT] = {paper_mollify ? ns * 3 * sizeof(cl_float) : 0, NULL,
+                             CL_MEM_READ_WRITE},
         [BUF_BLOCK_RESULT] = {ns * 4 * sizeof(cl_float), NULL, CL_MEM_WRITE_ONLY},
         [BUF_BLOCK_EXTRA] = {ns * 2 * sizeof(cl_float), NULL, CL_MEM_WRITE_ONLY},
         [BUF_BLOCK_PAIRS] = {nb * 2 * sizeof(cl_uint), NULL, CL_MEM_WRITE_ONLY},
+        [BUF_FACET_SCRATCH] = {pb->bilateral ? nf * sizeof(cl_float4) : 0, NULL,
+                               CL_MEM_READ_WRITE},
+        [BUF_CELL_PAIRS] = {pb->bilateral ? nc * sizeof(cl_ulong) : 0, NULL, CL_MEM_WRITE_ONLY},
     };
     uint64_t total = 0, largest = 0;
     for (int b = 0; b < BUF_COUNT; b++) {
@@ -448,6 +511,8 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
      * arrays themselves (no copy, no second allocation; they are aligned for it, see alloc.c), a
      * GPU copies them when first used. They stay alive until the buffers are released. */
     for (int b = 0; b < BUF_COUNT; b++) {
+        if (spec[b].size == 0) /* a buffer this run's mode does not use */
+            continue;
         cl_int err = CL_SUCCESS;
         cl_mem_flags flags = spec[b].flags | (spec[b].host ? CL_MEM_USE_HOST_PTR : 0);
         buf[b] = clCreateBuffer(ctx->context, flags, spec[b].size, spec[b].host, &err);
@@ -469,15 +534,26 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     cl_float reach2 = (cl_float)((pb->radius / h) * (pb->radius / h));
     cl_float mollify_reach2 = (cl_float)((pb->mollify_radius / h) * (pb->mollify_radius / h));
     /* Exponents in base 2 (the kernels' fast_exp2): 1 / 2 sigma^2 scaled by log2 e. */
-    const double log2e = 1.4426950408889634;
-    cl_float inv_2sm2 = (cl_float)(log2e * h * h / (2 * pb->sigma_m * pb->sigma_m));
-    cl_float inv_2sf2 = (cl_float)(log2e * h * h / (2 * pb->sigma_f * pb->sigma_f));
+    cl_float inv_2sm2 = (cl_float)(LOG2_E * h * h / (2 * pb->sigma_m * pb->sigma_m));
+    cl_float inv_2sf2 = (cl_float)(LOG2_E * h * h / (2 * pb->sigma_f * pb->sigma_f));
     cl_float inv_2sg2 =
-        isinf(pb->sigma_g) ? 0.0f : (cl_float)(log2e * h * h / (2 * pb->sigma_g * pb->sigma_g));
+        isinf(pb->sigma_g) ? 0.0f : (cl_float)(LOG2_E * h * h / (2 * pb->sigma_g * pb->sigma_g));
+    /* the other influence functions take x^2 / sigma_g^2 itself */
+    cl_float inv_sg2 = isinf(pb->sigma_g) ? 0.0f : (cl_float)(h * h / (pb->sigma_g * pb->sigma_g));
+    cl_int influence = pb->influence;
     cl_int want_confidence = sink->confidence != NULL;
     cl_int predict_centroid = pb->predict_centroid;
+    cl_mem normals = buf[BUF_FACET_NORMAL]; /* the predictors' normals, once filtered */
+    uint64_t bilateral_pairs = 0;
 
-    if (pb->mollify) {
+    if (pb->bilateral) {
+        err = run_bilateral(ctx, pb, &grid, buf, &normals, &bilateral_pairs);
+        if (err != CL_SUCCESS) {
+            st = rs_cl_fail(error, err, "bilateral_cell_normals", ctx->device_name);
+            goto cleanup;
+        }
+        t_mollify = rs_now_ms();
+    } else if (pb->mollify) {
         arg_setter s = {ctx->kernels[RS_KERNEL_MOLLIFY], 0, CL_SUCCESS};
         arg(&s, sizeof bcount, &bcount);
         arg(&s, sizeof mollify_reach2, &mollify_reach2);
@@ -523,12 +599,14 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     arg(&s, sizeof reach2, &reach2);
     arg(&s, sizeof inv_2sf2, &inv_2sf2);
     arg(&s, sizeof inv_2sg2, &inv_2sg2);
+    arg(&s, sizeof influence, &influence);
+    arg(&s, sizeof inv_sg2, &inv_sg2);
     arg(&s, sizeof want_confidence, &want_confidence);
     arg(&s, sizeof predict_centroid, &predict_centroid);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_POS]);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_CELL]);
     arg(&s, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
-    arg(&s, sizeof(cl_mem), &buf[BUF_FACET_NORMAL]);
+    arg(&s, sizeof(cl_mem), &normals);
     arg(&s, sizeof(cl_mem), &buf[BUF_CELL_COORD]);
     arg(&s, sizeof(cl_mem), &buf[BUF_CELL_START]);
     arg(&s, sizeof(cl_mem), &buf[BUF_COLUMN_FIRST]);
@@ -569,9 +647,10 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     stats->ms_robust += t_robust - t_normals;
     stats->ms_download += t_end - t_robust;
     for (size_t b = 0; b < nb; b++) {
-        stats->pairs_mollify += pb->mollify ? (uint64_t)pairs[2 * b] * RS_LANES : 0;
+        stats->pairs_mollify += paper_mollify ? (uint64_t)pairs[2 * b] * RS_LANES : 0;
         stats->pairs_robust += (uint64_t)pairs[2 * b + 1] * RS_LANES;
     }
+    stats->pairs_mollify += bilateral_pairs;
     stats->cells += grid.cell_count;
     stats->tiles++;
 
@@ -592,15 +671,15 @@ cleanup:
     return st;
 }
 
-rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const void *positions,
+/* One pass of the filter on the device (rs_filter_passes repeats it). */
+static rsmooth_status cl_pass(void *context, rsmooth_scalar scalar, const void *positions,
                               size_t vertex_count, const uint32_t *indices, size_t triangle_count,
                               const rsmooth_params *params, void *out_positions, float *out_weight,
                               float *out_confidence, rsmooth_report *report, rsmooth_error *error) {
     static const char where[] = "rsmooth_smooth";
+    rsmooth_context *ctx = context;
     double t_start = rs_now_ms();
     rs_error_clear(error);
-    if (!ctx)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "ctx is NULL");
     rs_problem pb;
     rsmooth_status st = rs_problem_prepare(&pb, scalar, positions, vertex_count, indices,
                                            triangle_count, params, out_positions, false, error,
@@ -638,4 +717,16 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     rs_problem_free(&pb);
     rs_release_free_memory();
     return st;
+}
+
+rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const void *positions,
+                              size_t vertex_count, const uint32_t *indices, size_t triangle_count,
+                              const rsmooth_params *params, void *out_positions, float *out_weight,
+                              float *out_confidence, rsmooth_report *report, rsmooth_error *error) {
+    rs_error_clear(error);
+    if (!ctx)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_smooth", "ctx is NULL");
+    return rs_filter_passes(cl_pass, ctx, scalar, positions, vertex_count, indices,
+                            triangle_count, params, out_positions, out_weight, out_confidence,
+                            report, error, "rsmooth_smooth");
 }

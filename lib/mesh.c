@@ -328,20 +328,29 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
         rs_problem_free(problem);
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for edges");
     }
-    double unit = p.absolute ? 1.0 : problem->mean_edge_length;
-    problem->sigma_f = p.sigma_f * unit;
-    problem->sigma_g = isinf(p.sigma_g) ? INFINITY : p.sigma_g * unit;
-    problem->sigma_m = problem->sigma_f / 2;
-    problem->radius = p.cutoff * problem->sigma_f;
-    problem->mollify_radius =
-        (p.mollify_cutoff > 0 ? p.mollify_cutoff : p.cutoff) * problem->sigma_f;
-    problem->predict_centroid = p.predictor == RSMOOTH_PREDICT_CENTROID;
-    problem->mollify = p.mollify != 0 && !problem->predict_centroid;
-    problem->progress = p.progress;
-    problem->progress_user = p.progress_user;
-    if (!(problem->sigma_f > 0) || !isfinite(problem->radius))
-        problem->facet_count = 0; /* no edge of non-zero length: nothing can move */
+    rs_problem_apply_params(problem, &p, p.absolute ? 1.0 : problem->mean_edge_length);
     return RSMOOTH_OK;
+}
+
+void rs_problem_apply_params(rs_problem *problem, const rsmooth_params *p, double unit) {
+    problem->sigma_f = p->sigma_f * unit;
+    problem->sigma_g = isinf(p->sigma_g) ? INFINITY : p->sigma_g * unit;
+    problem->sigma_m = problem->sigma_f / 2;
+    problem->radius = p->cutoff * problem->sigma_f;
+    problem->mollify_radius =
+        (p->mollify_cutoff > 0 ? p->mollify_cutoff : p->cutoff) * problem->sigma_f;
+    problem->predict_centroid = p->predictor == RSMOOTH_PREDICT_CENTROID;
+    problem->mollify = p->mollify != 0 && !problem->predict_centroid;
+    problem->bilateral = problem->mollify && p->normal_filter == RSMOOTH_NORMALS_BILATERAL;
+    problem->normal_sigma_s = p->normal_sigma_s * unit;
+    problem->normal_sigma_n = p->normal_sigma_n;
+    problem->normal_radius = problem->bilateral ? p->cutoff * problem->normal_sigma_s : 0;
+    problem->normal_iterations = p->normal_iterations;
+    problem->influence = isinf(problem->sigma_g) ? RSMOOTH_INFLUENCE_GAUSSIAN : p->influence;
+    problem->progress = p->progress;
+    problem->progress_user = p->progress_user;
+    if (!(problem->sigma_f > 0) || !isfinite(problem->radius) || !isfinite(problem->normal_radius))
+        problem->facet_count = 0; /* no edge of non-zero length: nothing can move */
 }
 
 void rs_store_unmoved(const rs_problem *problem, rsmooth_scalar scalar, void *out_positions,

@@ -21,6 +21,26 @@ rsmooth_status rsmooth_params_init(rsmooth_params *params) {
     params->progress = NULL;
     params->progress_user = NULL;
     params->predictor = RSMOOTH_PREDICT_PROJECTION;
+    params->normal_filter = RSMOOTH_NORMALS_MOLLIFY;
+    params->normal_sigma_s = 1.0;
+    params->normal_sigma_n = 0.35;
+    params->normal_iterations = 5;
+    params->influence = RSMOOTH_INFLUENCE_GAUSSIAN;
+    params->passes = 1;
+    params->pass_confidence = 0.0;
+    return RSMOOTH_OK;
+}
+
+rsmooth_status rsmooth_params_init_best(rsmooth_params *params) {
+    if (rsmooth_params_init(params) != RSMOOTH_OK)
+        return RSMOOTH_ERROR_INVALID_ARGUMENT;
+    params->sigma_f = 1.0;
+    params->sigma_g = 0.3;
+    params->normal_filter = RSMOOTH_NORMALS_BILATERAL;
+    params->normal_sigma_s = 1.0;
+    params->normal_sigma_n = 0.35;
+    params->normal_iterations = 5;
+    params->passes = 3;
     return RSMOOTH_OK;
 }
 
@@ -60,5 +80,29 @@ rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *o
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "predictor must be RSMOOTH_PREDICT_PROJECTION or RSMOOTH_PREDICT_CENTROID "
                        "(got %d)", out->predictor);
+    if (out->normal_filter != RSMOOTH_NORMALS_MOLLIFY &&
+        out->normal_filter != RSMOOTH_NORMALS_BILATERAL)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "normal_filter must be RSMOOTH_NORMALS_MOLLIFY or RSMOOTH_NORMALS_BILATERAL "
+                       "(got %d)", out->normal_filter);
+    if (!(out->normal_sigma_s > 0) || !isfinite(out->normal_sigma_s))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "normal_sigma_s must be positive and finite (got %g)", out->normal_sigma_s);
+    if (!(out->normal_sigma_n > 0) || !(out->normal_sigma_n <= 2))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "normal_sigma_n must be in (0, 2] (got %g)", out->normal_sigma_n);
+    if (out->normal_iterations < 1 || out->normal_iterations > RS_MAX_ROUNDS)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "normal_iterations must be in [1, %d] (got %d)", RS_MAX_ROUNDS,
+                       out->normal_iterations);
+    if (out->influence < RSMOOTH_INFLUENCE_GAUSSIAN || out->influence > RSMOOTH_INFLUENCE_HUBER)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "influence must be an rsmooth_influence, 0 to 3 (got %d)", out->influence);
+    if (out->passes < 1 || out->passes > RS_MAX_ROUNDS)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "passes must be in [1, %d] (got %d)", RS_MAX_ROUNDS, out->passes);
+    if (!(out->pass_confidence >= 0) || !(out->pass_confidence <= 1))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "pass_confidence must be in [0, 1] (got %g)", out->pass_confidence);
     return RSMOOTH_OK;
 }

@@ -91,6 +91,61 @@ static void mollified_normal(const rs_problem *pb, const double *mollified, size
         out[k] = n[k] / len;
 }
 
+/* Bilateral filter on the facet normals (RSMOOTH_NORMALS_BILATERAL), normal_iterations rounds:
+ * each facet's normal becomes the normalised sum of its neighbours' normals weighted by area, a
+ * Gaussian of centroid distance and a Gaussian of normal difference, so normals across a crease
+ * (far apart in direction) do not blend. Starts from the input normals; writes `normals`. */
+static bool bilateral_normals(const rs_problem *pb, const rs_grid *grid, neighbours *nb,
+                              double *normals) {
+    size_t nf = pb->facet_count;
+    double *prev = rs_alloc_array(nf, 3 * sizeof(double));
+    if (!prev)
+        return false;
+    memcpy(prev, pb->normal, nf * 3 * sizeof(double));
+    const double inv_2s2 = 1 / (2 * pb->normal_sigma_s * pb->normal_sigma_s);
+    const double inv_2n2 = 1 / (2 * pb->normal_sigma_n * pb->normal_sigma_n);
+    for (int round = 0; round < pb->normal_iterations; round++) {
+        for (size_t r = 0; r < nf; r++) {
+            if (!gather(pb, grid, pb->centroid + 3 * r, pb->normal_radius, nb)) {
+                rs_free(prev);
+                return false;
+            }
+            const double *nr = prev + 3 * r;
+            double acc[3] = {0, 0, 0};
+            for (size_t i = 0; i < nb->count; i++) {
+                const double *nq = prev + 3 * (size_t)nb->facet[i];
+                double dn[3];
+                rs_sub3(nq, nr, dn);
+                double w = pb->area[nb->facet[i]] * exp(-nb->dist2[i] * inv_2s2) *
+                           exp(-rs_dot3(dn, dn) * inv_2n2);
+                for (int k = 0; k < 3; k++)
+                    acc[k] += w * nq[k];
+            }
+            double len = sqrt(rs_dot3(acc, acc));
+            for (int k = 0; k < 3; k++)
+                normals[3 * r + k] = len > 0 ? acc[k] / len : nr[k];
+        }
+        memcpy(prev, normals, nf * 3 * sizeof(double));
+    }
+    rs_free(prev);
+    return true;
+}
+
+/* The robust weight g of a prediction at squared distance x2 (in units of sigma_g^2) for the
+ * influence functions other than the paper's Gaussian (Black et al. 1998). */
+static double influence_weight(int influence, double x2) {
+    switch (influence) {
+    case RSMOOTH_INFLUENCE_TUKEY: /* biweight, zero beyond c = sqrt(5) sigma_g */
+        return x2 < 5 ? (1 - x2 / 5) * (1 - x2 / 5) : 0;
+    case RSMOOTH_INFLUENCE_LORENTZIAN:
+        return 1 / (1 + x2);
+    case RSMOOTH_INFLUENCE_HUBER:
+        return x2 <= 1 ? 1 : 1 / sqrt(x2);
+    default:
+        return exp(-x2 / 2);
+    }
+}
+
 /* What facet q predicts for p, as a step from p: the projection Pi_q(p) - p = (n . d) n, with
  * d = c_q - p, or (centroid predictor) d itself. */
 static void prediction_step(const rs_problem *pb, const double n[3], const double d[3],
@@ -100,9 +155,39 @@ static void prediction_step(const rs_problem *pb, const double n[3], const doubl
         step[c] = pb->predict_centroid ? d[c] : t * n[c];
 }
 
+/* Eq. 3 with an influence function other than the Gaussian: these never underflow (Lorentzian,
+ * Huber) or are meant to reach zero (Tukey), so there is no rescue; k(p) = 0 leaves p in place. */
+static void estimate_vertex_robust_norm(const rs_problem *pb, const neighbours *nb,
+                                        const double *normals, const double p[3], double disp[3],
+                                        double *k_out, double *kf_out) {
+    const double inv_2sf2 = 1 / (2 * pb->sigma_f * pb->sigma_f);
+    const double inv_sg2 = 1 / (pb->sigma_g * pb->sigma_g);
+    double k = 0, kf = 0, acc[3] = {0, 0, 0};
+    for (size_t i = 0; i < nb->count; i++) {
+        uint32_t q = nb->facet[i];
+        double d[3], step[3];
+        rs_sub3(pb->centroid + 3 * (size_t)q, p, d);
+        prediction_step(pb, normals + 3 * (size_t)q, d, step);
+        double af = pb->area[q] * exp(-nb->dist2[i] * inv_2sf2);
+        double w = af * influence_weight(pb->influence, rs_dot3(step, step) * inv_sg2);
+        for (int c = 0; c < 3; c++)
+            acc[c] += w * step[c];
+        k += w;
+        kf += af;
+    }
+    for (int c = 0; c < 3; c++)
+        disp[c] = k > 0 ? acc[c] / k : 0;
+    *k_out = k;
+    *kf_out = kf;
+}
+
 /* Robust estimate for p (Eq. 3). Writes the displacement p' - p, k(p) and sum a f. */
 static void estimate_vertex(const rs_problem *pb, const neighbours *nb, const double *normals,
                             const double p[3], double disp[3], double *k_out, double *kf_out) {
+    if (pb->influence != RSMOOTH_INFLUENCE_GAUSSIAN) {
+        estimate_vertex_robust_norm(pb, nb, normals, p, disp, k_out, kf_out);
+        return;
+    }
     const double inv_2sf2 = 1 / (2 * pb->sigma_f * pb->sigma_f);
     const double inv_2sg2 = isinf(pb->sigma_g) ? 0 : 1 / (2 * pb->sigma_g * pb->sigma_g);
     double k = 0, kf = 0, acc[3] = {0, 0, 0};
@@ -151,21 +236,13 @@ static void estimate_vertex(const rs_problem *pb, const neighbours *nb, const do
     *kf_out = kf;
 }
 
-rsmooth_status rsmooth_smooth_reference(rsmooth_scalar scalar, const void *positions,
-                                        size_t vertex_count, const uint32_t *indices,
-                                        size_t triangle_count, const rsmooth_params *params,
-                                        void *out_positions, float *out_weight,
-                                        float *out_confidence, rsmooth_report *report,
-                                        rsmooth_error *error) {
-    static const char where[] = "rsmooth_smooth_reference";
-    double t_start = rs_now_ms();
-    rs_error_clear(error);
-    rs_problem pb;
-    rsmooth_status st = rs_problem_prepare(&pb, scalar, positions, vertex_count, indices,
-                                           triangle_count, params, out_positions, true, error,
-                                           where);
-    if (st != RSMOOTH_OK)
-        return st;
+rsmooth_status rs_reference_solve(const rs_problem *problem, rsmooth_scalar scalar,
+                                  void *out_positions, float *out_weight, float *out_confidence,
+                                  rsmooth_report *report, double t_start, rsmooth_error *error,
+                                  const char *where) {
+    const rs_problem pb = *problem; /* read-only view; the caller frees the problem */
+    size_t vertex_count = pb.vertex_count;
+    rsmooth_status st = RSMOOTH_OK;
     double t_facets = rs_now_ms();
 
     rs_grid grid;
@@ -179,7 +256,9 @@ rsmooth_status rsmooth_smooth_reference(rsmooth_scalar scalar, const void *posit
         goto done;
     }
 
-    st = rs_grid_build(&grid, pb.centroid, pb.facet_count, pb.radius, error);
+    /* one grid serves every reach: the robust pass's and the bilateral filter's */
+    st = rs_grid_build(&grid, pb.centroid, pb.facet_count, fmax(pb.radius, pb.normal_radius),
+                       error);
     if (st != RSMOOTH_OK)
         goto fail;
     t_grid = rs_now_ms();
@@ -187,7 +266,11 @@ rsmooth_status rsmooth_smooth_reference(rsmooth_scalar scalar, const void *posit
     normals = rs_alloc_array(pb.facet_count, 3 * sizeof(double));
     if (!normals)
         goto fail_memory;
-    if (pb.mollify) {
+    if (pb.bilateral) {
+        if (!bilateral_normals(&pb, &grid, &nb, normals))
+            goto fail_memory;
+        t_mollify = rs_now_ms();
+    } else if (pb.mollify) {
         mollified = rs_alloc_array(vertex_count, 3 * sizeof(double));
         if (!mollified)
             goto fail_memory;
@@ -249,6 +332,39 @@ cleanup:
     rs_free(mollified);
     rs_free(normals);
     rs_grid_free(&grid);
+    return st;
+}
+
+/* One pass of the filter (rs_filter_passes repeats it). */
+static rsmooth_status reference_pass(void *unused, rsmooth_scalar scalar, const void *positions,
+                                     size_t vertex_count, const uint32_t *indices,
+                                     size_t triangle_count, const rsmooth_params *params,
+                                     void *out_positions, float *out_weight,
+                                     float *out_confidence, rsmooth_report *report,
+                                     rsmooth_error *error) {
+    static const char where[] = "rsmooth_smooth_reference";
+    (void)unused;
+    double t_start = rs_now_ms();
+    rs_error_clear(error);
+    rs_problem pb;
+    rsmooth_status st = rs_problem_prepare(&pb, scalar, positions, vertex_count, indices,
+                                           triangle_count, params, out_positions, true, error,
+                                           where);
+    if (st != RSMOOTH_OK)
+        return st;
+    st = rs_reference_solve(&pb, scalar, out_positions, out_weight, out_confidence, report,
+                            t_start, error, where);
     rs_problem_free(&pb);
     return st;
+}
+
+rsmooth_status rsmooth_smooth_reference(rsmooth_scalar scalar, const void *positions,
+                                        size_t vertex_count, const uint32_t *indices,
+                                        size_t triangle_count, const rsmooth_params *params,
+                                        void *out_positions, float *out_weight,
+                                        float *out_confidence, rsmooth_report *report,
+                                        rsmooth_error *error) {
+    return rs_filter_passes(reference_pass, NULL, scalar, positions, vertex_count, indices,
+                            triangle_count, params, out_positions, out_weight, out_confidence,
+                            report, error, "rsmooth_smooth_reference");
 }

@@ -76,6 +76,9 @@ bool rs_radix_sort_u64(uint64_t *keys, uint32_t *values, size_t count);
 
 /* ---- params.c ---------------------------------------------------------------------------------- */
 
+/* Most bilateral rounds and filter passes one call may ask for. */
+#define RS_MAX_ROUNDS 100
+
 /* Copies the caller's params (NULL: defaults) into `out`, filling fields newer than the caller's
  * struct_size with defaults, and checks every value. */
 rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *out,
@@ -105,6 +108,12 @@ typedef struct rs_problem {
     double mollify_radius;       /* reach of the mollification pass (<= radius) */
     bool mollify;                /* false also when the predictor needs no normals (centroid) */
     bool predict_centroid;       /* predict c_q instead of Pi_q(p) */
+    bool bilateral;              /* with `mollify`: bilateral normal filter instead of the paper's */
+    double normal_sigma_s;       /* bilateral spatial width, mesh units */
+    double normal_sigma_n;       /* bilateral width on normal differences */
+    double normal_radius;        /* bilateral reach: cutoff * normal_sigma_s (0 when off) */
+    int normal_iterations;
+    int influence;               /* an rsmooth_influence */
     rsmooth_progress_fn progress; /* optional, from the params */
     void *progress_user;
 } rs_problem;
@@ -123,6 +132,12 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
                                   const uint32_t *indices, size_t triangle_count,
                                   const rsmooth_params *params, const void *out_positions,
                                   bool keep_facet_data, rsmooth_error *error, const char *where);
+
+/* The params-to-problem part of rs_problem_prepare: the absolute widths and radii (relative
+ * sigmas times `unit`, the mean edge length or, for point clouds, the point spacing; 1 when
+ * params->absolute) and the flags, from resolved params. Sets facet_count to 0 when nothing can
+ * move (unit 0). Point clouds (points.c) call it on a problem whose facets are the points. */
+void rs_problem_apply_params(rs_problem *problem, const rsmooth_params *params, double unit);
 
 /* Centroid, unit normal and area of the triangle with vertex indices tri[0..2] over `xyz`; false
  * (outputs unset) when its area is zero or not finite. The one formula every path uses. */
@@ -205,6 +220,33 @@ static inline void rs_cross3(const double a[3], const double b[3], double out[3]
  * smallest value, so the result is the mathematically defined weighted average. */
 #define RS_UNDERFLOW_RATIO 1e-30
 
+/* ---- reference.c / passes.c: the filter on a prepared problem, and repeated passes ----------- */
+
+/* The reference filter on a prepared problem (with its facet data kept), written to the caller's
+ * arrays; t_start is when the call began, for the report. The caller frees the problem. */
+rsmooth_status rs_reference_solve(const rs_problem *problem, rsmooth_scalar scalar,
+                                  void *out_positions, float *out_weight, float *out_confidence,
+                                  rsmooth_report *report, double t_start, rsmooth_error *error,
+                                  const char *where);
+
+/* One pass of a filter path, with rsmooth_smooth_reference's arguments; `ctx` is the path's own. */
+typedef rsmooth_status (*rs_filter_fn)(void *ctx, rsmooth_scalar scalar, const void *positions,
+                                       size_t vertex_count, const uint32_t *indices,
+                                       size_t triangle_count, const rsmooth_params *params,
+                                       void *out_positions, float *out_weight,
+                                       float *out_confidence, rsmooth_report *report,
+                                       rsmooth_error *error);
+
+/* Runs `one_pass` params->passes times (once, unchanged, when passes is 1), each pass from the
+ * previous pass's positions with the sigmas of the input, honouring pass_confidence. The caller's
+ * outputs are written only when every pass succeeded. */
+rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar scalar,
+                                const void *positions, size_t vertex_count,
+                                const uint32_t *indices, size_t triangle_count,
+                                const rsmooth_params *params, void *out_positions,
+                                float *out_weight, float *out_confidence, rsmooth_report *report,
+                                rsmooth_error *error, const char *where);
+
 /* ---- grid.c: uniform grid over facet centroids, facets sorted by cell ------------------------- */
 
 /* Occupied cells are found through an open-addressing hash on their integer coordinates, so far-apart
@@ -265,6 +307,37 @@ static inline uint32_t rs_grid_hash(int32_t x, int32_t y, int32_t z) {
 rsmooth_status rs_grid_order_points(const rs_grid *grid, const double *points, size_t count,
                                     uint32_t *order, int32_t *cells, rsmooth_error *error);
 
+/* ---- kdtree.c: neighbour queries over a point set (point clouds) ------------------------------ */
+
+typedef struct rs_kdtree {
+    const double *xyz; /* 3 per point, borrowed: must outlive the tree */
+    size_t count;
+    uint32_t *order;   /* point indices, arranged as the tree's ranges */
+    uint8_t *axis;     /* split axis of each internal node */
+} rs_kdtree;
+
+/* Points found by rs_kdtree_within, with squared distances; reused between queries. */
+typedef struct rs_kdtree_list {
+    size_t count, capacity;
+    uint32_t *index;
+    double *dist2;
+} rs_kdtree_list;
+
+/* Builds the tree over `count` points (< 2^32). false when out of memory (tree then empty). */
+bool rs_kdtree_build(rs_kdtree *tree, const double *xyz, size_t count);
+void rs_kdtree_free(rs_kdtree *tree);
+
+/* The squared distances from p to its k nearest points, point `skip` left out (UINT32_MAX: none),
+ * nearest first, into dist2[0 ..), and their indices into index[0 ..) when it is not NULL;
+ * returns how many were found (k, or fewer points). Thread-safe on a built tree. */
+size_t rs_kdtree_nearest(const rs_kdtree *tree, const double p[3], uint32_t skip, size_t k,
+                         double *dist2, uint32_t *index);
+
+/* Every point at distance <= radius from p, into `out` (cleared first). false when out of memory. */
+bool rs_kdtree_within(const rs_kdtree *tree, const double p[3], double radius,
+                      rs_kdtree_list *out);
+void rs_kdtree_list_free(rs_kdtree_list *list);
+
 /* ---- cl_device.c / cl_program.c: the OpenCL context object ------------------------------------ */
 
 #ifndef CL_TARGET_OPENCL_VERSION
@@ -275,7 +348,13 @@ rsmooth_status rs_grid_order_points(const rs_grid *grid, const double *points, s
 /* Vertices per block: the vector width the kernels use across vertices (float8, kernels/common.cl). */
 #define RS_LANES 8
 
-enum { RS_KERNEL_MOLLIFY, RS_KERNEL_NORMALS, RS_KERNEL_ROBUST, RS_KERNEL_COUNT };
+enum {
+    RS_KERNEL_MOLLIFY,
+    RS_KERNEL_NORMALS,
+    RS_KERNEL_BILATERAL,
+    RS_KERNEL_ROBUST,
+    RS_KERNEL_COUNT
+};
 
 struct rsmooth_context {
     cl_context context;
@@ -320,6 +399,9 @@ typedef struct rs_run_stats {
 
 /* Device bytes a run needs at most, estimated before its grid exists (tiles.c plans with it). */
 #define RS_DEVICE_BYTES_PER_FACET 64
+/* What the bilateral normal filter adds per facet: a second copy of the normals to alternate with,
+ * and a per-cell pair count (at most one cell per facet). */
+#define RS_DEVICE_BYTES_PER_BILATERAL_FACET 24
 #define RS_DEVICE_BYTES_PER_VERTEX 72
 
 /* One run of the whole pipeline on `problem` (facet_count > 0). When its buffers would exceed

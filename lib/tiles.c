@@ -5,8 +5,11 @@
  * come from their own vertices (within `reach`, the mesh's largest centroid-to-vertex distance),
  * which moved by the facets within `mollify_radius` of them. So a tile holding the facets whose
  * centroids lie within radius + reach + mollify_radius of its box computes its vertices as the
- * whole mesh would, up to float32 rounding (coordinates are local to a different grid). Boxes are
- * halved along their longest side until a tile fits. */
+ * whole mesh would, up to float32 rounding (coordinates are local to a different grid). The
+ * bilateral normal filter instead reads only facets' own centroids, areas and normals: each of its
+ * normal_iterations rounds reaches normal_radius further, so the halo is radius +
+ * normal_iterations * normal_radius there. Boxes are halved along their longest side until a tile
+ * fits. */
 #include "rsmooth_internal.h"
 
 #include <math.h>
@@ -42,9 +45,18 @@ static void report_tile_progress(void *user, double fraction) {
 
 /* Device bytes a tile of `vertices` core vertices and `facets` facets is expected to need (a
  * facet brings about half a vertex of its own). */
-static uint64_t estimate_bytes(size_t vertices, size_t facets) {
+static uint64_t estimate_bytes(const rs_problem *pb, size_t vertices, size_t facets) {
     size_t v = vertices > facets / 2 ? vertices : facets / 2;
-    return (uint64_t)facets * RS_DEVICE_BYTES_PER_FACET + (uint64_t)v * RS_DEVICE_BYTES_PER_VERTEX;
+    uint64_t per_facet = RS_DEVICE_BYTES_PER_FACET +
+                         (pb->bilateral ? RS_DEVICE_BYTES_PER_BILATERAL_FACET : 0);
+    return (uint64_t)facets * per_facet + (uint64_t)v * RS_DEVICE_BYTES_PER_VERTEX;
+}
+
+/* How far beyond a tile's vertices the facets its results depend on may lie (see the top). */
+static double halo_radius(const rs_problem *pb, double reach) {
+    if (pb->bilateral)
+        return pb->radius + pb->normal_iterations * pb->normal_radius;
+    return pb->radius + (pb->mollify ? pb->mollify_radius + reach : 0);
 }
 
 /* Vertices with no facet within reach of their tile stay where they are, with zero weight. */
@@ -170,7 +182,7 @@ static rsmooth_status solve_region(tiler *t, uint32_t *verts, size_t n, const ui
 
     rsmooth_status st = RSMOOTH_OK;
     uint64_t needed = 0;
-    if (!can_split || estimate_bytes(n, m) <= t->budget) {
+    if (!can_split || estimate_bytes(w, n, m) <= t->budget) {
         st = run_tile(t, verts, n, near, m, &needed);
         if (st != RSMOOTH_ERROR_OUT_OF_MEMORY || needed == 0 || !can_split) {
             if (st == RSMOOTH_ERROR_OUT_OF_MEMORY && needed > 0)
@@ -201,7 +213,7 @@ static rsmooth_status solve_region(tiler *t, uint32_t *verts, size_t n, const ui
 rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *pb, const rs_result_sink *sink,
                             rs_run_stats *stats, rsmooth_error *error) {
     uint64_t budget = rs_cl_usable_memory(ctx);
-    if (estimate_bytes(pb->vertex_count, pb->facet_count) <= budget) {
+    if (estimate_bytes(pb, pb->vertex_count, pb->facet_count) <= budget) {
         uint64_t needed = 0;
         rsmooth_status st = rs_cl_run(ctx, pb, sink, stats, &needed, error);
         if (st != RSMOOTH_ERROR_OUT_OF_MEMORY || needed == 0)
@@ -240,7 +252,7 @@ rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *pb, const rs
         for (size_t q = 0; q < pb->facet_count; q++)
             facets[q] = (uint32_t)q;
         /* a little extra: a facet exactly at the halo must not round out of it */
-        double halo = (pb->radius + (pb->mollify ? pb->mollify_radius + reach : 0)) * (1 + 1e-6);
+        double halo = halo_radius(pb, reach) * (1 + 1e-6);
         rs_result_sink scratch = {RSMOOTH_FLOAT64, positions, weight, confidence, NULL, nv};
         tiler t = {ctx, pb, &scratch, stats, halo, budget, sub_index, 0, error};
         st = solve_region(&t, verts, nv, facets, pb->facet_count, 0);

@@ -223,20 +223,21 @@ int main(void) {
     rsmooth_context_destroy(other);
     char broken_dir[] = "/tmp/rsmooth-broken-kernels-XXXXXX";
     CHECK(mkdtemp(broken_dir) != NULL);
-    static const char *const names[] = {"common.cl", "mollify.cl", "estimate.cl"};
-    for (int i = 0; i < 3; i++) {
+    static const char *const names[] = {"common.cl", "mollify.cl", "bilateral.cl", "estimate.cl"};
+    const int files = (int)(sizeof names / sizeof *names);
+    for (int i = 0; i < files; i++) {
         char path[256];
         snprintf(path, sizeof path, "%s/%s", broken_dir, names[i]);
         FILE *f = fopen(path, "w");
         CHECK(f);
-        fputs(i == 2 ? "__kernel void robust_vertex(void) { this is not C; }\n" : "\n", f);
+        fputs(i == files - 1 ? "__kernel void robust_vertex(void) { this is not C; }\n" : "\n", f);
         fclose(f);
     }
     setenv("RSMOOTH_KERNEL_DIR", broken_dir, 1);
     CHECK_STATUS(rsmooth_context_create(NULL, &other, &err), RSMOOTH_ERROR_KERNEL_BUILD);
     CHECK(other == NULL && err.build_log[0] != '\0');
     printf("broken kernel: %s; log starts: %.60s\n", err.message, err.build_log);
-    for (int i = 0; i < 3; i++) {
+    for (int i = 0; i < files; i++) {
         char path[256];
         snprintf(path, sizeof path, "%s/%s", broken_dir, names[i]);
         remove(path);

@@ -58,6 +58,51 @@ static double bf_mean_edge(const double *xyz, const uint32_t *idx, size_t tc) {
     return unique ? sum / (double)unique : 0;
 }
 
+/* Bilateral normal filter, every facet against every other: `rounds` times n_r <- normalise(sum
+ * a_q exp(-|c_q - c_r|^2 / 2 s^2) exp(-|n_q - n_r|^2 / 2 t^2) n_q) over |c_q - c_r| <= reach. */
+static void bf_bilateral(const double *cen, const double *nrm, const double *area, size_t fc,
+                         double reach, double s, double t, int rounds, double *out) {
+    double *prev = malloc((3 * fc + 1) * sizeof *prev);
+    CHECK(prev);
+    memcpy(prev, nrm, 3 * fc * sizeof *prev);
+    for (int round = 0; round < rounds; round++) {
+        for (size_t r = 0; r < fc; r++) {
+            double acc[3] = {0, 0, 0};
+            for (size_t q = 0; q < fc; q++) {
+                double d2 = dist2(cen + 3 * q, cen + 3 * r);
+                if (!(d2 <= reach * reach))
+                    continue;
+                double dn2 = dist2(prev + 3 * q, prev + 3 * r);
+                double w = area[q] * exp(-d2 / (2 * s * s)) * exp(-dn2 / (2 * t * t));
+                for (int k = 0; k < 3; k++)
+                    acc[k] += w * prev[3 * q + k];
+            }
+            double len = sqrt(dot(acc, acc));
+            for (int k = 0; k < 3; k++)
+                out[3 * r + k] = len > 0 ? acc[k] / len : prev[3 * r + k];
+        }
+        memcpy(prev, out, 3 * fc * sizeof *prev);
+    }
+    free(prev);
+}
+
+/* Black et al. 1998's weights at squared distance x2 in units of sigma_g^2, as rsmooth.h
+ * defines them. */
+static double bf_influence(int influence, double x2) {
+    double x = sqrt(x2);
+    switch (influence) {
+    case RSMOOTH_INFLUENCE_TUKEY: {
+        double c = sqrt(5.0);
+        return x < c ? pow(1 - (x / c) * (x / c), 2) : 0;
+    }
+    case RSMOOTH_INFLUENCE_LORENTZIAN:
+        return 1 / (1 + x * x);
+    case RSMOOTH_INFLUENCE_HUBER:
+        return x <= 1 ? 1 : 1 / x;
+    }
+    return exp(-x * x / 2);
+}
+
 static void brute_force(const double *xyz, size_t vc, const uint32_t *idx, size_t tc,
                         const rsmooth_params *prm, double *out, double *k_out, double *conf_out,
                         unsigned char *unreached, bf_stats *st) {
@@ -141,6 +186,11 @@ static void brute_force(const double *xyz, size_t vc, const uint32_t *idx, size_
         }
     }
     const int centroid = prm->predictor == RSMOOTH_PREDICT_CENTROID; /* predict c_q, not Pi_q(p) */
+    if (prm->mollify && !centroid && prm->normal_filter == RSMOOTH_NORMALS_BILATERAL)
+        bf_bilateral(cen, nrm, area, fc, prm->cutoff * prm->normal_sigma_s * unit,
+                     prm->normal_sigma_s * unit, prm->normal_sigma_n, prm->normal_iterations,
+                     mnrm);
+    const int influence = isinf(sg) ? RSMOOTH_INFLUENCE_GAUSSIAN : prm->influence;
     /* robust estimate, with the influence exponents shifted by their smallest (log-sum-exp) so no
      * weight underflows: p' = p + sum w t n / sum w is unchanged by the shift. */
     for (size_t v = 0; v < vc; v++) {
@@ -155,7 +205,10 @@ static void brute_force(const double *xyz, size_t vc, const uint32_t *idx, size_
             double t = dot(mnrm + 3 * q, d);
             double r2 = centroid ? d2 : t * t; /* |prediction - p|^2 */
             double e = isinf(sg) ? 0 : r2 / (2 * sg * sg);
-            e_min = fmin(e_min, e);
+            if (influence == RSMOOTH_INFLUENCE_GAUSSIAN) /* only the Gaussian is shifted */
+                e_min = fmin(e_min, e);
+            else
+                e_min = 0;
             count++;
         }
         double acc[3] = {0, 0, 0}, ws = 0, kf = 0;
@@ -169,7 +222,9 @@ static void brute_force(const double *xyz, size_t vc, const uint32_t *idx, size_
             double r2 = centroid ? d2 : t * t;
             double e = isinf(sg) ? 0 : r2 / (2 * sg * sg);
             double af = area[q] * exp(-d2 / (2 * sf * sf));
-            double w = af * exp(-(e - e_min));
+            double w = af * (influence == RSMOOTH_INFLUENCE_GAUSSIAN ? exp(-(e - e_min))
+                                                                     : bf_influence(influence,
+                                                                                    r2 / (sg * sg)));
             for (int k = 0; k < 3; k++)
                 acc[k] += w * (centroid ? d[k] : t * n[k]);
             ws += w;
@@ -195,6 +250,49 @@ static void brute_force(const double *xyz, size_t vc, const uint32_t *idx, size_
     free(area);
     free(mnrm);
     free(moll);
+}
+
+/* The filter run prm->passes times, each pass by brute_force from the previous positions with the
+ * input's sigmas; with pass_confidence, vertices that were confident keep their previous result.
+ * `st` describes the input. */
+static void brute_force_passes(const double *xyz, size_t vc, const uint32_t *idx, size_t tc,
+                               const rsmooth_params *prm, double *out, double *k_out,
+                               double *conf_out, unsigned char *unreached, bf_stats *st) {
+    if (prm->passes <= 1) {
+        brute_force(xyz, vc, idx, tc, prm, out, k_out, conf_out, unreached, st);
+        return;
+    }
+    double unit = prm->absolute ? 1 : bf_mean_edge(xyz, idx, tc);
+    rsmooth_params p = *prm;
+    p.sigma_f *= unit;
+    p.sigma_g *= unit;
+    p.normal_sigma_s *= unit;
+    p.absolute = 1;
+    p.passes = 1;
+    double *cur = malloc(3 * vc * sizeof *cur), *pk = malloc(vc * sizeof *pk);
+    double *pc = malloc(vc * sizeof *pc);
+    CHECK(cur && pk && pc);
+    memcpy(cur, xyz, 3 * vc * sizeof *cur);
+    bf_stats first;
+    for (int pass = 0; pass < prm->passes; pass++) {
+        brute_force(cur, vc, idx, tc, &p, out, k_out, conf_out, unreached, st);
+        if (pass == 0)
+            first = *st;
+        for (size_t v = 0; pass > 0 && p.pass_confidence > 0 && v < vc; v++)
+            if (pc[v] >= p.pass_confidence) {
+                memcpy(out + 3 * v, cur + 3 * v, 3 * sizeof *out);
+                k_out[v] = pk[v];
+                conf_out[v] = pc[v];
+            }
+        memcpy(cur, out, 3 * vc * sizeof *cur);
+        memcpy(pk, k_out, vc * sizeof *pk);
+        memcpy(pc, conf_out, vc * sizeof *pc);
+    }
+    first.unreached = st->unreached;
+    *st = first;
+    free(cur);
+    free(pk);
+    free(pc);
 }
 
 /* ---- comparison ------------------------------------------------------------------------------ */
@@ -233,7 +331,7 @@ static void run_case(const char *name, const double *xyz, size_t vc, const uint3
         fprintf(stderr, "%s: %s\n", name, err.message);
     CHECK_STATUS(s, RSMOOTH_OK);
     bf_stats st;
-    brute_force(xyz, vc, idx, tc, prm, bf, bk, bc, unreached, &st);
+    brute_force_passes(xyz, vc, idx, tc, prm, bf, bk, bc, unreached, &st);
 
     double max_dev = 0, max_move = 0, max_k = 0, max_c = 0;
     size_t worst = 0, kept_exactly = 0;
@@ -375,7 +473,7 @@ int main(void) {
     for (int i = 0; i < MESHES; i++) {
         const shape_mesh *m = &meshes[i];
         char name[96];
-        for (int variant = 0; variant < 10; variant++) {
+        for (int variant = 0; variant < 19; variant++) {
             rsmooth_params p = def;
             const char *what = "";
             switch (variant) {
@@ -426,6 +524,54 @@ int main(void) {
                 what = "centroid predictor, sigma_g 0.7";
                 p.predictor = RSMOOTH_PREDICT_CENTROID;
                 p.sigma_g = 0.7;
+                break;
+            /* beyond the paper */
+            case 10:
+                what = "bilateral normals, 1 round";
+                p.normal_filter = RSMOOTH_NORMALS_BILATERAL;
+                p.normal_iterations = 1;
+                break;
+            case 11:
+                what = "bilateral normals, 4 rounds, wide";
+                p.normal_filter = RSMOOTH_NORMALS_BILATERAL;
+                p.normal_iterations = 4;
+                p.normal_sigma_s = 1.6; /* reach beyond the robust pass's */
+                p.normal_sigma_n = 0.5;
+                p.sigma_f = 1.2;
+                break;
+            case 12:
+                what = "Tukey";
+                p.influence = RSMOOTH_INFLUENCE_TUKEY;
+                p.sigma_g = 0.3;
+                break;
+            case 13:
+                what = "Lorentzian";
+                p.influence = RSMOOTH_INFLUENCE_LORENTZIAN;
+                break;
+            case 14:
+                what = "Huber, centroid predictor";
+                p.influence = RSMOOTH_INFLUENCE_HUBER;
+                p.predictor = RSMOOTH_PREDICT_CENTROID;
+                break;
+            case 15:
+                what = "Tukey, sigma_g 0.004 (all rejected)";
+                p.influence = RSMOOTH_INFLUENCE_TUKEY;
+                p.sigma_g = 0.004;
+                break;
+            case 16:
+                what = "3 passes";
+                p.passes = 3;
+                break;
+            case 17:
+                what = "best preset (bilateral, 3 passes)";
+                rsmooth_params_init_best(&p);
+                break;
+            case 18:
+                what = "4 passes where confidence < 0.6, Huber";
+                p.passes = 4;
+                p.pass_confidence = 0.6;
+                p.influence = RSMOOTH_INFLUENCE_HUBER;
+                p.normal_filter = RSMOOTH_NORMALS_BILATERAL;
                 break;
             }
             snprintf(name, sizeof name, "%s, %s", names[i], what);

@@ -39,7 +39,7 @@
 #include <stdint.h>
 
 #define RSMOOTH_VERSION_MAJOR 0
-#define RSMOOTH_VERSION_MINOR 3
+#define RSMOOTH_VERSION_MINOR 4
 #define RSMOOTH_VERSION_PATCH 0
 
 #if defined(_WIN32)
@@ -113,6 +113,28 @@ typedef enum rsmooth_predictor {
                                      * the influence, if on, weighs |c_q - p| */
 } rsmooth_predictor;
 
+/* How the normals of the predictors' planes are made. */
+typedef enum rsmooth_normal_filter {
+    RSMOOTH_NORMALS_MOLLIFY = 0,  /* the paper (Sec. 3.2): the normals of a copy of the mesh whose
+                                   * vertices moved to the Gaussian average (width sigma_f / 2) of
+                                   * nearby centroids */
+    RSMOOTH_NORMALS_BILATERAL = 1 /* bilateral filter on the facet normals themselves, repeated
+                                   * normal_iterations times: n_r <- normalise(sum_q a_q
+                                   * exp(-|c_q - c_r|^2 / 2 s^2) exp(-|n_q - n_r|^2 / 2 t^2) n_q), s =
+                                   * normal_sigma_s, t = normal_sigma_n, facets within cutoff * s
+                                   * (Zheng et al. 2011). Keeps creases the Gaussian rounds */
+} rsmooth_normal_filter;
+
+/* The robust weight g of a prediction at distance x from the vertex (Black et al. 1998), all
+ * scaled by sigma_g so that outliers start being rejected near it. */
+typedef enum rsmooth_influence {
+    RSMOOTH_INFLUENCE_GAUSSIAN = 0,   /* exp(-x^2 / 2 sigma_g^2): the paper */
+    RSMOOTH_INFLUENCE_TUKEY = 1,      /* Tukey's biweight (1 - x^2 / c^2)^2 for x < c = sqrt(5)
+                                       * sigma_g, else 0: far outliers get no weight at all */
+    RSMOOTH_INFLUENCE_LORENTZIAN = 2, /* 1 / (1 + x^2 / sigma_g^2): heavy tails, never zero */
+    RSMOOTH_INFLUENCE_HUBER = 3       /* min(1, sigma_g / x): least squares near, L1 far */
+} rsmooth_influence;
+
 /* Filter parameters. Fill with rsmooth_params_init() first, then change fields: struct_size lets
  * later versions add fields without breaking callers compiled against this one. */
 typedef struct rsmooth_params {
@@ -132,10 +154,32 @@ typedef struct rsmooth_params {
     void *progress_user;          /* passed to `progress` unchanged */
     int predictor;                /* an rsmooth_predictor; default RSMOOTH_PREDICT_PROJECTION. (Added
                                    * in 0.2: callers with an older struct_size get the default.) */
+    /* Beyond the paper (added in 0.4; callers with an older struct_size get the defaults, which
+     * are the paper's filter exactly). */
+    int normal_filter;            /* an rsmooth_normal_filter: how the predictors' normals are
+                                   * smoothed when `mollify` is 1. Default RSMOOTH_NORMALS_MOLLIFY */
+    double normal_sigma_s;        /* bilateral: spatial width, units of sigma_f. Default 1 */
+    double normal_sigma_n;        /* bilateral: width on |n_q - n_r| between unit normals, (0, 2].
+                                   * Default 0.35 */
+    int normal_iterations;        /* bilateral: rounds, [1, 100]. Default 5 */
+    int influence;                /* an rsmooth_influence: the robust weight g. Default
+                                   * RSMOOTH_INFLUENCE_GAUSSIAN (the paper's) */
+    int passes;                   /* the whole filter this many times, [1, 100], each pass from the
+                                   * previous pass's positions (sigmas stay those of the input).
+                                   * Default 1 */
+    double pass_confidence;       /* 0 (default): every pass moves every vertex. In (0, 1]: passes
+                                   * after the first move only the vertices whose confidence in the
+                                   * previous pass was below this (low confidence: features and
+                                   * outliers, the paper's Sec. 5 suggestion) */
 } rsmooth_params;
 
 /* Fills `params` with the defaults above. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if params is NULL. */
 RSMOOTH_API rsmooth_status rsmooth_params_init(rsmooth_params *params);
+
+/* Fills `params` with rsmooth's most accurate mode, beyond the paper: bilateral normals, then
+ * several robust passes (settings measured on the benchmark models, docs/experiments.md). The
+ * sigmas suit noise of about 0.3 mean edge lengths; rsmooth_params_auto fits them to a mesh. */
+RSMOOTH_API rsmooth_status rsmooth_params_init_best(rsmooth_params *params);
 
 /* Mean length of the mesh's unique undirected edges (an edge shared by two triangles counts once),
  * in the mesh's units: the unit of relative sigmas. Writes 0 when there is no edge of non-zero length.
@@ -219,6 +263,52 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const vo
                                                  size_t vertex_count, const uint32_t *indices,
                                                  size_t triangle_count, double lambda, double mu,
                                                  unsigned iterations, void *out_positions,
+                                                 rsmooth_error *error);
+
+/* Point clouds with normals (beyond the paper; added in 0.4). A point set has no triangles, so
+ * each point p_i is its own facet: its centroid is p_i, its plane the tangent plane through p_i
+ * with normal n_i, and its area a_i = (sqrt(3) / 2) s_i^2, where s_i is p_i's mean distance to its
+ * 6 nearest other points (the area per point of a regular triangular lattice of spacing s_i), so
+ * densely sampled parts do not outweigh sparse ones. Then Eq. 3 as for meshes, confidence too.
+ *
+ * Relative sigmas are in units of the point spacing: the mean of s_i over the points
+ * (rsmooth_point_spacing). On the vertices of a mesh it is within a few percent of the mean edge
+ * length (0.92 to 1.00 on the benchmark models), so the same sigmas mean the same.
+ * Predictor normals: with params->mollify = 1 (default) the bilateral normal filter of
+ * rsmooth_normal_filter with normal_sigma_s, normal_sigma_n and normal_iterations, whatever
+ * normal_filter says (the paper's mollification moves triangle corners, which points lack); with
+ * mollify = 0 the input normals. params->passes > 1: each pass starts from the previous pass's
+ * positions and filtered normals (areas recomputed, sigmas those of the input's spacing), with
+ * pass_confidence as for meshes. params->predictor CENTROID averages neighbouring points.
+ *
+ * scalar          type of positions, normals, out_positions and out_normals.
+ * positions       3 * point_count values, finite, magnitude <= 1e150. Borrowed.
+ * normals         3 * point_count values: a normal per point, of any finite non-zero length
+ *                 (normalised here), oriented consistently (the bilateral filter compares them
+ *                 as vectors; the projections do not care). Borrowed.
+ * point_count     >= 1 and < 2^32.
+ * params          NULL means defaults (rsmooth_params_init).
+ * out_positions   3 * point_count values: the filtered points, in input order.
+ * out_normals     optional (NULL): 3 * point_count values receiving the unit normals the last pass
+ *                 predicted with (the filtered normals; the input's, normalised, with mollify 0).
+ * out_confidence  optional (NULL): point_count floats, k(p) / sum a f in [0, 1].
+ * report          optional (NULL): triangle_count 0, facet_count the points of non-zero area,
+ *                 mean_edge_length the point spacing; ms_mollify the normal filter.
+ * Outputs must not overlap the inputs or each other.
+ *
+ * Returns RSMOOTH_OK, RSMOOTH_ERROR_INVALID_ARGUMENT (naming the point of a non-finite or zero
+ * normal; no output written) or RSMOOTH_ERROR_OUT_OF_MEMORY (outputs undefined). Double
+ * precision, thread-safe. The OpenCL path does not take point clouds yet. */
+RSMOOTH_API rsmooth_status rsmooth_smooth_points_reference(
+    rsmooth_scalar scalar, const void *positions, const void *normals, size_t point_count,
+    const rsmooth_params *params, void *out_positions, void *out_normals, float *out_confidence,
+    rsmooth_report *report, rsmooth_error *error);
+
+/* The point spacing of a point set, as above: the mean over the points of each one's mean distance
+ * to its 6 nearest others (fewer when there are fewer points; 0 for one point). Fails like
+ * rsmooth_smooth_points_reference on bad positions. Thread-safe. */
+RSMOOTH_API rsmooth_status rsmooth_point_spacing(rsmooth_scalar scalar, const void *positions,
+                                                 size_t point_count, double *out_spacing,
                                                  rsmooth_error *error);
 
 /* ---------------------------------------------------------------------------------------------- */

@@ -10,7 +10,8 @@
  * Nothing is lost in a round trip through the same format: what a file carries beyond positions and
  * faces (PLY properties, elements and comments; OBJ texture coordinates, groups, objects, materials
  * and smoothing groups; OFF colours; STL header and attributes) is kept in `extras` and written back
- * unchanged, except vertex normals, which writers recompute from the (filtered) positions.
+ * unchanged, except vertex normals, which writers recompute from the (filtered) positions (point
+ * clouds, with no faces to recompute from, write their vertex_normals).
  * Converting to another format keeps what the target can hold (positions, faces, vertex colours,
  * normals); rsmooth_mesh_conversion_losses() says what it drops.
  *
@@ -70,6 +71,13 @@ typedef struct rsmooth_mesh {
      * format loses nothing (opaque; NULL when there is nothing). Writers to the same format use it
      * in place of vertex_colors / vertex_quality; set it to NULL to write only the fields above. */
     struct rsmooth_mesh_extras *extras;
+
+    /* The vertex normals the file held (added in 0.4): 3 * vertex_count values as read (PLY nx,
+     * ny, nz; OFF NOFF; OBJ vn when there are no faces and as many vn as v), NULL when it held
+     * none. Point clouds live on them. Writers emit them in place of recomputed normals when the
+     * mesh has no triangles (nothing to recompute from); a caller may set or replace them (the
+     * mesh frees them: allocate with malloc). */
+    double *vertex_normals;
 } rsmooth_mesh;
 
 /* Parses a whole file held in memory. With `format` AUTO, content starting with "ply" is PLY and

@@ -62,8 +62,9 @@ rsmooth_status rs_io_stl_read(const char *data, size_t size, rsmooth_mesh **mesh
 rsmooth_status rs_io_stl_write(const rsmooth_mesh *mesh, FILE *stream, bool binary,
                                rsmooth_error *error);
 
-/* The normals writers emit, recomputed from the positions: 3 * vertex_count doubles in a new
- * *normals (the caller frees it), or an error naming `where`. */
+/* The normals writers emit, recomputed from the positions (a mesh without triangles, a point cloud:
+ * its vertex_normals): 3 * vertex_count doubles in a new *normals (the caller frees it), or an
+ * error naming `where`. */
 rsmooth_status rs_io_vertex_normals(const rsmooth_mesh *mesh, double **normals, const char *where,
                                     rsmooth_error *error);
 

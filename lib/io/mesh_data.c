@@ -92,6 +92,7 @@ void rsmooth_mesh_destroy(rsmooth_mesh *mesh) {
     rs_free(mesh->triangles);
     rs_free(mesh->vertex_quality);
     rs_free(mesh->vertex_colors);
+    rs_free(mesh->vertex_normals);
     if (mesh->extras) {
         rs_io_ply_extras_free(mesh->extras->ply);
         rs_io_obj_extras_free(mesh->extras->obj);

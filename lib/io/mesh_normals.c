@@ -1,5 +1,5 @@
 /* Vertex normals recomputed from positions: what writers emit for files that carried normals, so
- * filtered meshes never keep their noisy input normals. */
+ * filtered meshes never keep their noisy input normals. Point clouds (no triangles) keep theirs. */
 #include "io/io_internal.h"
 
 #include <math.h>
@@ -48,6 +48,11 @@ rsmooth_status rs_io_vertex_normals(const rsmooth_mesh *mesh, double **normals, 
     if (!*normals)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "normals of %zu vertices",
                        mesh->vertex_count);
+    if (mesh->triangle_count == 0 && mesh->vertex_normals) {
+        /* a point cloud: no triangle to recompute from, so its own normals (filtered or read) */
+        memcpy(*normals, mesh->vertex_normals, mesh->vertex_count * 3 * sizeof(double));
+        return RSMOOTH_OK;
+    }
     rsmooth_error inner;
     if (rsmooth_mesh_vertex_normals(mesh, *normals, &inner) != RSMOOTH_OK) {
         rs_free(*normals);

@@ -423,6 +423,39 @@ static rsmooth_status attach_extras(obj_state *st, rsmooth_mesh *mesh, rsmooth_e
     return RSMOOTH_OK;
 }
 
+/* A point cloud's normals: with no faces to say which vn goes with which v, the i-th vn line is
+ * taken as the i-th vertex's normal when there are as many vn as v (what point-cloud exporters
+ * write). NULL otherwise, or when out of memory (the normals are optional). */
+static double *point_cloud_normals(const char *data, size_t size, size_t vertex_count) {
+    double *normals = rs_alloc_array(vertex_count, 3 * sizeof(double));
+    size_t found = 0;
+    const char *p = data, *end = data + size;
+    while (normals && p < end) {
+        const char *eol = memchr(p, '\n', (size_t)(end - p));
+        const char *line_end = eol ? eol : end, *token;
+        size_t len;
+        if (next_token(&p, line_end, &token, &len) && len == 2 && token[0] == 'v' &&
+            token[1] == 'n') {
+            double n[3];
+            int k = 0;
+            while (k < 3 && next_token(&p, line_end, &token, &len) &&
+                   rs_io_parse_double(token, len, &n[k]))
+                k++;
+            if (k < 3 || found == vertex_count) { /* malformed, or more vn than v */
+                rs_free(normals);
+                return NULL;
+            }
+            memcpy(normals + 3 * found++, n, sizeof n);
+        }
+        p = eol ? eol + 1 : end;
+    }
+    if (found != vertex_count) {
+        rs_free(normals);
+        return NULL;
+    }
+    return normals;
+}
+
 rsmooth_status rs_io_obj_read(const char *data, size_t size, rsmooth_mesh **mesh,
                               rsmooth_error *error) {
     obj_state st = {.data = data, .size = size, .known_vertex_count = -1};
@@ -469,6 +502,8 @@ rsmooth_status rs_io_obj_read(const char *data, size_t size, rsmooth_mesh **mesh
             *mesh = NULL;
         }
     }
+    if (status == RSMOOTH_OK && face_count == 0 && (*mesh)->has_vertex_normals)
+        (*mesh)->vertex_normals = point_cloud_normals(data, size, st.vertex_count);
     free_state(&st);
     return status;
 }

@@ -223,6 +223,7 @@ static rsmooth_status parse_header(off_reader *r, off_header *h, rsmooth_error *
 /* The parse in progress; freed whole on failure. */
 typedef struct off_state {
     double *positions;
+    double *normals;    /* NOFF: 3 per vertex as written */
     float *raw_colors;  /* 3 per vertex as written; bytes once the file's convention is known */
     bool color_above_one;
     uint32_t *offsets;
@@ -232,6 +233,7 @@ typedef struct off_state {
 
 static void free_state(off_state *st) {
     rs_free(st->positions);
+    rs_free(st->normals);
     rs_free(st->raw_colors);
     rs_free(st->offsets);
     rs_free(st->indices.data);
@@ -278,6 +280,8 @@ static rsmooth_status parse_vertex(off_reader *r, const off_header *h, off_state
         return rs_fail_parse(error, r->line, tokens[0] - r->data, where,
                              "vertex %zu has a non-finite coordinate", v);
     memcpy(st->positions + 3 * v, values, 3 * sizeof(double));
+    if (h->n)
+        memcpy(st->normals + 3 * v, values + 3, 3 * sizeof(double));
     if (h->c) {
         int components = count - base - (h->st ? 2 : 0);
         if (components >= 4) {
@@ -397,7 +401,10 @@ rsmooth_status rs_io_off_read(const char *data, size_t size, rsmooth_mesh **mesh
     st.extras = rs_calloc_array(1, sizeof *st.extras);
     if (h.c)
         st.raw_colors = rs_alloc_array(nv, 3 * sizeof(float));
+    if (h.n)
+        st.normals = rs_alloc_array(nv, 3 * sizeof(double));
     if (!st.positions || !st.offsets || !st.extras || (h.c && !st.raw_colors) ||
+        (h.n && !st.normals) ||
         !rs_io_u32vec_reserve(&st.indices, nf < SIZE_MAX / 3 ? 3 * nf : nf)) {
         free_state(&st);
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "%zu vertices, %zu faces", nv,
@@ -429,11 +436,14 @@ rsmooth_status rs_io_off_read(const char *data, size_t size, rsmooth_mesh **mesh
                               RSMOOTH_FORMAT_OFF, mesh, error);
     if (status != RSMOOTH_OK) {
         rs_free(colors);
+        rs_free(st.normals);
         rs_io_off_extras_free(x);
         return status;
     }
     (*mesh)->vertex_colors = colors;
     (*mesh)->has_vertex_normals = h.n;
+    (*mesh)->vertex_normals = st.normals;
+    st.normals = NULL;
     /* Kept only when there is something the generic writer would not reproduce. */
     if (x->vertex.offsets || x->face.offsets) {
         struct rsmooth_mesh_extras *holder = rs_io_mesh_extras(*mesh);

@@ -27,6 +27,7 @@ typedef struct ply_reader {
     size_t face_count;
     rs_io_u32vec indices;
     bool normals;
+    double *normal_values; /* 3 per vertex when `normals`: nx, ny, nz as read */
     size_t color[3]; /* property index of red, green, blue in the vertex element; SIZE_MAX: none */
     uint8_t *colors;
 } ply_reader;
@@ -603,12 +604,14 @@ static rsmooth_status read_binary_element(ply_reader *r, rs_ply_element *e, rsmo
     /* item_size is the minimum size of an item, checked for every element in read_data. */
     if (all_scalar) {
         if (is_vertex) {
-            size_t offsets[3] = {0, 0, 0};
-            rs_ply_type types[3] = {RS_PLY_NONE, RS_PLY_NONE, RS_PLY_NONE};
+            /* x, y, z, then nx, ny, nz (when read) */
+            size_t offsets[6] = {0, 0, 0, 0, 0, 0};
+            rs_ply_type types[6] = {RS_PLY_NONE, RS_PLY_NONE, RS_PLY_NONE,
+                                    RS_PLY_NONE, RS_PLY_NONE, RS_PLY_NONE};
             size_t at = 0;
             for (size_t k = 0; k < e->property_count; k++) {
                 const rs_ply_property *p = &e->properties[k];
-                if (p->role >= RS_PLY_X && p->role <= RS_PLY_Z) {
+                if (p->role >= RS_PLY_X && p->role <= RS_PLY_NZ) {
                     offsets[p->role - RS_PLY_X] = at;
                     types[p->role - RS_PLY_X] = p->type;
                 }
@@ -619,6 +622,9 @@ static rsmooth_status read_binary_element(ply_reader *r, rs_ply_element *e, rsmo
                 double *xyz = r->positions + 3 * i;
                 for (int c = 0; c < 3; c++)
                     xyz[c] = load_value(item + offsets[c], types[c], be);
+                for (int c = 0; r->normal_values && c < 3; c++)
+                    r->normal_values[3 * i + (size_t)c] =
+                        load_value(item + offsets[3 + c], types[3 + c], be);
                 if (!isfinite(xyz[0]) || !isfinite(xyz[1]) || !isfinite(xyz[2]))
                     return rs_fail_parse(error, -1, (int64_t)(item - data), where,
                                          "vertex %zu has a non-finite coordinate", i);
@@ -651,6 +657,9 @@ static rsmooth_status read_binary_element(ply_reader *r, rs_ply_element *e, rsmo
                     copy_values(row + p->row_offset, src, 1, size, r->swap);
                 else if (p->role >= RS_PLY_X && p->role <= RS_PLY_Z)
                     r->positions[3 * i + (uint64_t)(p->role - RS_PLY_X)] =
+                        load_value(src, p->type, be);
+                else if (p->role >= RS_PLY_NX && p->role <= RS_PLY_NZ)
+                    r->normal_values[3 * i + (uint64_t)(p->role - RS_PLY_NX)] =
                         load_value(src, p->type, be);
                 r->pos += size;
                 continue;
@@ -832,6 +841,9 @@ static rsmooth_status read_ascii_element(ply_reader *r, rs_ply_element *e, rsmoo
                     /* as stored in binary: a float property holds a float */
                     r->positions[3 * i + (uint64_t)(p->role - RS_PLY_X)] =
                         p->type == RS_PLY_FLOAT32 ? (double)(float)v : v;
+                else if (p->role >= RS_PLY_NX && p->role <= RS_PLY_NZ)
+                    r->normal_values[3 * i + (uint64_t)(p->role - RS_PLY_NX)] =
+                        p->type == RS_PLY_FLOAT32 ? (double)(float)v : v;
                 else if (p->role == RS_PLY_STORED && !store_value(row + p->row_offset, p->type, v))
                     return bad_value(r, e, p, p->type, v, offset, error);
                 continue;
@@ -953,7 +965,9 @@ static rsmooth_status read_data(ply_reader *r, rsmooth_error *error) {
         }
         if (is_vertex) {
             r->positions = rs_alloc_array(r->vertex_count, 3 * sizeof(double));
-            if (!r->positions)
+            if (r->normals)
+                r->normal_values = rs_alloc_array(r->vertex_count, 3 * sizeof(double));
+            if (!r->positions || (r->normals && !r->normal_values))
                 return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "%zu vertices",
                                r->vertex_count);
         }
@@ -1042,6 +1056,7 @@ rsmooth_status rs_io_ply_read(const char *data, size_t size, rsmooth_mesh **mesh
     }
     if (status != RSMOOTH_OK) {
         rs_free(r.positions);
+        rs_free(r.normal_values);
         rs_free(r.face_offsets);
         rs_free(r.indices.data);
         rs_free(r.colors);
@@ -1057,10 +1072,12 @@ rsmooth_status rs_io_ply_read(const char *data, size_t size, rsmooth_mesh **mesh
                               r.face_count, indices, format, &m, error);
     if (status != RSMOOTH_OK) {
         rs_free(r.colors);
+        rs_free(r.normal_values);
         rs_io_ply_extras_free(r.x);
         return status;
     }
     m->has_vertex_normals = r.normals;
+    m->vertex_normals = r.normal_values;
     m->vertex_colors = r.colors;
     if (plain) {
         rs_io_ply_extras_free(r.x);

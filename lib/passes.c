@@ -1,0 +1,149 @@
+/* Repeated passes (beyond the paper, its Sec. 5 suggestion): the filter run again from its own
+ * output, optionally only where the previous pass had low confidence. Each pass recomputes facet
+ * data, normals and the grid from the previous positions; the sigmas stay those the input's mean
+ * edge length gave, so later passes do not shrink their reach as the mesh smooths. */
+#include "rsmooth_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+/* The caller's progress callback, seen through one pass of `count`. */
+typedef struct pass_progress {
+    rsmooth_progress_fn progress;
+    void *user;
+    int pass, count;
+} pass_progress;
+
+static void report_pass_progress(void *user, double fraction) {
+    const pass_progress *pp = user;
+    pp->progress(pp->user, ((double)pp->pass + fraction) / (double)pp->count);
+}
+
+/* Stage times and work of one pass added to the sum of the passes before (counts, sigmas and
+ * device from the last pass, except the facet count: the input's). */
+static void add_report(rsmooth_report *sum, const rsmooth_report *pass) {
+    rsmooth_report keep = *sum;
+    *sum = *pass;
+    sum->ms_setup += keep.ms_setup;
+    sum->ms_facets += keep.ms_facets;
+    sum->ms_grid += keep.ms_grid;
+    sum->ms_upload += keep.ms_upload;
+    sum->ms_mollify += keep.ms_mollify;
+    sum->ms_normals += keep.ms_normals;
+    sum->ms_robust += keep.ms_robust;
+    sum->ms_download += keep.ms_download;
+    sum->pairs_mollify += keep.pairs_mollify;
+    sum->pairs_robust += keep.pairs_robust;
+    sum->tiles = keep.tiles > sum->tiles ? keep.tiles : sum->tiles;
+    if (keep.vertex_count) /* the facets of the input, not of the last pass's positions */
+        sum->facet_count = keep.facet_count;
+}
+
+rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar scalar,
+                                const void *positions, size_t vertex_count,
+                                const uint32_t *indices, size_t triangle_count,
+                                const rsmooth_params *params, void *out_positions,
+                                float *out_weight, float *out_confidence, rsmooth_report *report,
+                                rsmooth_error *error, const char *where) {
+    double t_start = rs_now_ms();
+    rs_error_clear(error);
+    rsmooth_params p;
+    rsmooth_status st = rs_params_resolve(params, &p, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
+    if (p.passes == 1) /* the paper's single pass, exactly as it was */
+        return one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, params,
+                        out_positions, out_weight, out_confidence, report, error);
+    if ((st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count, error,
+                                   where)) != RSMOOTH_OK ||
+        (st = rs_check_output_positions(scalar, positions, vertex_count, out_positions, error,
+                                        where)) != RSMOOTH_OK)
+        return st;
+
+    /* Fix the sigmas in mesh units once, from the input. */
+    double unit = 0;
+    if ((st = rsmooth_mean_edge_length(scalar, positions, vertex_count, indices, triangle_count,
+                                       &unit, error)) != RSMOOTH_OK)
+        return st;
+    if (!p.absolute) {
+        if (!(unit > 0)) /* no edge: nothing moves, one pass says so */
+            p.passes = 1;
+        p.sigma_f *= unit;
+        p.sigma_g *= unit; /* +INFINITY stays */
+        p.normal_sigma_s *= unit;
+        p.absolute = 1;
+    }
+    int passes = p.passes;
+    p.passes = 1;
+    pass_progress pp = {params ? params->progress : NULL, params ? params->progress_user : NULL, 0,
+                        passes};
+    if (pp.progress) {
+        p.progress = report_pass_progress;
+        p.progress_user = &pp;
+    }
+    if (passes == 1)
+        return one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, &p,
+                        out_positions, out_weight, out_confidence, report, error);
+
+    double *cur = rs_alloc_array(vertex_count, 3 * sizeof(double));
+    double *next = rs_alloc_array(vertex_count, 3 * sizeof(double));
+    float *weight = rs_alloc_array(vertex_count, sizeof(float));
+    float *confidence = rs_alloc_array(vertex_count, sizeof(float));
+    float *prev_weight = rs_alloc_array(vertex_count, sizeof(float));
+    float *prev_confidence = rs_alloc_array(vertex_count, sizeof(float));
+    if (!cur || !next || !weight || !confidence || !prev_weight || !prev_confidence) {
+        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for %d passes",
+                     passes);
+        goto done;
+    }
+    rsmooth_report sum, one;
+    memset(&sum, 0, sizeof sum);
+    for (int pass = 0; pass < passes; pass++) {
+        pp.pass = pass;
+        const void *from = pass == 0 ? positions : cur;
+        rsmooth_scalar from_scalar = pass == 0 ? scalar : RSMOOTH_FLOAT64;
+        st = one_pass(ctx, from_scalar, from, vertex_count, indices, triangle_count, &p, next,
+                      weight, confidence, report ? &one : NULL, error);
+        if (st != RSMOOTH_OK)
+            goto done;
+        if (report)
+            add_report(&sum, &one);
+        if (pass > 0 && p.pass_confidence > 0) {
+            /* confident vertices keep what the pass before gave them */
+            for (size_t v = 0; v < vertex_count; v++)
+                if (prev_confidence[v] >= p.pass_confidence) {
+                    memcpy(next + 3 * v, cur + 3 * v, 3 * sizeof(double));
+                    weight[v] = prev_weight[v];
+                    confidence[v] = prev_confidence[v];
+                }
+        }
+        double *t = cur;
+        cur = next;
+        next = t;
+        float *tw = prev_weight, *tc = prev_confidence;
+        prev_weight = weight;
+        prev_confidence = confidence;
+        weight = tw;
+        confidence = tc;
+    }
+    for (size_t v = 0; v < vertex_count; v++) {
+        rs_store_position(scalar, out_positions, v, cur + 3 * v);
+        if (out_weight)
+            out_weight[v] = prev_weight[v];
+        if (out_confidence)
+            out_confidence[v] = prev_confidence[v];
+    }
+    if (report) {
+        *report = sum;
+        report->mean_edge_length = unit; /* the input's, the unit of its sigmas */
+        report->ms_total = rs_now_ms() - t_start;
+    }
+done:
+    rs_free(cur);
+    rs_free(next);
+    rs_free(weight);
+    rs_free(confidence);
+    rs_free(prev_weight);
+    rs_free(prev_confidence);
+    return st;
+}

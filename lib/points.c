@@ -1,0 +1,461 @@
+/* Point clouds with normals (beyond the paper): the reference filter with the points as its facets.
+ * A point is a facet whose centroid is the point, whose plane is its tangent plane and whose area
+ * is estimated from how far its nearest neighbours are; rs_reference_solve then runs Eq. 3 on
+ * them unchanged. The normals are filtered here, since the paper's mollification moves triangle
+ * corners and points have none. */
+#include "rsmooth_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <stdlib.h>
+
+/* s_i, a point's spacing, is its mean distance to this many nearest others: on the vertices of a
+ * mesh, 6 (a regular vertex's ring) makes the mean s_i within a few percent of the mean edge
+ * length, so relative sigmas mean the same for a mesh and for its vertices as a point cloud. */
+#define SPACING_NEIGHBOURS 6
+/* The area per point of a regular triangular lattice of spacing s is (sqrt(3) / 2) s^2: the
+ * points' areas then sum to about the surface's. */
+#define LATTICE_AREA 0.86602540378443864676
+/* Points per chunk of the threaded neighbour search. */
+#define SPACING_GRAIN 4096
+/* Progress: the share of a pass that spacing and normal filtering take. */
+#define NORMALS_SHARE 0.2
+
+static const char where[] = "rsmooth_smooth_points_reference";
+
+typedef struct spacing_job {
+    const rs_kdtree *tree;
+    double *spacing; /* per point: s_i */
+} spacing_job;
+
+static void spacing_range(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const spacing_job *job = ctx;
+    double d2[SPACING_NEIGHBOURS];
+    (void)chunk;
+    for (size_t i = begin; i < end; i++) {
+        size_t found = rs_kdtree_nearest(job->tree, job->tree->xyz + 3 * i, (uint32_t)i,
+                                         SPACING_NEIGHBOURS, d2, NULL);
+        double sum = 0;
+        for (size_t j = 0; j < found; j++)
+            sum += sqrt(d2[j]);
+        job->spacing[i] = found ? sum / (double)found : 0;
+    }
+}
+
+/* s_i of every point of the tree, and their mean (summed in point order: the same on every run). */
+static double point_spacings(const rs_kdtree *tree, double *spacing) {
+    spacing_job job = {tree, spacing};
+    rs_parallel_for(tree->count, SPACING_GRAIN, spacing_range, &job);
+    double sum = 0;
+    for (size_t i = 0; i < tree->count; i++)
+        sum += spacing[i];
+    return sum / (double)tree->count;
+}
+
+/* Checks positions (what rs_check_mesh_arrays checks, worded for points). */
+static rsmooth_status check_positions(rsmooth_scalar scalar, const void *positions,
+                                      size_t point_count, rsmooth_error *error,
+                                      const char *caller) {
+    if (scalar != RSMOOTH_FLOAT32 && scalar != RSMOOTH_FLOAT64)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller,
+                       "scalar must be RSMOOTH_FLOAT32 or RSMOOTH_FLOAT64 (got %d)", (int)scalar);
+    if (!positions)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller, "positions is NULL");
+    if (point_count == 0)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller, "the point cloud is empty");
+    if (point_count >= UINT32_MAX || rs_mul_overflows(point_count, 3 * sizeof(double)))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller,
+                       "point count %zu exceeds the 32-bit index range", point_count);
+    for (size_t i = 0; i < 3 * point_count; i++) {
+        double x = rs_coordinate(scalar, positions, i);
+        if (!isfinite(x))
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller,
+                           "point %zu has a non-finite coordinate", i / 3);
+        if (fabs(x) > RS_MAX_COORDINATE)
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller,
+                           "point %zu has coordinate %g beyond the supported magnitude %g", i / 3,
+                           x, RS_MAX_COORDINATE);
+    }
+    return RSMOOTH_OK;
+}
+
+/* Normal i of the caller's array made unit length into out[0..2]; false when it has none. Scaled
+ * by its largest component first, so lengths near the double range neither overflow nor vanish. */
+static bool unit_normal(rsmooth_scalar scalar, const void *normals, size_t i, double out[3]) {
+    double m = 0;
+    for (int k = 0; k < 3; k++) {
+        out[k] = rs_coordinate(scalar, normals, 3 * i + (size_t)k);
+        if (!isfinite(out[k]))
+            return false;
+        m = fmax(m, fabs(out[k]));
+    }
+    if (!(m > 0))
+        return false;
+    for (int k = 0; k < 3; k++)
+        out[k] /= m;
+    double len = sqrt(rs_dot3(out, out));
+    for (int k = 0; k < 3; k++)
+        out[k] /= len;
+    return true;
+}
+
+/* Ranges overlap when neither ends before the other begins (NULL overlaps nothing). */
+static bool overlaps(const void *a, size_t a_size, const void *b, size_t b_size) {
+    const char *pa = a, *pb = b;
+    return pa && pb && pa < pb + b_size && pb < pa + a_size;
+}
+
+rsmooth_status rsmooth_point_spacing(rsmooth_scalar scalar, const void *positions,
+                                     size_t point_count, double *out_spacing,
+                                     rsmooth_error *error) {
+    static const char caller[] = "rsmooth_point_spacing";
+    rs_error_clear(error);
+    if (!out_spacing)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller, "out_spacing is NULL");
+    rsmooth_status st = check_positions(scalar, positions, point_count, error, caller);
+    if (st != RSMOOTH_OK)
+        return st;
+    double *xyz = rs_alloc_array(point_count, 3 * sizeof *xyz);
+    double *spacing = rs_alloc_array(point_count, sizeof *spacing);
+    rs_kdtree tree;
+    bool ok = xyz && spacing;
+    if (ok) {
+        for (size_t i = 0; i < 3 * point_count; i++)
+            xyz[i] = rs_coordinate(scalar, positions, i);
+        ok = rs_kdtree_build(&tree, xyz, point_count);
+    }
+    if (ok) {
+        *out_spacing = point_spacings(&tree, spacing);
+        rs_kdtree_free(&tree);
+    }
+    rs_free(xyz);
+    rs_free(spacing);
+    return ok ? RSMOOTH_OK
+              : rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, caller, "no memory for %zu points",
+                        point_count);
+}
+
+/* Bilateral filter on the points' normals: normal_iterations rounds of
+ * n_r <- normalise(sum_q a_q exp(-|p_q - p_r|^2 / 2 s^2) exp(-|n_q - n_r|^2 / 2 t^2) n_q) over the
+ * points q within normal_radius of p_r (itself included): RSMOOTH_NORMALS_BILATERAL with the
+ * points as facets. From `input` into `out`; `scratch` holds the previous round. */
+static bool bilateral_normals(const rs_problem *pb, const rs_kdtree *tree, const double *input,
+                              double *out, double *scratch, rs_kdtree_list *nb) {
+    size_t n = pb->facet_count;
+    const double inv_2s2 = 1 / (2 * pb->normal_sigma_s * pb->normal_sigma_s);
+    const double inv_2n2 = 1 / (2 * pb->normal_sigma_n * pb->normal_sigma_n);
+    memcpy(scratch, input, n * 3 * sizeof(double));
+    for (int round = 0; round < pb->normal_iterations; round++) {
+        for (size_t r = 0; r < n; r++) {
+            if (!rs_kdtree_within(tree, pb->centroid + 3 * r, pb->normal_radius, nb))
+                return false;
+            const double *nr = scratch + 3 * r;
+            double acc[3] = {0, 0, 0};
+            for (size_t i = 0; i < nb->count; i++) {
+                const double *nq = scratch + 3 * (size_t)nb->index[i];
+                double dn[3];
+                rs_sub3(nq, nr, dn);
+                double w = pb->area[nb->index[i]] * exp(-nb->dist2[i] * inv_2s2) *
+                           exp(-rs_dot3(dn, dn) * inv_2n2);
+                for (int k = 0; k < 3; k++)
+                    acc[k] += w * nq[k];
+            }
+            double len = sqrt(rs_dot3(acc, acc));
+            for (int k = 0; k < 3; k++)
+                out[3 * r + k] = len > 0 ? acc[k] / len : nr[k];
+        }
+        memcpy(scratch, out, n * 3 * sizeof(double));
+    }
+    return true;
+}
+
+/* Eigenvector of the smallest eigenvalue of the symmetric 3x3 matrix a (destroyed), by cyclic
+ * Jacobi rotations. */
+static void smallest_eigenvector(double a[3][3], double out[3]) {
+    double v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    for (int sweep = 0; sweep < 50; sweep++) {
+        double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+        if (!(off > 1e-30 * (a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2])))
+            break;
+        for (int p = 0; p < 2; p++)
+            for (int q = p + 1; q < 3; q++) {
+                if (a[p][q] == 0)
+                    continue;
+                double theta = (a[q][q] - a[p][p]) / (2 * a[p][q]);
+                double t = (theta >= 0 ? 1 : -1) / (fabs(theta) + sqrt(theta * theta + 1));
+                double c = 1 / sqrt(t * t + 1), s = t * c;
+                for (int k = 0; k < 3; k++) { /* a <- a J */
+                    double akp = a[k][p], akq = a[k][q];
+                    a[k][p] = c * akp - s * akq;
+                    a[k][q] = s * akp + c * akq;
+                }
+                for (int k = 0; k < 3; k++) { /* a <- J^T a */
+                    double apk = a[p][k], aqk = a[q][k];
+                    a[p][k] = c * apk - s * aqk;
+                    a[q][k] = s * apk + c * aqk;
+                }
+                for (int k = 0; k < 3; k++) {
+                    double vkp = v[k][p], vkq = v[k][q];
+                    v[k][p] = c * vkp - s * vkq;
+                    v[k][q] = s * vkp + c * vkq;
+                }
+            }
+    }
+    int m = 0;
+    for (int k = 1; k < 3; k++)
+        if (a[k][k] < a[m][m])
+            m = k;
+    for (int k = 0; k < 3; k++)
+        out[k] = v[k][m];
+}
+
+/* PCA normals of the current positions, oriented like `normal`, into normal. */
+static void pca_normals(const rs_kdtree *tree, size_t k, double *normal) {
+    double d2[64];
+    uint32_t idx[64];
+    for (size_t i = 0; i < tree->count; i++) {
+        const double *p = tree->xyz + 3 * i;
+        size_t found = rs_kdtree_nearest(tree, p, UINT32_MAX, k, d2, idx);
+        double mean[3] = {0, 0, 0};
+        for (size_t j = 0; j < found; j++)
+            for (int c = 0; c < 3; c++)
+                mean[c] += tree->xyz[3 * (size_t)idx[j] + c] / (double)found;
+        double a[3][3] = {{0}};
+        for (size_t j = 0; j < found; j++) {
+            double d[3];
+            rs_sub3(tree->xyz + 3 * (size_t)idx[j], mean, d);
+            for (int r = 0; r < 3; r++)
+                for (int c = 0; c < 3; c++)
+                    a[r][c] += d[r] * d[c];
+        }
+        double n[3];
+        smallest_eigenvector(a, n);
+        double len = sqrt(rs_dot3(n, n));
+        double sign = rs_dot3(n, normal + 3 * i) < 0 ? -1 : 1;
+        if (found >= 3 && len > 0)
+            for (int c = 0; c < 3; c++)
+                normal[3 * i + c] = sign * n[c] / len;
+    }
+}
+
+/* The caller's progress callback, seen through one pass's robust stage. */
+typedef struct pass_progress {
+    rsmooth_progress_fn progress;
+    void *user;
+    int pass, count;
+} pass_progress;
+
+static void report_pass_progress(void *user, double fraction) {
+    const pass_progress *pp = user;
+    pp->progress(pp->user, ((double)pp->pass + NORMALS_SHARE + (1 - NORMALS_SHARE) * fraction) /
+                               (double)pp->count);
+}
+
+/* Stage times of one pass added to those of the passes before (the rest from the last pass). */
+static void add_report(rsmooth_report *sum, const rsmooth_report *pass, int index) {
+    rsmooth_report keep = *sum;
+    *sum = *pass;
+    if (index == 0)
+        return;
+    sum->ms_facets += keep.ms_facets;
+    sum->ms_grid += keep.ms_grid;
+    sum->ms_mollify += keep.ms_mollify;
+    sum->ms_normals += keep.ms_normals;
+    sum->ms_robust += keep.ms_robust;
+    sum->facet_count = keep.facet_count; /* the input's */
+}
+
+/* Arrays of one call: the current and next positions and normals, per-point spacing and area,
+ * confidence of this and the previous pass. */
+typedef struct point_arrays {
+    double *xyz, *next, *normal, *filtered, *scratch, *spacing, *area;
+    float *confidence, *prev_confidence;
+} point_arrays;
+
+static void free_arrays(point_arrays *a) {
+    rs_free(a->xyz);
+    rs_free(a->next);
+    rs_free(a->normal);
+    rs_free(a->filtered);
+    rs_free(a->scratch);
+    rs_free(a->spacing);
+    rs_free(a->area);
+    rs_free(a->confidence);
+    rs_free(a->prev_confidence);
+}
+
+rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void *positions,
+                                               const void *normals, size_t point_count,
+                                               const rsmooth_params *params, void *out_positions,
+                                               void *out_normals, float *out_confidence,
+                                               rsmooth_report *report, rsmooth_error *error) {
+    double t_start = rs_now_ms();
+    rs_error_clear(error);
+    rsmooth_params p;
+    rsmooth_status st = rs_params_resolve(params, &p, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
+    if ((st = check_positions(scalar, positions, point_count, error, where)) != RSMOOTH_OK)
+        return st;
+    if (!normals)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "normals is NULL: a point cloud needs a normal per point");
+    for (size_t i = 0; i < point_count; i++) {
+        double n[3];
+        if (!unit_normal(scalar, normals, i, n))
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                           "point %zu has a %s normal", i,
+                           isfinite(rs_coordinate(scalar, normals, 3 * i)) &&
+                                   isfinite(rs_coordinate(scalar, normals, 3 * i + 1)) &&
+                                   isfinite(rs_coordinate(scalar, normals, 3 * i + 2))
+                               ? "zero-length"
+                               : "non-finite");
+    }
+    if (!out_positions)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_positions is NULL");
+    /* Every input is read before any output is written, so outputs may be the inputs; but two
+     * outputs in one place would mix. */
+    size_t vec_bytes = point_count * 3 * (scalar == RSMOOTH_FLOAT32 ? sizeof(float) : sizeof(double));
+    size_t conf_bytes = point_count * sizeof(float);
+    if (overlaps(out_positions, vec_bytes, out_normals, vec_bytes) ||
+        overlaps(out_positions, vec_bytes, out_confidence, conf_bytes) ||
+        overlaps(out_normals, vec_bytes, out_confidence, conf_bytes))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "out_positions, out_normals and out_confidence overlap");
+
+    size_t n = point_count;
+    point_arrays a = {0};
+    a.xyz = rs_alloc_array(n, 3 * sizeof(double));
+    a.next = rs_alloc_array(n, 3 * sizeof(double));
+    a.normal = rs_alloc_array(n, 3 * sizeof(double));
+    a.filtered = rs_alloc_array(n, 3 * sizeof(double));
+    a.scratch = rs_alloc_array(n, 3 * sizeof(double));
+    a.spacing = rs_alloc_array(n, sizeof(double));
+    a.area = rs_alloc_array(n, sizeof(double));
+    a.confidence = rs_alloc_array(n, sizeof(float));
+    a.prev_confidence = rs_alloc_array(n, sizeof(float));
+    rs_kdtree tree = {0};
+    rs_kdtree_list nb = {0};
+    if (!a.xyz || !a.next || !a.normal || !a.filtered || !a.scratch || !a.spacing || !a.area ||
+        !a.confidence || !a.prev_confidence)
+        goto fail_memory;
+    for (size_t i = 0; i < 3 * n; i++)
+        a.xyz[i] = rs_coordinate(scalar, positions, i);
+    for (size_t i = 0; i < n; i++)
+        unit_normal(scalar, normals, i, a.normal + 3 * i);
+
+    /* The unit of relative sigmas: the input's spacing, kept through the passes (as meshes keep
+     * their input's mean edge length), so later passes do not shrink their reach. */
+    double unit = 0, input_spacing = 0;
+    if (p.mollify) /* the one normal filter points have */
+        p.normal_filter = RSMOOTH_NORMALS_BILATERAL;
+    pass_progress pp = {p.progress, p.progress_user, 0, p.passes};
+    rsmooth_report sum, one;
+    memset(&sum, 0, sizeof sum);
+    size_t weighted_points = 0;
+    for (int pass = 0; pass < p.passes; pass++) {
+        double t_pass = rs_now_ms();
+        pp.pass = pass;
+        if (pp.progress)
+            pp.progress(pp.user, (double)pass / (double)p.passes);
+        if (!rs_kdtree_build(&tree, a.xyz, n))
+            goto fail_memory;
+        double spacing = point_spacings(&tree, a.spacing);
+        if (pass > 0 && getenv("RS_PTS_PCA") && atoi(getenv("RS_PTS_PCA")) > 0)
+            pca_normals(&tree, (size_t)atoi(getenv("RS_PTS_PCA")), a.normal);
+        if (pass == 0) {
+            input_spacing = spacing;
+            unit = p.absolute ? 1.0 : spacing;
+        }
+        double area_sum = 0;
+        size_t positive = 0;
+        for (size_t i = 0; i < n; i++) {
+            a.area[i] = LATTICE_AREA * a.spacing[i] * a.spacing[i];
+            area_sum += a.area[i];
+            positive += a.area[i] > 0;
+        }
+        if (pass == 0)
+            weighted_points = positive;
+
+        rs_problem pb;
+        memset(&pb, 0, sizeof pb);
+        pb.vertex_count = n;
+        pb.xyz = a.xyz;
+        pb.facet_count = n; /* points of zero area (duplicates) just carry no weight */
+        pb.centroid = a.xyz;
+        pb.normal = a.filtered;
+        pb.area = a.area;
+        pb.mean_edge_length = input_spacing; /* what the report gives as the unit */
+        pb.mean_area = area_sum / (double)n;
+        rs_problem_apply_params(&pb, &p, unit);
+        pb.progress = pp.progress ? report_pass_progress : NULL;
+        pb.progress_user = &pp;
+
+        double t_normals = rs_now_ms();
+        double normal_reach = pb.facet_count > 0 && pb.bilateral ? pb.normal_radius : 0;
+        if (normal_reach > 0) {
+            if (!bilateral_normals(&pb, &tree, a.normal, a.filtered, a.scratch, &nb))
+                goto fail_memory;
+        } else {
+            memcpy(a.filtered, a.normal, n * 3 * sizeof(double));
+        }
+        double ms_normals = rs_now_ms() - t_normals;
+        rs_kdtree_free(&tree);
+        /* the predictors' normals are final: the robust stage alone remains */
+        pb.mollify = pb.bilateral = false;
+        pb.normal_radius = 0;
+        st = rs_reference_solve(&pb, RSMOOTH_FLOAT64, a.next, NULL, a.confidence,
+                                report ? &one : NULL, t_pass, error, where);
+        if (st != RSMOOTH_OK)
+            goto done;
+        if (report) {
+            one.ms_facets -= ms_normals; /* spacing and areas stay there */
+            one.ms_mollify = ms_normals;
+            one.mollify_radius = normal_reach;
+            one.facet_count = weighted_points;
+            add_report(&sum, &one, pass);
+        }
+        if (pass > 0 && p.pass_confidence > 0) {
+            /* confident points keep what the pass before gave them */
+            for (size_t v = 0; v < n; v++)
+                if (a.prev_confidence[v] >= p.pass_confidence) {
+                    memcpy(a.next + 3 * v, a.xyz + 3 * v, 3 * sizeof(double));
+                    memcpy(a.filtered + 3 * v, a.normal + 3 * v, 3 * sizeof(double));
+                    a.confidence[v] = a.prev_confidence[v];
+                }
+        }
+        /* the next pass starts from these positions and normals */
+        double *t = a.xyz;
+        a.xyz = a.next;
+        a.next = t;
+        t = a.normal;
+        a.normal = a.filtered;
+        a.filtered = t;
+        float *c = a.prev_confidence;
+        a.prev_confidence = a.confidence;
+        a.confidence = c;
+    }
+    for (size_t v = 0; v < n; v++) {
+        rs_store_position(scalar, out_positions, v, a.xyz + 3 * v);
+        if (out_normals)
+            rs_store_position(scalar, out_normals, v, a.normal + 3 * v);
+        if (out_confidence)
+            out_confidence[v] = a.prev_confidence[v];
+    }
+    if (report) {
+        *report = sum;
+        report->ms_total = rs_now_ms() - t_start;
+    }
+    st = RSMOOTH_OK;
+    goto done;
+
+fail_memory:
+    st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for %zu points", n);
+done:
+    rs_kdtree_free(&tree);
+    rs_kdtree_list_free(&nb);
+    free_arrays(&a);
+    rs_release_free_memory();
+    return st;
+}
