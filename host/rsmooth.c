@@ -53,8 +53,8 @@ static const char usage_text[] =
     "\n"
     "Beyond the paper (the defaults above are the paper's filter, unchanged):\n"
     "  --best                the most accurate mode measured (docs/experiments.md): bilateral\n"
-    "                        normals, then 3 passes at sigma-f 1, sigma-g 0.3. Options after it\n"
-    "                        still apply, e.g. --best --passes 4\n"
+    "                        normals, then 3 passes at sigma-f 0.8, sigma-g 0.3. Options\n"
+    "                        after it still apply, e.g. --best --passes 4\n"
     "  --normals F           how the predicting planes' normals are smoothed: mollify (default,\n"
     "                        the paper's) or bilateral (keeps creases the Gaussian rounds)\n"
     "  --normal-sigma-s X    bilateral: spatial width, in the units of sigma-f (default 1)\n"
@@ -66,6 +66,11 @@ static const char usage_text[] =
     "  --passes N            run the filter N times, each from the previous result (default 1)\n"
     "  --pass-confidence C   passes after the first move only vertices whose confidence was\n"
     "                        below C in (0, 1]: more smoothing at features and outliers only\n"
+    "  --sigma-c X           colour in the weight: a triangle pulls a vertex by exp(-|dC|^2 / 2\n"
+    "                        X^2) less, dC the difference between its mean vertex colour and the\n"
+    "                        vertex's (RGB in [0, 1]), so colour edges stay sharp. Needs an input\n"
+    "                        with vertex colours (PLY red green blue, OBJ v x y z r g b, COFF);\n"
+    "                        e.g. 0.1\n"
     "\n"
     "Options:\n"
     "  -o, --output FILE     result mesh (.obj, .ply, .off, .stl); refuses to replace an existing\n"
@@ -135,6 +140,7 @@ typedef struct options {
     double lambda, mu;
     unsigned iterations;
     uint64_t memory_budget; /* 0: the library's default */
+    bool colors;            /* --sigma-c: the input's vertex colours in the weight */
     bool sigma_g_given, umbrella_given; /* for consistency checks against --method */
     bool ascii, json, force, quiet, in_place, stats, list_devices, best;
 } options;
@@ -250,6 +256,15 @@ static int parse_args(int argc, char **argv, options *opt) {
             else
                 opt->params.pass_confidence = x;
             i++;
+        } else if (!strcmp(a, "--sigma-c")) {
+            if (!value)
+                return cli_usage_error(NULL, "%s needs a value", a);
+            if (!cli_parse_number(value, &x) || !(x > 0))
+                return cli_usage_error(NULL, "--sigma-c must be a positive number (got '%s')",
+                                       value);
+            opt->params.sigma_c = x;
+            opt->colors = true;
+            i++;
         } else if (!strcmp(a, "--normal-iterations") || !strcmp(a, "--passes")) {
             if (!value)
                 return cli_usage_error(NULL, "%s needs a value", a);
@@ -323,6 +338,9 @@ static int parse_args(int argc, char **argv, options *opt) {
     if (umbrella && opt->confidence)
         return cli_usage_error(NULL, "--method %s has no confidence to write",
                                method_names[opt->method]);
+    if (umbrella && opt->colors)
+        return cli_usage_error(NULL, "--method %s has no weights for --sigma-c",
+                               method_names[opt->method]);
     if (opt->method == METHOD_GAUSSIAN) {
         if (opt->sigma_g_given)
             return cli_usage_error(NULL, "--method gaussian has no influence weight: drop "
@@ -383,10 +401,20 @@ static void print_json(const rsmooth_report *r, const options *opt, double ms_re
                opt->iterations);
     else {
         const rsmooth_params *p = &opt->params;
-        printf(",\"normals\":\"%s\"", p->mollify ? normal_filter_names[p->normal_filter] : "input");
-        if (p->mollify && p->normal_filter == RSMOOTH_NORMALS_BILATERAL)
+        /* a point cloud (no triangles) has the bilateral normal filter only, and its unit is the
+         * point spacing (given as mean_edge_length) */
+        bool points = r->triangle_count == 0;
+        int filter = points ? RSMOOTH_NORMALS_BILATERAL : p->normal_filter;
+        if (points)
+            printf(",\"point_cloud\":true");
+        printf(",\"normals\":\"%s\"", p->mollify ? normal_filter_names[filter] : "input");
+        if (p->mollify && filter == RSMOOTH_NORMALS_BILATERAL)
             printf(",\"normal_sigma_s\":%.9g,\"normal_sigma_n\":%.9g,\"normal_iterations\":%d",
                    p->normal_sigma_s, p->normal_sigma_n, p->normal_iterations);
+        if (p->colors) /* the colour factor's width; null: off */
+            printf(",\"sigma_c\":%.9g", p->sigma_c);
+        else
+            printf(",\"sigma_c\":null");
         printf(",\"influence\":\"%s\",\"passes\":%d,\"pass_confidence\":%.9g",
                influence_names[p->influence], p->passes, p->pass_confidence);
     }
@@ -448,24 +476,37 @@ static void print_stats(const rsmooth_mesh *mesh, const double *out, const float
     double moved_sum = 0;
     for (size_t v = 0; v < nv; v++)
         moved_sum += moved[v];
-    fprintf(stderr,
-            "mesh:        %zu vertices (%zu referenced by no triangle), %zu faces, %zu triangles\n"
-            "size:        %.6g x %.6g x %.6g, mean edge %.6g\n",
-            nv, unreferenced, mesh->face_count, mesh->triangle_count, hi[0] - lo[0],
-            hi[1] - lo[1], hi[2] - lo[2], r->mean_edge_length);
-    if (confidence) /* the robust filter and the Gaussian; the umbrella methods have neither */
+    bool points = mesh->triangle_count == 0; /* a point cloud: its unit is the point spacing */
+    const char *unit = points ? "point spacings" : "mean edge lengths";
+    if (points)
+        fprintf(stderr,
+                "cloud:       %zu points with normals, no faces\n"
+                "size:        %.6g x %.6g x %.6g, point spacing %.6g\n"
+                "filter:      sigma_f %.6g, sigma_g %.6g, reach %.6g (cloud units), %zu points "
+                "of zero area (duplicates)\n",
+                nv, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], r->mean_edge_length, r->sigma_f,
+                r->sigma_g, r->radius, nv - r->facet_count);
+    else
+        fprintf(stderr,
+                "mesh:        %zu vertices (%zu referenced by no triangle), %zu faces, %zu "
+                "triangles\n"
+                "size:        %.6g x %.6g x %.6g, mean edge %.6g\n",
+                nv, unreferenced, mesh->face_count, mesh->triangle_count, hi[0] - lo[0],
+                hi[1] - lo[1], hi[2] - lo[2], r->mean_edge_length);
+    if (!points && confidence) /* the robust filter and the Gaussian; umbrella methods have none */
         fprintf(stderr,
                 "filter:      sigma_f %.6g, sigma_g %.6g, reach %.6g (mesh units), %zu grid "
                 "cells in %zu tile%s, %zu triangles of zero area\n",
                 r->sigma_f, r->sigma_g, r->radius, r->grid_cell_count, r->tiles,
                 r->tiles == 1 ? "" : "s", r->triangle_count - r->facet_count);
-    else
+    else if (!points)
         fprintf(stderr, "filter:      %s\n", r->device);
-    fprintf(stderr, "moved:       mean %.4f, median %.4f, max %.4f mean edge lengths\n",
-            moved_sum / (double)nv, moved[nv / 2], moved[nv - 1]);
+    fprintf(stderr, "moved:       mean %.4f, median %.4f, max %.4f %s\n",
+            moved_sum / (double)nv, moved[nv / 2], moved[nv - 1], unit);
     if (confidence)
-        fprintf(stderr, "confidence:  mean %.3f, min %.3f, %zu vertices (%.1f%%) below 0.5\n",
-                conf_sum / (double)nv, conf_min, low, 100.0 * (double)low / (double)nv);
+        fprintf(stderr, "confidence:  mean %.3f, min %.3f, %zu %s (%.1f%%) below 0.5\n",
+                conf_sum / (double)nv, conf_min, low, points ? "points" : "vertices",
+                100.0 * (double)low / (double)nv);
     free(used);
     free(moved);
 }
@@ -651,6 +692,31 @@ static int write_confidence(rsmooth_mesh *mesh, const options *opt, float *confi
     return code;
 }
 
+/* --sigma-c: the input's vertex colours as floats in [0, 1], for rsmooth_params.colors. */
+static int input_colors(const options *opt, const rsmooth_mesh *mesh, bool points,
+                        float **colors) {
+    *colors = NULL;
+    if (!mesh->vertex_colors) {
+        fprintf(stderr, "rsmooth: %s has no vertex colours: --sigma-c needs them (PLY red, "
+                        "green, blue; OBJ v x y z r g b; COFF)\n", opt->input);
+        return EXIT_USAGE;
+    }
+    if (points) {
+        fprintf(stderr, "rsmooth: %s is a point cloud (no faces): --sigma-c works on meshes "
+                        "only for now\n", opt->input);
+        return EXIT_USAGE;
+    }
+    size_t n = 3 * mesh->vertex_count;
+    *colors = malloc(n * sizeof **colors);
+    if (!*colors) {
+        fprintf(stderr, "rsmooth: %s: out of memory\n", opt->input);
+        return EXIT_OTHER;
+    }
+    for (size_t i = 0; i < n; i++)
+        (*colors)[i] = (float)mesh->vertex_colors[i] / 255.0f;
+    return EXIT_OK;
+}
+
 int main(int argc, char **argv) {
     if (argc >= 2 && !strcmp(argv[1], "compare"))
         return cli_compare_main(argc - 1, argv + 1);
@@ -689,6 +755,12 @@ int main(int argc, char **argv) {
         rsmooth_mesh_destroy(mesh);
         return code;
     }
+    float *colors = NULL; /* --sigma-c */
+    if (opt.colors && (code = input_colors(&opt, mesh, points, &colors)) != EXIT_OK) {
+        rsmooth_mesh_destroy(mesh);
+        return code;
+    }
+    opt.params.colors = colors;
 
     size_t nv = mesh->vertex_count;
     double *out = malloc(nv * 3 * sizeof *out);
@@ -757,5 +829,6 @@ cleanup:
     free(out);
     free(out_normals);
     free(confidence);
+    free(colors);
     return code;
 }

@@ -14,6 +14,14 @@
  * `influence` (an RS_INFLUENCE_ value) picks g; every one but the Gaussian is a function of
  * u = x^2 / sigma_g^2 (x = |prediction - p|, inv_sg2 = h^2 / sigma_g^2) multiplying a f, and
  * has no rescue: a lane they give no weight at all (Tukey's) stays where it is.
+ * `use_color` = 1 multiplies each weight by the colour factor 2^-(|C_q - C_p|^2 inv_2sc2)
+ * (inv_2sc2 = log2 e / 2 sigma_c^2): C_q = facet_color[q].xyz, the mean colour of q's corners,
+ * C_p the lane's colour from block_color (per block, as block_pos: every lane's first component,
+ * then the second, then the third). With the Gaussian its exponent joins the influence's; the
+ * other influence functions multiply their weight by it. Either way the rescue covers it (with
+ * the other functions, the colour exponent alone is shifted). sum a f never includes it. The
+ * loops without colour are the specialisations they were (use_color = 0 folds every colour term
+ * away).
  */
 
 typedef struct robust_acc {
@@ -38,7 +46,8 @@ inline __attribute__((always_inline)) lanef influence_weight(lanef u, int influe
 inline __attribute__((always_inline)) robust_acc
 robust_sums(lanef px, lanef py, lanef pz, float3 lo, float3 hi, int4 anchor, float reach2,
             float inv_2sf2, float inv_2sg2, lanef shift, int want_confidence, int predict_centroid,
-            int influence, float inv_sg2,
+            int influence, float inv_sg2, int use_color, lanef cr, lanef cg, lanef cb,
+            float inv_2sc2, __global const float4 *facet_color,
             __global const float4 *facet_centroid, __global const float4 *normal,
             __global const int4 *cell_coord, __global const uint *cell_start,
             __global const uint *column_first, __global const int *column_table, uint column_mask,
@@ -58,13 +67,22 @@ robust_sums(lanef px, lanef py, lanef pz, float3 lo, float3 hi, int4 anchor, flo
             lanef t = n.x * ex + n.y * ey + n.z * ez;
             /* |prediction - p|^2: t^2 for the projection, d2 for the centroid */
             lanef x2 = predict_centroid ? d2 : t * t;
-            lanef w, af = 0.0f;
+            lanef w, af = 0.0f, ec = 0.0f;
+            if (use_color) { /* the colour exponent */
+                float4 fc = facet_color[q];
+                lanef dr = fc.x - cr, dg = fc.y - cg, db = fc.z - cb;
+                ec = (dr * dr + dg * dg + db * db) * inv_2sc2;
+            }
             if (influence == RS_INFLUENCE_GAUSSIAN) {
                 lanef e = x2 * inv_2sg2;
+                if (use_color)
+                    e += ec;
                 w = select((lanef)0.0f, fast_exp2(c.w - d2 * inv_2sf2 - (e - shift)), near);
             } else {
                 af = select((lanef)0.0f, fast_exp2(c.w - d2 * inv_2sf2), near);
                 w = af * influence_weight(x2 * inv_sg2, influence);
+                if (use_color)
+                    w *= fast_exp2(shift - ec); /* shifted by the rescue, as the Gaussian's */
             }
             if (predict_centroid) {
                 a.x += w * ex;
@@ -87,9 +105,14 @@ robust_sums(lanef px, lanef py, lanef pz, float3 lo, float3 hi, int4 anchor, flo
 }
 
 /* Per lane, the smallest influence exponent over the facets within reach (MAXFLOAT where none):
- * the shift that keeps a lane's largest weight near one. Only the rare rescue needs it. */
+ * the shift that keeps a lane's largest weight near one. Only the rare rescue needs it. With
+ * use_color the colour exponent adds to it (inv_2sg2 = 0: the colour exponent alone), and
+ * `tukey` leaves out the facets Tukey's weight rejects (x^2 inv_sg2 >= 5). */
 lanef smallest_exponent(lanef px, lanef py, lanef pz, float3 lo, float3 hi, int4 anchor,
-                        float reach2, float inv_2sg2, int predict_centroid,
+                        float reach2, float inv_2sg2, int predict_centroid, int tukey,
+                        float inv_sg2, int use_color,
+                        lanef cr, lanef cg, lanef cb, float inv_2sc2,
+                        __global const float4 *facet_color,
                         __global const float4 *facet_centroid, __global const float4 *normal,
                         __global const int4 *cell_coord, __global const uint *cell_start,
                         __global const uint *column_first, __global const int *column_table,
@@ -104,7 +127,15 @@ lanef smallest_exponent(lanef px, lanef py, lanef pz, float3 lo, float3 hi, int4
             lanef d2 = ex * ex + ey * ey + ez * ez;
             lanef t = n.x * ex + n.y * ey + n.z * ez;
             lanef e = (predict_centroid ? d2 : t * t) * inv_2sg2;
-            e_min = select(e_min, fmin(e_min, e), d2 <= reach2);
+            lanei counts = d2 <= reach2;
+            if (use_color) {
+                float4 fc = facet_color[q];
+                lanef dr = fc.x - cr, dg = fc.y - cg, db = fc.z - cb;
+                e += (dr * dr + dg * dg + db * db) * inv_2sc2;
+            }
+            if (tukey) /* only the facets Tukey's weight does not reject */
+                counts = counts && (predict_centroid ? d2 : t * t) * inv_sg2 < 5.0f;
+            e_min = select(e_min, fmin(e_min, e), counts);
         }
     })
     return e_min;
@@ -112,8 +143,11 @@ lanef smallest_exponent(lanef px, lanef py, lanef pz, float3 lo, float3 hi, int4
 
 __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float inv_2sg2,
                            int influence, float inv_sg2, int want_confidence, int predict_centroid,
+                           int use_color, float inv_2sc2,
                            __global const float *block_pos, __global const int4 *block_cell,
+                           __global const float *block_color,
                            __global const float4 *facet_centroid, __global const float4 *normal,
+                           __global const float4 *facet_color,
                            __global const int4 *cell_coord, __global const uint *cell_start,
                            __global const uint *column_first,
                            __global const int *column_table, uint column_mask,
@@ -128,62 +162,91 @@ __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float
     float3 hi = (float3)(lane_max(px), lane_max(py), lane_max(pz));
     int4 anchor = block_cell[b];
     uint pairs = 0, rescue_pairs = 0;
+    lanef cr = 0.0f, cg = 0.0f, cb = 0.0f; /* the lanes' colours, when use_color */
+    if (use_color) {
+        __global const float *col = block_color + 3 * RS_LANES * (size_t)b;
+        cr = load_lanes(0, col);
+        cg = load_lanes(1, col);
+        cb = load_lanes(2, col);
+    }
+    /* The colourless loops pass these: use_color 0 folds every colour term away. */
+#define NO_COLOR 0, (lanef)0.0f, (lanef)0.0f, (lanef)0.0f, inv_2sc2, facet_color
+#define COLOR 1, cr, cg, cb, inv_2sc2, facet_color
     robust_acc a;
     /* one specialised copy of the loop per flag combination (the other influence functions
-     * always sum a f: it is part of their weight) */
-    if (influence != RS_INFLUENCE_GAUSSIAN && predict_centroid)
+     * always sum a f: it is part of their weight); with colour, one copy for every mode */
+    if (use_color)
+        a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f,
+                        want_confidence, predict_centroid, influence, inv_sg2, COLOR,
+                        facet_centroid, normal, cell_coord, cell_start, column_first,
+                        column_table, column_mask, &pairs);
+    else if (influence != RS_INFLUENCE_GAUSSIAN && predict_centroid)
         a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 1,
-                        influence, inv_sg2, facet_centroid, normal, cell_coord, cell_start,
-                        column_first, column_table, column_mask, &pairs);
+                        influence, inv_sg2, NO_COLOR, facet_centroid, normal, cell_coord,
+                        cell_start, column_first, column_table, column_mask, &pairs);
     else if (influence == RS_INFLUENCE_TUKEY)
         a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 0,
-                        RS_INFLUENCE_TUKEY, inv_sg2, facet_centroid, normal, cell_coord,
+                        RS_INFLUENCE_TUKEY, inv_sg2, NO_COLOR, facet_centroid, normal, cell_coord,
                         cell_start, column_first, column_table, column_mask, &pairs);
     else if (influence == RS_INFLUENCE_LORENTZIAN)
         a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 0,
-                        RS_INFLUENCE_LORENTZIAN, inv_sg2, facet_centroid, normal, cell_coord,
-                        cell_start, column_first, column_table, column_mask, &pairs);
+                        RS_INFLUENCE_LORENTZIAN, inv_sg2, NO_COLOR, facet_centroid, normal,
+                        cell_coord, cell_start, column_first, column_table, column_mask, &pairs);
     else if (influence == RS_INFLUENCE_HUBER)
         a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 0,
-                        RS_INFLUENCE_HUBER, inv_sg2, facet_centroid, normal, cell_coord,
+                        RS_INFLUENCE_HUBER, inv_sg2, NO_COLOR, facet_centroid, normal, cell_coord,
                         cell_start, column_first, column_table, column_mask, &pairs);
     else if (predict_centroid)
         a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f,
-                        want_confidence, 1, RS_INFLUENCE_GAUSSIAN, inv_sg2, facet_centroid,
-                        normal, cell_coord, cell_start, column_first, column_table, column_mask,
-                        &pairs);
+                        want_confidence, 1, RS_INFLUENCE_GAUSSIAN, inv_sg2, NO_COLOR,
+                        facet_centroid, normal, cell_coord, cell_start, column_first,
+                        column_table, column_mask, &pairs);
     else if (want_confidence)
         a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1,
-                        0, RS_INFLUENCE_GAUSSIAN, inv_sg2, facet_centroid, normal, cell_coord,
-                        cell_start, column_first, column_table, column_mask, &pairs);
+                        0, RS_INFLUENCE_GAUSSIAN, inv_sg2, NO_COLOR, facet_centroid, normal,
+                        cell_coord, cell_start, column_first, column_table, column_mask, &pairs);
     else
         a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 0,
-                        0, RS_INFLUENCE_GAUSSIAN, inv_sg2, facet_centroid, normal, cell_coord,
-                        cell_start, column_first, column_table, column_mask, &pairs);
+                        0, RS_INFLUENCE_GAUSSIAN, inv_sg2, NO_COLOR, facet_centroid, normal,
+                        cell_coord, cell_start, column_first, column_table, column_mask, &pairs);
     lanef kf = a.kf;
     /* A lane whose Gaussian weights (nearly) all underflowed: redo its sums with the exponents
      * shifted by their smallest value, as the reference path does. Shifting never changes the
      * weighted average, only how well float32 holds it. The other influence functions keep
-     * their sums: a weight of zero there is a verdict, not an underflow. */
-    lanei rescue = influence == RS_INFLUENCE_GAUSSIAN ? a.k < RS_RESCUE_WEIGHT : (lanei)0;
+     * their sums: a weight of zero there is a verdict, not an underflow; but with colour, their
+     * colour factors can underflow, and the colour exponent alone is shifted. */
+    bool gaussian = influence == RS_INFLUENCE_GAUSSIAN;
+    lanei rescue = gaussian || use_color ? a.k < RS_RESCUE_WEIGHT : (lanei)0;
     lanef shift = 0.0f;
     if (any(rescue)) {
-        lanef e_min = smallest_exponent(px, py, pz, lo, hi, anchor, reach2, inv_2sg2,
-                                        predict_centroid, facet_centroid, normal, cell_coord,
+        lanef e_min = smallest_exponent(px, py, pz, lo, hi, anchor, reach2,
+                                        gaussian ? inv_2sg2 : 0.0f, predict_centroid,
+                                        influence == RS_INFLUENCE_TUKEY, inv_sg2, use_color,
+                                        cr, cg, cb, inv_2sc2,
+                                        facet_color, facet_centroid, normal, cell_coord,
                                         cell_start, column_first, column_table, column_mask);
         shift = select((lanef)0.0f, e_min, rescue && e_min < MAXFLOAT);
     }
     if (any(shift != 0.0f)) {
-        robust_acc r = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, shift,
-                                   0, predict_centroid, RS_INFLUENCE_GAUSSIAN, inv_sg2,
-                                   facet_centroid, normal, cell_coord, cell_start, column_first,
-                                   column_table, column_mask, &rescue_pairs);
+        robust_acc r;
+        if (use_color)
+            r = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, shift, 0,
+                            predict_centroid, influence, inv_sg2, COLOR,
+                            facet_centroid, normal, cell_coord, cell_start, column_first,
+                            column_table, column_mask, &rescue_pairs);
+        else
+            r = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, shift, 0,
+                            predict_centroid, RS_INFLUENCE_GAUSSIAN, inv_sg2, NO_COLOR,
+                            facet_centroid, normal, cell_coord, cell_start, column_first,
+                            column_table, column_mask, &rescue_pairs);
         lanei redo = shift != 0.0f;
         a.x = select(a.x, r.x, redo);
         a.y = select(a.y, r.y, redo);
         a.z = select(a.z, r.z, redo);
         a.k = select(a.k, r.k, redo);
     }
+#undef NO_COLOR
+#undef COLOR
     lanei some = a.k > 0.0f;
     __global float *out = block_result + 4 * RS_LANES * (size_t)b;
     store_lanes(select((lanef)0.0f, a.x / a.k, some), 0, out);

@@ -5,6 +5,7 @@
  * not depend on where the mesh sits; displacements return to double before they are added. */
 #include "rsmooth_internal.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <stdio.h>
@@ -27,6 +28,9 @@ typedef struct packed {
     cl_int4 *block_cell;      /* per block: its anchor, the lowest cell it spans */
     cl_float *block_pos;      /* per block: RS_LANES x, then y, then z, local to the anchor */
     uint32_t *slot;           /* caller's vertex index -> block * RS_LANES + lane */
+    /* the colour factor's, NULL when it is off */
+    cl_float4 *facet_color;   /* in grid order: the mean colour of the facet's corners, 0 */
+    cl_float *block_color;    /* per block, as block_pos: RS_LANES first components, ... */
 } packed;
 
 static void packed_free(packed *pk) {
@@ -37,6 +41,8 @@ static void packed_free(packed *pk) {
     rs_free(pk->block_cell);
     rs_free(pk->block_pos);
     rs_free(pk->slot);
+    rs_free(pk->facet_color);
+    rs_free(pk->block_color);
 }
 
 static cl_float4 local_point(const rs_grid *grid, const double p[3], const int32_t cell[3]) {
@@ -112,10 +118,14 @@ static void fill_blocks(void *ctx, size_t begin, size_t end, size_t chunk) {
             uint32_t v = job->order[i], lane = i - job->start[b];
             pk->slot[v] = (uint32_t)(b * RS_LANES + lane);
             cl_float4 local = local_point(job->grid, job->pb->xyz + 3 * (size_t)v, anchor);
+            const float *color = job->pb->colors ? job->pb->colors + 3 * (size_t)v : NULL;
             /* lane 0 also fills the unused lanes, so they compute something harmless */
             for (size_t l = lane; l < (lane == 0 ? RS_LANES : lane + 1); l++)
-                for (int k = 0; k < 3; k++)
+                for (int k = 0; k < 3; k++) {
                     pos[k * RS_LANES + l] = local.s[k];
+                    if (color)
+                        pk->block_color[3 * RS_LANES * b + k * RS_LANES + l] = color[k];
+                }
         }
     }
 }
@@ -138,8 +148,10 @@ static rsmooth_status pack_blocks(const rs_problem *pb, const rs_grid *grid, pac
     pk->block_count = blocks;
     pk->block_cell = rs_alloc_array(blocks, sizeof(cl_int4));
     pk->block_pos = rs_alloc_array(blocks, 3 * RS_LANES * sizeof(cl_float));
+    if (pb->colors)
+        pk->block_color = rs_alloc_array(blocks, 3 * RS_LANES * sizeof(cl_float));
     start = rs_alloc_array(blocks + 1, sizeof *start);
-    if (!pk->block_cell || !pk->block_pos || !start) {
+    if (!pk->block_cell || !pk->block_pos || !start || (pb->colors && !pk->block_color)) {
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth", "no memory for blocks");
         goto done;
     }
@@ -183,6 +195,12 @@ static void pack_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
         pk->facet_centroid[j] = cen;
         pk->facet_normal[j] = (cl_float4){{(float)n[0], (float)n[1], (float)n[2], 0}};
         const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
+        if (pb->colors) {
+            double color[3];
+            rs_triangle_color(pb->colors, tri, color);
+            pk->facet_color[j] =
+                (cl_float4){{(float)color[0], (float)color[1], (float)color[2], 0}};
+        }
         for (int corner = 0; corner < 3; corner++)
             pk->facet_vertices[3 * q + corner] = pk->slot[tri[corner]];
     }
@@ -197,8 +215,10 @@ static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, packed *pk
     pk->facet_vertices = rs_alloc_array(nf, 3 * sizeof(cl_uint));
     pk->facet_place = rs_alloc_array(nf, sizeof(cl_uint));
     pk->slot = rs_alloc_array(nv, sizeof(uint32_t));
+    if (pb->colors)
+        pk->facet_color = rs_alloc_array(nf, sizeof(cl_float4));
     if (!pk->facet_centroid || !pk->facet_normal || !pk->facet_vertices || !pk->facet_place ||
-        !pk->slot)
+        !pk->slot || (pb->colors && !pk->facet_color))
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth",
                        "no memory for device staging arrays");
     rsmooth_status st = pack_blocks(pb, grid, pk, error);
@@ -231,6 +251,8 @@ enum {
     BUF_BLOCK_PAIRS,
     BUF_FACET_SCRATCH, /* bilateral: the normals of every other round */
     BUF_CELL_PAIRS,    /* bilateral: facets each cell's groups evaluated in a round */
+    BUF_FACET_COLOR,   /* colour factor: per facet, in grid order */
+    BUF_BLOCK_COLOR,   /* colour factor: per block, as block_pos */
     BUF_COUNT
 };
 
@@ -351,10 +373,211 @@ static cl_int run_1d(rsmooth_context *ctx, const rs_problem *pb, cl_kernel kerne
     return err == CL_SUCCESS ? clFinish(ctx->queue) : err;
 }
 
+/* The bilateral rounds from lists (bilateral_count, bilateral_fill and bilateral_list_normals in
+ * kernels/bilateral.cl): the facets near each group are searched for once per run, with the parts
+ * of their weights that do not depend on normals, and every round streams them instead of
+ * searching again. They take 36 bytes a row, a row per facet near a group (tiles.c plans with
+ * RS_DEVICE_BYTES_PER_BILATERAL_FACET); when they would not fit the device (or the caller's
+ * budget), *listed stays false and run_bilateral searches in every round instead.
+ * RSMOOTH_BILATERAL_LISTS=0 forces that, for tests and measurements. */
+typedef struct bilateral_lists {
+    cl_uint4 *info; /* per group: first facet, lanes, cell, 0 */
+    cl_uint *facet; /* the lists, in host memory on a device that shares it */
+    cl_float *weight;
+    cl_kernel count, fill, round;
+    cl_mem group_info, list_start, list_facet, list_weight;
+} bilateral_lists;
+
+static void bilateral_lists_free(bilateral_lists *l) {
+    cl_mem mems[] = {l->group_info, l->list_start, l->list_facet, l->list_weight};
+    for (size_t i = 0; i < sizeof mems / sizeof *mems; i++)
+        if (mems[i])
+            clReleaseMemObject(mems[i]);
+    cl_kernel kernels[] = {l->count, l->fill, l->round};
+    for (size_t i = 0; i < sizeof kernels / sizeof *kernels; i++)
+        if (kernels[i])
+            clReleaseKernel(kernels[i]);
+    rs_free(l->info); /* after the buffers that used them */
+    rs_free(l->facet);
+    rs_free(l->weight);
+}
+
+/* Whether failing with `err` means that the lists did not fit (the rounds search instead). */
+static bool lists_out_of_room(cl_int err) {
+    return err == CL_MEM_OBJECT_ALLOCATION_FAILURE || err == CL_OUT_OF_RESOURCES ||
+           err == CL_OUT_OF_HOST_MEMORY || err == CL_INVALID_BUFFER_SIZE;
+}
+
+static cl_int run_bilateral_lists(rsmooth_context *ctx, const rs_problem *pb, const rs_grid *grid,
+                                  const cl_mem *buf, cl_mem *normals, uint64_t *pairs,
+                                  bool *listed) {
+    *listed = false;
+    const char *env = getenv("RSMOOTH_BILATERAL_LISTS");
+    if (env && !strcmp(env, "0"))
+        return CL_SUCCESS;
+    const double h = grid->cell_size, s = pb->normal_sigma_s, t = pb->normal_sigma_n;
+    cl_uint mask = grid->column_mask;
+    cl_float reach2 = (cl_float)((pb->normal_radius / h) * (pb->normal_radius / h));
+    cl_float inv_2s2 = (cl_float)(LOG2_E * h * h / (2 * s * s));
+    cl_float inv_2t2 = (cl_float)(LOG2_E / (2 * t * t)); /* normals are unit: no length scale */
+    /* The rounds' cheaper form of the normal term, 2 inv_2t2 (n_q . n_r - 1), loses about
+     * 2 inv_2t2 float ulps to cancellation: up to 2e-5 of a weight at this limit (t = 0.12),
+     * past which they take |n_q - n_r|^2 inv_2t2 itself. */
+    cl_int dot = inv_2t2 <= 50;
+    cl_float shift = dot ? 2 * inv_2t2 : 0;
+    double share = MOLLIFY_SHARE / (pb->normal_iterations + 2); /* a search costs about a round */
+
+    /* the groups of bilateral_cell_normals: each cell's facets, RS_LANES at a time */
+    size_t groups = 0;
+    for (size_t c = 0; c < grid->cell_count; c++)
+        groups += (grid->cell_start[c + 1] - grid->cell_start[c] + RS_LANES - 1) / RS_LANES;
+    /* what this run holds on the device already, and what the groups add */
+    size_t start_bytes = (groups + 1) * sizeof(cl_uint);
+    uint64_t held = groups * sizeof(cl_uint4) + start_bytes;
+    for (int b = 0; b < BUF_COUNT; b++) {
+        size_t size = 0;
+        if (buf[b] &&
+            clGetMemObjectInfo(buf[b], CL_MEM_SIZE, sizeof size, &size, NULL) == CL_SUCCESS)
+            held += size;
+    }
+    uint64_t usable = rs_cl_usable_memory(ctx);
+    if (held > usable || groups >= UINT32_MAX)
+        return CL_SUCCESS;
+    bilateral_lists l;
+    memset(&l, 0, sizeof l);
+    if (!(l.info = rs_alloc_array(groups, sizeof *l.info)))
+        return CL_SUCCESS; /* no host memory for them: search in each round */
+    for (size_t c = 0, g = 0; c < grid->cell_count; c++)
+        for (uint32_t f = grid->cell_start[c]; f < grid->cell_start[c + 1]; f += RS_LANES) {
+            uint32_t lanes = grid->cell_start[c + 1] - f;
+            l.info[g++] = (cl_uint4){{f, lanes < RS_LANES ? lanes : RS_LANES, (cl_uint)c, 0}};
+        }
+
+    cl_uint group_count = (cl_uint)groups;
+    cl_int err = CL_SUCCESS;
+    l.count = clCreateKernel(ctx->program, "bilateral_count", &err);
+    if (err == CL_SUCCESS)
+        l.fill = clCreateKernel(ctx->program, "bilateral_fill", &err);
+    if (err == CL_SUCCESS)
+        l.round = clCreateKernel(ctx->program, "bilateral_list_normals", &err);
+    if (err == CL_SUCCESS)
+        l.group_info = clCreateBuffer(ctx->context, CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR,
+                                      groups * sizeof(cl_uint4), l.info, &err);
+    if (err == CL_SUCCESS)
+        l.list_start = clCreateBuffer(ctx->context, CL_MEM_READ_WRITE, start_bytes, NULL, &err);
+    if (err != CL_SUCCESS)
+        goto done;
+
+    arg_setter a = {l.count, 0, CL_SUCCESS};
+    arg(&a, sizeof group_count, &group_count);
+    arg(&a, sizeof reach2, &reach2);
+    arg(&a, sizeof(cl_mem), &l.group_info);
+    arg(&a, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
+    arg(&a, sizeof(cl_mem), &buf[BUF_CELL_COORD]);
+    arg(&a, sizeof(cl_mem), &buf[BUF_CELL_START]);
+    arg(&a, sizeof(cl_mem), &buf[BUF_COLUMN_FIRST]);
+    arg(&a, sizeof(cl_mem), &buf[BUF_COLUMN_TABLE]);
+    arg(&a, sizeof mask, &mask);
+    arg(&a, sizeof(cl_mem), &l.list_start);
+    if ((err = a.err) != CL_SUCCESS ||
+        (err = run_1d(ctx, pb, l.count, groups, 0, share)) != CL_SUCCESS)
+        goto done;
+
+    /* counts to offsets, each group with its spare row */
+    cl_uint *start =
+        clEnqueueMapBuffer(ctx->queue, l.list_start, CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0,
+                           start_bytes, 0, NULL, NULL, &err);
+    if (err != CL_SUCCESS)
+        goto done;
+    uint64_t rows = 0, near_rows = 0;
+    for (size_t g = 0; g < groups; g++) {
+        uint64_t n = start[g];
+        start[g] = (cl_uint)rows;
+        near_rows += n;
+        rows += n + 1;
+    }
+    start[groups] = (cl_uint)rows;
+    if ((err = clEnqueueUnmapMemObject(ctx->queue, l.list_start, start, 0, NULL, NULL)) !=
+        CL_SUCCESS)
+        goto done;
+    uint64_t weight_bytes = rows * RS_LANES * sizeof(cl_float);
+    if (rows > UINT32_MAX / RS_LANES || held + rows * sizeof(cl_uint) + weight_bytes > usable ||
+        weight_bytes > ctx->max_allocation || weight_bytes > SIZE_MAX)
+        goto done; /* no room (err CL_SUCCESS): the rounds search instead */
+    /* A device that shares the host's memory gets it from rs_alloc_array, which asks for huge
+     * pages: faulting in tens of megabytes 4 KiB at a time costs more than filling them. */
+    cl_bool unified = CL_FALSE;
+    clGetDeviceInfo(ctx->device, CL_DEVICE_HOST_UNIFIED_MEMORY, sizeof unified, &unified, NULL);
+    cl_mem_flags flags = CL_MEM_READ_WRITE;
+    if (unified) {
+        l.facet = rs_alloc_array((size_t)rows, sizeof(cl_uint));
+        l.weight = rs_alloc_array((size_t)rows, RS_LANES * sizeof(cl_float));
+        if (!l.facet || !l.weight)
+            goto done;
+        flags |= CL_MEM_USE_HOST_PTR;
+    }
+    l.list_facet =
+        clCreateBuffer(ctx->context, flags, (size_t)rows * sizeof(cl_uint), l.facet, &err);
+    if (err == CL_SUCCESS)
+        l.list_weight = clCreateBuffer(ctx->context, flags, (size_t)weight_bytes, l.weight, &err);
+    if (err != CL_SUCCESS)
+        goto done;
+
+    a = (arg_setter){l.fill, 0, CL_SUCCESS};
+    arg(&a, sizeof group_count, &group_count);
+    arg(&a, sizeof reach2, &reach2);
+    arg(&a, sizeof inv_2s2, &inv_2s2);
+    arg(&a, sizeof shift, &shift);
+    arg(&a, sizeof(cl_mem), &l.group_info);
+    arg(&a, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
+    arg(&a, sizeof(cl_mem), &buf[BUF_CELL_COORD]);
+    arg(&a, sizeof(cl_mem), &buf[BUF_CELL_START]);
+    arg(&a, sizeof(cl_mem), &buf[BUF_COLUMN_FIRST]);
+    arg(&a, sizeof(cl_mem), &buf[BUF_COLUMN_TABLE]);
+    arg(&a, sizeof mask, &mask);
+    arg(&a, sizeof(cl_mem), &l.list_start);
+    arg(&a, sizeof(cl_mem), &l.list_facet);
+    arg(&a, sizeof(cl_mem), &l.list_weight);
+    if ((err = a.err) != CL_SUCCESS ||
+        (err = run_1d(ctx, pb, l.fill, groups, share, 2 * share)) != CL_SUCCESS)
+        goto done;
+    *listed = true;
+    /* as bilateral_cell_normals counts: every lane of every facet a round reads (the searches
+     * that built the lists are not counted) */
+    *pairs = near_rows * RS_LANES * (uint64_t)pb->normal_iterations;
+
+    cl_mem from = buf[BUF_FACET_NORMAL], to = buf[BUF_FACET_SCRATCH];
+    for (int round = 0; round < pb->normal_iterations && err == CL_SUCCESS; round++) {
+        a = (arg_setter){l.round, 0, CL_SUCCESS};
+        arg(&a, sizeof group_count, &group_count);
+        arg(&a, sizeof inv_2t2, &inv_2t2);
+        arg(&a, sizeof dot, &dot);
+        arg(&a, sizeof(cl_mem), &l.group_info);
+        arg(&a, sizeof(cl_mem), &l.list_start);
+        arg(&a, sizeof(cl_mem), &l.list_facet);
+        arg(&a, sizeof(cl_mem), &l.list_weight);
+        arg(&a, sizeof(cl_mem), &from);
+        arg(&a, sizeof(cl_mem), &to);
+        err = a.err != CL_SUCCESS
+                  ? a.err
+                  : run_1d(ctx, pb, l.round, groups, share * (round + 2), share * (round + 3));
+        cl_mem written = to;
+        to = from;
+        from = written;
+    }
+    *normals = from;
+done:
+    if (!*listed && lists_out_of_room(err))
+        err = clFinish(ctx->queue); /* they did not fit after all: search in each round */
+    bilateral_lists_free(&l);
+    return err;
+}
+
 /* The bilateral normal filter's rounds (kernels/bilateral.cl), each reading the normals the
  * previous one wrote: they alternate between the input normals' buffer and the scratch one.
  * *normals is left at the buffer holding the last round's; *pairs counts the facet pairs
- * evaluated (as vertex-facet pairs are: every lane of every facet looked at). */
+ * evaluated (as vertex-facet pairs are: every lane of every facet looked at). From lists where
+ * they fit (run_bilateral_lists), else searching in every round (bilateral_cell_normals). */
 static cl_int run_bilateral(rsmooth_context *ctx, const rs_problem *pb, const rs_grid *grid,
                             const cl_mem *buf, cl_mem *normals, uint64_t *pairs) {
     const double h = grid->cell_size, s = pb->normal_sigma_s, t = pb->normal_sigma_n;
@@ -364,7 +587,10 @@ static cl_int run_bilateral(rsmooth_context *ctx, const rs_problem *pb, const rs
     cl_float inv_2t2 = (cl_float)(LOG2_E / (2 * t * t)); /* normals are unit: no length scale */
     cl_mem from = buf[BUF_FACET_NORMAL], to = buf[BUF_FACET_SCRATCH];
     double share = MOLLIFY_SHARE / pb->normal_iterations;
-    cl_int err = CL_SUCCESS;
+    bool listed = false;
+    cl_int err = run_bilateral_lists(ctx, pb, grid, buf, normals, pairs, &listed);
+    if (err != CL_SUCCESS || listed)
+        return err;
     for (int round = 0; round < pb->normal_iterations && err == CL_SUCCESS; round++) {
         arg_setter a = {ctx->kernels[RS_KERNEL_BILATERAL], 0, CL_SUCCESS};
         arg(&a, sizeof cell_count, &cell_count);
@@ -491,6 +717,10 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
         [BUF_FACET_SCRATCH] = {pb->bilateral ? nf * sizeof(cl_float4) : 0, NULL,
                                CL_MEM_READ_WRITE},
         [BUF_CELL_PAIRS] = {pb->bilateral ? nc * sizeof(cl_ulong) : 0, NULL, CL_MEM_WRITE_ONLY},
+        [BUF_FACET_COLOR] = {pb->colors ? nf * sizeof(cl_float4) : 0, pk.facet_color,
+                             CL_MEM_READ_ONLY},
+        [BUF_BLOCK_COLOR] = {pb->colors ? ns * 3 * sizeof(cl_float) : 0, pk.block_color,
+                             CL_MEM_READ_ONLY},
     };
     uint64_t total = 0, largest = 0;
     for (int b = 0; b < BUF_COUNT; b++) {
@@ -543,6 +773,11 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     cl_int influence = pb->influence;
     cl_int want_confidence = sink->confidence != NULL;
     cl_int predict_centroid = pb->predict_centroid;
+    /* the colour factor's exponent, in base 2; colours have no length scale (finite however
+     * small sigma_c is, so equal colours still give 0) */
+    cl_int use_color = pb->colors != NULL;
+    cl_float inv_2sc2 =
+        use_color ? (cl_float)fmin(LOG2_E / (2 * pb->sigma_c * pb->sigma_c), FLT_MAX) : 0.0f;
     cl_mem normals = buf[BUF_FACET_NORMAL]; /* the predictors' normals, once filtered */
     uint64_t bilateral_pairs = 0;
 
@@ -603,10 +838,14 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     arg(&s, sizeof inv_sg2, &inv_sg2);
     arg(&s, sizeof want_confidence, &want_confidence);
     arg(&s, sizeof predict_centroid, &predict_centroid);
+    arg(&s, sizeof use_color, &use_color);
+    arg(&s, sizeof inv_2sc2, &inv_2sc2);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_POS]);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_CELL]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_COLOR]); /* NULL without colour: never read */
     arg(&s, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
     arg(&s, sizeof(cl_mem), &normals);
+    arg(&s, sizeof(cl_mem), &buf[BUF_FACET_COLOR]);
     arg(&s, sizeof(cl_mem), &buf[BUF_CELL_COORD]);
     arg(&s, sizeof(cl_mem), &buf[BUF_CELL_START]);
     arg(&s, sizeof(cl_mem), &buf[BUF_COLUMN_FIRST]);

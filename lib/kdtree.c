@@ -2,7 +2,7 @@
  * a radius). Unlike a uniform grid it needs no cell size, so scans with far outliers or very
  * uneven density cost O(log n) per query all the same. Implicit and balanced: a node is a range of
  * `order` split at its middle, children of node i are 2i + 1 and 2i + 2, and only each node's
- * split axis is stored. */
+ * split axis and value are stored. */
 #include "rsmooth_internal.h"
 
 #include <string.h>
@@ -69,6 +69,8 @@ static void build_node(rs_kdtree *tree, size_t node, size_t lo, size_t hi) {
     tree->axis[node] = (uint8_t)axis;
     size_t mid = lo + (hi - lo) / 2;
     select_middle(tree, tree->order, lo, hi, mid, axis);
+    /* kept: building the right child moves another point to order[mid] */
+    tree->split[node] = coordinate(tree, tree->order[mid], axis);
     build_node(tree, 2 * node + 1, lo, mid);
     build_node(tree, 2 * node + 2, mid, hi);
 }
@@ -86,7 +88,8 @@ bool rs_kdtree_build(rs_kdtree *tree, const double *xyz, size_t count) {
     size_t nodes = ((size_t)1 << (levels + 1)) - 1;
     tree->order = rs_alloc_array(count ? count : 1, sizeof *tree->order);
     tree->axis = rs_calloc_array(nodes, sizeof *tree->axis);
-    if (!tree->order || !tree->axis) {
+    tree->split = rs_calloc_array(nodes, sizeof *tree->split);
+    if (!tree->order || !tree->axis || !tree->split) {
         rs_kdtree_free(tree);
         return false;
     }
@@ -99,6 +102,7 @@ bool rs_kdtree_build(rs_kdtree *tree, const double *xyz, size_t count) {
 void rs_kdtree_free(rs_kdtree *tree) {
     rs_free(tree->order);
     rs_free(tree->axis);
+    rs_free(tree->split);
     memset(tree, 0, sizeof *tree);
 }
 
@@ -108,21 +112,15 @@ typedef struct knn_state {
     uint32_t skip;
     size_t k, found;
     double *dist2;
-    uint32_t *index; /* optional */
 } knn_state;
 
-static void knn_offer(knn_state *s, uint32_t q, double d2) {
+static void knn_offer(knn_state *s, double d2) {
     if (s->found == s->k && !(d2 < s->dist2[s->k - 1]))
         return;
     size_t i = s->found < s->k ? s->found++ : s->k - 1;
-    for (; i > 0 && s->dist2[i - 1] > d2; i--) { /* insertion: k is small */
+    for (; i > 0 && s->dist2[i - 1] > d2; i--) /* insertion: k is small */
         s->dist2[i] = s->dist2[i - 1];
-        if (s->index)
-            s->index[i] = s->index[i - 1];
-    }
     s->dist2[i] = d2;
-    if (s->index)
-        s->index[i] = q;
 }
 
 static void knn_node(const rs_kdtree *tree, knn_state *s, size_t node, size_t lo, size_t hi) {
@@ -133,13 +131,13 @@ static void knn_node(const rs_kdtree *tree, knn_state *s, size_t node, size_t lo
                 continue;
             double d[3];
             rs_sub3(tree->xyz + 3 * (size_t)q, s->p, d);
-            knn_offer(s, q, rs_dot3(d, d));
+            knn_offer(s, rs_dot3(d, d));
         }
         return;
     }
     size_t mid = lo + (hi - lo) / 2;
     int axis = tree->axis[node];
-    double diff = s->p[axis] - coordinate(tree, tree->order[mid], axis);
+    double diff = s->p[axis] - tree->split[node];
     /* the side holding p first; the other only if it can still hold a nearer point */
     bool left_first = diff < 0;
     if (left_first)
@@ -155,8 +153,8 @@ static void knn_node(const rs_kdtree *tree, knn_state *s, size_t node, size_t lo
 }
 
 size_t rs_kdtree_nearest(const rs_kdtree *tree, const double p[3], uint32_t skip, size_t k,
-                         double *dist2, uint32_t *index) {
-    knn_state s = {p, skip, k, 0, dist2, index};
+                         double *dist2) {
+    knn_state s = {p, skip, k, 0, dist2};
     if (k > 0 && tree->count > 0)
         knn_node(tree, &s, 0, 0, tree->count);
     return s.found;
@@ -197,7 +195,7 @@ static bool within_node(const rs_kdtree *tree, const double p[3], double r2, rs_
     }
     size_t mid = lo + (hi - lo) / 2;
     int axis = tree->axis[node];
-    double diff = p[axis] - coordinate(tree, tree->order[mid], axis);
+    double diff = p[axis] - tree->split[node];
     /* left holds coordinates <= the split, right >= it */
     if (diff <= 0 || diff * diff <= r2)
         if (!within_node(tree, p, r2, out, 2 * node + 1, lo, mid))

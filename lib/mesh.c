@@ -48,6 +48,20 @@ rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions
     return RSMOOTH_OK;
 }
 
+rsmooth_status rs_check_colors(const float *colors, size_t vertex_count, rsmooth_error *error,
+                               const char *where) {
+    for (size_t i = 0; colors && i < 3 * vertex_count; i++)
+        if (!isfinite(colors[i]))
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                           "vertex %zu has a non-finite colour component (%g)", i / 3,
+                           (double)colors[i]);
+        else if (fabsf(colors[i]) > (float)RS_MAX_COLOR)
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                           "vertex %zu has colour component %g beyond the supported magnitude %g",
+                           i / 3, (double)colors[i], RS_MAX_COLOR);
+    return RSMOOTH_OK;
+}
+
 static int compare_u32(const void *a, const void *b) {
     uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
     return (x > y) - (x < y);
@@ -172,6 +186,7 @@ void rs_problem_free(rs_problem *problem) {
     rs_free(problem->centroid);
     rs_free(problem->normal);
     rs_free(problem->area);
+    rs_free(problem->facet_color);
     memset(problem, 0, sizeof *problem);
 }
 
@@ -277,6 +292,9 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
     st = rs_check_output_positions(scalar, positions, vertex_count, out_positions, error, where);
     if (st != RSMOOTH_OK)
         return st;
+    st = rs_check_colors(p.colors, vertex_count, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
 
     problem->vertex_count = vertex_count;
     problem->indices = indices;
@@ -329,6 +347,16 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for edges");
     }
     rs_problem_apply_params(problem, &p, p.absolute ? 1.0 : problem->mean_edge_length);
+    if (keep_facet_data && problem->colors && problem->facet_count > 0) {
+        problem->facet_color = rs_alloc_array(problem->facet_count, 3 * sizeof(double));
+        if (!problem->facet_color) {
+            rs_problem_free(problem);
+            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for colours");
+        }
+        for (size_t q = 0; q < problem->facet_count; q++)
+            rs_triangle_color(problem->colors, indices + 3 * (size_t)problem->facet_triangle[q],
+                              problem->facet_color + 3 * q);
+    }
     return RSMOOTH_OK;
 }
 
@@ -347,6 +375,8 @@ void rs_problem_apply_params(rs_problem *problem, const rsmooth_params *p, doubl
     problem->normal_radius = problem->bilateral ? p->cutoff * problem->normal_sigma_s : 0;
     problem->normal_iterations = p->normal_iterations;
     problem->influence = isinf(problem->sigma_g) ? RSMOOTH_INFLUENCE_GAUSSIAN : p->influence;
+    problem->colors = isinf(p->sigma_c) ? NULL : p->colors; /* +INFINITY: the factor is 1 */
+    problem->sigma_c = p->sigma_c;
     problem->progress = p->progress;
     problem->progress_user = p->progress_user;
     if (!(problem->sigma_f > 0) || !isfinite(problem->radius) || !isfinite(problem->normal_radius))

@@ -28,17 +28,19 @@ rsmooth_status rsmooth_params_init(rsmooth_params *params) {
     params->influence = RSMOOTH_INFLUENCE_GAUSSIAN;
     params->passes = 1;
     params->pass_confidence = 0.0;
+    params->colors = NULL;
+    params->sigma_c = 0.1;
     return RSMOOTH_OK;
 }
 
 rsmooth_status rsmooth_params_init_best(rsmooth_params *params) {
     if (rsmooth_params_init(params) != RSMOOTH_OK)
         return RSMOOTH_ERROR_INVALID_ARGUMENT;
-    params->sigma_f = 1.0;
+    params->sigma_f = 0.8;
     params->sigma_g = 0.3;
     params->normal_filter = RSMOOTH_NORMALS_BILATERAL;
     params->normal_sigma_s = 1.0;
-    params->normal_sigma_n = 0.35;
+    params->normal_sigma_n = 0.45;
     params->normal_iterations = 5;
     params->passes = 3;
     return RSMOOTH_OK;
@@ -104,5 +106,9 @@ rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *o
     if (!(out->pass_confidence >= 0) || !(out->pass_confidence <= 1))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "pass_confidence must be in [0, 1] (got %g)", out->pass_confidence);
+    if (!(out->sigma_c > 0)) /* NaN fails too; +INFINITY turns the colour factor off */
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "sigma_c must be positive, or +infinity to turn the colour factor off "
+                       "(got %g)", out->sigma_c);
     return RSMOOTH_OK;
 }

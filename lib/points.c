@@ -6,9 +6,7 @@
 #include "rsmooth_internal.h"
 
 #include <math.h>
-#include <stdio.h>
 #include <string.h>
-#include <stdlib.h>
 
 /* s_i, a point's spacing, is its mean distance to this many nearest others: on the vertices of a
  * mesh, 6 (a regular vertex's ring) makes the mean s_i within a few percent of the mean edge
@@ -35,7 +33,7 @@ static void spacing_range(void *ctx, size_t begin, size_t end, size_t chunk) {
     (void)chunk;
     for (size_t i = begin; i < end; i++) {
         size_t found = rs_kdtree_nearest(job->tree, job->tree->xyz + 3 * i, (uint32_t)i,
-                                         SPACING_NEIGHBOURS, d2, NULL);
+                                         SPACING_NEIGHBOURS, d2);
         double sum = 0;
         for (size_t j = 0; j < found; j++)
             sum += sqrt(d2[j]);
@@ -80,24 +78,26 @@ static rsmooth_status check_positions(rsmooth_scalar scalar, const void *positio
     return RSMOOTH_OK;
 }
 
-/* Normal i of the caller's array made unit length into out[0..2]; false when it has none. Scaled
- * by its largest component first, so lengths near the double range neither overflow nor vanish. */
-static bool unit_normal(rsmooth_scalar scalar, const void *normals, size_t i, double out[3]) {
+/* Normal i of the caller's array made unit length into out[0..2]; NULL, or what is wrong with it.
+ * Scaled by its largest component first, so lengths near the double range neither overflow nor
+ * vanish. */
+static const char *unit_normal(rsmooth_scalar scalar, const void *normals, size_t i,
+                               double out[3]) {
     double m = 0;
     for (int k = 0; k < 3; k++) {
         out[k] = rs_coordinate(scalar, normals, 3 * i + (size_t)k);
         if (!isfinite(out[k]))
-            return false;
+            return "non-finite";
         m = fmax(m, fabs(out[k]));
     }
     if (!(m > 0))
-        return false;
+        return "zero-length";
     for (int k = 0; k < 3; k++)
         out[k] /= m;
     double len = sqrt(rs_dot3(out, out));
     for (int k = 0; k < 3; k++)
         out[k] /= len;
-    return true;
+    return NULL;
 }
 
 /* Ranges overlap when neither ends before the other begins (NULL overlaps nothing). */
@@ -170,75 +170,6 @@ static bool bilateral_normals(const rs_problem *pb, const rs_kdtree *tree, const
     return true;
 }
 
-/* Eigenvector of the smallest eigenvalue of the symmetric 3x3 matrix a (destroyed), by cyclic
- * Jacobi rotations. */
-static void smallest_eigenvector(double a[3][3], double out[3]) {
-    double v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-    for (int sweep = 0; sweep < 50; sweep++) {
-        double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
-        if (!(off > 1e-30 * (a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2])))
-            break;
-        for (int p = 0; p < 2; p++)
-            for (int q = p + 1; q < 3; q++) {
-                if (a[p][q] == 0)
-                    continue;
-                double theta = (a[q][q] - a[p][p]) / (2 * a[p][q]);
-                double t = (theta >= 0 ? 1 : -1) / (fabs(theta) + sqrt(theta * theta + 1));
-                double c = 1 / sqrt(t * t + 1), s = t * c;
-                for (int k = 0; k < 3; k++) { /* a <- a J */
-                    double akp = a[k][p], akq = a[k][q];
-                    a[k][p] = c * akp - s * akq;
-                    a[k][q] = s * akp + c * akq;
-                }
-                for (int k = 0; k < 3; k++) { /* a <- J^T a */
-                    double apk = a[p][k], aqk = a[q][k];
-                    a[p][k] = c * apk - s * aqk;
-                    a[q][k] = s * apk + c * aqk;
-                }
-                for (int k = 0; k < 3; k++) {
-                    double vkp = v[k][p], vkq = v[k][q];
-                    v[k][p] = c * vkp - s * vkq;
-                    v[k][q] = s * vkp + c * vkq;
-                }
-            }
-    }
-    int m = 0;
-    for (int k = 1; k < 3; k++)
-        if (a[k][k] < a[m][m])
-            m = k;
-    for (int k = 0; k < 3; k++)
-        out[k] = v[k][m];
-}
-
-/* PCA normals of the current positions, oriented like `normal`, into normal. */
-static void pca_normals(const rs_kdtree *tree, size_t k, double *normal) {
-    double d2[64];
-    uint32_t idx[64];
-    for (size_t i = 0; i < tree->count; i++) {
-        const double *p = tree->xyz + 3 * i;
-        size_t found = rs_kdtree_nearest(tree, p, UINT32_MAX, k, d2, idx);
-        double mean[3] = {0, 0, 0};
-        for (size_t j = 0; j < found; j++)
-            for (int c = 0; c < 3; c++)
-                mean[c] += tree->xyz[3 * (size_t)idx[j] + c] / (double)found;
-        double a[3][3] = {{0}};
-        for (size_t j = 0; j < found; j++) {
-            double d[3];
-            rs_sub3(tree->xyz + 3 * (size_t)idx[j], mean, d);
-            for (int r = 0; r < 3; r++)
-                for (int c = 0; c < 3; c++)
-                    a[r][c] += d[r] * d[c];
-        }
-        double n[3];
-        smallest_eigenvector(a, n);
-        double len = sqrt(rs_dot3(n, n));
-        double sign = rs_dot3(n, normal + 3 * i) < 0 ? -1 : 1;
-        if (found >= 3 && len > 0)
-            for (int c = 0; c < 3; c++)
-                normal[3 * i + c] = sign * n[c] / len;
-    }
-}
-
 /* The caller's progress callback, seen through one pass's robust stage. */
 typedef struct pass_progress {
     rsmooth_progress_fn progress;
@@ -266,15 +197,17 @@ static void add_report(rsmooth_report *sum, const rsmooth_report *pass, int inde
     sum->facet_count = keep.facet_count; /* the input's */
 }
 
-/* Arrays of one call: the current and next positions and normals, per-point spacing and area,
- * confidence of this and the previous pass. */
+/* Arrays of one call: the current and next positions; the input's unit normals, the previous
+ * pass's filtered normals and this pass's; per-point spacing and area; confidence of this and the
+ * previous pass. */
 typedef struct point_arrays {
-    double *xyz, *next, *normal, *filtered, *scratch, *spacing, *area;
+    double *xyz, *next, *input_normal, *normal, *filtered, *scratch, *spacing, *area;
     float *confidence, *prev_confidence;
 } point_arrays;
 
 static void free_arrays(point_arrays *a) {
     rs_free(a->xyz);
+    rs_free(a->input_normal);
     rs_free(a->next);
     rs_free(a->normal);
     rs_free(a->filtered);
@@ -303,20 +236,17 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
                        "normals is NULL: a point cloud needs a normal per point");
     for (size_t i = 0; i < point_count; i++) {
         double n[3];
-        if (!unit_normal(scalar, normals, i, n))
+        const char *wrong = unit_normal(scalar, normals, i, n);
+        if (wrong)
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                           "point %zu has a %s normal", i,
-                           isfinite(rs_coordinate(scalar, normals, 3 * i)) &&
-                                   isfinite(rs_coordinate(scalar, normals, 3 * i + 1)) &&
-                                   isfinite(rs_coordinate(scalar, normals, 3 * i + 2))
-                               ? "zero-length"
-                               : "non-finite");
+                           "point %zu has a %s normal", i, wrong);
     }
     if (!out_positions)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_positions is NULL");
     /* Every input is read before any output is written, so outputs may be the inputs; but two
      * outputs in one place would mix. */
-    size_t vec_bytes = point_count * 3 * (scalar == RSMOOTH_FLOAT32 ? sizeof(float) : sizeof(double));
+    size_t vec_bytes =
+        point_count * 3 * (scalar == RSMOOTH_FLOAT32 ? sizeof(float) : sizeof(double));
     size_t conf_bytes = point_count * sizeof(float);
     if (overlaps(out_positions, vec_bytes, out_normals, vec_bytes) ||
         overlaps(out_positions, vec_bytes, out_confidence, conf_bytes) ||
@@ -328,6 +258,7 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
     point_arrays a = {0};
     a.xyz = rs_alloc_array(n, 3 * sizeof(double));
     a.next = rs_alloc_array(n, 3 * sizeof(double));
+    a.input_normal = rs_alloc_array(n, 3 * sizeof(double));
     a.normal = rs_alloc_array(n, 3 * sizeof(double));
     a.filtered = rs_alloc_array(n, 3 * sizeof(double));
     a.scratch = rs_alloc_array(n, 3 * sizeof(double));
@@ -337,13 +268,13 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
     a.prev_confidence = rs_alloc_array(n, sizeof(float));
     rs_kdtree tree = {0};
     rs_kdtree_list nb = {0};
-    if (!a.xyz || !a.next || !a.normal || !a.filtered || !a.scratch || !a.spacing || !a.area ||
-        !a.confidence || !a.prev_confidence)
+    if (!a.xyz || !a.next || !a.input_normal || !a.normal || !a.filtered || !a.scratch ||
+        !a.spacing || !a.area || !a.confidence || !a.prev_confidence)
         goto fail_memory;
     for (size_t i = 0; i < 3 * n; i++)
         a.xyz[i] = rs_coordinate(scalar, positions, i);
     for (size_t i = 0; i < n; i++)
-        unit_normal(scalar, normals, i, a.normal + 3 * i);
+        unit_normal(scalar, normals, i, a.input_normal + 3 * i);
 
     /* The unit of relative sigmas: the input's spacing, kept through the passes (as meshes keep
      * their input's mean edge length), so later passes do not shrink their reach. */
@@ -362,8 +293,6 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
         if (!rs_kdtree_build(&tree, a.xyz, n))
             goto fail_memory;
         double spacing = point_spacings(&tree, a.spacing);
-        if (pass > 0 && getenv("RS_PTS_PCA") && atoi(getenv("RS_PTS_PCA")) > 0)
-            pca_normals(&tree, (size_t)atoi(getenv("RS_PTS_PCA")), a.normal);
         if (pass == 0) {
             input_spacing = spacing;
             unit = p.absolute ? 1.0 : spacing;
@@ -389,16 +318,22 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
         pb.mean_edge_length = input_spacing; /* what the report gives as the unit */
         pb.mean_area = area_sum / (double)n;
         rs_problem_apply_params(&pb, &p, unit);
+        pb.colors = NULL; /* the colour term is for meshes only, for now (rsmooth.h) */
         pb.progress = pp.progress ? report_pass_progress : NULL;
         pb.progress_user = &pp;
 
+        /* Every pass filters the input's normals, at the pass's positions. A mesh's passes
+         * recompute facet normals from the smoother positions; points have no normals but the
+         * input's, and filtering the previous pass's output again stacks the rounds, which
+         * flattens curved parts into facets (on point clouds of the benchmark models, 2 or 3
+         * passes so gave 2-6% lower E_v but 10-30% larger normal errors). */
         double t_normals = rs_now_ms();
         double normal_reach = pb.facet_count > 0 && pb.bilateral ? pb.normal_radius : 0;
         if (normal_reach > 0) {
-            if (!bilateral_normals(&pb, &tree, a.normal, a.filtered, a.scratch, &nb))
+            if (!bilateral_normals(&pb, &tree, a.input_normal, a.filtered, a.scratch, &nb))
                 goto fail_memory;
         } else {
-            memcpy(a.filtered, a.normal, n * 3 * sizeof(double));
+            memcpy(a.filtered, a.input_normal, n * 3 * sizeof(double));
         }
         double ms_normals = rs_now_ms() - t_normals;
         rs_kdtree_free(&tree);
@@ -425,7 +360,7 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
                     a.confidence[v] = a.prev_confidence[v];
                 }
         }
-        /* the next pass starts from these positions and normals */
+        /* the next pass starts from these positions; its output replaces these normals */
         double *t = a.xyz;
         a.xyz = a.next;
         a.next = t;

@@ -3,6 +3,7 @@
  * the OpenCL path is tested against and the fallback when no OpenCL device exists. */
 #include "rsmooth_internal.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -155,41 +156,79 @@ static void prediction_step(const rs_problem *pb, const double n[3], const doubl
         step[c] = pb->predict_centroid ? d[c] : t * n[c];
 }
 
+/* 1 / (2 sigma_c^2) of the colour factor, finite however small sigma_c is (a zero colour
+ * difference then still gives a zero exponent, not NaN). */
+static double color_inv_2s2(const rs_problem *pb) {
+    return fmin(1 / (2 * pb->sigma_c * pb->sigma_c), DBL_MAX);
+}
+
+/* The colour exponent |C_q - C_p|^2 / (2 sigma_c^2) of facet q for a vertex of colour `color`. */
+static double color_exponent(const rs_problem *pb, uint32_t q, const float *color,
+                             double inv_2sc2) {
+    const double *cq = pb->facet_color + 3 * (size_t)q;
+    double d[3] = {cq[0] - color[0], cq[1] - color[1], cq[2] - color[2]};
+    return rs_dot3(d, d) * inv_2sc2;
+}
+
 /* Eq. 3 with an influence function other than the Gaussian: these never underflow (Lorentzian,
- * Huber) or are meant to reach zero (Tukey), so there is no rescue; k(p) = 0 leaves p in place. */
+ * Huber) or are meant to reach zero (Tukey), so there is no rescue of their own; k(p) = 0 leaves
+ * p in place. With colour, though, the colour factors can all underflow: then the sums are redone
+ * with the colour exponents shifted by their smallest, as the Gaussian's rescue does. */
 static void estimate_vertex_robust_norm(const rs_problem *pb, const neighbours *nb,
-                                        const double *normals, const double p[3], double disp[3],
-                                        double *k_out, double *kf_out) {
+                                        const double *normals, const double p[3],
+                                        const float *color, double disp[3], double *k_out,
+                                        double *kf_out) {
     const double inv_2sf2 = 1 / (2 * pb->sigma_f * pb->sigma_f);
     const double inv_sg2 = 1 / (pb->sigma_g * pb->sigma_g);
+    const double inv_2sc2 = color ? color_inv_2s2(pb) : 0;
     double k = 0, kf = 0, acc[3] = {0, 0, 0};
-    for (size_t i = 0; i < nb->count; i++) {
-        uint32_t q = nb->facet[i];
-        double d[3], step[3];
-        rs_sub3(pb->centroid + 3 * (size_t)q, p, d);
-        prediction_step(pb, normals + 3 * (size_t)q, d, step);
-        double af = pb->area[q] * exp(-nb->dist2[i] * inv_2sf2);
-        double w = af * influence_weight(pb->influence, rs_dot3(step, step) * inv_sg2);
-        for (int c = 0; c < 3; c++)
-            acc[c] += w * step[c];
-        k += w;
-        kf += af;
+    double ec_min = INFINITY, shift = 0; /* the smallest colour exponent; the rescue's shift */
+    for (int round = 0; round < 2; round++) {
+        k = kf = 0;
+        acc[0] = acc[1] = acc[2] = 0;
+        for (size_t i = 0; i < nb->count; i++) {
+            uint32_t q = nb->facet[i];
+            double d[3], step[3];
+            rs_sub3(pb->centroid + 3 * (size_t)q, p, d);
+            prediction_step(pb, normals + 3 * (size_t)q, d, step);
+            double af = pb->area[q] * exp(-nb->dist2[i] * inv_2sf2);
+            double g = influence_weight(pb->influence, rs_dot3(step, step) * inv_sg2);
+            double w = af * g;
+            if (color) {
+                double ec = color_exponent(pb, q, color, inv_2sc2);
+                if (g > 0) /* the shift of the facets that have weight (Tukey rejects some) */
+                    ec_min = fmin(ec_min, ec);
+                w *= exp(shift - ec);
+            }
+            for (int c = 0; c < 3; c++)
+                acc[c] += w * step[c];
+            k += w;
+            kf += af;
+        }
+        if (!color || round > 0 || !(kf > 0) || k > kf * RS_UNDERFLOW_RATIO ||
+            !(ec_min < INFINITY))
+            break;
+        shift = ec_min;
     }
     for (int c = 0; c < 3; c++)
         disp[c] = k > 0 ? acc[c] / k : 0;
-    *k_out = k;
+    *k_out = k * exp(-shift);
     *kf_out = kf;
 }
 
-/* Robust estimate for p (Eq. 3). Writes the displacement p' - p, k(p) and sum a f. */
+/* Robust estimate for p (Eq. 3). Writes the displacement p' - p, k(p) and sum a f. `color` is p's
+ * colour when the colour factor is on (else NULL): its exponent adds to the influence's, so the
+ * underflow rescue covers both. */
 static void estimate_vertex(const rs_problem *pb, const neighbours *nb, const double *normals,
-                            const double p[3], double disp[3], double *k_out, double *kf_out) {
+                            const double p[3], const float *color, double disp[3], double *k_out,
+                            double *kf_out) {
     if (pb->influence != RSMOOTH_INFLUENCE_GAUSSIAN) {
-        estimate_vertex_robust_norm(pb, nb, normals, p, disp, k_out, kf_out);
+        estimate_vertex_robust_norm(pb, nb, normals, p, color, disp, k_out, kf_out);
         return;
     }
     const double inv_2sf2 = 1 / (2 * pb->sigma_f * pb->sigma_f);
     const double inv_2sg2 = isinf(pb->sigma_g) ? 0 : 1 / (2 * pb->sigma_g * pb->sigma_g);
+    const double inv_2sc2 = color ? color_inv_2s2(pb) : 0;
     double k = 0, kf = 0, acc[3] = {0, 0, 0};
     double e_min = INFINITY; /* smallest influence exponent, for the underflow rescue */
     for (size_t i = 0; i < nb->count; i++) {
@@ -201,6 +240,8 @@ static void estimate_vertex(const rs_problem *pb, const neighbours *nb, const do
         prediction_step(pb, n, d, step);
         double af = pb->area[q] * exp(-nb->dist2[i] * inv_2sf2);
         double e = rs_dot3(step, step) * inv_2sg2;
+        if (color)
+            e += color_exponent(pb, q, color, inv_2sc2);
         double w = af * exp(-e);
         for (int c = 0; c < 3; c++)
             acc[c] += w * step[c];
@@ -208,8 +249,9 @@ static void estimate_vertex(const rs_problem *pb, const neighbours *nb, const do
         kf += af;
         e_min = fmin(e_min, e);
     }
-    if (kf > 0 && !(k > kf * RS_UNDERFLOW_RATIO)) {
-        /* Every influence weight is tiny: weigh by exp(e_min - e) instead, whose largest is 1. */
+    if (kf > 0 && !(k > kf * RS_UNDERFLOW_RATIO) && e_min < INFINITY) {
+        /* Every influence weight is tiny: weigh by exp(e_min - e) instead, whose largest is 1.
+         * (Exponents that overflowed, from an extreme sigma_c, leave k = 0: p stays.) */
         double ks = 0;
         acc[0] = acc[1] = acc[2] = 0;
         for (size_t i = 0; i < nb->count; i++) {
@@ -219,8 +261,11 @@ static void estimate_vertex(const rs_problem *pb, const neighbours *nb, const do
             rs_sub3(pb->centroid + 3 * (size_t)q, p, d);
             double step[3];
             prediction_step(pb, n, d, step);
+            /* (without colour, the very expression of the paper mode, unchanged) */
             double w = pb->area[q] * exp(-nb->dist2[i] * inv_2sf2) *
-                       exp(e_min - rs_dot3(step, step) * inv_2sg2);
+                       (color ? exp(e_min - (rs_dot3(step, step) * inv_2sg2 +
+                                             color_exponent(pb, q, color, inv_2sc2)))
+                              : exp(e_min - rs_dot3(step, step) * inv_2sg2));
             for (int c = 0; c < 3; c++)
                 acc[c] += w * step[c];
             ks += w;
@@ -298,7 +343,8 @@ rsmooth_status rs_reference_solve(const rs_problem *problem, rsmooth_scalar scal
         if (v % PROGRESS_STEP == 0)
             rs_progress(&pb, robust_start + (1 - robust_start) * (double)v / (double)vertex_count);
         double disp[3], k, kf;
-        estimate_vertex(&pb, &nb, normals, p, disp, &k, &kf);
+        const float *color = pb.facet_color ? pb.colors + 3 * v : NULL;
+        estimate_vertex(&pb, &nb, normals, p, color, disp, &k, &kf);
         double out[3] = {p[0] + disp[0], p[1] + disp[1], p[2] + disp[2]};
         rs_store_position(scalar, out_positions, v, out);
         if (out_weight)

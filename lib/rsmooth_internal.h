@@ -114,6 +114,11 @@ typedef struct rs_problem {
     double normal_radius;        /* bilateral reach: cutoff * normal_sigma_s (0 when off) */
     int normal_iterations;
     int influence;               /* an rsmooth_influence */
+    /* The colour factor of the robust weight (rsmooth_params.colors), NULL when off: */
+    const float *colors;         /* 3 per vertex, borrowed (a tile's: its own copy) */
+    double *facet_color;         /* 3 per facet, the mean of its corners' colours; kept with the
+                                  * facet data (reference path), owned */
+    double sigma_c;              /* colour width, finite when colors is not NULL */
     rsmooth_progress_fn progress; /* optional, from the params */
     void *progress_user;
 } rs_problem;
@@ -138,6 +143,18 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
  * params->absolute) and the flags, from resolved params. Sets facet_count to 0 when nothing can
  * move (unit 0). Point clouds (points.c) call it on a problem whose facets are the points. */
 void rs_problem_apply_params(rs_problem *problem, const rsmooth_params *params, double unit);
+
+/* Checks rsmooth_params.colors, 3 finite values per vertex of magnitude <= RS_MAX_COLOR, naming
+ * the first vertex that fails. NULL passes. */
+rsmooth_status rs_check_colors(const float *colors, size_t vertex_count, rsmooth_error *error,
+                               const char *where);
+
+/* Mean colour of the triangle with vertex indices tri[0..2]: the C_q of the colour factor. */
+static inline void rs_triangle_color(const float *colors, const uint32_t *tri, double out[3]) {
+    for (int k = 0; k < 3; k++)
+        out[k] = ((double)colors[3 * (size_t)tri[0] + k] + (double)colors[3 * (size_t)tri[1] + k] +
+                  (double)colors[3 * (size_t)tri[2] + k]) / 3.0;
+}
 
 /* Centroid, unit normal and area of the triangle with vertex indices tri[0..2] over `xyz`; false
  * (outputs unset) when its area is zero or not finite. The one formula every path uses. */
@@ -214,6 +231,9 @@ static inline void rs_cross3(const double a[3], const double b[3], double out[3]
 
 /* Coordinates beyond this magnitude are refused: squared distances must not overflow a double. */
 #define RS_MAX_COORDINATE 1e150
+/* Colour components beyond this are refused: squared colour differences must stay finite in the
+ * kernels' float32. */
+#define RS_MAX_COLOR 1e15
 
 /* When k(p) falls below this fraction of sum a f, the influence weights have underflowed (float32
  * bottoms out near 1e-38): both paths then recompute the sums with the exponent shifted by its
@@ -314,6 +334,7 @@ typedef struct rs_kdtree {
     size_t count;
     uint32_t *order;   /* point indices, arranged as the tree's ranges */
     uint8_t *axis;     /* split axis of each internal node */
+    double *split;     /* and the coordinate it splits at: left <= split <= right */
 } rs_kdtree;
 
 /* Points found by rs_kdtree_within, with squared distances; reused between queries. */
@@ -328,10 +349,10 @@ bool rs_kdtree_build(rs_kdtree *tree, const double *xyz, size_t count);
 void rs_kdtree_free(rs_kdtree *tree);
 
 /* The squared distances from p to its k nearest points, point `skip` left out (UINT32_MAX: none),
- * nearest first, into dist2[0 ..), and their indices into index[0 ..) when it is not NULL;
- * returns how many were found (k, or fewer points). Thread-safe on a built tree. */
+ * nearest first, into dist2[0 ..); returns how many were found (k, or fewer points). Thread-safe
+ * on a built tree. */
 size_t rs_kdtree_nearest(const rs_kdtree *tree, const double p[3], uint32_t skip, size_t k,
-                         double *dist2, uint32_t *index);
+                         double *dist2);
 
 /* Every point at distance <= radius from p, into `out` (cleared first). false when out of memory. */
 bool rs_kdtree_within(const rs_kdtree *tree, const double p[3], double radius,
@@ -402,7 +423,19 @@ typedef struct rs_run_stats {
 /* What the bilateral normal filter adds per facet: a second copy of the normals to alternate with,
  * and a per-cell pair count (at most one cell per facet). */
 #define RS_DEVICE_BYTES_PER_BILATERAL_FACET 24
+/* And what its rounds' lists add where they fit (cl_smooth.c, run_bilateral_lists), per facet of
+ * problem `pb`: 20 bytes of group data and 36 a row, with about (1.5 r + 1.5)^2 rows per facet for
+ * a reach of r mean edge lengths (measured on the benchmark meshes: 11 to 14 at r = 2, 76 to 96
+ * at r = 6), and a spare row. Past 128 rows the estimate stops growing (a run whose lists do not
+ * fit searches in every round instead). Uses fmin and pow (math.h). */
+#define RS_DEVICE_BYTES_PER_BILATERAL_LIST_FACET(pb)                                              \
+    ((uint64_t)(20 + 36 * (1 + fmin(128.0, pow(1.5 * (pb)->normal_radius /                        \
+                                                    (pb)->mean_edge_length + 1.5, 2)))))
 #define RS_DEVICE_BYTES_PER_VERTEX 72
+/* What the colour factor adds: a float4 mean colour per facet, three floats per vertex slot
+ * (about 1.5 slots per vertex). */
+#define RS_DEVICE_BYTES_PER_COLOR_FACET 16
+#define RS_DEVICE_BYTES_PER_COLOR_VERTEX 20
 
 /* One run of the whole pipeline on `problem` (facet_count > 0). When its buffers would exceed
  * rs_cl_usable_memory or the device's largest allocation, returns RSMOOTH_ERROR_OUT_OF_MEMORY

@@ -44,12 +44,20 @@ static void report_tile_progress(void *user, double fraction) {
 }
 
 /* Device bytes a tile of `vertices` core vertices and `facets` facets is expected to need (a
- * facet brings about half a vertex of its own). */
+ * facet brings about half a vertex of its own). The bilateral rounds' lists are planned for while
+ * at least half of a tile's facets are its own (about two per core vertex): smaller tiles, mostly
+ * halo, would cost more than the rounds save, and theirs search instead where the lists do not
+ * fit. */
 static uint64_t estimate_bytes(const rs_problem *pb, size_t vertices, size_t facets) {
     size_t v = vertices > facets / 2 ? vertices : facets / 2;
+    bool lists = pb->bilateral && (uint64_t)facets <= 4 * (uint64_t)vertices;
     uint64_t per_facet = RS_DEVICE_BYTES_PER_FACET +
-                         (pb->bilateral ? RS_DEVICE_BYTES_PER_BILATERAL_FACET : 0);
-    return (uint64_t)facets * per_facet + (uint64_t)v * RS_DEVICE_BYTES_PER_VERTEX;
+                         (pb->bilateral ? RS_DEVICE_BYTES_PER_BILATERAL_FACET : 0) +
+                         (lists ? RS_DEVICE_BYTES_PER_BILATERAL_LIST_FACET(pb) : 0) +
+                         (pb->colors ? RS_DEVICE_BYTES_PER_COLOR_FACET : 0);
+    uint64_t per_vertex =
+        RS_DEVICE_BYTES_PER_VERTEX + (pb->colors ? RS_DEVICE_BYTES_PER_COLOR_VERTEX : 0);
+    return (uint64_t)facets * per_facet + (uint64_t)v * per_vertex;
 }
 
 /* How far beyond a tile's vertices the facets its results depend on may lie (see the top). */
@@ -84,6 +92,8 @@ static rsmooth_status run_tile(tiler *t, const uint32_t *verts, size_t n, const 
     rs_problem sub = *w;
     sub.xyz = NULL;
     sub.centroid = sub.normal = sub.area = NULL; /* computed from the vertices where needed */
+    sub.facet_color = NULL;
+    float *colors = NULL; /* the tile's vertices' colours, when the colour factor is on */
     uint32_t *list = rs_alloc_array(n + 3 * m, sizeof *list); /* tile vertex -> whole vertex */
     uint32_t *indices = rs_alloc_array(m, 3 * sizeof *indices);
     sub.facet_triangle = rs_alloc_array(m, sizeof(uint32_t));
@@ -118,6 +128,17 @@ static rsmooth_status run_tile(tiler *t, const uint32_t *verts, size_t n, const 
     }
     for (size_t v = 0; v < count; v++)
         memcpy(sub.xyz + 3 * v, w->xyz + 3 * (size_t)list[v], 3 * sizeof(double));
+    if (w->colors) {
+        colors = rs_alloc_array(count, 3 * sizeof *colors);
+        if (!colors) {
+            st = rs_fail(t->error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth",
+                         "no memory for a tile of %zu vertices", count);
+            goto done;
+        }
+        for (size_t v = 0; v < count; v++)
+            memcpy(colors + 3 * v, w->colors + 3 * (size_t)list[v], 3 * sizeof *colors);
+        sub.colors = colors;
+    }
     sub.vertex_count = count;
     sub.indices = indices;
     sub.triangle_count = sub.facet_count = m;
@@ -141,6 +162,7 @@ done:
         t->sub_index[list[v]] = ABSENT;
     rs_free(list);
     rs_free(indices);
+    rs_free(colors);
     sub.indices = NULL;
     rs_problem_free(&sub);
     return st;

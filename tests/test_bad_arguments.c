@@ -210,6 +210,45 @@ static void test_smooth_arguments(void) {
         }
     }
 
+    { /* the colour factor: sigma_c > 0, and every colour finite (one pass and several) */
+        float colors[3 * 25];
+        for (size_t i = 0; i < 3 * vc; i++)
+            colors[i] = 0.5f;
+        rsmooth_params p = params;
+        p.colors = colors;
+        c = base, c.params = &p;
+        static const double bad_sigma_c[] = {0.0, -0.1, NAN, -INFINITY};
+        for (size_t i = 0; i < sizeof bad_sigma_c / sizeof bad_sigma_c[0]; i++) {
+            p.sigma_c = bad_sigma_c[i];
+            char what[64];
+            snprintf(what, sizeof what, "sigma_c %g", bad_sigma_c[i]);
+            expect_invalid(what, c);
+        }
+        p.sigma_c = 0.1;
+        static const float bad_colors[] = {NAN, INFINITY, -INFINITY, 1e16f};
+        for (size_t i = 0; i < sizeof bad_colors / sizeof bad_colors[0]; i++) {
+            for (int passes = 1; passes <= 3; passes += 2) {
+                colors[3 * 7 + 2] = bad_colors[i];
+                p.passes = passes;
+                char what[64];
+                snprintf(what, sizeof what, "colour of vertex 7 = %g, %d pass%s",
+                         (double)bad_colors[i], passes, passes > 1 ? "es" : "");
+                expect_invalid(what, c);
+                rsmooth_error err;
+                CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, pos, vc, idx, tc, &p, g_out,
+                                                      NULL, NULL, NULL, &err),
+                             RSMOOTH_ERROR_INVALID_ARGUMENT);
+                CHECK(strstr(err.message, "vertex 7 ") != NULL); /* names the vertex */
+            }
+        }
+        colors[3 * 7 + 2] = 0.5f;
+        p.passes = 1;
+        p.sigma_c = INFINITY; /* off: valid */
+        CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, pos, vc, idx, tc, &p, g_out, NULL,
+                                              NULL, NULL, NULL),
+                     RSMOOTH_OK);
+    }
+
     c = base, c.scalar = (rsmooth_scalar)2;
     expect_invalid("scalar 2", c);
     c = base, c.scalar = (rsmooth_scalar)-1;

@@ -1,5 +1,6 @@
 /* The filters beyond the paper on the OpenCL path equal the double-precision reference path: the
- * bilateral normal filter (1 and 5 rounds, several widths, untiled and tiled) and each influence
+ * bilateral normal filter (1 and 5 rounds, several widths, untiled and tiled, its rounds from
+ * lists and searching) and each influence
  * function, on generated shapes and, when ../shared exists, on Fandisk0.3 and Bunny0.2. Per-vertex
  * deviation in mean edge lengths (max <= 1e-3, as test_cl_vs_reference), confidence within 1e-3;
  * two runs of the OpenCL path are bit-identical. */
@@ -131,6 +132,47 @@ static double compare(rsmooth_context *ctx, const char *name, const mesh_ref *m,
     return moved;
 }
 
+/* The bilateral rounds read lists of the facets near each group of facets where those fit the
+ * device, and search in every round where they do not (RSMOOTH_BILATERAL_LISTS=0 forces that):
+ * both equal the reference, each bit-identical when rerun, and the lists read fewer pairs. */
+static void compare_searching(rsmooth_context *ctx, const char *name, const mesh_ref *m,
+                              const rsmooth_params *params) {
+    size_t nv = m->vertex_count;
+    result ref, listed, searching, again;
+    result_alloc(&ref, nv);
+    result_alloc(&listed, nv);
+    result_alloc(&searching, nv);
+    result_alloc(&again, nv);
+    smooth(NULL, m, params, &ref);
+    smooth(ctx, m, params, &listed);
+    setenv("RSMOOTH_BILATERAL_LISTS", "0", 1);
+    smooth(ctx, m, params, &searching);
+    smooth(ctx, m, params, &again);
+    unsetenv("RSMOOTH_BILATERAL_LISTS");
+    double edge = ref.report.mean_edge_length;
+    double dev = max_deviation(searching.xyz, ref.xyz, nv, edge);
+    double apart = max_deviation(searching.xyz, listed.xyz, nv, edge);
+    double conf = 0;
+    for (size_t v = 0; v < nv; v++)
+        conf = fmax(conf, fabs((double)searching.confidence[v] - ref.confidence[v]));
+    bool same = memcmp(searching.xyz, again.xyz, nv * 3 * sizeof *again.xyz) == 0;
+    unsigned long long listed_pairs = (unsigned long long)listed.report.pairs_mollify;
+    unsigned long long searched_pairs = (unsigned long long)searching.report.pairs_mollify;
+    printf("%-52s V=%6zu deviation max %.3g, from the lists' %.3g  confidence %.2g  pairs %llu "
+           "(lists %llu)  %s\n",
+           name, nv, dev, apart, conf, searched_pairs, listed_pairs,
+           same ? "rerun bit-identical" : "RERUN DIFFERS");
+    CHECK(isfinite(dev));
+    CHECK_LE(dev, MAX_DEVIATION);
+    CHECK_LE(conf, 1e-3);
+    CHECK(same);
+    CHECK(listed_pairs > 0 && listed_pairs < searched_pairs);
+    result_free(&ref);
+    result_free(&listed);
+    result_free(&searching);
+    result_free(&again);
+}
+
 /* Bilateral normals with 1 and 5 rounds and a few widths, and each influence function. */
 static void compare_modes(rsmooth_context *ctx, const char *mesh_name, const mesh_ref *m,
                           bool quick) {
@@ -158,6 +200,11 @@ static void compare_modes(rsmooth_context *ctx, const char *mesh_name, const mes
         snprintf(name, sizeof name, "%s, bilateral s=%g t=%g K=%d", mesh_name, p.normal_sigma_s,
                  p.normal_sigma_n, p.normal_iterations);
         compare(ctx, name, m, &p, 0);
+        if (i == 1) {
+            snprintf(name, sizeof name, "%s, bilateral K=%d searching", mesh_name,
+                     p.normal_iterations);
+            compare_searching(ctx, name, m, &p);
+        }
     }
     for (size_t i = 0; i < sizeof influences / sizeof *influences; i++) {
         rsmooth_params_init(&p);
@@ -187,6 +234,136 @@ static mesh_ref shape_ref(const shape_mesh *s) {
     return (mesh_ref){s->xyz, s->vertex_count, s->indices, s->triangle_count};
 }
 
+/* Colours for the colour factor: the cube's six faces each their own (by the axis and sign of a
+ * vertex's largest coordinate); other shapes red below z = 0 and blue above, a colour edge
+ * across a smooth surface, plus a little random variation. */
+static float *shape_colors(const mesh_ref *m, bool cube) {
+    static const float face[6][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1},
+                                     {1, 1, 0}, {0, 1, 1}, {1, 0, 1}};
+    float *c = malloc(3 * m->vertex_count * sizeof *c);
+    CHECK(c);
+    uint64_t state = 77;
+    for (size_t v = 0; v < m->vertex_count; v++) {
+        const double *p = m->xyz + 3 * v;
+        int axis = 0;
+        for (int k = 1; k < 3; k++)
+            if (fabs(p[k]) > fabs(p[axis]))
+                axis = k;
+        const float *rgb = cube ? face[axis + (p[axis] < 0 ? 3 : 0)] : face[p[2] < 0 ? 0 : 2];
+        for (int k = 0; k < 3; k++)
+            c[3 * v + k] = rgb[k] + (cube ? 0.0f : 0.05f * (float)shape_gaussian(&state));
+    }
+    return c;
+}
+
+/* The colour factor on both paths: each influence function, the centroid predictor, the rescue
+ * (sigma_c small enough that colour alone underflows float32), bilateral normals and passes;
+ * sigma_c = +INFINITY is exactly colors = NULL, and a huge sigma_c the colourless result to
+ * float rounding; colours do change the result. */
+static void compare_colors(rsmooth_context *ctx, const char *mesh_name, const mesh_ref *m,
+                           const float *colors, bool quick) {
+    static const struct {
+        int influence;
+        const char *name;
+    } influences[] = {{RSMOOTH_INFLUENCE_GAUSSIAN, "Gaussian"},
+                      {RSMOOTH_INFLUENCE_TUKEY, "Tukey"},
+                      {RSMOOTH_INFLUENCE_LORENTZIAN, "Lorentzian"},
+                      {RSMOOTH_INFLUENCE_HUBER, "Huber"}};
+    char name[160];
+    rsmooth_params p;
+    for (size_t i = 0; i < sizeof influences / sizeof *influences; i++) {
+        if (quick && i > 1)
+            continue;
+        rsmooth_params_init(&p);
+        p.colors = colors;
+        p.sigma_c = 0.1;
+        p.influence = influences[i].influence;
+        snprintf(name, sizeof name, "%s, colour 0.1, %s", mesh_name, influences[i].name);
+        compare(ctx, name, m, &p, 0);
+        if (quick)
+            continue;
+        p.predictor = RSMOOTH_PREDICT_CENTROID;
+        snprintf(name, sizeof name, "%s, colour 0.1, %s, centroid", mesh_name,
+                 influences[i].name);
+        compare(ctx, name, m, &p, 0);
+    }
+    rsmooth_params_init(&p);
+    p.colors = colors;
+    p.sigma_c = 0.03; /* face colours 1 apart: 2^-(0.22 / 2 0.03^2 log2 e) underflows float */
+    snprintf(name, sizeof name, "%s, colour 0.03 (rescue)", mesh_name);
+    compare(ctx, name, m, &p, 0);
+    p.sigma_g = INFINITY;
+    snprintf(name, sizeof name, "%s, colour 0.03, sigma_g inf", mesh_name);
+    compare(ctx, name, m, &p, 0);
+    rsmooth_params_init_best(&p);
+    p.colors = colors;
+    p.sigma_c = 0.2;
+    snprintf(name, sizeof name, "%s, colour 0.2, best preset", mesh_name);
+    compare(ctx, name, m, &p, 0);
+
+    /* off three ways: NULL, +INFINITY (bit-identical) and huge (float rounding) */
+    size_t nv = m->vertex_count;
+    result none, inf, huge, narrow;
+    result_alloc(&none, nv);
+    result_alloc(&inf, nv);
+    result_alloc(&huge, nv);
+    result_alloc(&narrow, nv);
+    rsmooth_params_init(&p);
+    smooth(ctx, m, &p, &none);
+    p.colors = colors;
+    p.sigma_c = INFINITY;
+    smooth(ctx, m, &p, &inf);
+    p.sigma_c = 1e8;
+    smooth(ctx, m, &p, &huge);
+    p.sigma_c = 0.1;
+    smooth(ctx, m, &p, &narrow);
+    double edge = none.report.mean_edge_length;
+    bool identical = memcmp(none.xyz, inf.xyz, nv * 3 * sizeof *none.xyz) == 0 &&
+                     memcmp(none.confidence, inf.confidence, nv * sizeof *none.confidence) == 0;
+    double huge_dev = max_deviation(none.xyz, huge.xyz, nv, edge);
+    double change = max_deviation(none.xyz, narrow.xyz, nv, edge);
+    printf("%s: colour sigma_c inf %s colors NULL; sigma_c 1e8 vs none %.3g; sigma_c 0.1 "
+           "changes the result by %.3g mean edge lengths\n",
+           mesh_name, identical ? "bit-identical to" : "DIFFERS from", huge_dev, change);
+    CHECK(identical);
+    CHECK_LE(huge_dev, 1e-5);
+    CHECK(change > 1e-2);
+    result_free(&none);
+    result_free(&inf);
+    result_free(&huge);
+    result_free(&narrow);
+}
+
+/* The flat noisy plane coloured in two halves with a sharp colour edge (x <= the middle red, the
+ * others blue), against the reference: the centroid predictor without influence weight pulls the
+ * edge's vertices by their own side only. */
+static void colour_edge_plane(rsmooth_context *ctx) {
+    const int n = 40;
+    shape_mesh plane;
+    CHECK(shape_plane(&plane, n, n, 1.0) == 0);
+    CHECK(shape_add_normal_noise(&plane, 0.2, 99) == 0);
+    float *col = malloc(3 * plane.vertex_count * sizeof *col);
+    CHECK(col);
+    for (size_t v = 0; v < plane.vertex_count; v++) {
+        bool red = plane.xyz[3 * v] <= n / 2;
+        col[3 * v] = red ? 1.0f : 0.0f;
+        col[3 * v + 1] = 0.0f;
+        col[3 * v + 2] = red ? 0.0f : 1.0f;
+    }
+    mesh_ref m = shape_ref(&plane);
+    rsmooth_params p;
+    rsmooth_params_init(&p);
+    p.colors = col;
+    p.sigma_c = 0.05;
+    compare(ctx, "colour-edge plane, sigma_c 0.05", &m, &p, 0);
+    p.predictor = RSMOOTH_PREDICT_CENTROID;
+    p.sigma_g = INFINITY;
+    p.sigma_f = 1.0;
+    compare(ctx, "colour-edge plane, sigma_c 0.05, centroid, sg inf", &m, &p, 0);
+    free(col);
+    shape_free(&plane);
+}
+
 static void benchmark_meshes(rsmooth_context *ctx) {
     static const char *const models[] = {"Fandisk0.3", "Bunny0.2"};
     struct stat st;
@@ -207,6 +384,9 @@ static void benchmark_meshes(rsmooth_context *ctx) {
         }
         mesh_ref m = {mesh->positions, mesh->vertex_count, mesh->triangles, mesh->triangle_count};
         compare_modes(ctx, models[i], &m, true);
+        float *colors = shape_colors(&m, false);
+        compare_colors(ctx, models[i], &m, colors, true);
+        free(colors);
         rsmooth_mesh_destroy(mesh);
     }
 }
@@ -223,6 +403,32 @@ int main(void) {
 
     compare_modes(ctx, "noisy cube", &cube_ref, false);
     compare_modes(ctx, "noisy cylinder", &cyl_ref, true);
+    float *cube_colors = shape_colors(&cube_ref, true), *cyl_colors = shape_colors(&cyl_ref, false);
+    compare_colors(ctx, "noisy cube", &cube_ref, cube_colors, false);
+    compare_colors(ctx, "noisy cylinder", &cyl_ref, cyl_colors, true);
+    colour_edge_plane(ctx);
+    /* random colours with a narrow sigma_c: every facet's mean colour is far from its vertices',
+     * so the colour factor alone underflows float32 everywhere: the rescue, with colour */
+    float *random_colors = malloc(3 * cube.vertex_count * sizeof *random_colors);
+    CHECK(random_colors);
+    uint64_t state = 2024;
+    for (size_t i = 0; i < 3 * cube.vertex_count; i++)
+        random_colors[i] = (float)(0.5 + 0.3 * shape_gaussian(&state));
+    rsmooth_params cp;
+    rsmooth_params_init(&cp);
+    cp.colors = random_colors;
+    cp.sigma_c = 0.02;
+    compare(ctx, "noisy cube, random colours 0.02 (rescue)", &cube_ref, &cp, 0);
+    cp.sigma_g = INFINITY;
+    cp.predictor = RSMOOTH_PREDICT_CENTROID;
+    compare(ctx, "noisy cube, random colours 0.02, centroid, sg inf", &cube_ref, &cp, 0);
+    cp.sigma_g = 0.5;
+    cp.predictor = RSMOOTH_PREDICT_PROJECTION;
+    cp.influence = RSMOOTH_INFLUENCE_TUKEY; /* the colour exponent alone is shifted */
+    compare(ctx, "noisy cube, random colours 0.02, Tukey (rescue)", &cube_ref, &cp, 0);
+    cp.influence = RSMOOTH_INFLUENCE_LORENTZIAN;
+    compare(ctx, "noisy cube, random colours 0.02, Lorentzian (rescue)", &cube_ref, &cp, 0);
+    free(random_colors);
 
     /* The new modes do change the result (the parameters reach both paths)... */
     rsmooth_params p;
@@ -258,11 +464,43 @@ int main(void) {
     p.normal_sigma_s = 0.5;
     uint64_t budget = (uint64_t)rod.triangle_count * 40;
     compare(ctx, "noisy rod, bilateral s=0.5 K=5, tiled", &rod_ref, &p, budget);
+    /* With room for the rounds' lists in tiles that are mostly their own facets, the tiles read
+     * lists (fewer pairs than searching the same tiles) and still equal the reference. */
+    uint64_t roomy = (uint64_t)rod.triangle_count * 200;
+    compare(ctx, "noisy rod, bilateral s=0.5 K=5, tiled, lists", &rod_ref, &p, roomy);
+    result listed, searched;
+    result_alloc(&listed, rod.vertex_count);
+    result_alloc(&searched, rod.vertex_count);
+    rsmooth_context_set_memory_budget(ctx, roomy);
+    smooth(ctx, &rod_ref, &p, &listed);
+    setenv("RSMOOTH_BILATERAL_LISTS", "0", 1);
+    smooth(ctx, &rod_ref, &p, &searched);
+    unsetenv("RSMOOTH_BILATERAL_LISTS");
+    rsmooth_context_set_memory_budget(ctx, 0);
+    printf("  %zu tiles: pairs %llu from lists, %llu searching\n", listed.report.tiles,
+           (unsigned long long)listed.report.pairs_mollify,
+           (unsigned long long)searched.report.pairs_mollify);
+    CHECK(listed.report.tiles >= 2 && listed.report.tiles == searched.report.tiles);
+    CHECK(listed.report.pairs_mollify < searched.report.pairs_mollify);
+    result_free(&listed);
+    result_free(&searched);
     p.influence = RSMOOTH_INFLUENCE_TUKEY;
     compare(ctx, "noisy rod, bilateral + Tukey, tiled", &rod_ref, &p, budget);
+    /* tiles carry each vertex's colour to its tile (the facets' mean colours come from them) */
+    float *rod_colors = shape_colors(&rod_ref, false);
+    rsmooth_params_init(&p);
+    p.colors = rod_colors;
+    p.sigma_c = 0.1;
+    compare(ctx, "noisy rod, colour 0.1, tiled", &rod_ref, &p, (uint64_t)rod.triangle_count * 40);
+    p.normal_filter = RSMOOTH_NORMALS_BILATERAL;
+    p.influence = RSMOOTH_INFLUENCE_HUBER;
+    compare(ctx, "noisy rod, colour 0.1, bilateral + Huber, tiled", &rod_ref, &p, budget);
+    free(rod_colors);
     shape_free(&rod);
 
     benchmark_meshes(ctx);
+    free(cube_colors);
+    free(cyl_colors);
     shape_free(&cube);
     shape_free(&cyl);
     rsmooth_context_destroy(ctx);

@@ -204,8 +204,37 @@ expect 2 "$rsmooth" noisy.ply -o x.ply --normal-sigma-n 3
 expect 2 "$rsmooth" noisy.ply -o x.ply --pass-confidence 1.5
 [ -e x.ply ] && fail "a bad option wrote an output"
 
+# Colour in the weight: --sigma-c uses the input's vertex colours (a two-tone copy of the noisy
+# shape, built from the ascii confidence mesh: x y z quality r g b), on both paths alike; an input
+# without colours is refused.
+awk '/^element vertex/ { nv = $3 } /^element face/ { nf = $3 }
+  /^end_header/ { body = 1; printf "ply\nformat ascii 1.0\nelement vertex %d\nproperty double x\n" \
+    "property double y\nproperty double z\nproperty uchar red\nproperty uchar green\n" \
+    "property uchar blue\nelement face %d\nproperty list uchar int vertex_indices\n" \
+    "end_header\n", nv, nf; next }
+  body && NF == 7 { print $1, $2, $3, ($1 < 0 ? "255 0 0" : "0 0 255"); next } body { print }' \
+  conf_a.ply > two_tone.ply
+expect 0 "$rsmooth" two_tone.ply -o colour.ply -q --sigma-c 0.1 --json
+grep -q '"sigma_c":0.1,' out.txt || fail "--json does not report sigma_c: $(cat out.txt)"
+head -c 400 colour.ply | grep -q "property uchar red" || fail "--sigma-c output lost its colours"
+expect 0 "$rsmooth" two_tone.ply -o colourless.ply -q --json
+grep -q '"sigma_c":null' out.txt || fail "--json reports a colour width without --sigma-c"
+cmp -s colour.ply colourless.ply && fail "--sigma-c changed nothing"
+expect 0 "$rsmooth" two_tone.ply -o colour_ref.ply -q --sigma-c 0.1 --device reference
+expect 0 "$rsmooth" compare colour.ply colour_ref.ply --json
+ev_colour=$(sed -n 's/.*"ev": *\([0-9.eE+-]*\).*/\1/p' out.txt)
+awk -v a="$ev_colour" 'BEGIN { exit !(a < 1e-4) }' ||
+  fail "--sigma-c: the OpenCL and reference paths differ (ev $ev_colour)"
+expect 2 "$rsmooth" noisy.ply -o x.ply --sigma-c 0.1
+grep -q "noisy.ply has no vertex colours: --sigma-c needs them" err.txt ||
+  fail "an uncoloured input with --sigma-c is not explained: $(cat err.txt)"
+expect 2 "$rsmooth" two_tone.ply -o x.ply --sigma-c 0
+expect 2 "$rsmooth" two_tone.ply -o x.ply --sigma-c 0.1 --method taubin
+[ -e x.ply ] && fail "a refused --sigma-c call wrote its output"
+
 expect 0 "$rsmooth" --help
 grep -q "sigma-g" out.txt || fail "--help does not explain sigma-g"
+grep -q "\-\-sigma-c" out.txt || fail "--help does not explain --sigma-c"
 grep -q "\-\-best" out.txt || fail "--help does not explain --best"
 expect 0 "$rsmooth" --version
 

@@ -3,6 +3,7 @@
 #include "rsmooth.h"
 #include "test_util.h"
 
+#include <stdbool.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -103,6 +104,18 @@ static double bf_influence(int influence, double x2) {
     return exp(-x * x / 2);
 }
 
+/* |C_q - C_p|^2: C_q the mean colour of the triangle with corners tri[0..2], C_p = cp. */
+static double bf_color_dist2(const float *colors, const uint32_t *tri, const float *cp) {
+    double s = 0;
+    for (int k = 0; k < 3; k++) {
+        double mean = ((double)colors[3 * (size_t)tri[0] + k] +
+                       (double)colors[3 * (size_t)tri[1] + k] +
+                       (double)colors[3 * (size_t)tri[2] + k]) / 3;
+        s += (mean - cp[k]) * (mean - cp[k]);
+    }
+    return s;
+}
+
 static void brute_force(const double *xyz, size_t vc, const uint32_t *idx, size_t tc,
                         const rsmooth_params *prm, double *out, double *k_out, double *conf_out,
                         unsigned char *unreached, bf_stats *st) {
@@ -191,6 +204,10 @@ static void brute_force(const double *xyz, size_t vc, const uint32_t *idx, size_
                      prm->normal_sigma_s * unit, prm->normal_sigma_n, prm->normal_iterations,
                      mnrm);
     const int influence = isinf(sg) ? RSMOOTH_INFLUENCE_GAUSSIAN : prm->influence;
+    /* colour factor exp(-|C_q - C_p|^2 / 2 sigma_c^2), C_q the mean of q's corners' colours:
+     * with the Gaussian its exponent joins the influence's (and its shift) */
+    const float *col = prm->colors && !isinf(prm->sigma_c) ? prm->colors : NULL;
+    const double sc = prm->sigma_c;
     /* robust estimate, with the influence exponents shifted by their smallest (log-sum-exp) so no
      * weight underflows: p' = p + sum w t n / sum w is unchanged by the shift. */
     for (size_t v = 0; v < vc; v++) {
@@ -205,12 +222,19 @@ static void brute_force(const double *xyz, size_t vc, const uint32_t *idx, size_
             double t = dot(mnrm + 3 * q, d);
             double r2 = centroid ? d2 : t * t; /* |prediction - p|^2 */
             double e = isinf(sg) ? 0 : r2 / (2 * sg * sg);
-            if (influence == RSMOOTH_INFLUENCE_GAUSSIAN) /* only the Gaussian is shifted */
-                e_min = fmin(e_min, e);
-            else
-                e_min = 0;
+            double ec =
+                col ? bf_color_dist2(col, idx + 3 * (size_t)tri[q], col + 3 * v) / (2 * sc * sc)
+                    : 0;
+            /* the Gaussian's exponent is shifted with the colour's, the other functions' colour
+             * exponent alone (nothing without colour), over the facets they give weight */
+            if (influence == RSMOOTH_INFLUENCE_GAUSSIAN)
+                e_min = fmin(e_min, e + ec);
+            else if (bf_influence(influence, r2 / (sg * sg)) > 0)
+                e_min = fmin(e_min, ec);
             count++;
         }
+        if (!(e_min < INFINITY)) /* no facet with weight (Tukey): nothing to shift */
+            e_min = 0;
         double acc[3] = {0, 0, 0}, ws = 0, kf = 0;
         for (size_t q = 0; count && q < fc; q++) {
             double d2 = dist2(cen + 3 * q, p);
@@ -221,10 +245,13 @@ static void brute_force(const double *xyz, size_t vc, const uint32_t *idx, size_
             double t = dot(n, d);
             double r2 = centroid ? d2 : t * t;
             double e = isinf(sg) ? 0 : r2 / (2 * sg * sg);
+            double ec = col ? bf_color_dist2(col, idx + 3 * (size_t)tri[q], col + 3 * v) /
+                                  (2 * sc * sc)
+                            : 0;
             double af = area[q] * exp(-d2 / (2 * sf * sf));
-            double w = af * (influence == RSMOOTH_INFLUENCE_GAUSSIAN ? exp(-(e - e_min))
-                                                                     : bf_influence(influence,
-                                                                                    r2 / (sg * sg)));
+            double w = af * (influence == RSMOOTH_INFLUENCE_GAUSSIAN
+                                 ? exp(-(e + ec - e_min))
+                                 : bf_influence(influence, r2 / (sg * sg)) * exp(-(ec - e_min)));
             for (int k = 0; k < 3; k++)
                 acc[k] += w * (centroid ? d[k] : t * n[k]);
             ws += w;
@@ -453,6 +480,117 @@ static void make_soup(shape_mesh *m, uint64_t seed, size_t isolated) {
     m->triangle_count = t;
 }
 
+/* Colours for the colour factor: the cube's six faces each their own (by the axis and sign of a
+ * vertex's largest coordinate), the sphere's two halves (z < 0, z >= 0) and the soups' vertices
+ * random. RGB in [0, 1]. */
+static float *make_colors(const shape_mesh *m, int kind, uint64_t seed) {
+    static const float face[6][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1},
+                                     {1, 1, 0}, {0, 1, 1}, {1, 0, 1}};
+    float *c = malloc(3 * m->vertex_count * sizeof *c);
+    CHECK(c);
+    uint64_t s = seed;
+    for (size_t v = 0; v < m->vertex_count; v++) {
+        const double *p = m->xyz + 3 * v;
+        const float *rgb = NULL;
+        float random[3];
+        if (kind == 0) {
+            int axis = 0;
+            for (int k = 1; k < 3; k++)
+                if (fabs(p[k]) > fabs(p[axis]))
+                    axis = k;
+            rgb = face[axis + (p[axis] < 0 ? 3 : 0)];
+        } else if (kind == 1) {
+            rgb = face[p[2] < 0 ? 0 : 2];
+        } else {
+            for (int k = 0; k < 3; k++)
+                random[k] = (float)uniform(&s, 0, 1);
+            rgb = random;
+        }
+        memcpy(c + 3 * v, rgb, 3 * sizeof *c);
+    }
+    return c;
+}
+
+/* A flat noisy plane coloured in two halves with a sharp colour edge: vertices with x <= the
+ * middle red, the others blue. With a narrow sigma_c, the vertices along the edge (x = the middle)
+ * are pulled by their own side only: with the centroid predictor and no influence weight (a plain
+ * Gaussian average of centroids), they move away from the edge, towards -x, where without colours
+ * they stay on it to the noise's asymmetry. With sigma_c huge the result equals the colourless
+ * one (to 1e-12). Both against the brute force too. */
+static void colour_edge_plane(void) {
+    const int n = 24;
+    shape_mesh m;
+    CHECK(shape_plane(&m, n, n, 1.0) == 0);
+    CHECK(shape_add_normal_noise(&m, 0.2, 99) == 0);
+    const double middle = n / 2;
+    float *col = malloc(3 * m.vertex_count * sizeof *col);
+    CHECK(col);
+    for (size_t v = 0; v < m.vertex_count; v++) {
+        bool red = m.xyz[3 * v] <= middle;
+        col[3 * v] = red ? 1.0f : 0.0f;
+        col[3 * v + 1] = 0.0f;
+        col[3 * v + 2] = red ? 0.0f : 1.0f;
+    }
+    rsmooth_params p;
+    rsmooth_params_init(&p);
+    p.sigma_f = 1.0;
+    p.predictor = RSMOOTH_PREDICT_CENTROID;
+    p.sigma_g = INFINITY;
+    size_t nv = m.vertex_count;
+    double *plain = malloc(3 * nv * sizeof *plain), *narrow = malloc(3 * nv * sizeof *narrow);
+    double *wide = malloc(3 * nv * sizeof *wide);
+    CHECK(plain && narrow && wide);
+    rsmooth_error err;
+    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m.xyz, nv, m.indices,
+                                          m.triangle_count, &p, plain, NULL, NULL, NULL, &err),
+                 RSMOOTH_OK);
+    p.colors = col;
+    p.sigma_c = 0.05;
+    run_case("colour-edge plane, centroid, sigma_c 0.05", m.xyz, nv, m.indices, m.triangle_count,
+             &p, 0);
+    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m.xyz, nv, m.indices,
+                                          m.triangle_count, &p, narrow, NULL, NULL, NULL, &err),
+                 RSMOOTH_OK);
+    p.sigma_c = 1e8;
+    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m.xyz, nv, m.indices,
+                                          m.triangle_count, &p, wide, NULL, NULL, NULL, &err),
+                 RSMOOTH_OK);
+    /* the edge's vertices away from the plane's border (2 sigma_f = reach of 2.3 units) */
+    double plain_dx = 0, narrow_dx = -INFINITY, wide_dev = 0;
+    size_t edge = 0;
+    for (size_t v = 0; v < nv; v++) {
+        for (int k = 0; k < 3; k++)
+            wide_dev = fmax(wide_dev, fabs(wide[3 * v + k] - plain[3 * v + k]));
+        double y = m.xyz[3 * v + 1];
+        if (m.xyz[3 * v] != middle || y < 3 || y > n - 3)
+            continue;
+        edge++;
+        plain_dx = fmax(plain_dx, fabs(plain[3 * v] - middle));
+        narrow_dx = fmax(narrow_dx, narrow[3 * v] - middle); /* the least pull towards -x */
+    }
+    printf("colour-edge plane: %zu edge vertices: |dx| <= %.3g without colour, dx <= %.3g with "
+           "sigma_c 0.05 (pulled to their side); sigma_c 1e8 vs no colour: %.3g\n",
+           edge, plain_dx, narrow_dx, wide_dev);
+    CHECK(edge == (size_t)(n - 5));
+    CHECK_LE(plain_dx, 0.05);
+    CHECK_LE(narrow_dx, -0.2);
+    CHECK_LE(wide_dev, 1e-12);
+    /* the projection predictor with the Gaussian influence too, each against the brute force */
+    rsmooth_params_init(&p);
+    p.colors = col;
+    p.sigma_c = 0.05;
+    run_case("colour-edge plane, defaults, sigma_c 0.05", m.xyz, nv, m.indices, m.triangle_count,
+             &p, 0);
+    p.sigma_c = 1e8;
+    run_case("colour-edge plane, defaults, sigma_c 1e8", m.xyz, nv, m.indices, m.triangle_count,
+             &p, 0);
+    free(plain);
+    free(narrow);
+    free(wide);
+    free(col);
+    shape_free(&m);
+}
+
 int main(void) {
     rsmooth_params def;
     rsmooth_params_init(&def);
@@ -472,8 +610,9 @@ int main(void) {
 
     for (int i = 0; i < MESHES; i++) {
         const shape_mesh *m = &meshes[i];
+        float *colors = make_colors(m, i < 2 ? i : 2, 5150 + (uint64_t)i);
         char name[96];
-        for (int variant = 0; variant < 19; variant++) {
+        for (int variant = 0; variant < 26; variant++) {
             rsmooth_params p = def;
             const char *what = "";
             switch (variant) {
@@ -573,12 +712,58 @@ int main(void) {
                 p.influence = RSMOOTH_INFLUENCE_HUBER;
                 p.normal_filter = RSMOOTH_NORMALS_BILATERAL;
                 break;
+            /* the colour factor */
+            case 19:
+                what = "colour, sigma_c 0.1";
+                p.colors = colors;
+                p.sigma_c = 0.1;
+                break;
+            case 20:
+                what = "colour, sigma_c 1 (wide)";
+                p.colors = colors;
+                p.sigma_c = 1;
+                break;
+            case 21: /* every weight underflows: the rescue with colour exponents */
+                what = "colour 0.03, sigma_g 0.004 (underflow)";
+                p.colors = colors;
+                p.sigma_c = 0.03;
+                p.sigma_g = 0.004;
+                break;
+            case 22:
+                what = "colour 0.2, Tukey";
+                p.colors = colors;
+                p.sigma_c = 0.2;
+                p.influence = RSMOOTH_INFLUENCE_TUKEY;
+                p.sigma_g = 0.3;
+                break;
+            case 23:
+                what = "colour 0.05, Lorentzian, centroid, sg inf";
+                p.colors = colors;
+                p.sigma_c = 0.05;
+                p.influence = RSMOOTH_INFLUENCE_LORENTZIAN;
+                p.predictor = RSMOOTH_PREDICT_CENTROID;
+                p.sigma_g = INFINITY; /* the Gaussian then, with the colour exponent alone */
+                break;
+            case 24:
+                what = "colour 0.1, best preset";
+                rsmooth_params_init_best(&p);
+                p.colors = colors;
+                p.sigma_c = 0.1;
+                break;
+            case 25: /* colour factors below double's range: the colour rescue */
+                what = "colour 0.002, Huber (underflow)";
+                p.colors = colors;
+                p.sigma_c = 0.002;
+                p.influence = RSMOOTH_INFLUENCE_HUBER;
+                break;
             }
             snprintf(name, sizeof name, "%s, %s", names[i], what);
             run_case(name, m->xyz, m->vertex_count, m->indices, m->triangle_count, &p,
                      unreached[i]);
         }
+        free(colors);
     }
+    colour_edge_plane();
     for (int i = 0; i < MESHES; i++)
         shape_free(&meshes[i]);
     if (g_failures) {

@@ -171,6 +171,23 @@ typedef struct rsmooth_params {
                                    * after the first move only the vertices whose confidence in the
                                    * previous pass was below this (low confidence: features and
                                    * outliers, the paper's Sec. 5 suggestion) */
+    /* Colour in the influence weight (the paper's future work; added in 0.4). With a colour C_p
+     * per vertex, the robust weight of facet q for vertex p gains the factor
+     *     exp(-|C_q - C_p|^2 / (2 sigma_c^2)),   C_q = the mean colour of q's three vertices,
+     * so a vertex is pulled mostly by triangles of its own colour: a colour edge (a painted line,
+     * a texture seam, a material boundary in a scan) keeps its geometry as a sharp edge does. It
+     * applies to the robust estimate (Eq. 3) only; the predictors' normals (mollification or the
+     * bilateral filter) ignore colour. The confidence k / sum a f counts the factor in k only,
+     * so it drops where neighbouring triangles differ in colour. Meshes only for now:
+     * rsmooth_smooth_points_reference does not read these two fields. */
+    const float *colors;          /* NULL (default): off. Else 3 * vertex_count floats, a colour
+                                   * per vertex (e.g. RGB in [0, 1]; any finite values of
+                                   * magnitude <= 1e15), in the positions' vertex order. Borrowed:
+                                   * read during the call only. A bad one is an
+                                   * RSMOOTH_ERROR_INVALID_ARGUMENT naming its vertex */
+    double sigma_c;               /* colour width, in the colours' units, > 0; +INFINITY turns the
+                                   * colour factor off (the result is then exactly that of colors
+                                   * = NULL). Default 0.1 */
 } rsmooth_params;
 
 /* Fills `params` with the defaults above. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if params is NULL. */
@@ -278,8 +295,9 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const vo
  * rsmooth_normal_filter with normal_sigma_s, normal_sigma_n and normal_iterations, whatever
  * normal_filter says (the paper's mollification moves triangle corners, which points lack); with
  * mollify = 0 the input normals. params->passes > 1: each pass starts from the previous pass's
- * positions and filtered normals (areas recomputed, sigmas those of the input's spacing), with
- * pass_confidence as for meshes. params->predictor CENTROID averages neighbouring points.
+ * positions (areas recomputed, sigmas those of the input's spacing) and filters the input's
+ * normals anew there, with pass_confidence as for meshes. params->predictor CENTROID averages
+ * neighbouring points (plain Gaussian smoothing with sigma_g = +INFINITY).
  *
  * scalar          type of positions, normals, out_positions and out_normals.
  * positions       3 * point_count values, finite, magnitude <= 1e150. Borrowed.
@@ -294,7 +312,8 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const vo
  * out_confidence  optional (NULL): point_count floats, k(p) / sum a f in [0, 1].
  * report          optional (NULL): triangle_count 0, facet_count the points of non-zero area,
  *                 mean_edge_length the point spacing; ms_mollify the normal filter.
- * Outputs must not overlap the inputs or each other.
+ * Every input is read before any output is written: outputs may be the input arrays themselves,
+ * but must not overlap each other.
  *
  * Returns RSMOOTH_OK, RSMOOTH_ERROR_INVALID_ARGUMENT (naming the point of a non-finite or zero
  * normal; no output written) or RSMOOTH_ERROR_OUT_OF_MEMORY (outputs undefined). Double

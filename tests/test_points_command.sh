@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# The rsmooth command on point clouds: a PLY with normals and no faces is filtered as points (the
+# noise drops, the normals are written), and a cloud without normals, or asked for an edge-based
+# method, fails with exit status 2 and a message naming the file.
+set -uo pipefail
+rsmooth=$1
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+cd "$dir"
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+# expect STATUS COMMAND...: runs it, checks the exit status, keeps stderr in err.txt
+expect() {
+  local want=$1; shift
+  "$@" >out.txt 2>err.txt
+  local got=$?
+  [ "$got" -eq "$want" ] || fail "exit $got (wanted $want): $* -- $(cat err.txt)"
+}
+
+# A 40 x 40 grid of spacing 1 on z = 0 with noise of about 0.3 in z, normals +z (a little noisy),
+# and a colour per point: an ascii PLY cloud.
+awk 'BEGIN {
+  srand(7); n = 40
+  print "ply\nformat ascii 1.0\ncomment a scan\nelement vertex " n * n
+  print "property float x\nproperty float y\nproperty float z"
+  print "property float nx\nproperty float ny\nproperty float nz"
+  print "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header"
+  for (i = 0; i < n; i++) for (j = 0; j < n; j++) {
+    z = 0.3 * sqrt(12) * (rand() - 0.5)
+    printf "%d %d %.6f %.4f %.4f 1 10 20 30\n", i, j, z, 0.2 * (rand() - 0.5), 0.2 * (rand() - 0.5)
+  }
+}' >cloud.ply
+# mean |z| over the interior points of a cloud PLY written as ascii x y z nx ny nz ...
+mean_z() {
+  awk '/^end_header/ { body = 1; next }
+       body && $1 >= 4 && $1 <= 35 && $2 >= 4 && $2 <= 35 { s += ($3 < 0 ? -$3 : $3); m++ }
+       END { printf "%.6f\n", s / m }' "$1"
+}
+
+expect 0 "$rsmooth" cloud.ply -o smooth.ply --ascii --confidence conf.ply
+grep -q "point cloud" err.txt || fail "no note that the input is a point cloud: $(cat err.txt)"
+grep -q "1600 points with normals" err.txt || fail "summary does not count points: $(cat err.txt)"
+grep -q "property float nx" smooth.ply || fail "no normals written"
+grep -q "element face" smooth.ply && fail "the output gained faces"
+grep -q "comment a scan" smooth.ply || fail "the input's comment was lost"
+before=$(mean_z cloud.ply)
+after=$(mean_z smooth.ply)
+echo "mean |z| before $before, after $after"
+awk -v a="$after" -v b="$before" 'BEGIN { exit !(a < 0.6 * b) }' || fail "noise not reduced by 40%"
+# The filtered normals are unit and near +z; the colours are kept.
+awk '/^end_header/ { body = 1; next }
+     body { l = sqrt($4 * $4 + $5 * $5 + $6 * $6); if (l < 0.999 || l > 1.001 || $6 < 0.9) bad++
+            if ($7 != 10 || $9 != 30) bad++ }
+     END { exit bad > 0 }' smooth.ply || fail "written normals are not unit and near +z, or colours lost"
+grep -q "property float quality" conf.ply || fail "confidence cloud has no quality"
+
+# Binary and other formats; JSON says it was a point cloud.
+expect 0 "$rsmooth" cloud.ply -o smooth.obj -q --json
+grep -q '"point_cloud":true' out.txt || fail "--json does not say point_cloud: $(cat out.txt)"
+[ "$(grep -c '^vn ' smooth.obj)" -eq 1600 ] || fail "OBJ output lacks the 1600 normals"
+[ -s err.txt ] && fail "-q printed: $(cat err.txt)"
+expect 0 "$rsmooth" smooth.obj -o again.ply -q
+expect 0 "$rsmooth" cloud.ply -o best.ply --best --passes 2 -q
+
+# An OpenCL device named: still runs, on the reference path, and says so.
+expect 0 "$rsmooth" cloud.ply -o dev.ply --device cpu
+grep -q "not on device 'cpu'" err.txt || fail "no note that --device is not used: $(cat err.txt)"
+
+# No normals: a clear error naming the file.
+grep -v -e "property float n[xyz]" cloud.ply | awk '/^end_header/ { print; body = 1; next }
+  !body { print; next } { print $1, $2, $3, $7, $8, $9 }' >bare.ply
+expect 2 "$rsmooth" bare.ply -o out.ply
+grep -q "bare.ply has no faces and no vertex normals" err.txt || fail "message: $(cat err.txt)"
+[ -e out.ply ] && fail "a failed run wrote its output"
+expect 2 "$rsmooth" cloud.ply -o out.ply --method taubin
+grep -q "cloud.ply is a point cloud" err.txt || fail "taubin message: $(cat err.txt)"
+
+[ "$failures" -eq 0 ] || exit 1
+echo "point cloud command: all checks passed"
