@@ -693,17 +693,11 @@ static int write_confidence(rsmooth_mesh *mesh, const options *opt, float *confi
 }
 
 /* --sigma-c: the input's vertex colours as floats in [0, 1], for rsmooth_params.colors. */
-static int input_colors(const options *opt, const rsmooth_mesh *mesh, bool points,
-                        float **colors) {
+static int input_colors(const options *opt, const rsmooth_mesh *mesh, float **colors) {
     *colors = NULL;
     if (!mesh->vertex_colors) {
         fprintf(stderr, "rsmooth: %s has no vertex colours: --sigma-c needs them (PLY red, "
                         "green, blue; OBJ v x y z r g b; COFF)\n", opt->input);
-        return EXIT_USAGE;
-    }
-    if (points) {
-        fprintf(stderr, "rsmooth: %s is a point cloud (no faces): --sigma-c works on meshes "
-                        "only for now\n", opt->input);
         return EXIT_USAGE;
     }
     size_t n = 3 * mesh->vertex_count;
@@ -756,7 +750,7 @@ int main(int argc, char **argv) {
         return code;
     }
     float *colors = NULL; /* --sigma-c */
-    if (opt.colors && (code = input_colors(&opt, mesh, points, &colors)) != EXIT_OK) {
+    if (opt.colors && (code = input_colors(&opt, mesh, &colors)) != EXIT_OK) {
         rsmooth_mesh_destroy(mesh);
         return code;
     }

@@ -202,6 +202,7 @@ static void add_report(rsmooth_report *sum, const rsmooth_report *pass, int inde
  * previous pass. */
 typedef struct point_arrays {
     double *xyz, *next, *input_normal, *normal, *filtered, *scratch, *spacing, *area;
+    double *color; /* the colours as doubles, when the colour term is on */
     float *confidence, *prev_confidence;
 } point_arrays;
 
@@ -216,6 +217,7 @@ static void free_arrays(point_arrays *a) {
     rs_free(a->area);
     rs_free(a->confidence);
     rs_free(a->prev_confidence);
+    rs_free(a->color);
 }
 
 rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void *positions,
@@ -230,6 +232,8 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
     if (st != RSMOOTH_OK)
         return st;
     if ((st = check_positions(scalar, positions, point_count, error, where)) != RSMOOTH_OK)
+        return st;
+    if ((st = rs_check_colors(p.colors, point_count, error, where)) != RSMOOTH_OK)
         return st;
     if (!normals)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
@@ -266,6 +270,14 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
     a.area = rs_alloc_array(n, sizeof(double));
     a.confidence = rs_alloc_array(n, sizeof(float));
     a.prev_confidence = rs_alloc_array(n, sizeof(float));
+    if (p.colors && !isinf(p.sigma_c)) {
+        /* a point is its own facet: its colour is the facet's */
+        a.color = rs_alloc_array(n, 3 * sizeof(double));
+        if (!a.color)
+            goto fail_memory;
+        for (size_t i = 0; i < 3 * n; i++)
+            a.color[i] = p.colors[i];
+    }
     rs_kdtree tree = {0};
     rs_kdtree_list nb = {0};
     if (!a.xyz || !a.next || !a.input_normal || !a.normal || !a.filtered || !a.scratch ||
@@ -318,7 +330,7 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
         pb.mean_edge_length = input_spacing; /* what the report gives as the unit */
         pb.mean_area = area_sum / (double)n;
         rs_problem_apply_params(&pb, &p, unit);
-        pb.colors = NULL; /* the colour term is for meshes only, for now (rsmooth.h) */
+        pb.facet_color = pb.colors ? a.color : NULL;
         pb.progress = pp.progress ? report_pass_progress : NULL;
         pb.progress_user = &pp;
 

@@ -44,6 +44,15 @@ static void bf_spacings(const double *xyz, size_t n, double *s) {
     free(d);
 }
 
+static double bf_color_dist2(const float *colors, size_t q, size_t v) {
+    double s = 0;
+    for (int c = 0; c < 3; c++) {
+        double d = (double)colors[3 * q + c] - (double)colors[3 * v + c];
+        s += d * d;
+    }
+    return s;
+}
+
 static double bf_influence(int influence, double x2) { /* x2 in units of sigma_g^2 */
     switch (influence) {
     case RSMOOTH_INFLUENCE_TUKEY:
@@ -125,6 +134,8 @@ static void bf_points(const double *in_xyz, const double *in_nrm, size_t n, cons
                 double af = area[q] * exp(-d2 / (2 * sf * sf));
                 double g =
                     isinf(p->sigma_g) ? 1 : bf_influence(p->influence, dot(step, step) / (sg * sg));
+                if (p->colors) /* a point's own colour is its facet's */
+                    g *= exp(-bf_color_dist2(p->colors, q, v) / (2 * p->sigma_c * p->sigma_c));
                 for (int c = 0; c < 3; c++)
                     acc[c] += af * g * step[c];
                 k += af * g;
@@ -182,13 +193,21 @@ static void test_oracle(void) {
         float *got_c = malloc(n * sizeof *got_c);
         float *xyz32 = malloc(3 * n * sizeof *xyz32), *nrm32 = malloc(3 * n * sizeof *nrm32);
         float *got32 = malloc(3 * n * sizeof *got32), *got32_n = malloc(3 * n * sizeof *got32_n);
+        float *colors = malloc(3 * n * sizeof *colors);
+        CHECK(colors);
+        for (size_t i = 0; i < n; i++) { /* red below z = 0, blue above, slightly varied */
+            bool low = mesh->xyz[3 * i + 2] < 0;
+            colors[3 * i] = low ? 0.9f - 0.01f * (float)(i % 5) : 0.1f;
+            colors[3 * i + 1] = 0.2f;
+            colors[3 * i + 2] = low ? 0.1f : 0.8f + 0.01f * (float)(i % 3);
+        }
         double *xyz64 = malloc(3 * n * sizeof *xyz64), *nrm64 = malloc(3 * n * sizeof *nrm64);
         CHECK(want && want_n && want_c && got && got_n && got_c && xyz32 && nrm32 && got32 &&
               got32_n && xyz64 && nrm64);
         double spacing = 0;
         CHECK_STATUS(rsmooth_point_spacing(RSMOOTH_FLOAT64, mesh->xyz, n, &spacing, NULL),
                      RSMOOTH_OK);
-        for (int variant = 0; variant < 10; variant++) {
+        for (int variant = 0; variant < 12; variant++) {
             rsmooth_params p;
             rsmooth_params_init(&p);
             const char *what = "defaults";
@@ -238,6 +257,18 @@ static void test_oracle(void) {
                 p.cutoff = 3;
                 p.normal_iterations = 2;
                 p.normal_sigma_n = 0.6;
+                break;
+            case 10: /* the points of the half z < 0 red, the others blue */
+                what = "colour, sigma_c 0.3";
+                p.colors = colors;
+                p.sigma_c = 0.3;
+                break;
+            case 11:
+                what = "colour, sigma_c 0.3, tukey, 2 passes";
+                p.colors = colors;
+                p.sigma_c = 0.3;
+                p.influence = RSMOOTH_INFLUENCE_TUKEY;
+                p.passes = 2;
                 break;
             }
             bf_points(mesh->xyz, normals[m], n, &p, want, want_n, want_c);
@@ -289,7 +320,7 @@ static void test_oracle(void) {
             }
         }
         free(want), free(want_n), free(want_c), free(got), free(got_n), free(got_c);
-        free(xyz32), free(nrm32), free(got32), free(got32_n), free(xyz64), free(nrm64);
+        free(xyz32), free(nrm32), free(got32), free(got32_n), free(xyz64), free(nrm64), free(colors);
         free(normals[m]);
         shape_free(&meshes[m]);
     }

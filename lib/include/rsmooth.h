@@ -178,8 +178,8 @@ typedef struct rsmooth_params {
      * a texture seam, a material boundary in a scan) keeps its geometry as a sharp edge does. It
      * applies to the robust estimate (Eq. 3) only; the predictors' normals (mollification or the
      * bilateral filter) ignore colour. The confidence k / sum a f counts the factor in k only,
-     * so it drops where neighbouring triangles differ in colour. Meshes only for now:
-     * rsmooth_smooth_points_reference does not read these two fields. */
+     * so it drops where neighbouring triangles differ in colour. For point clouds
+     * (rsmooth_smooth_points_reference) a point's own colour is its facet's C_q. */
     const float *colors;          /* NULL (default): off. Else 3 * vertex_count floats, a colour
                                    * per vertex (e.g. RGB in [0, 1]; any finite values of
                                    * magnitude <= 1e15), in the positions' vertex order. Borrowed:
