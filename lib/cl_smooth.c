@@ -413,7 +413,8 @@ static cl_int run_bilateral_lists(rsmooth_context *ctx, const rs_problem *pb, co
                                   bool *listed) {
     *listed = false;
     const char *env = getenv("RSMOOTH_BILATERAL_LISTS");
-    if (env && !strcmp(env, "0"))
+    /* building them costs about what a searching round does: one round is cheaper without */
+    if ((env && !strcmp(env, "0")) || pb->normal_iterations < 2)
         return CL_SUCCESS;
     const double h = grid->cell_size, s = pb->normal_sigma_s, t = pb->normal_sigma_n;
     cl_uint mask = grid->column_mask;

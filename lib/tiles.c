@@ -43,14 +43,21 @@ static void report_tile_progress(void *user, double fraction) {
     tp->fn(tp->user, tp->from + tp->span * fraction);
 }
 
+static double halo_radius(const rs_problem *pb, double reach);
+
 /* Device bytes a tile of `vertices` core vertices and `facets` facets is expected to need (a
- * facet brings about half a vertex of its own). The bilateral rounds' lists are planned for while
- * at least half of a tile's facets are its own (about two per core vertex): smaller tiles, mostly
- * halo, would cost more than the rounds save, and theirs search instead where the lists do not
- * fit. */
+ * facet brings about half a vertex of its own). The bilateral rounds' lists are planned for only
+ * in tiles of at least 256 halo discs of facets, at least half of them the tile's own (about two
+ * per core vertex): splitting smaller to make room for them costs more in halos (K bilateral
+ * reaches wide) than the lists save (measured on Bunny0.2 with the best preset: one tile that
+ * searches in every round beat 2 to 9 with lists). Tiles take their lists wherever they fit
+ * anyway, planned or not. */
 static uint64_t estimate_bytes(const rs_problem *pb, size_t vertices, size_t facets) {
     size_t v = vertices > facets / 2 ? vertices : facets / 2;
-    bool lists = pb->bilateral && (uint64_t)facets <= 4 * (uint64_t)vertices;
+    double halo = pb->bilateral ? halo_radius(pb, 0) : 0; /* the bilateral halo needs no reach */
+    bool lists = pb->bilateral && pb->normal_iterations >= 2 && /* one round searches */
+                 (uint64_t)facets <= 4 * (uint64_t)vertices &&
+                 (double)facets >= 256 * 3.14159 * halo * halo / pb->mean_area;
     uint64_t per_facet = RS_DEVICE_BYTES_PER_FACET +
                          (pb->bilateral ? RS_DEVICE_BYTES_PER_BILATERAL_FACET : 0) +
                          (lists ? RS_DEVICE_BYTES_PER_BILATERAL_LIST_FACET(pb) : 0) +
