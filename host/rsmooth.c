@@ -63,6 +63,9 @@ static const char usage_text[] =
     "  --normal-iterations K bilateral: rounds (default 5)\n"
     "  --influence G         the robust weight on a prediction's distance: gaussian (default),\n"
     "                        tukey (zero beyond 2.24 sigma-g), lorentzian or huber (heavier tails)\n"
+    "  --auto                estimate the input's noise and pick the sigmas from it (with\n"
+    "                        --best also the rounds and passes); it prints the estimate. Options\n"
+    "                        given explicitly (e.g. --sigma-g) win over the rule\n"
     "  --passes N            run the filter N times, each from the previous result (default 1)\n"
     "  --pass-confidence C   passes after the first move only vertices whose confidence was\n"
     "                        below C in (0, 1]: more smoothing at features and outliers only\n"
@@ -143,7 +146,21 @@ typedef struct options {
     bool colors;            /* --sigma-c: the input's vertex colours in the weight */
     bool sigma_g_given, umbrella_given; /* for consistency checks against --method */
     bool ascii, json, force, quiet, in_place, stats, list_devices, best;
+    bool auto_params;       /* --auto */
+    unsigned given;         /* GIVEN_* bits: parameters set on the command line */
+    double noise;           /* --auto's estimate */
 } options;
+
+/* Parameters the command line set explicitly: --auto leaves them as given. */
+enum {
+    GIVEN_SIGMA_F = 1u << 0,
+    GIVEN_SIGMA_G = 1u << 1,
+    GIVEN_NORMAL_SIGMA_S = 1u << 2,
+    GIVEN_NORMAL_SIGMA_N = 1u << 3,
+    GIVEN_NORMAL_ITERATIONS = 1u << 4,
+    GIVEN_PASSES = 1u << 5,
+    GIVEN_INFLUENCE = 1u << 6
+};
 
 /* Returns -1 when the program should go on, else the exit status. */
 static int parse_args(int argc, char **argv, options *opt) {
@@ -219,9 +236,9 @@ static int parse_args(int argc, char **argv, options *opt) {
             if (!cli_parse_number(value, &x))
                 return cli_usage_error(NULL, "%s: not a number: '%s'", a, value);
             if (!strcmp(a, "--sigma-f"))
-                opt->params.sigma_f = x;
+                opt->params.sigma_f = x, opt->given |= GIVEN_SIGMA_F;
             else if (!strcmp(a, "--sigma-g"))
-                opt->params.sigma_g = x, opt->sigma_g_given = true;
+                opt->params.sigma_g = x, opt->sigma_g_given = true, opt->given |= GIVEN_SIGMA_G;
             else
                 opt->params.cutoff = x;
             i++;
@@ -238,10 +255,12 @@ static int parse_args(int argc, char **argv, options *opt) {
                                                      : "--influence: '%s' is not gaussian, tukey, "
                                                        "lorentzian or huber",
                                        value);
-            if (normals)
+            if (normals) {
                 opt->params.normal_filter = k;
-            else
+            } else {
                 opt->params.influence = k;
+                opt->given |= GIVEN_INFLUENCE;
+            }
             i++;
         } else if (!strcmp(a, "--normal-sigma-s") || !strcmp(a, "--normal-sigma-n") ||
                    !strcmp(a, "--pass-confidence")) {
@@ -250,9 +269,9 @@ static int parse_args(int argc, char **argv, options *opt) {
             if (!cli_parse_number(value, &x))
                 return cli_usage_error(NULL, "%s: not a number: '%s'", a, value);
             if (!strcmp(a, "--normal-sigma-s"))
-                opt->params.normal_sigma_s = x;
+                opt->params.normal_sigma_s = x, opt->given |= GIVEN_NORMAL_SIGMA_S;
             else if (!strcmp(a, "--normal-sigma-n"))
-                opt->params.normal_sigma_n = x;
+                opt->params.normal_sigma_n = x, opt->given |= GIVEN_NORMAL_SIGMA_N;
             else
                 opt->params.pass_confidence = x;
             i++;
@@ -272,10 +291,12 @@ static int parse_args(int argc, char **argv, options *opt) {
                 return cli_usage_error(NULL, "%s must be a whole number in [1, 100] (got '%s')", a,
                                        value);
             if (!strcmp(a, "--passes"))
-                opt->params.passes = (int)x;
+                opt->params.passes = (int)x, opt->given |= GIVEN_PASSES;
             else
-                opt->params.normal_iterations = (int)x;
+                opt->params.normal_iterations = (int)x, opt->given |= GIVEN_NORMAL_ITERATIONS;
             i++;
+        } else if (!strcmp(a, "--auto")) {
+            opt->auto_params = true;
         } else if (!strcmp(a, "--best")) {
             /* applied before the loop, so the options after it can change its settings */
         } else if (!strcmp(a, "--absolute")) {
@@ -340,6 +361,9 @@ static int parse_args(int argc, char **argv, options *opt) {
                                method_names[opt->method]);
     if (umbrella && opt->colors)
         return cli_usage_error(NULL, "--method %s has no weights for --sigma-c",
+                               method_names[opt->method]);
+    if (opt->auto_params && opt->method != METHOD_ROBUST)
+        return cli_usage_error(NULL, "--auto picks the robust filter's sigmas: drop --method %s",
                                method_names[opt->method]);
     if (opt->method == METHOD_GAUSSIAN) {
         if (opt->sigma_g_given)
@@ -417,6 +441,8 @@ static void print_json(const rsmooth_report *r, const options *opt, double ms_re
             printf(",\"sigma_c\":null");
         printf(",\"influence\":\"%s\",\"passes\":%d,\"pass_confidence\":%.9g",
                influence_names[p->influence], p->passes, p->pass_confidence);
+        if (opt->auto_params)
+            printf(",\"noise_estimate\":%.9g", opt->noise);
     }
     printf(",\"vertices\":%zu,\"triangles\":%zu,\"facets\":%zu,\"mean_edge_length\":%.9g,"
            "\"sigma_f\":%.9g,",
@@ -711,6 +737,49 @@ static int input_colors(const options *opt, const rsmooth_mesh *mesh, float **co
     return EXIT_OK;
 }
 
+/* --auto: the sigmas (and with --best its rounds and passes) from the input's estimated noise;
+ * options given after --auto still override them. */
+static int choose_params(options *opt, const rsmooth_mesh *mesh, bool points) {
+    if (points) {
+        fprintf(stderr, "rsmooth: %s is a point cloud: --auto needs faces to estimate the noise; "
+                        "give --sigma-f and --sigma-g\n", opt->input);
+        return EXIT_USAGE;
+    }
+    rsmooth_params chosen = opt->params;
+    rsmooth_error err;
+    if (rsmooth_params_auto(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
+                            mesh->triangles, mesh->triangle_count, &chosen, &opt->noise,
+                            &err) != RSMOOTH_OK) {
+        fprintf(stderr, "rsmooth: %s: --auto: %s\n", opt->input, err.message);
+        return EXIT_USAGE;
+    }
+    /* what the command line set explicitly wins over the rule */
+    const rsmooth_params *given = &opt->params;
+    if (opt->given & GIVEN_SIGMA_F)
+        chosen.sigma_f = given->sigma_f;
+    if (opt->given & GIVEN_SIGMA_G)
+        chosen.sigma_g = given->sigma_g;
+    if (opt->given & GIVEN_NORMAL_SIGMA_S)
+        chosen.normal_sigma_s = given->normal_sigma_s;
+    if (opt->given & GIVEN_NORMAL_SIGMA_N)
+        chosen.normal_sigma_n = given->normal_sigma_n;
+    if (opt->given & GIVEN_NORMAL_ITERATIONS)
+        chosen.normal_iterations = given->normal_iterations;
+    if (opt->given & GIVEN_PASSES)
+        chosen.passes = given->passes;
+    if (opt->given & GIVEN_INFLUENCE)
+        chosen.influence = given->influence;
+    if (opt->given & (GIVEN_SIGMA_F | GIVEN_SIGMA_G))
+        chosen.absolute = given->absolute;
+    opt->params = chosen;
+    if (!opt->quiet)
+        fprintf(stderr, "rsmooth: %s: noise estimate %.3g mean edge lengths: sigma_f %.3g, "
+                        "sigma_g %.3g%s\n", opt->input, opt->noise, chosen.sigma_f,
+                chosen.sigma_g,
+                chosen.normal_filter == RSMOOTH_NORMALS_BILATERAL ? " (best mode)" : "");
+    return EXIT_OK;
+}
+
 int main(int argc, char **argv) {
     if (argc >= 2 && !strcmp(argv[1], "compare"))
         return cli_compare_main(argc - 1, argv + 1);
@@ -755,6 +824,11 @@ int main(int argc, char **argv) {
         return code;
     }
     opt.params.colors = colors;
+    if (opt.auto_params && (code = choose_params(&opt, mesh, points)) != EXIT_OK) {
+        rsmooth_mesh_destroy(mesh);
+        free(colors);
+        return code;
+    }
 
     size_t nv = mesh->vertex_count;
     double *out = malloc(nv * 3 * sizeof *out);

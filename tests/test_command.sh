@@ -195,6 +195,14 @@ ev_paper=$(sed -n 's/.*"ev": *\([0-9.eE+-]*\).*/\1/p' out.txt)
 echo "ev paper defaults $ev_paper, best mode $ev_best"
 awk -v a="$ev_best" -v b="$ev_paper" 'BEGIN { exit !(a > 0 && a < b) }' ||
   fail "the best mode is not better than the paper's defaults"
+expect 0 "$rsmooth" noisy.ply -o auto.ply --best --auto --sigma-g 0.25 --device reference --json
+grep -q '"noise_estimate":0\.[1-4]' out.txt || fail "--auto did not estimate 0.3 edges of noise"
+sg=$(sed -n 's/.*"sigma_g":\([0-9.eE+-]*\).*/\1/p' out.txt)
+mel=$(sed -n 's/.*"mean_edge_length":\([0-9.eE+-]*\).*/\1/p' out.txt)
+awk -v a="$sg" -v m="$mel" 'BEGIN { r = a / m; exit !(r > 0.2499 && r < 0.2501) }' ||
+  fail "--sigma-g 0.25 given with --auto was not kept (sigma_g $sg, mean edge $mel)"
+grep -q "noise estimate" err.txt || fail "--auto did not say what it estimated"
+expect 2 "$rsmooth" noisy.ply -o x.ply --auto --method taubin
 expect 2 "$rsmooth" noisy.ply -o x.ply --normals gaussian
 expect 2 "$rsmooth" noisy.ply -o x.ply --influence cauchy
 expect 2 "$rsmooth" noisy.ply -o x.ply --passes 0
