@@ -1,5 +1,5 @@
-/* A k-d tree over points for the point-cloud filter's neighbour queries (k nearest, and all within
- * a radius). Unlike a uniform grid it needs no cell size, so scans with far outliers or very
+/* A k-d tree over points for the point-cloud filter's spacing: each point's k nearest neighbours.
+ * Unlike a uniform grid it needs no cell size, so scans with far outliers or very
  * uneven density cost O(log n) per query all the same. Implicit and balanced: a node is a range of
  * `order` split at its middle, children of node i are 2i + 1 and 2i + 2, and only each node's
  * split axis and value are stored. */
@@ -158,62 +158,4 @@ size_t rs_kdtree_nearest(const rs_kdtree *tree, const double p[3], uint32_t skip
     if (k > 0 && tree->count > 0)
         knn_node(tree, &s, 0, 0, tree->count);
     return s.found;
-}
-
-/* Appends q to `out`; false when out of memory. */
-static bool list_push(rs_kdtree_list *out, uint32_t q, double d2) {
-    if (out->count == out->capacity) {
-        size_t capacity = out->capacity ? 2 * out->capacity : 64;
-        uint32_t *index = rs_realloc_array(out->index, capacity, sizeof *index);
-        if (!index)
-            return false;
-        out->index = index;
-        double *dist2 = rs_realloc_array(out->dist2, capacity, sizeof *dist2);
-        if (!dist2)
-            return false;
-        out->dist2 = dist2;
-        out->capacity = capacity;
-    }
-    out->index[out->count] = q;
-    out->dist2[out->count] = d2;
-    out->count++;
-    return true;
-}
-
-static bool within_node(const rs_kdtree *tree, const double p[3], double r2, rs_kdtree_list *out,
-                        size_t node, size_t lo, size_t hi) {
-    if (hi - lo <= LEAF_SIZE) {
-        for (size_t i = lo; i < hi; i++) {
-            uint32_t q = tree->order[i];
-            double d[3];
-            rs_sub3(tree->xyz + 3 * (size_t)q, p, d);
-            double d2 = rs_dot3(d, d);
-            if (d2 <= r2 && !list_push(out, q, d2))
-                return false;
-        }
-        return true;
-    }
-    size_t mid = lo + (hi - lo) / 2;
-    int axis = tree->axis[node];
-    double diff = p[axis] - tree->split[node];
-    /* left holds coordinates <= the split, right >= it */
-    if (diff <= 0 || diff * diff <= r2)
-        if (!within_node(tree, p, r2, out, 2 * node + 1, lo, mid))
-            return false;
-    if (diff >= 0 || diff * diff <= r2)
-        if (!within_node(tree, p, r2, out, 2 * node + 2, mid, hi))
-            return false;
-    return true;
-}
-
-bool rs_kdtree_within(const rs_kdtree *tree, const double p[3], double radius,
-                      rs_kdtree_list *out) {
-    out->count = 0;
-    return tree->count == 0 || within_node(tree, p, radius * radius, out, 0, 0, tree->count);
-}
-
-void rs_kdtree_list_free(rs_kdtree_list *list) {
-    rs_free(list->index);
-    rs_free(list->dist2);
-    memset(list, 0, sizeof *list);
 }

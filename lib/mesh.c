@@ -404,7 +404,9 @@ void rs_report_problem(rsmooth_report *report, const rs_problem *problem, const 
     report->sigma_f = problem->sigma_f;
     report->sigma_g = problem->sigma_g;
     report->radius = problem->radius;
-    report->mollify_radius = problem->mollify ? problem->mollify_radius : 0;
+    report->mollify_radius = problem->bilateral ? problem->normal_radius
+                             : problem->mollify ? problem->mollify_radius
+                                                : 0;
     report->grid_cell_count = grid ? grid->cell_count : 0;
     snprintf(report->device, sizeof report->device, "%s", device);
 }

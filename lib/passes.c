@@ -7,21 +7,12 @@
 #include <math.h>
 #include <string.h>
 
-/* The caller's progress callback, seen through one pass of `count`. */
-typedef struct pass_progress {
-    rsmooth_progress_fn progress;
-    void *user;
-    int pass, count;
-} pass_progress;
-
-static void report_pass_progress(void *user, double fraction) {
-    const pass_progress *pp = user;
+void rs_report_pass_progress(void *user, double fraction) {
+    const rs_pass_progress *pp = user;
     pp->progress(pp->user, ((double)pp->pass + fraction) / (double)pp->count);
 }
 
-/* Stage times and work of one pass added to the sum of the passes before (counts, sigmas and
- * device from the last pass, except the facet count: the input's). */
-static void add_report(rsmooth_report *sum, const rsmooth_report *pass) {
+void rs_add_pass_report(rsmooth_report *sum, const rsmooth_report *pass) {
     rsmooth_report keep = *sum;
     *sum = *pass;
     sum->ms_setup += keep.ms_setup;
@@ -75,10 +66,10 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar
     }
     int passes = p.passes;
     p.passes = 1;
-    pass_progress pp = {params ? params->progress : NULL, params ? params->progress_user : NULL, 0,
+    rs_pass_progress pp = {params ? params->progress : NULL, params ? params->progress_user : NULL, 0,
                         passes};
     if (pp.progress) {
-        p.progress = report_pass_progress;
+        p.progress = rs_report_pass_progress;
         p.progress_user = &pp;
     }
     if (passes == 1)
@@ -107,7 +98,7 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar
         if (st != RSMOOTH_OK)
             goto done;
         if (report)
-            add_report(&sum, &one);
+            rs_add_pass_report(&sum, &one);
         if (pass > 0 && p.pass_confidence > 0) {
             /* confident vertices keep what the pass before gave them */
             for (size_t v = 0; v < vertex_count; v++)

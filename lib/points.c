@@ -1,8 +1,8 @@
 /* Point clouds with normals (beyond the paper): the reference filter with the points as its facets.
  * A point is a facet whose centroid is the point, whose plane is its tangent plane and whose area
- * is estimated from how far its nearest neighbours are; rs_reference_solve then runs Eq. 3 on
- * them unchanged. The normals are filtered here, since the paper's mollification moves triangle
- * corners and points have none. */
+ * is estimated from how far its nearest neighbours are; rs_reference_solve then runs the bilateral
+ * normal filter and Eq. 3 on them unchanged. Points always take the bilateral filter when they
+ * take one at all: the paper's mollification moves triangle corners, and points have none. */
 #include "rsmooth_internal.h"
 
 #include <math.h>
@@ -17,8 +17,6 @@
 #define LATTICE_AREA 0.86602540378443864676
 /* Points per chunk of the threaded neighbour search. */
 #define SPACING_GRAIN 4096
-/* Progress: the share of a pass that spacing and normal filtering take. */
-#define NORMALS_SHARE 0.2
 
 static const char where[] = "rsmooth_smooth_points_reference";
 
@@ -136,72 +134,11 @@ rsmooth_status rsmooth_point_spacing(rsmooth_scalar scalar, const void *position
                         point_count);
 }
 
-/* Bilateral filter on the points' normals: normal_iterations rounds of
- * n_r <- normalise(sum_q a_q exp(-|p_q - p_r|^2 / 2 s^2) exp(-|n_q - n_r|^2 / 2 t^2) n_q) over the
- * points q within normal_radius of p_r (itself included): RSMOOTH_NORMALS_BILATERAL with the
- * points as facets. From `input` into `out`; `scratch` holds the previous round. */
-static bool bilateral_normals(const rs_problem *pb, const rs_kdtree *tree, const double *input,
-                              double *out, double *scratch, rs_kdtree_list *nb) {
-    size_t n = pb->facet_count;
-    const double inv_2s2 = 1 / (2 * pb->normal_sigma_s * pb->normal_sigma_s);
-    const double inv_2n2 = 1 / (2 * pb->normal_sigma_n * pb->normal_sigma_n);
-    memcpy(scratch, input, n * 3 * sizeof(double));
-    for (int round = 0; round < pb->normal_iterations; round++) {
-        for (size_t r = 0; r < n; r++) {
-            if (!rs_kdtree_within(tree, pb->centroid + 3 * r, pb->normal_radius, nb))
-                return false;
-            const double *nr = scratch + 3 * r;
-            double acc[3] = {0, 0, 0};
-            for (size_t i = 0; i < nb->count; i++) {
-                const double *nq = scratch + 3 * (size_t)nb->index[i];
-                double dn[3];
-                rs_sub3(nq, nr, dn);
-                double w = pb->area[nb->index[i]] * exp(-nb->dist2[i] * inv_2s2) *
-                           exp(-rs_dot3(dn, dn) * inv_2n2);
-                for (int k = 0; k < 3; k++)
-                    acc[k] += w * nq[k];
-            }
-            double len = sqrt(rs_dot3(acc, acc));
-            for (int k = 0; k < 3; k++)
-                out[3 * r + k] = len > 0 ? acc[k] / len : nr[k];
-        }
-        memcpy(scratch, out, n * 3 * sizeof(double));
-    }
-    return true;
-}
-
-/* The caller's progress callback, seen through one pass's robust stage. */
-typedef struct pass_progress {
-    rsmooth_progress_fn progress;
-    void *user;
-    int pass, count;
-} pass_progress;
-
-static void report_pass_progress(void *user, double fraction) {
-    const pass_progress *pp = user;
-    pp->progress(pp->user, ((double)pp->pass + NORMALS_SHARE + (1 - NORMALS_SHARE) * fraction) /
-                               (double)pp->count);
-}
-
-/* Stage times of one pass added to those of the passes before (the rest from the last pass). */
-static void add_report(rsmooth_report *sum, const rsmooth_report *pass, int index) {
-    rsmooth_report keep = *sum;
-    *sum = *pass;
-    if (index == 0)
-        return;
-    sum->ms_facets += keep.ms_facets;
-    sum->ms_grid += keep.ms_grid;
-    sum->ms_mollify += keep.ms_mollify;
-    sum->ms_normals += keep.ms_normals;
-    sum->ms_robust += keep.ms_robust;
-    sum->facet_count = keep.facet_count; /* the input's */
-}
-
 /* Arrays of one call: the current and next positions; the input's unit normals, the previous
  * pass's filtered normals and this pass's; per-point spacing and area; confidence of this and the
  * previous pass. */
 typedef struct point_arrays {
-    double *xyz, *next, *input_normal, *normal, *filtered, *scratch, *spacing, *area;
+    double *xyz, *next, *input_normal, *normal, *filtered, *spacing, *area;
     double *color; /* the colours as doubles, when the colour term is on */
     float *confidence, *prev_confidence;
 } point_arrays;
@@ -212,7 +149,6 @@ static void free_arrays(point_arrays *a) {
     rs_free(a->next);
     rs_free(a->normal);
     rs_free(a->filtered);
-    rs_free(a->scratch);
     rs_free(a->spacing);
     rs_free(a->area);
     rs_free(a->confidence);
@@ -265,7 +201,6 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
     a.input_normal = rs_alloc_array(n, 3 * sizeof(double));
     a.normal = rs_alloc_array(n, 3 * sizeof(double));
     a.filtered = rs_alloc_array(n, 3 * sizeof(double));
-    a.scratch = rs_alloc_array(n, 3 * sizeof(double));
     a.spacing = rs_alloc_array(n, sizeof(double));
     a.area = rs_alloc_array(n, sizeof(double));
     a.confidence = rs_alloc_array(n, sizeof(float));
@@ -279,8 +214,7 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
             a.color[i] = p.colors[i];
     }
     rs_kdtree tree = {0};
-    rs_kdtree_list nb = {0};
-    if (!a.xyz || !a.next || !a.input_normal || !a.normal || !a.filtered || !a.scratch ||
+    if (!a.xyz || !a.next || !a.input_normal || !a.normal || !a.filtered ||
         !a.spacing || !a.area || !a.confidence || !a.prev_confidence)
         goto fail_memory;
     for (size_t i = 0; i < 3 * n; i++)
@@ -293,7 +227,7 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
     double unit = 0, input_spacing = 0;
     if (p.mollify) /* the one normal filter points have */
         p.normal_filter = RSMOOTH_NORMALS_BILATERAL;
-    pass_progress pp = {p.progress, p.progress_user, 0, p.passes};
+    rs_pass_progress pp = {p.progress, p.progress_user, 0, p.passes};
     rsmooth_report sum, one;
     memset(&sum, 0, sizeof sum);
     size_t weighted_points = 0;
@@ -325,43 +259,30 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
         pb.xyz = a.xyz;
         pb.facet_count = n; /* points of zero area (duplicates) just carry no weight */
         pb.centroid = a.xyz;
-        pb.normal = a.filtered;
+        pb.normal = a.input_normal;
         pb.area = a.area;
         pb.mean_edge_length = input_spacing; /* what the report gives as the unit */
         pb.mean_area = area_sum / (double)n;
         rs_problem_apply_params(&pb, &p, unit);
         pb.facet_color = pb.colors ? a.color : NULL;
-        pb.progress = pp.progress ? report_pass_progress : NULL;
+        pb.progress = pp.progress ? rs_report_pass_progress : NULL;
         pb.progress_user = &pp;
-
-        /* Every pass filters the input's normals, at the pass's positions. A mesh's passes
-         * recompute facet normals from the smoother positions; points have no normals but the
-         * input's, and filtering the previous pass's output again stacks the rounds, which
-         * flattens curved parts into facets (on point clouds of the benchmark models, 2 or 3
-         * passes so gave 2-6% lower E_v but 10-30% larger normal errors). */
-        double t_normals = rs_now_ms();
-        double normal_reach = pb.facet_count > 0 && pb.bilateral ? pb.normal_radius : 0;
-        if (normal_reach > 0) {
-            if (!bilateral_normals(&pb, &tree, a.input_normal, a.filtered, a.scratch, &nb))
-                goto fail_memory;
-        } else {
-            memcpy(a.filtered, a.input_normal, n * 3 * sizeof(double));
-        }
-        double ms_normals = rs_now_ms() - t_normals;
         rs_kdtree_free(&tree);
-        /* the predictors' normals are final: the robust stage alone remains */
-        pb.mollify = pb.bilateral = false;
-        pb.normal_radius = 0;
-        st = rs_reference_solve(&pb, RSMOOTH_FLOAT64, a.next, NULL, a.confidence,
+
+        /* Every pass filters the input's normals (pb.normal), at the pass's positions. A mesh's
+         * passes recompute facet normals from the smoother positions; points have no normals but
+         * the input's, and filtering the previous pass's output again stacks the rounds, which
+         * flattens curved parts into facets (on point clouds of the benchmark models, 2 or 3
+         * passes so gave 2-6% lower E_v but 10-30% larger normal errors). The reference solve
+         * writes the normals it predicted with; with no facet to weigh, they stay the input's. */
+        memcpy(a.filtered, a.input_normal, n * 3 * sizeof(double));
+        st = rs_reference_solve(&pb, RSMOOTH_FLOAT64, a.next, NULL, a.confidence, a.filtered,
                                 report ? &one : NULL, t_pass, error, where);
         if (st != RSMOOTH_OK)
             goto done;
         if (report) {
-            one.ms_facets -= ms_normals; /* spacing and areas stay there */
-            one.ms_mollify = ms_normals;
-            one.mollify_radius = normal_reach;
             one.facet_count = weighted_points;
-            add_report(&sum, &one, pass);
+            rs_add_pass_report(&sum, &one);
         }
         if (pass > 0 && p.pass_confidence > 0) {
             /* confident points keep what the pass before gave them */
@@ -401,7 +322,6 @@ fail_memory:
     st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for %zu points", n);
 done:
     rs_kdtree_free(&tree);
-    rs_kdtree_list_free(&nb);
     free_arrays(&a);
     rs_release_free_memory();
     return st;

@@ -283,8 +283,8 @@ static void estimate_vertex(const rs_problem *pb, const neighbours *nb, const do
 
 rsmooth_status rs_reference_solve(const rs_problem *problem, rsmooth_scalar scalar,
                                   void *out_positions, float *out_weight, float *out_confidence,
-                                  rsmooth_report *report, double t_start, rsmooth_error *error,
-                                  const char *where) {
+                                  double *out_normals, rsmooth_report *report, double t_start,
+                                  rsmooth_error *error, const char *where) {
     const rs_problem pb = *problem; /* read-only view; the caller frees the problem */
     size_t vertex_count = pb.vertex_count;
     rsmooth_status st = RSMOOTH_OK;
@@ -334,6 +334,8 @@ rsmooth_status rs_reference_solve(const rs_problem *problem, rsmooth_scalar scal
         memcpy(normals, pb.normal, pb.facet_count * 3 * sizeof(double));
     }
     t_normals = rs_now_ms();
+    if (out_normals)
+        memcpy(out_normals, normals, pb.facet_count * 3 * sizeof(double));
 
     double robust_start = pb.mollify ? MOLLIFY_SHARE : 0;
     for (size_t v = 0; v < vertex_count; v++) {
@@ -398,7 +400,7 @@ static rsmooth_status reference_pass(void *unused, rsmooth_scalar scalar, const 
                                            where);
     if (st != RSMOOTH_OK)
         return st;
-    st = rs_reference_solve(&pb, scalar, out_positions, out_weight, out_confidence, report,
+    st = rs_reference_solve(&pb, scalar, out_positions, out_weight, out_confidence, NULL, report,
                             t_start, error, where);
     rs_problem_free(&pb);
     return st;

@@ -261,11 +261,25 @@ void rs_params_from_noise(rsmooth_params *params, double noise, bool impulsive);
 /* ---- reference.c / passes.c: the filter on a prepared problem, and repeated passes ----------- */
 
 /* The reference filter on a prepared problem (with its facet data kept), written to the caller's
- * arrays; t_start is when the call began, for the report. The caller frees the problem. */
+ * arrays; out_normals (optional) receives the predictors' unit normals, 3 per facet, when there
+ * are facets. t_start is when the call began, for the report. The caller frees the problem. */
 rsmooth_status rs_reference_solve(const rs_problem *problem, rsmooth_scalar scalar,
                                   void *out_positions, float *out_weight, float *out_confidence,
-                                  rsmooth_report *report, double t_start, rsmooth_error *error,
-                                  const char *where);
+                                  double *out_normals, rsmooth_report *report, double t_start,
+                                  rsmooth_error *error, const char *where);
+
+/* The caller's progress callback seen through pass `pass` of `count` (rs_report_pass_progress
+ * is the callback to give the pass, with this as its user pointer). */
+typedef struct rs_pass_progress {
+    rsmooth_progress_fn progress;
+    void *user;
+    int pass, count;
+} rs_pass_progress;
+void rs_report_pass_progress(void *user, double fraction);
+
+/* Adds one pass's stage times and work to `sum`, the passes' so far (all zero before the first):
+ * counts, sigmas and device from the last pass, the facet count from the first. */
+void rs_add_pass_report(rsmooth_report *sum, const rsmooth_report *pass);
 
 /* One pass of a filter path, with rsmooth_smooth_reference's arguments; `ctx` is the path's own. */
 typedef rsmooth_status (*rs_filter_fn)(void *ctx, rsmooth_scalar scalar, const void *positions,
@@ -355,12 +369,6 @@ typedef struct rs_kdtree {
     double *split;     /* and the coordinate it splits at: left <= split <= right */
 } rs_kdtree;
 
-/* Points found by rs_kdtree_within, with squared distances; reused between queries. */
-typedef struct rs_kdtree_list {
-    size_t count, capacity;
-    uint32_t *index;
-    double *dist2;
-} rs_kdtree_list;
 
 /* Builds the tree over `count` points (< 2^32). false when out of memory (tree then empty). */
 bool rs_kdtree_build(rs_kdtree *tree, const double *xyz, size_t count);
@@ -372,10 +380,6 @@ void rs_kdtree_free(rs_kdtree *tree);
 size_t rs_kdtree_nearest(const rs_kdtree *tree, const double p[3], uint32_t skip, size_t k,
                          double *dist2);
 
-/* Every point at distance <= radius from p, into `out` (cleared first). false when out of memory. */
-bool rs_kdtree_within(const rs_kdtree *tree, const double p[3], double radius,
-                      rs_kdtree_list *out);
-void rs_kdtree_list_free(rs_kdtree_list *list);
 
 /* ---- cl_device.c / cl_program.c: the OpenCL context object ------------------------------------ */
 

@@ -275,7 +275,8 @@ typedef struct rsmooth_report {
     double ms_download;
     double ms_total;              /* the whole filter call */
     /* Work counts (0 where a path does not count them; the reference path does not). */
-    double mollify_radius;        /* reach of the mollification pass, mesh units */
+    double mollify_radius;        /* reach of the mollification pass (of one round of the
+                                   * bilateral normal filter when it replaces it), mesh units */
     uint64_t pairs_mollify;       /* vertex-facet pairs the mollification pass evaluated */
     uint64_t pairs_robust;        /* vertex-facet pairs the robust pass evaluated (each of them,
                                      within reach or not: the grid's waste is counted) */
