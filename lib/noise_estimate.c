@@ -607,8 +607,8 @@ rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positi
         if (valid > 0) {
             double sigma = robust_sigma(job.residual, job.variance, valid, scratch);
             *out_noise = sigma / unit;
-            out->tail = tail_share(job.residual, job.variance, valid, sigma);
-            out->impulsive = sigma > 0 && out->tail > IMPULSIVE_TAIL;
+            out->impulsive =
+                sigma > 0 && tail_share(job.residual, job.variance, valid, sigma) > IMPULSIVE_TAIL;
         }
     }
     rs_free(job.residual);

@@ -26,7 +26,9 @@ static double clamp01(double x) {
     return x < 0 ? 0 : x > 1 ? 1 : x;
 }
 
-void rs_params_from_noise(rsmooth_params *params, double noise, bool impulsive) {
+/* Sets the sigmas of `params` (and, when its normal_filter is bilateral, the best mode's rounds,
+ * passes and influence) for noise of `noise` mean edge lengths. */
+static void params_from_noise(rsmooth_params *params, double noise, bool impulsive) {
     double n = noise > 0 ? noise : 0;
     if (params->normal_filter != RSMOOTH_NORMALS_BILATERAL) {
         params->sigma_f = PAPER_SIGMA_F_AT_0 + PAPER_SIGMA_F_PER_NOISE * n;
@@ -67,7 +69,7 @@ rsmooth_status rsmooth_params_auto(rsmooth_scalar scalar, const void *positions,
     if (st != RSMOOTH_OK)
         return st;
     /* only the fields the caller's struct has are written */
-    rs_params_from_noise(&checked, stats.noise, stats.impulsive);
+    params_from_noise(&checked, stats.noise, stats.impulsive);
     size_t size = params->struct_size;
     memcpy(params, &checked, size < sizeof checked ? size : sizeof checked);
     params->struct_size = size;

@@ -244,8 +244,8 @@ static inline void rs_cross3(const double a[3], const double b[3], double out[3]
 
 typedef struct rs_noise_stats {
     double noise;   /* rsmooth_estimate_noise's estimate, mean edge lengths */
-    double tail;    /* share of vertices whose residual is beyond 4 robust sigmas */
-    bool impulsive; /* the tail is far heavier than a Gaussian's: a few vertices thrown far */
+    bool impulsive; /* the residuals' tail beyond 4 robust sigmas is far heavier than a
+                     * Gaussian's: a few vertices thrown far */
 } rs_noise_stats;
 
 /* rsmooth_estimate_noise with the tail statistic; errors name `caller`. */
@@ -253,10 +253,6 @@ rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positi
                                        size_t vertex_count, const uint32_t *indices,
                                        size_t triangle_count, rs_noise_stats *out,
                                        rsmooth_error *error, const char *caller);
-
-/* Sets the sigmas of `params` (and, when its normal_filter is bilateral, the best mode's rounds,
- * passes and influence) for noise of `noise` mean edge lengths (rsmooth_params_auto's rule). */
-void rs_params_from_noise(rsmooth_params *params, double noise, bool impulsive);
 
 /* ---- reference.c / passes.c: the filter on a prepared problem, and repeated passes ----------- */
 
