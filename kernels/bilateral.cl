@@ -16,6 +16,20 @@
  *   (which search once per run) do not fit the device.
  */
 
+/* A group's new normals: the sums (ax, ay, az) normalised, or the previous normal (nx, ny, nz)
+ * where a sum has zero length, for its `count` facets from `first` on. */
+inline void store_group_normals(lanef ax, lanef ay, lanef az, lanef nx, lanef ny, lanef nz,
+                                __global float4 *normal_out, uint first, uint count) {
+    float mx[RS_LANES], my[RS_LANES], mz[RS_LANES];
+    lanef len = sqrt(ax * ax + ay * ay + az * az);
+    lanei some = len > 0.0f;
+    store_lanes(select(nx, ax / len, some), 0, mx);
+    store_lanes(select(ny, ay / len, some), 0, my);
+    store_lanes(select(nz, az / len, some), 0, mz);
+    for (uint l = 0; l < count; l++)
+        normal_out[first + l] = (float4)(mx[l], my[l], mz[l], 0.0f);
+}
+
 __kernel void bilateral_cell_normals(uint cell_count, float reach2, float inv_2s2, float inv_2t2,
                                      __global const float4 *facet_centroid,
                                      __global const float4 *normal_in,
@@ -68,13 +82,7 @@ __kernel void bilateral_cell_normals(uint cell_count, float reach2, float inv_2s
                 az += w * nq.z;
             }
         })
-        lanef len = sqrt(ax * ax + ay * ay + az * az);
-        lanei some = len > 0.0f;
-        store_lanes(select(nx, ax / len, some), 0, mx);
-        store_lanes(select(ny, ay / len, some), 0, my);
-        store_lanes(select(nz, az / len, some), 0, mz);
-        for (uint l = 0; l < count; l++)
-            normal_out[group + l] = (float4)(mx[l], my[l], mz[l], 0.0f);
+        store_group_normals(ax, ay, az, nx, ny, nz, normal_out, group, count);
     }
     cell_pairs[c] = pairs;
 }
@@ -228,11 +236,5 @@ __kernel void bilateral_list_normals(uint group_count, float inv_2t2, int dot,
             az += w * nq.z;
         }
     }
-    lanef len = sqrt(ax * ax + ay * ay + az * az);
-    lanei some = len > 0.0f;
-    store_lanes(select(nx, ax / len, some), 0, mx);
-    store_lanes(select(ny, ay / len, some), 0, my);
-    store_lanes(select(nz, az / len, some), 0, mz);
-    for (uint l = 0; l < info.y; l++)
-        normal_out[info.x + l] = (float4)(mx[l], my[l], mz[l], 0.0f);
+    store_group_normals(ax, ay, az, nx, ny, nz, normal_out, info.x, info.y);
 }

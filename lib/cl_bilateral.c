@@ -107,11 +107,7 @@ static cl_int run_bilateral_lists(rsmooth_context *ctx, const rs_problem *pb, co
     arg(&a, sizeof reach2, &reach2);
     arg(&a, sizeof(cl_mem), &l.group_info);
     arg(&a, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
-    arg(&a, sizeof(cl_mem), &buf[BUF_CELL_COORD]);
-    arg(&a, sizeof(cl_mem), &buf[BUF_CELL_START]);
-    arg(&a, sizeof(cl_mem), &buf[BUF_COLUMN_FIRST]);
-    arg(&a, sizeof(cl_mem), &buf[BUF_COLUMN_TABLE]);
-    arg(&a, sizeof mask, &mask);
+    arg_grid(&a, buf, &mask);
     arg(&a, sizeof(cl_mem), &l.list_start);
     if ((err = a.err) != CL_SUCCESS ||
         (err = rs_cl_run_1d(ctx, pb, l.count, groups, 0, share)) != CL_SUCCESS)
@@ -164,11 +160,7 @@ static cl_int run_bilateral_lists(rsmooth_context *ctx, const rs_problem *pb, co
     arg(&a, sizeof shift, &shift);
     arg(&a, sizeof(cl_mem), &l.group_info);
     arg(&a, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
-    arg(&a, sizeof(cl_mem), &buf[BUF_CELL_COORD]);
-    arg(&a, sizeof(cl_mem), &buf[BUF_CELL_START]);
-    arg(&a, sizeof(cl_mem), &buf[BUF_COLUMN_FIRST]);
-    arg(&a, sizeof(cl_mem), &buf[BUF_COLUMN_TABLE]);
-    arg(&a, sizeof mask, &mask);
+    arg_grid(&a, buf, &mask);
     arg(&a, sizeof(cl_mem), &l.list_start);
     arg(&a, sizeof(cl_mem), &l.list_facet);
     arg(&a, sizeof(cl_mem), &l.list_weight);
@@ -233,11 +225,7 @@ cl_int rs_cl_run_bilateral(rsmooth_context *ctx, const rs_problem *pb, const rs_
         arg(&a, sizeof inv_2t2, &inv_2t2);
         arg(&a, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
         arg(&a, sizeof(cl_mem), &from);
-        arg(&a, sizeof(cl_mem), &buf[BUF_CELL_COORD]);
-        arg(&a, sizeof(cl_mem), &buf[BUF_CELL_START]);
-        arg(&a, sizeof(cl_mem), &buf[BUF_COLUMN_FIRST]);
-        arg(&a, sizeof(cl_mem), &buf[BUF_COLUMN_TABLE]);
-        arg(&a, sizeof mask, &mask);
+        arg_grid(&a, buf, &mask);
         arg(&a, sizeof(cl_mem), &to);
         arg(&a, sizeof(cl_mem), &buf[BUF_CELL_PAIRS]);
         err = a.err != CL_SUCCESS ? a.err

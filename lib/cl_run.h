@@ -47,6 +47,16 @@ static inline void arg(arg_setter *s, size_t size, const void *value) {
     s->index++;
 }
 
+/* The grid lookup every searching kernel takes, in the order they all declare it: cell_coord,
+ * cell_start, column_first, column_table, column_mask. */
+static inline void arg_grid(arg_setter *s, const cl_mem *buf, const cl_uint *column_mask) {
+    arg(s, sizeof(cl_mem), &buf[BUF_CELL_COORD]);
+    arg(s, sizeof(cl_mem), &buf[BUF_CELL_START]);
+    arg(s, sizeof(cl_mem), &buf[BUF_COLUMN_FIRST]);
+    arg(s, sizeof(cl_mem), &buf[BUF_COLUMN_TABLE]);
+    arg(s, sizeof *column_mask, column_mask);
+}
+
 /* Runs `kernel` over `count` work-items and waits; with progress requested, in slices enqueued
  * together (the device never idles between them) and reported as each completes, as fractions
  * from `from` to `to` of the whole filter. */

@@ -501,11 +501,7 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
         arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_POS]);
         arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_CELL]);
         arg(&s, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_CELL_COORD]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_CELL_START]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_COLUMN_FIRST]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_COLUMN_TABLE]);
-        arg(&s, sizeof mask, &mask);
+        arg_grid(&s, buf, &mask);
         arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_SHIFT]);
         arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_PAIRS]);
         err = s.err != CL_SUCCESS ? s.err : rs_cl_run_1d(ctx, pb, s.kernel, nb, 0, MOLLIFY_SHARE);
@@ -552,11 +548,7 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     arg(&s, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
     arg(&s, sizeof(cl_mem), &normals);
     arg(&s, sizeof(cl_mem), &buf[BUF_FACET_COLOR]);
-    arg(&s, sizeof(cl_mem), &buf[BUF_CELL_COORD]);
-    arg(&s, sizeof(cl_mem), &buf[BUF_CELL_START]);
-    arg(&s, sizeof(cl_mem), &buf[BUF_COLUMN_FIRST]);
-    arg(&s, sizeof(cl_mem), &buf[BUF_COLUMN_TABLE]);
-    arg(&s, sizeof mask, &mask);
+    arg_grid(&s, buf, &mask);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_RESULT]);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_EXTRA]);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_PAIRS]);
