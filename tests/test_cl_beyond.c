@@ -8,6 +8,7 @@
 #include "mesh_shapes.h"
 #include "rsmooth.h"
 #include "rsmooth_io.h"
+#include "test_benchmark.h"
 #include "test_cl_util.h"
 
 #include <math.h>
@@ -16,7 +17,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #define MAX_DEVIATION 1e-3 /* mean edge lengths */
 
@@ -366,22 +366,13 @@ static void colour_edge_plane(rsmooth_context *ctx) {
 
 static void benchmark_meshes(rsmooth_context *ctx) {
     static const char *const models[] = {"Fandisk0.3", "Bunny0.2"};
-    struct stat st;
     char dir[4096];
-    snprintf(dir, sizeof dir, "%s/data/benchmark", RSMOOTH_SHARED_DIR);
-    if (RSMOOTH_SHARED_DIR[0] == '\0' || stat(dir, &st) != 0) {
-        printf("benchmark meshes: %s absent, skipped\n", dir);
+    if (!benchmark_dir(dir, sizeof dir))
         return;
-    }
     for (size_t i = 0; i < sizeof models / sizeof *models; i++) {
-        char path[4200];
-        snprintf(path, sizeof path, "%s/%s/Noisy.obj", dir, models[i]);
-        rsmooth_mesh *mesh = NULL;
-        rsmooth_error err;
-        if (rsmooth_mesh_read_file(path, &mesh, &err) != RSMOOTH_OK) {
-            printf("%s: %s, skipped\n", path, err.message);
+        rsmooth_mesh *mesh = benchmark_read(dir, models[i], "Noisy.obj");
+        if (!mesh)
             continue;
-        }
         mesh_ref m = {mesh->positions, mesh->vertex_count, mesh->triangles, mesh->triangle_count};
         compare_modes(ctx, models[i], &m, true);
         float *colors = shape_colors(&m, false);

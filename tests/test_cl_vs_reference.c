@@ -3,6 +3,7 @@
 #include "mesh_shapes.h"
 #include "rsmooth.h"
 #include "rsmooth_io.h"
+#include "test_benchmark.h"
 #include "test_cl_util.h"
 
 #include <math.h>
@@ -10,7 +11,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #define MAX_DEVIATION 1e-3 /* mean edge lengths */
 
@@ -77,22 +77,13 @@ static void compare_shape(rsmooth_context *ctx, const char *name, const shape_me
 static void benchmark_meshes(rsmooth_context *ctx) {
     static const char *const models[] = {"Fandisk0.3", "Block0.4", "Bunny0.2", "SharpSphere0.3",
                                          "Twelve0.5Impulsive"};
-    struct stat st;
     char dir[4096];
-    snprintf(dir, sizeof dir, "%s/data/benchmark", RSMOOTH_SHARED_DIR);
-    if (RSMOOTH_SHARED_DIR[0] == '\0' || stat(dir, &st) != 0) {
-        printf("benchmark meshes: %s absent, skipped\n", dir);
+    if (!benchmark_dir(dir, sizeof dir))
         return;
-    }
     for (size_t i = 0; i < sizeof models / sizeof *models; i++) {
-        char path[4200];
-        snprintf(path, sizeof path, "%s/%s/Noisy.obj", dir, models[i]);
-        rsmooth_mesh *mesh = NULL;
-        rsmooth_error err;
-        if (rsmooth_mesh_read_file(path, &mesh, &err) != RSMOOTH_OK) {
-            printf("%s: %s, skipped\n", path, err.message);
+        rsmooth_mesh *mesh = benchmark_read(dir, models[i], "Noisy.obj");
+        if (!mesh)
             continue;
-        }
         const double settings[][2] = {{2, 0.5}, {1.5, 0.7}, {4, 1}};
         for (size_t s = 0; s < sizeof settings / sizeof *settings; s++) {
             rsmooth_params p;

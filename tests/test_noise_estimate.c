@@ -6,12 +6,12 @@
 #include "mesh_shapes.h"
 #include "rsmooth.h"
 #include "rsmooth_io.h"
+#include "test_benchmark.h"
 #include "test_util.h"
 
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <time.h>
 
 /* Gaussian noise of 0.1 to 0.5 mean edge lengths on the generated shapes reads within this
@@ -271,32 +271,22 @@ static void benchmark_meshes(void) {
     static const char *const models[] = {"Fandisk0.3", "Block0.4", "Bunny0.2", "SharpSphere0.3",
                                          "Twelve0.5Impulsive"};
     static const double nominal[] = {0.3, 0.4, 0.2, 0.3, 0.5};
-    struct stat st;
     char dir[4096];
-    snprintf(dir, sizeof dir, "%s/data/benchmark", RSMOOTH_SHARED_DIR);
-    if (RSMOOTH_SHARED_DIR[0] == '\0' || stat(dir, &st) != 0) {
-        printf("benchmark meshes: %s absent, skipped\n", dir);
+    if (!benchmark_dir(dir, sizeof dir))
         return;
-    }
     for (size_t i = 0; i < sizeof models / sizeof *models; i++) {
-        char path[4200];
-        rsmooth_mesh *noisy = NULL, *original = NULL;
-        rsmooth_error err;
-        snprintf(path, sizeof path, "%s/%s/Noisy.obj", dir, models[i]);
-        if (rsmooth_mesh_read_file(path, &noisy, &err) != RSMOOTH_OK) {
-            printf("%s: %s, skipped\n", path, err.message);
+        rsmooth_mesh *noisy = benchmark_read(dir, models[i], "Noisy.obj");
+        if (!noisy)
             continue;
-        }
         double t0 = now_ms();
         double est = estimate(noisy->positions, noisy->vertex_count, noisy->triangles,
                               noisy->triangle_count);
         double ms = now_ms() - t0;
         double unit = mean_edge(noisy->positions, noisy->vertex_count, noisy->triangles,
                                 noisy->triangle_count);
-        snprintf(path, sizeof path, "%s/%s/Original.obj", dir, models[i]);
+        rsmooth_mesh *original = benchmark_read(dir, models[i], "Original.obj");
         double truth = NAN, original_unit = NAN;
-        if (rsmooth_mesh_read_file(path, &original, &err) == RSMOOTH_OK &&
-            original->vertex_count == noisy->vertex_count &&
+        if (original && original->vertex_count == noisy->vertex_count &&
             original->triangle_count == noisy->triangle_count &&
             memcmp(original->triangles, noisy->triangles,
                    3 * noisy->triangle_count * sizeof *noisy->triangles) == 0) {
