@@ -4,18 +4,7 @@
 set -uo pipefail
 rsmooth=$1
 shape=$2
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-cd "$dir"
-failures=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-# expect STATUS COMMAND...: runs it, checks the exit status, keeps stderr in err.txt
-expect() {
-  local want=$1; shift
-  "$@" >out.txt 2>err.txt
-  local got=$?
-  [ "$got" -eq "$want" ] || fail "exit $got (wanted $want): $* -- $(cat err.txt)"
-}
+. "$(dirname "$0")/command_util.sh"
 
 expect 0 "$shape" make noisy.ply truth.ply --noise 0.3 --triangles 3000
 expect 0 "$rsmooth" noisy.ply -o smooth.ply --confidence conf.ply --json

@@ -4,18 +4,7 @@
 # method, fails with exit status 2 and a message naming the file.
 set -uo pipefail
 rsmooth=$1
-dir=$(mktemp -d)
-trap 'rm -rf "$dir"' EXIT
-cd "$dir"
-failures=0
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-# expect STATUS COMMAND...: runs it, checks the exit status, keeps stderr in err.txt
-expect() {
-  local want=$1; shift
-  "$@" >out.txt 2>err.txt
-  local got=$?
-  [ "$got" -eq "$want" ] || fail "exit $got (wanted $want): $* -- $(cat err.txt)"
-}
+. "$(dirname "$0")/command_util.sh"
 
 # A 40 x 40 grid of spacing 1 on z = 0 with noise of about 0.3 in z, normals +z (a little noisy),
 # and a colour per point: an ascii PLY cloud.

@@ -1,0 +1,14 @@
+# Sourced by the command tests (test_command.sh, test_points_command.sh): a scratch directory to
+# work in, removed on exit, and the checks they make.
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+cd "$dir"
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+# expect STATUS COMMAND...: runs it, checks the exit status, keeps stderr in err.txt
+expect() {
+  local want=$1; shift
+  "$@" >out.txt 2>err.txt
+  local got=$?
+  [ "$got" -eq "$want" ] || fail "exit $got (wanted $want): $* -- $(cat err.txt)"
+}
