@@ -174,19 +174,21 @@ static void compare_searching(rsmooth_context *ctx, const char *name, const mesh
 }
 
 /* Bilateral normals with 1 and 5 rounds and a few widths, and each influence function. */
+/* The influence functions, each with its name. */
+static const struct {
+    int influence;
+    const char *name;
+} influences[] = {{RSMOOTH_INFLUENCE_GAUSSIAN, "Gaussian"},
+                  {RSMOOTH_INFLUENCE_TUKEY, "Tukey"},
+                  {RSMOOTH_INFLUENCE_LORENTZIAN, "Lorentzian"},
+                  {RSMOOTH_INFLUENCE_HUBER, "Huber"}};
+
 static void compare_modes(rsmooth_context *ctx, const char *mesh_name, const mesh_ref *m,
                           bool quick) {
     static const struct {
         double sigma_s, sigma_n;
         int rounds;
     } bilateral[] = {{1, 0.35, 1}, {1, 0.35, 5}, {0.5, 0.2, 5}, {1.5, 0.6, 1}};
-    static const struct {
-        int influence;
-        const char *name;
-    } influences[] = {{RSMOOTH_INFLUENCE_GAUSSIAN, "Gaussian"},
-                      {RSMOOTH_INFLUENCE_TUKEY, "Tukey"},
-                      {RSMOOTH_INFLUENCE_LORENTZIAN, "Lorentzian"},
-                      {RSMOOTH_INFLUENCE_HUBER, "Huber"}};
     char name[160];
     rsmooth_params p;
     for (size_t i = 0; i < sizeof bilateral / sizeof *bilateral; i++) {
@@ -262,13 +264,6 @@ static float *shape_colors(const mesh_ref *m, bool cube) {
  * float rounding; colours do change the result. */
 static void compare_colors(rsmooth_context *ctx, const char *mesh_name, const mesh_ref *m,
                            const float *colors, bool quick) {
-    static const struct {
-        int influence;
-        const char *name;
-    } influences[] = {{RSMOOTH_INFLUENCE_GAUSSIAN, "Gaussian"},
-                      {RSMOOTH_INFLUENCE_TUKEY, "Tukey"},
-                      {RSMOOTH_INFLUENCE_LORENTZIAN, "Lorentzian"},
-                      {RSMOOTH_INFLUENCE_HUBER, "Huber"}};
     char name[160];
     rsmooth_params p;
     for (size_t i = 0; i < sizeof influences / sizeof *influences; i++) {
