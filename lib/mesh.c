@@ -35,15 +35,20 @@ rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                            "triangle %zu: index %u >= vertex count %zu", i / 3, indices[i],
                            vertex_count);
-    for (size_t i = 0; i < 3 * vertex_count; i++) {
+    return rs_check_coordinates(scalar, positions, vertex_count, "vertex", error, where);
+}
+
+rsmooth_status rs_check_coordinates(rsmooth_scalar scalar, const void *positions, size_t count,
+                                    const char *noun, rsmooth_error *error, const char *where) {
+    for (size_t i = 0; i < 3 * count; i++) {
         double x = rs_coordinate(scalar, positions, i);
         if (!isfinite(x))
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                           "vertex %zu has a non-finite coordinate", i / 3);
+                           "%s %zu has a non-finite coordinate", noun, i / 3);
         if (fabs(x) > RS_MAX_COORDINATE)
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                           "vertex %zu has coordinate %g beyond the supported magnitude %g", i / 3,
-                           x, RS_MAX_COORDINATE);
+                           "%s %zu has coordinate %g beyond the supported magnitude %g", noun,
+                           i / 3, x, RS_MAX_COORDINATE);
     }
     return RSMOOTH_OK;
 }

@@ -63,17 +63,7 @@ static rsmooth_status check_positions(rsmooth_scalar scalar, const void *positio
     if (point_count >= UINT32_MAX || rs_mul_overflows(point_count, 3 * sizeof(double)))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller,
                        "point count %zu exceeds the 32-bit index range", point_count);
-    for (size_t i = 0; i < 3 * point_count; i++) {
-        double x = rs_coordinate(scalar, positions, i);
-        if (!isfinite(x))
-            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller,
-                           "point %zu has a non-finite coordinate", i / 3);
-        if (fabs(x) > RS_MAX_COORDINATE)
-            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller,
-                           "point %zu has coordinate %g beyond the supported magnitude %g", i / 3,
-                           x, RS_MAX_COORDINATE);
-    }
-    return RSMOOTH_OK;
+    return rs_check_coordinates(scalar, positions, point_count, "point", error, caller);
 }
 
 /* Normal i of the caller's array made unit length into out[0..2]; NULL, or what is wrong with it.

@@ -194,6 +194,11 @@ rsmooth_status rs_check_output_positions(rsmooth_scalar scalar, const void *posi
                                          size_t vertex_count, const void *out_positions,
                                          rsmooth_error *error, const char *where);
 
+/* Checks that the 3 * count coordinates are finite and within RS_MAX_COORDINATE; a failure names
+ * the offending `noun` ("vertex", "point") by index. */
+rsmooth_status rs_check_coordinates(rsmooth_scalar scalar, const void *positions, size_t count,
+                                    const char *noun, rsmooth_error *error, const char *where);
+
 /* Checks the arrays only (shared with rsmooth_mean_edge_length). */
 rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions,
                                     size_t vertex_count, const uint32_t *indices,
