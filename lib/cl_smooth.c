@@ -168,7 +168,6 @@ typedef struct facet_job {
     const rs_problem *pb;
     const rs_grid *grid;
     packed *pk;
-    float inv_mean_area;
 } facet_job;
 
 static void place_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
@@ -190,7 +189,8 @@ static void pack_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
         int32_t cell[3];
         rs_grid_facet_cell(job->grid, c, cell);
         cl_float4 cen = local_point(job->grid, c, cell);
-        cen.s[3] = log2f((float)area * job->inv_mean_area);
+        /* the ratio in double: area and mean area apart could each leave float's range */
+        cen.s[3] = (float)log2(area / pb->mean_area);
         pk->facet_centroid[j] = cen;
         pk->facet_normal[j] = (cl_float4){{(float)n[0], (float)n[1], (float)n[2], 0}};
         const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
@@ -227,7 +227,7 @@ static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, packed *pk
     /* Facets are read in the caller's order (mostly coherent in memory). What the pair loops read
      * (centroid, normal) goes to its place in grid order; the vertex slots, which only the
      * per-facet normals kernel reads, stay in the caller's order, with `place` to find the rest. */
-    facet_job job = {pb, grid, pk, (float)(1 / pb->mean_area)};
+    facet_job job = {pb, grid, pk};
     rs_parallel_for(nf, PARALLEL_GRAIN, place_facets, &job);
     rs_parallel_for(nf, PARALLEL_GRAIN, pack_facets, &job);
     return RSMOOTH_OK;
@@ -346,7 +346,7 @@ typedef struct result_job {
 static void store_results(void *ctx, size_t begin, size_t end, size_t chunk) {
     const result_job *job = ctx;
     const rs_result_sink *sink = job->sink;
-    const double mean_area = job->pb->mean_area;
+    const double mean_area = job->pb->mean_area, unscale = 1 / job->pb->scale;
     (void)chunk;
     for (size_t v = begin; v < end; v++) {
         size_t b = job->pk->slot[v] / RS_LANES, lane = job->pk->slot[v] % RS_LANES;
@@ -357,11 +357,11 @@ static void store_results(void *ctx, size_t begin, size_t end, size_t chunk) {
         double out[3];
         for (int k = 0; k < 3; k++)
             out[k] = p[k] + (double)res[k * RS_LANES] * job->h;
-        rs_store_position(sink->scalar, sink->positions, to, out);
+        rs_store_position(sink->scalar, sink->positions, to, out, unscale);
         double k = (double)res[3 * RS_LANES] * exp2(-(double)ext[RS_LANES]) * mean_area;
         double kf = (double)ext[0] * mean_area;
         if (sink->weight)
-            sink->weight[to] = (float)k;
+            sink->weight[to] = rs_weight_value(k, unscale);
         if (sink->confidence)
             sink->confidence[to] = kf > 0 ? (float)fmin(1.0, k / kf) : 0.0f;
     }

@@ -8,8 +8,8 @@
 
 rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions,
                                     size_t vertex_count, const uint32_t *indices,
-                                    size_t triangle_count, rsmooth_error *error,
-                                    const char *where) {
+                                    size_t triangle_count, double *magnitude,
+                                    rsmooth_error *error, const char *where) {
     if (scalar != RSMOOTH_FLOAT32 && scalar != RSMOOTH_FLOAT64)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "scalar must be RSMOOTH_FLOAT32 or RSMOOTH_FLOAT64 (got %d)", (int)scalar);
@@ -35,21 +35,28 @@ rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                            "triangle %zu: index %u >= vertex count %zu", i / 3, indices[i],
                            vertex_count);
-    return rs_check_coordinates(scalar, positions, vertex_count, "vertex", error, where);
+    return rs_check_coordinates(scalar, positions, vertex_count, "vertex", magnitude, error,
+                                where);
 }
 
 rsmooth_status rs_check_coordinates(rsmooth_scalar scalar, const void *positions, size_t count,
-                                    const char *noun, rsmooth_error *error, const char *where) {
+                                    const char *noun, double *magnitude, rsmooth_error *error,
+                                    const char *where) {
+    double largest = 0;
     for (size_t i = 0; i < 3 * count; i++) {
-        double x = rs_coordinate(scalar, positions, i);
-        if (!isfinite(x))
-            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                           "%s %zu has a non-finite coordinate", noun, i / 3);
-        if (fabs(x) > RS_MAX_COORDINATE)
+        double x = fabs(rs_coordinate(scalar, positions, i));
+        if (!(x <= RS_MAX_COORDINATE)) {
+            if (!isfinite(x))
+                return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                               "%s %zu has a non-finite coordinate", noun, i / 3);
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                            "%s %zu has coordinate %g beyond the supported magnitude %g", noun,
-                           i / 3, x, RS_MAX_COORDINATE);
+                           i / 3, rs_coordinate(scalar, positions, i), RS_MAX_COORDINATE);
+        }
+        largest = x > largest ? x : largest;
     }
+    if (magnitude)
+        *magnitude = largest;
     return RSMOOTH_OK;
 }
 
@@ -140,28 +147,23 @@ rsmooth_status rsmooth_mean_edge_length(rsmooth_scalar scalar, const void *posit
     rs_error_clear(error);
     if (!out_length)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_length is NULL");
+    double magnitude = 0, scale = 1;
     rsmooth_status st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices,
-                                             triangle_count, error, where);
+                                             triangle_count, &magnitude, error, where);
+    if (st == RSMOOTH_OK)
+        st = rs_mesh_scale(scalar, positions, indices, triangle_count, magnitude, &scale, error,
+                           where);
     if (st != RSMOOTH_OK)
         return st;
     double *xyz = rs_alloc_array(vertex_count, 3 * sizeof *xyz);
     if (!xyz)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for positions");
-    for (size_t i = 0; i < 3 * vertex_count; i++)
-        xyz[i] = rs_coordinate(scalar, positions, i);
+    rs_scale_positions(scalar, positions, vertex_count, scale, xyz);
     bool ok = rs_mean_edge_length(xyz, vertex_count, indices, triangle_count, out_length);
+    *out_length /= scale; /* exact: a power of two */
     rs_free(xyz);
     return ok ? RSMOOTH_OK
               : rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for edges");
-}
-
-void rs_store_position(rsmooth_scalar scalar, void *out_positions, size_t v, const double p[3]) {
-    for (int c = 0; c < 3; c++) {
-        if (scalar == RSMOOTH_FLOAT32)
-            ((float *)out_positions)[3 * v + c] = (float)p[c];
-        else
-            ((double *)out_positions)[3 * v + c] = p[c];
-    }
 }
 
 bool rs_triangle_geometry(const double *xyz, const uint32_t *tri, double centroid[3],
@@ -233,8 +235,9 @@ typedef struct geometry_job {
 static void convert_positions(void *ctx, size_t begin, size_t end, size_t chunk) {
     const geometry_job *job = ctx;
     (void)chunk;
+    const double scale = job->problem->scale;
     for (size_t i = 3 * begin; i < 3 * end; i++)
-        job->problem->xyz[i] = rs_coordinate(job->scalar, job->positions, i);
+        job->problem->xyz[i] = rs_coordinate(job->scalar, job->positions, i) * scale;
 }
 
 /* First pass, over blocks [begin, end): which triangles are facets, how many per block, their
@@ -290,8 +293,9 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
     rsmooth_status st = rs_params_resolve(params, &p, error, where);
     if (st != RSMOOTH_OK)
         return st;
-    st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count, error,
-                              where);
+    double magnitude = 0;
+    st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count,
+                              &magnitude, error, where);
     if (st != RSMOOTH_OK)
         return st;
     st = rs_check_output_positions(scalar, positions, vertex_count, out_positions, error, where);
@@ -300,7 +304,13 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
     st = rs_check_colors(p.colors, vertex_count, error, where);
     if (st != RSMOOTH_OK)
         return st;
+    double scale = 1;
+    st = rs_mesh_scale(scalar, positions, indices, triangle_count, magnitude, &scale, error,
+                       where);
+    if (st != RSMOOTH_OK)
+        return st;
 
+    problem->scale = scale;
     problem->vertex_count = vertex_count;
     problem->indices = indices;
     problem->triangle_count = triangle_count;
@@ -351,7 +361,7 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
         rs_problem_free(problem);
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for edges");
     }
-    rs_problem_apply_params(problem, &p, p.absolute ? 1.0 : problem->mean_edge_length);
+    rs_problem_apply_params(problem, &p, p.absolute ? scale : problem->mean_edge_length);
     if (keep_facet_data && problem->colors && problem->facet_count > 0) {
         problem->facet_color = rs_alloc_array(problem->facet_count, 3 * sizeof(double));
         if (!problem->facet_color) {
@@ -388,17 +398,6 @@ void rs_problem_apply_params(rs_problem *problem, const rsmooth_params *p, doubl
         problem->facet_count = 0; /* no edge of non-zero length: nothing can move */
 }
 
-void rs_store_unmoved(const rs_problem *problem, rsmooth_scalar scalar, void *out_positions,
-                      float *out_weight, float *out_confidence) {
-    for (size_t v = 0; v < problem->vertex_count; v++) {
-        rs_store_position(scalar, out_positions, v, problem->xyz + 3 * v);
-        if (out_weight)
-            out_weight[v] = 0;
-        if (out_confidence)
-            out_confidence[v] = 0;
-    }
-}
-
 void rs_report_problem(rsmooth_report *report, const rs_problem *problem, const rs_grid *grid,
                        const char *device) {
     memset(report, 0, sizeof *report);
@@ -412,6 +411,15 @@ void rs_report_problem(rsmooth_report *report, const rs_problem *problem, const 
     report->mollify_radius = problem->bilateral ? problem->normal_radius
                              : problem->mollify ? problem->mollify_radius
                                                 : 0;
+    rs_report_unscale(report, 1 / problem->scale);
     report->grid_cell_count = grid ? grid->cell_count : 0;
     snprintf(report->device, sizeof report->device, "%s", device);
+}
+
+void rs_report_unscale(rsmooth_report *report, double unscale) {
+    report->mean_edge_length *= unscale; /* exact: a power of two */
+    report->sigma_f *= unscale;
+    report->sigma_g *= unscale;
+    report->radius *= unscale;
+    report->mollify_radius *= unscale;
 }

@@ -536,8 +536,12 @@ rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positi
                                        size_t vertex_count, const uint32_t *indices,
                                        size_t triangle_count, rs_noise_stats *out,
                                        rsmooth_error *error, const char *caller) {
+    double magnitude = 0, scale = 1;
     rsmooth_status st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices,
-                                             triangle_count, error, caller);
+                                             triangle_count, &magnitude, error, caller);
+    if (st == RSMOOTH_OK) /* internal units (scale.c): the estimate is a ratio, unchanged */
+        st = rs_mesh_scale(scalar, positions, indices, triangle_count, magnitude, &scale, error,
+                           caller);
     if (st != RSMOOTH_OK)
         return st;
     memset(out, 0, sizeof *out);
@@ -545,8 +549,7 @@ rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positi
     double *xyz = rs_alloc_array(vertex_count, 3 * sizeof *xyz);
     if (!xyz)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, caller, "no memory for positions");
-    for (size_t i = 0; i < 3 * vertex_count; i++)
-        xyz[i] = rs_coordinate(scalar, positions, i);
+    rs_scale_positions(scalar, positions, vertex_count, scale, xyz);
     double unit = 0;
     if (!rs_mean_edge_length(xyz, vertex_count, indices, triangle_count, &unit)) {
         rs_free(xyz);

@@ -30,12 +30,36 @@ void rs_add_pass_report(rsmooth_report *sum, const rsmooth_report *pass) {
         sum->facet_count = keep.facet_count;
 }
 
+static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar scalar,
+                                    const void *positions, size_t vertex_count,
+                                    const uint32_t *indices, size_t triangle_count,
+                                    const rsmooth_params *params, void *out_positions,
+                                    float *out_weight, float *out_confidence,
+                                    rsmooth_report *report, rsmooth_error *error,
+                                    const char *where);
+
 rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar scalar,
                                 const void *positions, size_t vertex_count,
                                 const uint32_t *indices, size_t triangle_count,
                                 const rsmooth_params *params, void *out_positions,
                                 float *out_weight, float *out_confidence, rsmooth_report *report,
                                 rsmooth_error *error, const char *where) {
+    rsmooth_status st = filter_passes(one_pass, ctx, scalar, positions, vertex_count, indices,
+                                      triangle_count, params, out_positions, out_weight,
+                                      out_confidence, report, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
+    return rs_check_results(scalar, out_positions, out_weight, out_confidence, vertex_count,
+                            "vertex", error, where);
+}
+
+static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar scalar,
+                                    const void *positions, size_t vertex_count,
+                                    const uint32_t *indices, size_t triangle_count,
+                                    const rsmooth_params *params, void *out_positions,
+                                    float *out_weight, float *out_confidence,
+                                    rsmooth_report *report, rsmooth_error *error,
+                                    const char *where) {
     double t_start = rs_now_ms();
     rs_error_clear(error);
     rsmooth_params p;
@@ -45,8 +69,8 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar
     if (p.passes == 1) /* the paper's single pass, exactly as it was */
         return one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, params,
                         out_positions, out_weight, out_confidence, report, error);
-    if ((st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count, error,
-                                   where)) != RSMOOTH_OK ||
+    if ((st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count,
+                                   NULL, error, where)) != RSMOOTH_OK ||
         (st = rs_check_output_positions(scalar, positions, vertex_count, out_positions, error,
                                         where)) != RSMOOTH_OK)
         return st;
@@ -118,7 +142,7 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar
         confidence = tc;
     }
     for (size_t v = 0; v < vertex_count; v++) {
-        rs_store_position(scalar, out_positions, v, cur + 3 * v);
+        rs_store_position(scalar, out_positions, v, cur + 3 * v, 1); /* caller's units */
         if (out_weight)
             out_weight[v] = prev_weight[v];
         if (out_confidence)

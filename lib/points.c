@@ -49,9 +49,10 @@ static double point_spacings(const rs_kdtree *tree, double *spacing) {
     return sum / (double)tree->count;
 }
 
-/* Checks positions (what rs_check_mesh_arrays checks, worded for points). */
+/* Checks positions (what rs_check_mesh_arrays checks, worded for points) and chooses the scale
+ * of internal units (scale.c). */
 static rsmooth_status check_positions(rsmooth_scalar scalar, const void *positions,
-                                      size_t point_count, rsmooth_error *error,
+                                      size_t point_count, double *scale, rsmooth_error *error,
                                       const char *caller) {
     if (scalar != RSMOOTH_FLOAT32 && scalar != RSMOOTH_FLOAT64)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller,
@@ -63,7 +64,12 @@ static rsmooth_status check_positions(rsmooth_scalar scalar, const void *positio
     if (point_count >= UINT32_MAX || rs_mul_overflows(point_count, 3 * sizeof(double)))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller,
                        "point count %zu exceeds the 32-bit index range", point_count);
-    return rs_check_coordinates(scalar, positions, point_count, "point", error, caller);
+    double magnitude = 0;
+    rsmooth_status st =
+        rs_check_coordinates(scalar, positions, point_count, "point", &magnitude, error, caller);
+    if (st != RSMOOTH_OK)
+        return st;
+    return rs_points_scale(scalar, positions, point_count, magnitude, scale, error, caller);
 }
 
 /* Normal i of the caller's array made unit length into out[0..2]; NULL, or what is wrong with it.
@@ -101,7 +107,8 @@ rsmooth_status rsmooth_point_spacing(rsmooth_scalar scalar, const void *position
     rs_error_clear(error);
     if (!out_spacing)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller, "out_spacing is NULL");
-    rsmooth_status st = check_positions(scalar, positions, point_count, error, caller);
+    double scale = 1;
+    rsmooth_status st = check_positions(scalar, positions, point_count, &scale, error, caller);
     if (st != RSMOOTH_OK)
         return st;
     double *xyz = rs_alloc_array(point_count, 3 * sizeof *xyz);
@@ -109,12 +116,11 @@ rsmooth_status rsmooth_point_spacing(rsmooth_scalar scalar, const void *position
     rs_kdtree tree;
     bool ok = xyz && spacing;
     if (ok) {
-        for (size_t i = 0; i < 3 * point_count; i++)
-            xyz[i] = rs_coordinate(scalar, positions, i);
+        rs_scale_positions(scalar, positions, point_count, scale, xyz);
         ok = rs_kdtree_build(&tree, xyz, point_count);
     }
     if (ok) {
-        *out_spacing = point_spacings(&tree, spacing);
+        *out_spacing = point_spacings(&tree, spacing) / scale; /* exact: a power of two */
         rs_kdtree_free(&tree);
     }
     rs_free(xyz);
@@ -157,7 +163,9 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
     rsmooth_status st = rs_params_resolve(params, &p, error, where);
     if (st != RSMOOTH_OK)
         return st;
-    if ((st = check_positions(scalar, positions, point_count, error, where)) != RSMOOTH_OK)
+    double scale = 1;
+    if ((st = check_positions(scalar, positions, point_count, &scale, error, where)) !=
+        RSMOOTH_OK)
         return st;
     if ((st = rs_check_colors(p.colors, point_count, error, where)) != RSMOOTH_OK)
         return st;
@@ -207,8 +215,7 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
     if (!a.xyz || !a.next || !a.input_normal || !a.normal || !a.filtered ||
         !a.spacing || !a.area || !a.confidence || !a.prev_confidence)
         goto fail_memory;
-    for (size_t i = 0; i < 3 * n; i++)
-        a.xyz[i] = rs_coordinate(scalar, positions, i);
+    rs_scale_positions(scalar, positions, n, scale, a.xyz);
     for (size_t i = 0; i < n; i++)
         unit_normal(scalar, normals, i, a.input_normal + 3 * i);
 
@@ -231,7 +238,7 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
         double spacing = point_spacings(&tree, a.spacing);
         if (pass == 0) {
             input_spacing = spacing;
-            unit = p.absolute ? 1.0 : spacing;
+            unit = p.absolute ? scale : spacing;
         }
         double area_sum = 0;
         size_t positive = 0;
@@ -246,6 +253,7 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
         rs_problem pb;
         memset(&pb, 0, sizeof pb);
         pb.vertex_count = n;
+        pb.scale = 1; /* the solve writes next positions in internal units, as a.xyz holds */
         pb.xyz = a.xyz;
         pb.facet_count = n; /* points of zero area (duplicates) just carry no weight */
         pb.centroid = a.xyz;
@@ -295,17 +303,18 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
         a.confidence = c;
     }
     for (size_t v = 0; v < n; v++) {
-        rs_store_position(scalar, out_positions, v, a.xyz + 3 * v);
+        rs_store_position(scalar, out_positions, v, a.xyz + 3 * v, 1 / scale);
         if (out_normals)
-            rs_store_position(scalar, out_normals, v, a.normal + 3 * v);
+            rs_store_position(scalar, out_normals, v, a.normal + 3 * v, 1); /* unit vectors */
         if (out_confidence)
             out_confidence[v] = a.prev_confidence[v];
     }
     if (report) {
         *report = sum;
+        rs_report_unscale(report, 1 / scale);
         report->ms_total = rs_now_ms() - t_start;
     }
-    st = RSMOOTH_OK;
+    st = rs_check_results(scalar, out_positions, NULL, out_confidence, n, "point", error, where);
     goto done;
 
 fail_memory:

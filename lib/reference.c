@@ -348,9 +348,9 @@ rsmooth_status rs_reference_solve(const rs_problem *problem, rsmooth_scalar scal
         const float *color = pb.facet_color ? pb.colors + 3 * v : NULL;
         estimate_vertex(&pb, &nb, normals, p, color, disp, &k, &kf);
         double out[3] = {p[0] + disp[0], p[1] + disp[1], p[2] + disp[2]};
-        rs_store_position(scalar, out_positions, v, out);
+        rs_store_position(scalar, out_positions, v, out, 1 / pb.scale);
         if (out_weight)
-            out_weight[v] = (float)k;
+            out_weight[v] = rs_weight_value(k, 1 / pb.scale);
         if (out_confidence)
             out_confidence[v] = kf > 0 ? (float)fmin(1.0, k / kf) : 0.0f;
     }

@@ -86,10 +86,12 @@ rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *o
 
 /* ---- mesh.c: the validated problem both paths solve ------------------------------------------- */
 
-/* A facet is a triangle of non-zero area; zero-area triangles carry no weight and are left out. */
+/* A facet is a triangle of non-zero area; zero-area triangles carry no weight and are left out.
+ * Every length in a problem is in internal units: the caller's times `scale` (scale.c). */
 typedef struct rs_problem {
     size_t vertex_count;
-    double *xyz;                 /* 3 * vertex_count, the input converted to double (owned) */
+    double scale;                /* internal units per caller unit: a power of two */
+    double *xyz;                 /* 3 * vertex_count, the input in double, times `scale` (owned) */
     size_t triangle_count;
     const uint32_t *indices;     /* borrowed from the caller */
     size_t facet_count;
@@ -195,22 +197,60 @@ rsmooth_status rs_check_output_positions(rsmooth_scalar scalar, const void *posi
                                          rsmooth_error *error, const char *where);
 
 /* Checks that the 3 * count coordinates are finite and within RS_MAX_COORDINATE; a failure names
- * the offending `noun` ("vertex", "point") by index. */
+ * the offending `noun` ("vertex", "point") by index. Writes the largest |coordinate| to
+ * *magnitude when it is not NULL. */
 rsmooth_status rs_check_coordinates(rsmooth_scalar scalar, const void *positions, size_t count,
-                                    const char *noun, rsmooth_error *error, const char *where);
+                                    const char *noun, double *magnitude, rsmooth_error *error,
+                                    const char *where);
 
-/* Checks the arrays only (shared with rsmooth_mean_edge_length). */
+/* Checks the arrays only (shared with rsmooth_mean_edge_length); *magnitude (optional) as
+ * rs_check_coordinates gives it. */
 rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions,
                                     size_t vertex_count, const uint32_t *indices,
-                                    size_t triangle_count, rsmooth_error *error,
-                                    const char *where);
+                                    size_t triangle_count, double *magnitude,
+                                    rsmooth_error *error, const char *where);
+
+/* ---- scale.c: internal units ------------------------------------------------------------------ */
+
+/* The power of two both paths multiply coordinates by (and divide results by), chosen so a
+ * typical edge (of sampled triangles; for points, the distance between consecutive points) is
+ * about 1 long while the largest coordinate, `magnitude` (rs_check_coordinates), stays below
+ * 2^500. Exact, so results do not depend on it. RSMOOTH_ERROR_INVALID_ARGUMENT when no power of
+ * two fits both (a coordinate more than about 1e225 typical edges from the origin). */
+rsmooth_status rs_mesh_scale(rsmooth_scalar scalar, const void *positions,
+                             const uint32_t *indices, size_t triangle_count, double magnitude,
+                             double *scale, rsmooth_error *error, const char *where);
+rsmooth_status rs_points_scale(rsmooth_scalar scalar, const void *positions, size_t count,
+                               double magnitude, double *scale, rsmooth_error *error,
+                               const char *where);
+
+/* Caller's coordinates -> internal units: out[i] = coordinate i times `scale`, i < 3 count. */
+void rs_scale_positions(rsmooth_scalar scalar, const void *positions, size_t count, double scale,
+                        double *out);
+
+/* ---- results.c: what a call writes ----------------------------------------------------------- */
+
+/* k(p) (internal area units) as the float out_weight holds, in the caller's area units; NaN
+ * when it exceeds FLT_MAX (rs_check_results then fails the call). */
+float rs_weight_value(double k, double unscale);
+
+/* Checks a call's outputs before it returns RSMOOTH_OK: every position and weight finite in the
+ * caller's type (a float32 result beyond FLT_MAX, or k(p) of a mesh whose areas exceed float's
+ * range, is RSMOOTH_ERROR_NUMERICAL naming the vertex) and every confidence in [0, 1]. Any array
+ * but out_positions may be NULL. */
+rsmooth_status rs_check_results(rsmooth_scalar scalar, const void *out_positions,
+                                const float *out_weight, const float *out_confidence,
+                                size_t count, const char *noun, rsmooth_error *error,
+                                const char *where);
 
 /* Mean length of unique undirected edges over `xyz` (double). false on allocation failure. */
 bool rs_mean_edge_length(const double *xyz, size_t vertex_count, const uint32_t *indices,
                          size_t triangle_count, double *out_length);
 
-/* Writes the result for vertex v (double xyz) into the caller's array of type `scalar`. */
-void rs_store_position(rsmooth_scalar scalar, void *out_positions, size_t v, const double p[3]);
+/* Writes the result for vertex v (double xyz, internal units) into the caller's array of type
+ * `scalar`, times `unscale` (1 / the problem's scale; 1 for values in the caller's units). */
+void rs_store_position(rsmooth_scalar scalar, void *out_positions, size_t v, const double p[3],
+                       double unscale);
 
 /* Geometry helpers shared by the reference path and the host side of the OpenCL path. */
 static inline double rs_dot3(const double a[3], const double b[3]) {
@@ -485,8 +525,10 @@ const char *rs_cl_error_name(cl_int code);
 void rs_store_unmoved(const rs_problem *problem, rsmooth_scalar scalar, void *out_positions,
                       float *out_weight, float *out_confidence);
 
-/* Fills the parts of a report both paths share. */
+/* Fills the parts of a report both paths share (lengths in the caller's units). */
 void rs_report_problem(rsmooth_report *report, const rs_problem *problem, const rs_grid *grid,
                        const char *device);
+/* Multiplies a report's lengths by `unscale`: internal units to the caller's. */
+void rs_report_unscale(rsmooth_report *report, double unscale);
 
 #endif /* RSMOOTH_INTERNAL_H */

@@ -25,6 +25,8 @@ const char *rsmooth_status_str(rsmooth_status status) {
         return "OpenCL runtime error";
     case RSMOOTH_ERROR_UNSUPPORTED:
         return "unsupported";
+    case RSMOOTH_ERROR_NUMERICAL:
+        return "result not representable";
     }
     return "unknown status";
 }

@@ -83,7 +83,7 @@ rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const void *position
     static const char where[] = "rsmooth_smooth_taubin";
     rs_error_clear(error);
     rsmooth_status st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices,
-                                             triangle_count, error, where);
+                                             triangle_count, NULL, error, where);
     if (st == RSMOOTH_OK)
         st = rs_check_output_positions(scalar, positions, vertex_count, out_positions, error,
                                        where);
@@ -116,9 +116,10 @@ rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const void *position
         }
     }
     for (size_t v = 0; v < vertex_count; v++)
-        rs_store_position(scalar, out_positions, v, cur + 3 * v);
+        rs_store_position(scalar, out_positions, v, cur + 3 * v, 1); /* linear: no scale */
     rs_free(a);
     rs_free(b);
     adjacency_free(&adj);
-    return RSMOOTH_OK;
+    return rs_check_results(scalar, out_positions, NULL, NULL, vertex_count, "vertex", error,
+                            where);
 }

@@ -78,7 +78,8 @@ static double halo_radius(const rs_problem *pb, double reach) {
 static void store_unmoved(tiler *t, const uint32_t *verts, size_t n) {
     const rs_result_sink *sink = t->sink;
     for (size_t i = 0; i < n; i++) {
-        rs_store_position(sink->scalar, sink->positions, verts[i], t->whole->xyz + 3 * verts[i]);
+        rs_store_position(sink->scalar, sink->positions, verts[i], t->whole->xyz + 3 * verts[i],
+                          1 / t->whole->scale);
         if (sink->weight)
             sink->weight[verts[i]] = 0;
         if (sink->confidence)
@@ -287,7 +288,7 @@ rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *pb, const rs
         st = solve_region(&t, verts, nv, facets, pb->facet_count, 0);
     }
     for (size_t v = 0; st == RSMOOTH_OK && v < nv; v++) {
-        rs_store_position(sink->scalar, sink->positions, v, positions + 3 * v);
+        rs_store_position(sink->scalar, sink->positions, v, positions + 3 * v, 1); /* unscaled */
         if (weight)
             sink->weight[v] = weight[v];
         if (confidence)

@@ -47,7 +47,7 @@
 
 #define RSMOOTH_VERSION_MAJOR 0
 #define RSMOOTH_VERSION_MINOR 4
-#define RSMOOTH_VERSION_PATCH 0
+#define RSMOOTH_VERSION_PATCH 1
 
 #if defined(_WIN32)
 #if defined(RSMOOTH_BUILDING_LIBRARY) && defined(RSMOOTH_SHARED)
@@ -80,7 +80,11 @@ typedef enum rsmooth_status {
     RSMOOTH_ERROR_NO_DEVICE = 5,        /* no OpenCL platform, or no device matches the choice */
     RSMOOTH_ERROR_KERNEL_BUILD = 6,     /* the OpenCL program failed to build (see build_log) */
     RSMOOTH_ERROR_OPENCL = 7,           /* an OpenCL call failed (see cl_error and where) */
-    RSMOOTH_ERROR_UNSUPPORTED = 8       /* valid request this build or device cannot do */
+    RSMOOTH_ERROR_UNSUPPORTED = 8,      /* valid request this build or device cannot do */
+    RSMOOTH_ERROR_NUMERICAL = 9         /* a result would not be finite in the output's type (a
+                                         * float32 position beyond FLT_MAX, k(p) beyond float's
+                                         * range): nothing non-finite is ever returned as OK.
+                                         * (Added in 0.4.1) */
 } rsmooth_status;
 
 /* Static, human-readable text for a status. Never NULL; thread-safe. */
@@ -293,7 +297,10 @@ typedef struct rsmooth_report {
  *
  * scalar         type of `positions` and `out_positions`.
  * positions      3 * vertex_count floats or doubles (x, y, z per vertex), finite, magnitude
- *                <= 1e150. Borrowed.
+ *                <= 1e150. Borrowed. Any scale works alike, from edges of 1e-300 (float32:
+ *                1e-36) to coordinates of 1e150: both paths work in units of a power of two
+ *                near the mesh's typical edge, which is exact. A mesh whose largest coordinate
+ *                lies more than 1e225 typical edges from the origin is refused.
  * vertex_count   >= 1 and < 2^32.
  * indices        3 * triangle_count vertex indices, each < vertex_count. May be NULL only when
  *                triangle_count is 0 (then nothing moves). Any soup is fine: duplicated, unreferenced
@@ -301,14 +308,19 @@ typedef struct rsmooth_report {
  * params         NULL means defaults (rsmooth_params_init).
  * out_positions  3 * vertex_count values of `scalar`, in the input's vertex order. Must not overlap
  *                `positions`.
- * out_weight     optional (NULL): vertex_count floats receiving k(p) = sum a f g (area units).
+ * out_weight     optional (NULL): vertex_count floats receiving k(p) = sum a f g (area units;
+ *                a k beyond FLT_MAX, e.g. on a mesh with edges of 1e20, is
+ *                RSMOOTH_ERROR_NUMERICAL, one below float's range rounds to 0: the confidence
+ *                is the scale-free measure).
  * out_confidence optional (NULL): vertex_count floats receiving k(p) / sum a f, in [0, 1]; 0 where
  *                no facet is within reach (such vertices keep their position).
  * report         optional (NULL): figures of the run.
  * error          optional (NULL): detail on failure.
  *
- * Returns RSMOOTH_OK, RSMOOTH_ERROR_INVALID_ARGUMENT (then no output is written) or
- * RSMOOTH_ERROR_OUT_OF_MEMORY (outputs undefined). Thread-safe (no shared state). */
+ * Returns RSMOOTH_OK, RSMOOTH_ERROR_INVALID_ARGUMENT (then no output is written),
+ * RSMOOTH_ERROR_OUT_OF_MEMORY or RSMOOTH_ERROR_NUMERICAL (a float32 result beyond FLT_MAX, a
+ * weight beyond float's range; outputs undefined). RSMOOTH_OK guarantees every output is finite.
+ * Thread-safe (no shared state). */
 RSMOOTH_API rsmooth_status rsmooth_smooth_reference(rsmooth_scalar scalar, const void *positions,
                                                     size_t vertex_count, const uint32_t *indices,
                                                     size_t triangle_count,
@@ -323,7 +335,8 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_reference(rsmooth_scalar scalar, const
  * shrinks the mesh. U(p) is the uniform umbrella operator: the mean of p's edge neighbours minus p.
  * Unlike the filter above these need connectivity (vertices without an edge stay) and round sharp
  * edges. lambda in (0, 1], mu in [-1, 0]. Same arrays and argument errors as
- * rsmooth_smooth_reference; double precision, one thread, thread-safe. */
+ * rsmooth_smooth_reference (RSMOOTH_ERROR_NUMERICAL when a float32 result leaves float's range);
+ * double precision, one thread, thread-safe. */
 RSMOOTH_API rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const void *positions,
                                                  size_t vertex_count, const uint32_t *indices,
                                                  size_t triangle_count, double lambda, double mu,
@@ -364,7 +377,8 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const vo
  * but must not overlap each other.
  *
  * Returns RSMOOTH_OK, RSMOOTH_ERROR_INVALID_ARGUMENT (naming the point of a non-finite or zero
- * normal; no output written) or RSMOOTH_ERROR_OUT_OF_MEMORY (outputs undefined). Double
+ * normal; no output written), RSMOOTH_ERROR_OUT_OF_MEMORY or RSMOOTH_ERROR_NUMERICAL (outputs
+ * undefined). Double
  * precision, thread-safe. The OpenCL path does not take point clouds yet. */
 RSMOOTH_API rsmooth_status rsmooth_smooth_points_reference(
     rsmooth_scalar scalar, const void *positions, const void *normals, size_t point_count,
