@@ -238,6 +238,10 @@ static rsmooth_status read_memory_limits(rsmooth_context *ctx, rsmooth_error *er
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_context_create",
                        "RSMOOTH_MEMORY_BUDGET='%s' is not a byte count (examples: 268435456, "
                        "256M, 1.5G)", budget);
+    if (budget && *budget && ctx->memory_budget == 0) /* as the command's --memory-budget 0 */
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_context_create",
+                       "RSMOOTH_MEMORY_BUDGET='%s' leaves no memory: unset it for the device's "
+                       "own limit", budget);
     return RSMOOTH_OK;
 }
 
@@ -248,16 +252,37 @@ uint64_t rs_cl_usable_memory(const rsmooth_context *ctx) {
 }
 
 void rsmooth_context_set_memory_budget(rsmooth_context *ctx, uint64_t bytes) {
-    if (ctx)
-        ctx->memory_budget = bytes;
+    if (!ctx)
+        return;
+    rs_context_lock(ctx);
+    ctx->memory_budget = bytes;
+    rs_context_unlock(ctx);
 }
 
 uint64_t rsmooth_context_memory_budget(const rsmooth_context *ctx) {
-    return ctx ? rs_cl_usable_memory(ctx) : 0;
+    if (!ctx)
+        return 0;
+    rsmooth_context *shared = (rsmooth_context *)ctx; /* the lock is the one mutable part */
+    rs_context_lock(shared);
+    uint64_t bytes = rs_cl_usable_memory(ctx);
+    rs_context_unlock(shared);
+    return bytes;
+}
+
+void rs_context_lock(rsmooth_context *ctx) {
+    pthread_mutex_lock(&ctx->lock);
+}
+
+void rs_context_unlock(rsmooth_context *ctx) {
+    pthread_mutex_unlock(&ctx->lock);
 }
 
 static rsmooth_context *new_context(void) {
     rsmooth_context *ctx = rs_calloc_array(1, sizeof *ctx);
+    if (ctx && pthread_mutex_init(&ctx->lock, NULL) != 0) {
+        rs_free(ctx);
+        return NULL;
+    }
     return ctx;
 }
 
@@ -366,6 +391,7 @@ void rsmooth_context_destroy(rsmooth_context *ctx) {
         clReleaseCommandQueue(ctx->queue);
     if (ctx->context)
         clReleaseContext(ctx->context);
+    pthread_mutex_destroy(&ctx->lock);
     rs_free(ctx);
 }
 

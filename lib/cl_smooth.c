@@ -664,7 +664,11 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     rs_error_clear(error);
     if (!ctx)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_smooth", "ctx is NULL");
-    return rs_filter_passes(cl_pass, ctx, scalar, positions, vertex_count, indices,
-                            triangle_count, params, out_positions, out_weight, out_confidence,
-                            report, error, "rsmooth_smooth");
+    /* the kernels' arguments and the queue are the context's: one call at a time */
+    rs_context_lock(ctx);
+    rsmooth_status st = rs_filter_passes(cl_pass, ctx, scalar, positions, vertex_count, indices,
+                                         triangle_count, params, out_positions, out_weight,
+                                         out_confidence, report, error, "rsmooth_smooth");
+    rs_context_unlock(ctx);
+    return st;
 }

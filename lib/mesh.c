@@ -216,6 +216,44 @@ rsmooth_status rs_check_output_positions(rsmooth_scalar scalar, const void *posi
     return RSMOOTH_OK;
 }
 
+rsmooth_status rs_check_outputs(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
+                                const uint32_t *indices, size_t triangle_count,
+                                const float *colors, const void *out_positions,
+                                const float *out_weight, const float *out_confidence,
+                                rsmooth_error *error, const char *where) {
+    if (rs_mul_overflows(vertex_count, 3 * sizeof(double)) ||
+        rs_mul_overflows(triangle_count, 3 * sizeof(uint32_t)))
+        return RSMOOTH_OK; /* no such arrays: the count checks refuse the call */
+    size_t xyz = vertex_count * 3 * (scalar == RSMOOTH_FLOAT32 ? sizeof(float) : sizeof(double));
+    size_t per_vertex = vertex_count * sizeof(float);
+    const struct {
+        const char *name;
+        const void *at;
+        size_t bytes;
+    } in[] = {{"positions", positions, xyz},
+              {"indices", indices, triangle_count * 3 * sizeof(uint32_t)},
+              {"params->colors", colors, 3 * per_vertex}},
+      out[] = {{"out_positions", out_positions, xyz},
+               {"out_weight", out_weight, per_vertex},
+               {"out_confidence", out_confidence, per_vertex}};
+    const size_t ins = sizeof in / sizeof *in, outs = sizeof out / sizeof *out;
+    for (size_t o = 0; o < outs; o++) {
+        if (!out[o].at || out[o].bytes == 0)
+            continue;
+        for (size_t i = 0; i < ins + o; i++) { /* every input, and the outputs before this one */
+            const char *name = i < ins ? in[i].name : out[i - ins].name;
+            const void *at = i < ins ? in[i].at : out[i - ins].at;
+            size_t bytes = i < ins ? in[i].bytes : out[i - ins].bytes;
+            if (at && overlaps(out[o].at, out[o].bytes, at, bytes))
+                return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                               "%s overlaps %s: smoothing reads every input while writing, and "
+                               "each output needs its own memory",
+                               out[o].name, name);
+        }
+    }
+    return RSMOOTH_OK;
+}
+
 /* Triangles per block of the facet loops (and elements per chunk below which a loop is not worth
  * a thread). */
 #define GEOMETRY_BLOCK 8192

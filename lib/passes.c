@@ -64,6 +64,9 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
     rs_error_clear(error);
     rsmooth_params p;
     rsmooth_status st = rs_params_resolve(params, &p, error, where);
+    if (st == RSMOOTH_OK)
+        st = rs_check_outputs(scalar, positions, vertex_count, indices, triangle_count, p.colors,
+                              out_positions, out_weight, out_confidence, error, where);
     if (st != RSMOOTH_OK)
         return st;
     if (p.passes == 1) /* the paper's single pass, exactly as it was */

@@ -196,6 +196,14 @@ rsmooth_status rs_check_output_positions(rsmooth_scalar scalar, const void *posi
                                          size_t vertex_count, const void *out_positions,
                                          rsmooth_error *error, const char *where);
 
+/* Checks every output of a filter call against every input (positions, indices, colours) and
+ * against each other: none may share a byte, since the filter reads all inputs while writing. */
+rsmooth_status rs_check_outputs(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
+                                const uint32_t *indices, size_t triangle_count,
+                                const float *colors, const void *out_positions,
+                                const float *out_weight, const float *out_confidence,
+                                rsmooth_error *error, const char *where);
+
 /* Checks that the 3 * count coordinates are finite and within RS_MAX_COORDINATE; a failure names
  * the offending `noun` ("vertex", "point") by index. Writes the largest |coordinate| to
  * *magnitude when it is not NULL. */
@@ -428,6 +436,7 @@ size_t rs_kdtree_nearest(const rs_kdtree *tree, const double p[3], uint32_t skip
 #define CL_TARGET_OPENCL_VERSION 120
 #endif
 #include <CL/cl.h>
+#include <pthread.h>
 
 /* Vertices per block: the vector width the kernels use across vertices (float8, kernels/common.cl). */
 #define RS_LANES 8
@@ -441,6 +450,7 @@ enum {
 };
 
 struct rsmooth_context {
+    pthread_mutex_t lock;     /* serialises the calls of threads sharing the context */
     cl_context context;
     cl_device_id device;
     cl_command_queue queue;
@@ -453,6 +463,10 @@ struct rsmooth_context {
     uint64_t max_allocation;  /* CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest one buffer may be */
     uint64_t memory_budget;   /* caller's or RSMOOTH_MEMORY_BUDGET's limit; 0: the device's */
 };
+
+/* A context's calls hold its lock while they use it: threads sharing one run one at a time. */
+void rs_context_lock(rsmooth_context *ctx);
+void rs_context_unlock(rsmooth_context *ctx);
 
 /* Bytes one run may hold on the device: the caller's budget, else most of the device's memory. */
 uint64_t rs_cl_usable_memory(const rsmooth_context *ctx);

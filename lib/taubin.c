@@ -87,6 +87,9 @@ rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const void *position
     if (st == RSMOOTH_OK)
         st = rs_check_output_positions(scalar, positions, vertex_count, out_positions, error,
                                        where);
+    if (st == RSMOOTH_OK)
+        st = rs_check_outputs(scalar, positions, vertex_count, indices, triangle_count, NULL,
+                              out_positions, NULL, NULL, error, where);
     if (st != RSMOOTH_OK)
         return st;
     if (!(lambda > 0 && lambda <= 1))

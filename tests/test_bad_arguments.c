@@ -6,20 +6,32 @@
 #include <stdint.h>
 #include <string.h>
 
-/* The entry points under test, all with rsmooth_smooth_reference's signature. The OpenCL path can
- * join through a wrapper that passes its context, e.g. a static rsmooth_context created in main. */
+/* The entry points under test, all with rsmooth_smooth_reference's signature. The OpenCL path
+ * joins through a wrapper that passes the context main creates, when there is a device. */
 typedef rsmooth_status (*smooth_fn)(rsmooth_scalar scalar, const void *positions,
                                     size_t vertex_count, const uint32_t *indices,
                                     size_t triangle_count, const rsmooth_params *params,
                                     void *out_positions, float *out_weight, float *out_confidence,
                                     rsmooth_report *report, rsmooth_error *error);
 
-static const struct {
+static rsmooth_context *g_context;
+
+static rsmooth_status smooth_opencl(rsmooth_scalar scalar, const void *positions,
+                                    size_t vertex_count, const uint32_t *indices,
+                                    size_t triangle_count, const rsmooth_params *params,
+                                    void *out_positions, float *out_weight, float *out_confidence,
+                                    rsmooth_report *report, rsmooth_error *error) {
+    return rsmooth_smooth(g_context, scalar, positions, vertex_count, indices, triangle_count,
+                          params, out_positions, out_weight, out_confidence, report, error);
+}
+
+static struct {
     const char *name;
     smooth_fn fn;
-} entry_points[] = {
+} entry_points[2] = {
     {"rsmooth_smooth_reference", rsmooth_smooth_reference},
 };
+static size_t g_entry_points = 1;
 
 /* One call's arguments. */
 typedef struct call {
@@ -59,7 +71,7 @@ static int outputs_untouched(void) {
 static int g_cases;
 
 static void expect_invalid(const char *what, call c) {
-    for (size_t e = 0; e < sizeof entry_points / sizeof entry_points[0]; e++) {
+    for (size_t e = 0; e < g_entry_points; e++) {
         rsmooth_error err;
         memset(&err, 0, sizeof err);
         fill_sentinels();
@@ -104,7 +116,7 @@ static void test_smooth_arguments(void) {
     const call base = {RSMOOTH_FLOAT64, pos,   vc,       idx,          tc,
                        &params,         g_out, g_weight, g_confidence, &g_report};
     /* the base call is valid and writes its outputs */
-    for (size_t e = 0; e < sizeof entry_points / sizeof entry_points[0]; e++) {
+    for (size_t e = 0; e < g_entry_points; e++) {
         rsmooth_error err;
         fill_sentinels();
         CHECK_STATUS(entry_points[e].fn(base.scalar, base.positions, base.vertex_count,
@@ -323,6 +335,59 @@ static void test_smooth_arguments(void) {
         expect_invalid("float32 out_positions = positions + 1", c);
         CHECK(memcmp(shared32, pos32, sizeof pos32) == 0);
     }
+
+    /* Every other output against every input, and the outputs against each other: each refused
+     * with the inputs left as they were. One buffer holds an input and lends its tail (or head)
+     * to an output. */
+    {
+        enum { WORDS = 2048 };
+        static uint32_t arena[WORDS]; /* aligned for doubles too: static storage */
+        static uint32_t pristine[WORDS];
+        double *arena_d = (double *)(void *)arena;
+        float *arena_f = (float *)(void *)arena;
+        /* positions in the arena, the weights or confidences starting inside them */
+        memcpy(arena_d, pos, 3 * vc * sizeof(double));
+        memcpy(pristine, arena, sizeof arena);
+        c = base, c.positions = arena_d, c.out_weight = arena_f + 6 * vc - 2;
+        expect_invalid("out_weight overlaps positions' last vertex", c);
+        c = base, c.positions = arena_d, c.out_confidence = arena_f;
+        expect_invalid("out_confidence = positions", c);
+        CHECK(memcmp(arena, pristine, sizeof arena) == 0);
+        /* indices in the arena, out_positions over their end */
+        memset(arena, 0, sizeof arena);
+        memcpy(arena, idx, 3 * tc * sizeof(uint32_t));
+        memcpy(pristine, arena, sizeof arena);
+        c = base, c.indices = arena, c.out_positions = arena_d + (3 * tc - 2) / 2;
+        expect_invalid("out_positions overlaps indices", c);
+        c = base, c.indices = arena, c.out_weight = arena_f;
+        expect_invalid("out_weight = indices", c);
+        CHECK(memcmp(arena, pristine, sizeof arena) == 0);
+        /* colours in the arena, the confidence inside them */
+        rsmooth_params colored;
+        rsmooth_params_init(&colored);
+        for (size_t i = 0; i < 3 * vc; i++)
+            arena_f[i] = 0.5f;
+        memcpy(pristine, arena, sizeof arena);
+        colored.colors = arena_f;
+        c = base, c.params = &colored, c.out_confidence = arena_f + vc;
+        expect_invalid("out_confidence overlaps params->colors", c);
+        CHECK(memcmp(arena, pristine, sizeof arena) == 0);
+        /* two outputs in one place */
+        c = base, c.out_weight = g_weight, c.out_confidence = g_weight + 1;
+        expect_invalid("out_confidence overlaps out_weight", c);
+        c = base, c.out_weight = (float *)(void *)g_out;
+        expect_invalid("out_weight overlaps out_positions", c);
+        /* and Taubin's one output against its indices */
+        memset(arena, 0, sizeof arena);
+        memcpy(arena, idx, 3 * tc * sizeof(uint32_t));
+        memcpy(pristine, arena, sizeof arena);
+        rsmooth_error err;
+        CHECK_STATUS(rsmooth_smooth_taubin(RSMOOTH_FLOAT64, pos, vc, arena, tc, 0.5, -0.53, 3,
+                                           arena_d + 1, &err),
+                     RSMOOTH_ERROR_INVALID_ARGUMENT);
+        printf("rsmooth_smooth_taubin out_positions over indices -> \"%s\"\n", err.message);
+        CHECK(memcmp(arena, pristine, sizeof arena) == 0);
+    }
     shape_free(&plane);
 }
 
@@ -394,9 +459,16 @@ static void test_mean_edge_length(void) {
 }
 
 int main(void) {
+    if (rsmooth_context_create(NULL, &g_context, NULL) == RSMOOTH_OK) {
+        entry_points[g_entry_points].name = "rsmooth_smooth";
+        entry_points[g_entry_points++].fn = smooth_opencl;
+    } else {
+        printf("no OpenCL device: the reference path alone\n");
+    }
     test_smooth_arguments();
     test_status_strings();
     test_mean_edge_length();
     printf("bad_arguments: %d bad calls refused with nothing written\n", g_cases);
+    rsmooth_context_destroy(g_context);
     return 0;
 }

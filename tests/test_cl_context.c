@@ -1,11 +1,12 @@
 /* The OpenCL context: device choice by spec, a caller's own queue (retained, never owned), bit-identical
- * repeated runs, and argument errors that leave the output untouched. */
+ * repeated runs, threads sharing one context, and argument errors that leave the output untouched. */
 #define _POSIX_C_SOURCE 200809L
 #include "mesh_shapes.h"
 #include "rsmooth_cl.h"
 #include "test_cl_util.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -64,6 +65,69 @@ static void check_progress(rsmooth_context *ctx, const shape_mesh *m, const doub
     free(out);
 }
 
+/* Threads sharing one context: each thread filters its own noisy cube again and again; every
+ * result must equal the same call made alone (the context serialises its calls). */
+#define SHARING_THREADS 8
+#define CALLS_PER_THREAD 10
+
+typedef struct sharer {
+    rsmooth_context *ctx;
+    const shape_mesh *mesh;
+    const double *alone; /* the result of the same call with no other thread running */
+    double *out;
+    int wrong, failed;
+} sharer;
+
+static void *share_context(void *arg) {
+    sharer *s = arg;
+    size_t n = 3 * s->mesh->vertex_count;
+    for (int call = 0; call < CALLS_PER_THREAD; call++) {
+        rsmooth_error err;
+        if (rsmooth_smooth(s->ctx, RSMOOTH_FLOAT64, s->mesh->xyz, s->mesh->vertex_count,
+                           s->mesh->indices, s->mesh->triangle_count, NULL, s->out, NULL, NULL,
+                           NULL, &err) != RSMOOTH_OK)
+            s->failed++;
+        else if (memcmp(s->out, s->alone, n * sizeof *s->out) != 0)
+            s->wrong++;
+    }
+    return NULL;
+}
+
+static void check_shared_context(rsmooth_context *ctx) {
+    shape_mesh meshes[SHARING_THREADS];
+    sharer sharers[SHARING_THREADS];
+    pthread_t threads[SHARING_THREADS];
+    for (int t = 0; t < SHARING_THREADS; t++) {
+        /* different sizes and noise, so a mixed-up call shows */
+        CHECK(shape_cube(&meshes[t], 24 + 2 * t, 1.0) == 0);
+        CHECK(shape_add_normal_noise(&meshes[t], 0.3, 100 + (uint64_t)t) == 0);
+        size_t n = 3 * meshes[t].vertex_count;
+        double *alone = malloc(n * sizeof *alone), *out = malloc(n * sizeof *out);
+        CHECK(alone && out);
+        CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, meshes[t].xyz, meshes[t].vertex_count,
+                                    meshes[t].indices, meshes[t].triangle_count, NULL, alone,
+                                    NULL, NULL, NULL, NULL),
+                     RSMOOTH_OK);
+        sharers[t] = (sharer){ctx, &meshes[t], alone, out, 0, 0};
+    }
+    for (int t = 0; t < SHARING_THREADS; t++)
+        CHECK(pthread_create(&threads[t], NULL, share_context, &sharers[t]) == 0);
+    int wrong = 0, failed = 0;
+    for (int t = 0; t < SHARING_THREADS; t++) {
+        CHECK(pthread_join(threads[t], NULL) == 0);
+        wrong += sharers[t].wrong;
+        failed += sharers[t].failed;
+        free((double *)sharers[t].alone);
+        free(sharers[t].out);
+        shape_free(&meshes[t]);
+    }
+    printf("%d threads sharing one context, %d calls: %d failed, %d differ from the call made "
+           "alone\n",
+           SHARING_THREADS, SHARING_THREADS * CALLS_PER_THREAD, failed, wrong);
+    CHECK_EQ_INT(failed, 0);
+    CHECK_EQ_INT(wrong, 0);
+}
+
 int main(void) {
     rsmooth_context *ctx = open_test_context();
     shape_mesh cube;
@@ -78,6 +142,7 @@ int main(void) {
     smooth_cube(ctx, &cube, b);
     CHECK(memcmp(a, b, n * sizeof *a) == 0);
     printf("two runs: bit-identical\n");
+    check_shared_context(ctx);
 
     /* One host thread or several: the same bits (static chunks, fixed-size partial sums). */
     {

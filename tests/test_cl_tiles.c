@@ -146,7 +146,7 @@ static void check_too_small(rsmooth_context *ctx, const shape_mesh *m) {
     free(xyz);
 }
 
-/* RSMOOTH_MEMORY_BUDGET sets the budget at creation; junk there is refused by name. */
+/* RSMOOTH_MEMORY_BUDGET sets the budget at creation; junk or zero there is refused by name. */
 static void check_environment(void) {
     rsmooth_context *ctx = NULL;
     rsmooth_error err;
@@ -154,9 +154,14 @@ static void check_environment(void) {
     CHECK_STATUS(rsmooth_context_create(NULL, &ctx, &err), RSMOOTH_OK);
     CHECK(rsmooth_context_memory_budget(ctx) == 3u << 20);
     rsmooth_context_destroy(ctx);
-    setenv("RSMOOTH_MEMORY_BUDGET", "lots", 1);
-    CHECK_STATUS(rsmooth_context_create(NULL, &ctx, &err), RSMOOTH_ERROR_INVALID_ARGUMENT);
-    CHECK(ctx == NULL && strstr(err.message, "RSMOOTH_MEMORY_BUDGET") != NULL);
+    /* junk, and a budget of nothing (as the command refuses --memory-budget 0) */
+    static const char *const refused[] = {"lots", "0", "0M", "-5M", "12Q"};
+    for (size_t i = 0; i < sizeof refused / sizeof *refused; i++) {
+        setenv("RSMOOTH_MEMORY_BUDGET", refused[i], 1);
+        CHECK_STATUS(rsmooth_context_create(NULL, &ctx, &err), RSMOOTH_ERROR_INVALID_ARGUMENT);
+        CHECK(ctx == NULL && strstr(err.message, "RSMOOTH_MEMORY_BUDGET") != NULL);
+        printf("RSMOOTH_MEMORY_BUDGET=%s: %s\n", refused[i], err.message);
+    }
     unsetenv("RSMOOTH_MEMORY_BUDGET");
 }
 

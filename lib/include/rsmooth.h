@@ -409,7 +409,10 @@ typedef struct rsmooth_context rsmooth_context;
  * RSMOOTH_KERNEL_DIR to load kernels/ *.cl from a directory instead of the embedded copies, and
  * RSMOOTH_BUILD_OPTIONS to append OpenCL build options.
  * Returns RSMOOTH_ERROR_NO_DEVICE, RSMOOTH_ERROR_KERNEL_BUILD, RSMOOTH_ERROR_OPENCL, ... with *ctx
- * set to NULL on failure. Thread-safe; the context itself must be used by one thread at a time. */
+ * set to NULL on failure. Thread-safe. A context may be shared by threads: its calls are
+ * serialised (each holds the context while it runs), so threads sharing one wait for each other;
+ * give each thread its own context to filter concurrently. RSMOOTH_MEMORY_BUDGET set but not a
+ * positive byte count is RSMOOTH_ERROR_INVALID_ARGUMENT naming it. */
 RSMOOTH_API rsmooth_status rsmooth_context_create(const char *device, rsmooth_context **ctx,
                                                   rsmooth_error *error);
 
@@ -440,6 +443,7 @@ RSMOOTH_API double rsmooth_context_build_ms(const rsmooth_context *ctx);
 
 /* Limits the device memory one filter call holds to `bytes` (0: most of the device's memory, the
  * default; the environment variable RSMOOTH_MEMORY_BUDGET, e.g. "256M", sets it at creation).
+ * Thread-safe: waits for a running call on the context.
  * A mesh that needs more, or a buffer larger than the device's largest allocation, is cut into
  * spatial tiles, each run with the facets within reach of its vertices: results agree with an
  * untiled run to float32 rounding (rsmooth_report.tiles says how many ran). */

@@ -30,7 +30,8 @@ extern "C" {
  * the queue. The queue (and its context) are retained here and released by rsmooth_context_destroy;
  * the caller keeps its own reference and must not release the queue early. The program is built for
  * the queue's device. Fails like rsmooth_context_create (RSMOOTH_ERROR_INVALID_ARGUMENT for a NULL or
- * invalid queue). */
+ * invalid queue). The context's calls are serialised among themselves; work the caller enqueues on
+ * the same queue from other threads meanwhile is the caller's to order. */
 RSMOOTH_API rsmooth_status rsmooth_context_create_from_queue(cl_command_queue queue,
                                                              rsmooth_context **ctx,
                                                              rsmooth_error *error);
