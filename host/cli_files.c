@@ -1,14 +1,13 @@
 /* The rsmooth command's file handling (see cli_files.h). */
 #define _POSIX_C_SOURCE 200809L
 #include "cli_files.h"
+#include "cli_output.h"
 
 #include <errno.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <unistd.h>
 
 #define READ_CHUNK (8u << 20)
 
@@ -91,94 +90,21 @@ rsmooth_format cli_output_format(const char *path, bool ascii) {
     return format;
 }
 
-static bool same_file(const char *a, const char *b) {
-    struct stat sa, sb;
-    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev &&
-           sa.st_ino == sb.st_ino;
-}
-
 int cli_check_output(const char *path, const char *input, bool force, bool in_place) {
-    struct stat st;
-    bool exists = stat(path, &st) == 0;
-    if (!in_place && same_file(path, input)) {
+    if (!in_place && cli_same_file(path, input)) {
         fprintf(stderr, "rsmooth: %s: refusing to overwrite the input file (use --in-place)\n",
                 path);
         return EXIT_USAGE;
     }
-    if (exists && S_ISDIR(st.st_mode)) {
-        fprintf(stderr, "rsmooth: %s: is a directory\n", path);
-        return EXIT_USAGE;
-    }
-    if (exists && !force && !in_place) {
-        fprintf(stderr, "rsmooth: %s: already exists (use --force to replace it)\n", path);
-        return EXIT_USAGE;
-    }
+    int code = cli_check_output_path(path, force || in_place);
+    if (code >= 0)
+        return code;
     if (rsmooth_format_from_path(path) == RSMOOTH_FORMAT_AUTO) {
         fprintf(stderr, "rsmooth: %s: unknown output format (use .obj, .ply, .off or .stl)\n",
                 path);
         return EXIT_USAGE;
     }
     return -1;
-}
-
-/* The temporary file being written, removed if a signal interrupts the command. */
-static volatile sig_atomic_t have_temporary;
-static char temporary[4096];
-
-static void remove_temporary_and_exit(int signal_number) {
-    if (have_temporary)
-        unlink(temporary);
-    signal(signal_number, SIG_DFL);
-    raise(signal_number);
-}
-
-int cli_write_atomically(const char *path, cli_writer write, void *user) {
-    if (strlen(path) + 16 > sizeof temporary) {
-        fprintf(stderr, "rsmooth: %s: path too long\n", path);
-        return EXIT_OTHER;
-    }
-    snprintf(temporary, sizeof temporary, "%s.tmp-XXXXXX", path);
-    int fd = mkstemp(temporary);
-    if (fd < 0) {
-        fprintf(stderr, "rsmooth: %s: cannot create a temporary file beside it: %s\n", path,
-                strerror(errno));
-        return EXIT_OTHER;
-    }
-    have_temporary = 1;
-    signal(SIGINT, remove_temporary_and_exit);
-    signal(SIGTERM, remove_temporary_and_exit);
-    signal(SIGHUP, remove_temporary_and_exit);
-    FILE *f = fdopen(fd, "wb");
-    char message[256] = "";
-    bool ok = false;
-    if (f) {
-        ok = write(f, user, message, sizeof message) == 0;
-        if (fclose(f) != 0 && ok) {
-            ok = false;
-            snprintf(message, sizeof message, "%s", strerror(errno));
-        }
-    } else {
-        snprintf(message, sizeof message, "%s", strerror(errno));
-        close(fd);
-    }
-    if (ok) {
-        mode_t mask = umask(0); /* mkstemp makes 0600 files; give the usual permissions */
-        umask(mask);
-        chmod(temporary, 0666 & ~mask);
-        if (rename(temporary, path) != 0) {
-            snprintf(message, sizeof message, "%s", strerror(errno));
-            ok = false;
-        }
-    }
-    if (!ok) {
-        fprintf(stderr, "rsmooth: %s: cannot write: %s\n", path, message);
-        unlink(temporary);
-    }
-    have_temporary = 0;
-    signal(SIGINT, SIG_DFL);
-    signal(SIGTERM, SIG_DFL);
-    signal(SIGHUP, SIG_DFL);
-    return ok ? EXIT_OK : EXIT_OTHER;
 }
 
 typedef struct mesh_write {
@@ -195,7 +121,8 @@ static int write_mesh_stream(FILE *f, void *user, char *message, size_t size) {
     return -1;
 }
 
-int cli_write_mesh(const rsmooth_mesh *mesh, const char *path, rsmooth_format format) {
+int cli_write_mesh(const rsmooth_mesh *mesh, const char *path, rsmooth_format format,
+                   bool replace, bool quiet) {
     mesh_write w = {mesh, format};
-    return cli_write_atomically(path, write_mesh_stream, &w);
+    return cli_write_atomically(path, replace, quiet, write_mesh_stream, &w);
 }

@@ -1,5 +1,5 @@
-/* File handling of the rsmooth command: reading with progress, refusing to clobber, and writing
- * through a temporary file that is renamed only when complete. */
+/* Mesh files of the rsmooth command: reading with progress, checking an output before the work,
+ * and writing atomically (cli_output.h). */
 #ifndef RSMOOTH_CLI_FILES_H
 #define RSMOOTH_CLI_FILES_H
 
@@ -21,20 +21,15 @@ int cli_read_mesh(const char *path, cli_progress *bar, rsmooth_mesh **mesh);
 /* The output format for `path` (by extension), ascii variants when `ascii`; AUTO if unknown. */
 rsmooth_format cli_output_format(const char *path, bool ascii);
 
-/* -1 when `path` may be written: not the input (unless `in_place`), not an existing file unless
- * `force`, not a directory, a known extension. Else prints why and returns EXIT_USAGE. */
+/* -1 when `path` may be written: not the input (unless `in_place`), a known extension, and as
+ * cli_check_output_path allows with `force || in_place` (not an existing file without them, never
+ * a directory or a link to nothing). Else prints why and returns EXIT_USAGE. */
 int cli_check_output(const char *path, const char *input, bool force, bool in_place);
 
-/* Writes into a stream; returns 0, or -1 with what went wrong in `message`. */
-typedef int (*cli_writer)(FILE *stream, void *user, char *message, size_t size);
-
-/* Calls `write` on a temporary file beside `path` and renames it into place only when everything
- * succeeded, so an error or an interruption (SIGINT, SIGTERM, SIGHUP remove it) never leaves a
- * partial file. Prints what fails; returns EXIT_OK or EXIT_OTHER. */
-int cli_write_atomically(const char *path, cli_writer write, void *user);
-
-/* Writes `mesh` to a temporary file beside `path` and renames it into place, so an error or an
- * interruption never leaves a partial file. Prints what fails; returns EXIT_OK or EXIT_OTHER. */
-int cli_write_mesh(const rsmooth_mesh *mesh, const char *path, rsmooth_format format);
+/* Writes `mesh` through cli_write_atomically (`replace`: --force or --in-place; `quiet`: no
+ * warning about an owner that could not be kept). Returns EXIT_OK, EXIT_USAGE (the file exists
+ * and `replace` is off, or appeared meanwhile) or EXIT_OTHER. */
+int cli_write_mesh(const rsmooth_mesh *mesh, const char *path, rsmooth_format format,
+                   bool replace, bool quiet);
 
 #endif

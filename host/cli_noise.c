@@ -42,7 +42,9 @@ static const char noise_usage_text[] =
     "                   The same INPUT, options and seed give the same OUTPUT, byte for\n"
     "                   byte; a vertex moved by --impulsive moves exactly as without it.\n"
     "  --ascii          write PLY and STL as ascii (default binary little-endian)\n"
-    "  -f, --force      replace OUTPUT if it exists (never INPUT)\n"
+    "  -f, --force      replace OUTPUT if it exists (never INPUT), keeping its permissions,\n"
+    "                   owner and group; a symbolic link is written through (rsmooth --help,\n"
+    "                   Output files)\n"
     "  -q, --quiet      print nothing but errors\n"
     "  -h, --help       print this help\n"
     "\n"
@@ -50,7 +52,8 @@ static const char noise_usage_text[] =
     "  rsmooth noise fandisk.obj fandisk-0.3.obj --sigma 0.3 --seed 7\n"
     "  rsmooth noise part.ply part-impulsive.ply --sigma 0.5 --impulsive 0.1\n"
     "\n"
-    "Exit status: 0 success, 2 bad usage or bad input file, 1 other.\n";
+    "Exit status: 0 success, 2 bad usage, a bad input file or an OUTPUT that may not be\n"
+    "written, 1 other.\n";
 
 typedef struct noise_args {
     const char *input, *output;
@@ -190,7 +193,7 @@ int cli_noise_main(int argc, char **argv) {
     if (!a.quiet && rsmooth_mesh_conversion_losses(mesh, format, lost, sizeof lost) > 0)
         fprintf(stderr, "rsmooth noise: %s: this format cannot hold, so drops: %s\n", a.output,
                 lost);
-    if ((code = cli_write_mesh(mesh, a.output, format)) != EXIT_OK)
+    if ((code = cli_write_mesh(mesh, a.output, format, a.force, a.quiet)) != EXIT_OK)
         goto cleanup;
 
     if (!a.quiet) {

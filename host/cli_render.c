@@ -3,6 +3,7 @@
 #include "cli_args.h"
 #include "cli_commands.h"
 #include "cli_files.h"
+#include "cli_output.h"
 #include "mesh_render.h"
 #include "png_write.h"
 #include "rsmooth_io.h"
@@ -13,8 +14,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #define DEFAULT_PANEL 800
 #define MAX_SIDE 16384 /* keeps the supersampled buffers within a few GiB */
@@ -34,13 +33,15 @@ static const char render_usage[] =
     "  --azimuth DEG       camera angle about the up axis; 0 looks along -z (default 35)\n"
     "  --elevation DEG     camera angle above the horizon, in (-90, 90) (default 25)\n"
     "  --orthographic      parallel projection instead of perspective\n"
-    "  -f, --force         replace OUT if it exists\n"
+    "  -f, --force         replace OUT if it exists, keeping its permissions, owner and group\n"
+    "                      (a symbolic link is written through: rsmooth --help, Output files)\n"
     "  -h, --help          print this help\n"
     "\n"
     "Example:\n"
     "  rsmooth render noisy.ply smooth.ply conf.ply -o compare.png\n"
     "\n"
-    "Exit status: 0 success, 2 bad usage or an unreadable or malformed input, 1 other.\n";
+    "Exit status: 0 success, 2 bad usage, an unreadable or malformed input or an OUT that may\n"
+    "not be written, 1 other.\n";
 
 static bool parse_size(const char *s, int *w, int *h) {
     char *end;
@@ -137,29 +138,18 @@ int cli_render_main(int argc, char **argv) {
         free(inputs);
         return cli_usage_error("render", "--size is too narrow for that many panels");
     }
-    struct stat st;
-    if (stat(output, &st) == 0) {
-        if (S_ISDIR(st.st_mode)) {
-            fprintf(stderr, "rsmooth render: %s: is a directory\n", output);
+    for (size_t i = 0; i < input_count; i++) {
+        if (cli_same_file(output, inputs[i])) {
+            fprintf(stderr, "rsmooth render: %s: refusing to overwrite an input file\n", output);
             free(inputs);
             return 2;
-        }
-        if (!force) {
-            fprintf(stderr, "rsmooth render: %s: already exists (use --force to replace it)\n",
-                    output);
-            free(inputs);
-            return 2;
-        }
-        for (size_t i = 0; i < input_count; i++) {
-            struct stat in;
-            if (stat(inputs[i], &in) == 0 && in.st_dev == st.st_dev && in.st_ino == st.st_ino) {
-                fprintf(stderr, "rsmooth render: %s: refusing to overwrite an input file\n",
-                        output);
-                free(inputs);
-                return 2;
-            }
         }
     }
+    if ((status = cli_check_output_path(output, force)) >= 0) {
+        free(inputs);
+        return status;
+    }
+    status = 0;
 
     rsmooth_mesh **meshes = calloc(input_count, sizeof *meshes);
     render_mesh *views = calloc(input_count, sizeof *views);
@@ -189,7 +179,7 @@ int cli_render_main(int argc, char **argv) {
         goto done;
     }
     picture pic = {rgb, width, height};
-    status = cli_write_atomically(output, write_picture, &pic);
+    status = cli_write_atomically(output, force, false, write_picture, &pic);
 done:
     if (meshes)
         for (size_t i = 0; i < input_count; i++)

@@ -5,6 +5,7 @@
 #include "cli_args.h"
 #include "cli_commands.h"
 #include "cli_files.h"
+#include "cli_output.h"
 #include "cli_progress.h"
 #include "rsmooth_io.h"
 
@@ -77,7 +78,7 @@ static const char usage_text[] =
     "\n"
     "Options:\n"
     "  -o, --output FILE     result mesh (.obj, .ply, .off, .stl); refuses to replace an existing\n"
-    "                        file without --force, and never writes the input\n"
+    "                        file without --force, and never writes the input (see Output files)\n"
     "  --in-place            replace the input with the result (atomically; instead of -o)\n"
     "  --absolute            read --sigma-f and --sigma-g in the mesh's own units\n"
     "  --cutoff C            ignore triangles farther than C * sigma-f (default 2, range (0, 5])\n"
@@ -110,17 +111,30 @@ static const char usage_text[] =
     "  --stats               print statistics of the mesh and of what the filter did\n"
     "  --json                print one JSON object of counts, sigmas, device and stage times (ms)\n"
     "                        on stdout\n"
-    "  -f, --force           replace existing output files\n"
+    "  -f, --force           replace existing output files (see Output files)\n"
     "  -q, --quiet           print nothing but errors (no summary, warnings or progress bar)\n"
     "  --version             print the version\n"
     "  -h, --help            print this help\n"
+    "\n"
+    "Output files:\n"
+    "  The result goes to a temporary file in the output's folder (unnamed where the system\n"
+    "  allows, else .rsmooth-XXXXXX) that is put in place only when complete: an error, Ctrl-C\n"
+    "  or even kill -9 leaves no partial file, and the file it replaces stays as it was.\n"
+    "  Without --force nothing is ever replaced, not even by a concurrent run writing the same\n"
+    "  new file: one of them writes it, the other exits 2 ('already exists').\n"
+    "  A file replaced (--force, --in-place) keeps its permissions, owner and group; a user who\n"
+    "  is not root cannot give a file away, so then the result is theirs and a warning says so.\n"
+    "  A symbolic link is written through: --in-place on a link, or -o naming a link with\n"
+    "  --force, replaces the file it names and leaves the link as it is. A link to a missing\n"
+    "  file, a directory or another special file is never written.\n"
     "\n"
     "Examples:\n"
     "  rsmooth scan.ply -o smooth.ply\n"
     "  rsmooth part.stl -o part-smooth.stl --sigma-f 3 --sigma-g 0.4 --confidence conf.ply\n"
     "  rsmooth scan.obj --in-place --device gpu --stats\n"
     "\n"
-    "Exit status: 0 success, 2 bad usage or bad input file, 3 OpenCL device failure, 1 other.\n";
+    "Exit status: 0 success, 2 bad usage, a bad input file or an output that may not be\n"
+    "written (it exists, or appeared while this run worked), 3 OpenCL device failure, 1 other.\n";
 
 /* --method: the filter, or a baseline to compare it with. */
 typedef enum method { METHOD_ROBUST, METHOD_GAUSSIAN, METHOD_LAPLACIAN, METHOD_TAUBIN } method;
@@ -680,6 +694,11 @@ static int smooth_points(const options *opt, const rsmooth_mesh *mesh, double *o
 
 /* The confidence mesh: the result's surface, coloured, written without the input's extras. */
 static int write_confidence(rsmooth_mesh *mesh, const options *opt, float *confidence) {
+    if (cli_same_file(opt->confidence, opt->output)) { /* e.g. out.ply and ./out.ply */
+        fprintf(stderr, "rsmooth: %s: is the output file; the confidence mesh needs its own file\n",
+                opt->confidence);
+        return EXIT_USAGE;
+    }
     size_t nv = mesh->vertex_count;
     uint8_t *colours = malloc(nv * 3);
     if (!colours) {
@@ -709,8 +728,8 @@ static int write_confidence(rsmooth_mesh *mesh, const options *opt, float *confi
     mesh->vertex_quality = confidence;
     mesh->vertex_colors = colours;
     mesh->extras = NULL;
-    int code =
-        cli_write_mesh(mesh, opt->confidence, cli_output_format(opt->confidence, opt->ascii));
+    int code = cli_write_mesh(mesh, opt->confidence, cli_output_format(opt->confidence, opt->ascii),
+                              opt->force, opt->quiet);
     mesh->vertex_quality = quality;
     mesh->vertex_colors = input_colours;
     mesh->extras = extras;
@@ -796,7 +815,7 @@ int main(int argc, char **argv) {
     if ((code = cli_check_output(opt.output, opt.input, opt.force, opt.in_place)) >= 0)
         return code;
     if (opt.confidence) {
-        if (!strcmp(opt.confidence, opt.output)) {
+        if (!strcmp(opt.confidence, opt.output) || cli_same_file(opt.confidence, opt.output)) {
             fprintf(stderr, "rsmooth: %s: the confidence mesh needs its own file\n",
                     opt.confidence);
             return EXIT_USAGE;
@@ -858,7 +877,7 @@ int main(int argc, char **argv) {
     rsmooth_format format = cli_output_format(opt.output, opt.ascii);
     cli_progress_clear(&bar);
     warn_losses(mesh, opt.output, format, opt.quiet);
-    code = cli_write_mesh(mesh, opt.output, format);
+    code = cli_write_mesh(mesh, opt.output, format, opt.force || opt.in_place, opt.quiet);
     if (code == EXIT_OK && opt.confidence)
         code = write_confidence(mesh, &opt, confidence);
     mesh->positions = input_positions;

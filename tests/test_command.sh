@@ -76,7 +76,7 @@ expect 2 "$rsmooth" noisy.ply
 expect 3 "$rsmooth" noisy.ply -o x.ply --device "no such device"
 grep -q "no such device" err.txt || fail "device failure not explained: $(cat err.txt)"
 [ -e x.ply ] && fail "output written after a failure"
-ls ./*tmp-* >/dev/null 2>&1 && fail "temporary files left behind: $(ls ./*tmp-*)"
+ls -A | grep -qE 'tmp-|^\.rsmooth-' && fail "temporary files left behind: $(ls -A)"
 
 # With no OpenCL platform at all, auto falls back to the reference path with a warning.
 OCL_ICD_VENDORS=/nonexistent OCL_ICD_FILENAMES= expect 0 "$rsmooth" noisy.ply -o fallback.ply
@@ -166,7 +166,7 @@ expect 0 "$rsmooth" render noisy.ply -o pair.png --force --azimuth 200 --elevati
 expect 2 "$rsmooth" render missing.ply -o missing.png
 [ -e missing.png ] && fail "render wrote a picture of a missing mesh"
 expect 2 "$rsmooth" render noisy.ply -o bad.png --elevation 90
-ls pair.png.tmp-* >/dev/null 2>&1 && fail "render left a temporary file"
+ls -A | grep -qE 'tmp-|^\.rsmooth-' && fail "render left a temporary file: $(ls -A)"
 
 # Beyond the paper: the best mode beats the paper's defaults on the same noisy shape, and every
 # new option is checked before any file is read.
@@ -229,10 +229,187 @@ expect 2 "$rsmooth" two_tone.ply -o x.ply --sigma-c 0
 expect 2 "$rsmooth" two_tone.ply -o x.ply --sigma-c 0.1 --method taubin
 [ -e x.ply ] && fail "a refused --sigma-c call wrote its output"
 
+# ---- Files on disk ----------------------------------------------------------------------------
+# mode_owner FILE: "MODE UID GID"
+mode_owner() { stat -c '%a %u %g' "$1"; }
+# only_files DIR NAME...: fails unless DIR holds exactly these names (nothing left behind)
+only_files() {
+  local where=$1; shift
+  local have want
+  have=$(ls -A "$where" | sort | tr '\n' ' ')
+  want=$(printf '%s\n' "$@" | sort | tr '\n' ' ')
+  [ "$have" = "$want" ] || fail "$where holds '$have', wanted '$want'"
+}
+expect 0 "$shape" make small.ply smalltruth.ply --noise 0.3 --triangles 2000
+expect 0 "$rsmooth" small.ply -o small_a.ply -q --device reference --sigma-g inf
+expect 0 "$rsmooth" small.ply -o small_b.ply -q --device reference
+cmp -s small_a.ply small_b.ply && fail "two settings give the same result: the tests below cannot tell them apart"
+
+# Two runs racing to one new output without --force: exactly one exits 0, the file is complete and
+# the winner's; the other exits 2 saying the file exists, and leaves nothing behind. Also with the
+# named temporary the command falls back to where O_TMPFILE is missing (RSMOOTH_NAMED_TEMPORARY=1;
+# RSMOOTH_UNUSED=1 changes nothing).
+for temporary in RSMOOTH_UNUSED RSMOOTH_NAMED_TEMPORARY; do
+  rm -rf race && mkdir race
+  late=0
+  for i in $(seq 1 20); do
+    env $temporary=1 "$rsmooth" small.ply -o race/out$i.ply -q --device reference --sigma-g inf \
+      2>race.a &
+    a=$!
+    env $temporary=1 "$rsmooth" small.ply -o race/out$i.ply -q --device reference 2>race.b &
+    b=$!
+    wait $a; sa=$?
+    wait $b; sb=$?
+    if [ "$sa" -eq 0 ] && [ "$sb" -eq 2 ]; then winner=small_a.ply loser=race.b
+    elif [ "$sa" -eq 2 ] && [ "$sb" -eq 0 ]; then winner=small_b.ply loser=race.a
+    else fail "racing runs ($temporary temporary) exited $sa and $sb: $(cat race.a race.b)"; continue
+    fi
+    grep -q "race/out$i.ply: already exists" $loser || fail "the racing loser says: $(cat $loser)"
+    grep -q "while" $loser && late=$((late + 1))
+    cmp -s race/out$i.ply $winner || fail "race/out$i.ply is not the winner's result"
+  done
+  only_files race $(for i in $(seq 1 20); do echo out$i.ply; done)
+  echo "races ($temporary temporary): 20 pairs, $late lost at the final link (the rest at the start)"
+done
+
+# kill -9 while the result is being written (a 300,000-triangle OBJ: about 0.3 s of writing) leaves
+# nothing but the previous target, untouched; the kill lands once the process holds a file open in
+# the output's folder, which it does only while writing.
+# kill_while_writing DIR COMMAND...
+kill_while_writing() {
+  local where caught=0 status pid
+  where=$(cd "$1" && pwd -P); shift
+  "$@" 2>/dev/null &
+  pid=$!
+  for _ in $(seq 1 20000); do
+    if ls -l /proc/$pid/fd 2>/dev/null | grep -q -- "-> $where/"; then
+      kill -9 $pid && caught=1
+      break
+    fi
+    kill -0 $pid 2>/dev/null || break
+  done
+  { wait $pid; } 2>/dev/null # no "Killed" notice from the shell
+  status=$?
+  [ $caught -eq 1 ] && [ $status -eq 137 ] ||
+    fail "could not kill the command while it wrote (status $status): $*"
+}
+expect 0 "$shape" make large.ply largetruth.ply --triangles 300000
+rm -rf killed && mkdir killed
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > killed/target.obj
+cp killed/target.obj target_before.obj
+kill_while_writing killed "$rsmooth" large.ply -o killed/target.obj --force --method laplacian --iterations 1
+only_files killed target.obj
+cmp -s killed/target.obj target_before.obj || fail "kill -9 changed the previous target"
+kill_while_writing killed "$rsmooth" large.ply -o killed/new.obj --method laplacian --iterations 1
+only_files killed target.obj
+# where O_TMPFILE is missing the temporary has a name: a short hidden one, the target untouched
+RSMOOTH_NAMED_TEMPORARY=1 kill_while_writing killed "$rsmooth" large.ply -o killed/target.obj --force --method laplacian --iterations 1
+cmp -s killed/target.obj target_before.obj || fail "kill -9 changed the previous target (named)"
+ls -A killed | grep -v '^target\.obj$' | grep -qv '^\.rsmooth-' &&
+  fail "the named temporary is not .rsmooth-XXXXXX: $(ls -A killed)"
+
+# An output name of 255 bytes (the longest a name may be): created, replaced and smoothed in place.
+long=$(printf '%0251d' 0 | tr 0 n).ply
+for temporary in RSMOOTH_UNUSED RSMOOTH_NAMED_TEMPORARY; do
+  rm -f "$long"
+  env $temporary=1 "$rsmooth" small.ply -o "$long" -q --device reference 2>err.txt ||
+    fail "a 255-byte output name failed: $(cat err.txt)"
+  cmp -s "$long" small_b.ply || fail "the 255-byte output does not hold the result"
+  env $temporary=1 "$rsmooth" small.ply -o "$long" --force -q --device reference --sigma-g inf 2>err.txt ||
+    fail "replacing a 255-byte output name failed: $(cat err.txt)"
+  cmp -s "$long" small_a.ply || fail "--force did not replace the 255-byte output"
+  env $temporary=1 "$rsmooth" "$long" --in-place -q --device reference 2>err.txt ||
+    fail "--in-place on a 255-byte name failed: $(cat err.txt)"
+done
+rm -f "$long"
+
+# --in-place and --force keep the mode, owner and group of the file they replace; a new file gets
+# the umask's mode.
+cp small.ply perm.ply && chmod 0600 perm.ply
+cp small_a.ply permout.ply && chmod 0640 permout.ply
+if [ "$(id -u)" -eq 0 ]; then
+  chown 1234:1234 perm.ply
+  chown 1234:5678 permout.ply
+  owner_600="600 1234 1234" owner_640="640 1234 5678"
+else
+  echo "not root: checking that modes are kept (owners are the runner's own)"
+  owner_600="600 $(id -u) $(id -g)" owner_640="640 $(id -u) $(id -g)"
+fi
+expect 0 "$rsmooth" perm.ply --in-place -q --device reference
+[ "$(mode_owner perm.ply)" = "$owner_600" ] ||
+  fail "--in-place changed the mode or owner: $(mode_owner perm.ply), was $owner_600"
+cmp -s perm.ply small_b.ply || fail "--in-place did not write the result"
+expect 0 "$rsmooth" small.ply -o permout.ply --force -q --device reference
+[ "$(mode_owner permout.ply)" = "$owner_640" ] ||
+  fail "--force changed the mode or owner: $(mode_owner permout.ply), was $owner_640"
+cmp -s permout.ply small_b.ply || fail "--force did not write the result"
+(umask 027 && "$rsmooth" small.ply -o umask.ply -q --device reference) || fail "umask run failed"
+[ "$(stat -c %a umask.ply)" = 640 ] || fail "a new file ignores the umask: $(stat -c %a umask.ply)"
+# Not root: another user's file replaced keeps its mode; its owner cannot be kept, and that is said.
+if [ "$(id -u)" -eq 0 ] && command -v setpriv >/dev/null &&
+  setpriv --reuid=1234 --regid=1234 --clear-groups true 2>/dev/null; then
+  as_user() { setpriv --reuid=1234 --regid=1234 --clear-groups "$@"; }
+  chmod 0711 "$dir"
+  mkdir -m 0777 shared
+  cp small.ply shared/in.ply && chmod 0644 shared/in.ply
+  cp small_a.ply shared/theirs.ply && chown 4321:4321 shared/theirs.ply && chmod 0604 shared/theirs.ply
+  expect 0 as_user "$rsmooth" shared/in.ply -o shared/theirs.ply --force --device reference
+  [ "$(mode_owner shared/theirs.ply)" = "604 1234 1234" ] ||
+    fail "another user's file replaced: $(mode_owner shared/theirs.ply), wanted 604 1234 1234"
+  grep -q "shared/theirs.ply: warning: .*owner" err.txt ||
+    fail "the changed owner is not said: $(cat err.txt)"
+  cp small.ply shared/mine.ply && chown 1234:1234 shared/mine.ply && chmod 0600 shared/mine.ply
+  expect 0 as_user "$rsmooth" shared/mine.ply --in-place --device reference
+  [ "$(mode_owner shared/mine.ply)" = "600 1234 1234" ] ||
+    fail "a user's own file in place: $(mode_owner shared/mine.ply)"
+  grep -q "warning" err.txt && fail "a warning for a file whose owner was kept: $(cat err.txt)"
+  cmp -s shared/mine.ply small_b.ply || fail "--in-place as a user did not write the result"
+  only_files shared in.ply theirs.ply mine.ply
+else
+  echo "skipping the non-root ownership checks (needs root and setpriv)"
+fi
+
+# Symbolic links: --in-place writes through to the file a link names (the link stays); -o naming a
+# link to a file needs --force and then writes through too; a link to nothing is never written
+# through; a file that is not a regular file is never replaced.
+rm -rf real && mkdir real
+cp small.ply real/target.ply && chmod 0640 real/target.ply
+ln -s real/target.ply link.ply
+ln -s link.ply link2.ply
+expect 0 "$rsmooth" link2.ply --in-place -q --device reference
+[ -L link.ply ] && [ "$(readlink link.ply)" = real/target.ply ] || fail "--in-place replaced the link"
+[ -L link2.ply ] && [ "$(readlink link2.ply)" = link.ply ] || fail "--in-place replaced the link"
+cmp -s real/target.ply small_b.ply || fail "--in-place on a link did not smooth its target"
+[ "$(stat -c %a real/target.ply)" = 640 ] || fail "--in-place on a link changed the target's mode"
+only_files real target.ply
+cp small_a.ply real/out.ply
+ln -s real/out.ply outlink.ply
+expect 2 "$rsmooth" small.ply -o outlink.ply --device reference
+grep -q "outlink.ply: already exists" err.txt || fail "a link to a file replaced: $(cat err.txt)"
+cmp -s real/out.ply small_a.ply || fail "a link's target changed without --force"
+expect 0 "$rsmooth" small.ply -o outlink.ply --force -q --device reference
+[ -L outlink.ply ] || fail "-o LINK --force replaced the link"
+cmp -s real/out.ply small_b.ply || fail "-o LINK --force did not write the link's target"
+ln -s real/nothing.ply dangling.ply
+for force in "" --force; do
+  expect 2 "$rsmooth" small.ply -o dangling.ply $force --device reference
+  grep -q "dangling.ply: is a symbolic link to .*nothing.ply.*, which does not exist" err.txt ||
+    fail "a dangling link $force is not explained: $(cat err.txt)"
+  [ -L dangling.ply ] && [ ! -e real/nothing.ply ] || fail "a dangling link was written $force"
+done
+only_files real target.ply out.ply
+mkfifo fifo.ply
+expect 2 "$rsmooth" small.ply -o fifo.ply --force --device reference
+grep -q "fifo.ply: is not a regular file" err.txt || fail "a FIFO output is not refused: $(cat err.txt)"
+[ -p fifo.ply ] || fail "a FIFO was replaced"
+
 expect 0 "$rsmooth" --help
 grep -q "sigma-g" out.txt || fail "--help does not explain sigma-g"
 grep -q "\-\-sigma-c" out.txt || fail "--help does not explain --sigma-c"
 grep -q "\-\-best" out.txt || fail "--help does not explain --best"
+grep -q "symbolic link" out.txt || fail "--help does not say what happens to symbolic links"
+grep -q "owner" out.txt || fail "--help does not say that the mode and owner are kept"
+grep -q "concurrent" out.txt || fail "--help does not say what concurrent runs do"
 expect 0 "$rsmooth" --version
 
 if [ "$failures" -ne 0 ]; then

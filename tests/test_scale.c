@@ -3,7 +3,8 @@
  * supported range: coordinates up to 1e150 in magnitude, edges down to normal doubles), float64,
  * and from 1e-36 to 1e36 in float32. Oracles: the result at scale s equals s times the result at
  * scale 1 (the filter is scale-free), the result is closer to the noise-free roof than the input,
- * and the OpenCL path agrees with the reference path within 1e-3 mean edge lengths. Also: no
+ * and the OpenCL path agrees with the reference path within 1e-3 mean edge lengths; the noise
+ * estimate and point clouds are scale-free too. Also: no
  * non-finite value is ever returned with RSMOOTH_OK (a tetrahedron with one vertex at 1e39, float32
  * results beyond FLT_MAX, weights beyond float's range). */
 #include "mesh_shapes.h"
@@ -293,6 +294,53 @@ static void test_dynamic_range(void) {
     shape_free(&r.noisy);
 }
 
+/* The other scale-free results at the ends of the range: the noise estimate, and a point cloud
+ * (the roof's vertices with their normals) filtered on the reference path. */
+static void test_points_and_noise(const roof *r) {
+    const shape_mesh *m = &r->noisy;
+    size_t n = m->vertex_count;
+    double *normals = malloc(3 * n * sizeof *normals), *xyz = malloc(3 * n * sizeof *xyz);
+    double *out = malloc(3 * n * sizeof *out), *at_one = malloc(3 * n * sizeof *at_one);
+    CHECK(normals && xyz && out && at_one);
+    CHECK(shape_vertex_normals(m, normals) == 0);
+    rsmooth_error err;
+    double noise_one = 0, spacing_one = 0;
+    CHECK_STATUS(rsmooth_estimate_noise(RSMOOTH_FLOAT64, m->xyz, n, m->indices, m->triangle_count,
+                                        &noise_one, &err),
+                 RSMOOTH_OK);
+    CHECK_STATUS(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, m->xyz, normals, n, NULL, at_one,
+                                                 NULL, NULL, NULL, &err),
+                 RSMOOTH_OK);
+    CHECK_STATUS(rsmooth_point_spacing(RSMOOTH_FLOAT64, m->xyz, n, &spacing_one, &err),
+                 RSMOOTH_OK);
+    static const int decades[] = {SMALLEST_DECADE, -150, -20, 20, 150 - 2};
+    for (size_t i = 0; i < sizeof decades / sizeof *decades; i++) {
+        double s = pow(10, decades[i]), noise = 0, spacing = 0, moved = 0;
+        for (size_t k = 0; k < 3 * n; k++)
+            xyz[k] = m->xyz[k] * s;
+        CHECK_STATUS(rsmooth_estimate_noise(RSMOOTH_FLOAT64, xyz, n, m->indices,
+                                            m->triangle_count, &noise, &err),
+                     RSMOOTH_OK);
+        CHECK_STATUS(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, normals, n, NULL, out,
+                                                     NULL, NULL, NULL, &err),
+                     RSMOOTH_OK);
+        CHECK_STATUS(rsmooth_point_spacing(RSMOOTH_FLOAT64, xyz, n, &spacing, &err), RSMOOTH_OK);
+        for (size_t k = 0; k < 3 * n; k++)
+            moved = fmax(moved, fabs(out[k] / s - at_one[k]));
+        printf("at 1e%d: noise %.6f (at 1: %.6f), point spacing / s %.6f (%.6f), points / s - "
+               "points at 1: %.3g\n",
+               decades[i], noise, noise_one, spacing / s, spacing_one, moved);
+        CHECK_NEAR(noise, noise_one, 1e-9);
+        CHECK_NEAR(spacing / s, spacing_one, 1e-9);
+        CHECK_LE(moved, 1e-9);
+    }
+    CHECK(noise_one > 0.05); /* there is noise to find */
+    free(normals);
+    free(xyz);
+    free(out);
+    free(at_one);
+}
+
 int main(void) {
     rsmooth_context *ctx = open_test_context();
     roof r;
@@ -314,6 +362,7 @@ int main(void) {
     CHECK_LE(s32.worst_cl, 1e-3);
     CHECK_LE(s32.worst_gain, 0.6);
     test_tall_tetrahedron(ctx);
+    test_points_and_noise(&r);
     test_unrepresentable(ctx);
     test_dynamic_range();
     shape_free(&r.noisy);
