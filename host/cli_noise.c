@@ -17,6 +17,10 @@
 #include <string.h>
 
 #define DEFAULT_SEED 1
+/* Mean edge lengths: larger noise no longer leaves a noisy copy of the mesh. */
+#define MAX_SIGMA 1e6
+/* The largest coordinate magnitude rsmooth reads (rsmooth.h): the output must stay readable. */
+#define MAX_COORDINATE 1e150
 
 static const char noise_usage_text[] =
     "usage: rsmooth noise INPUT OUTPUT --sigma S [options]\n"
@@ -28,8 +32,9 @@ static const char noise_usage_text[] =
     "\n"
     "Options:\n"
     "  --sigma S        standard deviation of each vertex's displacement along its direction,\n"
-    "                   in mean edge lengths of INPUT (the mean over its unique edges); >= 0.\n"
-    "                   Required.\n"
+    "                   in mean edge lengths of INPUT (the mean over its unique edges); in\n"
+    "                   [0, 1e6]. Required. Noise that would carry a coordinate beyond 1e150\n"
+    "                   (what rsmooth reads) is refused and nothing is written.\n"
     "  --direction D    normal (default): along the vertex normal (area-weighted normals of\n"
     "                   INPUT; a vertex no triangle uses gets a random direction). random:\n"
     "                   along a uniformly random unit direction per vertex, so the noise also\n"
@@ -96,9 +101,9 @@ static int parse_noise_args(int argc, char **argv, noise_args *a) {
             if (!cli_parse_number(value, &x))
                 return cli_usage_error("noise", "%s: not a number: '%s'", arg, value);
             if (!strcmp(arg, "--sigma")) {
-                if (!(x >= 0) || !isfinite(x))
-                    return cli_usage_error("noise", "--sigma must be a number >= 0 (got '%s')",
-                                           value);
+                if (!(x >= 0 && x <= MAX_SIGMA))
+                    return cli_usage_error("noise", "--sigma must be in [0, %g] mean edge lengths "
+                                           "(got '%s')", MAX_SIGMA, value);
                 a->noise.sigma = x;
                 a->have_sigma = true;
             } else {
@@ -156,6 +161,22 @@ static int parse_noise_args(int argc, char **argv, noise_args *a) {
     return -1;
 }
 
+/* The noisy mesh must be one rsmooth reads back: every coordinate finite and within
+ * MAX_COORDINATE. Else says which vertex went where and returns EXIT_USAGE (nothing written). */
+static int check_coordinates(const noise_args *a, const rsmooth_mesh *mesh) {
+    for (size_t v = 0; v < mesh->vertex_count; v++) {
+        const double *p = mesh->positions + 3 * v;
+        if (fabs(p[0]) <= MAX_COORDINATE && fabs(p[1]) <= MAX_COORDINATE &&
+            fabs(p[2]) <= MAX_COORDINATE)
+            continue;
+        fprintf(stderr, "rsmooth noise: %s: not written: --sigma %g would move vertex %zu of %s "
+                        "to (%g, %g, %g), beyond the supported magnitude %g (lower --sigma)\n",
+                a->output, a->noise.sigma, v, a->input, p[0], p[1], p[2], MAX_COORDINATE);
+        return EXIT_USAGE;
+    }
+    return EXIT_OK;
+}
+
 int cli_noise_main(int argc, char **argv) {
     noise_args a;
     int code = parse_noise_args(argc, argv, &a);
@@ -187,6 +208,9 @@ int cli_noise_main(int argc, char **argv) {
         fprintf(stderr, "rsmooth noise: %s: out of memory\n", a.input);
         goto cleanup;
     }
+
+    if ((code = check_coordinates(&a, mesh)) != EXIT_OK)
+        goto cleanup;
 
     rsmooth_format format = cli_output_format(a.output, a.ascii);
     char lost[512];

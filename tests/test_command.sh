@@ -403,6 +403,18 @@ expect 2 "$rsmooth" small.ply -o fifo.ply --force --device reference
 grep -q "fifo.ply: is not a regular file" err.txt || fail "a FIFO output is not refused: $(cat err.txt)"
 [ -p fifo.ply ] || fail "a FIFO was replaced"
 
+# rsmooth noise never writes what rsmooth refuses: an absurd sigma is a usage error, and noise that
+# would carry a vertex beyond the supported magnitude (1e150) is refused before writing.
+expect 2 "$rsmooth" noise smalltruth.ply huge.ply --sigma 1e308
+grep -q -- "--sigma" err.txt || fail "--sigma 1e308 is not explained: $(cat err.txt)"
+[ -e huge.ply ] && fail "rsmooth noise wrote a result for --sigma 1e308"
+printf 'v 0 0 0\nv 1e148 0 0\nv 0 1e148 0\nv 0 0 1e148\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n' > vast.obj
+expect 2 "$rsmooth" noise vast.obj vast_noisy.obj --sigma 1e4
+grep -q "vast_noisy.obj: .*beyond" err.txt || fail "noise beyond 1e150 is not explained: $(cat err.txt)"
+[ -e vast_noisy.obj ] && fail "rsmooth noise wrote coordinates beyond 1e150"
+expect 0 "$rsmooth" noise vast.obj vast_noisy.obj --sigma 1e-3 -q
+expect 0 "$rsmooth" vast_noisy.obj -o vast_smooth.obj -q --device reference
+
 expect 0 "$rsmooth" --help
 grep -q "sigma-g" out.txt || fail "--help does not explain sigma-g"
 grep -q "\-\-sigma-c" out.txt || fail "--help does not explain --sigma-c"
