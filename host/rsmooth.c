@@ -103,10 +103,11 @@ static const char usage_text[] =
     "                        mesh's range: red its lowest (few triangles agreed: sharp edges,\n"
     "                        outliers, sparse parts), blue its highest. OBJ: colours only.\n"
     "  --ascii               write PLY and STL as ascii (default binary little-endian)\n"
-    "  --memory-budget SIZE  device memory one run may hold (e.g. 256M, 2G; default: most of the\n"
-    "                        device's). A mesh that needs more is filtered in spatial tiles, with\n"
-    "                        the same result to float rounding. Also read from\n"
-    "                        RSMOOTH_MEMORY_BUDGET.\n"
+    "  --memory-budget SIZE  device memory one run may hold (e.g. 256M, 2G; above 0; default:\n"
+    "                        most of the device's). A mesh that needs more is filtered in spatial\n"
+    "                        tiles, with the same result to float rounding. Also read from\n"
+    "                        RSMOOTH_MEMORY_BUDGET (the option wins); for the default leave both\n"
+    "                        out.\n"
     "  --list-devices        list the OpenCL devices and how --device names them, then exit\n"
     "  --stats               print statistics of the mesh and of what the filter did\n"
     "  --json                print one JSON object of counts, sigmas, device and stage times (ms)\n"
@@ -215,7 +216,8 @@ static int parse_args(int argc, char **argv, options *opt) {
                 return cli_usage_error(NULL, "%s needs a value", a);
             if (!cli_parse_bytes(value, &opt->memory_budget) || opt->memory_budget == 0)
                 return cli_usage_error(NULL, "--memory-budget: '%s' is not a byte count above 0 "
-                                             "(examples: 256M, 1.5G)", value);
+                                             "(examples: 256M, 1.5G; leave it out for most of "
+                                             "the device's memory)", value);
             i++;
         } else if (!strcmp(a, "--method")) {
             if (!value)
@@ -595,6 +597,9 @@ static int smooth(const options *opt, const rsmooth_mesh *mesh, double *out, flo
     rsmooth_status st;
     double ms_setup = 0;
     if (!reference) {
+        /* the option wins over the environment, as --device over RSMOOTH_DEVICE */
+        if (opt->memory_budget)
+            unsetenv("RSMOOTH_MEMORY_BUDGET");
         double t = cli_now_ms();
         st = rsmooth_context_create(device, &ctx, &err);
         ms_setup = cli_now_ms() - t;
@@ -606,6 +611,10 @@ static int smooth(const options *opt, const rsmooth_mesh *mesh, double *out, flo
                 fprintf(stderr, "rsmooth: warning: %s; using the reference path (slower)\n",
                         err.message);
             reference = true;
+        } else if (st == RSMOOTH_ERROR_INVALID_ARGUMENT) { /* a setting: RSMOOTH_MEMORY_BUDGET */
+            cli_progress_clear(bar);
+            fprintf(stderr, "rsmooth: %s\n", err.message);
+            return EXIT_USAGE;
         } else if (st != RSMOOTH_OK) {
             cli_progress_clear(bar);
             fprintf(stderr, "rsmooth: device '%s': %s: %s\n", device ? device : "auto",

@@ -81,25 +81,48 @@ static void raw_io(const char *path, size_t bytes, double *write_ms, double *rea
     unlink(path);
 }
 
+/* Exit statuses, as the rsmooth command's. */
+enum { EXIT_OK = 0, EXIT_OTHER = 1, EXIT_USAGE = 2, EXIT_DEVICE = 3 };
+
+static const char io_usage[] =
+    "usage: rsmooth-bench io [--triangles N] [--repeat R] [--dir DIR]\n"
+    "  times writing and reading a binary PLY and an OBJ of a generated noisy closed cylinder\n"
+    "  beside a raw write and read of the same bytes (the disk-bound limit); medians over R\n"
+    "  repetitions (JSON)\n"
+    "  --triangles N   about N triangles, at least 100 (default 1000000)\n"
+    "  --repeat R      repetitions, 1..99 (default 3)\n"
+    "  --dir DIR       where the files are written, then removed (default /tmp)\n";
+
+static int io_usage_error(const char *message, const char *value) {
+    fprintf(stderr, "rsmooth-bench io: %s '%s'\nTry 'rsmooth-bench io --help'.\n", message, value);
+    return EXIT_USAGE;
+}
+
 static int bench_io(int argc, char **argv) {
-    long triangles = 1000000;
+    double triangles = 1000000, x;
     int repeat = 3;
     const char *dir = "/tmp";
-    for (int i = 2; i + 1 < argc; i += 2) {
-        if (!strcmp(argv[i], "--triangles"))
-            triangles = atol(argv[i + 1]);
-        else if (!strcmp(argv[i], "--repeat"))
-            repeat = atoi(argv[i + 1]);
-        else if (!strcmp(argv[i], "--dir"))
-            dir = argv[i + 1];
-        else {
-            fprintf(stderr, "rsmooth-bench: unknown option %s\n", argv[i]);
-            return 2;
+    for (int i = 2; i < argc; i++) {
+        const char *a = argv[i], *value = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            fputs(io_usage, stdout);
+            return EXIT_OK;
+        } else if (strcmp(a, "--triangles") && strcmp(a, "--repeat") && strcmp(a, "--dir")) {
+            return io_usage_error("unknown option", a);
+        } else if (!value) {
+            return io_usage_error("an option needs a value:", a);
+        } else if (!strcmp(a, "--dir")) {
+            dir = value;
+        } else if (!strcmp(a, "--triangles")) {
+            if (!cli_parse_number(value, &triangles) ||
+                !(triangles >= 100 && triangles <= 1e9 && triangles == floor(triangles)))
+                return io_usage_error("--triangles must be a whole number in [100, 1e9]:", value);
+        } else if (!cli_parse_number(value, &x) || !(x >= 1 && x <= 99 && x == floor(x))) {
+            return io_usage_error("--repeat must be a whole number in 1..99:", value);
+        } else {
+            repeat = (int)x;
         }
-    }
-    if (triangles < 100 || repeat < 1 || repeat > 99) {
-        fprintf(stderr, "rsmooth-bench: need --triangles >= 100 and --repeat in 1..99\n");
-        return 2;
+        i++;
     }
     shape_mesh shape;
     if (shape_capped_cylinder(&shape, 1.0, 1.5, (size_t)triangles) != 0 ||
@@ -169,9 +192,6 @@ static int bench_io(int argc, char **argv) {
 
 /* ---- filter ---------------------------------------------------------------------------------- */
 
-/* Exit statuses, as the rsmooth command's. */
-enum { EXIT_OK = 0, EXIT_OTHER = 1, EXIT_USAGE = 2, EXIT_DEVICE = 3 };
-
 static const char filter_usage[] =
     "usage: rsmooth-bench filter [MESH] [--triangles N] [--noise S] [--sigma-f X] [--sigma-g Y]\n"
     "                            [--device D] [--repeat R] [--memory-budget SIZE] [--no-pairs]\n"
@@ -236,7 +256,8 @@ static int parse_filter_args(int argc, char **argv, filter_options *opt) {
             if (!value)
                 return filter_usage_error("--memory-budget needs a value", NULL);
             if (!cli_parse_bytes(value, &opt->memory_budget) || opt->memory_budget == 0)
-                return filter_usage_error("--memory-budget: not a byte count above 0:", value);
+                return filter_usage_error("--memory-budget: not a byte count above 0 (leave it "
+                                          "out for most of the device's memory):", value);
             i++;
         } else if (!strcmp(a, "--device")) {
             if (!value)
@@ -367,6 +388,10 @@ static int create_context(const char *device, rsmooth_context **ctx, double *ms)
     *ms = now_ms() - t0;
     if (st == RSMOOTH_OK)
         return EXIT_OK;
+    if (st == RSMOOTH_ERROR_INVALID_ARGUMENT) { /* a setting: RSMOOTH_MEMORY_BUDGET */
+        fprintf(stderr, "rsmooth-bench: %s\n", err.message);
+        return EXIT_USAGE;
+    }
     fprintf(stderr, "rsmooth-bench: device '%s': %s: %s\n", device ? device : "auto",
             rsmooth_status_str(st), err.message);
     if (err.build_log[0])
@@ -462,6 +487,9 @@ static int bench_filter(int argc, char **argv) {
     bench_grid grid;
     memset(&grid, 0, sizeof grid);
 
+    /* the option wins over the environment, as in the rsmooth command */
+    if (opt.memory_budget)
+        unsetenv("RSMOOTH_MEMORY_BUDGET");
     /* The program build twice: from source, then (PoCL) from its on-disk binary cache. */
     double ms_create_first, ms_create_cached, ms_build_first, ms_build_cached;
     if ((code = create_context(opt.device, &ctx, &ms_create_first)) != EXIT_OK)
@@ -632,10 +660,9 @@ int main(int argc, char **argv) {
         return bench_filter(argc, argv);
     bool help = argc >= 2 && (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help"));
     fprintf(help ? stdout : stderr,
-            "usage: rsmooth-bench io [--triangles N] [--repeat R] [--dir DIR]\n"
-            "  prints mesh-file read/write speed beside raw I/O of the same bytes (JSON)\n"
-            "%s"
-            "Each prints one JSON object of figures on stdout, never a pass or fail.\n",
-            filter_usage);
-    return help ? 0 : 2;
+            "%s%s"
+            "Each prints one JSON object of figures on stdout, never a pass or fail; "
+            "'rsmooth-bench io --help' and\n'rsmooth-bench filter --help' print one mode's help.\n",
+            io_usage, filter_usage);
+    return help ? EXIT_OK : EXIT_USAGE;
 }

@@ -7,6 +7,27 @@ bench=$1
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 
+# Every mode's --help prints its usage and exits 0 without running anything (io ran its benchmark).
+for mode in "" io filter; do
+  "$bench" $mode --help >"$dir/help.txt" 2>&1
+  status=$?
+  if [ "$status" -ne 0 ] || ! grep -q "^usage: rsmooth-bench ${mode:-io}" "$dir/help.txt" ||
+    grep -q '{' "$dir/help.txt"; then
+    echo "FAIL: rsmooth-bench $mode --help exited $status and printed: $(head -c 300 "$dir/help.txt")"
+    exit 1
+  fi
+done
+"$bench" io --repeat >/dev/null 2>&1
+[ $? -eq 2 ] || { echo "FAIL: rsmooth-bench io --repeat (no value) is not a usage error"; exit 1; }
+# A junk RSMOOTH_MEMORY_BUDGET is a usage error (2), not a device failure (3).
+RSMOOTH_MEMORY_BUDGET=lots "$bench" filter --triangles 300 --repeat 1 --no-pairs >/dev/null \
+  2>"$dir/err.txt"
+status=$?
+if [ "$status" -ne 2 ] && ! grep -q "no OpenCL device" "$dir/err.txt"; then
+  echo "FAIL: a junk RSMOOTH_MEMORY_BUDGET gives exit $status, not 2: $(cat "$dir/err.txt")"
+  exit 1
+fi
+
 "$bench" filter --triangles 3000 --repeat 2 >"$dir/out.json" 2>"$dir/err.txt"
 status=$?
 cat "$dir/err.txt"

@@ -415,6 +415,18 @@ grep -q "vast_noisy.obj: .*beyond" err.txt || fail "noise beyond 1e150 is not ex
 expect 0 "$rsmooth" noise vast.obj vast_noisy.obj --sigma 1e-3 -q
 expect 0 "$rsmooth" vast_noisy.obj -o vast_smooth.obj -q --device reference
 
+# The memory budget: junk or 0 is a usage error (2) from the option and from the variable alike;
+# the option wins over the variable.
+for budget in lots 0; do
+  RSMOOTH_MEMORY_BUDGET=$budget expect 2 "$rsmooth" small.ply -o x.ply
+  grep -q "RSMOOTH_MEMORY_BUDGET='$budget'" err.txt ||
+    fail "RSMOOTH_MEMORY_BUDGET=$budget is not named: $(cat err.txt)"
+done
+expect 2 "$rsmooth" small.ply -o x.ply --memory-budget 0
+grep -q "leave it out" err.txt || fail "--memory-budget 0 does not say how to get the default: $(cat err.txt)"
+RSMOOTH_MEMORY_BUDGET=lots expect 0 "$rsmooth" small.ply -o budget.ply -q --memory-budget 256M
+[ -e x.ply ] && fail "a refused memory budget wrote its output"
+
 expect 0 "$rsmooth" --help
 grep -q "sigma-g" out.txt || fail "--help does not explain sigma-g"
 grep -q "\-\-sigma-c" out.txt || fail "--help does not explain --sigma-c"
