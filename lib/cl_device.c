@@ -1,7 +1,7 @@
 /* Choosing an OpenCL device and owning (or sharing) its context and queue. */
 #define _POSIX_C_SOURCE 200809L
 #include "rsmooth_cl.h"
-#include "rsmooth_internal.h"
+#include "cl_internal.h"
 
 #include <ctype.h>
 #include <stdio.h>

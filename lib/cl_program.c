@@ -1,7 +1,7 @@
 /* Assembling and building the OpenCL program: a generated prelude, then common.cl, then one file per
  * phase. Kernels are embedded at build time; RSMOOTH_KERNEL_DIR loads them from a directory instead. */
 #define _POSIX_C_SOURCE 200809L
-#include "rsmooth_internal.h"
+#include "cl_internal.h"
 
 #include <stdio.h>
 #include <stdlib.h>

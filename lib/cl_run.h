@@ -3,7 +3,8 @@
 #ifndef RSMOOTH_CL_RUN_H
 #define RSMOOTH_CL_RUN_H
 
-#include "rsmooth_internal.h"
+#include "cl_internal.h"
+#include "spatial.h"
 
 #define LOG2_E 1.4426950408889634
 

@@ -637,7 +637,7 @@ static rsmooth_status cl_pass(void *context, rsmooth_scalar scalar, const void *
     if (st == RSMOOTH_OK) {
         rs_progress(&pb, 1.0);
         if (report) {
-            rs_report_problem(report, &pb, NULL, ctx->device_name);
+            rs_report_problem(report, &pb, 0, ctx->device_name);
             report->grid_cell_count = stats.cells;
             report->ms_facets = t_facets - t_start;
             report->ms_grid = stats.ms_grid;

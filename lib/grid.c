@@ -1,6 +1,6 @@
 /* Uniform grid over facet centroids: facets sorted by cell into contiguous ranges, occupied cells
  * found through a hash of their integer coordinates. Both paths and the kernels read it. */
-#include "rsmooth_internal.h"
+#include "spatial.h"
 
 #include <math.h>
 #include <string.h>

@@ -3,7 +3,7 @@
  * uneven density cost O(log n) per query all the same. Implicit and balanced: a node is a range of
  * `order` split at its middle, children of node i are 2i + 1 and 2i + 2, and only each node's
  * split axis and value are stored. */
-#include "rsmooth_internal.h"
+#include "spatial.h"
 
 #include <string.h>
 

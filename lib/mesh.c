@@ -435,29 +435,3 @@ void rs_problem_apply_params(rs_problem *problem, const rsmooth_params *p, doubl
     if (!(problem->sigma_f > 0) || !isfinite(problem->radius) || !isfinite(problem->normal_radius))
         problem->facet_count = 0; /* no edge of non-zero length: nothing can move */
 }
-
-void rs_report_problem(rsmooth_report *report, const rs_problem *problem, const rs_grid *grid,
-                       const char *device) {
-    memset(report, 0, sizeof *report);
-    report->vertex_count = problem->vertex_count;
-    report->triangle_count = problem->triangle_count;
-    report->facet_count = problem->facet_count;
-    report->mean_edge_length = problem->mean_edge_length;
-    report->sigma_f = problem->sigma_f;
-    report->sigma_g = problem->sigma_g;
-    report->radius = problem->radius;
-    report->mollify_radius = problem->bilateral ? problem->normal_radius
-                             : problem->mollify ? problem->mollify_radius
-                                                : 0;
-    rs_report_unscale(report, 1 / problem->scale);
-    report->grid_cell_count = grid ? grid->cell_count : 0;
-    snprintf(report->device, sizeof report->device, "%s", device);
-}
-
-void rs_report_unscale(rsmooth_report *report, double unscale) {
-    report->mean_edge_length *= unscale; /* exact: a power of two */
-    report->sigma_f *= unscale;
-    report->sigma_g *= unscale;
-    report->radius *= unscale;
-    report->mollify_radius *= unscale;
-}

@@ -39,7 +39,7 @@
  * not its neighbours. Up to MAX_SAMPLES vertices are used, at a fixed stride; each sample depends on
  * the positions alone and the medians on the samples alone, so the result is the same on every
  * run and for any thread count. */
-#include "rsmooth_internal.h"
+#include "spatial.h"
 
 #include <math.h>
 #include <stdlib.h>

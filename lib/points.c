@@ -3,7 +3,7 @@
  * is estimated from how far its nearest neighbours are; rs_reference_solve then runs the bilateral
  * normal filter and Eq. 3 on them unchanged. Points always take the bilateral filter when they
  * take one at all: the paper's mollification moves triangle corners, and points have none. */
-#include "rsmooth_internal.h"
+#include "spatial.h"
 
 #include <math.h>
 #include <string.h>

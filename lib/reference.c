@@ -1,7 +1,7 @@
 /* The reference path: Jones, Durand & Desbrun 2003 in double precision on one thread, written to be
  * read beside the paper. Mollification (Sec. 3.2), then robust estimation (Eq. 3). It is the oracle
  * the OpenCL path is tested against and the fallback when no OpenCL device exists. */
-#include "rsmooth_internal.h"
+#include "spatial.h"
 
 #include <float.h>
 #include <math.h>
@@ -359,7 +359,7 @@ done:
     rs_progress(&pb, 1.0);
     if (report) {
         double now = rs_now_ms();
-        rs_report_problem(report, &pb, &grid, "reference (double, 1 thread)");
+        rs_report_problem(report, &pb, grid.cell_count, "reference (double, 1 thread)");
         report->tiles = 1;
         report->ms_facets = t_facets - t_start;
         report->ms_grid = t_grid - t_facets;

@@ -5,6 +5,8 @@
 
 #include <float.h>
 #include <math.h>
+#include <stdio.h>
+#include <string.h>
 
 void rs_store_position(rsmooth_scalar scalar, void *out_positions, size_t v, const double p[3],
                        double unscale) {
@@ -66,4 +68,30 @@ rsmooth_status rs_check_results(rsmooth_scalar scalar, const void *out_positions
                            "the confidence of %s %zu (%g) is not in [0, 1]", noun, v,
                            (double)out_confidence[v]);
     return RSMOOTH_OK;
+}
+
+void rs_report_problem(rsmooth_report *report, const rs_problem *problem, size_t cell_count,
+                       const char *device) {
+    memset(report, 0, sizeof *report);
+    report->vertex_count = problem->vertex_count;
+    report->triangle_count = problem->triangle_count;
+    report->facet_count = problem->facet_count;
+    report->mean_edge_length = problem->mean_edge_length;
+    report->sigma_f = problem->sigma_f;
+    report->sigma_g = problem->sigma_g;
+    report->radius = problem->radius;
+    report->mollify_radius = problem->bilateral ? problem->normal_radius
+                             : problem->mollify ? problem->mollify_radius
+                                                : 0;
+    rs_report_unscale(report, 1 / problem->scale);
+    report->grid_cell_count = cell_count;
+    snprintf(report->device, sizeof report->device, "%s", device);
+}
+
+void rs_report_unscale(rsmooth_report *report, double unscale) {
+    report->mean_edge_length *= unscale; /* exact: a power of two */
+    report->sigma_f *= unscale;
+    report->sigma_g *= unscale;
+    report->radius *= unscale;
+    report->mollify_radius *= unscale;
 }

@@ -51,7 +51,6 @@ static inline bool rs_mul_overflows(size_t a, size_t b) {
 /* Monotonic clock in milliseconds. */
 double rs_now_ms(void);
 
-
 /* ---- parallel.c: host loops on every core ------------------------------------------------------ */
 
 /* Elements [begin, end) of a loop, as chunk number `chunk` (chunks are contiguous and in order). */
@@ -218,47 +217,9 @@ rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions
                                     size_t triangle_count, double *magnitude,
                                     rsmooth_error *error, const char *where);
 
-/* ---- scale.c: internal units ------------------------------------------------------------------ */
-
-/* The power of two both paths multiply coordinates by (and divide results by), chosen so a
- * typical edge (of sampled triangles; for points, the distance between consecutive points) is
- * about 1 long while the largest coordinate, `magnitude` (rs_check_coordinates), stays below
- * 2^500. Exact, so results do not depend on it. RSMOOTH_ERROR_INVALID_ARGUMENT when no power of
- * two fits both (a coordinate more than about 1e225 typical edges from the origin). */
-rsmooth_status rs_mesh_scale(rsmooth_scalar scalar, const void *positions,
-                             const uint32_t *indices, size_t triangle_count, double magnitude,
-                             double *scale, rsmooth_error *error, const char *where);
-rsmooth_status rs_points_scale(rsmooth_scalar scalar, const void *positions, size_t count,
-                               double magnitude, double *scale, rsmooth_error *error,
-                               const char *where);
-
-/* Caller's coordinates -> internal units: out[i] = coordinate i times `scale`, i < 3 count. */
-void rs_scale_positions(rsmooth_scalar scalar, const void *positions, size_t count, double scale,
-                        double *out);
-
-/* ---- results.c: what a call writes ----------------------------------------------------------- */
-
-/* k(p) (internal area units) as the float out_weight holds, in the caller's area units; NaN
- * when it exceeds FLT_MAX (rs_check_results then fails the call). */
-float rs_weight_value(double k, double unscale);
-
-/* Checks a call's outputs before it returns RSMOOTH_OK: every position and weight finite in the
- * caller's type (a float32 result beyond FLT_MAX, or k(p) of a mesh whose areas exceed float's
- * range, is RSMOOTH_ERROR_NUMERICAL naming the vertex) and every confidence in [0, 1]. Any array
- * but out_positions may be NULL. */
-rsmooth_status rs_check_results(rsmooth_scalar scalar, const void *out_positions,
-                                const float *out_weight, const float *out_confidence,
-                                size_t count, const char *noun, rsmooth_error *error,
-                                const char *where);
-
 /* Mean length of unique undirected edges over `xyz` (double). false on allocation failure. */
 bool rs_mean_edge_length(const double *xyz, size_t vertex_count, const uint32_t *indices,
                          size_t triangle_count, double *out_length);
-
-/* Writes the result for vertex v (double xyz, internal units) into the caller's array of type
- * `scalar`, times `unscale` (1 / the problem's scale; 1 for values in the caller's units). */
-void rs_store_position(rsmooth_scalar scalar, void *out_positions, size_t v, const double p[3],
-                       double unscale);
 
 /* Geometry helpers shared by the reference path and the host side of the OpenCL path. */
 static inline double rs_dot3(const double a[3], const double b[3]) {
@@ -292,6 +253,55 @@ static inline void rs_cross3(const double a[3], const double b[3], double out[3]
  * bottoms out near 1e-38): both paths then recompute the sums with the exponent shifted by its
  * smallest value, so the result is the mathematically defined weighted average. */
 #define RS_UNDERFLOW_RATIO 1e-30
+
+/* ---- scale.c: internal units ------------------------------------------------------------------ */
+
+/* The power of two both paths multiply coordinates by (and divide results by), chosen so a
+ * typical edge (of sampled triangles; for points, the distance between consecutive points) is
+ * about 1 long while the largest coordinate, `magnitude` (rs_check_coordinates), stays below
+ * 2^500. Exact, so results do not depend on it. RSMOOTH_ERROR_INVALID_ARGUMENT when no power of
+ * two fits both (a coordinate more than about 1e225 typical edges from the origin). */
+rsmooth_status rs_mesh_scale(rsmooth_scalar scalar, const void *positions,
+                             const uint32_t *indices, size_t triangle_count, double magnitude,
+                             double *scale, rsmooth_error *error, const char *where);
+rsmooth_status rs_points_scale(rsmooth_scalar scalar, const void *positions, size_t count,
+                               double magnitude, double *scale, rsmooth_error *error,
+                               const char *where);
+
+/* Caller's coordinates -> internal units: out[i] = coordinate i times `scale`, i < 3 count. */
+void rs_scale_positions(rsmooth_scalar scalar, const void *positions, size_t count, double scale,
+                        double *out);
+
+/* ---- results.c: what a call writes ----------------------------------------------------------- */
+
+/* k(p) (internal area units) as the float out_weight holds, in the caller's area units; NaN
+ * when it exceeds FLT_MAX (rs_check_results then fails the call). */
+float rs_weight_value(double k, double unscale);
+
+/* Checks a call's outputs before it returns RSMOOTH_OK: every position and weight finite in the
+ * caller's type (a float32 result beyond FLT_MAX, or k(p) of a mesh whose areas exceed float's
+ * range, is RSMOOTH_ERROR_NUMERICAL naming the vertex) and every confidence in [0, 1]. Any array
+ * but out_positions may be NULL. */
+rsmooth_status rs_check_results(rsmooth_scalar scalar, const void *out_positions,
+                                const float *out_weight, const float *out_confidence,
+                                size_t count, const char *noun, rsmooth_error *error,
+                                const char *where);
+
+/* Writes the result for vertex v (double xyz, internal units) into the caller's array of type
+ * `scalar`, times `unscale` (1 / the problem's scale; 1 for values in the caller's units). */
+void rs_store_position(rsmooth_scalar scalar, void *out_positions, size_t v, const double p[3],
+                       double unscale);
+
+/* Writes every vertex unmoved, with zero weight and confidence: the result when no facet carries
+ * weight (no triangles, or all of zero area). */
+void rs_store_unmoved(const rs_problem *problem, rsmooth_scalar scalar, void *out_positions,
+                      float *out_weight, float *out_confidence);
+
+/* Fills the parts of a report both paths share (lengths in the caller's units). */
+void rs_report_problem(rsmooth_report *report, const rs_problem *problem, size_t cell_count,
+                       const char *device);
+/* Multiplies a report's lengths by `unscale`: internal units to the caller's. */
+void rs_report_unscale(rsmooth_report *report, double unscale);
 
 /* ---- noise_estimate.c / params_auto.c: automatic parameters -------------------------------- */
 
@@ -347,202 +357,5 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar
                                 const rsmooth_params *params, void *out_positions,
                                 float *out_weight, float *out_confidence, rsmooth_report *report,
                                 rsmooth_error *error, const char *where);
-
-/* ---- grid.c: uniform grid over facet centroids, facets sorted by cell ------------------------- */
-
-/* Occupied cells are found through an open-addressing hash on their integer coordinates, so far-apart
- * components cost no empty cells. Cell edge >= reach / split, so a vertex's neighbours lie within
- * `split` cells of its own (the 27 around it when split is 1). */
-typedef struct rs_grid {
-    double origin[3];        /* minimum corner of the centroids' bounding box */
-    double cell_size;        /* h >= reach / split */
-    double inv_cell_size;    /* 1 / h: cells are found by multiplying (the margin in h absorbs
-                                the rounding) */
-    int32_t split;           /* cells per reach */
-    int32_t dims[3];         /* cells per axis covering the centroids */
-    size_t cell_count;       /* occupied cells */
-    int32_t *cell_coord;     /* 4 per cell: x, y, z, 0 */
-    uint32_t *cell_start;    /* cell_count + 1: facets of cell i are facet_order[start[i]..start[i+1]) */
-    uint32_t *facet_order;   /* facet ids sorted by cell */
-    /* rs_grid_build only: a hash table of the occupied cells */
-    uint32_t table_mask;     /* hash table size - 1 (a power of two) */
-    int32_t *table;          /* table_mask + 1 slots: cell index or -1 */
-    /* rs_grid_build_columns only. Columns: the occupied cells of one (x, y), consecutive in cell
-     * order (sorted by x, y, z). */
-    size_t column_count;
-    uint32_t *column_first;  /* column_count + 1: cells of column j are column_first[j] .. [j+1]-1 */
-    uint32_t column_mask;    /* column hash table size - 1 */
-    int32_t *column_table;   /* column_mask + 1 slots: column index or -1, hashed on (x, y, 0) */
-} rs_grid;
-
-/* Builds the grid over `count` points (3 doubles each) with cells at least `reach` wide, its
- * occupied cells found through `table` (rs_grid_find): the reference path's grid. */
-rsmooth_status rs_grid_build(rs_grid *grid, const double *points, size_t count, double reach,
-                             rsmooth_error *error);
-/* The OpenCL path's grid: cells at least reach / split wide (split >= 1) over the box [lo, hi],
- * which must hold every point (it may hold more: the OpenCL path makes it hold the vertices too, so
- * none of them is clamped), its occupied cells found by column (no `table`). */
-rsmooth_status rs_grid_build_columns(rs_grid *grid, const double *points, size_t count,
-                                     double reach, int split, const double lo[3],
-                                     const double hi[3], rsmooth_error *error);
-void rs_grid_free(rs_grid *grid);
-
-/* Cell coordinates of a point, clamped to [-split - 1, dims + split]: a point clamped there is more
- * than `split` cells away from every facet, so clamping never loses a neighbour. */
-void rs_grid_cell_of(const rs_grid *grid, const double p[3], int32_t cell[3]);
-
-/* The cell the grid filed a point it was built over in (rs_grid_cell_of, within the grid). */
-void rs_grid_facet_cell(const rs_grid *grid, const double p[3], int32_t cell[3]);
-
-/* Index of the occupied cell at (x, y, z), or -1 (a grid from rs_grid_build). */
-int32_t rs_grid_find(const rs_grid *grid, int32_t x, int32_t y, int32_t z);
-
-/* The hash both host and kernels use to place a cell in the table. */
-static inline uint32_t rs_grid_hash(int32_t x, int32_t y, int32_t z) {
-    return ((uint32_t)x * 73856093u) ^ ((uint32_t)y * 19349663u) ^ ((uint32_t)z * 83492791u);
-}
-
-/* Orders `count` points (3 doubles each) by grid cell in Morton (Z) order, so points that follow
- * each other are close in every direction: order[i] is the index of the i-th point in that order
- * and cells[3 i .. 3 i + 2] its cell (as rs_grid_cell_of gives it). */
-rsmooth_status rs_grid_order_points(const rs_grid *grid, const double *points, size_t count,
-                                    uint32_t *order, int32_t *cells, rsmooth_error *error);
-
-/* ---- kdtree.c: neighbour queries over a point set (point clouds) ------------------------------ */
-
-typedef struct rs_kdtree {
-    const double *xyz; /* 3 per point, borrowed: must outlive the tree */
-    size_t count;
-    uint32_t *order;   /* point indices, arranged as the tree's ranges */
-    uint8_t *axis;     /* split axis of each internal node */
-    double *split;     /* and the coordinate it splits at: left <= split <= right */
-} rs_kdtree;
-
-
-/* Builds the tree over `count` points (< 2^32). false when out of memory (tree then empty). */
-bool rs_kdtree_build(rs_kdtree *tree, const double *xyz, size_t count);
-void rs_kdtree_free(rs_kdtree *tree);
-
-/* The squared distances from p to its k nearest points, point `skip` left out (UINT32_MAX: none),
- * nearest first, into dist2[0 ..); returns how many were found (k, or fewer points). Thread-safe
- * on a built tree. */
-size_t rs_kdtree_nearest(const rs_kdtree *tree, const double p[3], uint32_t skip, size_t k,
-                         double *dist2);
-
-
-/* ---- cl_device.c / cl_program.c: the OpenCL context object ------------------------------------ */
-
-#ifndef CL_TARGET_OPENCL_VERSION
-#define CL_TARGET_OPENCL_VERSION 120
-#endif
-#include <CL/cl.h>
-#include <pthread.h>
-
-/* Vertices per block: the vector width the kernels use across vertices (float8, kernels/common.cl). */
-#define RS_LANES 8
-
-enum {
-    RS_KERNEL_MOLLIFY,
-    RS_KERNEL_NORMALS,
-    RS_KERNEL_BILATERAL,
-    RS_KERNEL_ROBUST,
-    RS_KERNEL_COUNT
-};
-
-struct rsmooth_context {
-    pthread_mutex_t lock;     /* serialises the calls of threads sharing the context */
-    cl_context context;
-    cl_device_id device;
-    cl_command_queue queue;
-    cl_program program;
-    cl_kernel kernels[RS_KERNEL_COUNT];
-    char device_name[256];
-    double build_ms;
-    size_t local_size;        /* work-group size used for every kernel */
-    uint64_t global_memory;   /* CL_DEVICE_GLOBAL_MEM_SIZE */
-    uint64_t max_allocation;  /* CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest one buffer may be */
-    uint64_t memory_budget;   /* caller's or RSMOOTH_MEMORY_BUDGET's limit; 0: the device's */
-};
-
-/* A context's calls hold its lock while they use it: threads sharing one run one at a time. */
-void rs_context_lock(rsmooth_context *ctx);
-void rs_context_unlock(rsmooth_context *ctx);
-
-/* Bytes one run may hold on the device: the caller's budget, else most of the device's memory. */
-uint64_t rs_cl_usable_memory(const rsmooth_context *ctx);
-
-/* Reads a byte count such as "256M", "1.5G", "4096" (suffixes K, M, G, T: powers of 1024).
- * false when `text` is not one. */
-bool rs_parse_bytes(const char *text, uint64_t *bytes);
-
-/* ---- cl_smooth.c / tiles.c: the OpenCL path ------------------------------------------------- */
-
-/* Where a run's results go: vertex v < core_count of the problem it solved is written to entry
- * target[v] (v itself when target is NULL) of the caller's arrays; the others are a tile's halo. */
-typedef struct rs_result_sink {
-    rsmooth_scalar scalar;
-    void *positions;
-    float *weight, *confidence; /* optional */
-    const uint32_t *target;
-    size_t core_count;
-} rs_result_sink;
-
-/* Stage times and work, summed over the runs (tiles) of one call. */
-typedef struct rs_run_stats {
-    double ms_grid, ms_upload, ms_mollify, ms_normals, ms_robust, ms_download;
-    uint64_t pairs_mollify, pairs_robust; /* vertex-facet pairs each pass evaluated */
-    size_t cells;      /* occupied grid cells */
-    size_t tiles;
-} rs_run_stats;
-
-/* Device bytes a run needs at most, estimated before its grid exists (tiles.c plans with it). */
-#define RS_DEVICE_BYTES_PER_FACET 64
-/* What the bilateral normal filter adds per facet: a second copy of the normals to alternate with,
- * and a per-cell pair count (at most one cell per facet). */
-#define RS_DEVICE_BYTES_PER_BILATERAL_FACET 24
-/* And what its rounds' lists add where they fit (cl_smooth.c, run_bilateral_lists), per facet of
- * problem `pb`: 20 bytes of group data and 36 a row, with about (1.5 r + 1.5)^2 rows per facet for
- * a reach of r mean edge lengths (measured on the benchmark meshes: 11 to 14 at r = 2, 76 to 96
- * at r = 6), and a spare row. Past 128 rows the estimate stops growing (a run whose lists do not
- * fit searches in every round instead). Uses fmin and pow (math.h). */
-#define RS_DEVICE_BYTES_PER_BILATERAL_LIST_FACET(pb)                                              \
-    ((uint64_t)(20 + 36 * (1 + fmin(128.0, pow(1.5 * (pb)->normal_radius /                        \
-                                                    (pb)->mean_edge_length + 1.5, 2)))))
-#define RS_DEVICE_BYTES_PER_VERTEX 72
-/* What the colour factor adds: a float4 mean colour per facet, three floats per vertex slot
- * (about 1.5 slots per vertex). */
-#define RS_DEVICE_BYTES_PER_COLOR_FACET 16
-#define RS_DEVICE_BYTES_PER_COLOR_VERTEX 20
-
-/* One run of the whole pipeline on `problem` (facet_count > 0). When its buffers would exceed
- * rs_cl_usable_memory or the device's largest allocation, returns RSMOOTH_ERROR_OUT_OF_MEMORY
- * with `*needed` set to the bytes it wanted, having run nothing. */
-rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *problem, const rs_result_sink *sink,
-                         rs_run_stats *stats, uint64_t *needed, rsmooth_error *error);
-
-/* The filter on `problem`: one run when it fits the device, else spatial tiles, each with the
- * facets within reach of its vertices' results (tiles.c). */
-rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *problem,
-                            const rs_result_sink *sink, rs_run_stats *stats, rsmooth_error *error);
-
-/* Builds the program from the embedded kernels (or RSMOOTH_KERNEL_DIR) and creates the kernels. */
-rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error);
-
-/* Records an OpenCL failure: status RSMOOTH_ERROR_OPENCL with the raw code and failing call. */
-rsmooth_status rs_cl_fail(rsmooth_error *error, cl_int code, const char *call, const char *what);
-
-/* Symbolic name of an OpenCL error code, e.g. "CL_OUT_OF_RESOURCES". */
-const char *rs_cl_error_name(cl_int code);
-
-/* Writes every vertex unmoved, with zero weight and confidence: the result when no facet carries
- * weight (no triangles, or all of zero area). */
-void rs_store_unmoved(const rs_problem *problem, rsmooth_scalar scalar, void *out_positions,
-                      float *out_weight, float *out_confidence);
-
-/* Fills the parts of a report both paths share (lengths in the caller's units). */
-void rs_report_problem(rsmooth_report *report, const rs_problem *problem, const rs_grid *grid,
-                       const char *device);
-/* Multiplies a report's lengths by `unscale`: internal units to the caller's. */
-void rs_report_unscale(rsmooth_report *report, double unscale);
 
 #endif /* RSMOOTH_INTERNAL_H */

@@ -10,7 +10,7 @@
  * normal_iterations rounds reaches normal_radius further, so the halo is radius +
  * normal_iterations * normal_radius there. Boxes are halved along their longest side until a tile
  * fits. */
-#include "rsmooth_internal.h"
+#include "cl_internal.h"
 
 #include <math.h>
 #include <string.h>

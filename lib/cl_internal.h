@@ -1,0 +1,112 @@
+/* The OpenCL path's shared declarations: the context object, and the run and tiles that filter a
+ * prepared problem on its device. Internal, not installed. */
+#ifndef RSMOOTH_CL_INTERNAL_H
+#define RSMOOTH_CL_INTERNAL_H
+
+#include "rsmooth_internal.h"
+
+/* ---- cl_device.c / cl_program.c: the OpenCL context object ------------------------------------ */
+
+#ifndef CL_TARGET_OPENCL_VERSION
+#define CL_TARGET_OPENCL_VERSION 120
+#endif
+#include <CL/cl.h>
+#include <pthread.h>
+
+/* Vertices per block: the vector width the kernels use across vertices (float8, kernels/common.cl). */
+#define RS_LANES 8
+
+enum {
+    RS_KERNEL_MOLLIFY,
+    RS_KERNEL_NORMALS,
+    RS_KERNEL_BILATERAL,
+    RS_KERNEL_ROBUST,
+    RS_KERNEL_COUNT
+};
+
+struct rsmooth_context {
+    pthread_mutex_t lock;     /* serialises the calls of threads sharing the context */
+    cl_context context;
+    cl_device_id device;
+    cl_command_queue queue;
+    cl_program program;
+    cl_kernel kernels[RS_KERNEL_COUNT];
+    char device_name[256];
+    double build_ms;
+    size_t local_size;        /* work-group size used for every kernel */
+    uint64_t global_memory;   /* CL_DEVICE_GLOBAL_MEM_SIZE */
+    uint64_t max_allocation;  /* CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest one buffer may be */
+    uint64_t memory_budget;   /* caller's or RSMOOTH_MEMORY_BUDGET's limit; 0: the device's */
+};
+
+/* A context's calls hold its lock while they use it: threads sharing one run one at a time. */
+void rs_context_lock(rsmooth_context *ctx);
+void rs_context_unlock(rsmooth_context *ctx);
+
+/* Bytes one run may hold on the device: the caller's budget, else most of the device's memory. */
+uint64_t rs_cl_usable_memory(const rsmooth_context *ctx);
+
+/* Reads a byte count such as "256M", "1.5G", "4096" (suffixes K, M, G, T: powers of 1024).
+ * false when `text` is not one. */
+bool rs_parse_bytes(const char *text, uint64_t *bytes);
+
+/* ---- cl_smooth.c / tiles.c: the OpenCL path ------------------------------------------------- */
+
+/* Where a run's results go: vertex v < core_count of the problem it solved is written to entry
+ * target[v] (v itself when target is NULL) of the caller's arrays; the others are a tile's halo. */
+typedef struct rs_result_sink {
+    rsmooth_scalar scalar;
+    void *positions;
+    float *weight, *confidence; /* optional */
+    const uint32_t *target;
+    size_t core_count;
+} rs_result_sink;
+
+/* Stage times and work, summed over the runs (tiles) of one call. */
+typedef struct rs_run_stats {
+    double ms_grid, ms_upload, ms_mollify, ms_normals, ms_robust, ms_download;
+    uint64_t pairs_mollify, pairs_robust; /* vertex-facet pairs each pass evaluated */
+    size_t cells;      /* occupied grid cells */
+    size_t tiles;
+} rs_run_stats;
+
+/* Device bytes a run needs at most, estimated before its grid exists (tiles.c plans with it). */
+#define RS_DEVICE_BYTES_PER_FACET 64
+/* What the bilateral normal filter adds per facet: a second copy of the normals to alternate with,
+ * and a per-cell pair count (at most one cell per facet). */
+#define RS_DEVICE_BYTES_PER_BILATERAL_FACET 24
+/* And what its rounds' lists add where they fit (cl_smooth.c, run_bilateral_lists), per facet of
+ * problem `pb`: 20 bytes of group data and 36 a row, with about (1.5 r + 1.5)^2 rows per facet for
+ * a reach of r mean edge lengths (measured on the benchmark meshes: 11 to 14 at r = 2, 76 to 96
+ * at r = 6), and a spare row. Past 128 rows the estimate stops growing (a run whose lists do not
+ * fit searches in every round instead). Uses fmin and pow (math.h). */
+#define RS_DEVICE_BYTES_PER_BILATERAL_LIST_FACET(pb)                                              \
+    ((uint64_t)(20 + 36 * (1 + fmin(128.0, pow(1.5 * (pb)->normal_radius /                        \
+                                                    (pb)->mean_edge_length + 1.5, 2)))))
+#define RS_DEVICE_BYTES_PER_VERTEX 72
+/* What the colour factor adds: a float4 mean colour per facet, three floats per vertex slot
+ * (about 1.5 slots per vertex). */
+#define RS_DEVICE_BYTES_PER_COLOR_FACET 16
+#define RS_DEVICE_BYTES_PER_COLOR_VERTEX 20
+
+/* One run of the whole pipeline on `problem` (facet_count > 0). When its buffers would exceed
+ * rs_cl_usable_memory or the device's largest allocation, returns RSMOOTH_ERROR_OUT_OF_MEMORY
+ * with `*needed` set to the bytes it wanted, having run nothing. */
+rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *problem, const rs_result_sink *sink,
+                         rs_run_stats *stats, uint64_t *needed, rsmooth_error *error);
+
+/* The filter on `problem`: one run when it fits the device, else spatial tiles, each with the
+ * facets within reach of its vertices' results (tiles.c). */
+rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *problem,
+                            const rs_result_sink *sink, rs_run_stats *stats, rsmooth_error *error);
+
+/* Builds the program from the embedded kernels (or RSMOOTH_KERNEL_DIR) and creates the kernels. */
+rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error);
+
+/* Records an OpenCL failure: status RSMOOTH_ERROR_OPENCL with the raw code and failing call. */
+rsmooth_status rs_cl_fail(rsmooth_error *error, cl_int code, const char *call, const char *what);
+
+/* Symbolic name of an OpenCL error code, e.g. "CL_OUT_OF_RESOURCES". */
+const char *rs_cl_error_name(cl_int code);
+
+#endif /* RSMOOTH_CL_INTERNAL_H */
