@@ -29,6 +29,36 @@ typedef struct output_target {
     struct stat st;
 } output_target;
 
+/* The directory part of `path`: "." for a bare name, "/" for a file at the root. */
+static void directory_of(const char *path, char *dir, size_t size) {
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        snprintf(dir, size, ".");
+    else if (slash == path)
+        snprintf(dir, size, "/");
+    else
+        snprintf(dir, size, "%.*s", (int)(slash - path), path);
+}
+
+/* -1 when the folder of `target` exists and this user may create files in it, else prints why
+ * (naming `path`) and returns EXIT_USAGE: found before the work, not after it. */
+static int check_folder(const char *path, const char *target) {
+    char dir[PATH_MAX];
+    directory_of(target, dir, sizeof dir);
+    struct stat st;
+    if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
+        fprintf(stderr, "rsmooth: %s: cannot write there: '%s': %s\n", path, dir,
+                stat(dir, &st) != 0 ? strerror(errno) : "not a folder");
+        return EXIT_USAGE;
+    }
+    if (access(dir, W_OK | X_OK) != 0) {
+        fprintf(stderr, "rsmooth: %s: cannot write in folder '%s': %s\n", path, dir,
+                strerror(errno));
+        return EXIT_USAGE;
+    }
+    return -1;
+}
+
 /* Fills `t` for `path`; prints why and returns EXIT_USAGE when `path` may not be written. */
 static int resolve_output(const char *path, bool replace, output_target *t) {
     memset(t, 0, sizeof *t);
@@ -43,7 +73,7 @@ static int resolve_output(const char *path, bool replace, output_target *t) {
             return EXIT_USAGE;
         }
         strcpy(t->path, path);
-        return -1;
+        return check_folder(path, t->path);
     }
     t->exists = true;
     t->st = st;
@@ -88,7 +118,7 @@ static int resolve_output(const char *path, bool replace, output_target *t) {
         fprintf(stderr, "rsmooth: %s: already exists (use --force to replace it)\n", path);
         return EXIT_USAGE;
     }
-    return -1;
+    return check_folder(path, t->path);
 }
 
 int cli_check_output_path(const char *path, bool replace) {
@@ -117,17 +147,6 @@ static void catch_signals(void (*handler)(int)) {
     signal(SIGINT, handler);
     signal(SIGTERM, handler);
     signal(SIGHUP, handler);
-}
-
-/* The directory part of `path`: "." for a bare name, "/" for a file at the root. */
-static void directory_of(const char *path, char *dir, size_t size) {
-    const char *slash = strrchr(path, '/');
-    if (!slash)
-        snprintf(dir, size, ".");
-    else if (slash == path)
-        snprintf(dir, size, "/");
-    else
-        snprintf(dir, size, "%.*s", (int)(slash - path), path);
 }
 
 /* `temporary` = the directory of `path` + TEMPORARY_NAME (the X's still to fill). */
@@ -323,9 +342,13 @@ int cli_write_atomically(const char *path, bool replace, bool quiet, cli_writer 
         snprintf(message, sizeof message, "%s", strerror(errno));
         ok = false;
     }
-    if (f ? fclose(f) != 0 : close(fd) != 0) {
-        if (ok) /* the data was complete and flushed: only a late report of an earlier error */
-            fprintf(stderr, "rsmooth: %s: warning: closing it: %s\n", path, strerror(errno));
+    /* After publishing, since the unnamed file is linked through its descriptor. A network file
+     * system may report a failed write only now: then a new file is taken back out. */
+    if ((f ? fclose(f) : close(fd)) != 0 && ok) {
+        snprintf(message, sizeof message, "%s", strerror(errno));
+        ok = false;
+        if (!replace)
+            unlink(t.path);
     }
     if (taken)
         fprintf(stderr, "rsmooth: %s: already exists: another program created it while this "

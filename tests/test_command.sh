@@ -269,7 +269,7 @@ for temporary in RSMOOTH_UNUSED RSMOOTH_NAMED_TEMPORARY; do
     cmp -s race/out$i.ply $winner || fail "race/out$i.ply is not the winner's result"
   done
   only_files race $(for i in $(seq 1 20); do echo out$i.ply; done)
-  echo "races ($temporary temporary): 20 pairs, $late lost at the final link (the rest at the start)"
+  echo "races ($temporary temporary): 20 pairs, $late of the losers lost at the final no-replace step"
 done
 
 # kill -9 while the result is being written (a 300,000-triangle OBJ: about 0.3 s of writing) leaves
@@ -365,6 +365,10 @@ if [ "$(id -u)" -eq 0 ] && command -v setpriv >/dev/null &&
   grep -q "warning" err.txt && fail "a warning for a file whose owner was kept: $(cat err.txt)"
   cmp -s shared/mine.ply small_b.ply || fail "--in-place as a user did not write the result"
   only_files shared in.ply theirs.ply mine.ply
+  mkdir -m 0755 locked
+  expect 2 as_user "$rsmooth" shared/in.ply -o locked/x.ply --device reference
+  grep -q "locked/x.ply: cannot write in folder 'locked'" err.txt ||
+    fail "an output folder the user may not write in is not explained: $(cat err.txt)"
 else
   echo "skipping the non-root ownership checks (needs root and setpriv)"
 fi
@@ -398,6 +402,11 @@ for force in "" --force; do
   [ -L dangling.ply ] && [ ! -e real/nothing.ply ] || fail "a dangling link was written $force"
 done
 only_files real target.ply out.ply
+# An output folder that is missing, or that the user may not write in, is found before the work.
+expect 2 "$rsmooth" small.ply -o nofolder/x.ply --device reference
+grep -q "nofolder/x.ply: cannot write there: 'nofolder'" err.txt ||
+  fail "a missing output folder is not explained before the work: $(cat err.txt)"
+grep -q "vertices" err.txt && fail "the work was done before finding the output folder missing"
 mkfifo fifo.ply
 expect 2 "$rsmooth" small.ply -o fifo.ply --force --device reference
 grep -q "fifo.ply: is not a regular file" err.txt || fail "a FIFO output is not refused: $(cat err.txt)"
