@@ -299,6 +299,11 @@ int cli_write_atomically(const char *path, bool replace, bool quiet, cli_writer 
         memset(&t, 0, sizeof t);
         strcpy(t.path, path);
     }
+    /* A new file replaces this name only: say so where other names share the old one. */
+    if (t.exists && t.st.st_nlink > 1 && !quiet)
+        fprintf(stderr, "rsmooth: %s: warning: the file has %ld hard links; only this name gets "
+                        "the result, the others keep the old content\n", path,
+                (long)t.st.st_nlink);
     catch_signals(remove_temporary_and_exit);
     char proc[64];
     const char *unnamed = proc;

@@ -402,6 +402,14 @@ for force in "" --force; do
   [ -L dangling.ply ] && [ ! -e real/nothing.ply ] || fail "a dangling link was written $force"
 done
 only_files real target.ply out.ply
+# A file with another hard link: this name gets the result, the other keeps the old content, and
+# a warning says so.
+cp small.ply hard.ply && ln hard.ply hard_other.ply
+expect 0 "$rsmooth" hard.ply --in-place --device reference
+grep -q "hard.ply: warning: the file has 2 hard links" err.txt ||
+  fail "--in-place on a file with two hard links says nothing: $(cat err.txt)"
+cmp -s hard.ply small_b.ply && cmp -s hard_other.ply small.ply ||
+  fail "--in-place on a hard link: the name or its other link does not hold what it should"
 # An output folder that is missing, or that the user may not write in, is found before the work.
 expect 2 "$rsmooth" small.ply -o nofolder/x.ply --device reference
 grep -q "nofolder/x.ply: cannot write there: 'nofolder'" err.txt ||
