@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 /* ---- a byte buffer the tests build files in */
 
@@ -94,6 +95,175 @@ static inline void check_face(const rsmooth_mesh *m, size_t f, const uint32_t *e
     CHECK_EQ_INT(m->face_offsets[f + 1] - m->face_offsets[f], n);
     for (size_t i = 0; i < n; i++)
         CHECK_EQ_INT(m->face_indices[m->face_offsets[f] + i], expected[i]);
+}
+
+/* ---- what every reader and writer owes (issue 12): shared by the format tests */
+
+/* Reads `size` bytes of `data` from an exact-size copy (ASan sees any over-read) as `format`. */
+static inline rsmooth_status read_exact_copy(const void *data, size_t size, rsmooth_format format,
+                                             rsmooth_mesh **mesh, rsmooth_error *err) {
+    void *copy = malloc(size ? size : 1);
+    CHECK(copy != NULL);
+    memcpy(copy, data, size);
+    rsmooth_status s = rsmooth_mesh_read_memory(copy, size, format, mesh, err);
+    free(copy);
+    return s;
+}
+
+/* Every prefix of a file, read through automatic detection as the command reads it, either reads or
+ * fails with a parse error that locates itself (a line or a byte offset within the prefix) and
+ * says more than the OBJ fallback's bare "no vertices". */
+static inline void check_prefixes_located(const char *what, const void *data, size_t size) {
+    for (size_t len = 0; len <= size; len++) {
+        rsmooth_mesh *m = NULL;
+        rsmooth_error err;
+        rsmooth_status s = read_exact_copy(data, len, RSMOOTH_FORMAT_AUTO, &m, &err);
+        CHECK((s == RSMOOTH_OK) == (m != NULL));
+        rsmooth_mesh_destroy(m);
+        if (s == RSMOOTH_OK)
+            continue;
+        bool located = (err.line >= 1) || (err.byte_offset >= 0 && (size_t)err.byte_offset <= len);
+        if ((s != RSMOOTH_ERROR_PARSE && s != RSMOOTH_ERROR_UNSUPPORTED) || !located ||
+            strcmp(err.message, "no vertices") == 0 || strlen(err.message) < 20) {
+            fprintf(stderr, "%s, prefix of %zu bytes: status %d, line %lld, byte %lld: '%s'\n",
+                    what, len, (int)s, (long long)err.line, (long long)err.byte_offset,
+                    err.message);
+            exit(1);
+        }
+    }
+}
+
+/* The tetrahedron (0 0 0) (1 0 0) (0 1 0) (0 0 1), its four faces outward. */
+static inline rsmooth_mesh *tetrahedron(rsmooth_scalar precision) {
+    static const double xyz[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const uint32_t faces[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    rsmooth_mesh *m = NULL;
+    rsmooth_error err;
+    CHECK_EQ_INT(rsmooth_mesh_create(4, 4, 12, &m, &err), RSMOOTH_OK);
+    memcpy(m->positions, xyz, sizeof xyz);
+    memcpy(m->face_indices, faces, sizeof faces);
+    for (uint32_t f = 1; f <= 4; f++)
+        m->face_offsets[f] = 3 * f;
+    m->precision = precision;
+    CHECK_EQ_INT(rsmooth_mesh_triangulate(m, &err), RSMOOTH_OK);
+    return m;
+}
+
+/* Writes `mesh` as `format` to memory; the status, with *size the bytes the stream received. */
+static inline rsmooth_status write_to_memory(const rsmooth_mesh *mesh, rsmooth_format format,
+                                             char **data, size_t *size, rsmooth_error *err) {
+    *data = NULL;
+    *size = 0;
+    FILE *f = open_memstream(data, size);
+    CHECK(f != NULL);
+    rsmooth_status s = rsmooth_mesh_write_stream(mesh, f, format, err);
+    CHECK(fclose(f) == 0);
+    return s;
+}
+
+/* The writer of `format` refuses, with INVALID_ARGUMENT, a message naming the vertex and nothing
+ * written to the stream (nor a file created), every coordinate rsmooth could not read back: NaN,
+ * infinities and magnitudes beyond the supported 1e150. */
+static inline void check_writer_refuses_unreadable(rsmooth_format format) {
+    const double bad[] = {NAN, INFINITY, -INFINITY, 1.0000000000000002e150, -1e151, 1e300};
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        for (int coordinate = 0; coordinate < 3; coordinate++) {
+            rsmooth_mesh *m = tetrahedron(RSMOOTH_FLOAT64);
+            m->positions[3 * 2 + (size_t)coordinate] = bad[i];
+            char *data;
+            size_t size;
+            rsmooth_error err;
+            rsmooth_status s = write_to_memory(m, format, &data, &size, &err);
+            if (s != RSMOOTH_ERROR_INVALID_ARGUMENT || size != 0 ||
+                !strstr(err.message, "vertex 2 ")) {
+                fprintf(stderr, "format %d, coordinate %g: status %d, %zu bytes written, '%s'\n",
+                        (int)format, bad[i], (int)s, size, err.message);
+                exit(1);
+            }
+            free(data);
+            char path[] = "/tmp/rsmooth_test_refused_XXXXXX";
+            int fd = mkstemp(path);
+            CHECK(fd >= 0);
+            close(fd);
+            remove(path);
+            CHECK_EQ_INT(rsmooth_mesh_write_file(m, path, format, &err),
+                         RSMOOTH_ERROR_INVALID_ARGUMENT);
+            CHECK(access(path, F_OK) != 0); /* refused before the file was created */
+            rsmooth_mesh_destroy(m);
+        }
+    }
+}
+
+/* Extreme values a writer must give back bit for bit: the supported magnitude, the smallest
+ * subnormals, -0, and decimals no short form holds. */
+static const double extreme_doubles[] = {1e150,
+                                         -1e150,
+                                         4.9406564584124654e-324,
+                                         -9.8813129168249309e-324,
+                                         2.2250738585072014e-308,
+                                         -0.0,
+                                         1e-300,
+                                         0.1,
+                                         -0.30000000000000004,
+                                         123456789.12345679,
+                                         9007199254740993.0,
+                                         1.0 / 3.0};
+static const float extreme_floats[] = {3.40282347e38f, -3.40282347e38f, 1.40129846e-45f,
+                                       -2.80259693e-45f, 1.17549435e-38f, -0.0f,
+                                       0.1f,            -0.3f,            16777217.0f,
+                                       1.0f / 3.0f,     1e-40f,           7.0f};
+
+/* A triangle soup holding `count` values (padded with 1s) as its coordinates. */
+static inline rsmooth_mesh *mesh_of_values(const double *values, size_t count,
+                                           rsmooth_scalar precision) {
+    size_t triangles = (count + 8) / 9;
+    rsmooth_mesh *m = NULL;
+    rsmooth_error err;
+    CHECK_EQ_INT(rsmooth_mesh_create(3 * triangles, triangles, 3 * triangles, &m, &err),
+                 RSMOOTH_OK);
+    for (size_t i = 0; i < 9 * triangles; i++)
+        m->positions[i] = i < count ? values[i] : (double)(i % 3 == 0);
+    for (size_t i = 0; i < 3 * triangles; i++)
+        m->face_indices[i] = (uint32_t)i;
+    for (size_t f = 1; f <= triangles; f++)
+        m->face_offsets[f] = (uint32_t)(3 * f);
+    m->precision = precision;
+    CHECK_EQ_INT(rsmooth_mesh_triangulate(m, &err), RSMOOTH_OK);
+    return m;
+}
+
+/* Writes the extreme values as `format` and reads them back: every coordinate bit for bit (float32
+ * formats get the float extremes). rsmooth reads what it writes. */
+static inline void check_extremes_round_trip(rsmooth_format format, rsmooth_scalar precision) {
+    double values[sizeof extreme_doubles / sizeof extreme_doubles[0]];
+    size_t count = sizeof values / sizeof values[0];
+    for (size_t i = 0; i < count; i++)
+        values[i] = precision == RSMOOTH_FLOAT32 ? (double)extreme_floats[i] : extreme_doubles[i];
+    rsmooth_mesh *m = mesh_of_values(values, count, precision);
+    char *data;
+    size_t size;
+    rsmooth_error err;
+    rsmooth_status s = write_to_memory(m, format, &data, &size, &err);
+    if (s != RSMOOTH_OK)
+        fprintf(stderr, "format %d: %s\n", (int)format, err.message);
+    CHECK_EQ_INT(s, RSMOOTH_OK);
+    rsmooth_mesh *back = NULL;
+    s = read_exact_copy(data, size, RSMOOTH_FORMAT_AUTO, &back, &err);
+    if (s != RSMOOTH_OK)
+        fprintf(stderr, "format %d: written, then '%s' (line %lld, byte %lld)\n", (int)format,
+                err.message, (long long)err.line, (long long)err.byte_offset);
+    CHECK_EQ_INT(s, RSMOOTH_OK);
+    CHECK_EQ_INT(back->vertex_count, m->vertex_count); /* a soup: STL keeps the order */
+    for (size_t i = 0; i < 3 * m->vertex_count; i++) {
+        if (memcmp(&back->positions[i], &m->positions[i], sizeof(double)) != 0) {
+            fprintf(stderr, "format %d: coordinate %zu written as %.17g, read as %.17g\n",
+                    (int)format, i, m->positions[i], back->positions[i]);
+            exit(1);
+        }
+    }
+    rsmooth_mesh_destroy(back);
+    rsmooth_mesh_destroy(m);
+    free(data);
 }
 
 #endif

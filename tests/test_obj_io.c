@@ -113,7 +113,7 @@ static void test_index_forms(void) {
     rsmooth_mesh_destroy(m);
 
     /* Nothing beyond v and f: no extras, no colours, no normals. */
-    m = parse_ok("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1//1 2//1 3//1\n");
+    m = parse_ok("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     CHECK(m->extras == NULL && m->vertex_colors == NULL && !m->has_vertex_normals);
     rsmooth_mesh_destroy(m);
 }
@@ -141,7 +141,8 @@ static void test_crlf_and_forward_references(void) {
                              "123456789012345678901234",
                              "1e-300",
                              "4.9406564584124654e-324",
-                             "1.7976931348623157e308",
+                             "1e150", /* the largest supported magnitude */
+                             "-9.9999999999999991e149",
                              ".5",
                              "5.",
                              "+2.5E+3",
@@ -163,8 +164,11 @@ static void test_crlf_and_forward_references(void) {
 }
 
 static void test_errors(void) {
-    EXPECT_PARSE_ERROR("", -1, "no vertices");
-    EXPECT_PARSE_ERROR("# only a comment\n\ng x\n", -1, "no vertices");
+    /* No vertex: blamed on the end, or on the first statement OBJ does not know. */
+    EXPECT_PARSE_ERROR("", 1, "no vertices");
+    EXPECT_PARSE_ERROR("# only a comment\n\ng x\n", 3, "no vertices: the file ends (line 3)");
+    EXPECT_PARSE_ERROR("# c\nsolidus 1 2\nvertex 1 2 3\n", 2,
+                       "no vertices (no 'v x y z' line), and 'solidus' is not an OBJ statement");
     EXPECT_PARSE_ERROR("v 0 0 0\nv 1 nan 0\nv 0 0 0\n", 2, "vertex 2 has a non-finite coordinate");
     EXPECT_PARSE_ERROR("v 0 0 0\nv 1 1 1\nv 0 0 inf\n", 3, "vertex 3 has a non-finite");
     EXPECT_PARSE_ERROR("v 0 0 0\n\nv 1 1e999 1\n", 3, "vertex 2 has a non-finite");
@@ -248,7 +252,7 @@ static rsmooth_mesh *make_mesh(size_t nv, size_t nf) {
     }
     m->positions[0] = -0.0;
     m->positions[1] = 1e-300;
-    m->positions[2] = -1.7976931348623157e308;
+    m->positions[2] = -1e150; /* the supported magnitude */
     uint32_t k = 0;
     for (size_t f = 0; f < nf; f++) {
         uint32_t n = 3 + lcg() % 4;
@@ -670,7 +674,7 @@ static void test_faithful(void) {
 
     /* Without vn lines: faces keep their vt, gain no vn; no vn lines appear. */
     rsmooth_mesh *m = parse_ok("g a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 1\n"
-                               "f 1/1 2/-1 3\nf 3 2//7 1/2\n");
+                               "f 1/1 2/-1 3\nf 3 2 1/2\n");
     CHECK(!m->has_vertex_normals);
     size_t size;
     char *out = mesh_to_memory(m, RSMOOTH_FORMAT_OBJ, &size);
@@ -678,6 +682,171 @@ static void test_faithful(void) {
     CHECK(strstr(out, "vn") == NULL);
     free(out);
     rsmooth_mesh_destroy(m);
+}
+
+/* ---- issue 12: writers refuse what cannot be read back; byte-order marks; located errors */
+
+static void test_write_refusals_and_extremes(void) {
+    check_writer_refuses_unreadable(RSMOOTH_FORMAT_OBJ);
+    check_extremes_round_trip(RSMOOTH_FORMAT_OBJ, RSMOOTH_FLOAT64);
+
+    /* A float32 mesh holding a value beyond float range: written as the double it is, not "inf". */
+    rsmooth_mesh *m = tetrahedron(RSMOOTH_FLOAT32);
+    m->positions[5] = 1e100;
+    size_t size;
+    char *text = mesh_to_memory(m, RSMOOTH_FORMAT_OBJ, &size);
+    CHECK(strstr(text, "inf") == NULL);
+    rsmooth_mesh *back = parse_n_ok(text, size);
+    CHECK_NEAR(back->positions[5], 1e100, 0);
+    rsmooth_mesh_destroy(back);
+    free(text);
+
+    /* A point cloud's own normals are written, exactly, and refused when non-finite. */
+    m->face_count = m->triangle_count = 0;
+    m->precision = RSMOOTH_FLOAT64;
+    m->positions[5] = 0;
+    m->has_vertex_normals = 1;
+    m->vertex_normals = calloc(12, sizeof(double));
+    CHECK(m->vertex_normals != NULL);
+    m->vertex_normals[2] = 1.0 / 3.0;
+    text = mesh_to_memory(m, RSMOOTH_FORMAT_OBJ, &size);
+    back = parse_n_ok(text, size);
+    CHECK(back->vertex_normals != NULL);
+    CHECK(memcmp(back->vertex_normals, m->vertex_normals, 12 * sizeof(double)) == 0);
+    rsmooth_mesh_destroy(back);
+    free(text);
+    m->vertex_normals[7] = NAN;
+    rsmooth_error err;
+    char *data;
+    CHECK_EQ_INT(write_to_memory(m, RSMOOTH_FORMAT_OBJ, &data, &size, &err),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK(size == 0 && strstr(err.message, "vertex 2 has a non-finite normal") != NULL);
+    free(data);
+    rsmooth_mesh_destroy(m);
+}
+
+/* A file read with and without a leading byte-order mark: the same mesh. */
+static void check_same_mesh(const rsmooth_mesh *a, const rsmooth_mesh *b) {
+    CHECK(meshes_equal(a, b, false));
+}
+
+static void test_byte_order_mark(void) {
+    static const char tet[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                              "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    char marked[sizeof tet + 3] = "\xEF\xBB\xBF";
+    memcpy(marked + 3, tet, sizeof tet);
+    rsmooth_mesh *plain = parse_ok(tet);
+    for (int auto_format = 0; auto_format < 2; auto_format++) {
+        rsmooth_mesh *m = NULL;
+        rsmooth_error err;
+        CHECK_EQ_INT(read_exact_copy(marked, strlen(marked),
+                                     auto_format ? RSMOOTH_FORMAT_AUTO : RSMOOTH_FORMAT_OBJ, &m,
+                                     &err),
+                     RSMOOTH_OK);
+        check_same_mesh(m, plain); /* the first vertex is not lost to the mark */
+        CHECK_EQ_INT(m->source_format, RSMOOTH_FORMAT_OBJ);
+
+        /* Written back as OBJ: the mark, then what the unmarked file writes. */
+        size_t size, plain_size;
+        char *out = mesh_to_memory(m, RSMOOTH_FORMAT_OBJ, &size);
+        char *plain_out = mesh_to_memory(plain, RSMOOTH_FORMAT_OBJ, &plain_size);
+        CHECK_EQ_INT(size, plain_size + 3);
+        CHECK(memcmp(out, "\xEF\xBB\xBF", 3) == 0 && memcmp(out + 3, plain_out, plain_size) == 0);
+        free(out);
+        free(plain_out);
+
+        /* Converting drops it and says so, as for other losses. */
+        char losses[256];
+        CHECK_EQ_INT(rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_OBJ, losses, sizeof losses),
+                     0);
+        CHECK_EQ_INT(rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_OFF, losses, sizeof losses),
+                     1);
+        CHECK(strcmp(losses, "UTF-8 byte-order mark") == 0);
+        CHECK_EQ_INT(
+            rsmooth_mesh_conversion_losses(plain, RSMOOTH_FORMAT_OFF, losses, sizeof losses), 0);
+        out = mesh_to_memory(m, RSMOOTH_FORMAT_OFF, &size);
+        CHECK(strncmp(out, "OFF\n", 4) == 0);
+        free(out);
+        rsmooth_mesh_destroy(m);
+    }
+    rsmooth_mesh_destroy(plain);
+
+    /* Error locations count the mark's bytes: the offset is in the file. */
+    const char *bad = "\xEF\xBB\xBFv 0 0 0\nv 1 x 0\n";
+    rsmooth_mesh *m = NULL;
+    rsmooth_error err;
+    CHECK_EQ_INT(read_exact_copy(bad, strlen(bad), RSMOOTH_FORMAT_AUTO, &m, &err),
+                 RSMOOTH_ERROR_PARSE);
+    CHECK_EQ_INT(err.line, 2);
+    CHECK_EQ_INT(err.byte_offset, strchr(bad, 'x') - bad);
+}
+
+/* Expects automatic detection to fail on `size` bytes with a parse error at `line` and `offset`
+ * whose message holds `needle`. */
+static void expect_auto_error(int at, const void *data, size_t size, long long line,
+                              long long offset, const char *needle) {
+    rsmooth_mesh *m = NULL;
+    rsmooth_error err;
+    rsmooth_status s = read_exact_copy(data, size, RSMOOTH_FORMAT_AUTO, &m, &err);
+    if (s != RSMOOTH_ERROR_PARSE || err.line != line || err.byte_offset != offset ||
+        !strstr(err.message, needle)) {
+        fprintf(stderr,
+                "test_obj_io.c:%d: status %d line %lld byte %lld '%s'; expected line %lld byte "
+                "%lld '%s'\n",
+                at, (int)s, (long long)err.line, (long long)err.byte_offset, err.message, line,
+                offset, needle);
+        exit(1);
+    }
+    CHECK(m == NULL);
+}
+
+static void test_detection_errors(void) {
+    expect_auto_error(__LINE__, "", 0, 1, 0, "the file is empty");
+    expect_auto_error(__LINE__, "\n# nothing\n\n", 12, 4, 12, "only blanks and comments");
+    expect_auto_error(__LINE__, "\xEF\xBB\xBF", 3, 1, 3, "only blanks and comments");
+    /* text that is no mesh: blamed on its first word */
+    expect_auto_error(__LINE__, "hello world\n", 12, 1, 0, "'hello' is not an OBJ statement");
+    /* binary content of no format: taken for a binary STL, whose size is then wrong */
+    unsigned char binary[150];
+    for (size_t i = 0; i < sizeof binary; i++)
+        binary[i] = (unsigned char)(i * 37 + 11);
+    binary[5] = 0;
+    expect_auto_error(__LINE__, binary, sizeof binary, -1, 150, "binary content (byte 5 is 0x00)");
+    expect_auto_error(__LINE__, binary, 60, -1, 60, "at least 84 bytes expected");
+    /* every prefix of an OBJ file fails with a location, or reads */
+    check_prefixes_located("OBJ", small_obj, strlen(small_obj));
+}
+
+static void test_attribute_indices(void) {
+    const char *v3 = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    char text[256];
+    /* vt / vn indices beyond their lines are refused where they stand, forward ones too */
+    snprintf(text, sizeof text, "%svt 0 0\nf 1/1 2/2 3/1\n", v3);
+    EXPECT_PARSE_ERROR(text, 5, "texture index 2 out of range (1 texture coordinates)");
+    snprintf(text, sizeof text, "%svn 0 0 1\nf 1//1 2//1 3//2\nvn 1 0 0\nf 1//3 2//1 3//1\n", v3);
+    EXPECT_PARSE_ERROR(text, 7, "normal index 3 out of range (2 normals)");
+    snprintf(text, sizeof text, "%svn 0 0 1\nf 1//-2 2//1 3//1\n", v3);
+    EXPECT_PARSE_ERROR(text, 5, "normal index -2 out of range (1 normals)");
+    snprintf(text, sizeof text, "%sf 1//1 2//1 3//1\n", v3);
+    EXPECT_PARSE_ERROR(text, 4, "normal index 1 out of range (0 normals)");
+    snprintf(text, sizeof text, "%sf 1/1/1 2/1/1 3/1/1\nvn 0 0 1\n", v3);
+    EXPECT_PARSE_ERROR(text, 4, "texture index 1 out of range (0 texture coordinates)");
+    /* forward references within the final counts read */
+    snprintf(text, sizeof text, "%sf 1/1/1 2/2/1 3/1/1\nvt 0 0\nvt 1 0\nvn 0 0 1\n", v3);
+    rsmooth_mesh *m = parse_ok(text);
+    CHECK_EQ_INT(m->face_count, 1);
+    rsmooth_mesh_destroy(m);
+    /* vn lines hold three finite numbers */
+    snprintf(text, sizeof text, "%svn 0 x 1\n", v3);
+    EXPECT_PARSE_ERROR(text, 4, "malformed number 'x'");
+    snprintf(text, sizeof text, "%svn 0 0\n", v3);
+    EXPECT_PARSE_ERROR(text, 4, "'vn' takes 3 numbers");
+    snprintf(text, sizeof text, "%svn 0 nan 1\n", v3);
+    EXPECT_PARSE_ERROR(text, 4, "normal 1 has a non-finite component");
+    /* coordinates beyond the supported magnitude are refused where they stand */
+    EXPECT_PARSE_ERROR("v 0 0 0\nv 0 -1.0000000000000002e150 0\n", 2,
+                       "vertex 2 has coordinate -1e+150 beyond the supported magnitude 1e+150");
+    EXPECT_PARSE_ERROR("v 0 0 0\n\nv 0 0 1e300\n", 3, "vertex 2 has coordinate 1e+300 beyond");
 }
 
 int main(void) {
@@ -690,6 +859,10 @@ int main(void) {
     test_files();
     test_create_and_triangulate();
     test_faithful();
+    test_write_refusals_and_extremes();
+    test_byte_order_mark();
+    test_detection_errors();
+    test_attribute_indices();
     printf("obj_io: all checks passed\n");
     return 0;
 }

@@ -360,6 +360,8 @@ static void test_truncated_prefixes(void) {
     }
     /* Only prefixes cut inside the last face's last index or its line end can still parse. */
     CHECK(ok_count <= 2);
+    /* Read as the command reads it (detection first): every failure located too. */
+    check_prefixes_located("OFF", small_off, n);
 }
 
 static uint32_t lcg_state = 777;
@@ -406,11 +408,106 @@ static void test_garbage(void) {
     }
 }
 
+/* Expects automatic detection to fail with `status` at `line` holding `needle`. */
+static void expect_auto_error(int at, const char *text, rsmooth_status status, long long line,
+                              const char *needle) {
+    rsmooth_mesh *m = NULL;
+    rsmooth_error err;
+    rsmooth_status s = parse_n(text, strlen(text), RSMOOTH_FORMAT_AUTO, &m, &err);
+    if (s != status || err.line != line || err.byte_offset < 0 || !strstr(err.message, needle)) {
+        fprintf(stderr, "test_off_io.c:%d: status %d line %lld byte %lld '%s'; expected %d, %lld, "
+                        "'%s'\n",
+                at, (int)s, (long long)err.line, (long long)err.byte_offset, err.message,
+                (int)status, line, needle);
+        exit(1);
+    }
+    CHECK(m == NULL);
+}
+
 static void test_detection(void) {
     /* AUTO reads OFF by its keyword; the extension picks it for writing. */
     rsmooth_mesh *m = parse_ok("NOFF 3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n");
     rsmooth_mesh_destroy(m);
     CHECK_EQ_INT(rsmooth_format_from_path("a.off"), RSMOOTH_FORMAT_OFF);
+
+    /* What may come before the keyword, and its lowercase spelling: read as the same mesh. */
+    static const char body[] = "3 1 0\n0 0 0\n1 0 0\n0 1 0.5\n3 0 1 2\n";
+    static const char *const openings[] = {"# made by hand\nOFF\n", "\nOFF\n", "  \tOFF\n",
+                                           "off\n", "# c\n\n  off\n", "\xEF\xBB\xBF# c\nOFF\n"};
+    char text[256];
+    snprintf(text, sizeof text, "OFF\n%s", body);
+    rsmooth_mesh *reference = parse_ok(text);
+    for (size_t i = 0; i < sizeof openings / sizeof openings[0]; i++) {
+        snprintf(text, sizeof text, "%s%s", openings[i], body);
+        m = parse_ok(text);
+        check_same_geometry(m, reference);
+        rsmooth_mesh_destroy(m);
+    }
+    rsmooth_mesh_destroy(reference);
+
+    /* Variants this reader does not read: "not supported", with their line and byte. */
+    expect_auto_error(__LINE__, "# c\n4OFF\n3 1 0\n", RSMOOTH_ERROR_UNSUPPORTED, 2,
+                      "4OFF: 4-dimensional vertices are not supported");
+    expect_auto_error(__LINE__, "nOFF\n4\n3 1 0\n", RSMOOTH_ERROR_UNSUPPORTED, 1,
+                      "n-dimensional vertices are not supported");
+    expect_auto_error(__LINE__, "OFF BINARY\n", RSMOOTH_ERROR_UNSUPPORTED, 1,
+                      "binary OFF is not supported");
+    expect_auto_error(__LINE__, "XOFF\n3 1 0\n", RSMOOTH_ERROR_PARSE, 1,
+                      "the file starts with 'XOFF'");
+}
+
+static void test_write_refusals_and_extremes(void) {
+    check_writer_refuses_unreadable(RSMOOTH_FORMAT_OFF);
+    check_extremes_round_trip(RSMOOTH_FORMAT_OFF, RSMOOTH_FLOAT64);
+
+    /* Coordinates beyond the supported magnitude and non-finite normals: refused where they are. */
+    EXPECT_ERROR("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1e151 0\n3 0 1 2\n", RSMOOTH_ERROR_PARSE, 5,
+                 "vertex 2 has coordinate 1e+151 beyond the supported magnitude 1e+150");
+    EXPECT_ERROR("NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 inf 0 1\n0 1 0 0 0 1\n3 0 1 2\n",
+                 RSMOOTH_ERROR_PARSE, 4, "vertex 1 has a non-finite normal");
+
+    /* A point cloud's own normals (NOFF, no faces) are written exactly. */
+    rsmooth_mesh *m = parse_ok("NOFF\n2 0 0\n0 0 0 0.1 0.2 0.97467943448089633\n"
+                               "1 0 0 0.3333333333333333 0 -0.94280904158206336\n");
+    CHECK(m->vertex_normals != NULL);
+    size_t size;
+    char *text = mesh_to_memory(m, RSMOOTH_FORMAT_OFF, &size);
+    rsmooth_mesh *back = parse_size_ok(text, size);
+    CHECK(back->vertex_normals != NULL);
+    CHECK(memcmp(back->vertex_normals, m->vertex_normals, 6 * sizeof(double)) == 0);
+    rsmooth_mesh_destroy(back);
+    free(text);
+    rsmooth_mesh_destroy(m);
+}
+
+static void test_byte_order_mark(void) {
+    static const char colored[] = "COFF\n3 1 0\n0 0 0 1 0 0 1\n1 0 0 0 1 0 1\n"
+                                  "0 1 0 0 0 1 1\n3 0 1 2 0.5 0.5 0.5\n";
+    char marked[sizeof colored + 3] = "\xEF\xBB\xBF";
+    memcpy(marked + 3, colored, sizeof colored);
+    rsmooth_mesh *m = parse_ok(marked);
+    rsmooth_mesh *plain = parse_ok(colored);
+    check_same_geometry(m, plain);
+    size_t size, plain_size;
+    char *out = mesh_to_memory(m, RSMOOTH_FORMAT_OFF, &size);
+    char *plain_out = mesh_to_memory(plain, RSMOOTH_FORMAT_OFF, &plain_size);
+    CHECK_EQ_INT(size, plain_size + 3);
+    CHECK(memcmp(out, "\xEF\xBB\xBF", 3) == 0 && memcmp(out + 3, plain_out, plain_size) == 0);
+    char losses[256];
+    rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_STL_ASCII, losses, sizeof losses);
+    CHECK(strstr(losses, "UTF-8 byte-order mark") != NULL);
+    CHECK_EQ_INT(rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_OFF, NULL, 0), 0);
+    free(out);
+    free(plain_out);
+    rsmooth_mesh_destroy(plain);
+    rsmooth_mesh_destroy(m);
+    /* explicitly as OFF too, with errors located in the file's bytes */
+    const char *bad = "\xEF\xBB\xBFOFF\n3 1 0\n0 0 0\n1 y 0\n0 1 0\n3 0 1 2\n";
+    m = NULL;
+    rsmooth_error err;
+    CHECK_EQ_INT(parse_n(bad, strlen(bad), RSMOOTH_FORMAT_OFF, &m, &err), RSMOOTH_ERROR_PARSE);
+    CHECK_EQ_INT(err.line, 4);
+    CHECK_EQ_INT(err.byte_offset, strchr(bad, 'y') - bad);
 }
 
 int main(void) {
@@ -420,6 +517,8 @@ int main(void) {
     test_truncated_prefixes();
     test_garbage();
     test_detection();
+    test_write_refusals_and_extremes();
+    test_byte_order_mark();
     printf("off_io: all checks passed\n");
     return 0;
 }

@@ -331,7 +331,7 @@ static void test_errors(void) {
     snprintf(text, sizeof text, "%s0 0 0\n1 0 0\n0 1 0\n3 0 1\n", header);
     err = EXPECT_PARSE_ERROR(text, strlen(text), "data ends inside element 'face' item 0");
     snprintf(text, sizeof text, "%s0 0 0\n1 0 0\n0 1 0\n3 0 1 2.5\n", header);
-    EXPECT_PARSE_ERROR(text, strlen(text), "face index 2.5 out of range");
+    EXPECT_PARSE_ERROR(text, strlen(text), "value 2.5 does not fit the type 'int'");
     snprintf(text, sizeof text, "%s0 0 0\n1 0 0\n0 1 zero\n3 0 1 2\n", header);
     err = EXPECT_PARSE_ERROR(text, strlen(text), "malformed number 'zero'");
     CHECK_EQ_INT(err.line, 12);
@@ -514,6 +514,7 @@ static void test_round_trip(void) {
 /* ---- truncation */
 
 static void check_prefixes(const bytes *b) {
+    check_prefixes_located("PLY", b->data, b->size);
     for (size_t len = 0; len < b->size; len++) {
         rsmooth_mesh *m = NULL;
         rsmooth_error err;
@@ -567,6 +568,195 @@ static void test_corruption(void) {
     bytes_free(&goods[1]);
 }
 
+/* ---- issue 12: writers refuse what cannot be read back; byte-order marks; located errors;
+ * values the declared types cannot hold */
+
+/* Expects a parse error (any format family, read by AUTO) at `line` holding `needle`. */
+static rsmooth_error expect_line(int at, const char *text, long long line, const char *needle) {
+    rsmooth_error err = expect_parse_error(at, text, strlen(text), needle);
+    if (err.line != line) {
+        fprintf(stderr, "test_ply_io.c:%d: '%s' at line %lld, expected line %lld\n", at,
+                err.message, (long long)err.line, line);
+        exit(1);
+    }
+    return err;
+}
+#define EXPECT_LINE(text, line, needle) expect_line(__LINE__, text, line, needle)
+
+static void test_write_refusals_and_extremes(void) {
+    const rsmooth_format formats[2] = {RSMOOTH_FORMAT_PLY_ASCII, RSMOOTH_FORMAT_PLY_BINARY};
+    for (int i = 0; i < 2; i++) {
+        check_writer_refuses_unreadable(formats[i]);
+        check_extremes_round_trip(formats[i], RSMOOTH_FLOAT64);
+        check_extremes_round_trip(formats[i], RSMOOTH_FLOAT32);
+
+        /* a non-finite quality is refused before anything is written */
+        rsmooth_mesh *m = tetrahedron(RSMOOTH_FLOAT32);
+        m->vertex_quality = calloc(4, sizeof(float));
+        CHECK(m->vertex_quality != NULL);
+        m->vertex_quality[1] = NAN;
+        char *data;
+        size_t size;
+        rsmooth_error err;
+        CHECK_EQ_INT(write_to_memory(m, formats[i], &data, &size, &err),
+                     RSMOOTH_ERROR_INVALID_ARGUMENT);
+        CHECK(size == 0 && strstr(err.message, "vertex 1 has a non-finite quality") != NULL);
+        free(data);
+
+        /* a float32 mesh holding a value beyond float range is written as double, not as inf */
+        m->vertex_quality[1] = 0.5f;
+        m->positions[5] = -1e100;
+        rsmooth_mesh *back = write_and_read(m, formats[i]);
+        CHECK_EQ_INT(back->precision, RSMOOTH_FLOAT64);
+        CHECK(back->positions[5] == -1e100);
+        rsmooth_mesh_destroy(back);
+        rsmooth_mesh_destroy(m);
+    }
+
+    /* Written faithfully, a value the file's own float type cannot hold is refused, unwritten. */
+    bytes b = ascii_square();
+    rsmooth_mesh *m = parse_ok(&b);
+    m->positions[3] = 1e60;
+    char *data;
+    size_t size;
+    rsmooth_error err;
+    CHECK_EQ_INT(write_to_memory(m, RSMOOTH_FORMAT_PLY_BINARY, &data, &size, &err),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK(size == 0 && strstr(err.message, "vertex 1: x = ") != NULL &&
+          strstr(err.message, "does not fit the file's 'float' type") != NULL);
+    free(data);
+    rsmooth_mesh_destroy(m);
+    bytes_free(&b);
+}
+
+static void test_byte_order_mark(void) {
+    bytes plain_file = ascii_square();
+    bytes b = {0};
+    put_text(&b, "\xEF\xBB\xBF");
+    put(&b, plain_file.data, plain_file.size);
+    rsmooth_mesh *m = parse_ok(&b);
+    check_square(m);
+    rsmooth_mesh *plain = parse_ok(&plain_file);
+    for (int binary = 0; binary < 2; binary++) {
+        /* Both encodings open with a text header: the mark goes back before it. */
+        rsmooth_format format = binary ? RSMOOTH_FORMAT_PLY_BINARY : RSMOOTH_FORMAT_PLY_ASCII;
+        size_t size, plain_size;
+        char *out = mesh_to_memory(m, format, &size);
+        char *plain_out = mesh_to_memory(plain, format, &plain_size);
+        CHECK_EQ_INT(size, plain_size + 3);
+        CHECK(memcmp(out, "\xEF\xBB\xBF", 3) == 0 && memcmp(out + 3, plain_out, plain_size) == 0);
+        rsmooth_mesh *back = NULL;
+        rsmooth_error err;
+        CHECK_EQ_INT(read_exact_copy(out, size, RSMOOTH_FORMAT_AUTO, &back, &err), RSMOOTH_OK);
+        check_square(back);
+        CHECK(back->extras != NULL && back->extras != plain->extras);
+        CHECK_EQ_INT(rsmooth_mesh_conversion_losses(back, RSMOOTH_FORMAT_PLY_ASCII, NULL, 0), 0);
+        rsmooth_mesh_destroy(back);
+        free(out);
+        free(plain_out);
+    }
+    char losses[512];
+    rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_OBJ, losses, sizeof losses);
+    CHECK(strstr(losses, "UTF-8 byte-order mark") != NULL);
+    rsmooth_mesh_conversion_losses(plain, RSMOOTH_FORMAT_OBJ, losses, sizeof losses);
+    CHECK(strstr(losses, "byte-order") == NULL);
+    rsmooth_mesh_destroy(plain);
+    rsmooth_mesh_destroy(m);
+
+    /* A binary PLY with a mark reads too; errors count the mark's bytes. */
+    bytes binary = common_square(false);
+    bytes marked = {0};
+    put_text(&marked, "\xEF\xBB\xBF");
+    put(&marked, binary.data, binary.size);
+    m = parse_ok(&marked);
+    check_square(m);
+    rsmooth_mesh_destroy(m);
+    size_t index_at = marked.size - 4;
+    marked.data[index_at] = 9;
+    rsmooth_error err = EXPECT_PARSE_ERROR(marked.data, marked.size, "face index 9 out of range");
+    CHECK_EQ_INT(err.byte_offset, index_at);
+    bytes_free(&marked);
+    bytes_free(&binary);
+    bytes_free(&b);
+    bytes_free(&plain_file);
+}
+
+#define SQUARE_HEADER(vertex_props, face_list)                                                    \
+    "ply\nformat ascii 1.0\nelement vertex 3\n" vertex_props "element face 1\n" face_list          \
+    "end_header\n"
+
+static void test_detection_and_lenience(void) {
+    /* Leading blanks or lines before "ply": a located error, not the OBJ fallback. */
+    const char *indented = " ply\nformat ascii 1.0\nelement vertex 1\n" VERTEX_XYZ "end_header\n0 0 0\n";
+    rsmooth_error err = EXPECT_LINE(indented, 1, "a PLY file must start with the line 'ply'");
+    CHECK_EQ_INT(err.byte_offset, 1);
+    err = EXPECT_LINE("\r\n\nply\nformat ascii 1.0\n", 3, "after 3 bytes of blanks");
+    CHECK_EQ_INT(err.byte_offset, 3);
+    EXPECT_LINE("PLY\nformat ascii 1.0\n", 1, "must start with the line 'ply' (lowercase)");
+    EXPECT_LINE("ply", 1, "the file ends after 'ply'");
+    EXPECT_LINE("plyx\nformat ascii 1.0\n", 1, "the first line is 'plyx', not 'ply' alone");
+    /* a header cut short (a truncated binary PLY): located where it ends */
+    bytes b = common_square(false);
+    err = EXPECT_PARSE_ERROR(b.data, 60, "header ends without 'end_header'");
+    CHECK(err.line > 1 && err.byte_offset > 0 && err.byte_offset <= 60);
+    bytes_free(&b);
+    EXPECT_LINE("ply\nformat ascii 1.0\nelement face 0\n" FACE_LIST "end_header\n", 5,
+                "the header declares no 'element vertex'");
+
+    /* A property named twice in one element. */
+    EXPECT_LINE("ply\nformat ascii 1.0\nelement vertex 3\n" VERTEX_XYZ "property float y\n"
+                "end_header\n0 0 0 0\n",
+                7, "a second property of the same name in one element: 'y'");
+
+    /* An extra or missing value is blamed on its own row, not on a later one. */
+    const char *header = SQUARE_HEADER(VERTEX_XYZ, FACE_LIST);
+    char text[512];
+    snprintf(text, sizeof text, "%s0 0 0\n1 0 0 7\n0 1 0\n3 0 1 2\n", header);
+    err = EXPECT_LINE(text, 11, "extra value '7' on the line of element 'vertex' item 1");
+    CHECK_EQ_INT(err.byte_offset, strstr(text, " 7\n") + 1 - text);
+    snprintf(text, sizeof text, "%s0 0 0\n1 0\n0 1 0\n3 0 1 2\n", header);
+    EXPECT_LINE(text, 11, "element 'vertex' item 1 ends with its line");
+    snprintf(text, sizeof text, "%s0 0 0\n1 0 0\n0 1 0\n3 0 1 2 0\n", header);
+    EXPECT_LINE(text, 13, "extra value '0' on the line of element 'face' item 0");
+
+    /* Values their declared types cannot hold, refused at read time with their line. */
+    static const struct {
+        const char *x_type, *x, *needle;
+    } misfits[] = {{"uchar", "300", "value 300 does not fit the type 'uchar' of property 'x'"},
+                   {"char", "-200", "value -200 does not fit the type 'char'"},
+                   {"int", "2.5", "value 2.5 does not fit the type 'int'"},
+                   {"ushort", "-1", "value -1 does not fit the type 'ushort'"},
+                   {"float", "1e39", "does not fit the type 'float' of property 'x'"},
+                   {"double", "1e151", "vertex 1 has coordinate 1e+151 beyond the supported"},
+                   {"float", "nan", "vertex 1 has a non-finite coordinate"}};
+    for (size_t i = 0; i < sizeof misfits / sizeof misfits[0]; i++) {
+        snprintf(text, sizeof text,
+                 "ply\nformat ascii 1.0\nelement vertex 3\nproperty %s x\nproperty float y\n"
+                 "property float z\nend_header\n0 0 0\n%s 0 0\n0 1 0\n",
+                 misfits[i].x_type, misfits[i].x);
+        expect_line(__LINE__, text, 9, misfits[i].needle);
+    }
+    snprintf(text, sizeof text, "%s0 0 0\n1 0 0\n0 1 0\n3 0 1 256\n",
+             SQUARE_HEADER(VERTEX_XYZ, "property list uchar uchar vertex_indices\n"));
+    EXPECT_LINE(text, 13, "value 256 does not fit the type 'uchar' of property 'vertex_indices'");
+    snprintf(text, sizeof text, "%s0 0 0\n1 0 0\n0 1 0\n256 0 1 2\n", header);
+    EXPECT_LINE(text, 13, "value 256 does not fit the type 'uchar'");
+    snprintf(text, sizeof text, "%s0 0 0 0 0 1\n1 0 0 0 nan 1\n0 1 0 0 0 1\n3 0 1 2\n",
+             SQUARE_HEADER(VERTEX_XYZ "property float nx\nproperty float ny\nproperty float nz\n",
+                           FACE_LIST));
+    EXPECT_LINE(text, 14, "vertex 1 has a non-finite normal");
+
+    /* Binary: the byte offset of the vertex beyond the supported magnitude. */
+    b = binary_square(false, true);
+    size_t y2 = b.size - 3 * 27 + 8; /* vertex 2's y: each vertex is 3 doubles, a short, a byte */
+    double huge = -2e150;
+    memcpy(b.data + y2, &huge, 8);
+    err = EXPECT_PARSE_ERROR(b.data, b.size, "vertex 2 has coordinate -2e+150 beyond");
+    CHECK_EQ_INT(err.byte_offset, y2 - 8);
+    CHECK_EQ_INT(err.line, -1);
+    bytes_free(&b);
+}
+
 int main(void) {
     test_ascii();
     test_binary();
@@ -575,6 +765,9 @@ int main(void) {
     test_round_trip();
     test_truncated_prefixes();
     test_corruption();
+    test_write_refusals_and_extremes();
+    test_byte_order_mark();
+    test_detection_and_lenience();
     printf("ply_io: all checks passed\n");
     return 0;
 }

@@ -684,7 +684,43 @@ static void test_prefixes(void) {
                 CHECK_EQ_INT(s, RSMOOTH_OK);
             rsmooth_mesh_destroy(m);
         }
+        check_prefixes_located("rich PLY", b.data, b.size);
         bytes_free(&b);
+    }
+}
+
+/* Normals recomputed at the ends of the supported range (coordinates near 1e150 and far below
+ * 1e-150, where a triangle's cross product overflows or underflows a double) equal those of the
+ * same mesh at unit scale, area weights included. */
+static void test_normals_at_extreme_scales(void) {
+    /* vertex 0 is shared by a small and a large triangle of different planes */
+    const double unit[5][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 1}, {-2, 0, 0}, {0, 0, 2}};
+    const uint32_t two_faces[6] = {0, 1, 2, 0, 3, 4};
+    /* the oracle, by hand at unit scale: the faces' cross products (1,0,0) x (0,1,1) = (0,-1,1)
+     * and (-2,0,0) x (0,0,2) = (0,4,0) sum to (0,3,1) at vertex 0 */
+    const double n0[3] = {0, 3, 1};
+    double len = sqrt(n0[0] * n0[0] + n0[1] * n0[1] + n0[2] * n0[2]);
+    const double scales[] = {1, 1e150, 1e-160, 1e-300, 4.9406564584124654e-322 * 1024};
+    for (size_t s = 0; s < sizeof scales / sizeof scales[0]; s++) {
+        rsmooth_mesh *m = NULL;
+        rsmooth_error err;
+        CHECK_EQ_INT(rsmooth_mesh_create(5, 2, 6, &m, &err), RSMOOTH_OK);
+        for (int i = 0; i < 15; i++)
+            m->positions[i] = unit[i / 3][i % 3] * scales[s];
+        memcpy(m->face_indices, two_faces, sizeof two_faces);
+        m->face_offsets[1] = 3;
+        m->face_offsets[2] = 6;
+        CHECK_EQ_INT(rsmooth_mesh_triangulate(m, &err), RSMOOTH_OK);
+        double normals[15];
+        CHECK_EQ_INT(rsmooth_mesh_vertex_normals(m, normals, &err), RSMOOTH_OK);
+        printf("scale %g: vertex 0 normal %.17g %.17g %.17g\n", scales[s], normals[0], normals[1],
+               normals[2]);
+        for (int c = 0; c < 3; c++)
+            CHECK_NEAR(normals[c], n0[c] / len, 1e-15);
+        const double n1[3] = {0, -1 / sqrt(2), 1 / sqrt(2)}; /* vertex 1: the small face only */
+        for (int c = 0; c < 3; c++)
+            CHECK_NEAR(normals[3 + c], n1[c], 1e-15);
+        rsmooth_mesh_destroy(m);
     }
 }
 
@@ -729,6 +765,7 @@ int main(void) {
     test_empty_lists();
     test_prefixes();
     test_corruption();
+    test_normals_at_extreme_scales();
     printf("ply_roundtrip: all checks passed\n");
     return 0;
 }

@@ -286,7 +286,7 @@ static void test_binary(void) {
     rsmooth_mesh_destroy(m);
     /* The same with one byte more: its size is what is wrong, though it starts like ascii. */
     put(&b, "", 1);
-    EXPECT_PARSE_ERROR(b.data, b.size, "binary STL of 3 triangles needs 234 bytes, file has 235");
+    EXPECT_PARSE_ERROR(b.data, b.size, "84 + 50 × 3 = 234 bytes expected, 235 found");
     bytes_free(&b);
 }
 
@@ -295,15 +295,15 @@ static void test_errors(void) {
     /* Counts that disagree with the size, zero and too many triangles. */
     bytes b = binary_sample("x", NULL);
     b.data[80] = 4;
-    err = EXPECT_PARSE_ERROR(b.data, b.size, "binary STL of 4 triangles needs 284 bytes, file has 234");
+    err = EXPECT_PARSE_ERROR(b.data, b.size, "84 + 50 × 4 = 284 bytes expected, 234 found");
     CHECK_EQ_INT(err.line, -1);
     b.data[80] = 2;
-    EXPECT_PARSE_ERROR(b.data, b.size, "binary STL of 2 triangles needs 184 bytes, file has 234");
+    EXPECT_PARSE_ERROR(b.data, b.size, "84 + 50 × 2 = 184 bytes expected, 234 found");
     memset(b.data + 80, 0, 4);
     EXPECT_PARSE_ERROR(b.data, 84, "no triangles");
-    EXPECT_PARSE_ERROR(b.data, b.size, "no triangles");
+    EXPECT_PARSE_ERROR(b.data, b.size, "84 + 50 × 0 = 84 bytes expected, 234 found");
     memset(b.data + 80, 0xff, 4);
-    EXPECT_PARSE_ERROR(b.data, b.size, "more than 1431655764");
+    EXPECT_PARSE_ERROR(b.data, b.size, "84 + 50 × 4294967295 = 214748364834 bytes expected");
     EXPECT_PARSE_ERROR(b.data, 83, "at least 84 bytes");
     EXPECT_PARSE_ERROR(b.data, 0, "at least 84 bytes");
     b.data[80] = 3;
@@ -396,6 +396,7 @@ static void test_truncated(void) {
     ascii_end += 8;
     for (int k = 0; k < 2; k++) {
         const bytes *b = &samples[k];
+        check_prefixes_located(k ? "binary STL" : "ascii STL", b->data, b->size);
         for (size_t n = 0; n <= b->size; n++) {
             rsmooth_mesh *m = NULL;
             rsmooth_error err;
@@ -457,7 +458,7 @@ static void test_round_trip(void) {
     rsmooth_error err;
     FILE *sink = fopen("/dev/null", "wb");
     CHECK(sink != NULL);
-    m->positions[0] = 1e300;
+    m->positions[0] = 1e100; /* supported, but beyond float32 */
     CHECK_STATUS(rsmooth_mesh_write_stream(m, sink, RSMOOTH_FORMAT_STL_BINARY, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(err.message, "float32") != NULL);
@@ -518,6 +519,75 @@ static void test_indexed(void) {
     rsmooth_mesh_destroy(m);
 }
 
+/* ---- issue 12 */
+
+static void test_write_refusals_and_extremes(void) {
+    check_writer_refuses_unreadable(RSMOOTH_FORMAT_STL_ASCII);
+    check_writer_refuses_unreadable(RSMOOTH_FORMAT_STL_BINARY);
+    check_extremes_round_trip(RSMOOTH_FORMAT_STL_ASCII, RSMOOTH_FLOAT64);
+    check_extremes_round_trip(RSMOOTH_FORMAT_STL_BINARY, RSMOOTH_FLOAT32);
+    /* ascii beyond the supported magnitude: refused at its facet's line */
+    rsmooth_error err = EXPECT_ASCII_ERROR(
+        GOOD_FACET "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 -3e150\n"
+                   "vertex 0 1 0\nendloop\nendfacet\n",
+        "facet 1 has coordinate -3e+150 beyond the supported magnitude 1e+150");
+    CHECK_EQ_INT(err.line, 9);
+}
+
+/* A binary STL whose size disagrees with its count, read through detection as the command does:
+ * the sizes, the count's offset and where the data ends, whatever its header says. */
+static void test_detected_sizes(void) {
+    const char *headers[] = {"", "solid but binary", "exported by something"};
+    for (size_t h = 0; h < sizeof headers / sizeof headers[0]; h++) {
+        bytes b = binary_sample(headers[h], NULL);
+        if (h == 0)
+            memset(b.data, ' ', 80); /* a blank header: text, until the count's bytes */
+        for (size_t cut = 1; cut <= 60; cut += 59) {
+            size_t size = b.size - cut;
+            rsmooth_error err =
+                expect_parse_error(__LINE__, b.data, size, RSMOOTH_FORMAT_AUTO,
+                                   "84 + 50 × 3 = 234 bytes expected");
+            char found[32];
+            snprintf(found, sizeof found, "%zu found", size);
+            CHECK(strstr(err.message, found) != NULL);
+            CHECK_EQ_INT(err.byte_offset, size);
+        }
+        bytes_free(&b);
+    }
+}
+
+static void test_byte_order_mark(void) {
+    bytes plain = ascii_sample();
+    bytes b = {0};
+    put_text(&b, "\xEF\xBB\xBF");
+    put(&b, plain.data, plain.size);
+    for (int explicit_format = 0; explicit_format < 2; explicit_format++) {
+        rsmooth_mesh *m =
+            parse_ok(b.data, b.size, explicit_format ? RSMOOTH_FORMAT_STL_ASCII : RSMOOTH_FORMAT_AUTO);
+        check_soup(m, 3, 0);
+        rsmooth_mesh *p = parse_ok(plain.data, plain.size, RSMOOTH_FORMAT_AUTO);
+        size_t size, plain_size;
+        char *out = mesh_to_memory(m, RSMOOTH_FORMAT_STL_ASCII, &size);
+        char *plain_out = mesh_to_memory(p, RSMOOTH_FORMAT_STL_ASCII, &plain_size);
+        CHECK_EQ_INT(size, plain_size + 3);
+        CHECK(memcmp(out, "\xEF\xBB\xBF", 3) == 0 && memcmp(out + 3, plain_out, plain_size) == 0);
+        free(out);
+        free(plain_out);
+        /* binary STL has no text to mark: dropped, and said so */
+        char losses[256];
+        rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_STL_BINARY, losses, sizeof losses);
+        CHECK(strstr(losses, "UTF-8 byte-order mark") != NULL);
+        CHECK_EQ_INT(rsmooth_mesh_conversion_losses(p, RSMOOTH_FORMAT_STL_BINARY, NULL, 0), 0);
+        out = mesh_to_memory(m, RSMOOTH_FORMAT_STL_BINARY, &size);
+        CHECK(memcmp(out, "\xEF\xBB\xBF", 3) != 0);
+        free(out);
+        rsmooth_mesh_destroy(p);
+        rsmooth_mesh_destroy(m);
+    }
+    bytes_free(&b);
+    bytes_free(&plain);
+}
+
 int main(void) {
     test_ascii();
     test_binary();
@@ -525,6 +595,9 @@ int main(void) {
     test_truncated();
     test_round_trip();
     test_indexed();
+    test_write_refusals_and_extremes();
+    test_detected_sizes();
+    test_byte_order_mark();
     printf("stl io: ok\n");
     return 0;
 }

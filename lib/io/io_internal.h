@@ -15,6 +15,21 @@
 #define RS_IO_MAX_VERTICES ((uint64_t)UINT32_MAX)
 #define RS_IO_MAX_FACE_INDICES ((uint64_t)UINT32_MAX)
 
+/* The UTF-8 byte-order mark some editors put before text (EF BB BF). */
+#define RS_IO_UTF8_BOM "\xEF\xBB\xBF"
+#define RS_IO_UTF8_BOM_SIZE 3
+
+/* A coordinate readers accept and writers write: finite and within RS_MAX_COORDINATE, the range the
+ * filter supports (so what rsmooth writes, rsmooth reads). */
+static inline bool rs_io_coordinate_ok(double x) {
+    return x >= -RS_MAX_COORDINATE && x <= RS_MAX_COORDINATE; /* false for NaN */
+}
+
+/* Checks a vertex's x y z as read (rs_io_coordinate_ok), failing with a parse error at `line` /
+ * `byte_offset` that names vertex `number` (numbered as the format numbers vertices). */
+rsmooth_status rs_io_check_vertex(const double xyz[3], size_t number, int64_t line,
+                                  int64_t byte_offset, const char *where, rsmooth_error *error);
+
 /* Parses the whole token s[0, len) as a decimal floating-point number. Exact (correctly rounded)
  * fast path for plain decimals, strtod on a bounded NUL-terminated copy otherwise. Accepts what
  * strtod accepts (so "nan" and "inf" parse, to be rejected as non-finite by the caller). */
@@ -42,6 +57,12 @@ rsmooth_status rs_io_mesh_adopt(double *positions, size_t vertex_count, rsmooth_
  * indices) so the writers never read out of bounds. RSMOOTH_ERROR_INVALID_ARGUMENT otherwise. */
 rsmooth_status rs_io_mesh_check(const rsmooth_mesh *mesh, const char *where, rsmooth_error *error);
 
+/* Checks the values a writer would write, before it writes anything: every position
+ * (rs_io_coordinate_ok) and vertex_quality value finite, naming the first vertex that is not.
+ * RSMOOTH_ERROR_INVALID_ARGUMENT otherwise. */
+rsmooth_status rs_io_mesh_check_values(const rsmooth_mesh *mesh, const char *where,
+                                       rsmooth_error *error);
+
 /* Format parsers over a buffer that is not NUL-terminated (obj_read.c, ply_read.c). */
 rsmooth_status rs_io_obj_read(const char *data, size_t size, rsmooth_mesh **mesh,
                               rsmooth_error *error);
@@ -61,6 +82,11 @@ rsmooth_status rs_io_stl_read(const char *data, size_t size, rsmooth_mesh **mesh
                               rsmooth_error *error);
 rsmooth_status rs_io_stl_write(const rsmooth_mesh *mesh, FILE *stream, bool binary,
                                rsmooth_error *error);
+
+/* The mesh's own normals are what writers emit (a point cloud: no triangle to recompute from). */
+static inline bool rs_io_normals_are_data(const rsmooth_mesh *mesh) {
+    return mesh->triangle_count == 0 && mesh->vertex_normals;
+}
 
 /* The normals writers emit, recomputed from the positions (a mesh without triangles, a point cloud:
  * its vertex_normals): 3 * vertex_count doubles in a new *normals (the caller frees it), or an
@@ -82,7 +108,16 @@ struct rsmooth_mesh_extras {
     rs_obj_extras *obj;
     rs_off_extras *off;
     rs_stl_extras *stl;
+    bool utf8_bom; /* the text began with a UTF-8 byte-order mark (mesh->source_format's family) */
 };
+
+/* Whether writing `mesh` as `format` writes the byte-order mark it was read with: in the source's
+ * own format family, where the file opens with text (all but binary STL, whose header is bytes). */
+bool rs_io_keeps_bom(const rsmooth_mesh *mesh, rsmooth_format format);
+
+/* Writes the byte-order mark when rs_io_keeps_bom; false when the stream fails. Writers call it
+ * after their checks, before their first byte. */
+bool rs_io_put_bom(const rsmooth_mesh *mesh, rsmooth_format format, FILE *stream);
 
 /* Each frees its record (accepts NULL). */
 void rs_io_ply_extras_free(rs_ply_extras *extras);

@@ -116,6 +116,19 @@ size_t rs_io_loss_add(char *list, size_t size, const char *what) {
     return 1;
 }
 
+bool rs_io_keeps_bom(const rsmooth_mesh *mesh, rsmooth_format format) {
+    if (!mesh->extras || !mesh->extras->utf8_bom || format == RSMOOTH_FORMAT_STL_BINARY)
+        return false;
+    rsmooth_format source = mesh->source_format;
+    return source == format || (rs_io_is_ply(source) && rs_io_is_ply(format)) ||
+           (rs_io_is_stl(source) && rs_io_is_stl(format));
+}
+
+bool rs_io_put_bom(const rsmooth_mesh *mesh, rsmooth_format format, FILE *stream) {
+    return !rs_io_keeps_bom(mesh, format) ||
+           fwrite(RS_IO_UTF8_BOM, 1, RS_IO_UTF8_BOM_SIZE, stream) == RS_IO_UTF8_BOM_SIZE;
+}
+
 size_t rsmooth_mesh_conversion_losses(const rsmooth_mesh *mesh, rsmooth_format format,
                                       char *buffer, size_t size) {
     char scratch[1];
@@ -135,6 +148,8 @@ size_t rsmooth_mesh_conversion_losses(const rsmooth_mesh *mesh, rsmooth_format f
     if (mesh->vertex_quality && !rs_io_is_ply(format))
         lost += rs_io_loss_add(buffer, size, "vertex quality");
     if (mesh->extras) {
+        if (mesh->extras->utf8_bom && !rs_io_keeps_bom(mesh, format))
+            lost += rs_io_loss_add(buffer, size, "UTF-8 byte-order mark");
         lost += rs_io_ply_losses(mesh->extras->ply, format, buffer, size);
         lost += rs_io_obj_losses(mesh->extras->obj, format, buffer, size);
         lost += rs_io_off_losses(mesh->extras->off, format, buffer, size);
@@ -195,6 +210,41 @@ rsmooth_status rs_io_mesh_check(const rsmooth_mesh *mesh, const char *where, rsm
                 return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                                "face %zu: index %u >= vertex count %zu", f,
                                (unsigned)mesh->face_indices[i], mesh->vertex_count);
+    }
+    return RSMOOTH_OK;
+}
+
+rsmooth_status rs_io_mesh_check_values(const rsmooth_mesh *mesh, const char *where,
+                                       rsmooth_error *error) {
+    for (size_t i = 0; i < 3 * mesh->vertex_count; i++) {
+        double x = mesh->positions[i];
+        if (!isfinite(x))
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                           "vertex %zu has a non-finite coordinate (%g): not written", i / 3, x);
+        if (!rs_io_coordinate_ok(x))
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                           "vertex %zu has coordinate %g beyond the supported magnitude %g: not "
+                           "written (rsmooth could not read it back)",
+                           i / 3, x, RS_MAX_COORDINATE);
+    }
+    for (size_t i = 0; mesh->vertex_quality && i < mesh->vertex_count; i++)
+        if (!isfinite(mesh->vertex_quality[i]))
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                           "vertex %zu has a non-finite quality (%g): not written", i,
+                           (double)mesh->vertex_quality[i]);
+    return RSMOOTH_OK;
+}
+
+rsmooth_status rs_io_check_vertex(const double xyz[3], size_t number, int64_t line,
+                                  int64_t byte_offset, const char *where, rsmooth_error *error) {
+    for (int k = 0; k < 3; k++) {
+        if (!isfinite(xyz[k]))
+            return rs_fail_parse(error, line, byte_offset, where,
+                                 "vertex %zu has a non-finite coordinate", number);
+        if (!rs_io_coordinate_ok(xyz[k]))
+            return rs_fail_parse(error, line, byte_offset, where,
+                                 "vertex %zu has coordinate %g beyond the supported magnitude %g",
+                                 number, xyz[k], RS_MAX_COORDINATE);
     }
     return RSMOOTH_OK;
 }

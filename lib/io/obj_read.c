@@ -9,17 +9,24 @@ static const char where[] = "rsmooth_mesh_read (OBJ)";
 typedef struct obj_state {
     const char *data;
     size_t size;
-    /* When >= 0, positive face indices are checked against it as they are read: used by the second
-     * pass that locates the face of an index beyond the final vertex count (forward references make
-     * that count unknown during the first pass). */
-    int64_t known_vertex_count;
+    /* When >= 0, positive face indices (v, vt, vn) are checked against them as they are read: used
+     * by the second pass that locates the face of an index beyond the final count (forward
+     * references make the counts unknown during the first pass). */
+    int64_t known_vertex_count, known_vt_count, known_vn_count;
     double *positions;
     size_t vertex_count;
     size_t position_capacity; /* in vertices */
     rs_io_u32vec offsets;
     rs_io_u32vec indices;
     uint64_t max_index; /* largest 0-based positive index seen */
+    int64_t max_vt, max_vn; /* largest 1-based vt, vn index seen (0: none) */
     size_t vt_count;    /* vt lines so far: negative vt indices count back from it */
+    size_t vn_count;    /* vn lines so far: the same for vn */
+    /* The first statement OBJ does not know: where a file without vertices is blamed. */
+    int64_t unknown_line;
+    const char *unknown;
+    size_t unknown_len;
+    int64_t last_line;
     /* vt index of each face corner, kept in step with `indices` once any corner names one. */
     rs_io_u32vec corner_vt;
     bool any_vt;
@@ -110,7 +117,6 @@ static rsmooth_status parse_vertex(obj_state *st, const char *p, const char *end
     const char *token;
     size_t len;
     int n = 0;
-    bool finite = true;
     double rgb[3] = {0, 0, 0};
     /* x y z, then optionally w, or r g b (colours); any others must be numbers too. */
     while (next_token(&p, end, &token, &len)) {
@@ -120,7 +126,6 @@ static rsmooth_status parse_vertex(obj_state *st, const char *p, const char *end
                                  (int)(len > 40 ? 40 : len), token);
         if (n < 3) {
             xyz[n] = v;
-            finite = finite && isfinite(v);
         } else if (n < 6) {
             rgb[n - 3] = v;
         }
@@ -132,9 +137,11 @@ static rsmooth_status parse_vertex(obj_state *st, const char *p, const char *end
     if (n < 3)
         return rs_fail_parse(error, line, statement - st->data, where,
                              "vertex %zu has %d coordinates (3 needed)", st->vertex_count + 1, n);
-    if (!finite) /* numbered as f statements refer to it: 1-based */
-        return rs_fail_parse(error, line, statement - st->data, where,
-                             "vertex %zu has a non-finite coordinate", st->vertex_count + 1);
+    /* numbered as f statements refer to it: 1-based */
+    rsmooth_status status =
+        rs_io_check_vertex(xyz, st->vertex_count + 1, line, statement - st->data, where, error);
+    if (status != RSMOOTH_OK)
+        return status;
     if (n == 6) {
         if (!store_color(st, rgb))
             return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "vertex colours");
@@ -148,10 +155,10 @@ static rsmooth_status parse_vertex(obj_state *st, const char *p, const char *end
     return RSMOOTH_OK;
 }
 
-/* Parses "v", "v/vt", "v//vn" or "v/vt/vn": the vertex index into *out, the vt index (0 when there
- * is none) into *vt; the vn part must be an integer but is not kept (writers recompute normals). */
-static bool parse_index(const char *s, size_t len, int64_t *out, int64_t *vt) {
-    *vt = 0;
+/* Parses "v", "v/vt", "v//vn" or "v/vt/vn": the vertex index into *out, the vt and vn indices (0
+ * when there is none) into *vt and *vn, all as in the file (1-based, or negative: relative). */
+static bool parse_index(const char *s, size_t len, int64_t *out, int64_t *vt, int64_t *vn) {
+    *vt = *vn = 0;
     size_t i = 0;
     int part = 0;
     while (part < 3) {
@@ -172,10 +179,11 @@ static bool parse_index(const char *s, size_t len, int64_t *out, int64_t *vt) {
             *out = negative ? -v : v;
         } else if (empty && (negative || part == 2)) {
             return false; /* "v/-" or "v/vt/" */
-        } else if (part == 1 && !empty) {
-            *vt = negative ? -v : v;
-            if (*vt == 0)
-                return false; /* "v/0": OBJ indices start at 1 */
+        } else if (!empty) {
+            int64_t *index = part == 1 ? vt : vn;
+            *index = negative ? -v : v;
+            if (*index == 0)
+                return false; /* "v/0", "v//0": OBJ indices start at 1 */
         }
         if (i == len)
             return true;
@@ -187,24 +195,35 @@ static bool parse_index(const char *s, size_t len, int64_t *out, int64_t *vt) {
     return false; /* a third slash */
 }
 
-/* Records the vt index (as in the file, 0: none) of the corner about to be appended to st->indices,
- * made absolute so the writer never depends on how many vt lines came before. */
-static rsmooth_status record_vt(obj_state *st, int64_t vt, int64_t line, const char *token,
-                                rsmooth_error *error) {
-    uint32_t value = RS_OBJ_NO_VT;
-    if (vt < 0) {
-        int64_t absolute = (int64_t)st->vt_count + vt;
-        if (absolute < 0)
-            return rs_fail_parse(error, line, token - st->data, where,
-                                 "texture index %lld out of range (%zu texture coordinates)",
-                                 (long long)vt, st->vt_count);
-        value = (uint32_t)absolute;
-    } else if (vt > 0) {
-        if (vt > (int64_t)UINT32_MAX - 1) /* not checked against the count: vt may come later */
-            return rs_fail_parse(error, line, token - st->data, where,
-                                 "texture index %lld out of range", (long long)vt);
-        value = (uint32_t)(vt - 1);
+/* Checks a vt or vn index of a face corner against the lines of its kind: negative ones against
+ * those so far, positive ones against the final count once known (the second pass). Returns it
+ * 0-based, or -1 for none. */
+static rsmooth_status check_attribute_index(obj_state *st, int64_t index, const char *kind,
+                                            size_t count_so_far, int64_t known_count,
+                                            int64_t *max_seen, int64_t line, const char *token,
+                                            int64_t *zero_based, rsmooth_error *error) {
+    *zero_based = -1;
+    if (index == 0)
+        return RSMOOTH_OK;
+    int64_t absolute = index < 0 ? (int64_t)count_so_far + index : index - 1;
+    if (absolute < 0 || absolute > (int64_t)UINT32_MAX - 2 ||
+        (index > 0 && known_count >= 0 && absolute >= known_count)) {
+        size_t lines = index < 0 || known_count < 0 ? count_so_far : (size_t)known_count;
+        bool vt = kind[1] == 't';
+        return rs_fail_parse(error, line, token - st->data, where,
+                             "%s index %lld out of range (%zu %s)", vt ? "texture" : "normal",
+                             (long long)index, lines, vt ? "texture coordinates" : "normals");
     }
+    if (index > *max_seen)
+        *max_seen = index;
+    *zero_based = absolute;
+    return RSMOOTH_OK;
+}
+
+/* Records the vt index (0-based, or -1: none) of the corner about to be appended to st->indices,
+ * made absolute so the writer never depends on how many vt lines came before. */
+static rsmooth_status record_vt(obj_state *st, int64_t vt, rsmooth_error *error) {
+    uint32_t value = vt < 0 ? RS_OBJ_NO_VT : (uint32_t)vt;
     size_t corner = st->indices.count;
     if (!rs_io_u32vec_reserve(&st->corner_vt, corner + 1 - st->corner_vt.count))
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "%zu texture indices",
@@ -227,10 +246,19 @@ static rsmooth_status parse_face(obj_state *st, const char *p, const char *end, 
     size_t len;
     size_t first = st->indices.count;
     while (next_token(&p, end, &token, &len)) {
-        int64_t index, vt;
-        if (!parse_index(token, len, &index, &vt))
+        int64_t index, vt, vn;
+        if (!parse_index(token, len, &index, &vt, &vn))
             return rs_fail_parse(error, line, token - st->data, where,
                                  "malformed face index '%.*s'", (int)(len > 40 ? 40 : len), token);
+        int64_t vt_index, vn_index;
+        rsmooth_status status =
+            check_attribute_index(st, vt, "vt", st->vt_count, st->known_vt_count, &st->max_vt,
+                                  line, token, &vt_index, error);
+        if (status == RSMOOTH_OK)
+            status = check_attribute_index(st, vn, "vn", st->vn_count, st->known_vn_count,
+                                           &st->max_vn, line, token, &vn_index, error);
+        if (status != RSMOOTH_OK)
+            return status;
         int64_t zero_based;
         if (index == 0)
             return rs_fail_parse(error, line, token - st->data, where,
@@ -256,8 +284,8 @@ static rsmooth_status parse_face(obj_state *st, const char *p, const char *end, 
         if (!rs_io_u32vec_reserve(&st->indices, 1))
             return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "%zu face indices",
                            st->indices.count + 1);
-        if (vt != 0 || st->any_vt) {
-            rsmooth_status status = record_vt(st, vt, line, token, error);
+        if (vt_index >= 0 || st->any_vt) {
+            status = record_vt(st, vt_index, error);
             if (status != RSMOOTH_OK)
                 return status;
         }
@@ -275,6 +303,28 @@ static rsmooth_status parse_face(obj_state *st, const char *p, const char *end, 
     if (!rs_io_u32vec_reserve(&st->offsets, 1))
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "%zu faces", st->offsets.count);
     st->offsets.data[st->offsets.count++] = (uint32_t)st->indices.count;
+    return RSMOOTH_OK;
+}
+
+/* "vn x y z": three finite numbers (a point cloud's normals are its data; a mesh's are
+ * recomputed on output, but a file holding others is not what it claims). */
+static rsmooth_status parse_normal(obj_state *st, const char *p, const char *end, int64_t line,
+                                   const char *statement, rsmooth_error *error) {
+    const char *token;
+    size_t len;
+    int n = 0;
+    for (; n < 3 && next_token(&p, end, &token, &len); n++) {
+        double v;
+        if (!rs_io_parse_double(token, len, &v))
+            return rs_fail_parse(error, line, token - st->data, where, "malformed number '%.*s'",
+                                 (int)(len > 40 ? 40 : len), token);
+        if (!isfinite(v))
+            return rs_fail_parse(error, line, token - st->data, where,
+                                 "normal %zu has a non-finite component", st->vn_count);
+    }
+    if (n < 3 || next_token(&p, end, &token, &len))
+        return rs_fail_parse(error, line, statement - st->data, where,
+                             "normal %zu: 'vn' takes 3 numbers", st->vn_count);
     return RSMOOTH_OK;
 }
 
@@ -298,8 +348,10 @@ static unsigned classify(obj_state *st, const char *s, size_t len) {
         st->vt_count++;
         return RS_OBJ_TEXCOORDS;
     }
-    if (len == 2 && s[0] == 'v' && s[1] == 'n')
+    if (len == 2 && s[0] == 'v' && s[1] == 'n') {
+        st->vn_count++;
         return RS_OBJ_NORMALS;
+    }
     if (len == 6 && (memcmp(s, "mtllib", 6) == 0 || memcmp(s, "usemtl", 6) == 0))
         return RS_OBJ_MATERIALS;
     return RS_OBJ_OTHER;
@@ -340,6 +392,7 @@ static rsmooth_status parse_all(obj_state *st, rsmooth_error *error) {
         size_t len;
         const char *q = p, *start = p;
         p = eol ? eol + 1 : end;
+        st->last_line = line;
         int kind = RS_OBJ_RUN_TEXT;
         if (!next_token(&q, line_end, &statement, &len)) {
             if (q < line_end)
@@ -354,7 +407,15 @@ static rsmooth_status parse_all(obj_state *st, rsmooth_error *error) {
                 status = parse_face(st, q, line_end, line, statement, &plain, error);
                 kind = RS_OBJ_RUN_F;
             } else {
-                st->kinds |= classify(st, statement, len);
+                unsigned kind_bit = classify(st, statement, len);
+                st->kinds |= kind_bit;
+                if (kind_bit == RS_OBJ_NORMALS)
+                    status = parse_normal(st, q, line_end, line, statement, error);
+                if (kind_bit == RS_OBJ_OTHER && !st->unknown) {
+                    st->unknown = statement;
+                    st->unknown_len = len;
+                    st->unknown_line = line;
+                }
             }
             if (status != RSMOOTH_OK)
                 return status;
@@ -456,22 +517,43 @@ static double *point_cloud_normals(const char *data, size_t size, size_t vertex_
     return normals;
 }
 
+/* A file without a vertex: blamed on its first statement OBJ does not know (the likeliest sign
+ * that it is something else), else on its end. */
+static rsmooth_status no_vertices(const obj_state *st, rsmooth_error *error) {
+    if (st->unknown)
+        return rs_fail_parse(error, st->unknown_line, st->unknown - st->data, where,
+                             "no vertices (no 'v x y z' line), and '%.*s' is not an OBJ statement",
+                             (int)(st->unknown_len > 40 ? 40 : st->unknown_len), st->unknown);
+    return rs_fail_parse(error, st->last_line > 0 ? st->last_line : 1, (int64_t)st->size, where,
+                         "no vertices: the file ends (line %lld) without a 'v x y z' line",
+                         (long long)(st->last_line > 0 ? st->last_line : 1));
+}
+
 rsmooth_status rs_io_obj_read(const char *data, size_t size, rsmooth_mesh **mesh,
                               rsmooth_error *error) {
-    obj_state st = {.data = data, .size = size, .known_vertex_count = -1};
+    obj_state st = {.data = data,
+                    .size = size,
+                    .known_vertex_count = -1,
+                    .known_vt_count = -1,
+                    .known_vn_count = -1};
     rsmooth_status status = parse_all(&st, error);
     if (status == RSMOOTH_OK && st.vertex_count == 0)
-        status = rs_fail_parse(error, -1, -1, where, "no vertices");
-    if (status == RSMOOTH_OK && st.indices.count > 0 && st.max_index >= st.vertex_count) {
-        /* Rare error path: parse again, checking each index against the final count, so the error
-         * names the line of the first offending face. */
-        obj_state again = {
-            .data = data, .size = size, .known_vertex_count = (int64_t)st.vertex_count};
+        status = no_vertices(&st, error);
+    if (status == RSMOOTH_OK &&
+        ((st.indices.count > 0 && st.max_index >= st.vertex_count) ||
+         st.max_vt > (int64_t)st.vt_count || st.max_vn > (int64_t)st.vn_count)) {
+        /* Rare error path: parse again, checking each index against the final counts, so the
+         * error names the line of the first offending face. */
+        obj_state again = {.data = data,
+                           .size = size,
+                           .known_vertex_count = (int64_t)st.vertex_count,
+                           .known_vt_count = (int64_t)st.vt_count,
+                           .known_vn_count = (int64_t)st.vn_count};
         status = parse_all(&again, error);
         free_state(&again);
         if (status == RSMOOTH_OK) /* unreachable unless the two passes disagree */
-            status = rs_fail_parse(error, -1, -1, where, "face index out of range (%zu vertices)",
-                                   st.vertex_count);
+            status = rs_fail_parse(error, st.last_line, (int64_t)size, where,
+                                   "face index out of range (%zu vertices)", st.vertex_count);
     }
     if (status != RSMOOTH_OK) {
         free_state(&st);

@@ -2,14 +2,17 @@
 #include "io/obj_format.h"
 
 #include <errno.h>
+#include <math.h>
 #include <string.h>
 
 static const char where[] = "rsmooth_mesh_write_stream";
 
 /* Writes " v" so that it reads back as the same value (the same float when `as_float`): with 15
- * significant digits when they suffice (unchanged coordinates keep their short form), else 17. */
+ * significant digits when they suffice (unchanged coordinates keep their short form), else 17.
+ * A value beyond float range is written as the double it is (text holds either). */
 static bool put_coord(FILE *stream, double v, bool as_float) {
     char buf[40];
+    as_float = as_float && isfinite((float)v);
     int short_digits = as_float ? 6 : 15, full_digits = as_float ? 9 : 17;
     double value = as_float ? (double)(float)v : v;
     int n = snprintf(buf, sizeof buf, " %.*g", short_digits, value);
@@ -27,14 +30,20 @@ static bool put_position(FILE *stream, const rsmooth_mesh *mesh, size_t v) {
            put_coord(stream, p[1], as_float) && put_coord(stream, p[2], as_float);
 }
 
-/* vertex_count vn lines, each ended by `eol`. */
-static bool put_normals(FILE *stream, const double *normals, size_t count, const char *eol,
-                        size_t eol_len) {
+/* vertex_count vn lines, each ended by `eol`: recomputed normals to 9 digits (ample for a unit
+ * vector), a point cloud's own normals (its data) so that they read back exactly. */
+static bool put_normals(FILE *stream, const rsmooth_mesh *mesh, const double *normals,
+                        const char *eol, size_t eol_len) {
+    bool exact = rs_io_normals_are_data(mesh), as_float = mesh->precision == RSMOOTH_FLOAT32;
     bool ok = true;
-    for (size_t i = 0; ok && i < count; i++) {
+    for (size_t i = 0; ok && i < mesh->vertex_count; i++) {
         const double *n = normals + 3 * i;
-        ok = fprintf(stream, "vn %.9g %.9g %.9g", n[0], n[1], n[2]) >= 0 &&
-             fwrite(eol, 1, eol_len, stream) == eol_len;
+        if (exact)
+            ok = fputs("vn", stream) != EOF && put_coord(stream, n[0], as_float) &&
+                 put_coord(stream, n[1], as_float) && put_coord(stream, n[2], as_float);
+        else
+            ok = fprintf(stream, "vn %.9g %.9g %.9g", n[0], n[1], n[2]) >= 0;
+        ok = ok && fwrite(eol, 1, eol_len, stream) == eol_len;
     }
     return ok;
 }
@@ -132,7 +141,7 @@ static bool write_text(const rsmooth_mesh *mesh, const rs_obj_extras *x, const d
                  fwrite(q, 1, (size_t)(content_end - q), stream) == (size_t)(content_end - q);
         } else if (keyword && len == 2 && token[0] == 'v' && token[1] == 'n') {
             if (!at->normals_written && normals)
-                ok = put_normals(stream, normals, mesh->vertex_count,
+                ok = put_normals(stream, mesh, normals,
                                  ending_len ? ending : (x->crlf ? "\r\n" : "\n"),
                                  ending_len ? ending_len : (x->crlf ? 2 : 1));
             at->normals_written = true;
@@ -191,7 +200,7 @@ static bool write_generic(const rsmooth_mesh *mesh, const double *normals, FILE 
         ok = ok && putc('\n', stream) != EOF;
     }
     if (ok && normals)
-        ok = put_normals(stream, normals, mesh->vertex_count, "\n", 1);
+        ok = put_normals(stream, mesh, normals, "\n", 1);
     for (size_t f = 0; ok && f < mesh->face_count; f++)
         ok = put_face(stream, mesh, f, NULL, normals != NULL) && putc('\n', stream) != EOF;
     return ok;
@@ -212,8 +221,9 @@ rsmooth_status rs_io_obj_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_e
             return status;
     }
     errno = 0;
-    bool ok = faithful ? write_faithful(mesh, x, normals, stream)
-                       : write_generic(mesh, normals, stream);
+    bool ok = rs_io_put_bom(mesh, RSMOOTH_FORMAT_OBJ, stream);
+    ok = ok && (faithful ? write_faithful(mesh, x, normals, stream)
+                         : write_generic(mesh, normals, stream));
     rs_free(normals);
     ok = ok && fflush(stream) == 0 && !ferror(stream);
     if (!ok)

@@ -2,6 +2,8 @@
 #include "io/off_format.h"
 
 #include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
 #include <string.h>
 
 static const char where[] = "rsmooth_mesh_read (OFF)";
@@ -167,6 +169,28 @@ static rsmooth_status parse_counts(off_reader *r, const char *p, const char *sto
     return RSMOOTH_OK;
 }
 
+/* A variant this reader does not read: RSMOOTH_ERROR_UNSUPPORTED, located at `token`. */
+static rsmooth_status unsupported(const off_reader *r, const char *token, rsmooth_error *error,
+                                  const char *format, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+static rsmooth_status unsupported(const off_reader *r, const char *token, rsmooth_error *error,
+                                  const char *format, ...) {
+    if (!error)
+        return RSMOOTH_ERROR_UNSUPPORTED;
+    char message[sizeof error->message];
+    va_list args;
+    va_start(args, format);
+    vsnprintf(message, sizeof message, format, args);
+    va_end(args);
+    rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, where, "%s", message);
+    error->line = r->line; /* rs_fail leaves the location to parse errors */
+    error->byte_offset = token - r->data;
+    return RSMOOTH_ERROR_UNSUPPORTED;
+}
+
 static rsmooth_status parse_header(off_reader *r, off_header *h, rsmooth_error *error) {
     const char *p, *stop, *token;
     size_t len;
@@ -195,23 +219,24 @@ static rsmooth_status parse_header(off_reader *r, off_header *h, rsmooth_error *
         dim = true;
         i++;
     }
-    if (len - i != 3 || memcmp(token + i, "OFF", 3) != 0)
+    /* "off" in any case: some writers use lowercase (the prefix letters keep their case: 'n' is
+     * the dimension prefix, 'N' normals) */
+    bool off = len - i == 3 && (token[i] | 0x20) == 'o' && (token[i + 1] | 0x20) == 'f' &&
+               (token[i + 2] | 0x20) == 'f';
+    if (!off)
         return rs_fail_parse(error, r->line, token - r->data, where,
                              "missing OFF header: the file starts with '%.*s', not OFF, COFF, "
                              "NOFF, CNOFF, STOFF or a combination",
                              TOKEN_TEXT(token, len));
     if (four || dim)
-        return rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, where,
-                       "line %lld: %.*s: %s vertices are not supported (only 3D OFF)",
-                       (long long)r->line, TOKEN_TEXT(token, len),
-                       dim ? "n-dimensional" : "4-dimensional");
+        return unsupported(r, token, error, "%.*s: %s vertices are not supported (only 3D OFF)",
+                           TOKEN_TEXT(token, len), dim ? "n-dimensional" : "4-dimensional");
     memcpy(h->keyword, token, len);
     h->keyword[len] = '\0';
     const char *rest = p;
     if (next_token(&p, stop, &token, &len)) {
         if (len == 6 && memcmp(token, "BINARY", 6) == 0)
-            return rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, where,
-                           "line %lld: binary OFF is not supported", (long long)r->line);
+            return unsupported(r, token, error, "binary OFF is not supported");
         return parse_counts(r, rest, stop, h, error); /* the counts on the keyword's line */
     }
     if (!next_line(r, &p, &stop))
@@ -276,9 +301,12 @@ static rsmooth_status parse_vertex(off_reader *r, const off_header *h, off_state
             return rs_fail_parse(error, r->line, tokens[k] - r->data, where,
                                  "vertex %zu: malformed number '%.*s'", v,
                                  TOKEN_TEXT(tokens[k], lens[k]));
-    if (!isfinite(values[0]) || !isfinite(values[1]) || !isfinite(values[2]))
-        return rs_fail_parse(error, r->line, tokens[0] - r->data, where,
-                             "vertex %zu has a non-finite coordinate", v);
+    rsmooth_status status = rs_io_check_vertex(values, v, r->line, tokens[0] - r->data, where, error);
+    if (status != RSMOOTH_OK)
+        return status;
+    if (h->n && (!isfinite(values[3]) || !isfinite(values[4]) || !isfinite(values[5])))
+        return rs_fail_parse(error, r->line, tokens[3] - r->data, where,
+                             "vertex %zu has a non-finite normal", v);
     memcpy(st->positions + 3 * v, values, 3 * sizeof(double));
     if (h->n)
         memcpy(st->normals + 3 * v, values + 3, 3 * sizeof(double));

@@ -2,6 +2,7 @@
 #include "io/off_format.h"
 
 #include <errno.h>
+#include <math.h>
 #include <string.h>
 
 static const char where[] = "rsmooth_mesh_write_stream";
@@ -10,6 +11,7 @@ static const char where[] = "rsmooth_mesh_write_stream";
  * 15 significant digits when they suffice (unchanged coordinates keep their short form), else 17. */
 static bool put_coord(FILE *stream, const char *sep, double v, bool as_float) {
     char buf[40];
+    as_float = as_float && isfinite((float)v); /* else the double it is: text holds either */
     int short_digits = as_float ? 6 : 15, full_digits = as_float ? 9 : 17;
     double value = as_float ? (double)(float)v : v;
     size_t skip = strlen(sep);
@@ -72,11 +74,42 @@ static bool put_vertex(FILE *stream, const rsmooth_mesh *mesh, size_t v, const d
     bool as_float = mesh->precision == RSMOOTH_FLOAT32;
     bool ok = put_coord(stream, "", p[0], as_float) && put_coord(stream, " ", p[1], as_float) &&
               put_coord(stream, " ", p[2], as_float);
-    if (ok && normals) {
+    if (ok && normals) { /* recomputed: 9 digits; a point cloud's own (its data): exact */
         const double *n = normals + 3 * v;
-        ok = fprintf(stream, " %.9g %.9g %.9g", n[0], n[1], n[2]) >= 0;
+        if (rs_io_normals_are_data(mesh))
+            ok = put_coord(stream, " ", n[0], as_float) && put_coord(stream, " ", n[1], as_float) &&
+                 put_coord(stream, " ", n[2], as_float);
+        else
+            ok = fprintf(stream, " %.9g %.9g %.9g", n[0], n[1], n[2]) >= 0;
     }
     return ok;
+}
+
+/* The file the mesh was read from: its keyword, edge count and the text after each vertex's
+ * position and each face's indices. */
+static bool write_faithful(const rsmooth_mesh *mesh, const rs_off_extras *x, const double *normals,
+                           FILE *stream) {
+    bool ok = fprintf(stream, "%s\n%zu %zu %llu\n", x->keyword, mesh->vertex_count,
+                      mesh->face_count, (unsigned long long)x->edge_count) >= 0;
+    for (size_t v = 0; ok && v < mesh->vertex_count; v++)
+        ok = put_vertex(stream, mesh, v, normals) && put_text(stream, &x->vertex, v) &&
+             putc('\n', stream) != EOF;
+    return ok && put_faces(stream, mesh, &x->face);
+}
+
+/* OFF, COFF, NOFF or CNOFF from the mesh's own fields. */
+static bool write_generic(const rsmooth_mesh *mesh, const double *normals, FILE *stream) {
+    const uint8_t *colors = mesh->vertex_colors;
+    bool ok = fprintf(stream, "%s%sOFF\n%zu %zu 0\n", colors ? "C" : "", normals ? "N" : "",
+                      mesh->vertex_count, mesh->face_count) >= 0;
+    for (size_t v = 0; ok && v < mesh->vertex_count; v++) {
+        ok = put_vertex(stream, mesh, v, normals);
+        if (ok && colors)
+            ok = fprintf(stream, " %u %u %u 255", colors[3 * v], colors[3 * v + 1],
+                         colors[3 * v + 2]) >= 0;
+        ok = ok && putc('\n', stream) != EOF;
+    }
+    return ok && put_faces(stream, mesh, NULL);
 }
 
 rsmooth_status rs_io_off_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_error *error) {
@@ -92,27 +125,9 @@ rsmooth_status rs_io_off_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_e
             return status;
     }
     errno = 0;
-    bool ok;
-    if (faithful) {
-        ok = fprintf(stream, "%s\n%zu %zu %llu\n", x->keyword, mesh->vertex_count,
-                     mesh->face_count, (unsigned long long)x->edge_count) >= 0;
-        for (size_t v = 0; ok && v < mesh->vertex_count; v++)
-            ok = put_vertex(stream, mesh, v, normals) && put_text(stream, &x->vertex, v) &&
-                 putc('\n', stream) != EOF;
-        ok = ok && put_faces(stream, mesh, &x->face);
-    } else {
-        const uint8_t *colors = mesh->vertex_colors;
-        ok = fprintf(stream, "%s%sOFF\n%zu %zu 0\n", colors ? "C" : "", normals ? "N" : "",
-                     mesh->vertex_count, mesh->face_count) >= 0;
-        for (size_t v = 0; ok && v < mesh->vertex_count; v++) {
-            ok = put_vertex(stream, mesh, v, normals);
-            if (ok && colors)
-                ok = fprintf(stream, " %u %u %u 255", colors[3 * v], colors[3 * v + 1],
-                             colors[3 * v + 2]) >= 0;
-            ok = ok && putc('\n', stream) != EOF;
-        }
-        ok = ok && put_faces(stream, mesh, NULL);
-    }
+    bool ok = rs_io_put_bom(mesh, RSMOOTH_FORMAT_OFF, stream) &&
+              (faithful ? write_faithful(mesh, x, normals, stream)
+                        : write_generic(mesh, normals, stream));
     rs_free(normals);
     ok = ok && fflush(stream) == 0 && !ferror(stream);
     if (!ok)

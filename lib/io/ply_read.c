@@ -15,6 +15,8 @@ typedef struct ply_reader {
     size_t size;
     size_t pos;   /* read position in data */
     int64_t line; /* ascii: current line, 1-based */
+    bool crossed_line; /* ascii: the last token read came after a line end */
+    int64_t end_header_line;
     ply_encoding encoding;
     bool swap;        /* binary data in the other byte order than the host's */
     rs_ply_extras *x; /* the header, and the values kept */
@@ -138,6 +140,11 @@ static rsmooth_status add_property(ply_reader *r, const char *const *tok, const 
         name_len = len[2];
     }
     rs_ply_element *e = &x->elements[x->element_count - 1];
+    for (size_t k = 0; k < e->property_count; k++) /* a name must say which value it is */
+        if (token_is(name, name_len, e->properties[k].name))
+            return header_error(r, (size_t)(name - r->data), error,
+                                "a second property of the same name in one element:", name,
+                                name_len);
     if (e->property_count == e->property_capacity) {
         size_t capacity = e->property_capacity ? 2 * e->property_capacity : 8;
         rs_ply_property *p = rs_realloc_array(e->properties, capacity, sizeof *p);
@@ -190,9 +197,18 @@ static rsmooth_status add_element(ply_reader *r, const char *const *tok, const s
 static rsmooth_status parse_header(ply_reader *r, rsmooth_error *error) {
     const char *data = r->data;
     /* Magic: "ply" alone on the first line. */
-    if (r->size < 4 || memcmp(data, "ply", 3) != 0 ||
-        !(data[3] == '\n' || (data[3] == '\r' && r->size > 4 && data[4] == '\n')))
-        return rs_fail_parse(error, 1, 0, where, "not a PLY file (the first line is not 'ply')");
+    bool magic = r->size >= 3 && memcmp(data, "ply", 3) == 0;
+    if (magic && (r->size == 3 || (r->size == 4 && data[3] == '\r')))
+        return rs_fail_parse(error, 1, (int64_t)r->size, where,
+                             "the file ends after 'ply' (a header up to 'end_header' expected)");
+    if (!magic || !(data[3] == '\n' || (data[3] == '\r' && data[4] == '\n'))) {
+        size_t len = 0;
+        while (len < r->size && len < 40 && data[len] != '\n' && data[len] != '\r')
+            len++;
+        return rs_fail_parse(error, 1, 0, where,
+                             "not a PLY file: the first line is '%.*s', not 'ply' alone", (int)len,
+                             data);
+    }
     r->pos = data[3] == '\n' ? 4 : 5;
     r->line = 2;
     bool have_format = false;
@@ -240,6 +256,7 @@ static rsmooth_status parse_header(ply_reader *r, rsmooth_error *error) {
             if (!have_format)
                 return rs_fail_parse(error, r->line, (int64_t)offset, where,
                                      "header has no 'format' line");
+            r->end_header_line = r->line;
             r->line++; /* ascii data starts on the next line */
             return RSMOOTH_OK;
         } else if (token_is(tok[0], len[0], "format")) {
@@ -399,6 +416,19 @@ static rsmooth_status face_index(ply_reader *r, double v, int64_t line, int64_t 
         return rs_fail_parse(error, line, offset, where,
                              "face index %.17g out of range (%zu vertices)", v, r->vertex_count);
     r->indices.data[r->indices.count++] = (uint32_t)v;
+    return RSMOOTH_OK;
+}
+
+/* A vertex as read: coordinates rsmooth supports, and finite normals (a point cloud's data; a
+ * mesh's are recomputed, but a file holding others is not what it claims). */
+static rsmooth_status check_vertex(const ply_reader *r, size_t i, int64_t line, int64_t offset,
+                                   rsmooth_error *error) {
+    rsmooth_status status = rs_io_check_vertex(r->positions + 3 * i, i, line, offset, where, error);
+    if (status != RSMOOTH_OK || !r->normal_values)
+        return status;
+    const double *n = r->normal_values + 3 * i;
+    if (!isfinite(n[0]) || !isfinite(n[1]) || !isfinite(n[2]))
+        return rs_fail_parse(error, line, offset, where, "vertex %zu has a non-finite normal", i);
     return RSMOOTH_OK;
 }
 
@@ -625,9 +655,9 @@ static rsmooth_status read_binary_element(ply_reader *r, rs_ply_element *e, rsmo
                 for (int c = 0; r->normal_values && c < 3; c++)
                     r->normal_values[3 * i + (size_t)c] =
                         load_value(item + offsets[3 + c], types[3 + c], be);
-                if (!isfinite(xyz[0]) || !isfinite(xyz[1]) || !isfinite(xyz[2]))
-                    return rs_fail_parse(error, -1, (int64_t)(item - data), where,
-                                         "vertex %zu has a non-finite coordinate", i);
+                rsmooth_status status = check_vertex(r, i, -1, (int64_t)(item - data), error);
+                if (status != RSMOOTH_OK)
+                    return status;
             }
         }
         if (e->row_size > 0) {
@@ -700,11 +730,9 @@ static rsmooth_status read_binary_element(ply_reader *r, rs_ply_element *e, rsmo
             r->pos += bytes;
         }
         if (is_vertex) {
-            const double *xyz = r->positions + 3 * i;
-            if (!isfinite(xyz[0]) || !isfinite(xyz[1]) || !isfinite(xyz[2]))
-                return rs_fail_parse(error, -1, (int64_t)item_start, where,
-                                     "vertex %llu has a non-finite coordinate",
-                                     (unsigned long long)i);
+            rsmooth_status status = check_vertex(r, (size_t)i, -1, (int64_t)item_start, error);
+            if (status != RSMOOTH_OK)
+                return status;
         }
     }
     return RSMOOTH_OK;
@@ -712,12 +740,16 @@ static rsmooth_status read_binary_element(ply_reader *r, rs_ply_element *e, rsmo
 
 /* ---- data: ascii */
 
-/* Next whitespace-separated token; counts lines. False at the end of the data. */
+/* Next whitespace-separated token; counts lines, and sets r->crossed_line when it passed a line end.
+ * False at the end of the data. */
 static bool next_token(ply_reader *r, const char **token, size_t *len) {
     const char *p = r->data + r->pos, *end = r->data + r->size;
+    r->crossed_line = false;
     for (; p < end && is_space(*p); p++)
-        if (*p == '\n')
+        if (*p == '\n') {
             r->line++;
+            r->crossed_line = true;
+        }
     if (p == end) {
         r->pos = r->size;
         return false;
@@ -731,75 +763,79 @@ static bool next_token(ply_reader *r, const char **token, size_t *len) {
     return true;
 }
 
-static rsmooth_status read_ascii_value(ply_reader *r, const rs_ply_element *e, uint64_t item,
-                                       double *value, size_t *offset, rsmooth_error *error) {
+/* Where an ascii item stands: each item is one line, so a value missing from it or one too many
+ * is blamed on that line rather than on a later item. */
+typedef struct ascii_item {
+    const rs_ply_element *element;
+    uint64_t index;
+    int64_t line;
+    size_t start; /* offset of its first value */
+    bool started;
+} ascii_item;
+
+static rsmooth_status read_ascii_value(ply_reader *r, ascii_item *item, double *value,
+                                       size_t *offset, rsmooth_error *error) {
     const char *token;
     size_t len;
-    if (!next_token(r, &token, &len))
+    bool found = next_token(r, &token, &len);
+    if (found && item->started && r->crossed_line)
+        return rs_fail_parse(error, item->line, (int64_t)item->start, where,
+                             "element '%.40s' item %llu ends with its line before all the values "
+                             "the header declares",
+                             item->element->name, (unsigned long long)item->index);
+    if (!found)
         return rs_fail_parse(error, r->line, (int64_t)r->size, where,
-                             "data ends inside element '%.40s' item %llu", e->name,
-                             (unsigned long long)item);
+                             "data ends inside element '%.40s' item %llu", item->element->name,
+                             (unsigned long long)item->index);
     *offset = (size_t)(token - r->data);
+    if (!item->started) {
+        item->started = true;
+        item->line = r->line;
+        item->start = *offset;
+    }
     if (!rs_io_parse_double(token, len, value))
         return rs_fail_parse(error, r->line, (int64_t)*offset, where, "malformed number '%.*s'",
                              (int)(len > 40 ? 40 : len), token);
     return RSMOOTH_OK;
 }
 
-/* Stores v as a value of type t (host order); false when t cannot hold it exactly (integers) —
- * kept values must survive unchanged, so nothing is rounded. */
-static bool store_value(unsigned char *dst, rs_ply_type t, double v) {
-    if (!rs_ply_type_is_float(t) && v != floor(v))
-        return false; /* also NaN and infinities */
+/* After an item's values, only blanks may remain on its line. */
+static rsmooth_status end_ascii_item(ply_reader *r, const ascii_item *item, rsmooth_error *error) {
+    size_t p = r->pos;
+    while (p < r->size && r->data[p] != '\n' && is_space(r->data[p]))
+        p++;
+    if (p == r->size || r->data[p] == '\n')
+        return RSMOOTH_OK;
+    size_t end = p;
+    while (end < r->size && !is_space(r->data[end]))
+        end++;
+    return rs_fail_parse(error, item->line, (int64_t)p, where,
+                         "extra value '%.*s' on the line of element '%.40s' item %llu (more values "
+                         "than the header declares)",
+                         (int)(end - p > 40 ? 40 : end - p), r->data + p, item->element->name,
+                         (unsigned long long)item->index);
+}
+
+/* true when a value of type t holds v as written: integers within the type's range and whole
+ * (NaN and infinities are not), floats within float range unless written as an infinity or NaN
+ * (which the checks of what they are, coordinates or normals, refuse; other properties keep them). */
+static bool value_fits(rs_ply_type t, double v) {
     switch (t) {
-    case RS_PLY_INT8: {
-        if (v < INT8_MIN || v > INT8_MAX)
-            return false;
-        int8_t x = (int8_t)v;
-        memcpy(dst, &x, sizeof x);
-        return true;
-    }
-    case RS_PLY_UINT8: {
-        if (v < 0 || v > UINT8_MAX)
-            return false;
-        *dst = (uint8_t)v;
-        return true;
-    }
-    case RS_PLY_INT16: {
-        if (v < INT16_MIN || v > INT16_MAX)
-            return false;
-        int16_t x = (int16_t)v;
-        memcpy(dst, &x, sizeof x);
-        return true;
-    }
-    case RS_PLY_UINT16: {
-        if (v < 0 || v > UINT16_MAX)
-            return false;
-        uint16_t x = (uint16_t)v;
-        memcpy(dst, &x, sizeof x);
-        return true;
-    }
-    case RS_PLY_INT32: {
-        if (v < INT32_MIN || v > INT32_MAX)
-            return false;
-        int32_t x = (int32_t)v;
-        memcpy(dst, &x, sizeof x);
-        return true;
-    }
-    case RS_PLY_UINT32: {
-        if (v < 0 || v > UINT32_MAX)
-            return false;
-        uint32_t x = (uint32_t)v;
-        memcpy(dst, &x, sizeof x);
-        return true;
-    }
-    case RS_PLY_FLOAT32: {
-        float x = (float)v;
-        memcpy(dst, &x, sizeof x);
-        return true;
-    }
+    case RS_PLY_INT8:
+        return v == floor(v) && v >= INT8_MIN && v <= INT8_MAX;
+    case RS_PLY_UINT8:
+        return v == floor(v) && v >= 0 && v <= UINT8_MAX;
+    case RS_PLY_INT16:
+        return v == floor(v) && v >= INT16_MIN && v <= INT16_MAX;
+    case RS_PLY_UINT16:
+        return v == floor(v) && v >= 0 && v <= UINT16_MAX;
+    case RS_PLY_INT32:
+        return v == floor(v) && v >= INT32_MIN && v <= INT32_MAX;
+    case RS_PLY_UINT32:
+        return v == floor(v) && v >= 0 && v <= UINT32_MAX;
+    case RS_PLY_FLOAT32:
+        return !isfinite(v) || isfinite((float)v);
     case RS_PLY_FLOAT64:
-        memcpy(dst, &v, sizeof v);
         return true;
     case RS_PLY_NONE:
         break;
@@ -807,21 +843,70 @@ static bool store_value(unsigned char *dst, rs_ply_type t, double v) {
     return false;
 }
 
-static rsmooth_status bad_value(const ply_reader *r, const rs_ply_element *e,
-                                const rs_ply_property *p, rs_ply_type type, double v, size_t offset,
-                                rsmooth_error *error) {
-    return rs_fail_parse(error, r->line, (int64_t)offset, where,
-                         "value %.17g does not fit the type '%s' of property '%.40s' (element "
-                         "'%.40s')",
-                         v, rs_ply_spelling(rs_ply_canonical_spelling(type)), p->name, e->name);
+/* Stores v, which fits type t, as a value of type t (host order). */
+static void store_value(unsigned char *dst, rs_ply_type t, double v) {
+    switch (t) {
+    case RS_PLY_INT8: {
+        int8_t x = (int8_t)v;
+        memcpy(dst, &x, sizeof x);
+        return;
+    }
+    case RS_PLY_UINT8:
+        *dst = (uint8_t)v;
+        return;
+    case RS_PLY_INT16: {
+        int16_t x = (int16_t)v;
+        memcpy(dst, &x, sizeof x);
+        return;
+    }
+    case RS_PLY_UINT16: {
+        uint16_t x = (uint16_t)v;
+        memcpy(dst, &x, sizeof x);
+        return;
+    }
+    case RS_PLY_INT32: {
+        int32_t x = (int32_t)v;
+        memcpy(dst, &x, sizeof x);
+        return;
+    }
+    case RS_PLY_UINT32: {
+        uint32_t x = (uint32_t)v;
+        memcpy(dst, &x, sizeof x);
+        return;
+    }
+    case RS_PLY_FLOAT32: {
+        float x = (float)v;
+        memcpy(dst, &x, sizeof x);
+        return;
+    }
+    case RS_PLY_FLOAT64:
+        memcpy(dst, &v, sizeof v);
+        return;
+    case RS_PLY_NONE:
+        break;
+    }
+}
+
+/* Reads the next value of the item, which must fit `type` (the property's, or its list's count or
+ * item type). */
+static rsmooth_status read_typed_value(ply_reader *r, ascii_item *item, const rs_ply_property *p,
+                                       rs_ply_type type, double *value, size_t *offset,
+                                       rsmooth_error *error) {
+    rsmooth_status status = read_ascii_value(r, item, value, offset, error);
+    if (status == RSMOOTH_OK && !value_fits(type, *value))
+        return rs_fail_parse(error, r->line, (int64_t)*offset, where,
+                             "value %.17g does not fit the type '%s' of property '%.40s' (element "
+                             "'%.40s')",
+                             *value, rs_ply_spelling(rs_ply_canonical_spelling(type)), p->name,
+                             item->element->name);
+    return status;
 }
 
 static rsmooth_status read_ascii_element(ply_reader *r, rs_ply_element *e, rsmooth_error *error) {
     const bool is_vertex = e == r->vertex_element, is_face = e == r->face_element;
     rsmooth_status status;
     for (uint64_t i = 0; i < e->count; i++) {
-        size_t item_start = 0;
-        int64_t item_line = 0;
+        ascii_item item = {.element = e, .index = i};
         unsigned char *row = e->rows ? e->rows + (size_t)i * e->row_size : NULL;
         if (is_face)
             r->face_offsets[i] = (uint32_t)r->indices.count;
@@ -829,65 +914,57 @@ static rsmooth_status read_ascii_element(ply_reader *r, rs_ply_element *e, rsmoo
             const rs_ply_property *p = &e->properties[k];
             double v;
             size_t offset;
-            status = read_ascii_value(r, e, i, &v, &offset, error);
-            if (status != RSMOOTH_OK)
-                return status;
-            if (k == 0) {
-                item_start = offset;
-                item_line = r->line;
-            }
             if (p->count_type == RS_PLY_NONE) {
+                status = read_typed_value(r, &item, p, p->type, &v, &offset, error);
+                if (status != RSMOOTH_OK)
+                    return status;
+                /* as stored in binary: a float property holds a float */
+                double stored = p->type == RS_PLY_FLOAT32 ? (double)(float)v : v;
                 if (p->role >= RS_PLY_X && p->role <= RS_PLY_Z)
-                    /* as stored in binary: a float property holds a float */
-                    r->positions[3 * i + (uint64_t)(p->role - RS_PLY_X)] =
-                        p->type == RS_PLY_FLOAT32 ? (double)(float)v : v;
+                    r->positions[3 * i + (uint64_t)(p->role - RS_PLY_X)] = stored;
                 else if (p->role >= RS_PLY_NX && p->role <= RS_PLY_NZ)
-                    r->normal_values[3 * i + (uint64_t)(p->role - RS_PLY_NX)] =
-                        p->type == RS_PLY_FLOAT32 ? (double)(float)v : v;
-                else if (p->role == RS_PLY_STORED && !store_value(row + p->row_offset, p->type, v))
-                    return bad_value(r, e, p, p->type, v, offset, error);
+                    r->normal_values[3 * i + (uint64_t)(p->role - RS_PLY_NX)] = stored;
+                else if (p->role == RS_PLY_STORED)
+                    store_value(row + p->row_offset, p->type, v);
                 continue;
             }
+            status = read_typed_value(r, &item, p, p->count_type, &v, &offset, error);
+            if (status != RSMOOTH_OK)
+                return status;
             /* A list: every item takes at least 2 bytes ("1 "), which bounds the count. */
-            if (!(v >= 0 && v == floor(v) && v <= (double)(r->size - r->pos)))
+            if (!(v >= 0 && v <= (double)(r->size - r->pos)))
                 return rs_fail_parse(error, r->line, (int64_t)offset, where,
                                      "bad list count %.17g in element '%.40s' item %llu", v,
                                      e->name, (unsigned long long)i);
             uint64_t n = (uint64_t)v;
             if (p->role == RS_PLY_FACE_LIST) {
                 status = face_begin(r, n, i, r->line, (int64_t)offset, error);
-                if (status != RSMOOTH_OK)
-                    return status;
-                for (uint64_t j = 0; j < n; j++) {
-                    status = read_ascii_value(r, e, i, &v, &offset, error);
+                for (uint64_t j = 0; status == RSMOOTH_OK && j < n; j++) {
+                    status = read_typed_value(r, &item, p, p->type, &v, &offset, error);
                     if (status == RSMOOTH_OK)
                         status = face_index(r, v, r->line, (int64_t)offset, error);
-                    if (status != RSMOOTH_OK)
-                        return status;
                 }
+                if (status != RSMOOTH_OK)
+                    return status;
                 continue;
             }
-            if (!store_value(row + p->row_offset, p->count_type, v))
-                return bad_value(r, e, p, p->count_type, v, offset, error);
+            store_value(row + p->row_offset, p->count_type, v);
             const size_t size = rs_ply_type_size(p->type);
             for (uint64_t j = 0; j < n; j++) {
-                status = read_ascii_value(r, e, i, &v, &offset, error);
+                status = read_typed_value(r, &item, p, p->type, &v, &offset, error);
                 if (status != RSMOOTH_OK)
                     return status;
                 if (!list_reserve(e, size))
                     return list_oom(e, error);
-                if (!store_value(e->list_items + e->list_bytes, p->type, v))
-                    return bad_value(r, e, p, p->type, v, offset, error);
+                store_value(e->list_items + e->list_bytes, p->type, v);
                 e->list_bytes += size;
             }
         }
-        if (is_vertex) {
-            const double *xyz = r->positions + 3 * i;
-            if (!isfinite(xyz[0]) || !isfinite(xyz[1]) || !isfinite(xyz[2]))
-                return rs_fail_parse(error, item_line, (int64_t)item_start, where,
-                                     "vertex %llu has a non-finite coordinate",
-                                     (unsigned long long)i);
-        }
+        status = end_ascii_item(r, &item, error);
+        if (status == RSMOOTH_OK && is_vertex)
+            status = check_vertex(r, (size_t)i, item.line, (int64_t)item.start, error);
+        if (status != RSMOOTH_OK)
+            return status;
     }
     return RSMOOTH_OK;
 }
@@ -1024,8 +1101,12 @@ static rsmooth_status find_elements(ply_reader *r, rsmooth_error *error) {
             x->face_element = ei;
         }
     }
-    if (!r->vertex_element || r->vertex_element->count == 0)
-        return rs_fail_parse(error, -1, -1, where, "no vertices");
+    if (!r->vertex_element)
+        return rs_fail_parse(error, r->end_header_line, -1, where,
+                             "no vertices: the header declares no 'element vertex'");
+    if (r->vertex_element->count == 0)
+        return rs_fail_parse(error, r->vertex_element->header_line, -1, where,
+                             "no vertices: 'element vertex 0'");
     if (r->vertex_element->count >= RS_IO_MAX_VERTICES)
         return rs_fail_parse(error, r->vertex_element->header_line, -1, where,
                              "%llu vertices: too many (indices are 32-bit)",

@@ -83,10 +83,23 @@ static rsmooth_status io_failure(rsmooth_error *error) {
 
 /* ---- generic path: the mesh's own fields */
 
-static bool write_header(const rsmooth_mesh *mesh, FILE *stream, bool binary, bool wide_count,
-                         bool unsigned_index) {
-    const char *scalar = mesh->precision == RSMOOTH_FLOAT32 ? "float" : "double";
-    bool ok = fprintf(stream,
+/* Positions (and normals) go out as float when the mesh holds float32 data that fits one, else as
+ * double, so a value beyond float range is never written as an infinity. */
+static bool use_float(const rsmooth_mesh *mesh, const double *normals) {
+    if (mesh->precision != RSMOOTH_FLOAT32)
+        return false;
+    for (size_t i = 0; i < 3 * mesh->vertex_count; i++)
+        if (!isfinite((float)mesh->positions[i]) || (normals && !isfinite((float)normals[i])))
+            return false;
+    return true;
+}
+
+static bool write_header(const rsmooth_mesh *mesh, FILE *stream, bool binary, bool f32,
+                         bool wide_count, bool unsigned_index) {
+    const char *scalar = f32 ? "float" : "double";
+    bool ok = rs_io_put_bom(mesh, binary ? RSMOOTH_FORMAT_PLY_BINARY : RSMOOTH_FORMAT_PLY_ASCII,
+                            stream) &&
+              fprintf(stream,
                       "ply\nformat %s 1.0\ncomment written by rsmooth\nelement vertex %zu\n"
                       "property %s x\nproperty %s y\nproperty %s z\n",
                       binary ? "binary_little_endian" : "ascii", mesh->vertex_count, scalar, scalar,
@@ -104,12 +117,11 @@ static bool write_header(const rsmooth_mesh *mesh, FILE *stream, bool binary, bo
     return ok;
 }
 
-static bool write_binary(const rsmooth_mesh *mesh, const double *normals, FILE *stream,
+static bool write_binary(const rsmooth_mesh *mesh, const double *normals, FILE *stream, bool f32,
                          bool wide_count) {
     out_buffer *out = out_open(stream);
     if (!out)
         return false;
-    const bool f32 = mesh->precision == RSMOOTH_FLOAT32;
     for (size_t i = 0; out->ok && i < mesh->vertex_count; i++) {
         unsigned char *p = out_reserve(out, 6 * 8 + 4 + 3);
         for (int set = 0; set < (normals ? 2 : 1); set++) {
@@ -153,8 +165,7 @@ static bool write_binary(const rsmooth_mesh *mesh, const double *normals, FILE *
     return out_close(out);
 }
 
-static bool write_ascii(const rsmooth_mesh *mesh, const double *normals, FILE *stream) {
-    const bool f32 = mesh->precision == RSMOOTH_FLOAT32;
+static bool write_ascii(const rsmooth_mesh *mesh, const double *normals, FILE *stream, bool f32) {
     bool ok = true;
     for (size_t i = 0; ok && i < mesh->vertex_count; i++) {
         for (int set = 0; ok && set < (normals ? 2 : 1); set++) {
@@ -197,11 +208,12 @@ static rsmooth_status write_generic(const rsmooth_mesh *mesh, FILE *stream, bool
         if (status != RSMOOTH_OK)
             return status;
     }
+    const bool f32 = use_float(mesh, normals);
     errno = 0;
-    bool ok = write_header(mesh, stream, binary, wide_count, unsigned_index);
+    bool ok = write_header(mesh, stream, binary, f32, wide_count, unsigned_index);
     if (ok)
-        ok = binary ? write_binary(mesh, normals, stream, wide_count)
-                    : write_ascii(mesh, normals, stream);
+        ok = binary ? write_binary(mesh, normals, stream, f32, wide_count)
+                    : write_ascii(mesh, normals, stream, f32);
     rs_free(normals);
     ok = ok && fflush(stream) == 0 && !ferror(stream);
     return ok ? RSMOOTH_OK : io_failure(error);
@@ -312,29 +324,42 @@ static face_types choose_face_types(const rsmooth_mesh *mesh, const rs_ply_prope
     return ft;
 }
 
-/* Integer-typed coordinates must hold the (rounded) filtered positions. */
-static rsmooth_status check_positions(const rsmooth_mesh *mesh, const rs_ply_element *v,
-                                      rsmooth_error *error) {
+/* The file's types must hold the filtered positions (rounded, for integer types) and the normals:
+ * checked before anything is written. */
+static rsmooth_status check_vertex_values(const rsmooth_mesh *mesh, const rs_ply_element *v,
+                                          const double *normals, rsmooth_error *error) {
     for (size_t k = 0; k < v->property_count; k++) {
         const rs_ply_property *p = &v->properties[k];
-        if (p->role < RS_PLY_X || p->role > RS_PLY_Z || rs_ply_type_is_float(p->type))
+        const double *values;
+        int c;
+        if (p->role >= RS_PLY_X && p->role <= RS_PLY_Z) {
+            values = mesh->positions;
+            c = p->role - RS_PLY_X;
+        } else if (p->role >= RS_PLY_NX && p->role <= RS_PLY_NZ && normals) {
+            values = normals;
+            c = p->role - RS_PLY_NX;
+        } else {
             continue;
-        int c = p->role - RS_PLY_X;
+        }
         for (size_t i = 0; i < mesh->vertex_count; i++) {
-            double value = round(mesh->positions[3 * i + (size_t)c]);
-            if (!type_holds(p->type, value))
+            double value = values[3 * i + (size_t)c];
+            bool fits = p->type == RS_PLY_FLOAT32   ? isfinite((float)value)
+                        : rs_ply_type_is_float(p->type) ? true
+                                                        : type_holds(p->type, round(value));
+            if (!fits)
                 return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                                "vertex %zu: %s = %.17g does not fit the file's '%s' type", i,
-                               p->name, mesh->positions[3 * i + (size_t)c],
-                               rs_ply_spelling(p->spelling));
+                               p->name, value, rs_ply_spelling(p->spelling));
         }
     }
     return RSMOOTH_OK;
 }
 
-static bool write_faithful_header(const rs_ply_extras *x, FILE *stream, bool binary,
-                                  const face_types *ft) {
-    bool ok = fputs("ply\n", stream) >= 0;
+static bool write_faithful_header(const rsmooth_mesh *mesh, const rs_ply_extras *x, FILE *stream,
+                                  bool binary, const face_types *ft) {
+    bool ok = rs_io_put_bom(mesh, binary ? RSMOOTH_FORMAT_PLY_BINARY : RSMOOTH_FORMAT_PLY_ASCII,
+                            stream) &&
+              fputs("ply\n", stream) >= 0;
     for (size_t c = 0; ok && c < x->comment_count; c++)
         if (x->comments[c].before_format)
             ok = fprintf(stream, "%s\n", x->comments[c].text) >= 0;
@@ -429,9 +454,7 @@ static rsmooth_status write_element(const rsmooth_mesh *mesh, const rs_ply_extra
 static rsmooth_status write_faithful(const rsmooth_mesh *mesh, const rs_ply_extras *x, FILE *stream,
                                      bool binary, rsmooth_error *error) {
     const rs_ply_element *v = &x->elements[x->vertex_element];
-    rsmooth_status status = check_positions(mesh, v, error);
-    if (status != RSMOOTH_OK)
-        return status;
+    rsmooth_status status = RSMOOTH_OK;
     face_types ft = {RS_PLY_NONE, RS_PLY_NONE, 0, 0};
     if (x->face_element != SIZE_MAX) {
         const rs_ply_element *f = &x->elements[x->face_element];
@@ -447,9 +470,14 @@ static rsmooth_status write_faithful(const rsmooth_mesh *mesh, const rs_ply_extr
                 return status;
         }
     }
+    status = check_vertex_values(mesh, v, normals, error);
+    if (status != RSMOOTH_OK) {
+        rs_free(normals);
+        return status;
+    }
     errno = 0;
     out_buffer *out = NULL;
-    bool ok = write_faithful_header(x, stream, binary, &ft);
+    bool ok = write_faithful_header(mesh, x, stream, binary, &ft);
     if (ok)
         ok = (out = out_open(stream)) != NULL;
     for (size_t ei = 0; ok && status == RSMOOTH_OK && ei < x->element_count; ei++)

@@ -97,22 +97,25 @@ static rsmooth_status read_binary(const unsigned char *data, size_t size, rsmoot
                                   rsmooth_error *error) {
     if (size < RS_STL_HEADER_SIZE + 4)
         return rs_fail_parse(error, -1, (int64_t)size, where,
-                             "binary STL needs at least 84 bytes (header and triangle count), "
-                             "file has %zu",
+                             "binary STL: at least 84 bytes expected (an 80-byte header and the "
+                             "triangle count), %zu found",
                              size);
     uint32_t declared = get_u32(data + RS_STL_HEADER_SIZE);
+    uint64_t need = RS_STL_HEADER_SIZE + 4 + (uint64_t)RS_STL_RECORD_SIZE * declared;
+    if (need != (uint64_t)size) /* located where the data ends early, or where the excess starts */
+        return rs_fail_parse(error, -1, (int64_t)(size < need ? size : need), where,
+                             "binary STL of %lu triangles (the count at byte 80): 84 + 50 × %lu = "
+                             "%llu bytes expected, %zu found",
+                             (unsigned long)declared, (unsigned long)declared,
+                             (unsigned long long)need, size);
     if (declared == 0)
-        return rs_fail_parse(error, -1, RS_STL_HEADER_SIZE, where, "no triangles");
+        return rs_fail_parse(error, -1, RS_STL_HEADER_SIZE, where,
+                             "no triangles (the count at byte 80 is 0)");
     if ((size_t)declared > RS_STL_MAX_TRIANGLES)
         return rs_fail_parse(error, -1, RS_STL_HEADER_SIZE, where,
                              "binary STL declares %lu triangles: more than %zu (3 vertices each, "
                              "fewer than 2^32 in all)",
                              (unsigned long)declared, RS_STL_MAX_TRIANGLES);
-    uint64_t need = RS_STL_HEADER_SIZE + 4 + (uint64_t)RS_STL_RECORD_SIZE * declared;
-    if (need != (uint64_t)size)
-        return rs_fail_parse(error, -1, (int64_t)(size < need ? size : need), where,
-                             "binary STL of %lu triangles needs %llu bytes, file has %zu",
-                             (unsigned long)declared, (unsigned long long)need, size);
     size_t t = declared;
     stl_soup soup = {0};
     if (!soup_reserve(&soup, t))
@@ -281,7 +284,8 @@ static rsmooth_status read_facet(stl_lexer *lx, stl_soup *soup, rsmooth_error *e
     }
     double *xyz = soup->positions + 9 * facet;
     size_t vertices = 0;
-    bool finite = true;
+    bool supported = true; /* every coordinate finite and within the supported magnitude */
+    double first_bad = 0;
     for (;;) {
         if (!next_token(lx))
             return expected(lx, "endloop", error);
@@ -294,7 +298,10 @@ static rsmooth_status read_facet(stl_lexer *lx, stl_soup *soup, rsmooth_error *e
             status = read_number(lx, &v[k], error);
             if (status != RSMOOTH_OK)
                 return status;
-            finite = finite && isfinite(v[k]);
+            if (supported && !rs_io_coordinate_ok(v[k])) {
+                supported = false;
+                first_bad = v[k];
+            }
         }
         if (vertices < 3)
             memcpy(xyz + 3 * vertices, v, sizeof v);
@@ -304,9 +311,13 @@ static rsmooth_status read_facet(stl_lexer *lx, stl_soup *soup, rsmooth_error *e
         return rs_fail_parse(error, facet_line, (int64_t)facet_pos, where,
                              "facet %zu has %zu vertices (STL facets are triangles)", facet,
                              vertices);
-    if (!finite)
+    if (!supported && !isfinite(first_bad))
         return rs_fail_parse(error, facet_line, (int64_t)facet_pos, where,
                              "facet %zu has a non-finite vertex", facet);
+    if (!supported)
+        return rs_fail_parse(error, facet_line, (int64_t)facet_pos, where,
+                             "facet %zu has coordinate %g beyond the supported magnitude %g", facet,
+                             first_bad, RS_MAX_COORDINATE);
     status = expect_keyword(lx, "endfacet", error);
     if (status == RSMOOTH_OK)
         soup->triangle_count++;

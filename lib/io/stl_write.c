@@ -263,7 +263,9 @@ rsmooth_status rs_io_stl_write(const rsmooth_mesh *mesh, FILE *stream, bool bina
         return status;
     const rs_stl_extras *x = usable_extras(mesh);
     errno = 0;
-    bool ok = binary ? write_binary(mesh, x, stream) : write_ascii(mesh, x, stream);
+    bool ok = binary ? write_binary(mesh, x, stream)
+                     : rs_io_put_bom(mesh, RSMOOTH_FORMAT_STL_ASCII, stream) &&
+                           write_ascii(mesh, x, stream);
     ok = ok && fflush(stream) == 0 && !ferror(stream);
     if (!ok)
         return rs_fail(error, RSMOOTH_ERROR_IO, "rsmooth_mesh_write_stream", "writing STL: %s",
