@@ -1,9 +1,10 @@
 /* The rsmooth command's file handling (see cli_files.h). */
-#define _POSIX_C_SOURCE 200809L
+#define _XOPEN_SOURCE 700 /* realpath */
 #include "cli_files.h"
 #include "cli_output.h"
 
 #include <errno.h>
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -82,6 +83,11 @@ int cli_read_mesh(const char *path, cli_progress *bar, rsmooth_mesh **mesh) {
 }
 
 rsmooth_format cli_output_format(const char *path, bool ascii) {
+    /* by the name of the file written: a symbolic link's target (see cli_output.h) */
+    char target[PATH_MAX];
+    struct stat st;
+    if (lstat(path, &st) == 0 && S_ISLNK(st.st_mode) && realpath(path, target))
+        path = target;
     rsmooth_format format = rsmooth_format_from_path(path);
     if (ascii && format == RSMOOTH_FORMAT_PLY_BINARY)
         return RSMOOTH_FORMAT_PLY_ASCII;
@@ -99,7 +105,7 @@ int cli_check_output(const char *path, const char *input, bool force, bool in_pl
     int code = cli_check_output_path(path, force || in_place);
     if (code >= 0)
         return code;
-    if (rsmooth_format_from_path(path) == RSMOOTH_FORMAT_AUTO) {
+    if (cli_output_format(path, false) == RSMOOTH_FORMAT_AUTO) {
         fprintf(stderr, "rsmooth: %s: unknown output format (use .obj, .ply, .off or .stl)\n",
                 path);
         return EXIT_USAGE;

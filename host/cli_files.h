@@ -18,7 +18,8 @@ enum { EXIT_OK = 0, EXIT_OTHER = 1, EXIT_USAGE = 2, EXIT_DEVICE = 3 };
  * unreadable file) or EXIT_OTHER. */
 int cli_read_mesh(const char *path, cli_progress *bar, rsmooth_mesh **mesh);
 
-/* The output format for `path` (by extension), ascii variants when `ascii`; AUTO if unknown. */
+/* The output format for `path` (by the extension of the file written: a symbolic link's target),
+ * ascii variants when `ascii`; AUTO if unknown. */
 rsmooth_format cli_output_format(const char *path, bool ascii);
 
 /* -1 when `path` may be written: not the input (unless `in_place`), a known extension, and as

@@ -386,6 +386,10 @@ expect 0 "$rsmooth" link2.ply --in-place -q --device reference
 cmp -s real/target.ply small_b.ply || fail "--in-place on a link did not smooth its target"
 [ "$(stat -c %a real/target.ply)" = 640 ] || fail "--in-place on a link changed the target's mode"
 only_files real target.ply
+# the format follows the file written: a link named .obj to a PLY file stays PLY
+ln -s real/target.ply objlink.obj
+expect 0 "$rsmooth" objlink.obj --in-place -q --device reference
+[ "$(head -c 3 real/target.ply)" = ply ] || fail "--in-place through a .obj link wrote OBJ into a .ply"
 cp small_a.ply real/out.ply
 ln -s real/out.ply outlink.ply
 expect 2 "$rsmooth" small.ply -o outlink.ply --device reference
