@@ -127,8 +127,8 @@ static int write_mesh_stream(FILE *f, void *user, char *message, size_t size) {
     return -1;
 }
 
-int cli_write_mesh(const rsmooth_mesh *mesh, const char *path, rsmooth_format format,
-                   bool replace, bool quiet) {
+int cli_write_mesh(const rsmooth_mesh *mesh, const char *path, rsmooth_format format, bool replace,
+                   bool quiet) {
     mesh_write w = {mesh, format};
     return cli_write_atomically(path, replace, quiet, write_mesh_stream, &w);
 }

@@ -30,7 +30,7 @@ int cli_check_output(const char *path, const char *input, bool force, bool in_pl
 /* Writes `mesh` through cli_write_atomically (`replace`: --force or --in-place; `quiet`: no
  * warning about an owner that could not be kept). Returns EXIT_OK, EXIT_USAGE (the file exists
  * and `replace` is off, or appeared meanwhile) or EXIT_OTHER. */
-int cli_write_mesh(const rsmooth_mesh *mesh, const char *path, rsmooth_format format,
-                   bool replace, bool quiet);
+int cli_write_mesh(const rsmooth_mesh *mesh, const char *path, rsmooth_format format, bool replace,
+                   bool quiet);
 
 #endif

@@ -102,8 +102,10 @@ static int parse_noise_args(int argc, char **argv, noise_args *a) {
                 return cli_usage_error("noise", "%s: not a number: '%s'", arg, value);
             if (!strcmp(arg, "--sigma")) {
                 if (!(x >= 0 && x <= MAX_SIGMA))
-                    return cli_usage_error("noise", "--sigma must be in [0, %g] mean edge lengths "
-                                           "(got '%s')", MAX_SIGMA, value);
+                    return cli_usage_error("noise",
+                                           "--sigma must be in [0, %g] mean edge lengths "
+                                           "(got '%s')",
+                                           MAX_SIGMA, value);
                 a->noise.sigma = x;
                 a->have_sigma = true;
             } else {
@@ -169,8 +171,9 @@ static int check_coordinates(const noise_args *a, const rsmooth_mesh *mesh) {
         if (fabs(p[0]) <= MAX_COORDINATE && fabs(p[1]) <= MAX_COORDINATE &&
             fabs(p[2]) <= MAX_COORDINATE)
             continue;
-        fprintf(stderr, "rsmooth noise: %s: not written: --sigma %g would move vertex %zu of %s "
-                        "to (%g, %g, %g), beyond the supported magnitude %g (lower --sigma)\n",
+        fprintf(stderr,
+                "rsmooth noise: %s: not written: --sigma %g would move vertex %zu of %s "
+                "to (%g, %g, %g), beyond the supported magnitude %g (lower --sigma)\n",
                 a->output, a->noise.sigma, v, a->input, p[0], p[1], p[2], MAX_COORDINATE);
         return EXIT_USAGE;
     }

@@ -88,12 +88,16 @@ static int resolve_output(const char *path, bool replace, output_target *t) {
         target[n > 0 ? n : 0] = '\0';
         if (!realpath(path, t->path) || stat(t->path, &t->st) != 0) {
             if (errno == ENOENT)
-                fprintf(stderr, "rsmooth: %s: is a symbolic link to '%s', which does not exist: "
-                                "not writing through it (remove the link, or name the file to "
-                                "create)\n", path, target);
+                fprintf(stderr,
+                        "rsmooth: %s: is a symbolic link to '%s', which does not exist: "
+                        "not writing through it (remove the link, or name the file to "
+                        "create)\n",
+                        path, target);
             else
-                fprintf(stderr, "rsmooth: %s: is a symbolic link to '%s' that cannot be "
-                                "followed: %s\n", path, target, strerror(errno));
+                fprintf(stderr,
+                        "rsmooth: %s: is a symbolic link to '%s' that cannot be "
+                        "followed: %s\n",
+                        path, target, strerror(errno));
             return EXIT_USAGE;
         }
         if (strlen(t->path) + sizeof TEMPORARY_NAME > sizeof t->path) {
@@ -110,8 +114,10 @@ static int resolve_output(const char *path, bool replace, output_target *t) {
         return EXIT_USAGE;
     }
     if (!replace && t->link) {
-        fprintf(stderr, "rsmooth: %s: already exists (a symbolic link to %s; use --force to "
-                        "write the result there)\n", path, t->path);
+        fprintf(stderr,
+                "rsmooth: %s: already exists (a symbolic link to %s; use --force to "
+                "write the result there)\n",
+                path, t->path);
         return EXIT_USAGE;
     }
     if (!replace) {
@@ -229,8 +235,9 @@ static int keep_owner_and_mode(int fd, const struct stat *old, const char *path,
     if (now.st_gid != old->st_gid)
         mode &= ~(mode_t)S_ISGID;
     if ((now.st_uid != old->st_uid || now.st_gid != old->st_gid) && !quiet)
-        fprintf(stderr, "rsmooth: %s: warning: the owner could not be kept: it was %ld:%ld, the "
-                        "result is %ld:%ld (only root can give a file away); its mode %o is kept\n",
+        fprintf(stderr,
+                "rsmooth: %s: warning: the owner could not be kept: it was %ld:%ld, the "
+                "result is %ld:%ld (only root can give a file away); its mode %o is kept\n",
                 path, (long)old->st_uid, (long)old->st_gid, (long)now.st_uid, (long)now.st_gid,
                 (unsigned)mode);
     return fchmod(fd, mode);
@@ -282,8 +289,7 @@ static int publish(const char *proc, const char *target, bool replace) {
     return -1;
 }
 
-int cli_write_atomically(const char *path, bool replace, bool quiet, cli_writer write,
-                         void *user) {
+int cli_write_atomically(const char *path, bool replace, bool quiet, cli_writer write, void *user) {
     output_target t;
     if (replace) {
         int code = resolve_output(path, true, &t);
@@ -301,9 +307,10 @@ int cli_write_atomically(const char *path, bool replace, bool quiet, cli_writer 
     }
     /* A new file replaces this name only: say so where other names share the old one. */
     if (t.exists && t.st.st_nlink > 1 && !quiet)
-        fprintf(stderr, "rsmooth: %s: warning: the file has %ld hard links; only this name gets "
-                        "the result, the others keep the old content\n", path,
-                (long)t.st.st_nlink);
+        fprintf(stderr,
+                "rsmooth: %s: warning: the file has %ld hard links; only this name gets "
+                "the result, the others keep the old content\n",
+                path, (long)t.st.st_nlink);
     catch_signals(remove_temporary_and_exit);
     char proc[64];
     const char *unnamed = proc;
@@ -321,8 +328,10 @@ int cli_write_atomically(const char *path, bool replace, bool quiet, cli_writer 
     }
     bool ok = true;
     if (t.exists && keep_owner_and_mode(fd, &t.st, path, quiet) != 0) {
-        snprintf(message, sizeof message, "cannot give it the permissions of the file it "
-                                          "replaces: %s", strerror(errno));
+        snprintf(message, sizeof message,
+                 "cannot give it the permissions of the file it "
+                 "replaces: %s",
+                 strerror(errno));
         ok = false;
     }
     FILE *f = ok ? fdopen(fd, "wb") : NULL;
@@ -356,8 +365,10 @@ int cli_write_atomically(const char *path, bool replace, bool quiet, cli_writer 
             unlink(t.path);
     }
     if (taken)
-        fprintf(stderr, "rsmooth: %s: already exists: another program created it while this "
-                        "run was working (use --force to replace it)\n", path);
+        fprintf(stderr,
+                "rsmooth: %s: already exists: another program created it while this "
+                "run was working (use --force to replace it)\n",
+                path);
     else if (!ok)
         fprintf(stderr, "rsmooth: %s: cannot write: %s\n", path, message);
     if (!ok && have_temporary)

@@ -257,7 +257,8 @@ static int parse_filter_args(int argc, char **argv, filter_options *opt) {
                 return filter_usage_error("--memory-budget needs a value", NULL);
             if (!cli_parse_bytes(value, &opt->memory_budget) || opt->memory_budget == 0)
                 return filter_usage_error("--memory-budget: not a byte count above 0 (leave it "
-                                          "out for most of the device's memory):", value);
+                                          "out for most of the device's memory):",
+                                          value);
             i++;
         } else if (!strcmp(a, "--device")) {
             if (!value)
