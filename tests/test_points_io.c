@@ -214,6 +214,26 @@ static void test_off_obj(void) {
     const char *fewer = "v 0 0 0\nv 1 0 0\nvn 0 0 1\n";
     m = read_ok(fewer, strlen(fewer));
     CHECK(m->has_vertex_normals && m->vertex_normals == NULL);
+    /* Normals that match no vertex are no normals to write: OBJ keeps the lines as they were,
+     * other formats invent none (they read back without normals) and say they drop them. */
+    size_t size;
+    char *out = mesh_to_memory(m, RSMOOTH_FORMAT_OBJ, &size);
+    CHECK_EQ_INT(size, strlen(fewer));
+    CHECK(memcmp(out, fewer, size) == 0);
+    free(out);
+    const rsmooth_format others[] = {RSMOOTH_FORMAT_PLY_ASCII, RSMOOTH_FORMAT_PLY_BINARY,
+                                     RSMOOTH_FORMAT_OFF};
+    for (size_t i = 0; i < sizeof others / sizeof others[0]; i++) {
+        char lost[128];
+        CHECK_EQ_INT(rsmooth_mesh_conversion_losses(m, others[i], lost, sizeof lost), 1);
+        CHECK(strcmp(lost, "vertex normals") == 0);
+        out = mesh_to_memory(m, others[i], &size);
+        rsmooth_mesh *back = read_ok(out, size);
+        CHECK(!back->has_vertex_normals && back->vertex_normals == NULL);
+        rsmooth_mesh_destroy(back);
+        free(out);
+    }
+    CHECK_EQ_INT(rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_OBJ, NULL, 0), 0);
     rsmooth_mesh_destroy(m);
     const char *faces = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n";
     m = read_ok(faces, strlen(faces));

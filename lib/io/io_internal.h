@@ -83,6 +83,12 @@ rsmooth_status rs_io_stl_read(const char *data, size_t size, rsmooth_mesh **mesh
 rsmooth_status rs_io_stl_write(const rsmooth_mesh *mesh, FILE *stream, bool binary,
                                rsmooth_error *error);
 
+/* Whether there are normals to write: recomputed from triangles, or a point cloud's own (a point
+ * cloud whose file held normals that matched no vertex has none). */
+static inline bool rs_io_normals_available(const rsmooth_mesh *mesh) {
+    return mesh->triangle_count > 0 || mesh->vertex_normals;
+}
+
 /* The mesh's own normals are what writers emit (a point cloud: no triangle to recompute from). */
 static inline bool rs_io_normals_are_data(const rsmooth_mesh *mesh) {
     return mesh->triangle_count == 0 && mesh->vertex_normals;

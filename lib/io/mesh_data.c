@@ -143,7 +143,9 @@ size_t rsmooth_mesh_conversion_losses(const rsmooth_mesh *mesh, rsmooth_format f
     bool stl = rs_io_is_stl(format);
     if (mesh->vertex_colors && (stl || format == RSMOOTH_FORMAT_AUTO))
         lost += rs_io_loss_add(buffer, size, "vertex colours");
-    if (mesh->has_vertex_normals && stl)
+    /* a point cloud whose normals matched no vertex keeps them only as its own format's text */
+    if (mesh->has_vertex_normals &&
+        (stl || (!rs_io_normals_available(mesh) && format != mesh->source_format)))
         lost += rs_io_loss_add(buffer, size, "vertex normals");
     if (mesh->vertex_quality && !rs_io_is_ply(format))
         lost += rs_io_loss_add(buffer, size, "vertex quality");

@@ -139,8 +139,8 @@ static bool write_text(const rsmooth_mesh *mesh, const rs_obj_extras *x, const d
                 next_token(&q, content_end, &token, &len);
             ok = put_position(stream, mesh, at->v++) &&
                  fwrite(q, 1, (size_t)(content_end - q), stream) == (size_t)(content_end - q);
-        } else if (keyword && len == 2 && token[0] == 'v' && token[1] == 'n') {
-            if (!at->normals_written && normals)
+        } else if (keyword && len == 2 && token[0] == 'v' && token[1] == 'n' && normals) {
+            if (!at->normals_written)
                 ok = put_normals(stream, mesh, normals,
                                  ending_len ? ending : (x->crlf ? "\r\n" : "\n"),
                                  ending_len ? ending_len : (x->crlf ? 2 : 1));
@@ -213,7 +213,8 @@ rsmooth_status rs_io_obj_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_e
     bool faithful = x && x->vertex_count == mesh->vertex_count &&
                     x->face_count == mesh->face_count && mesh->face_offsets &&
                     x->offsets_hash == rs_obj_offsets_hash(mesh->face_offsets, mesh->face_count);
-    bool want_normals = faithful ? (x->kinds & RS_OBJ_NORMALS) != 0 : mesh->has_vertex_normals;
+    bool want_normals = (faithful ? (x->kinds & RS_OBJ_NORMALS) != 0 : mesh->has_vertex_normals) &&
+                        rs_io_normals_available(mesh);
     double *normals = NULL;
     if (want_normals) {
         rsmooth_status status = rs_io_vertex_normals(mesh, &normals, where, error);

@@ -117,7 +117,9 @@ rsmooth_status rs_io_off_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_e
     /* The extras describe the mesh as read: they apply while its counts are unchanged. */
     bool faithful =
         x && x->vertex_count == mesh->vertex_count && x->face_count == mesh->face_count;
-    bool want_normals = faithful ? x->normals : mesh->has_vertex_normals;
+    /* NOFF lines need normals; otherwise only normals there are (see rs_io_normals_available) */
+    bool want_normals =
+        faithful ? x->normals : mesh->has_vertex_normals && rs_io_normals_available(mesh);
     double *normals = NULL;
     if (want_normals) {
         rsmooth_status status = rs_io_vertex_normals(mesh, &normals, where, error);

@@ -95,7 +95,7 @@ static bool use_float(const rsmooth_mesh *mesh, const double *normals) {
 }
 
 static bool write_header(const rsmooth_mesh *mesh, FILE *stream, bool binary, bool f32,
-                         bool wide_count, bool unsigned_index) {
+                         bool normals, bool wide_count, bool unsigned_index) {
     const char *scalar = f32 ? "float" : "double";
     bool ok = rs_io_put_bom(mesh, binary ? RSMOOTH_FORMAT_PLY_BINARY : RSMOOTH_FORMAT_PLY_ASCII,
                             stream) &&
@@ -104,7 +104,7 @@ static bool write_header(const rsmooth_mesh *mesh, FILE *stream, bool binary, bo
                       "property %s x\nproperty %s y\nproperty %s z\n",
                       binary ? "binary_little_endian" : "ascii", mesh->vertex_count, scalar, scalar,
                       scalar) >= 0;
-    if (ok && mesh->has_vertex_normals)
+    if (ok && normals)
         ok = fprintf(stream, "property %s nx\nproperty %s ny\nproperty %s nz\n", scalar, scalar,
                      scalar) >= 0;
     if (ok && mesh->vertex_quality)
@@ -203,14 +203,14 @@ static rsmooth_status write_generic(const rsmooth_mesh *mesh, FILE *stream, bool
     /* "int" indices, as most tools expect, unless a vertex index would not fit in one. */
     bool unsigned_index = mesh->vertex_count > (size_t)INT32_MAX;
     double *normals = NULL;
-    if (mesh->has_vertex_normals) {
+    if (mesh->has_vertex_normals && rs_io_normals_available(mesh)) {
         rsmooth_status status = rs_io_vertex_normals(mesh, &normals, where, error);
         if (status != RSMOOTH_OK)
             return status;
     }
     const bool f32 = use_float(mesh, normals);
     errno = 0;
-    bool ok = write_header(mesh, stream, binary, f32, wide_count, unsigned_index);
+    bool ok = write_header(mesh, stream, binary, f32, normals != NULL, wide_count, unsigned_index);
     if (ok)
         ok = binary ? write_binary(mesh, normals, stream, f32, wide_count)
                     : write_ascii(mesh, normals, stream, f32);
