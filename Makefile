@@ -6,7 +6,7 @@ WERROR ?= OFF
 DEMO ?= out/demo
 FUZZ_SECONDS ?= 60
 FUZZ_BUILD ?= $(BUILD)-fuzz
-FUZZERS = obj ply off stl
+FUZZERS = obj ply off stl auto
 
 .PHONY: all deps configure build demo experiments check sanitize fuzz install clean
 
@@ -47,9 +47,10 @@ sanitize: deps
 	cmake --build $(BUILD)-sanitize -j $(JOBS)
 	cd $(BUILD)-sanitize && ctest --output-on-failure
 
-# Each reader under libFuzzer with ASan and UBSan for $(FUZZ_SECONDS) s, from the seed corpus
-# make_seed_corpus writes (each run on a copy); all run, and any crash, leak or sanitizer report
-# fails the target. Inputs that fail are left in $(FUZZ_BUILD)/artifacts.
+# Each reader, and automatic detection (fuzz_auto), under libFuzzer with ASan and UBSan for
+# $(FUZZ_SECONDS) s each, from the seed corpus make_seed_corpus writes (each run on a copy); each
+# target writes what it read back and compares the values. All run, and any crash, leak, sanitizer
+# report or changed value fails the target. Inputs that fail are left in $(FUZZ_BUILD)/artifacts.
 fuzz:
 	@.ci/install-deps.sh fuzz
 	CC=clang cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRSMOOTH_SANITIZE=ON \

@@ -1,6 +1,8 @@
 /* Writes the fuzzers' seed corpus (small valid files of every format and variant) into DIR/obj,
- * DIR/ply, DIR/off and DIR/stl, and checks each parses; with no DIR, into a temporary directory that
- * is removed afterwards (the ctest). */
+ * DIR/ply, DIR/off and DIR/stl, and all of them mixed into DIR/auto (the automatic detection
+ * target's), with byte-order marks, what may come before an OFF keyword, and files detection must
+ * refuse with a located error; checks each reads (or is refused) as intended. With no DIR, into a
+ * temporary directory that is removed afterwards (the ctest). */
 #define _POSIX_C_SOURCE 200809L
 #include "rsmooth_io.h"
 #include "test_io_util.h"
@@ -20,7 +22,7 @@ static const double square[5][3] = {
 
 /* ---- writing and checking */
 
-#define MAX_SEEDS 64
+#define MAX_SEEDS 160
 
 typedef struct corpus {
     const char *dir;
@@ -38,9 +40,7 @@ static rsmooth_format format_of(const char *kind) {
     return RSMOOTH_FORMAT_OBJ;
 }
 
-/* Writes DIR/kind/name and checks it reads as the fuzzer for `kind` will read it (a reader not
- * written yet says UNSUPPORTED, which is no failure of the sample). */
-static void emit(corpus *c, const char *kind, const char *name, const bytes *b) {
+static void write_seed(corpus *c, const char *kind, const char *name, const bytes *b) {
     char path[4096];
     snprintf(path, sizeof path, "%s/%s/%s", c->dir, kind, name);
     FILE *f = fopen(path, "wb");
@@ -51,15 +51,49 @@ static void emit(corpus *c, const char *kind, const char *name, const bytes *b) 
     if (c->written < MAX_SEEDS)
         c->paths[c->written] = strdup(path);
     c->written++;
+}
+
+/* Checks that `b` reads as `format` (or, when !readable, is refused with a located parse or
+ * unsupported error, as detection must refuse it). */
+static void check_seed(corpus *c, const char *kind, const char *name, const bytes *b,
+                       rsmooth_format format, bool readable) {
     rsmooth_mesh *mesh = NULL;
     rsmooth_error err;
-    rsmooth_status s = rsmooth_mesh_read_memory(b->data, b->size, format_of(kind), &mesh, &err);
-    if (s != RSMOOTH_OK && s != RSMOOTH_ERROR_UNSUPPORTED) {
-        fprintf(stderr, "make_seed_corpus: %s does not parse: %s (line %lld, byte %lld)\n", path,
+    rsmooth_status s = rsmooth_mesh_read_memory(b->data, b->size, format, &mesh, &err);
+    bool located = err.line >= 1 || err.byte_offset >= 0;
+    bool as_intended = readable ? s == RSMOOTH_OK
+                                : (s == RSMOOTH_ERROR_PARSE || s == RSMOOTH_ERROR_UNSUPPORTED) &&
+                                      located;
+    if (!as_intended) {
+        fprintf(stderr, "make_seed_corpus: %s/%s %s: status %d, %s (line %lld, byte %lld)\n",
+                kind, name, readable ? "does not read" : "is not refused with a location", (int)s,
                 err.message, (long long)err.line, (long long)err.byte_offset);
         c->failed++;
     }
     rsmooth_mesh_destroy(mesh);
+}
+
+/* Writes DIR/kind/name, read as the fuzzer for `kind` reads it, and DIR/auto/kind_name, read through
+ * detection: both must read. */
+static void emit(corpus *c, const char *kind, const char *name, const bytes *b) {
+    write_seed(c, kind, name, b);
+    check_seed(c, kind, name, b, format_of(kind), true);
+    char auto_name[256];
+    snprintf(auto_name, sizeof auto_name, "%s_%s", kind, name);
+    write_seed(c, "auto", auto_name, b);
+    check_seed(c, "auto", auto_name, b, RSMOOTH_FORMAT_AUTO, true);
+}
+
+/* A seed for the detection target only: `text` (with a UTF-8 byte-order mark first when `bom`),
+ * which must read, or be refused with a location when !readable. */
+static void emit_auto(corpus *c, const char *name, bool bom, const char *text, bool readable) {
+    bytes b = {0};
+    if (bom)
+        put_text(&b, "\xEF\xBB\xBF");
+    put_text(&b, text);
+    write_seed(c, "auto", name, &b);
+    check_seed(c, "auto", name, &b, RSMOOTH_FORMAT_AUTO, readable);
+    bytes_free(&b);
 }
 
 static void emit_text(corpus *c, const char *kind, const char *name, const char *text) {
@@ -97,6 +131,7 @@ static void obj_seeds(corpus *c) {
     emit_text(c, "obj", "colours.obj",
               "v 0 0 0 1 0 0\nv 1.5 0 0 0 1 0\nv 1.5 1.25 0 0 0 1\nv 0 1.25 -0.5 1 1 1\n"
               "v\t0.25\t-1\t3\t0.5 0.5 0.5   # trailing comment\n"
+              "vn 0 0 1\n"
               "f 1//1 2//1 3//1\nf 1//1 3//1 4//1\nf 5 1 2\n");
     emit_text(c, "obj", "polygons.obj",
               "v 0 0 0\nv 1 0 0\nv 1.5 1 0\nv 0.5 1.5 0\nv -0.5 1 0\nv 0 0 1.0 1.0\n"
@@ -106,6 +141,9 @@ static void obj_seeds(corpus *c) {
               "l 1 2\np 3\ncstype bezier\n"
               "f -6 -5 -1\n");
     emit_text(c, "obj", "forward.obj", "f 1 2 3\nf 3 2 4\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n");
+    emit_text(c, "obj", "extremes.obj",
+              "v 1e150 -1e150 -0\nv 4.9406564584124654e-324 2.2250738585072014e-308 0.1\n"
+              "v 0 1 1e-300\nvn 0 0 1\nf 1//1 2//1 3//1\n");
 }
 
 /* ---- PLY */
@@ -303,6 +341,61 @@ static void stl_seeds(corpus *c) {
     stl_binary_seed(c, "binary_blank.stl", "", NULL);
 }
 
+/* ---- detection only: byte-order marks, what comes before a keyword, what must be refused */
+
+static const char tetrahedron_obj[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                                      "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+static const char triangle_off[] = "3 1 0\n0 0 0\n1 0 0\n0 1 0.5\n3 0 1 2\n";
+
+static void auto_seeds(corpus *c) {
+    emit_auto(c, "bom.obj", true, tetrahedron_obj, true);
+    emit_auto(c, "bom_ascii.ply", true,
+              "ply\nformat ascii 1.0\ncomment marked\nelement vertex 3\nproperty float x\n"
+              "property float y\nproperty float z\nelement face 1\n"
+              "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+              true);
+    emit_auto(c, "bom.off", true, "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0.5\n3 0 1 2\n", true);
+    emit_auto(c, "bom_ascii.stl", true,
+              "solid marked\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+              "vertex 0 1 0\nendloop\nendfacet\nendsolid marked\n",
+              true);
+    char text[512];
+    static const struct {
+        const char *name, *opening;
+    } off_openings[] = {{"comment_first.off", "# made by hand\nOFF\n"},
+                        {"blank_first.off", "\n\nOFF\n"},
+                        {"indented.off", "  \tCOFF\n"},
+                        {"lowercase.off", "off\n"}};
+    for (size_t i = 0; i < sizeof off_openings / sizeof off_openings[0]; i++) {
+        const char *body = strstr(off_openings[i].opening, "COFF")
+                               ? "3 1 0\n0 0 0 1 0 0\n1 0 0 0 1 0\n0 1 0 0 0 1\n3 0 1 2\n"
+                               : triangle_off;
+        snprintf(text, sizeof text, "%s%s", off_openings[i].opening, body);
+        emit_auto(c, off_openings[i].name, false, text, true);
+    }
+    /* refused, each with a location: leading blanks before "ply", 4D and nD OFF, a cut binary
+     * STL (the size disagrees with the count), text that is no mesh */
+    emit_auto(c, "indented.ply", false,
+              " ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+              "property float z\nend_header\n0 0 0\n",
+              false);
+    snprintf(text, sizeof text, "4OFF\n%s", "3 1 0\n0 0 0 1\n1 0 0 1\n0 1 0 1\n3 0 1 2\n");
+    emit_auto(c, "four.off", false, text, false);
+    emit_auto(c, "dimension.off", false, "nOFF\n4\n3 1 0\n0 0 0 0\n1 0 0 0\n0 1 0 0\n3 0 1 2\n",
+              false);
+    emit_auto(c, "no_mesh.txt", false, "hello world\n", false);
+    bytes b = {0};
+    unsigned char head[80];
+    memset(head, ' ', sizeof head);
+    put(&b, head, sizeof head);
+    put_uint(&b, 2, 4);
+    for (int k = 0; k < 20; k++) /* 80 bytes: short of the 2 * 50 the count needs */
+        put_f32(&b, (float)k);
+    write_seed(c, "auto", "cut_binary.stl", &b);
+    check_seed(c, "auto", "cut_binary.stl", &b, RSMOOTH_FORMAT_AUTO, false);
+    bytes_free(&b);
+}
+
 /* ---- main */
 
 static void make_dir(const char *path) {
@@ -312,7 +405,7 @@ static void make_dir(const char *path) {
     }
 }
 
-static const char *const kinds[] = {"obj", "ply", "off", "stl"};
+static const char *const kinds[] = {"obj", "ply", "off", "stl", "auto"};
 
 static void remove_corpus(corpus *c) {
     for (int i = 0; i < c->written && i < MAX_SEEDS; i++)
@@ -348,6 +441,7 @@ int main(int argc, char **argv) {
     ply_seeds(&c);
     off_seeds(&c);
     stl_seeds(&c);
+    auto_seeds(&c);
     printf("%d seed files in %s, %d failed to parse\n", c.written, c.dir, c.failed);
     if (argc < 2)
         remove_corpus(&c);
