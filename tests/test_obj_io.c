@@ -813,6 +813,13 @@ static void test_detection_errors(void) {
     binary[5] = 0;
     expect_auto_error(__LINE__, binary, sizeof binary, -1, 150, "binary content (byte 5 is 0x00)");
     expect_auto_error(__LINE__, binary, 60, -1, 60, "at least 84 bytes expected");
+    /* an OBJ with a stray control byte (a DOS end-of-file mark) is still an OBJ */
+    const char dos[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n\x1a";
+    rsmooth_mesh *m = NULL;
+    rsmooth_error err;
+    CHECK_EQ_INT(read_exact_copy(dos, sizeof dos - 1, RSMOOTH_FORMAT_AUTO, &m, &err), RSMOOTH_OK);
+    CHECK_EQ_INT(m->vertex_count, 3);
+    rsmooth_mesh_destroy(m);
     /* every prefix of an OBJ file fails with a location, or reads */
     check_prefixes_located("OBJ", small_obj, strlen(small_obj));
 }

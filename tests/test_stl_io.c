@@ -526,6 +526,23 @@ static void test_write_refusals_and_extremes(void) {
     check_writer_refuses_unreadable(RSMOOTH_FORMAT_STL_BINARY);
     check_extremes_round_trip(RSMOOTH_FORMAT_STL_ASCII, RSMOOTH_FLOAT64);
     check_extremes_round_trip(RSMOOTH_FORMAT_STL_BINARY, RSMOOTH_FLOAT32);
+    /* refused by the STL writer itself (no triangles, a value beyond float32): no file either */
+    rsmooth_mesh *m = tetrahedron(RSMOOTH_FLOAT64);
+    char path[] = "/tmp/rsmooth_test_stl_refused_XXXXXX";
+    int fd = mkstemp(path);
+    CHECK(fd >= 0);
+    close(fd);
+    remove(path);
+    m->positions[4] = 1e100;
+    CHECK_EQ_INT(rsmooth_mesh_write_file(m, path, RSMOOTH_FORMAT_STL_BINARY, NULL),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK(access(path, F_OK) != 0);
+    m->positions[4] = 0;
+    m->triangle_count = 0;
+    CHECK_EQ_INT(rsmooth_mesh_write_file(m, path, RSMOOTH_FORMAT_STL_ASCII, NULL),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK(access(path, F_OK) != 0);
+    rsmooth_mesh_destroy(m);
     /* ascii beyond the supported magnitude: refused at its facet's line */
     rsmooth_error err = EXPECT_ASCII_ERROR(
         GOOD_FACET "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 -3e150\n"

@@ -13,7 +13,13 @@
  * unchanged, except vertex normals, which writers recompute from the (filtered) positions (point
  * clouds, with no faces to recompute from, write their vertex_normals).
  * Converting to another format keeps what the target can hold (positions, faces, vertex colours,
- * normals); rsmooth_mesh_conversion_losses() says what it drops.
+ * normals); rsmooth_mesh_conversion_losses() says what it drops. A UTF-8 byte-order mark before a
+ * text file is accepted and written back by the same format (PLY: either encoding; not binary STL).
+ *
+ * What rsmooth writes, rsmooth reads back to the same numbers: writers refuse the values readers
+ * refuse (non-finite or beyond 1e150, the magnitude the filter supports), and write every
+ * coordinate with the digits (text) or bits (binary) that give it back exactly, as a double or as
+ * the float32 the file holds.
  *
  *     rsmooth_mesh *mesh = NULL;
  *     rsmooth_error err;
@@ -80,18 +86,30 @@ typedef struct rsmooth_mesh {
     double *vertex_normals;
 } rsmooth_mesh;
 
-/* Parses a whole file held in memory. With `format` AUTO, content starting with "ply" is PLY and
- * anything else OBJ; any PLY value reads every PLY encoding (the header decides). On failure *mesh is NULL and `error` holds the line
- * (text) or byte offset (binary) and what is wrong; status RSMOOTH_ERROR_PARSE for malformed content
- * (truncation, bad numbers, indices out of range, faces with fewer than 3 vertices, non-finite
- * coordinates, counts larger than the data can hold), RSMOOTH_ERROR_OUT_OF_MEMORY. Thread-safe. */
+/* Parses a whole file held in memory. Any PLY value reads every PLY encoding (the header decides),
+ * either STL value both STL encodings (the size decides). With `format` AUTO, the content decides:
+ *   - a binary STL by its exact size (84 + 50 x the count at byte 80), whatever its header says;
+ *   - after an optional UTF-8 byte-order mark: PLY when the file starts with "ply";
+ *   - then by the first word past blank lines, indentation and '#' comments: an OFF keyword (OFF,
+ *     COFF, NOFF, CNOFF, STOFF... in any case of "off"), "solid" (ascii STL);
+ *   - binary content (NUL or control bytes) not opening with an OBJ statement: a binary STL whose
+ *     size disagrees with its count, which is then the error;
+ *   - anything else OBJ.
+ * On failure *mesh is NULL and `error` says what was expected and where: its line (text, 1-based)
+ * or byte offset (binary; from the file's first byte, a byte-order mark included) is always set.
+ * RSMOOTH_ERROR_PARSE for malformed content (an empty file, "ply" after blanks, truncation, bad
+ * numbers, values a PLY property's declared type cannot hold, a PLY property named twice in an
+ * element, an ascii PLY row with a value too many or too few, indices out of range (OBJ vt and vn
+ * too), faces with fewer than 3 vertices, non-finite coordinates or normals, coordinates beyond
+ * 1e150 in magnitude, counts larger than the data can hold); RSMOOTH_ERROR_UNSUPPORTED for variants
+ * not read (4OFF, nOFF, binary OFF), also located; RSMOOTH_ERROR_OUT_OF_MEMORY. Thread-safe. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_read_memory(const void *data, size_t size,
                                                     rsmooth_format format, rsmooth_mesh **mesh,
                                                     rsmooth_error *error);
 
-/* Reads a file, its format told by the content: "ply" magic, an OFF keyword, a binary STL's exact
- * size or ascii "solid", else OBJ. RSMOOTH_ERROR_IO when the path cannot
- * be opened or read (a directory, missing, unreadable), else as rsmooth_mesh_read_memory. */
+/* Reads a file, its format told by the content (rsmooth_mesh_read_memory with AUTO).
+ * RSMOOTH_ERROR_IO when the path cannot be opened or read (a directory, missing, unreadable), else
+ * as rsmooth_mesh_read_memory. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_read_file(const char *path, rsmooth_mesh **mesh,
                                                   rsmooth_error *error);
 
@@ -102,13 +120,17 @@ RSMOOTH_API rsmooth_status rsmooth_mesh_read_stream(FILE *stream, const char *na
 
 /* Writes `mesh` (its faces as polygons, not the fanned triangles; STL: the triangles) to an open
  * stream. `format` must not be AUTO; big-endian PLY output is RSMOOTH_ERROR_UNSUPPORTED. Returns
- * RSMOOTH_ERROR_IO when the stream fails. */
+ * RSMOOTH_ERROR_INVALID_ARGUMENT, naming the vertex and having written nothing, for what no reader
+ * would read back: a coordinate that is NaN, infinite or beyond 1e150 in magnitude, a non-finite
+ * vertex_quality or point-cloud normal, a value the format or the file's own PLY types cannot hold
+ * (beyond float32 for binary STL); RSMOOTH_ERROR_IO when the stream fails. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, FILE *stream,
                                                      rsmooth_format format, rsmooth_error *error);
 
 /* Writes `mesh` to `path` (created or truncated). AUTO picks the format from the extension: .obj,
- * .ply (binary little-endian), .off, .stl (binary). Callers that must never leave a partial file write to a temporary
- * path and rename it (the rsmooth command does). */
+ * .ply (binary little-endian), .off, .stl (binary). A mesh refused as by rsmooth_mesh_write_stream
+ * creates no file. Callers that must never leave a partial file write to a temporary path and
+ * rename it (the rsmooth command does). */
 RSMOOTH_API rsmooth_status rsmooth_mesh_write_file(const rsmooth_mesh *mesh, const char *path,
                                                    rsmooth_format format, rsmooth_error *error);
 

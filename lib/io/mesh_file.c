@@ -103,6 +103,17 @@ static bool is_off_keyword(const char *token, size_t len) {
     return len >= 3 && len <= 16 && token_is_ci(token + len - 3, 3, "off");
 }
 
+/* The statements an OBJ file opens with (past comments): such a file is read as OBJ even if a stray
+ * control byte follows (the OBJ reader then locates it). */
+static bool is_obj_statement(const char *token, size_t len) {
+    static const char *const statements[] = {"v", "vt", "vn", "vp", "f",      "l",
+                                             "p", "g",  "o",  "s",  "mtllib", "usemtl"};
+    for (size_t i = 0; i < sizeof statements / sizeof statements[0]; i++)
+        if (len == strlen(statements[i]) && memcmp(token, statements[i], len) == 0)
+            return true;
+    return false;
+}
+
 /* Offset of the first byte no text holds (NUL or a control character other than blanks) among
  * the first 4 KiB, or SIZE_MAX. */
 static size_t first_binary_byte(const char *data, size_t size) {
@@ -138,8 +149,9 @@ static rsmooth_status read_binary_content(const char *data, size_t size, size_t 
 
 /* What RSMOOTH_FORMAT_AUTO reads: a binary STL by its exact size; after any byte-order mark, PLY
  * by its first bytes "ply"; then by the first token past blanks and comments: an OFF keyword, or
- * "solid" (ascii STL); binary content (a binary STL of the wrong size); else OBJ. Content none of
- * them can hold gets a located error that says what was expected. */
+ * "solid" (ascii STL); binary content not opening with an OBJ statement (a binary STL of the wrong
+ * size); else OBJ. Content none of them can hold gets a located error that says what was
+ * expected. */
 static rsmooth_status read_auto(const char *data, size_t size, rsmooth_mesh **mesh,
                                 rsmooth_error *error) {
     static const char where[] = "rsmooth_mesh_read";
@@ -164,7 +176,7 @@ static rsmooth_status read_auto(const char *data, size_t size, rsmooth_mesh **me
                              "with the line 'ply' (lowercase) at its first byte",
                              token, t.offset);
     size_t binary_byte = first_binary_byte(data, size);
-    if (binary_byte != SIZE_MAX)
+    if (binary_byte != SIZE_MAX && !is_obj_statement(token, t.len))
         return read_binary_content(data, size, binary_byte, mesh, error);
     if (t.len == 0)
         return rs_fail_parse(error, t.line, (int64_t)size, where,
@@ -306,8 +318,9 @@ rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, FILE *stream,
     rs_error_clear(error);
     if (!stream)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "stream is NULL");
+    /* Checked before the first byte: a refused mesh leaves the stream as it was. */
     rsmooth_status status = rs_io_mesh_check(mesh, where, error);
-    if (status == RSMOOTH_OK) /* before the first byte: a refused mesh leaves the stream as it was */
+    if (status == RSMOOTH_OK)
         status = rs_io_mesh_check_values(mesh, where, error);
     if (status != RSMOOTH_OK)
         return status;
@@ -355,6 +368,8 @@ rsmooth_status rsmooth_mesh_write_file(const rsmooth_mesh *mesh, const char *pat
     if (format == RSMOOTH_FORMAT_PLY_BINARY_BE)
         return rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, where,
                        "big-endian PLY output is not supported");
+    struct stat before;
+    bool existed = stat(path, &before) == 0;
     FILE *file = fopen(path, "wb");
     if (!file)
         return rs_fail(error, RSMOOTH_ERROR_IO, where, "cannot create '%s': %s", path,
@@ -362,6 +377,8 @@ rsmooth_status rsmooth_mesh_write_file(const rsmooth_mesh *mesh, const char *pat
     status = rsmooth_mesh_write_stream(mesh, file, format, error);
     errno = 0;
     bool closed = fclose(file) == 0;
+    if (status == RSMOOTH_ERROR_INVALID_ARGUMENT && !existed)
+        remove(path); /* the writer refused before its first byte: leave no empty file */
     if (status == RSMOOTH_ERROR_IO) {
         char detail[sizeof error->message]; /* rs_fail clears `error` before formatting */
         snprintf(detail, sizeof detail, "%s", error ? error->message : "write failed");
