@@ -79,8 +79,8 @@ static void compare_values(const rsmooth_mesh *mesh, const rsmooth_mesh *back,
     if (stl)
         return; /* no faces but the soup's, no colours, no normals */
     size_t index_count = mesh->face_offsets[mesh->face_count];
-    if (memcmp(back->face_offsets, mesh->face_offsets,
-               (mesh->face_count + 1) * sizeof(uint32_t)) != 0 ||
+    if (memcmp(back->face_offsets, mesh->face_offsets, (mesh->face_count + 1) * sizeof(uint32_t)) !=
+            0 ||
         memcmp(back->face_indices, mesh->face_indices, index_count * sizeof(uint32_t)) != 0)
         fail("the faces changed", format, NULL);
     if ((mesh->vertex_colors == NULL) != (back->vertex_colors == NULL) ||
@@ -103,8 +103,8 @@ static void compare_values(const rsmooth_mesh *mesh, const rsmooth_mesh *back,
     }
     for (size_t i = 0; i < 3 * mesh->vertex_count; i++) {
         double b = back->vertex_normals[i];
-        bool same = data ? same_value(mesh->vertex_normals[i], b, as_float)
-                         : fabs(expected[i] - b) <= 1e-6;
+        bool same =
+            data ? same_value(mesh->vertex_normals[i], b, as_float) : fabs(expected[i] - b) <= 1e-6;
         if (!same) {
             snprintf(detail, sizeof detail, "vertex %zu: %.17g expected, %.17g read", i / 3,
                      data ? mesh->vertex_normals[i] : expected[i], b);
@@ -161,8 +161,7 @@ static void round_trip(const rsmooth_mesh *mesh, rsmooth_format format) {
         char *again;
         size_t again_length;
         status = write_memory(back, format, &again, &again_length, &err);
-        if (status == RSMOOTH_OK &&
-            (again_length != length || memcmp(again, text, length) != 0)) {
+        if (status == RSMOOTH_OK && (again_length != length || memcmp(again, text, length) != 0)) {
             fprintf(stderr, "fuzz_read: first write:\n%.*s\nsecond write:\n%.*s\n",
                     (int)(length > 1000 ? 1000 : length), text,
                     (int)(again_length > 1000 ? 1000 : again_length), again);

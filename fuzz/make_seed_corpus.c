@@ -61,20 +61,20 @@ static void check_seed(corpus *c, const char *kind, const char *name, const byte
     rsmooth_error err;
     rsmooth_status s = rsmooth_mesh_read_memory(b->data, b->size, format, &mesh, &err);
     bool located = err.line >= 1 || err.byte_offset >= 0;
-    bool as_intended = readable ? s == RSMOOTH_OK
-                                : (s == RSMOOTH_ERROR_PARSE || s == RSMOOTH_ERROR_UNSUPPORTED) &&
-                                      located;
+    bool as_intended =
+        readable ? s == RSMOOTH_OK
+                 : (s == RSMOOTH_ERROR_PARSE || s == RSMOOTH_ERROR_UNSUPPORTED) && located;
     if (!as_intended) {
-        fprintf(stderr, "make_seed_corpus: %s/%s %s: status %d, %s (line %lld, byte %lld)\n",
-                kind, name, readable ? "does not read" : "is not refused with a location", (int)s,
+        fprintf(stderr, "make_seed_corpus: %s/%s %s: status %d, %s (line %lld, byte %lld)\n", kind,
+                name, readable ? "does not read" : "is not refused with a location", (int)s,
                 err.message, (long long)err.line, (long long)err.byte_offset);
         c->failed++;
     }
     rsmooth_mesh_destroy(mesh);
 }
 
-/* Writes DIR/kind/name, read as the fuzzer for `kind` reads it, and DIR/auto/kind_name, read through
- * detection: both must read. */
+/* Writes DIR/kind/name, read as the fuzzer for `kind` reads it, and DIR/auto/kind_name, read
+ * through detection: both must read. */
 static void emit(corpus *c, const char *kind, const char *name, const bytes *b) {
     write_seed(c, kind, name, b);
     check_seed(c, kind, name, b, format_of(kind), true);

@@ -208,10 +208,9 @@ static const double extreme_doubles[] = {1e150,
                                          123456789.12345679,
                                          9007199254740993.0,
                                          1.0 / 3.0};
-static const float extreme_floats[] = {3.40282347e38f, -3.40282347e38f, 1.40129846e-45f,
-                                       -2.80259693e-45f, 1.17549435e-38f, -0.0f,
-                                       0.1f,            -0.3f,            16777217.0f,
-                                       1.0f / 3.0f,     1e-40f,           7.0f};
+static const float extreme_floats[] = {
+    3.40282347e38f, -3.40282347e38f, 1.40129846e-45f, -2.80259693e-45f, 1.17549435e-38f, -0.0f,
+    0.1f,           -0.3f,           16777217.0f,     1.0f / 3.0f,      1e-40f,          7.0f};
 
 /* A triangle soup holding `count` values (padded with 1s) as its coordinates. */
 static inline rsmooth_mesh *mesh_of_values(const double *values, size_t count,

@@ -415,8 +415,9 @@ static void expect_auto_error(int at, const char *text, rsmooth_status status, l
     rsmooth_error err;
     rsmooth_status s = parse_n(text, strlen(text), RSMOOTH_FORMAT_AUTO, &m, &err);
     if (s != status || err.line != line || err.byte_offset < 0 || !strstr(err.message, needle)) {
-        fprintf(stderr, "test_off_io.c:%d: status %d line %lld byte %lld '%s'; expected %d, %lld, "
-                        "'%s'\n",
+        fprintf(stderr,
+                "test_off_io.c:%d: status %d line %lld byte %lld '%s'; expected %d, %lld, "
+                "'%s'\n",
                 at, (int)s, (long long)err.line, (long long)err.byte_offset, err.message,
                 (int)status, line, needle);
         exit(1);
@@ -432,8 +433,9 @@ static void test_detection(void) {
 
     /* What may come before the keyword, and its lowercase spelling: read as the same mesh. */
     static const char body[] = "3 1 0\n0 0 0\n1 0 0\n0 1 0.5\n3 0 1 2\n";
-    static const char *const openings[] = {"# made by hand\nOFF\n", "\nOFF\n", "  \tOFF\n",
-                                           "off\n", "# c\n\n  off\n", "\xEF\xBB\xBF# c\nOFF\n"};
+    static const char *const openings[] = {
+        "# made by hand\nOFF\n", "\nOFF\n", "  \tOFF\n", "off\n", "# c\n\n  off\n",
+        "\xEF\xBB\xBF# c\nOFF\n"};
     char text[256];
     snprintf(text, sizeof text, "OFF\n%s", body);
     rsmooth_mesh *reference = parse_ok(text);

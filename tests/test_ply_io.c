@@ -681,13 +681,14 @@ static void test_byte_order_mark(void) {
     bytes_free(&plain_file);
 }
 
-#define SQUARE_HEADER(vertex_props, face_list)                                                    \
+#define SQUARE_HEADER(vertex_props, face_list)                                                     \
     "ply\nformat ascii 1.0\nelement vertex 3\n" vertex_props "element face 1\n" face_list          \
     "end_header\n"
 
 static void test_detection_and_lenience(void) {
     /* Leading blanks or lines before "ply": a located error, not the OBJ fallback. */
-    const char *indented = " ply\nformat ascii 1.0\nelement vertex 1\n" VERTEX_XYZ "end_header\n0 0 0\n";
+    const char *indented =
+        " ply\nformat ascii 1.0\nelement vertex 1\n" VERTEX_XYZ "end_header\n0 0 0\n";
     rsmooth_error err = EXPECT_LINE(indented, 1, "a PLY file must start with the line 'ply'");
     CHECK_EQ_INT(err.byte_offset, 1);
     err = EXPECT_LINE("\r\n\nply\nformat ascii 1.0\n", 3, "after 3 bytes of blanks");

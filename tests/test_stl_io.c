@@ -561,9 +561,8 @@ static void test_detected_sizes(void) {
             memset(b.data, ' ', 80); /* a blank header: text, until the count's bytes */
         for (size_t cut = 1; cut <= 60; cut += 59) {
             size_t size = b.size - cut;
-            rsmooth_error err =
-                expect_parse_error(__LINE__, b.data, size, RSMOOTH_FORMAT_AUTO,
-                                   "84 + 50 × 3 = 234 bytes expected");
+            rsmooth_error err = expect_parse_error(__LINE__, b.data, size, RSMOOTH_FORMAT_AUTO,
+                                                   "84 + 50 × 3 = 234 bytes expected");
             char found[32];
             snprintf(found, sizeof found, "%zu found", size);
             CHECK(strstr(err.message, found) != NULL);
@@ -579,8 +578,8 @@ static void test_byte_order_mark(void) {
     put_text(&b, "\xEF\xBB\xBF");
     put(&b, plain.data, plain.size);
     for (int explicit_format = 0; explicit_format < 2; explicit_format++) {
-        rsmooth_mesh *m =
-            parse_ok(b.data, b.size, explicit_format ? RSMOOTH_FORMAT_STL_ASCII : RSMOOTH_FORMAT_AUTO);
+        rsmooth_mesh *m = parse_ok(
+            b.data, b.size, explicit_format ? RSMOOTH_FORMAT_STL_ASCII : RSMOOTH_FORMAT_AUTO);
         check_soup(m, 3, 0);
         rsmooth_mesh *p = parse_ok(plain.data, plain.size, RSMOOTH_FORMAT_AUTO);
         size_t size, plain_size;

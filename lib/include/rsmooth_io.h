@@ -9,12 +9,12 @@
  *
  * Nothing is lost in a round trip through the same format: what a file carries beyond positions and
  * faces (PLY properties, elements and comments; OBJ texture coordinates, groups, objects, materials
- * and smoothing groups; OFF colours; STL header and attributes) is kept in `extras` and written back
- * unchanged, except vertex normals, which writers recompute from the (filtered) positions (point
- * clouds, with no faces to recompute from, write their vertex_normals).
- * Converting to another format keeps what the target can hold (positions, faces, vertex colours,
- * normals); rsmooth_mesh_conversion_losses() says what it drops. A UTF-8 byte-order mark before a
- * text file is accepted and written back by the same format (PLY: either encoding; not binary STL).
+ * and smoothing groups; OFF colours; STL header and attributes) is kept in `extras` and written
+ * back unchanged, except vertex normals, which writers recompute from the (filtered) positions
+ * (point clouds, with no faces to recompute from, write their vertex_normals). Converting to
+ * another format keeps what the target can hold (positions, faces, vertex colours, normals);
+ * rsmooth_mesh_conversion_losses() says what it drops. A UTF-8 byte-order mark before a text file
+ * is accepted and written back by the same format (PLY: either encoding; not binary STL).
  *
  * What rsmooth writes, rsmooth reads back to the same numbers: writers refuse the values readers
  * refuse (non-finite or beyond 1e150, the magnitude the filter supports), and write every

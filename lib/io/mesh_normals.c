@@ -6,9 +6,10 @@
 #include <math.h>
 #include <string.h>
 
-/* A triangle's cross product (twice its area along its normal) overflows beyond coordinates of about
- * 1e154 and underflows below 1e-162, so each is carried as a vector of magnitude about 1 times 2^e,
- * and each vertex's sum at the exponent of its largest term (smaller terms scaled into it). */
+/* A triangle's cross product (twice its area along its normal) overflows beyond coordinates of
+ * about 1e154 and underflows below 1e-162, so each is carried as a vector of magnitude about 1
+ * times 2^e, and each vertex's sum at the exponent of its largest term (smaller terms scaled into
+ * it). */
 static void add_scaled(double sum[3], int *sum_exponent, const double m[3], int e) {
     if (*sum_exponent == INT_MIN) { /* the first term */
         memcpy(sum, m, 3 * sizeof *sum);

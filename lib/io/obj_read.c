@@ -252,8 +252,8 @@ static rsmooth_status parse_face(obj_state *st, const char *p, const char *end, 
                                  "malformed face index '%.*s'", (int)(len > 40 ? 40 : len), token);
         int64_t vt_index, vn_index;
         rsmooth_status status =
-            check_attribute_index(st, vt, "vt", st->vt_count, st->known_vt_count, &st->max_vt,
-                                  line, token, &vt_index, error);
+            check_attribute_index(st, vt, "vt", st->vt_count, st->known_vt_count, &st->max_vt, line,
+                                  token, &vt_index, error);
         if (status == RSMOOTH_OK)
             status = check_attribute_index(st, vn, "vn", st->vn_count, st->known_vn_count,
                                            &st->max_vn, line, token, &vn_index, error);

@@ -301,7 +301,8 @@ static rsmooth_status parse_vertex(off_reader *r, const off_header *h, off_state
             return rs_fail_parse(error, r->line, tokens[k] - r->data, where,
                                  "vertex %zu: malformed number '%.*s'", v,
                                  TOKEN_TEXT(tokens[k], lens[k]));
-    rsmooth_status status = rs_io_check_vertex(values, v, r->line, tokens[0] - r->data, where, error);
+    rsmooth_status status =
+        rs_io_check_vertex(values, v, r->line, tokens[0] - r->data, where, error);
     if (status != RSMOOTH_OK)
         return status;
     if (h->n && (!isfinite(values[3]) || !isfinite(values[4]) || !isfinite(values[5])))

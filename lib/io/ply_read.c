@@ -740,8 +740,8 @@ static rsmooth_status read_binary_element(ply_reader *r, rs_ply_element *e, rsmo
 
 /* ---- data: ascii */
 
-/* Next whitespace-separated token; counts lines, and sets r->crossed_line when it passed a line end.
- * False at the end of the data. */
+/* Next whitespace-separated token; counts lines, and sets r->crossed_line when it passed a line
+ * end. False at the end of the data. */
 static bool next_token(ply_reader *r, const char **token, size_t *len) {
     const char *p = r->data + r->pos, *end = r->data + r->size;
     r->crossed_line = false;
@@ -818,7 +818,8 @@ static rsmooth_status end_ascii_item(ply_reader *r, const ascii_item *item, rsmo
 
 /* true when a value of type t holds v as written: integers within the type's range and whole
  * (NaN and infinities are not), floats within float range unless written as an infinity or NaN
- * (which the checks of what they are, coordinates or normals, refuse; other properties keep them). */
+ * (which the checks of what they are, coordinates or normals, refuse; other properties keep them).
+ */
 static bool value_fits(rs_ply_type t, double v) {
     switch (t) {
     case RS_PLY_INT8:

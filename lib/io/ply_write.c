@@ -343,7 +343,7 @@ static rsmooth_status check_vertex_values(const rsmooth_mesh *mesh, const rs_ply
         }
         for (size_t i = 0; i < mesh->vertex_count; i++) {
             double value = values[3 * i + (size_t)c];
-            bool fits = p->type == RS_PLY_FLOAT32   ? isfinite((float)value)
+            bool fits = p->type == RS_PLY_FLOAT32       ? isfinite((float)value)
                         : rs_ply_type_is_float(p->type) ? true
                                                         : type_holds(p->type, round(value));
             if (!fits)
