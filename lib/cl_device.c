@@ -237,7 +237,7 @@ static rsmooth_status read_memory_limits(rsmooth_context *ctx, rsmooth_error *er
     if (budget && *budget && !rs_parse_bytes(budget, &ctx->memory_budget))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_context_create",
                        "RSMOOTH_MEMORY_BUDGET='%s' is not a byte count (examples: 268435456, "
-                       "256M, 1.5G)", budget);
+                       "256M, 1.5G; unset it for the device's own limit)", budget);
     if (budget && *budget && ctx->memory_budget == 0) /* as the command's --memory-budget 0 */
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_context_create",
                        "RSMOOTH_MEMORY_BUDGET='%s' leaves no memory: unset it for the device's "
