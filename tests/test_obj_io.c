@@ -854,6 +854,8 @@ static void test_attribute_indices(void) {
     EXPECT_PARSE_ERROR("v 0 0 0\nv 0 -1.0000000000000002e150 0\n", 2,
                        "vertex 2 has coordinate -1e+150 beyond the supported magnitude 1e+150");
     EXPECT_PARSE_ERROR("v 0 0 0\n\nv 0 0 1e300\n", 3, "vertex 2 has coordinate 1e+300 beyond");
+    /* colours too must be numbers (they were read as black) */
+    EXPECT_PARSE_ERROR("v 0 0 0 1 0 0\nv 1 0 0 0.5 nan 0\n", 2, "vertex 2 has a non-finite colour");
 }
 
 int main(void) {

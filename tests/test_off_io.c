@@ -467,6 +467,8 @@ static void test_write_refusals_and_extremes(void) {
                  "vertex 2 has coordinate 1e+151 beyond the supported magnitude 1e+150");
     EXPECT_ERROR("NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 inf 0 1\n0 1 0 0 0 1\n3 0 1 2\n",
                  RSMOOTH_ERROR_PARSE, 4, "vertex 1 has a non-finite normal");
+    EXPECT_ERROR("COFF\n3 1 0\n0 0 0 1 0 0\n1 0 0 0 1 0\n0 1 0 0 -inf 1\n3 0 1 2\n",
+                 RSMOOTH_ERROR_PARSE, 5, "vertex 2 has a non-finite colour");
 
     /* A point cloud's own normals (NOFF, no faces) are written exactly. */
     rsmooth_mesh *m = parse_ok("NOFF\n2 0 0\n0 0 0 0.1 0.2 0.97467943448089633\n"

@@ -746,6 +746,35 @@ static void test_detection_and_lenience(void) {
              SQUARE_HEADER(VERTEX_XYZ "property float nx\nproperty float ny\nproperty float nz\n",
                            FACE_LIST));
     EXPECT_LINE(text, 14, "vertex 1 has a non-finite normal");
+    snprintf(text, sizeof text, "%s0 0 0 1 0 0\n1 0 0 0 nan 0\n0 1 0 0 0 1\n3 0 1 2\n",
+             SQUARE_HEADER(VERTEX_XYZ "property float red\nproperty float green\n"
+                                      "property float blue\n",
+                           FACE_LIST));
+    EXPECT_LINE(text, 14, "vertex 1 has a non-finite colour ('green')");
+    /* the same in binary (both vertex layouts), located by the vertex's first byte */
+    for (int with_list = 0; with_list < 2; with_list++) {
+        bytes c = {0};
+        put_text(&c, "ply\nformat binary_little_endian 1.0\nelement vertex 2\n" VERTEX_XYZ
+                     "property double red\nproperty double green\nproperty double blue\n");
+        if (with_list)
+            put_text(&c, "property list uchar int ids\n");
+        put_text(&c, "end_header\n");
+        size_t vertex1 = 0;
+        for (int v = 0; v < 2; v++) {
+            if (v == 1)
+                vertex1 = c.size;
+            for (int k = 0; k < 3; k++)
+                put_f32(&c, (float)(v + k));
+            put_f64(&c, 0.5);
+            put_f64(&c, v == 1 ? INFINITY : 0.25);
+            put_f64(&c, 1);
+            if (with_list)
+                put_u8(&c, 0);
+        }
+        err = EXPECT_PARSE_ERROR(c.data, c.size, "vertex 1 has a non-finite colour ('green')");
+        CHECK_EQ_INT(err.byte_offset, vertex1);
+        bytes_free(&c);
+    }
 
     /* Binary: the byte offset of the vertex beyond the supported magnitude. */
     b = binary_square(false, true);

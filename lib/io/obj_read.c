@@ -143,6 +143,9 @@ static rsmooth_status parse_vertex(obj_state *st, const char *p, const char *end
     if (status != RSMOOTH_OK)
         return status;
     if (n == 6) {
+        if (!isfinite(rgb[0]) || !isfinite(rgb[1]) || !isfinite(rgb[2]))
+            return rs_fail_parse(error, line, statement - st->data, where,
+                                 "vertex %zu has a non-finite colour", st->vertex_count + 1);
         if (!store_color(st, rgb))
             return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "vertex colours");
     } else {

@@ -320,9 +320,12 @@ static rsmooth_status parse_vertex(off_reader *r, const off_header *h, off_state
         }
         for (int k = 0; k < 3; k++) {
             double c = values[base + k];
+            if (!isfinite(c))
+                return rs_fail_parse(error, r->line, tokens[base + k] - r->data, where,
+                                     "vertex %zu has a non-finite colour", v);
             if (c > 1)
                 st->color_above_one = true;
-            st->raw_colors[3 * v + (size_t)k] = (float)(isfinite(c) ? c : 0);
+            st->raw_colors[3 * v + (size_t)k] = (float)c;
         }
     }
     if (count > base) { /* colour, texture coordinates (and anything else) kept as written */

@@ -419,16 +419,25 @@ static rsmooth_status face_index(ply_reader *r, double v, int64_t line, int64_t 
     return RSMOOTH_OK;
 }
 
-/* A vertex as read: coordinates rsmooth supports, and finite normals (a point cloud's data; a
- * mesh's are recomputed, but a file holding others is not what it claims). */
+/* A vertex as read (its row stored): coordinates rsmooth supports, finite normals (a point cloud's
+ * data; a mesh's are recomputed, but a file holding others is not what it claims) and finite colour
+ * channels (they become vertex_colors). */
 static rsmooth_status check_vertex(const ply_reader *r, size_t i, int64_t line, int64_t offset,
                                    rsmooth_error *error) {
     rsmooth_status status = rs_io_check_vertex(r->positions + 3 * i, i, line, offset, where, error);
-    if (status != RSMOOTH_OK || !r->normal_values)
+    if (status != RSMOOTH_OK)
         return status;
-    const double *n = r->normal_values + 3 * i;
-    if (!isfinite(n[0]) || !isfinite(n[1]) || !isfinite(n[2]))
+    const double *n = r->normal_values ? r->normal_values + 3 * i : NULL;
+    if (n && (!isfinite(n[0]) || !isfinite(n[1]) || !isfinite(n[2])))
         return rs_fail_parse(error, line, offset, where, "vertex %zu has a non-finite normal", i);
+    const rs_ply_element *v = r->vertex_element;
+    for (int c = 0; r->color[0] != SIZE_MAX && c < 3; c++) {
+        const rs_ply_property *p = &v->properties[r->color[c]];
+        if (rs_ply_type_is_float(p->type) &&
+            !isfinite(rs_ply_host_value(v->rows + i * v->row_size + p->row_offset, p->type)))
+            return rs_fail_parse(error, line, offset, where,
+                                 "vertex %zu has a non-finite colour ('%.40s')", i, p->name);
+    }
     return RSMOOTH_OK;
 }
 
@@ -633,6 +642,11 @@ static rsmooth_status read_binary_element(ply_reader *r, rs_ply_element *e, rsmo
     }
     /* item_size is the minimum size of an item, checked for every element in read_data. */
     if (all_scalar) {
+        if (e->row_size > 0) { /* first: the vertex checks read the colours from the rows */
+            rsmooth_status status = copy_rows(r, e, item_size, error);
+            if (status != RSMOOTH_OK)
+                return status;
+        }
         if (is_vertex) {
             /* x, y, z, then nx, ny, nz (when read) */
             size_t offsets[6] = {0, 0, 0, 0, 0, 0};
@@ -659,11 +673,6 @@ static rsmooth_status read_binary_element(ply_reader *r, rs_ply_element *e, rsmo
                 if (status != RSMOOTH_OK)
                     return status;
             }
-        }
-        if (e->row_size > 0) {
-            rsmooth_status status = copy_rows(r, e, item_size, error);
-            if (status != RSMOOTH_OK)
-                return status;
         }
         r->pos += (size_t)e->count * item_size;
         return RSMOOTH_OK;
