@@ -66,3 +66,25 @@ void cli_print_json_string(const char *text) {
     }
     putchar('"');
 }
+
+int cli_check_environment(void) {
+    static const struct {
+        const char *name;
+        long lo, hi;
+    } knobs[] = {{"RSMOOTH_HOST_THREADS", 1, 64}, {"RSMOOTH_CELLS_PER_REACH", 1, 8}};
+    for (size_t i = 0; i < sizeof knobs / sizeof *knobs; i++) {
+        const char *text = getenv(knobs[i].name);
+        if (!text || !*text)
+            continue;
+        char *end = NULL;
+        errno = 0;
+        long v = strtol(text, &end, 10);
+        if (*end != '\0' || errno == ERANGE || v < knobs[i].lo || v > knobs[i].hi) {
+            fprintf(stderr, "rsmooth: %s='%s' is not an integer in [%ld, %ld] (unset it for the "
+                            "default)\n",
+                    knobs[i].name, text, knobs[i].lo, knobs[i].hi);
+            return EXIT_USAGE;
+        }
+    }
+    return -1;
+}

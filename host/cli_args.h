@@ -22,4 +22,10 @@ void cli_print_json_string(const char *text);
 /* Parses a byte count: "268435456", "256M", "1.5G", "512KiB" (K, M, G, T are powers of 1024). */
 bool cli_parse_bytes(const char *text, uint64_t *out);
 
+/* Checks the environment variables that tune rsmooth (RSMOOTH_HOST_THREADS, an integer in [1, 64];
+ * RSMOOTH_CELLS_PER_REACH, in [1, 8]): the library reads them where they apply and falls back to
+ * its default on junk, so the command refuses junk first. Returns -1 when all are fine or unset,
+ * else prints which is wrong and returns the usage exit status. */
+int cli_check_environment(void);
+
 #endif

@@ -60,11 +60,40 @@ size_t mesh_noise_moved_count(size_t vertex_count, double impulsive_fraction) {
     return k >= (double)vertex_count ? vertex_count : (size_t)k;
 }
 
+/* A copy of the positions times a power of two, *unit, that brings the largest coordinate near 1,
+ * so squares and cross products neither overflow nor underflow at any scale (at 1e-300 they
+ * would vanish); the scaling is exact, so at ordinary scales every result has the same bits.
+ * NULL when out of memory. */
+static double *scaled_copy(const double *xyz, size_t vertex_count, double *unit) {
+    double largest = 0;
+    for (size_t i = 0; i < 3 * vertex_count; i++)
+        largest = fmax(largest, fabs(xyz[i]));
+    int exponent = 0;
+    frexp(largest, &exponent);
+    *unit = ldexp(1.0, -exponent);
+    double *scaled = malloc((vertex_count ? 3 * vertex_count : 1) * sizeof *scaled);
+    for (size_t i = 0; scaled && i < 3 * vertex_count; i++)
+        scaled[i] = xyz[i] * *unit;
+    return scaled;
+}
+
+/* The mean edge length of positions already scaled by `unit`, in the caller's units. */
+static double scaled_mean_edge_length(const double *scaled, double unit, size_t vertex_count,
+                                      const uint32_t *triangles, size_t triangle_count) {
+    /* A read-only view: shape_mean_edge_length does not write through the pointers. */
+    shape_mesh view = {vertex_count, (double *)scaled, triangle_count, (uint32_t *)triangles};
+    return shape_mean_edge_length(&view) / unit;
+}
+
 double mesh_noise_mean_edge_length(const double *xyz, size_t vertex_count,
                                    const uint32_t *triangles, size_t triangle_count) {
-    /* A read-only view: shape_mean_edge_length does not write through the pointers. */
-    shape_mesh view = {vertex_count, (double *)xyz, triangle_count, (uint32_t *)triangles};
-    return shape_mean_edge_length(&view);
+    double unit = 1;
+    double *scaled = scaled_copy(xyz, vertex_count, &unit);
+    if (!scaled)
+        return NAN;
+    double edge = scaled_mean_edge_length(scaled, unit, vertex_count, triangles, triangle_count);
+    free(scaled);
+    return edge;
 }
 
 /* Floyd's sampling: exactly k distinct indices of [0, n), each k-subset equally likely, in O(k)
@@ -95,35 +124,46 @@ int mesh_add_noise(double *xyz, size_t vertex_count, const uint32_t *triangles,
     if (vertex_count == 0 || options->sigma == 0)
         return 0; /* adding 0 could still turn -0.0 into +0.0: leave the bits alone */
 
-    double edge = mesh_noise_mean_edge_length(xyz, vertex_count, triangles, triangle_count);
-    if (isnan(edge))
+    /* edge lengths and normals from the scaled copy (see scaled_copy) */
+    double unit = 1;
+    double *scaled = scaled_copy(xyz, vertex_count, &unit);
+    if (!scaled)
         return -1;
+    double edge = scaled_mean_edge_length(scaled, unit, vertex_count, triangles, triangle_count);
     double scale = options->sigma * edge;
-    if (!isfinite(scale))
+    if (isnan(edge) || !isfinite(scale)) {
+        free(scaled);
         return -1;
-    if (scale == 0)
+    }
+    if (scale == 0) {
+        free(scaled);
         return 0;
+    }
 
     size_t moved = mesh_noise_moved_count(vertex_count, options->impulsive_fraction);
     unsigned char *chosen = NULL;
     double *normals = NULL;
     if (moved < vertex_count) {
         chosen = calloc(vertex_count, 1);
-        if (!chosen)
+        if (!chosen) {
+            free(scaled);
             return -1;
+        }
         uint64_t select_state = mix64(options->seed ^ SELECT_STREAM);
         choose_vertices(chosen, vertex_count, moved, &select_state);
     }
     if (options->direction == MESH_NOISE_NORMAL) {
         normals = malloc(3 * vertex_count * sizeof *normals);
         /* The normals of the input, before any vertex moves. */
-        shape_mesh view = {vertex_count, xyz, triangle_count, (uint32_t *)triangles};
+        shape_mesh view = {vertex_count, scaled, triangle_count, (uint32_t *)triangles};
         if (!normals || shape_vertex_normals(&view, normals) != 0) {
             free(normals);
             free(chosen);
+            free(scaled);
             return -1;
         }
     }
+    free(scaled);
 
     /* All displacements are computed from the input's normals and added in one pass; a vertex's
      * move does not depend on another's. */

@@ -16,6 +16,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 static const char usage_text[] =
     "usage: rsmooth INPUT -o OUTPUT [options]\n"
@@ -69,7 +70,8 @@ static const char usage_text[] =
     "                        given explicitly (e.g. --sigma-g) win over the rule\n"
     "  --passes N            run the filter N times, each from the previous result (default 1)\n"
     "  --pass-confidence C   passes after the first move only vertices whose confidence was\n"
-    "                        below C in (0, 1]: more smoothing at features and outliers only\n"
+    "                        below C: more smoothing at features and outliers only. In [0, 1];\n"
+    "                        0 (the default) moves every vertex in every pass\n"
     "  --sigma-c X           colour in the weight: a triangle pulls a vertex by exp(-|dC|^2 / 2\n"
     "                        X^2) less, dC the difference between its mean vertex colour and the\n"
     "                        vertex's (RGB in [0, 1]), so colour edges stay sharp. Needs an input\n"
@@ -136,8 +138,10 @@ static const char usage_text[] =
     "  rsmooth part.stl -o part-smooth.stl --sigma-f 3 --sigma-g 0.4 --confidence conf.ply\n"
     "  rsmooth scan.obj --in-place --device gpu --stats\n"
     "\n"
-    "Exit status: 0 success, 2 bad usage, a bad input file or an output that may not be\n"
-    "written (it exists, or appeared while this run worked), 3 OpenCL device failure, 1 other.\n";
+    "Exit status: 0 success, 2 bad usage (also a --device that names no device here), a bad\n"
+    "input file or an output that may not be written (it exists, or appeared while this run\n"
+    "worked), 3 an OpenCL device that fails, 1 other (a result not finite in the output\n"
+    "file's number type is one: nothing non-finite is ever written).\n";
 
 /* --method: the filter, or a baseline to compare it with. */
 typedef enum method { METHOD_ROBUST, METHOD_GAUSSIAN, METHOD_LAPLACIAN, METHOD_TAUBIN } method;
@@ -623,6 +627,10 @@ static int smooth(const options *opt, const rsmooth_mesh *mesh, double *out, flo
                     rsmooth_status_str(st), err.message);
             if (err.build_log[0])
                 fprintf(stderr, "%s\n", err.build_log);
+            if (st == RSMOOTH_ERROR_NO_DEVICE) { /* the choice names nothing here: a usage error */
+                fprintf(stderr, "rsmooth: --list-devices shows what --device can name\n");
+                return EXIT_USAGE;
+            }
             return st == RSMOOTH_ERROR_OUT_OF_MEMORY ? EXIT_OTHER : EXIT_DEVICE;
         }
     }
@@ -659,8 +667,13 @@ static int smooth(const options *opt, const rsmooth_mesh *mesh, double *out, flo
 /* A mesh without triangles is a point cloud: it needs its normals, and a method without edges. */
 static int check_point_cloud(const options *opt, const rsmooth_mesh *mesh) {
     if (!mesh->vertex_normals) {
-        fprintf(stderr, "rsmooth: %s has no faces and no vertex normals: a point cloud needs "
-                        "normals (nx, ny, nz)\n", opt->input);
+        /* what is missing would come after everything the file holds: name its end */
+        struct stat st;
+        long long end = stat(opt->input, &st) == 0 ? (long long)st.st_size : -1;
+        fprintf(stderr,
+                "rsmooth: %s: byte %lld (the end): %zu vertices but no faces and no vertex "
+                "normals: a mesh needs faces, a point cloud normals (nx, ny, nz)\n",
+                opt->input, end, mesh->vertex_count);
         return EXIT_USAGE;
     }
     if (method_uses_edges(opt->method)) {
@@ -819,7 +832,7 @@ int main(int argc, char **argv) {
         return cli_render_main(argc - 1, argv + 1);
     options opt;
     int code = parse_args(argc, argv, &opt);
-    if (code >= 0)
+    if (code >= 0 || (code = cli_check_environment()) >= 0)
         return code;
     if (opt.list_devices)
         return list_devices();

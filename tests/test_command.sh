@@ -73,8 +73,14 @@ expect 2 "$rsmooth" noisy.ply -o x.ply --method laplacian --confidence c.ply
 [ -e x.ply ] && fail "a refused --method call wrote its output"
 expect 2 "$rsmooth" noisy.ply -o x.ply --bogus
 expect 2 "$rsmooth" noisy.ply
-expect 3 "$rsmooth" noisy.ply -o x.ply --device "no such device"
-grep -q "no such device" err.txt || fail "device failure not explained: $(cat err.txt)"
+# A device choice that names no device here is a usage error (2), as is junk in a tuning variable.
+expect 2 "$rsmooth" noisy.ply -o x.ply --device "no such device"
+grep -q "no such device" err.txt || fail "unknown device not explained: $(cat err.txt)"
+grep -q "list-devices" err.txt || fail "unknown device: no hint at --list-devices: $(cat err.txt)"
+RSMOOTH_DEVICE=99:99 expect 2 "$rsmooth" noisy.ply -o x.ply
+RSMOOTH_HOST_THREADS=two expect 2 "$rsmooth" noisy.ply -o x.ply
+grep -q "RSMOOTH_HOST_THREADS" err.txt || fail "junk RSMOOTH_HOST_THREADS not named: $(cat err.txt)"
+RSMOOTH_CELLS_PER_REACH=0 expect 2 "$rsmooth" noisy.ply -o x.ply
 [ -e x.ply ] && fail "output written after a failure"
 ls -A | grep -qE 'tmp-|^\.rsmooth-' && fail "temporary files left behind: $(ls -A)"
 
@@ -447,6 +453,40 @@ expect 2 "$rsmooth" small.ply -o x.ply --memory-budget 0
 grep -q "leave it out" err.txt || fail "--memory-budget 0 does not say how to get the default: $(cat err.txt)"
 RSMOOTH_MEMORY_BUDGET=lots expect 0 "$rsmooth" small.ply -o budget.ply -q --memory-budget 256M
 [ -e x.ply ] && fail "a refused memory budget wrote its output"
+
+# Every scale alike (issue 12): a tetrahedron reaching 1e39 and a noisy grid at 1e-20 and 1e120
+# come out finite on both paths, moved, and the same on both; vertices only, no faces and no
+# normals, is refused naming the end of the file.
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1e39\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n' > tall.obj
+for device in cpu reference; do
+  expect 0 "$rsmooth" tall.obj -o tall_$device.obj --device $device
+  grep -qiE 'nan|inf' tall_$device.obj && fail "non-finite output on $device: $(cat tall_$device.obj)"
+done
+expect 0 "$shape" make grid.obj grid_truth.obj --noise 0.3 --triangles 800
+for scale in 1e-20 1e120; do
+  awk -v s=$scale '/^v / { printf "v %.17g %.17g %.17g\n", $2 * s, $3 * s, $4 * s; next } { print }' \
+    grid.obj > grid_$scale.obj
+  expect 0 "$rsmooth" grid_$scale.obj -o grid_${scale}_cpu.obj --device cpu
+  expect 0 "$rsmooth" grid_$scale.obj -o grid_${scale}_ref.obj --device reference
+  grep -qiE 'nan|inf' grid_${scale}_cpu.obj && fail "non-finite output at $scale"
+  cmp -s grid_$scale.obj grid_${scale}_ref.obj && fail "nothing moved at $scale"
+  # largest OpenCL - reference difference against the largest move, both in mesh units
+  paste -d' ' <(grep '^v ' grid_$scale.obj) <(grep '^v ' grid_${scale}_cpu.obj) \
+    <(grep '^v ' grid_${scale}_ref.obj) | awk -v s=$scale '
+    function abs(x) { return x < 0 ? -x : x }
+    { for (k = 2; k <= 4; k++) { m = abs($(k + 8) - $k); if (m > move) move = m
+                                 d = abs($(k + 4) - $(k + 8)); if (d > diff) diff = d } }
+    END { printf "grid at %s: largest move %.3g, OpenCL - reference %.3g\n", s, move, diff
+          exit !(move > 0 && diff < 1e-3 * move) }' || fail "OpenCL and reference disagree at $scale"
+done
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\n' > vertices_only.obj
+expect 2 "$rsmooth" vertices_only.obj -o x.obj
+grep -q "vertices_only.obj: byte 24" err.txt || fail "no faces, no normals: not located: $(cat err.txt)"
+# rsmooth noise works at every scale too (its mean edge and normals are scale-free)
+printf 'v 0 0 0\nv 1e-300 0 0\nv 0 1e-300 0\nv 0 0 1e-300\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n' \
+  > tiny.obj
+expect 0 "$rsmooth" noise tiny.obj tiny_noisy.obj --sigma 0.1
+cmp -s tiny.obj tiny_noisy.obj && fail "rsmooth noise did not move a mesh at 1e-300"
 
 expect 0 "$rsmooth" --help
 grep -q "sigma-g" out.txt || fail "--help does not explain sigma-g"
