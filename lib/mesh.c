@@ -50,7 +50,7 @@ rsmooth_status rs_check_coordinates(rsmooth_scalar scalar, const void *positions
                 return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                                "%s %zu has a non-finite coordinate", noun, i / 3);
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                           "%s %zu has coordinate %g beyond the supported magnitude %g", noun,
+                           "%s %zu has coordinate %.17g beyond the supported magnitude %g", noun,
                            i / 3, rs_coordinate(scalar, positions, i), RS_MAX_COORDINATE);
         }
         largest = x > largest ? x : largest;
@@ -69,7 +69,7 @@ rsmooth_status rs_check_colors(const float *colors, size_t vertex_count, rsmooth
                            (double)colors[i]);
         else if (fabsf(colors[i]) > (float)RS_MAX_COLOR)
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                           "vertex %zu has colour component %g beyond the supported magnitude %g",
+                           "vertex %zu has colour component %.9g beyond the supported magnitude %g",
                            i / 3, (double)colors[i], RS_MAX_COLOR);
     return RSMOOTH_OK;
 }

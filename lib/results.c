@@ -51,7 +51,7 @@ rsmooth_status rs_check_results(rsmooth_scalar scalar, const void *out_positions
                                : "");
         if (fabs(x) > RS_MAX_COORDINATE)
             return rs_fail(error, RSMOOTH_ERROR_NUMERICAL, where,
-                           "the result for %s %zu has coordinate %g beyond the supported "
+                           "the result for %s %zu has coordinate %.17g beyond the supported "
                            "magnitude %g",
                            noun, i / 3, x, RS_MAX_COORDINATE);
     }
