@@ -5,6 +5,7 @@
 #include "rsmooth_io.h"
 #include "test_util.h"
 
+#include <math.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -161,6 +162,16 @@ static inline rsmooth_status write_to_memory(const rsmooth_mesh *mesh, rsmooth_f
     return s;
 }
 
+/* The shortest "%.Ng" text that reads back as v: how messages print a value compared with a limit
+ * (1.0000000000000002e150 is not "1e+150"). */
+static inline void shortest_digits(double v, char *text, size_t size) {
+    for (int digits = 1; digits <= 17; digits++) {
+        snprintf(text, size, "%.*g", digits, v);
+        if (strtod(text, NULL) == v)
+            return;
+    }
+}
+
 /* The writer of `format` refuses, with INVALID_ARGUMENT, a message naming the vertex and nothing
  * written to the stream (nor a file created), every coordinate rsmooth could not read back: NaN,
  * infinities and magnitudes beyond the supported 1e150. */
@@ -174,8 +185,12 @@ static inline void check_writer_refuses_unreadable(rsmooth_format format) {
             size_t size;
             rsmooth_error err;
             rsmooth_status s = write_to_memory(m, format, &data, &size, &err);
+            /* a finite value is printed with the digits that tell it from the limit */
+            char digits[40];
+            shortest_digits(bad[i], digits, sizeof digits);
             if (s != RSMOOTH_ERROR_INVALID_ARGUMENT || size != 0 ||
-                !strstr(err.message, "vertex 2 ")) {
+                !strstr(err.message, "vertex 2 ") ||
+                (isfinite(bad[i]) && !strstr(err.message, digits))) {
                 fprintf(stderr, "format %d, coordinate %g: status %d, %zu bytes written, '%s'\n",
                         (int)format, bad[i], (int)s, size, err.message);
                 exit(1);

@@ -851,8 +851,13 @@ static void test_attribute_indices(void) {
     snprintf(text, sizeof text, "%svn 0 nan 1\n", v3);
     EXPECT_PARSE_ERROR(text, 4, "normal 1 has a non-finite component");
     /* coordinates beyond the supported magnitude are refused where they stand */
+    /* with the digits that tell the value from the limit (%g printed both as 1e+150) */
     EXPECT_PARSE_ERROR("v 0 0 0\nv 0 -1.0000000000000002e150 0\n", 2,
-                       "vertex 2 has coordinate -1e+150 beyond the supported magnitude 1e+150");
+                       "vertex 2 has coordinate -1.0000000000000002e+150 beyond the supported "
+                       "magnitude 1e+150");
+    EXPECT_PARSE_ERROR("v 0 0 0\nv 1.0000001e150 0 0\n", 2,
+                       "vertex 2 has coordinate 1.0000001e+150 beyond the supported magnitude "
+                       "1e+150");
     EXPECT_PARSE_ERROR("v 0 0 0\n\nv 0 0 1e300\n", 3, "vertex 2 has coordinate 1e+300 beyond");
     /* colours too must be numbers (they were read as black) */
     EXPECT_PARSE_ERROR("v 0 0 0 1 0 0\nv 1 0 0 0.5 nan 0\n", 2, "vertex 2 has a non-finite colour");

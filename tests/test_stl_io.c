@@ -462,6 +462,13 @@ static void test_round_trip(void) {
     CHECK_STATUS(rsmooth_mesh_write_stream(m, sink, RSMOOTH_FORMAT_STL_BINARY, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(err.message, "float32") != NULL);
+    /* just beyond float32's largest, in digits that tell the two apart (%g printed 3.40282e+38) */
+    m->positions[0] = 3.4028236e38;
+    CHECK_STATUS(rsmooth_mesh_write_stream(m, sink, RSMOOTH_FORMAT_STL_BINARY, &err),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(err.message, "vertex 0 has coordinate 3.4028236e+38 beyond the largest float32 "
+                              "3.4028234663852886e+38") != NULL);
+    CHECK(strstr(err.message, "ascii STL, OBJ or a PLY with double") != NULL);
     CHECK_STATUS(rsmooth_mesh_write_stream(m, sink, RSMOOTH_FORMAT_STL_ASCII, &err), RSMOOTH_OK);
     m->positions[0] = NAN;
     CHECK_STATUS(rsmooth_mesh_write_stream(m, sink, RSMOOTH_FORMAT_STL_ASCII, &err),

@@ -25,6 +25,14 @@ static inline bool rs_io_coordinate_ok(double x) {
     return x >= -RS_MAX_COORDINATE && x <= RS_MAX_COORDINATE; /* false for NaN */
 }
 
+/* The shortest decimal form of v that reads back as v (up to 17 significant digits), for messages
+ * that compare a value with a limit: "%g" prints 1.0000001e150 as the limit 1e+150 itself. The
+ * text lives as long as the full expression that calls this. */
+typedef struct rs_io_digits {
+    char text[32];
+} rs_io_digits;
+rs_io_digits rs_io_shortest(double v);
+
 /* Checks a vertex's x y z as read (rs_io_coordinate_ok), failing with a parse error at `line` /
  * `byte_offset` that names vertex `number` (numbered as the format numbers vertices). */
 rsmooth_status rs_io_check_vertex(const double xyz[3], size_t number, int64_t line,

@@ -225,9 +225,9 @@ rsmooth_status rs_io_mesh_check_values(const rsmooth_mesh *mesh, const char *whe
                            "vertex %zu has a non-finite coordinate (%g): not written", i / 3, x);
         if (!rs_io_coordinate_ok(x))
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                           "vertex %zu has coordinate %g beyond the supported magnitude %g: not "
+                           "vertex %zu has coordinate %s beyond the supported magnitude %s: not "
                            "written (rsmooth could not read it back)",
-                           i / 3, x, RS_MAX_COORDINATE);
+                           i / 3, rs_io_shortest(x).text, rs_io_shortest(RS_MAX_COORDINATE).text);
     }
     for (size_t i = 0; mesh->vertex_quality && i < mesh->vertex_count; i++)
         if (!isfinite(mesh->vertex_quality[i]))
@@ -235,6 +235,16 @@ rsmooth_status rs_io_mesh_check_values(const rsmooth_mesh *mesh, const char *whe
                            "vertex %zu has a non-finite quality (%g): not written", i,
                            (double)mesh->vertex_quality[i]);
     return RSMOOTH_OK;
+}
+
+rs_io_digits rs_io_shortest(double v) {
+    rs_io_digits d;
+    for (int digits = 1; digits <= 17; digits++) {
+        snprintf(d.text, sizeof d.text, "%.*g", digits, v);
+        if (!isfinite(v) || strtod(d.text, NULL) == v)
+            break;
+    }
+    return d;
 }
 
 rsmooth_status rs_io_check_vertex(const double xyz[3], size_t number, int64_t line,
@@ -245,8 +255,9 @@ rsmooth_status rs_io_check_vertex(const double xyz[3], size_t number, int64_t li
                                  "vertex %zu has a non-finite coordinate", number);
         if (!rs_io_coordinate_ok(xyz[k]))
             return rs_fail_parse(error, line, byte_offset, where,
-                                 "vertex %zu has coordinate %g beyond the supported magnitude %g",
-                                 number, xyz[k], RS_MAX_COORDINATE);
+                                 "vertex %zu has coordinate %s beyond the supported magnitude %s",
+                                 number, rs_io_shortest(xyz[k]).text,
+                                 rs_io_shortest(RS_MAX_COORDINATE).text);
     }
     return RSMOOTH_OK;
 }

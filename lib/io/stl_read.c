@@ -316,8 +316,9 @@ static rsmooth_status read_facet(stl_lexer *lx, stl_soup *soup, rsmooth_error *e
                              "facet %zu has a non-finite vertex", facet);
     if (!supported)
         return rs_fail_parse(error, facet_line, (int64_t)facet_pos, where,
-                             "facet %zu has coordinate %g beyond the supported magnitude %g", facet,
-                             first_bad, RS_MAX_COORDINATE);
+                             "facet %zu has coordinate %s beyond the supported magnitude %s", facet,
+                             rs_io_shortest(first_bad).text,
+                             rs_io_shortest(RS_MAX_COORDINATE).text);
     status = expect_keyword(lx, "endfacet", error);
     if (status == RSMOOTH_OK)
         soup->triangle_count++;

@@ -60,8 +60,11 @@ static rsmooth_status check_triangles(const rsmooth_mesh *mesh, bool binary,
             double x = binary ? (double)(float)xyz[k] : xyz[k];
             if (!isfinite(x))
                 return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                               "vertex %lu coordinate %g cannot be written%s", (unsigned long)v,
-                               xyz[k], binary ? " as a float32 (binary STL)" : "");
+                               "vertex %lu has coordinate %s beyond the largest float32 %s: "
+                               "binary STL cannot hold it (ascii STL, OBJ or a PLY with double "
+                               "properties can)",
+                               (unsigned long)v, rs_io_shortest(xyz[k]).text,
+                               rs_io_shortest(FLT_MAX).text);
         }
     }
     return RSMOOTH_OK;
