@@ -321,10 +321,12 @@ static void test_errors(void) {
     bytes_free(&b);
 
     /* ascii: keywords, vertex counts, numbers, with their line */
+    /* a bad coordinate is located at its own vertex line (it was the facet's first line) */
     err = EXPECT_ASCII_ERROR(GOOD_FACET "facet normal 0 0 1\nouter loop\nvertex nan 0 0\n"
                                         "vertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n",
                              "facet 1 has a non-finite vertex");
-    CHECK_EQ_INT(err.line, 9);
+    CHECK_EQ_INT(err.line, 11);
+    CHECK_EQ_INT(err.byte_offset, strlen("solid t\n" GOOD_FACET "facet normal 0 0 1\nouter loop\n"));
     EXPECT_ASCII_ERROR("facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 inf\n"
                        "vertex 0 1 0\nendloop\nendfacet\n",
                        "facet 0 has a non-finite vertex");
@@ -550,12 +552,15 @@ static void test_write_refusals_and_extremes(void) {
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     CHECK(access(path, F_OK) != 0);
     rsmooth_mesh_destroy(m);
-    /* ascii beyond the supported magnitude: refused at its facet's line */
+    /* ascii beyond the supported magnitude: refused at its vertex line, in digits that tell the
+     * value from the limit */
     rsmooth_error err = EXPECT_ASCII_ERROR(
-        GOOD_FACET "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 -3e150\n"
+        GOOD_FACET "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 -1.0000001e150\n"
                    "vertex 0 1 0\nendloop\nendfacet\n",
-        "facet 1 has coordinate -3e+150 beyond the supported magnitude 1e+150");
-    CHECK_EQ_INT(err.line, 9);
+        "facet 1 has coordinate -1.0000001e+150 beyond the supported magnitude 1e+150");
+    CHECK_EQ_INT(err.line, 12);
+    CHECK_EQ_INT(err.byte_offset,
+                 strlen("solid t\n" GOOD_FACET "facet normal 0 0 1\nouter loop\nvertex 0 0 0\n"));
 }
 
 /* A binary STL whose size disagrees with its count, read through detection as the command does:
@@ -577,6 +582,36 @@ static void test_detected_sizes(void) {
         }
         bytes_free(&b);
     }
+}
+
+/* A '#' comment line before "solid": detection takes the file for ascii STL (the first word past
+ * blanks and comments), and the ascii reader refuses the comment at its line, saying why (it was
+ * read as a binary STL of 540090488 triangles). Comments between facets likewise. */
+static void test_comments(void) {
+    const char *body = "solid t\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n"
+                       "   vertex 1 0 0\n   vertex 0 1 0\n  endloop\n endfacet\nendsolid t\n";
+    char text[512];
+    snprintf(text, sizeof text, "# made by hand\n%s", body);
+    const rsmooth_format formats[2] = {RSMOOTH_FORMAT_AUTO, RSMOOTH_FORMAT_STL_ASCII};
+    for (int f = 0; f < 2; f++) {
+        rsmooth_error err = expect_parse_error(__LINE__, text, strlen(text), formats[f],
+                                               "a '#' comment where 'solid' was expected: ascii "
+                                               "STL has no comments");
+        CHECK_EQ_INT(err.line, 1);
+        CHECK_EQ_INT(err.byte_offset, 0);
+    }
+    /* after blank lines and a byte-order mark: the comment's own line and byte */
+    snprintf(text, sizeof text, "\xEF\xBB\xBF\n  \n  #made by hand\n%s", body);
+    rsmooth_error err = expect_parse_error(__LINE__, text, strlen(text), RSMOOTH_FORMAT_AUTO,
+                                           "ascii STL has no comments");
+    CHECK_EQ_INT(err.line, 3);
+    CHECK_EQ_INT(err.byte_offset, 3 + 6);
+    /* between facets */
+    err = EXPECT_ASCII_ERROR(GOOD_FACET "# a comment\n" GOOD_FACET,
+                             "a '#' comment where 'facet' was expected: ascii STL has no comments");
+    CHECK_EQ_INT(err.line, 9);
+    /* without the comment the same text reads */
+    rsmooth_mesh_destroy(parse_ok(body, strlen(body), RSMOOTH_FORMAT_AUTO));
 }
 
 static void test_byte_order_mark(void) {
@@ -621,6 +656,7 @@ int main(void) {
     test_write_refusals_and_extremes();
     test_detected_sizes();
     test_byte_order_mark();
+    test_comments();
     printf("stl io: ok\n");
     return 0;
 }

@@ -91,7 +91,8 @@ typedef struct rsmooth_mesh {
  *   - a binary STL by its exact size (84 + 50 x the count at byte 80), whatever its header says;
  *   - after an optional UTF-8 byte-order mark: PLY when the file starts with "ply";
  *   - then by the first word past blank lines, indentation and '#' comments: an OFF keyword (OFF,
- *     COFF, NOFF, CNOFF, STOFF... in any case of "off"), "solid" (ascii STL);
+ *     COFF, NOFF, CNOFF, STOFF... in any case of "off"), "solid" (ascii STL; ascii STL has no
+ *     comments, so a '#' line before "solid" or between facets is refused at its line);
  *   - binary content (NUL or control bytes) not opening with an OBJ statement: a binary STL whose
  *     size disagrees with its count, which is then the error;
  *   - anything else OBJ.

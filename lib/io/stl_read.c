@@ -233,6 +233,11 @@ static rsmooth_status expected(const stl_lexer *lx, const char *word, rsmooth_er
     if (lx->len == 0)
         return rs_fail_parse(error, lx->line, (int64_t)lx->token_pos, where,
                              "data ends where '%s' was expected", word);
+    if (lx->token[0] == '#') /* some tools comment STL files: say why it is refused */
+        return rs_fail_parse(error, lx->line, (int64_t)lx->token_pos, where,
+                             "a '#' comment where '%s' was expected: ascii STL has no comments "
+                             "(remove the line to read the file)",
+                             word);
     return rs_fail_parse(error, lx->line, (int64_t)lx->token_pos, where,
                          "expected '%s', found '%.*s'", word, (int)(lx->len > 40 ? 40 : lx->len),
                          lx->token);
@@ -286,6 +291,8 @@ static rsmooth_status read_facet(stl_lexer *lx, stl_soup *soup, rsmooth_error *e
     size_t vertices = 0;
     bool supported = true; /* every coordinate finite and within the supported magnitude */
     double first_bad = 0;
+    int64_t bad_line = 0; /* the first bad value's "vertex" line and keyword */
+    size_t bad_pos = 0;
     for (;;) {
         if (!next_token(lx))
             return expected(lx, "endloop", error);
@@ -293,6 +300,8 @@ static rsmooth_status read_facet(stl_lexer *lx, stl_soup *soup, rsmooth_error *e
             break;
         if (!keyword_is(lx, "vertex"))
             return expected(lx, vertices < 3 ? "vertex" : "endloop", error);
+        int64_t vertex_line = lx->line;
+        size_t vertex_pos = lx->token_pos;
         double v[3];
         for (int k = 0; k < 3; k++) {
             status = read_number(lx, &v[k], error);
@@ -301,6 +310,8 @@ static rsmooth_status read_facet(stl_lexer *lx, stl_soup *soup, rsmooth_error *e
             if (supported && !rs_io_coordinate_ok(v[k])) {
                 supported = false;
                 first_bad = v[k];
+                bad_line = vertex_line;
+                bad_pos = vertex_pos;
             }
         }
         if (vertices < 3)
@@ -311,11 +322,12 @@ static rsmooth_status read_facet(stl_lexer *lx, stl_soup *soup, rsmooth_error *e
         return rs_fail_parse(error, facet_line, (int64_t)facet_pos, where,
                              "facet %zu has %zu vertices (STL facets are triangles)", facet,
                              vertices);
+    /* located at the vertex line that holds the value, once the facet is known to be whole */
     if (!supported && !isfinite(first_bad))
-        return rs_fail_parse(error, facet_line, (int64_t)facet_pos, where,
+        return rs_fail_parse(error, bad_line, (int64_t)bad_pos, where,
                              "facet %zu has a non-finite vertex", facet);
     if (!supported)
-        return rs_fail_parse(error, facet_line, (int64_t)facet_pos, where,
+        return rs_fail_parse(error, bad_line, (int64_t)bad_pos, where,
                              "facet %zu has coordinate %s beyond the supported magnitude %s", facet,
                              rs_io_shortest(first_bad).text,
                              rs_io_shortest(RS_MAX_COORDINATE).text);
@@ -411,9 +423,14 @@ static rsmooth_status read_ascii(const char *data, size_t size, rsmooth_mesh **m
 
 /* ---- entry points */
 
+/* The first word past blanks and '#' comment lines is "solid", as format detection sees it; the
+ * ascii reader then refuses the comments with their line. */
 static bool starts_with_solid(const char *data, size_t size) {
     stl_lexer lx = {.data = data, .size = size};
-    return next_token(&lx) && keyword_is(&lx, "solid");
+    while (next_token(&lx) && lx.token[0] == '#')
+        while (lx.pos < lx.size && lx.data[lx.pos] != '\n')
+            lx.pos++;
+    return keyword_is(&lx, "solid");
 }
 
 rsmooth_status rs_io_stl_read(const char *data, size_t size, rsmooth_mesh **mesh,
