@@ -685,6 +685,77 @@ static void test_byte_order_mark(void) {
     "ply\nformat ascii 1.0\nelement vertex 3\n" vertex_props "element face 1\n" face_list          \
     "end_header\n"
 
+/* Bytes after the last element: blanks (the line end some writers append) read, anything else is
+ * refused where it starts, since a header that counts fewer items than the data holds would drop
+ * the rest (it was read, and the rest silently dropped). */
+static void test_trailing_data(void) {
+    bytes goods[3] = {binary_square(false, false), binary_square(true, true), common_square(false)};
+    for (int g = 0; g < 3; g++) {
+        const bytes *good = &goods[g];
+        const char *blanks[] = {"\n", "\r\n", " \n\n\t"};
+        for (size_t k = 0; k < sizeof blanks / sizeof blanks[0]; k++) {
+            bytes b = {0};
+            put(&b, good->data, good->size);
+            put_text(&b, blanks[k]);
+            rsmooth_mesh *m = parse_ok(&b);
+            check_square(m);
+            rsmooth_mesh_destroy(m);
+            bytes_free(&b);
+        }
+        /* one face more than the header declares, after a line end */
+        bytes b = {0};
+        put(&b, good->data, good->size);
+        put_text(&b, "\n");
+        put_u8(&b, 3);
+        put_i32(&b, 0);
+        put_i32(&b, 1);
+        put_i32(&b, 2);
+        rsmooth_error err = EXPECT_PARSE_ERROR(b.data, b.size,
+                                               "13 bytes after the data the header "
+                                               "declares");
+        CHECK_EQ_INT(err.byte_offset, good->size + 1);
+        CHECK(strstr(err.message, "0x03") != NULL);
+        bytes_free(&b);
+        /* a NUL is no blank */
+        put(&b, good->data, good->size);
+        put(&b, "\n\0", 2);
+        err = EXPECT_PARSE_ERROR(b.data, b.size, "1 bytes after the data");
+        CHECK_EQ_INT(err.byte_offset, good->size + 1);
+        bytes_free(&b);
+    }
+    /* A face count one short of the data: the second face is refused where it starts. */
+    bytes b = common_square(false);
+    unsigned char *count = NULL;
+    for (size_t i = 0; !count && i + 14 <= b.size; i++)
+        if (memcmp(b.data + i, "element face 2", 14) == 0)
+            count = b.data + i;
+    CHECK(count != NULL);
+    count[13] = '1';
+    rsmooth_error err = EXPECT_PARSE_ERROR(b.data, b.size,
+                                           "13 bytes after the data the header "
+                                           "declares");
+    CHECK_EQ_INT(err.byte_offset, b.size - 13);
+    bytes_free(&b);
+    for (int g = 0; g < 3; g++)
+        bytes_free(&goods[g]);
+
+    /* ascii: blank lines may follow, a line of values may not */
+    const char *text = "ply\nformat ascii 1.0\nelement vertex 3\n" VERTEX_XYZ
+                       "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                       "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    char longer[512];
+    snprintf(longer, sizeof longer, "%s\n  \r\n\t", text);
+    bytes ok = {0};
+    put_text(&ok, longer);
+    rsmooth_mesh_destroy(parse_ok(&ok));
+    bytes_free(&ok);
+    snprintf(longer, sizeof longer, "%s\n3 0 2 1\n", text);
+    err = EXPECT_LINE(longer, 15, "'3' after the data the header declares");
+    CHECK_EQ_INT(err.byte_offset, strlen(text) + 1);
+    snprintf(longer, sizeof longer, "%send\n", text);
+    EXPECT_LINE(longer, 14, "'end' after the data the header declares");
+}
+
 static void test_detection_and_lenience(void) {
     /* Leading blanks or lines before "ply": a located error, not the OBJ fallback. */
     const char *indented =
@@ -798,6 +869,7 @@ int main(void) {
     test_write_refusals_and_extremes();
     test_byte_order_mark();
     test_detection_and_lenience();
+    test_trailing_data();
     printf("ply_io: all checks passed\n");
     return 0;
 }

@@ -100,7 +100,9 @@ typedef struct rsmooth_mesh {
  * or byte offset (binary; from the file's first byte, a byte-order mark included) is always set.
  * RSMOOTH_ERROR_PARSE for malformed content (an empty file, "ply" after blanks, truncation, bad
  * numbers, values a PLY property's declared type cannot hold, a PLY property named twice in an
- * element, an ascii PLY row with a value too many or too few, indices out of range (OBJ vt and vn
+ * element, an ascii PLY row with a value too many or too few, anything but blanks after a PLY
+ * file's last element (binary: by byte offset; the header's counts would leave it out), indices
+ * out of range (OBJ vt and vn
  * too), faces with fewer than 3 vertices, non-finite coordinates or normals, coordinates beyond
  * 1e150 in magnitude, counts larger than the data can hold); RSMOOTH_ERROR_UNSUPPORTED for variants
  * not read (4OFF, nOFF, binary OFF), also located; RSMOOTH_ERROR_OUT_OF_MEMORY. Thread-safe. */

@@ -194,6 +194,31 @@ static rsmooth_status read_data(rs_ply_reader *r, rsmooth_error *error) {
     return RSMOOTH_OK;
 }
 
+/* After the last element only blanks may follow (line ends some writers append): anything else is
+ * data the header's counts leave out, which a reader would silently drop. */
+static rsmooth_status check_end(rs_ply_reader *r, rsmooth_error *error) {
+    size_t p = r->pos;
+    int64_t line = r->line;
+    for (; p < r->size && rs_ply_is_space(r->data[p]); p++)
+        if (r->data[p] == '\n')
+            line++;
+    if (p == r->size)
+        return RSMOOTH_OK;
+    if (r->encoding != RS_PLY_ASCII)
+        return rs_fail_parse(
+            error, -1, (int64_t)p, where,
+            "%zu bytes after the data the header declares (from byte %zu, 0x%02x): "
+            "the header's counts leave data out",
+            r->size - p, p, (unsigned)(unsigned char)r->data[p]);
+    size_t end = p;
+    while (end < r->size && !rs_ply_is_space(r->data[end]))
+        end++;
+    return rs_fail_parse(error, line, (int64_t)p, where,
+                         "'%.*s' after the data the header declares: the header's counts leave "
+                         "data out",
+                         (int)(end - p > 40 ? 40 : end - p), r->data + p);
+}
+
 rsmooth_status rs_io_ply_read(const char *data, size_t size, rsmooth_mesh **mesh,
                               rsmooth_error *error) {
     rs_ply_reader r = {.data = data, .size = size, .precision = RSMOOTH_FLOAT32};
@@ -208,6 +233,8 @@ rsmooth_status rs_io_ply_read(const char *data, size_t size, rsmooth_mesh **mesh
         status = rs_ply_assign_roles(&r, error);
     if (status == RSMOOTH_OK)
         status = read_data(&r, error);
+    if (status == RSMOOTH_OK)
+        status = check_end(&r, error);
     uint32_t *indices = r.indices.data;
     if (status == RSMOOTH_OK && !indices) {
         indices = rs_alloc_array(1, sizeof(uint32_t));
