@@ -37,8 +37,8 @@ static rsmooth_mesh *parse_ok(const char *text) {
 
 /* Expects `status` at `line` (-1: any) with a message containing `needle`. */
 #define EXPECT_ERROR(text, status, line, needle) expect_error(__LINE__, text, status, line, needle)
-static void expect_error(int at, const char *text, rsmooth_status status, long long line,
-                         const char *needle) {
+static rsmooth_error expect_error(int at, const char *text, rsmooth_status status, long long line,
+                                  const char *needle) {
     rsmooth_mesh *mesh = (rsmooth_mesh *)&mesh; /* must be reset to NULL */
     rsmooth_error err;
     rsmooth_status s = parse_n(text, strlen(text), RSMOOTH_FORMAT_OFF, &mesh, &err);
@@ -51,6 +51,7 @@ static void expect_error(int at, const char *text, rsmooth_status status, long l
     }
     CHECK(mesh == NULL);
     CHECK_EQ_INT(err.status, status);
+    return err;
 }
 
 static void check_color(const rsmooth_mesh *m, size_t v, int r, int g, int b) {
@@ -61,7 +62,8 @@ static void check_color(const rsmooth_mesh *m, size_t v, int r, int g, int b) {
 }
 
 static void test_variants(void) {
-    /* Plain OFF: comments and blank lines anywhere, a quad, a pentagon, trailing data ignored. */
+    /* Plain OFF: comments and blank lines anywhere, a quad, a pentagon, comments after the faces.
+     */
     rsmooth_mesh *m = parse_ok("OFF\n"
                                "# a comment\n"
                                "\n"
@@ -75,7 +77,7 @@ static void test_variants(void) {
                                "3 0 1 4\n"
                                "4 0 1 2 3\n"
                                "5 0 1 2 3 4\n"
-                               "extra trailing data\n");
+                               "# the end\n\n");
     CHECK_EQ_INT(m->vertex_count, 5);
     CHECK_EQ_INT(m->face_count, 3);
     CHECK_NEAR(m->positions[14], 1, 0);
@@ -289,7 +291,7 @@ static void test_errors(void) {
     /* vertex lines */
     EXPECT_ERROR("OFF\n3 1 0\n0 0 0\n1 0\n0 1 0\n3 0 1 2\n# pad\n", P, 4, "vertex 1 has 2 values");
     EXPECT_ERROR("COFF\n3 1 0\n0 0 0 1 1 1\n1 0 0 1 1\n0 1 0 1 1 1\n3 0 1 2\n# pad\n", P, 4,
-                 "vertex 1 has 5 values (COFF needs 6)");
+                 "vertex 1 has 5 values (COFF declares 6 or 7: x y z r g b [a])");
     EXPECT_ERROR("OFF\n3 1 0\n0 0 0\n1 0 x\n0 1 0\n3 0 1 2\n# pad\n", P, 4, "malformed number 'x'");
     EXPECT_ERROR("OFF\n3 1 0\n0 0 0\n1 0 0\n0 nan 0\n3 0 1 2\n# pad\n", P, 5,
                  "vertex 2 has a non-finite coordinate");
@@ -484,6 +486,99 @@ static void test_write_refusals_and_extremes(void) {
     rsmooth_mesh_destroy(m);
 }
 
+/* A line holds exactly the values its variant declares (issue 12's campaign: '0 1 0 7' read as
+ * 0 1 0 and written back with its ' 7'; a stray CR running two COFF lines together): refused at the
+ * first value too many, or at the line when too few; face colours are a colormap index or r g b
+ * [a]; nothing but comments after the declared faces. */
+static void test_values_per_line(void) {
+    const rsmooth_status P = RSMOOTH_ERROR_PARSE;
+    struct {
+        const char *keyword, *line, *needle;
+    } vertices[] = {
+        {"OFF", "0 1 0 7", "vertex 1 has 4 values (OFF declares 3: x y z)"},
+        {"NOFF", "0 1 0 0 0 1 7", "vertex 1 has 7 values (NOFF declares 6: x y z nx ny nz)"},
+        {"COFF", "0 1 -0.0\r54441 3 125 115 255",
+         "vertex 1 has 8 values (COFF declares 6 or 7: x y z r g b [a])"},
+        {"COFF", "0 1 0 1 1", "vertex 1 has 5 values (COFF declares 6 or 7"},
+        {"CNOFF", "0 1 0 0 0 1 1 1 1 1 1", "vertex 1 has 11 values (CNOFF declares 9 or 10"},
+        {"STOFF", "0 1 0 0.5", "vertex 1 has 4 values (STOFF declares 5: x y z s t)"},
+        {"STCNOFF", "0 1 0 0 0 1 1 1 1 1 0 0 0",
+         "vertex 1 has more than 12 values (STCNOFF declares 11 or 12: x y z nx ny nz r g b [a] "
+         "s t)"},
+        {"COFF", "0 1 0 256 0 0", "vertex 1: colour component '256' outside 0 to 255"},
+        {"COFF", "0 1 0 1 -0.5 0 1", "vertex 1: colour component '-0.5' outside 0 to 255"},
+        {"STOFF", "0 1 0 0.5 nan", "vertex 1 has a non-finite texture coordinate"},
+    };
+    const char *good[] = {"OFF",   "0 0 0",       "NOFF",    "0 0 0 0 0 1",
+                          "COFF",  "0 0 0 1 0 0", "CNOFF",   "0 0 0 0 0 1 1 0 0 1",
+                          "STOFF", "0 0 0 0 0",   "STCNOFF", "0 0 0 0 0 1 1 1 1 1 0 0"};
+    for (size_t i = 0; i < sizeof vertices / sizeof vertices[0]; i++) {
+        const char *first = NULL;
+        for (size_t g = 0; g < sizeof good / sizeof good[0]; g += 2)
+            if (!strcmp(good[g], vertices[i].keyword))
+                first = good[g + 1];
+        CHECK(first != NULL);
+        char text[512];
+        snprintf(text, sizeof text, "%s\n3 1 0\n%s\n%s\n%s\n3 0 1 2\n", vertices[i].keyword, first,
+                 vertices[i].line, first);
+        rsmooth_error err = expect_error(__LINE__, text, P, 4, vertices[i].needle);
+        /* too many: at the first value too many; else within the line */
+        const char *line = strstr(text, vertices[i].line);
+        CHECK(err.byte_offset >= line - text &&
+              err.byte_offset < line - text + (long long)strlen(vertices[i].line));
+        if (i == 0)
+            CHECK_EQ_INT(err.byte_offset, line - text + 6);
+        if (i == 1)
+            CHECK_EQ_INT(err.byte_offset, line - text + 12);
+        /* the same line is good with the values its keyword declares */
+        snprintf(text, sizeof text, "%s\n3 1 0\n%s\n%s\n%s\n3 0 1 2\n", vertices[i].keyword, first,
+                 first, first);
+        rsmooth_mesh_destroy(parse_ok(text));
+    }
+
+    /* Face lines: the indices, then nothing, a colormap index, or a colour of 3 or 4 components. */
+    const char *head = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n";
+    const char *faces_ok[] = {"3 0 1 2", "3 0 1 2 7", "3 0 1 2 1 0 0", "3 0 1 2 0.5 0.5 0.5 1",
+                              "3 0 1 2 255 0 0 255"};
+    for (size_t i = 0; i < sizeof faces_ok / sizeof faces_ok[0]; i++) {
+        char text[256];
+        snprintf(text, sizeof text, "%s%s\n", head, faces_ok[i]);
+        rsmooth_mesh *m = parse_ok(text);
+        /* and written back as read */
+        size_t size;
+        char *out = mesh_to_memory(m, RSMOOTH_FORMAT_OFF, &size);
+        CHECK(strstr(out, faces_ok[i]) != NULL);
+        free(out);
+        rsmooth_mesh_destroy(m);
+    }
+    struct {
+        const char *face, *needle;
+    } faces_bad[] = {
+        {"3 0 1 2 1 0", "face 0 has 2 values after its indices (a face colour is a colormap "
+                        "index, or r g b [a])"},
+        {"3 0 1 2 1 0 0 1 1", "face 0 has 5 values after its indices"},
+        {"3 0 1 2 0.5", "face 0: colormap index '0.5' is not a whole number >= 0"},
+        {"3 0 1 2 -1", "face 0: colormap index '-1'"},
+        {"3 0 1 2 300 0 0", "face 0: colour component '300' outside 0 to 255"},
+        {"3 0 1 2 1 x 0", "face 0: malformed colour 'x'"},
+        {"3 0 1 2 1 inf 0", "face 0 has a non-finite colour"},
+    };
+    for (size_t i = 0; i < sizeof faces_bad / sizeof faces_bad[0]; i++) {
+        char text[256];
+        snprintf(text, sizeof text, "%s%s\n", head, faces_bad[i].face);
+        expect_error(__LINE__, text, P, 6, faces_bad[i].needle);
+    }
+
+    /* After the declared faces: comments and blanks, nothing else (it was ignored). */
+    rsmooth_mesh_destroy(parse_ok("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n\n# end\n  \n"));
+    const char *more = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n# c\n3 0 2 1\n";
+    rsmooth_error err = expect_error(__LINE__, more, P, 8,
+                                     "'3' after the 3 vertices and 1 faces the header declares");
+    CHECK_EQ_INT(err.byte_offset, strstr(more, "3 0 2 1") - more);
+    expect_error(__LINE__, "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\nextra trailing data\n", P, 7,
+                 "'extra' after the 3 vertices");
+}
+
 static void test_byte_order_mark(void) {
     static const char colored[] = "COFF\n3 1 0\n0 0 0 1 0 0 1\n1 0 0 0 1 0 1\n"
                                   "0 1 0 0 0 1 1\n3 0 1 2 0.5 0.5 0.5\n";
@@ -523,6 +618,7 @@ int main(void) {
     test_detection();
     test_write_refusals_and_extremes();
     test_byte_order_mark();
+    test_values_per_line();
     printf("off_io: all checks passed\n");
     return 0;
 }

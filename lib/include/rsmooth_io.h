@@ -98,14 +98,20 @@ typedef struct rsmooth_mesh {
  *   - anything else OBJ.
  * On failure *mesh is NULL and `error` says what was expected and where: its line (text, 1-based)
  * or byte offset (binary; from the file's first byte, a byte-order mark included) is always set.
- * RSMOOTH_ERROR_PARSE for malformed content (an empty file, "ply" after blanks, truncation, bad
- * numbers, values a PLY property's declared type cannot hold, a PLY property named twice in an
- * element, an ascii PLY row with a value too many or too few, anything but blanks after a PLY
- * file's last element (binary: by byte offset; the header's counts would leave it out), indices
- * out of range (OBJ vt and vn
- * too), faces with fewer than 3 vertices, non-finite coordinates or normals, coordinates beyond
- * 1e150 in magnitude, counts larger than the data can hold); RSMOOTH_ERROR_UNSUPPORTED for variants
- * not read (4OFF, nOFF, binary OFF), also located; RSMOOTH_ERROR_OUT_OF_MEMORY. Thread-safe. */
+ * RSMOOTH_ERROR_PARSE for malformed content: an empty file, "ply" after blanks, truncation, bad
+ * numbers, indices out of range (OBJ vt and vn too), faces with fewer than 3 vertices, non-finite
+ * coordinates or normals, coordinates beyond 1e150 in magnitude, counts larger than the data can
+ * hold, and per format:
+ *   - PLY: values a property's declared type cannot hold, a property named twice in an element, an
+ *     ascii row with a value too many or too few, anything but blanks after the last element
+ *     (binary: at its byte offset; the header's counts would leave it out);
+ *   - OFF: a vertex line with other than the values its keyword declares (x y z; N: nx ny nz;
+ *     C: r g b or r g b a, integers 0 to 255 or floats 0 to 1; ST: s t; in that order), a face
+ *     line with anything after its indices but a colormap index (a whole number) or an r g b [a]
+ *     colour, anything but comments after the declared faces;
+ *   - ascii STL: a '#' comment anywhere (ascii STL has none).
+ * RSMOOTH_ERROR_UNSUPPORTED for variants not read (4OFF, nOFF, binary OFF), also located;
+ * RSMOOTH_ERROR_OUT_OF_MEMORY. Thread-safe. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_read_memory(const void *data, size_t size,
                                                     rsmooth_format format, rsmooth_mesh **mesh,
                                                     rsmooth_error *error);

@@ -265,8 +265,47 @@ static void free_state(off_state *st) {
     rs_io_off_extras_free(st->extras);
 }
 
-/* The tokens of a vertex line this reader looks at; the rest are counted. */
-#define MAX_TOKENS 16
+/* The most values a line may hold: x y z nx ny nz r g b a s t. */
+#define MAX_TOKENS 12
+
+/* The tokens of a line from p up to stop, at most MAX_TOKENS; *count is how many there are, and
+ * *beyond the first one past MAX_TOKENS (or NULL). */
+static void split_line(const char *p, const char *stop, const char **tokens, size_t *lens,
+                       int *count, const char **beyond) {
+    const char *token;
+    size_t len;
+    *count = 0;
+    *beyond = NULL;
+    while (next_token(&p, stop, &token, &len)) {
+        if (*count == MAX_TOKENS) {
+            *beyond = token;
+            return;
+        }
+        tokens[*count] = token;
+        lens[(*count)++] = len;
+    }
+}
+
+/* A colour component as OFF writes them: integers 0 to 255 or floats 0 to 1 (the file's values
+ * tell which), so anything outside [0, 255] is no colour. */
+static rsmooth_status check_color(const off_reader *r, const char *token, size_t len, double c,
+                                  const char *what, size_t number, rsmooth_error *error) {
+    if (!isfinite(c))
+        return rs_fail_parse(error, r->line, token - r->data, where,
+                             "%s %zu has a non-finite colour", what, number);
+    if (c < 0 || c > 255)
+        return rs_fail_parse(error, r->line, token - r->data, where,
+                             "%s %zu: colour component '%.*s' outside 0 to 255 (integer colours) "
+                             "or 0 to 1 (float colours)",
+                             what, number, TOKEN_TEXT(token, len));
+    return RSMOOTH_OK;
+}
+
+/* What a vertex line of this variant holds: "x y z[ nx ny nz][ r g b [a]][ s t]". */
+static void vertex_layout(const off_header *h, char *text, size_t size) {
+    snprintf(text, size, "x y z%s%s%s", h->n ? " nx ny nz" : "", h->c ? " r g b [a]" : "",
+             h->st ? " s t" : "");
+}
 
 static rsmooth_status parse_vertex(off_reader *r, const off_header *h, off_state *st, size_t v,
                                    rsmooth_error *error) {
@@ -275,28 +314,29 @@ static rsmooth_status parse_vertex(off_reader *r, const off_header *h, off_state
         return rs_fail_parse(error, r->line, -1, where,
                              "the file ends after %zu of %llu vertices (fewer than declared)", v,
                              (unsigned long long)h->vertex_count);
-    const char *tokens[MAX_TOKENS];
+    const char *tokens[MAX_TOKENS], *beyond;
     size_t lens[MAX_TOKENS];
-    const char *token, *last_end = p;
-    size_t len;
-    int count = 0;
-    while (next_token(&p, stop, &token, &len)) {
-        if (count < MAX_TOKENS) {
-            tokens[count] = token;
-            lens[count] = len;
-        }
-        count = count < INT32_MAX ? count + 1 : count;
-        last_end = token + len;
+    int count;
+    split_line(p, stop, tokens, lens, &count, &beyond);
+    /* Exactly what the keyword declares: x y z, nx ny nz (N), r g b or r g b a (C), s t (ST).
+     * Anything more is no OFF (a stray value, or two lines run together by a lone CR). */
+    int base = h->n ? 6 : 3, tail = h->st ? 2 : 0;
+    int least = base + (h->c ? 3 : 0) + tail, most = least + (h->c ? 1 : 0);
+    if (count < least || count > most || beyond) {
+        char layout[64];
+        vertex_layout(h, layout, sizeof layout);
+        const char *at = beyond ? beyond : count > most ? tokens[most] : tokens[0];
+        char declared[32];
+        if (least == most)
+            snprintf(declared, sizeof declared, "%d", least);
+        else
+            snprintf(declared, sizeof declared, "%d or %d", least, most);
+        return rs_fail_parse(error, r->line, at - r->data, where,
+                             "vertex %zu has %s%d values (%s declares %s: %s)", v,
+                             beyond ? "more than " : "", count, h->keyword, declared, layout);
     }
-    int base = h->n ? 6 : 3; /* x y z [nx ny nz], then [r g b [a]] [s t] */
-    int need = base + (h->c ? 3 : 0) + (h->st ? 2 : 0);
-    if (count < need)
-        return rs_fail_parse(error, r->line, tokens[0] - r->data, where,
-                             "vertex %zu has %d values (%s needs %d)", v, count, h->keyword,
-                             need);
     double values[MAX_TOKENS];
-    int checked = count < MAX_TOKENS ? count : MAX_TOKENS;
-    for (int k = 0; k < checked; k++)
+    for (int k = 0; k < count; k++)
         if (!rs_io_parse_double(tokens[k], lens[k], &values[k]))
             return rs_fail_parse(error, r->line, tokens[k] - r->data, where,
                                  "vertex %zu: malformed number '%.*s'", v,
@@ -311,31 +351,70 @@ static rsmooth_status parse_vertex(off_reader *r, const off_header *h, off_state
     memcpy(st->positions + 3 * v, values, 3 * sizeof(double));
     if (h->n)
         memcpy(st->normals + 3 * v, values + 3, 3 * sizeof(double));
-    if (h->c) {
-        int components = count - base - (h->st ? 2 : 0);
-        if (components >= 4) {
-            st->extras->alpha = true;
-            if (values[base + 3] > 1) /* "r g b 255": integer colours */
-                st->color_above_one = true;
-        }
-        for (int k = 0; k < 3; k++) {
-            double c = values[base + k];
-            if (!isfinite(c))
-                return rs_fail_parse(error, r->line, tokens[base + k] - r->data, where,
-                                     "vertex %zu has a non-finite colour", v);
-            if (c > 1)
-                st->color_above_one = true;
-            st->raw_colors[3 * v + (size_t)k] = (float)c;
-        }
+    int components = count - base - tail;
+    for (int k = 0; k < components; k++) {
+        status =
+            check_color(r, tokens[base + k], lens[base + k], values[base + k], "vertex", v, error);
+        if (status != RSMOOTH_OK)
+            return status;
+        if (values[base + k] > 1) /* "r g b 255": integer colours */
+            st->color_above_one = true;
+        if (k < 3)
+            st->raw_colors[3 * v + (size_t)k] = (float)values[base + k];
     }
-    if (count > base) { /* colour, texture coordinates (and anything else) kept as written */
+    if (components == 4)
+        st->extras->alpha = true;
+    for (int k = count - tail; k < count; k++)
+        if (!isfinite(values[k]))
+            return rs_fail_parse(error, r->line, tokens[k] - r->data, where,
+                                 "vertex %zu has a non-finite texture coordinate", v);
+    if (count > base) { /* colour and texture coordinates, kept as written */
         const char *from = tokens[base];
+        const char *last_end = tokens[count - 1] + lens[count - 1];
         if (!texts_append(&st->extras->vertex, v, h->vertex_count, from,
                           (size_t)(last_end - from)))
             return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "OFF vertex extras");
     } else if (st->extras->vertex.offsets) {
         texts_append(&st->extras->vertex, v, h->vertex_count, "", 0);
     }
+    return RSMOOTH_OK;
+}
+
+/* What may follow a face's indices (Geomview's OFF): nothing, a colormap index, or a colour of 3
+ * or 4 components (integers 0 to 255 or floats 0 to 1). */
+static rsmooth_status check_face_color(const off_reader *r, size_t f, const char *p,
+                                       const char *stop, const char **from, const char **last_end,
+                                       rsmooth_error *error) {
+    const char *tokens[MAX_TOKENS], *beyond;
+    size_t lens[MAX_TOKENS];
+    int count;
+    split_line(p, stop, tokens, lens, &count, &beyond);
+    *from = *last_end = NULL;
+    if (count == 0)
+        return RSMOOTH_OK;
+    if (count == 2 || count > 4)
+        return rs_fail_parse(error, r->line, (count == 2 ? tokens[0] : tokens[4]) - r->data, where,
+                             "face %zu has %s%d values after its indices (a face colour is a "
+                             "colormap index, or r g b [a])",
+                             f, beyond ? "more than " : "", count);
+    for (int k = 0; k < count; k++) {
+        double c;
+        if (!rs_io_parse_double(tokens[k], lens[k], &c))
+            return rs_fail_parse(error, r->line, tokens[k] - r->data, where,
+                                 "face %zu: malformed colour '%.*s'", f,
+                                 TOKEN_TEXT(tokens[k], lens[k]));
+        int64_t index;
+        if (count == 1 && !(parse_int(tokens[k], lens[k], &index) && index >= 0))
+            return rs_fail_parse(error, r->line, tokens[k] - r->data, where,
+                                 "face %zu: colormap index '%.*s' is not a whole number >= 0", f,
+                                 TOKEN_TEXT(tokens[k], lens[k]));
+        rsmooth_status status =
+            count == 1 ? RSMOOTH_OK : check_color(r, tokens[k], lens[k], c, "face", f, error);
+        if (status != RSMOOTH_OK)
+            return status;
+    }
+    *from = tokens[0];
+    *last_end = tokens[count - 1] + lens[count - 1];
     return RSMOOTH_OK;
 }
 
@@ -377,18 +456,30 @@ static rsmooth_status parse_face(off_reader *r, const off_header *h, off_state *
     }
     st->offsets[f + 1] = (uint32_t)st->indices.count;
     /* A face colour (r g b [a] or a colormap index), kept as written. */
-    const char *from = NULL, *last_end = NULL;
-    while (next_token(&p, stop, &token, &len)) {
-        if (!from)
-            from = token;
-        last_end = token + len;
-    }
+    const char *from, *last_end;
+    rsmooth_status status = check_face_color(r, f, p, stop, &from, &last_end, error);
+    if (status != RSMOOTH_OK)
+        return status;
     bool ok = from ? texts_append(&st->extras->face, f, h->face_count, from,
                                   (size_t)(last_end - from))
                    : texts_append(&st->extras->face, f, h->face_count, "", 0);
     if (!ok)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "OFF face colours");
     return RSMOOTH_OK;
+}
+
+/* Past the declared faces only blanks and comments may follow: anything else (another face, a
+ * count too low) would be silently dropped. */
+static rsmooth_status check_end(off_reader *r, const off_header *h, rsmooth_error *error) {
+    const char *p, *stop, *token;
+    size_t len;
+    if (!next_line(r, &p, &stop) || !next_token(&p, stop, &token, &len))
+        return RSMOOTH_OK;
+    return rs_fail_parse(error, r->line, token - r->data, where,
+                         "'%.*s' after the %llu vertices and %llu faces the header declares (only "
+                         "comments may follow)",
+                         TOKEN_TEXT(token, len), (unsigned long long)h->vertex_count,
+                         (unsigned long long)h->face_count);
 }
 
 /* Colours as bytes: integers 0..255 when any value exceeds 1 (whether written "255" or "255.0"),
@@ -446,7 +537,8 @@ rsmooth_status rs_io_off_read(const char *data, size_t size, rsmooth_mesh **mesh
         status = parse_vertex(&r, &h, &st, v, error);
     for (size_t f = 0; status == RSMOOTH_OK && f < nf; f++)
         status = parse_face(&r, &h, &st, f, error);
-    /* Anything after the faces (some writers add edges) is ignored. */
+    if (status == RSMOOTH_OK)
+        status = check_end(&r, &h, error);
     uint8_t *colors = NULL;
     if (status == RSMOOTH_OK && h.c && !(colors = color_bytes(&st, nv)))
         status = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "vertex colours");
