@@ -71,6 +71,10 @@ static inline void bytes_free(bytes *b) {
 
 /* ---- meshes */
 
+static inline bool io_test_is_stl(rsmooth_format f) {
+    return f == RSMOOTH_FORMAT_STL_ASCII || f == RSMOOTH_FORMAT_STL_BINARY;
+}
+
 /* Writes `mesh` in `format` into a malloc'd buffer, NUL-terminated (*size without the NUL). Needs
  * _POSIX_C_SOURCE 200809L for open_memstream. */
 static inline void *mesh_to_memory(const rsmooth_mesh *mesh, rsmooth_format format, size_t *size) {
@@ -196,6 +200,11 @@ static inline void check_writer_refuses_unreadable(rsmooth_format format) {
                 exit(1);
             }
             free(data);
+            /* the query runs the same checks without writing: the same status and message */
+            rsmooth_error query;
+            CHECK_EQ_INT(rsmooth_mesh_check_writable(m, format, &query),
+                         RSMOOTH_ERROR_INVALID_ARGUMENT);
+            CHECK(strcmp(query.message, err.message) == 0);
             char path[] = "/tmp/rsmooth_test_refused_XXXXXX";
             int fd = mkstemp(path);
             CHECK(fd >= 0);
@@ -278,6 +287,106 @@ static inline void check_extremes_round_trip(rsmooth_format format, rsmooth_scal
     rsmooth_mesh_destroy(back);
     rsmooth_mesh_destroy(m);
     free(data);
+}
+
+/* Writes `m` as `format`: the status rsmooth_mesh_check_writable gave first (the writer must agree
+ * with it, message included), and when OK the mesh read back (else NULL, nothing written). */
+static inline rsmooth_mesh *write_checked(const rsmooth_mesh *m, rsmooth_format format,
+                                          rsmooth_status *status, rsmooth_error *err) {
+    rsmooth_error query;
+    *status = rsmooth_mesh_check_writable(m, format, &query);
+    char *data;
+    size_t size;
+    rsmooth_status s = write_to_memory(m, format, &data, &size, err);
+    if (s != *status || (s != RSMOOTH_OK && strcmp(query.message, err->message) != 0)) {
+        fprintf(stderr, "format %d: rsmooth_mesh_check_writable %d '%s', writer %d '%s'\n",
+                (int)format, (int)*status, query.message, (int)s, err->message);
+        exit(1);
+    }
+    rsmooth_mesh *back = NULL;
+    if (s == RSMOOTH_OK) {
+        CHECK_EQ_INT(read_exact_copy(data, size, RSMOOTH_FORMAT_AUTO, &back, err), RSMOOTH_OK);
+    } else {
+        CHECK(size == 0);
+    }
+    free(data);
+    return back;
+}
+
+/* Float32 at the mesh's own scale (issue 12's campaign: a tetrahedron at 1e-150 written as binary
+ * STL came out as four vertices at 0 0 0 with exit 0; at 1e-45..1e-43 the float32 subnormals moved
+ * vertices by up to 0.8 edge lengths). A writer whose file stores float32 (binary STL) refuses such
+ * a mesh, naming the vertex and what holds it; the others write it exactly, float32 meshes too
+ * (their float mode falls back to the doubles). A normal-sized mesh with a stray subnormal
+ * coordinate is no such mesh: float32's error there is far below its precision at the mesh's
+ * scale. */
+static inline void check_float32_scale(rsmooth_format format) {
+    const bool float_file = format == RSMOOTH_FORMAT_STL_BINARY;
+    const double scales[] = {1e-150, 1e-300, 1e-45, 1e-44, 1e-43, 1e-40};
+    for (size_t i = 0; i < sizeof scales / sizeof scales[0]; i++) {
+        for (int precision = 0; precision < 2; precision++) {
+            rsmooth_mesh *m = tetrahedron(precision ? RSMOOTH_FLOAT32 : RSMOOTH_FLOAT64);
+            for (size_t k = 0; k < 12; k++)
+                m->positions[k] *= scales[i];
+            m->positions[4] *= 1.25; /* vertex 1's y: no power of two, never a float */
+            rsmooth_status status;
+            rsmooth_error err;
+            rsmooth_mesh *back = write_checked(m, format, &status, &err);
+            if (float_file) {
+                if (status != RSMOOTH_ERROR_INVALID_ARGUMENT || !strstr(err.message, "vertex ") ||
+                    !strstr(err.message, "float32") ||
+                    !strstr(err.message, "ascii STL, OBJ or a PLY with double")) {
+                    fprintf(stderr, "format %d, scale %g: status %d '%s'\n", (int)format, scales[i],
+                            (int)status, err.message);
+                    exit(1);
+                }
+            } else {
+                CHECK_EQ_INT(status, RSMOOTH_OK);
+                CHECK_EQ_INT(back->vertex_count, io_test_is_stl(format) ? 12 : 4);
+                for (size_t v = 0; v < back->vertex_count; v++) {
+                    size_t source = io_test_is_stl(format) ? m->triangles[v] : v;
+                    for (int c = 0; c < 3; c++) {
+                        double a = m->positions[3 * source + (size_t)c];
+                        double b = back->positions[3 * v + (size_t)c];
+                        if (memcmp(&a, &b, sizeof a) != 0) {
+                            fprintf(stderr, "format %d, scale %g: %.17g written, %.17g read\n",
+                                    (int)format, scales[i], a, b);
+                            exit(1);
+                        }
+                    }
+                }
+            }
+            rsmooth_mesh_destroy(back);
+            /* a mesh at 1, with one coordinate at that size: written by every format, float32
+             * rounding within float32's precision at the mesh's scale */
+            rsmooth_mesh_destroy(m);
+            m = tetrahedron(precision ? RSMOOTH_FLOAT32 : RSMOOTH_FLOAT64);
+            m->positions[5] = 1.25 * scales[i];
+            back = write_checked(m, format, &status, &err);
+            CHECK_EQ_INT(status, RSMOOTH_OK);
+            for (size_t v = 0; v < back->vertex_count; v++) {
+                size_t source = io_test_is_stl(format) ? m->triangles[v] : v;
+                for (int c = 0; c < 3; c++) {
+                    double a = m->positions[3 * source + (size_t)c];
+                    CHECK(fabs(back->positions[3 * v + (size_t)c] - a) <= 0x1p-24);
+                }
+            }
+            rsmooth_mesh_destroy(back);
+            rsmooth_mesh_destroy(m);
+        }
+    }
+    /* Float32 values at that scale that are exactly floats lose nothing: written as the floats
+     * they are (text: digits that read back as that float). */
+    rsmooth_mesh *m = tetrahedron(RSMOOTH_FLOAT32);
+    for (size_t k = 0; k < 12; k++)
+        m->positions[k] *= 0x1p-146; /* 8 times the smallest subnormal float */
+    rsmooth_status status;
+    rsmooth_error err;
+    rsmooth_mesh *back = write_checked(m, format, &status, &err);
+    CHECK_EQ_INT(status, RSMOOTH_OK);
+    CHECK((float)back->positions[io_test_is_stl(format) ? 6 : 3] == 0x1p-146f);
+    rsmooth_mesh_destroy(back);
+    rsmooth_mesh_destroy(m);
 }
 
 #endif

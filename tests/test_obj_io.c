@@ -689,6 +689,42 @@ static void test_faithful(void) {
 static void test_write_refusals_and_extremes(void) {
     check_writer_refuses_unreadable(RSMOOTH_FORMAT_OBJ);
     check_extremes_round_trip(RSMOOTH_FORMAT_OBJ, RSMOOTH_FLOAT64);
+    check_float32_scale(RSMOOTH_FORMAT_OBJ);
+
+    /* The query: what the writers refuse, without writing; the arguments a writer refuses too. */
+    {
+        rsmooth_mesh *t = tetrahedron(RSMOOTH_FLOAT64);
+        rsmooth_error e;
+        const rsmooth_format all[] = {RSMOOTH_FORMAT_OBJ,        RSMOOTH_FORMAT_PLY_ASCII,
+                                      RSMOOTH_FORMAT_PLY_BINARY, RSMOOTH_FORMAT_OFF,
+                                      RSMOOTH_FORMAT_STL_ASCII,  RSMOOTH_FORMAT_STL_BINARY};
+        for (size_t f = 0; f < sizeof all / sizeof all[0]; f++)
+            CHECK_EQ_INT(rsmooth_mesh_check_writable(t, all[f], &e), RSMOOTH_OK);
+        CHECK_EQ_INT(rsmooth_mesh_check_writable(t, RSMOOTH_FORMAT_OBJ, NULL), RSMOOTH_OK);
+        CHECK_EQ_INT(rsmooth_mesh_check_writable(NULL, RSMOOTH_FORMAT_OBJ, &e),
+                     RSMOOTH_ERROR_INVALID_ARGUMENT);
+        CHECK_EQ_INT(rsmooth_mesh_check_writable(t, RSMOOTH_FORMAT_AUTO, &e),
+                     RSMOOTH_ERROR_INVALID_ARGUMENT);
+        CHECK_EQ_INT(rsmooth_mesh_check_writable(t, (rsmooth_format)99, &e),
+                     RSMOOTH_ERROR_INVALID_ARGUMENT);
+        CHECK_EQ_INT(rsmooth_mesh_check_writable(t, RSMOOTH_FORMAT_PLY_BINARY_BE, &e),
+                     RSMOOTH_ERROR_UNSUPPORTED);
+        /* a face index out of range, a triangle list that no longer matches: as the writers say */
+        t->face_indices[4] = 9;
+        for (size_t f = 0; f < sizeof all / sizeof all[0]; f++) {
+            rsmooth_status s;
+            CHECK(write_checked(t, all[f], &s, &e) == NULL);
+            CHECK_EQ_INT(s, RSMOOTH_ERROR_INVALID_ARGUMENT);
+        }
+        t->face_indices[4] = 1;
+        t->triangles[4] = 9;
+        t->has_vertex_normals = 1;
+        for (size_t f = 0; f < sizeof all / sizeof all[0]; f++) {
+            rsmooth_status s;
+            rsmooth_mesh_destroy(write_checked(t, all[f], &s, &e));
+        }
+        rsmooth_mesh_destroy(t);
+    }
 
     /* A float32 mesh holding a value beyond float range: written as the double it is, not "inf". */
     rsmooth_mesh *m = tetrahedron(RSMOOTH_FLOAT32);

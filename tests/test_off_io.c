@@ -463,6 +463,7 @@ static void test_detection(void) {
 static void test_write_refusals_and_extremes(void) {
     check_writer_refuses_unreadable(RSMOOTH_FORMAT_OFF);
     check_extremes_round_trip(RSMOOTH_FORMAT_OFF, RSMOOTH_FLOAT64);
+    check_float32_scale(RSMOOTH_FORMAT_OFF);
 
     /* Coordinates beyond the supported magnitude and non-finite normals: refused where they are. */
     EXPECT_ERROR("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1e151 0\n3 0 1 2\n", RSMOOTH_ERROR_PARSE, 5,

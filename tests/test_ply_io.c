@@ -589,6 +589,7 @@ static void test_write_refusals_and_extremes(void) {
         check_writer_refuses_unreadable(formats[i]);
         check_extremes_round_trip(formats[i], RSMOOTH_FLOAT64);
         check_extremes_round_trip(formats[i], RSMOOTH_FLOAT32);
+        check_float32_scale(formats[i]);
 
         /* a non-finite quality is refused before anything is written */
         rsmooth_mesh *m = tetrahedron(RSMOOTH_FLOAT32);
@@ -625,6 +626,41 @@ static void test_write_refusals_and_extremes(void) {
     CHECK(size == 0 && strstr(err.message, "vertex 1: x = ") != NULL &&
           strstr(err.message, "does not fit the file's 'float' type") != NULL);
     free(data);
+    rsmooth_mesh_destroy(m);
+
+    /* ... nor one it holds only below float32's precision at the mesh's scale: the square moved to
+     * 1e-150 (it was written as zeros, exit 0), with the query saying the same without writing */
+    m = parse_ok(&b);
+    for (size_t k = 0; k < 3 * m->vertex_count; k++)
+        m->positions[k] *= 1e-150;
+    for (int binary = 0; binary < 2; binary++) {
+        rsmooth_format format = binary ? RSMOOTH_FORMAT_PLY_BINARY : RSMOOTH_FORMAT_PLY_ASCII;
+        CHECK_EQ_INT(write_to_memory(m, format, &data, &size, &err),
+                     RSMOOTH_ERROR_INVALID_ARGUMENT);
+        CHECK(size == 0 && strstr(err.message, "vertex 1: x = 1.5e-150") != NULL &&
+              strstr(err.message, "the file's 'float' type") != NULL &&
+              strstr(err.message, "a PLY with double") != NULL);
+        free(data);
+        rsmooth_error query;
+        CHECK_EQ_INT(rsmooth_mesh_check_writable(m, format, &query),
+                     RSMOOTH_ERROR_INVALID_ARGUMENT);
+        CHECK(strcmp(query.message, err.message) == 0);
+    }
+    /* without the file's header (extras NULL) rsmooth picks double: written exactly */
+    struct rsmooth_mesh_extras *extras = m->extras;
+    m->extras = NULL;
+    rsmooth_mesh *back = write_and_read(m, RSMOOTH_FORMAT_PLY_BINARY);
+    CHECK(memcmp(back->positions, m->positions, 15 * sizeof(double)) == 0);
+    rsmooth_mesh_destroy(back);
+    m->extras = extras;
+    rsmooth_mesh_destroy(m);
+    /* a stray subnormal in a mesh at 1 is no such mesh */
+    m = parse_ok(&b);
+    m->positions[2] = 1e-40;
+    CHECK_EQ_INT(rsmooth_mesh_check_writable(m, RSMOOTH_FORMAT_PLY_BINARY, &err), RSMOOTH_OK);
+    back = write_and_read(m, RSMOOTH_FORMAT_PLY_BINARY);
+    CHECK(back->positions[2] == (double)1e-40f);
+    rsmooth_mesh_destroy(back);
     rsmooth_mesh_destroy(m);
     bytes_free(&b);
 }

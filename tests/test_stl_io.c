@@ -470,7 +470,7 @@ static void test_round_trip(void) {
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(err.message, "vertex 0 has coordinate 3.4028236e+38 beyond the largest float32 "
                               "3.4028234663852886e+38") != NULL);
-    CHECK(strstr(err.message, "ascii STL, OBJ or a PLY with double") != NULL);
+    CHECK(strstr(err.message, "; ascii STL, OBJ or a PLY with double can") != NULL);
     CHECK_STATUS(rsmooth_mesh_write_stream(m, sink, RSMOOTH_FORMAT_STL_ASCII, &err), RSMOOTH_OK);
     m->positions[0] = NAN;
     CHECK_STATUS(rsmooth_mesh_write_stream(m, sink, RSMOOTH_FORMAT_STL_ASCII, &err),
@@ -535,8 +535,11 @@ static void test_write_refusals_and_extremes(void) {
     check_writer_refuses_unreadable(RSMOOTH_FORMAT_STL_BINARY);
     check_extremes_round_trip(RSMOOTH_FORMAT_STL_ASCII, RSMOOTH_FLOAT64);
     check_extremes_round_trip(RSMOOTH_FORMAT_STL_BINARY, RSMOOTH_FLOAT32);
+    check_float32_scale(RSMOOTH_FORMAT_STL_ASCII);
+    check_float32_scale(RSMOOTH_FORMAT_STL_BINARY);
     /* refused by the STL writer itself (no triangles, a value beyond float32): no file either */
     rsmooth_mesh *m = tetrahedron(RSMOOTH_FLOAT64);
+    rsmooth_error err0;
     char path[] = "/tmp/rsmooth_test_stl_refused_XXXXXX";
     int fd = mkstemp(path);
     CHECK(fd >= 0);
@@ -551,6 +554,26 @@ static void test_write_refusals_and_extremes(void) {
     CHECK_EQ_INT(rsmooth_mesh_write_file(m, path, RSMOOTH_FORMAT_STL_ASCII, NULL),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     CHECK(access(path, F_OK) != 0);
+    rsmooth_mesh_destroy(m);
+    /* issue 12's reproducer: the OBJ tetrahedron at 1e-150, written as binary STL, was four
+     * vertices at 0 0 0 with exit 0 */
+    const char *tiny = "v 0 0 0\nv 1e-150 0 0\nv 0 1e-150 0\nv 0 0 1e-150\n"
+                       "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    m = parse_ok(tiny, strlen(tiny), RSMOOTH_FORMAT_AUTO);
+    CHECK_EQ_INT(rsmooth_mesh_write_file(m, path, RSMOOTH_FORMAT_STL_BINARY, &err0),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK(access(path, F_OK) != 0);
+    CHECK(strstr(err0.message,
+                 "vertex 2: float32 rounds coordinate 1e-150 to 0, beyond its precision") != NULL);
+    CHECK_EQ_INT(rsmooth_mesh_check_writable(m, RSMOOTH_FORMAT_STL_BINARY, &err0),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK_EQ_INT(rsmooth_mesh_check_writable(m, RSMOOTH_FORMAT_STL_ASCII, &err0), RSMOOTH_OK);
+    CHECK_EQ_INT(rsmooth_mesh_write_file(m, path, RSMOOTH_FORMAT_STL_ASCII, &err0), RSMOOTH_OK);
+    rsmooth_mesh *back = NULL;
+    CHECK_EQ_INT(rsmooth_mesh_read_file(path, &back, &err0), RSMOOTH_OK);
+    CHECK(back->positions[6] == 1e-150); /* facet 0's third corner: vertex 1 */
+    rsmooth_mesh_destroy(back);
+    remove(path);
     rsmooth_mesh_destroy(m);
     /* ascii beyond the supported magnitude: refused at its vertex line, in digits that tell the
      * value from the limit */

@@ -17,9 +17,10 @@
  * is accepted and written back by the same format (PLY: either encoding; not binary STL).
  *
  * What rsmooth writes, rsmooth reads back to the same numbers: writers refuse the values readers
- * refuse (non-finite or beyond 1e150, the magnitude the filter supports), and write every
- * coordinate with the digits (text) or bits (binary) that give it back exactly, as a double or as
- * the float32 the file holds.
+ * refuse (non-finite or beyond 1e150, the magnitude the filter supports) and a mesh a float32 file
+ * cannot hold at its own scale, and write every coordinate with the digits (text) or bits (binary)
+ * that give it back exactly, as a double or as the float32 the file holds.
+ * rsmooth_mesh_check_writable tells beforehand whether a format's writer would refuse a mesh.
  *
  *     rsmooth_mesh *mesh = NULL;
  *     rsmooth_error err;
@@ -130,11 +131,35 @@ RSMOOTH_API rsmooth_status rsmooth_mesh_read_stream(FILE *stream, const char *na
 /* Writes `mesh` (its faces as polygons, not the fanned triangles; STL: the triangles) to an open
  * stream. `format` must not be AUTO; big-endian PLY output is RSMOOTH_ERROR_UNSUPPORTED. Returns
  * RSMOOTH_ERROR_INVALID_ARGUMENT, naming the vertex and having written nothing, for what no reader
- * would read back: a coordinate that is NaN, infinite or beyond 1e150 in magnitude, a non-finite
- * vertex_quality or point-cloud normal, a value the format or the file's own PLY types cannot hold
- * (beyond float32 for binary STL); RSMOOTH_ERROR_IO when the stream fails. */
+ * would read back as it is (rsmooth_mesh_check_writable lists it); RSMOOTH_ERROR_IO when the
+ * stream fails.
+ *
+ * Float32 and the mesh's scale: a file that stores float32 must hold the mesh at its own scale, so
+ * binary STL, and PLY written with the input's header (its extras) whose x y z are 'float', refuse
+ * a coordinate beyond FLT_MAX or one float32 rounds by more than its precision at the mesh's
+ * largest coordinate M (|x - (float)x| > 2^-24 M): in practice a whole mesh below FLT_MIN
+ * (1.2e-38), whose subnormal floats would lose its shape (at 1e-150 every vertex is 0 0 0); a mesh
+ * at 1 with a stray 1e-40 is written. Where rsmooth picks the type it never refuses for it: PLY
+ * written without the input's header uses float for float32 data only while float32 holds it at
+ * its scale, else double; text formats write a float32 mesh's values with float digits on the same
+ * condition, else as the doubles they are. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, FILE *stream,
                                                      rsmooth_format format, rsmooth_error *error);
+
+/* Runs exactly the refusals of rsmooth_mesh_write_stream for `format` without writing anything
+ * (for a caller that wants to know before it filters whether the output format can hold the mesh):
+ * RSMOOTH_OK when the writer would write it; else the status and message the writer would give:
+ * RSMOOTH_ERROR_INVALID_ARGUMENT, naming the vertex (or face, triangle), for a mesh that is not
+ * well-formed (NULL arrays, faces of fewer than 3 vertices, indices out of range), a coordinate
+ * that is NaN, infinite or beyond 1e150 in magnitude, a non-finite vertex_quality or point-cloud
+ * normal, what the format cannot hold (STL: no triangles, more than 2^32 - 1 for binary; binary
+ * STL's float32, and the 'float' or integer types of a PLY file written with its input's header, at
+ * the mesh's scale: see above), and for AUTO or an unknown format; RSMOOTH_ERROR_UNSUPPORTED for
+ * big-endian PLY. A mesh that passes may still fail to write for want of memory or a stream error
+ * (RSMOOTH_ERROR_OUT_OF_MEMORY, RSMOOTH_ERROR_IO). O(vertices + face indices), allocates nothing
+ * and computes no normals. Thread-safe; `error` may be NULL. */
+RSMOOTH_API rsmooth_status rsmooth_mesh_check_writable(const rsmooth_mesh *mesh,
+                                                       rsmooth_format format, rsmooth_error *error);
 
 /* Writes `mesh` to `path` (created or truncated). AUTO picks the format from the extension: .obj,
  * .ply (binary little-endian), .off, .stl (binary). A mesh refused as by rsmooth_mesh_write_stream

@@ -71,15 +71,53 @@ rsmooth_status rs_io_mesh_check(const rsmooth_mesh *mesh, const char *where, rsm
 rsmooth_status rs_io_mesh_check_values(const rsmooth_mesh *mesh, const char *where,
                                        rsmooth_error *error);
 
+/* A coordinate float32 cannot hold at the mesh's own scale: beyond FLT_MAX, or rounded by more
+ * than float32's precision relative to the largest coordinate magnitude, |x - (float)x| >
+ * 2^-24 * largest. No normal float is that far off, so in practice: a value beyond float range,
+ * or a whole mesh below FLT_MIN (1.2e-38) whose subnormal floats lose its shape (a mesh at 1 with
+ * a stray 1e-40 is held). */
+typedef struct rs_io_float32_misfit {
+    size_t vertex;
+    int axis;       /* 0, 1, 2: x, y, z */
+    double value;   /* the coordinate */
+    double rounded; /* as a float32 */
+    double largest; /* the mesh's largest coordinate magnitude */
+} rs_io_float32_misfit;
+
+/* Finds the first misfit among the vertices `indices` names (index_count entries; every one of
+ * vertex_count when indices is NULL), in the components whose bit is set in `axes` (1 x, 2 y,
+ * 4 z), the scale taken from all three of those vertices'. false when there is none. */
+bool rs_io_float32_misfit_find(const double *xyz, size_t vertex_count, const uint32_t *indices,
+                               size_t index_count, unsigned axes, rs_io_float32_misfit *misfit);
+
+/* A float32 mesh whose positions (and a point cloud's own normals) float32 holds at their scale:
+ * text writers then write them at float precision (shortest digits of the float), else every value
+ * as the double it is. */
+bool rs_io_float32_holds(const rsmooth_mesh *mesh);
+
+/* Every refusal of the writer of `format`, run before its first byte (rsmooth_mesh_check_writable
+ * and rsmooth_mesh_write_stream): rs_io_mesh_check, rs_io_mesh_check_values, then the format's
+ * own check. AUTO or an unknown value is INVALID_ARGUMENT, big-endian PLY UNSUPPORTED. */
+rsmooth_status rs_io_check_writable(const rsmooth_mesh *mesh, rsmooth_format format,
+                                    const char *where, rsmooth_error *error);
+
+/* Each format's own refusals (before its writer runs; the mesh already passed rs_io_mesh_check and
+ * rs_io_mesh_check_values): what its file cannot hold (STL: no triangles, binary STL's float32;
+ * PLY: the input's declared types), and the normals it would write. */
+rsmooth_status rs_io_obj_check(const rsmooth_mesh *mesh, rsmooth_error *error);
+rsmooth_status rs_io_ply_check(const rsmooth_mesh *mesh, rsmooth_error *error);
+rsmooth_status rs_io_off_check(const rsmooth_mesh *mesh, rsmooth_error *error);
+rsmooth_status rs_io_stl_check(const rsmooth_mesh *mesh, bool binary, rsmooth_error *error);
+
 /* Format parsers over a buffer that is not NUL-terminated (obj_read.c, ply_read.c). */
 rsmooth_status rs_io_obj_read(const char *data, size_t size, rsmooth_mesh **mesh,
                               rsmooth_error *error);
 rsmooth_status rs_io_ply_read(const char *data, size_t size, rsmooth_mesh **mesh,
                               rsmooth_error *error);
 
-/* Format writers; the mesh is already checked. Each writes faithfully from its own format's extras
- * when the mesh has them, else the generic fields (positions, faces, vertex_colors, vertex_quality,
- * has_vertex_normals) it can hold. */
+/* Format writers; the mesh already passed rs_io_check_writable. Each writes faithfully from its own
+ * format's extras when the mesh has them, else the generic fields (positions, faces, vertex_colors,
+ * vertex_quality, has_vertex_normals) it can hold. */
 rsmooth_status rs_io_obj_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_error *error);
 rsmooth_status rs_io_ply_write(const rsmooth_mesh *mesh, FILE *stream, bool binary,
                                rsmooth_error *error);
@@ -101,6 +139,11 @@ static inline bool rs_io_normals_available(const rsmooth_mesh *mesh) {
 static inline bool rs_io_normals_are_data(const rsmooth_mesh *mesh) {
     return mesh->triangle_count == 0 && mesh->vertex_normals;
 }
+
+/* What rs_io_vertex_normals refuses, checked without computing: a point cloud's own normals must be
+ * finite; recomputing needs the triangles (present, indices in range). */
+rsmooth_status rs_io_check_normals(const rsmooth_mesh *mesh, const char *where,
+                                   rsmooth_error *error);
 
 /* The normals writers emit, recomputed from the positions (a mesh without triangles, a point cloud:
  * its vertex_normals): 3 * vertex_count doubles in a new *normals (the caller frees it), or an

@@ -185,58 +185,6 @@ rsmooth_format rsmooth_format_from_path(const char *path) {
     return RSMOOTH_FORMAT_AUTO;
 }
 
-rsmooth_status rs_io_mesh_check(const rsmooth_mesh *mesh, const char *where, rsmooth_error *error) {
-    if (!mesh)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "mesh is NULL");
-    if ((uint64_t)mesh->vertex_count >= RS_IO_MAX_VERTICES)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "vertex count %zu not below 2^32", mesh->vertex_count);
-    if (mesh->vertex_count > 0 && !mesh->positions)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "positions is NULL");
-    if (mesh->face_count == 0)
-        return RSMOOTH_OK;
-    if (!mesh->face_offsets || !mesh->face_indices)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "%zu faces but face_offsets or face_indices is NULL", mesh->face_count);
-    if (mesh->face_offsets[0] != 0)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "face_offsets[0] is %u, not 0",
-                       (unsigned)mesh->face_offsets[0]);
-    for (size_t f = 0; f < mesh->face_count; f++) {
-        uint32_t begin = mesh->face_offsets[f], end = mesh->face_offsets[f + 1];
-        if (end < begin || end - begin < 3)
-            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                           "face %zu has %lld vertices (at least 3 needed)", f,
-                           (long long)end - (long long)begin);
-        for (uint32_t i = begin; i < end; i++)
-            if (mesh->face_indices[i] >= mesh->vertex_count)
-                return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                               "face %zu: index %u >= vertex count %zu", f,
-                               (unsigned)mesh->face_indices[i], mesh->vertex_count);
-    }
-    return RSMOOTH_OK;
-}
-
-rsmooth_status rs_io_mesh_check_values(const rsmooth_mesh *mesh, const char *where,
-                                       rsmooth_error *error) {
-    for (size_t i = 0; i < 3 * mesh->vertex_count; i++) {
-        double x = mesh->positions[i];
-        if (!isfinite(x))
-            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                           "vertex %zu has a non-finite coordinate (%g): not written", i / 3, x);
-        if (!rs_io_coordinate_ok(x))
-            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                           "vertex %zu has coordinate %s beyond the supported magnitude %s: not "
-                           "written (rsmooth could not read it back)",
-                           i / 3, rs_io_shortest(x).text, rs_io_shortest(RS_MAX_COORDINATE).text);
-    }
-    for (size_t i = 0; mesh->vertex_quality && i < mesh->vertex_count; i++)
-        if (!isfinite(mesh->vertex_quality[i]))
-            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                           "vertex %zu has a non-finite quality (%g): not written", i,
-                           (double)mesh->vertex_quality[i]);
-    return RSMOOTH_OK;
-}
-
 rs_io_digits rs_io_shortest(double v) {
     rs_io_digits d;
     for (int digits = 1; digits <= 17; digits++) {

@@ -106,18 +106,9 @@ rsmooth_status rsmooth_mesh_read_stream(FILE *stream, const char *name, rsmooth_
     return status;
 }
 
-rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, FILE *stream,
-                                         rsmooth_format format, rsmooth_error *error) {
-    static const char where[] = "rsmooth_mesh_write_stream";
-    rs_error_clear(error);
-    if (!stream)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "stream is NULL");
-    /* Checked before the first byte: a refused mesh leaves the stream as it was. */
-    rsmooth_status status = rs_io_mesh_check(mesh, where, error);
-    if (status == RSMOOTH_OK)
-        status = rs_io_mesh_check_values(mesh, where, error);
-    if (status != RSMOOTH_OK)
-        return status;
+/* Writes a mesh that passed rs_io_check_writable for `format`. */
+static rsmooth_status write_checked(const rsmooth_mesh *mesh, FILE *stream, rsmooth_format format,
+                                    rsmooth_error *error) {
     switch (format) {
     case RSMOOTH_FORMAT_OBJ:
         return rs_io_obj_write(mesh, stream, error);
@@ -125,20 +116,31 @@ rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, FILE *stream,
         return rs_io_ply_write(mesh, stream, false, error);
     case RSMOOTH_FORMAT_PLY_BINARY:
         return rs_io_ply_write(mesh, stream, true, error);
-    case RSMOOTH_FORMAT_PLY_BINARY_BE:
-        return rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, where,
-                       "big-endian PLY output is not supported");
     case RSMOOTH_FORMAT_OFF:
         return rs_io_off_write(mesh, stream, error);
     case RSMOOTH_FORMAT_STL_ASCII:
         return rs_io_stl_write(mesh, stream, false, error);
     case RSMOOTH_FORMAT_STL_BINARY:
         return rs_io_stl_write(mesh, stream, true, error);
+    case RSMOOTH_FORMAT_PLY_BINARY_BE: /* refused by the check */
     case RSMOOTH_FORMAT_AUTO:
         break;
     }
-    return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+    return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_mesh_write_stream",
                    "format %d: give OBJ, PLY, OFF or STL", (int)format);
+}
+
+rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, FILE *stream,
+                                         rsmooth_format format, rsmooth_error *error) {
+    static const char where[] = "rsmooth_mesh_write_stream";
+    rs_error_clear(error);
+    if (!stream)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "stream is NULL");
+    /* Every refusal before the first byte: a refused mesh leaves the stream as it was. */
+    rsmooth_status status = rs_io_check_writable(mesh, format, where, error);
+    if (status != RSMOOTH_OK)
+        return status;
+    return write_checked(mesh, stream, format, error);
 }
 
 rsmooth_status rsmooth_mesh_write_file(const rsmooth_mesh *mesh, const char *path,
@@ -153,22 +155,17 @@ rsmooth_status rsmooth_mesh_write_file(const rsmooth_mesh *mesh, const char *pat
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                            "cannot tell the format of '%s' (use .obj, .ply, .off or .stl)", path);
     }
-    /* Check before creating the file, so a bad mesh leaves no file behind. */
-    rsmooth_status status = rs_io_mesh_check(mesh, where, error);
-    if (status == RSMOOTH_OK)
-        status = rs_io_mesh_check_values(mesh, where, error);
+    /* Every refusal before creating the file, so a refused mesh leaves no file behind. */
+    rsmooth_status status = rs_io_check_writable(mesh, format, where, error);
     if (status != RSMOOTH_OK)
         return status;
-    if (format == RSMOOTH_FORMAT_PLY_BINARY_BE)
-        return rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, where,
-                       "big-endian PLY output is not supported");
     struct stat before;
     bool existed = stat(path, &before) == 0;
     FILE *file = fopen(path, "wb");
     if (!file)
         return rs_fail(error, RSMOOTH_ERROR_IO, where, "cannot create '%s': %s", path,
                        strerror(errno));
-    status = rsmooth_mesh_write_stream(mesh, file, format, error);
+    status = write_checked(mesh, file, format, error);
     errno = 0;
     bool closed = fclose(file) == 0;
     if (status == RSMOOTH_ERROR_INVALID_ARGUMENT && !existed)

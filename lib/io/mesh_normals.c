@@ -89,29 +89,44 @@ rsmooth_status rsmooth_mesh_vertex_normals(const rsmooth_mesh *mesh, double *nor
     return RSMOOTH_OK;
 }
 
+rsmooth_status rs_io_check_normals(const rsmooth_mesh *mesh, const char *where,
+                                   rsmooth_error *error) {
+    if (rs_io_normals_are_data(mesh)) {
+        /* a point cloud: no triangle to recompute from, so its own normals (filtered or read),
+         * which must be finite to be read back */
+        for (size_t i = 0; i < 3 * mesh->vertex_count; i++)
+            if (!isfinite(mesh->vertex_normals[i]))
+                return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                               "vertex %zu has a non-finite normal (%g): not written", i / 3,
+                               mesh->vertex_normals[i]);
+        return RSMOOTH_OK;
+    }
+    if (mesh->triangle_count > 0 && !mesh->triangles)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "normals: %zu triangles but triangles is NULL", mesh->triangle_count);
+    for (size_t t = 0; t < 3 * mesh->triangle_count; t++)
+        if (mesh->triangles[t] >= mesh->vertex_count)
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                           "normals: triangle %zu has an index out of range", t / 3);
+    return RSMOOTH_OK;
+}
+
 rsmooth_status rs_io_vertex_normals(const rsmooth_mesh *mesh, double **normals, const char *where,
                                     rsmooth_error *error) {
+    *normals = NULL;
+    rsmooth_status status = rs_io_check_normals(mesh, where, error);
+    if (status != RSMOOTH_OK)
+        return status;
     *normals = rs_alloc_array(mesh->vertex_count, 3 * sizeof(double));
     if (!*normals)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "normals of %zu vertices",
                        mesh->vertex_count);
     if (rs_io_normals_are_data(mesh)) {
-        /* a point cloud: no triangle to recompute from, so its own normals (filtered or read),
-         * which must be finite to be read back */
-        for (size_t i = 0; i < 3 * mesh->vertex_count; i++) {
-            if (!isfinite(mesh->vertex_normals[i])) {
-                rs_free(*normals);
-                *normals = NULL;
-                return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                               "vertex %zu has a non-finite normal (%g): not written", i / 3,
-                               mesh->vertex_normals[i]);
-            }
-        }
         memcpy(*normals, mesh->vertex_normals, mesh->vertex_count * 3 * sizeof(double));
         return RSMOOTH_OK;
     }
     rsmooth_error inner;
-    rsmooth_status status = rsmooth_mesh_vertex_normals(mesh, *normals, &inner);
+    status = rsmooth_mesh_vertex_normals(mesh, *normals, &inner);
     if (status != RSMOOTH_OK) {
         rs_free(*normals);
         *normals = NULL;

@@ -23,9 +23,9 @@ static bool put_coord(FILE *stream, double v, bool as_float) {
     return n > 0 && fwrite(buf, 1, (size_t)n, stream) == (size_t)n;
 }
 
-static bool put_position(FILE *stream, const rsmooth_mesh *mesh, size_t v) {
+/* `as_float`: a float32 mesh that float32 holds at its scale (rs_io_float32_holds). */
+static bool put_position(FILE *stream, const rsmooth_mesh *mesh, size_t v, bool as_float) {
     const double *p = mesh->positions + 3 * v;
-    bool as_float = mesh->precision == RSMOOTH_FLOAT32;
     return putc('v', stream) != EOF && put_coord(stream, p[0], as_float) &&
            put_coord(stream, p[1], as_float) && put_coord(stream, p[2], as_float);
 }
@@ -33,8 +33,8 @@ static bool put_position(FILE *stream, const rsmooth_mesh *mesh, size_t v) {
 /* vertex_count vn lines, each ended by `eol`: recomputed normals to 9 digits (ample for a unit
  * vector), a point cloud's own normals (its data) so that they read back exactly. */
 static bool put_normals(FILE *stream, const rsmooth_mesh *mesh, const double *normals,
-                        const char *eol, size_t eol_len) {
-    bool exact = rs_io_normals_are_data(mesh), as_float = mesh->precision == RSMOOTH_FLOAT32;
+                        const char *eol, size_t eol_len, bool as_float) {
+    bool exact = rs_io_normals_are_data(mesh);
     bool ok = true;
     for (size_t i = 0; ok && i < mesh->vertex_count; i++) {
         const double *n = normals + 3 * i;
@@ -115,6 +115,7 @@ static bool next_token(const char **p, const char *end, const char **token, size
 typedef struct faithful_cursor {
     size_t v, f;
     bool normals_written;
+    bool as_float; /* rs_io_float32_holds */
 } faithful_cursor;
 
 /* Writes the text lines [p, end): v gets the new position (what follows its coordinates kept), the
@@ -137,13 +138,13 @@ static bool write_text(const rsmooth_mesh *mesh, const rs_obj_extras *x, const d
         if (keyword && len == 1 && token[0] == 'v' && at->v < mesh->vertex_count) {
             for (int k = 0; k < 3; k++) /* the reader accepted the line: three numbers follow */
                 next_token(&q, content_end, &token, &len);
-            ok = put_position(stream, mesh, at->v++) &&
+            ok = put_position(stream, mesh, at->v++, at->as_float) &&
                  fwrite(q, 1, (size_t)(content_end - q), stream) == (size_t)(content_end - q);
         } else if (keyword && len == 2 && token[0] == 'v' && token[1] == 'n' && normals) {
             if (!at->normals_written)
                 ok = put_normals(stream, mesh, normals,
                                  ending_len ? ending : (x->crlf ? "\r\n" : "\n"),
-                                 ending_len ? ending_len : (x->crlf ? 2 : 1));
+                                 ending_len ? ending_len : (x->crlf ? 2 : 1), at->as_float);
             at->normals_written = true;
             p = next;
             continue;
@@ -165,8 +166,8 @@ static bool write_text(const rsmooth_mesh *mesh, const rs_obj_extras *x, const d
 
 /* Writes the file the mesh was read from, run by run. */
 static bool write_faithful(const rsmooth_mesh *mesh, const rs_obj_extras *x, const double *normals,
-                           FILE *stream) {
-    faithful_cursor at = {0, 0, false};
+                           bool as_float, FILE *stream) {
+    faithful_cursor at = {0, 0, false, as_float};
     const char *eol = x->crlf ? "\r\n" : "\n";
     size_t eol_len = x->crlf ? 2 : 1;
     bool ok = true;
@@ -177,7 +178,7 @@ static bool write_faithful(const rsmooth_mesh *mesh, const rs_obj_extras *x, con
                             x->text + run->start + run->count, &at, stream);
         } else if (run->kind == RS_OBJ_RUN_V) {
             for (size_t i = 0; ok && i < run->count && at.v < mesh->vertex_count; i++)
-                ok = put_position(stream, mesh, at.v++) &&
+                ok = put_position(stream, mesh, at.v++, as_float) &&
                      fwrite(eol, 1, eol_len, stream) == eol_len;
         } else {
             for (size_t i = 0; ok && i < run->count && at.f < mesh->face_count; i++)
@@ -188,11 +189,12 @@ static bool write_faithful(const rsmooth_mesh *mesh, const rs_obj_extras *x, con
     return ok;
 }
 
-static bool write_generic(const rsmooth_mesh *mesh, const double *normals, FILE *stream) {
+static bool write_generic(const rsmooth_mesh *mesh, const double *normals, bool as_float,
+                          FILE *stream) {
     bool ok = fprintf(stream, "# written by rsmooth\n# %zu vertices, %zu faces\n",
                       mesh->vertex_count, mesh->face_count) >= 0;
     for (size_t i = 0; ok && i < mesh->vertex_count; i++) {
-        ok = put_position(stream, mesh, i);
+        ok = put_position(stream, mesh, i, as_float);
         if (ok && mesh->vertex_colors) {
             const uint8_t *c = mesh->vertex_colors + 3 * i;
             ok = fprintf(stream, " %.4g %.4g %.4g", c[0] / 255.0, c[1] / 255.0, c[2] / 255.0) >= 0;
@@ -200,21 +202,36 @@ static bool write_generic(const rsmooth_mesh *mesh, const double *normals, FILE 
         ok = ok && putc('\n', stream) != EOF;
     }
     if (ok && normals)
-        ok = put_normals(stream, mesh, normals, "\n", 1);
+        ok = put_normals(stream, mesh, normals, "\n", 1, as_float);
     for (size_t f = 0; ok && f < mesh->face_count; f++)
         ok = put_face(stream, mesh, f, NULL, normals != NULL) && putc('\n', stream) != EOF;
     return ok;
 }
 
-rsmooth_status rs_io_obj_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_error *error) {
+/* The OBJ record of the mesh, when it still describes it: its vertices and face structure are
+ * unchanged (positions may differ: that is what smoothing does). */
+static const rs_obj_extras *faithful_extras(const rsmooth_mesh *mesh) {
     const rs_obj_extras *x = mesh->extras ? mesh->extras->obj : NULL;
-    /* The extras describe the mesh as read: they apply while its vertices and face structure are
-     * unchanged (positions may differ: that is what smoothing does). */
     bool faithful = x && x->vertex_count == mesh->vertex_count &&
                     x->face_count == mesh->face_count && mesh->face_offsets &&
                     x->offsets_hash == rs_obj_offsets_hash(mesh->face_offsets, mesh->face_count);
-    bool want_normals = (faithful ? (x->kinds & RS_OBJ_NORMALS) != 0 : mesh->has_vertex_normals) &&
-                        rs_io_normals_available(mesh);
+    return faithful ? x : NULL;
+}
+
+static bool wants_normals(const rsmooth_mesh *mesh, const rs_obj_extras *x) {
+    return (x ? (x->kinds & RS_OBJ_NORMALS) != 0 : mesh->has_vertex_normals) &&
+           rs_io_normals_available(mesh);
+}
+
+rsmooth_status rs_io_obj_check(const rsmooth_mesh *mesh, rsmooth_error *error) {
+    return wants_normals(mesh, faithful_extras(mesh)) ? rs_io_check_normals(mesh, where, error)
+                                                      : RSMOOTH_OK;
+}
+
+rsmooth_status rs_io_obj_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_error *error) {
+    const rs_obj_extras *x = faithful_extras(mesh);
+    const bool faithful = x != NULL;
+    bool want_normals = wants_normals(mesh, x);
     double *normals = NULL;
     if (want_normals) {
         rsmooth_status status = rs_io_vertex_normals(mesh, &normals, where, error);
@@ -223,8 +240,9 @@ rsmooth_status rs_io_obj_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_e
     }
     errno = 0;
     bool ok = rs_io_put_bom(mesh, RSMOOTH_FORMAT_OBJ, stream);
-    ok = ok && (faithful ? write_faithful(mesh, x, normals, stream)
-                         : write_generic(mesh, normals, stream));
+    const bool as_float = rs_io_float32_holds(mesh);
+    ok = ok && (faithful ? write_faithful(mesh, x, normals, as_float, stream)
+                         : write_generic(mesh, normals, as_float, stream));
     rs_free(normals);
     ok = ok && fflush(stream) == 0 && !ferror(stream);
     if (!ok)

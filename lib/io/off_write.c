@@ -69,9 +69,10 @@ static bool put_faces(FILE *stream, const rsmooth_mesh *mesh, const rs_off_texts
 }
 
 /* A vertex line's position, then the recomputed normal when `normals`. */
-static bool put_vertex(FILE *stream, const rsmooth_mesh *mesh, size_t v, const double *normals) {
+/* `as_float`: a float32 mesh that float32 holds at its scale (rs_io_float32_holds). */
+static bool put_vertex(FILE *stream, const rsmooth_mesh *mesh, size_t v, const double *normals,
+                       bool as_float) {
     const double *p = mesh->positions + 3 * v;
-    bool as_float = mesh->precision == RSMOOTH_FLOAT32;
     bool ok = put_coord(stream, "", p[0], as_float) && put_coord(stream, " ", p[1], as_float) &&
               put_coord(stream, " ", p[2], as_float);
     if (ok && normals) { /* recomputed: 9 digits; a point cloud's own (its data): exact */
@@ -88,22 +89,23 @@ static bool put_vertex(FILE *stream, const rsmooth_mesh *mesh, size_t v, const d
 /* The file the mesh was read from: its keyword, edge count and the text after each vertex's
  * position and each face's indices. */
 static bool write_faithful(const rsmooth_mesh *mesh, const rs_off_extras *x, const double *normals,
-                           FILE *stream) {
+                           bool as_float, FILE *stream) {
     bool ok = fprintf(stream, "%s\n%zu %zu %llu\n", x->keyword, mesh->vertex_count,
                       mesh->face_count, (unsigned long long)x->edge_count) >= 0;
     for (size_t v = 0; ok && v < mesh->vertex_count; v++)
-        ok = put_vertex(stream, mesh, v, normals) && put_text(stream, &x->vertex, v) &&
+        ok = put_vertex(stream, mesh, v, normals, as_float) && put_text(stream, &x->vertex, v) &&
              putc('\n', stream) != EOF;
     return ok && put_faces(stream, mesh, &x->face);
 }
 
 /* OFF, COFF, NOFF or CNOFF from the mesh's own fields. */
-static bool write_generic(const rsmooth_mesh *mesh, const double *normals, FILE *stream) {
+static bool write_generic(const rsmooth_mesh *mesh, const double *normals, bool as_float,
+                          FILE *stream) {
     const uint8_t *colors = mesh->vertex_colors;
     bool ok = fprintf(stream, "%s%sOFF\n%zu %zu 0\n", colors ? "C" : "", normals ? "N" : "",
                       mesh->vertex_count, mesh->face_count) >= 0;
     for (size_t v = 0; ok && v < mesh->vertex_count; v++) {
-        ok = put_vertex(stream, mesh, v, normals);
+        ok = put_vertex(stream, mesh, v, normals, as_float);
         if (ok && colors)
             ok = fprintf(stream, " %u %u %u 255", colors[3 * v], colors[3 * v + 1],
                          colors[3 * v + 2]) >= 0;
@@ -112,14 +114,27 @@ static bool write_generic(const rsmooth_mesh *mesh, const double *normals, FILE 
     return ok && put_faces(stream, mesh, NULL);
 }
 
-rsmooth_status rs_io_off_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_error *error) {
+/* The OFF record of the mesh, while it describes it: its counts are unchanged. */
+static const rs_off_extras *faithful_extras(const rsmooth_mesh *mesh) {
     const rs_off_extras *x = mesh->extras ? mesh->extras->off : NULL;
-    /* The extras describe the mesh as read: they apply while its counts are unchanged. */
-    bool faithful =
-        x && x->vertex_count == mesh->vertex_count && x->face_count == mesh->face_count;
-    /* NOFF lines need normals; otherwise only normals there are (see rs_io_normals_available) */
-    bool want_normals =
-        faithful ? x->normals : mesh->has_vertex_normals && rs_io_normals_available(mesh);
+    return x && x->vertex_count == mesh->vertex_count && x->face_count == mesh->face_count ? x
+                                                                                           : NULL;
+}
+
+/* NOFF lines need normals; otherwise only normals there are (see rs_io_normals_available) */
+static bool wants_normals(const rsmooth_mesh *mesh, const rs_off_extras *x) {
+    return x ? x->normals : mesh->has_vertex_normals && rs_io_normals_available(mesh);
+}
+
+rsmooth_status rs_io_off_check(const rsmooth_mesh *mesh, rsmooth_error *error) {
+    return wants_normals(mesh, faithful_extras(mesh)) ? rs_io_check_normals(mesh, where, error)
+                                                      : RSMOOTH_OK;
+}
+
+rsmooth_status rs_io_off_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_error *error) {
+    const rs_off_extras *x = faithful_extras(mesh);
+    const bool faithful = x != NULL;
+    bool want_normals = wants_normals(mesh, x);
     double *normals = NULL;
     if (want_normals) {
         rsmooth_status status = rs_io_vertex_normals(mesh, &normals, where, error);
@@ -128,8 +143,8 @@ rsmooth_status rs_io_off_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_e
     }
     errno = 0;
     bool ok = rs_io_put_bom(mesh, RSMOOTH_FORMAT_OFF, stream) &&
-              (faithful ? write_faithful(mesh, x, normals, stream)
-                        : write_generic(mesh, normals, stream));
+              (faithful ? write_faithful(mesh, x, normals, rs_io_float32_holds(mesh), stream)
+                        : write_generic(mesh, normals, rs_io_float32_holds(mesh), stream));
     rs_free(normals);
     ok = ok && fflush(stream) == 0 && !ferror(stream);
     if (!ok)

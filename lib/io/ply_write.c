@@ -83,15 +83,12 @@ static rsmooth_status io_failure(rsmooth_error *error) {
 
 /* ---- generic path: the mesh's own fields */
 
-/* Positions (and normals) go out as float when the mesh holds float32 data that fits one, else as
- * double, so a value beyond float range is never written as an infinity. */
-static bool use_float(const rsmooth_mesh *mesh, const double *normals) {
-    if (mesh->precision != RSMOOTH_FLOAT32)
-        return false;
-    for (size_t i = 0; i < 3 * mesh->vertex_count; i++)
-        if (!isfinite((float)mesh->positions[i]) || (normals && !isfinite((float)normals[i])))
-            return false;
-    return true;
+/* Positions (and normals) go out as float when the mesh holds float32 data that float32 holds at
+ * its scale (rs_io_float32_holds: recomputed normals are unit vectors, which it always holds), else
+ * as double: rsmooth picks the type here, so it never refuses for it. A value beyond float range is
+ * never written as an infinity, nor a mesh at 1e-150 as zeros. */
+static bool use_float(const rsmooth_mesh *mesh) {
+    return rs_io_float32_holds(mesh);
 }
 
 static bool write_header(const rsmooth_mesh *mesh, FILE *stream, bool binary, bool f32,
@@ -208,7 +205,7 @@ static rsmooth_status write_generic(const rsmooth_mesh *mesh, FILE *stream, bool
         if (status != RSMOOTH_OK)
             return status;
     }
-    const bool f32 = use_float(mesh, normals);
+    const bool f32 = use_float(mesh);
     errno = 0;
     bool ok = write_header(mesh, stream, binary, f32, normals != NULL, wide_count, unsigned_index);
     if (ok)
@@ -324,10 +321,14 @@ static face_types choose_face_types(const rsmooth_mesh *mesh, const rs_ply_prope
     return ft;
 }
 
-/* The file's types must hold the filtered positions (rounded, for integer types) and the normals:
+/* The file's types must hold the filtered positions (rounded, for integer types) and a point
+ * cloud's own normals (`normals`, NULL for recomputed ones: unit vectors every float type holds),
+ * and its float x y z must hold the positions at the mesh's scale (rs_io_float32_misfit_find):
  * checked before anything is written. */
 static rsmooth_status check_vertex_values(const rsmooth_mesh *mesh, const rs_ply_element *v,
                                           const double *normals, rsmooth_error *error) {
+    unsigned float_axes = 0;
+    const rs_ply_property *axis[3] = {NULL, NULL, NULL};
     for (size_t k = 0; k < v->property_count; k++) {
         const rs_ply_property *p = &v->properties[k];
         const double *values;
@@ -335,6 +336,9 @@ static rsmooth_status check_vertex_values(const rsmooth_mesh *mesh, const rs_ply
         if (p->role >= RS_PLY_X && p->role <= RS_PLY_Z) {
             values = mesh->positions;
             c = p->role - RS_PLY_X;
+            axis[c] = p;
+            if (p->type == RS_PLY_FLOAT32)
+                float_axes |= 1u << c;
         } else if (p->role >= RS_PLY_NX && p->role <= RS_PLY_NZ && normals) {
             values = normals;
             c = p->role - RS_PLY_NX;
@@ -352,7 +356,18 @@ static rsmooth_status check_vertex_values(const rsmooth_mesh *mesh, const rs_ply
                                p->name, value, rs_ply_spelling(p->spelling));
         }
     }
-    return RSMOOTH_OK;
+    rs_io_float32_misfit misfit;
+    if (float_axes == 0 || !rs_io_float32_misfit_find(mesh->positions, mesh->vertex_count, NULL, 0,
+                                                      float_axes, &misfit))
+        return RSMOOTH_OK;
+    const rs_ply_property *p = axis[misfit.axis];
+    return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, /* 256 bytes: say it briefly */
+                   "vertex %zu: %s = %s is %s in the file's '%s' type, beyond float32's precision "
+                   "at the mesh's scale (largest %s); a PLY with double x y z (extras NULL), OBJ "
+                   "or ascii STL holds it",
+                   misfit.vertex, p->name, rs_io_shortest(misfit.value).text,
+                   rs_io_shortest(misfit.rounded).text, rs_ply_spelling(p->spelling),
+                   rs_io_shortest(misfit.largest).text);
 }
 
 static bool write_faithful_header(const rsmooth_mesh *mesh, const rs_ply_extras *x, FILE *stream,
@@ -470,11 +485,6 @@ static rsmooth_status write_faithful(const rsmooth_mesh *mesh, const rs_ply_extr
                 return status;
         }
     }
-    status = check_vertex_values(mesh, v, normals, error);
-    if (status != RSMOOTH_OK) {
-        rs_free(normals);
-        return status;
-    }
     errno = 0;
     out_buffer *out = NULL;
     bool ok = write_faithful_header(mesh, x, stream, binary, &ft);
@@ -492,14 +502,42 @@ static rsmooth_status write_faithful(const rsmooth_mesh *mesh, const rs_ply_extr
     return ok ? RSMOOTH_OK : io_failure(error);
 }
 
-rsmooth_status rs_io_ply_write(const rsmooth_mesh *mesh, FILE *stream, bool binary,
-                               rsmooth_error *error) {
+/* The PLY record of the mesh, while it describes it (the same vertex and face counts). */
+static const rs_ply_extras *faithful_extras(const rsmooth_mesh *mesh) {
     const rs_ply_extras *x = mesh->extras ? mesh->extras->ply : NULL;
     if (x && x->vertex_element < x->element_count &&
         x->elements[x->vertex_element].count == mesh->vertex_count &&
         (x->face_element < x->element_count
              ? x->elements[x->face_element].count == mesh->face_count
              : mesh->face_count == 0))
-        return write_faithful(mesh, x, stream, binary, error);
-    return write_generic(mesh, stream, binary, error);
+        return x;
+    return NULL;
+}
+
+/* Whether the faithful path writes normals: the vertex element has nx, ny, nz roles. */
+static bool faithful_normals(const rs_ply_extras *x) {
+    const rs_ply_element *v = &x->elements[x->vertex_element];
+    for (size_t k = 0; k < v->property_count; k++)
+        if (v->properties[k].role >= RS_PLY_NX && v->properties[k].role <= RS_PLY_NZ)
+            return true;
+    return false;
+}
+
+rsmooth_status rs_io_ply_check(const rsmooth_mesh *mesh, rsmooth_error *error) {
+    const rs_ply_extras *x = faithful_extras(mesh);
+    bool normals =
+        x ? faithful_normals(x) : mesh->has_vertex_normals && rs_io_normals_available(mesh);
+    rsmooth_status status = normals ? rs_io_check_normals(mesh, where, error) : RSMOOTH_OK;
+    if (status == RSMOOTH_OK && x)
+        status =
+            check_vertex_values(mesh, &x->elements[x->vertex_element],
+                                rs_io_normals_are_data(mesh) ? mesh->vertex_normals : NULL, error);
+    return status;
+}
+
+rsmooth_status rs_io_ply_write(const rsmooth_mesh *mesh, FILE *stream, bool binary,
+                               rsmooth_error *error) {
+    const rs_ply_extras *x = faithful_extras(mesh);
+    return x ? write_faithful(mesh, x, stream, binary, error)
+             : write_generic(mesh, stream, binary, error);
 }

@@ -35,10 +35,9 @@ static void facet_normal(const double *a, const double *b, const double *c, doub
         n[k] = m[k] / len;
 }
 
-/* The triangles must index the positions, and every coordinate must be writable (finite; within
- * float32 range for binary), checked before anything is written. */
-static rsmooth_status check_triangles(const rsmooth_mesh *mesh, bool binary,
-                                      rsmooth_error *error) {
+/* The triangles must index the positions, and binary STL's float32 must hold every coordinate
+ * they use at the mesh's scale (rs_io_float32_misfit_find): checked before anything is written. */
+rsmooth_status rs_io_stl_check(const rsmooth_mesh *mesh, bool binary, rsmooth_error *error) {
     size_t t = mesh->triangle_count;
     if (t == 0)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
@@ -49,25 +48,27 @@ static rsmooth_status check_triangles(const rsmooth_mesh *mesh, bool binary,
     if (binary && (uint64_t)t > UINT32_MAX)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "%zu triangles: binary STL holds at most 2^32 - 1", t);
-    for (size_t i = 0; i < 3 * t; i++) {
-        uint32_t v = mesh->triangles[i];
-        if (v >= mesh->vertex_count)
+    for (size_t i = 0; i < 3 * t; i++)
+        if (mesh->triangles[i] >= mesh->vertex_count)
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                           "triangle %zu: index %lu >= vertex count %zu", i / 3, (unsigned long)v,
-                           mesh->vertex_count);
-        const double *xyz = mesh->positions + 3 * (size_t)v;
-        for (int k = 0; k < 3; k++) {
-            double x = binary ? (double)(float)xyz[k] : xyz[k];
-            if (!isfinite(x))
-                return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                               "vertex %lu has coordinate %s beyond the largest float32 %s: "
-                               "binary STL cannot hold it (ascii STL, OBJ or a PLY with double "
-                               "properties can)",
-                               (unsigned long)v, rs_io_shortest(xyz[k]).text,
-                               rs_io_shortest(FLT_MAX).text);
-        }
-    }
-    return RSMOOTH_OK;
+                           "triangle %zu: index %lu >= vertex count %zu", i / 3,
+                           (unsigned long)mesh->triangles[i], mesh->vertex_count);
+    rs_io_float32_misfit misfit;
+    if (!binary || !rs_io_float32_misfit_find(mesh->positions, mesh->vertex_count, mesh->triangles,
+                                              3 * t, 7, &misfit))
+        return RSMOOTH_OK;
+    if (!isfinite(misfit.rounded))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "vertex %zu has coordinate %s beyond the largest float32 %s: binary STL "
+                       "cannot hold it; ascii STL, OBJ or a PLY with double can",
+                       misfit.vertex, rs_io_shortest(misfit.value).text,
+                       rs_io_shortest(FLT_MAX).text);
+    return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, /* 256 bytes: say it briefly */
+                   "vertex %zu: float32 rounds coordinate %s to %s, beyond its precision at the "
+                   "mesh's scale (largest %s): binary STL cannot hold this mesh; ascii STL, OBJ or "
+                   "a PLY with double can",
+                   misfit.vertex, rs_io_shortest(misfit.value).text,
+                   rs_io_shortest(misfit.rounded).text, rs_io_shortest(misfit.largest).text);
 }
 
 /* The STL record of the mesh, when it still describes these triangles. */
@@ -177,8 +178,10 @@ static bool write_name(FILE *stream, const char *keyword, const char *name, size
     return putc('\n', stream) != EOF;
 }
 
-static bool write_facets(const rsmooth_mesh *mesh, size_t first, size_t count, FILE *stream) {
-    const bool f32 = mesh->precision == RSMOOTH_FLOAT32;
+/* `f32`: float32 data that float32 holds at its scale (rs_io_float32_holds), written at float
+ * precision; else every value as the double it is. */
+static bool write_facets(const rsmooth_mesh *mesh, size_t first, size_t count, bool f32,
+                         FILE *stream) {
     for (size_t i = first; i < first + count; i++) {
         const uint32_t *tri = mesh->triangles + 3 * i;
         const double *v[3];
@@ -190,11 +193,8 @@ static bool write_facets(const rsmooth_mesh *mesh, size_t first, size_t count, F
             0)
             return false;
         for (int c = 0; c < 3; c++) {
-            /* float32 data is written at float precision, unless a value would not fit one. */
-            bool fits = isfinite((float)v[c][0]) && isfinite((float)v[c][1]) &&
-                        isfinite((float)v[c][2]);
             int written;
-            if (f32 && fits)
+            if (f32)
                 written = fprintf(stream, "      vertex %.9g %.9g %.9g\n", (double)(float)v[c][0],
                                   (double)(float)v[c][1], (double)(float)v[c][2]);
             else
@@ -210,8 +210,9 @@ static bool write_facets(const rsmooth_mesh *mesh, size_t first, size_t count, F
 }
 
 static bool write_solid(const rsmooth_mesh *mesh, const char *name, size_t len, size_t first,
-                        size_t count, FILE *stream) {
-    return write_name(stream, "solid", name, len) && write_facets(mesh, first, count, stream) &&
+                        size_t count, bool f32, FILE *stream) {
+    return write_name(stream, "solid", name, len) &&
+           write_facets(mesh, first, count, f32, stream) &&
            write_name(stream, "endsolid", name, len);
 }
 
@@ -238,11 +239,13 @@ static size_t header_name(const unsigned char *header, const char **name) {
 }
 
 static bool write_ascii(const rsmooth_mesh *mesh, const rs_stl_extras *x, FILE *stream) {
+    const bool f32 = rs_io_float32_holds(mesh);
     if (x && !x->binary) {
         size_t first = 0;
         for (size_t s = 0; s < x->solid_count; s++) {
             const rs_stl_solid *solid = &x->solids[s];
-            if (!write_solid(mesh, solid->name, solid->name_len, first, solid->facet_count, stream))
+            if (!write_solid(mesh, solid->name, solid->name_len, first, solid->facet_count, f32,
+                             stream))
                 return false;
             first += solid->facet_count;
         }
@@ -256,14 +259,11 @@ static bool write_ascii(const rsmooth_mesh *mesh, const rs_stl_extras *x, FILE *
         name = from_header;
         len = header_len;
     }
-    return write_solid(mesh, name, len, 0, mesh->triangle_count, stream);
+    return write_solid(mesh, name, len, 0, mesh->triangle_count, f32, stream);
 }
 
 rsmooth_status rs_io_stl_write(const rsmooth_mesh *mesh, FILE *stream, bool binary,
                                rsmooth_error *error) {
-    rsmooth_status status = check_triangles(mesh, binary, error);
-    if (status != RSMOOTH_OK)
-        return status;
     const rs_stl_extras *x = usable_extras(mesh);
     errno = 0;
     bool ok = binary ? write_binary(mesh, x, stream)
