@@ -10,7 +10,9 @@
  *     recomputed by the writers, to 9 digits in text (float precision), so they are compared with
  *     the mesh's recomputed normals within 1e-6;
  *   - the writer of the mesh's own format must accept it, and writing what it read back again
- *     gives the same bytes (nothing drifts between round trips). */
+ *     gives the same bytes (nothing drifts between round trips);
+ *   - rsmooth_mesh_check_writable agrees with every writer: OK where it writes, the writer's own
+ *     status and message where it refuses. */
 #define _POSIX_C_SOURCE 200809L
 #include "rsmooth_io.h"
 
@@ -135,8 +137,17 @@ static rsmooth_status write_memory(const rsmooth_mesh *mesh, rsmooth_format form
 static void round_trip(const rsmooth_mesh *mesh, rsmooth_format format) {
     char *text;
     size_t length;
-    rsmooth_error err;
+    rsmooth_error err, query;
+    rsmooth_status expected = rsmooth_mesh_check_writable(mesh, format, &query);
     rsmooth_status status = write_memory(mesh, format, &text, &length, &err);
+    bool refused = status == RSMOOTH_ERROR_INVALID_ARGUMENT || status == RSMOOTH_ERROR_UNSUPPORTED;
+    if ((refused || status == RSMOOTH_OK) &&
+        (expected != status || (refused && strcmp(query.message, err.message) != 0))) {
+        char detail[600];
+        snprintf(detail, sizeof detail, "rsmooth_mesh_check_writable %d '%s', writer %d '%s'",
+                 (int)expected, query.message, (int)status, err.message);
+        fail("the query and the writer disagree", format, detail);
+    }
     bool own = format == own_format(mesh);
     if (status == RSMOOTH_ERROR_OUT_OF_MEMORY ||
         (status == RSMOOTH_ERROR_INVALID_ARGUMENT && !own)) {

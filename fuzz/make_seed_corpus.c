@@ -384,6 +384,24 @@ static void auto_seeds(corpus *c) {
     emit_auto(c, "dimension.off", false, "nOFF\n4\n3 1 0\n0 0 0 0\n1 0 0 0\n0 1 0 0\n3 0 1 2\n",
               false);
     emit_auto(c, "no_mesh.txt", false, "hello world\n", false);
+    /* what the readers refuse since the hostile-input campaign: a comment before an ascii STL's
+     * "solid", a value too many on an OFF line, content after the declared faces, data after a
+     * PLY file's last element (ascii here, binary below); and what they still read: comments after
+     * an OFF file's faces, a face's colormap index, a line end after a PLY file's data */
+    emit_auto(c, "comment_first.stl", false,
+              "# made by hand\nsolid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"
+              "vertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n",
+              false);
+    emit_auto(c, "extra_value.off", false, "OFF\n3 1 0\n0 0 0\n0 1 0 7\n1 0 0\n3 0 1 2\n", false);
+    emit_auto(c, "more_faces.off", false, "OFF\n3 1 0\n0 0 0\n0 1 0\n1 0 0\n3 0 1 2\n3 0 2 1\n",
+              false);
+    emit_auto(c, "tail_comment.off", false,
+              "OFF\n3 1 0\n0 0 0\n0 1 0\n1 0 0\n3 0 1 2 7\n# the end\n", true);
+    emit_auto(c, "more_faces.ply", false,
+              "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+              "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+              "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 2 1\n",
+              false);
     bytes b = {0};
     unsigned char head[80];
     memset(head, ' ', sizeof head);
@@ -394,6 +412,25 @@ static void auto_seeds(corpus *c) {
     write_seed(c, "auto", "cut_binary.stl", &b);
     check_seed(c, "auto", "cut_binary.stl", &b, RSMOOTH_FORMAT_AUTO, false);
     bytes_free(&b);
+    static const char binary_ply[] = "ply\nformat binary_little_endian 1.0\nelement vertex 3\n"
+                                     "property float x\nproperty float y\nproperty float z\n"
+                                     "element face 1\nproperty list uchar int vertex_indices\n"
+                                     "end_header\n";
+    for (int extra = 0; extra < 2; extra++) {
+        put_text(&b, binary_ply);
+        for (int k = 0; k < 9; k++)
+            put_f32(&b, k == 3 || k == 7 ? 1.0f : 0.0f);
+        for (int face = 0; face < 1 + extra; face++) { /* the header counts one */
+            put_uint(&b, 3, 1);
+            for (uint32_t v = 0; v < 3; v++)
+                put_uint(&b, face ? 2 - v : v, 4);
+        }
+        put_text(&b, "\n");
+        const char *name = extra ? "more_faces_binary.ply" : "line_end_binary.ply";
+        write_seed(c, "auto", name, &b);
+        check_seed(c, "auto", name, &b, RSMOOTH_FORMAT_AUTO, !extra);
+        bytes_free(&b);
+    }
 }
 
 /* ---- main */
