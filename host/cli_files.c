@@ -127,6 +127,15 @@ static int write_mesh_stream(FILE *f, void *user, char *message, size_t size) {
     return -1;
 }
 
+int cli_check_writable(const rsmooth_mesh *mesh, const char *path, rsmooth_format format,
+                       const char *input) {
+    rsmooth_error err;
+    if (rsmooth_mesh_check_writable(mesh, format, &err) == RSMOOTH_OK)
+        return -1;
+    fprintf(stderr, "rsmooth: %s: cannot hold %s: %s\n", path, input, err.message);
+    return EXIT_USAGE;
+}
+
 int cli_write_mesh(const rsmooth_mesh *mesh, const char *path, rsmooth_format format, bool replace,
                    bool quiet) {
     mesh_write w = {mesh, format};

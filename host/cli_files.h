@@ -27,6 +27,13 @@ rsmooth_format cli_output_format(const char *path, bool ascii);
  * a directory or a link to nothing). Else prints why and returns EXIT_USAGE. */
 int cli_check_output(const char *path, const char *input, bool force, bool in_place);
 
+/* -1 when `format`'s writer would accept `mesh` (rsmooth_mesh_check_writable), else prints
+ * "rsmooth: PATH: cannot hold INPUT: why" and returns EXIT_USAGE: called on the input before any
+ * work, so a result its output's number type cannot hold (a binary STL of a mesh at 1e-150 or
+ * 1e39) costs no filtering. The result has the input's scale; the writer checks it again. */
+int cli_check_writable(const rsmooth_mesh *mesh, const char *path, rsmooth_format format,
+                       const char *input);
+
 /* Writes `mesh` through cli_write_atomically (`replace`: --force or --in-place; `quiet`: no
  * warning about an owner that could not be kept). Returns EXIT_OK, EXIT_USAGE (the file exists
  * and `replace` is off, or appeared meanwhile) or EXIT_OTHER. */

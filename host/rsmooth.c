@@ -761,6 +761,21 @@ static int write_confidence(rsmooth_mesh *mesh, const options *opt, float *confi
     return code;
 }
 
+/* Whether the output files' formats can hold the input (the result has its scale): refused before
+ * any filtering. The confidence mesh is written without the input's extras, so checked so. */
+static int check_outputs_hold(const options *opt, rsmooth_mesh *mesh) {
+    int code = cli_check_writable(mesh, opt->output, cli_output_format(opt->output, opt->ascii),
+                                  opt->input);
+    if (code >= 0 || !opt->confidence)
+        return code >= 0 ? code : EXIT_OK;
+    struct rsmooth_mesh_extras *extras = mesh->extras;
+    mesh->extras = NULL;
+    code = cli_check_writable(mesh, opt->confidence,
+                              cli_output_format(opt->confidence, opt->ascii), opt->input);
+    mesh->extras = extras;
+    return code >= 0 ? code : EXIT_OK;
+}
+
 /* --sigma-c: the input's vertex colours as floats in [0, 1], for rsmooth_params.colors. */
 static int input_colors(const options *opt, const rsmooth_mesh *mesh, float **colors) {
     *colors = NULL;
@@ -858,6 +873,10 @@ int main(int argc, char **argv) {
     double ms_read = cli_now_ms() - t0;
     bool points = mesh->triangle_count == 0; /* a point cloud: its points and normals filtered */
     if (points && (code = check_point_cloud(&opt, mesh)) != EXIT_OK) {
+        rsmooth_mesh_destroy(mesh);
+        return code;
+    }
+    if ((code = check_outputs_hold(&opt, mesh)) != EXIT_OK) {
         rsmooth_mesh_destroy(mesh);
         return code;
     }

@@ -479,6 +479,17 @@ for scale in 1e-20 1e120; do
     END { printf "grid at %s: largest move %.3g, OpenCL - reference %.3g\n", s, move, diff
           exit !(move > 0 && diff < 1e-3 * move) }' || fail "OpenCL and reference disagree at $scale"
 done
+# An output whose number type cannot hold the input at its scale is refused before any work, with
+# nothing written (binary STL stores float32: a mesh at 1e-150 would come out all zeros).
+printf 'v 0 0 0\nv 1e-150 0 0\nv 0 1e-150 0\nv 0 0 1e-150\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n' \
+  > small150.obj
+expect 2 "$rsmooth" small150.obj -o small150.stl
+grep -q "small150.stl: cannot hold small150.obj" err.txt || fail "float32 STL at 1e-150: $(cat err.txt)"
+[ -e small150.stl ] && fail "a binary STL was written for a mesh at 1e-150"
+expect 2 "$rsmooth" small150.obj -o small150.obj.out.ply --confidence small150_conf.stl
+[ -e small150.obj.out.ply ] && fail "output written although the confidence file cannot hold it"
+expect 0 "$rsmooth" small150.obj -o small150.ply
+expect 0 "$rsmooth" small150.obj -o small150_ascii.stl --ascii
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\n' > vertices_only.obj
 expect 2 "$rsmooth" vertices_only.obj -o x.obj
 grep -q "vertices_only.obj: byte 24" err.txt || fail "no faces, no normals: not located: $(cat err.txt)"
