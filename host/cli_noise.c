@@ -173,7 +173,7 @@ static int check_coordinates(const noise_args *a, const rsmooth_mesh *mesh) {
             continue;
         fprintf(stderr,
                 "rsmooth noise: %s: not written: --sigma %g would move vertex %zu of %s "
-                "to (%g, %g, %g), beyond the supported magnitude %g (lower --sigma)\n",
+                "to (%.17g, %.17g, %.17g), beyond the supported magnitude %g (lower --sigma)\n",
                 a->output, a->noise.sigma, v, a->input, p[0], p[1], p[2], MAX_COORDINATE);
         return EXIT_USAGE;
     }
