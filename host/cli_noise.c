@@ -192,6 +192,10 @@ int cli_noise_main(int argc, char **argv) {
     rsmooth_mesh *mesh = NULL;
     if ((code = cli_read_mesh(a.input, NULL, &mesh)) != EXIT_OK)
         return code;
+    rsmooth_format format = cli_output_format(a.output, a.ascii);
+    /* what the output's format cannot hold, before the work (a binary STL of a mesh at 1e100) */
+    if ((code = cli_check_writable(mesh, a.output, format, a.input)) >= 0)
+        goto cleanup;
 
     size_t nv = mesh->vertex_count;
     double edge =
@@ -214,8 +218,9 @@ int cli_noise_main(int argc, char **argv) {
 
     if ((code = check_coordinates(&a, mesh)) != EXIT_OK)
         goto cleanup;
+    if ((code = cli_check_writable(mesh, a.output, format, a.input)) >= 0)
+        goto cleanup; /* the noise carried a value out of the format's range */
 
-    rsmooth_format format = cli_output_format(a.output, a.ascii);
     char lost[512];
     if (!a.quiet && rsmooth_mesh_conversion_losses(mesh, format, lost, sizeof lost) > 0)
         fprintf(stderr, "rsmooth noise: %s: this format cannot hold, so drops: %s\n", a.output,

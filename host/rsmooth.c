@@ -623,7 +623,8 @@ static int smooth(const options *opt, const rsmooth_mesh *mesh, double *out, flo
             return EXIT_USAGE;
         } else if (st != RSMOOTH_OK) {
             cli_progress_clear(bar);
-            fprintf(stderr, "rsmooth: device '%s': %s: %s\n", device ? device : "auto",
+            fprintf(stderr, "rsmooth: device '%s'%s: %s: %s\n", device ? device : "auto",
+                    opt->device || !device ? "" : " (from RSMOOTH_DEVICE)",
                     rsmooth_status_str(st), err.message);
             if (err.build_log[0])
                 fprintf(stderr, "%s\n", err.build_log);

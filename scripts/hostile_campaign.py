@@ -2035,7 +2035,7 @@ def option_table():
         "--normal-sigma-n": (bil, JUNK + ["0", "-1", "2.000001", "3", "inf", "-inf"], ["2", "1e-300"]),
         "--normal-iterations": (bil, JUNK + INT_JUNK, ["0", "0x10", "1e1", "+3", "007"]),
         "--passes": ([], JUNK + INT_JUNK + ["0"], ["0x2", "1e1", "+2"]),
-        "--pass-confidence": (["--passes", "2"], JUNK + ["0", "-0.5", "1.000001", "inf", "-inf"], ["1", "1e-300"]),
+        "--pass-confidence": (["--passes", "2"], JUNK + ["-0.5", "1.000001", "inf", "-inf"], ["0", "1", "1e-300"]),
         "--sigma-c": (["--best"], JUNK + ["0", "-1", "-inf", "1e-400"], ["inf", "1e308", "1e-300"]),
         "--iterations": (["--method", "taubin"], JUNK + INT_JUNK, ["0", "0x10", "1e1"]),
         "--lambda": (["--method", "laplacian"], JUNK + ["inf", "-inf"], ["0", "-1", "2", "1e308", "-1e308"]),

@@ -78,6 +78,7 @@ expect 2 "$rsmooth" noisy.ply -o x.ply --device "no such device"
 grep -q "no such device" err.txt || fail "unknown device not explained: $(cat err.txt)"
 grep -q "list-devices" err.txt || fail "unknown device: no hint at --list-devices: $(cat err.txt)"
 RSMOOTH_DEVICE=99:99 expect 2 "$rsmooth" noisy.ply -o x.ply
+grep -q "RSMOOTH_DEVICE" err.txt || fail "a device from RSMOOTH_DEVICE is not named so: $(cat err.txt)"
 RSMOOTH_HOST_THREADS=two expect 2 "$rsmooth" noisy.ply -o x.ply
 grep -q "RSMOOTH_HOST_THREADS" err.txt || fail "junk RSMOOTH_HOST_THREADS not named: $(cat err.txt)"
 RSMOOTH_CELLS_PER_REACH=0 expect 2 "$rsmooth" noisy.ply -o x.ply
@@ -488,6 +489,9 @@ grep -q "small150.stl: cannot hold small150.obj" err.txt || fail "float32 STL at
 [ -e small150.stl ] && fail "a binary STL was written for a mesh at 1e-150"
 expect 2 "$rsmooth" small150.obj -o small150.obj.out.ply --confidence small150_conf.stl
 [ -e small150.obj.out.ply ] && fail "output written although the confidence file cannot hold it"
+expect 2 "$rsmooth" noise small150.obj small150_noisy.stl --sigma 0.1
+grep -q "small150_noisy.stl: cannot hold small150.obj" err.txt || fail "noise to STL at 1e-150: $(cat err.txt)"
+[ -e small150_noisy.stl ] && fail "rsmooth noise wrote a binary STL of a mesh at 1e-150"
 expect 0 "$rsmooth" small150.obj -o small150.ply
 expect 0 "$rsmooth" small150.obj -o small150_ascii.stl --ascii
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\n' > vertices_only.obj
