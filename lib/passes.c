@@ -36,29 +36,6 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                                     const rsmooth_params *params, void *out_positions,
                                     float *out_weight, float *out_confidence,
                                     rsmooth_report *report, rsmooth_error *error,
-                                    const char *where);
-
-rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar scalar,
-                                const void *positions, size_t vertex_count,
-                                const uint32_t *indices, size_t triangle_count,
-                                const rsmooth_params *params, void *out_positions,
-                                float *out_weight, float *out_confidence, rsmooth_report *report,
-                                rsmooth_error *error, const char *where) {
-    rsmooth_status st = filter_passes(one_pass, ctx, scalar, positions, vertex_count, indices,
-                                      triangle_count, params, out_positions, out_weight,
-                                      out_confidence, report, error, where);
-    if (st != RSMOOTH_OK)
-        return st;
-    return rs_check_results(scalar, out_positions, out_weight, out_confidence, vertex_count,
-                            "vertex", error, where);
-}
-
-static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar scalar,
-                                    const void *positions, size_t vertex_count,
-                                    const uint32_t *indices, size_t triangle_count,
-                                    const rsmooth_params *params, void *out_positions,
-                                    float *out_weight, float *out_confidence,
-                                    rsmooth_report *report, rsmooth_error *error,
                                     const char *where) {
     double t_start = rs_now_ms();
     rs_error_clear(error);
@@ -164,4 +141,20 @@ done:
     rs_free(prev_weight);
     rs_free(prev_confidence);
     return st;
+}
+
+/* The passes, then the last check of what they wrote (results.c): never a non-finite OK. */
+rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar scalar,
+                                const void *positions, size_t vertex_count,
+                                const uint32_t *indices, size_t triangle_count,
+                                const rsmooth_params *params, void *out_positions,
+                                float *out_weight, float *out_confidence, rsmooth_report *report,
+                                rsmooth_error *error, const char *where) {
+    rsmooth_status st = filter_passes(one_pass, ctx, scalar, positions, vertex_count, indices,
+                                      triangle_count, params, out_positions, out_weight,
+                                      out_confidence, report, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
+    return rs_check_results(scalar, out_positions, out_weight, out_confidence, vertex_count,
+                            "vertex", error, where);
 }

@@ -56,6 +56,17 @@ typedef struct sweep {
     int decades;
 } sweep;
 
+/* Keeps the worst figures of the sweep so far. */
+static void record_decade(sweep *out, int decade, double diff, double gain, double scaled) {
+    out->worst_scaled = fmax(out->worst_scaled, scaled);
+    out->worst_gain = fmax(out->worst_gain, gain);
+    if (diff >= out->worst_cl) {
+        out->worst_cl = diff;
+        out->worst_cl_decade = decade;
+    }
+    out->decades++;
+}
+
 static void smooth_both(rsmooth_context *ctx, rsmooth_scalar scalar, const void *xyz,
                         const shape_mesh *m, void *out_ref, void *out_cl, double *edge) {
     rsmooth_error err;
@@ -102,16 +113,7 @@ static void sweep_float64(rsmooth_context *ctx, const roof *r, sweep *out) {
                 diff = fmax(diff, fabs(cl[i] - ref[i]) / edge);
             }
         }
-        double gain = rms_error(r, ref, s) / before;
-        if (scaled > out->worst_scaled)
-            out->worst_scaled = scaled;
-        if (gain > out->worst_gain)
-            out->worst_gain = gain;
-        if (diff >= out->worst_cl) {
-            out->worst_cl = diff;
-            out->worst_cl_decade = d;
-        }
-        out->decades++;
+        record_decade(out, d, diff, rms_error(r, ref, s) / before, scaled);
     }
     free(xyz);
     free(ref);
@@ -141,14 +143,7 @@ static void sweep_float32(rsmooth_context *ctx, const roof *r, sweep *out) {
                 diff = fmax(diff, fabs((double)cl[i] - (double)ref[i]) / edge);
             }
         }
-        double gain = rms_error(r, as_double, s) / before;
-        if (gain > out->worst_gain)
-            out->worst_gain = gain;
-        if (diff >= out->worst_cl) {
-            out->worst_cl = diff;
-            out->worst_cl_decade = d;
-        }
-        out->decades++;
+        record_decade(out, d, diff, rms_error(r, as_double, s) / before, 0);
     }
     free(xyz);
     free(ref);
