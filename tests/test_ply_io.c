@@ -894,7 +894,30 @@ static void test_detection_and_lenience(void) {
     bytes_free(&b);
 }
 
+/* "-0" in an integer property is the integer 0: read as +0, as a binary file would hold it, so
+ * writing it back (as "0", or 0 in binary) reads back the same (found by fuzz_ply). */
+static void test_integer_negative_zero(void) {
+    static const char text[] = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                               "property float y\nproperty uint z\nelement face 1\n"
+                               "property list uchar int vertex_indices\nend_header\n"
+                               "-0 0 -0\n1 0 0\n0 1 0\n3 0 1 -0\n";
+    bytes b = {0};
+    put_text(&b, text);
+    rsmooth_mesh *m = parse_ok(&b);
+    CHECK(signbit(m->positions[0])); /* a float keeps its sign */
+    CHECK(m->positions[2] == 0 && !signbit(m->positions[2]));
+    for (int f = 0; f < 2; f++) {
+        rsmooth_format format = f ? RSMOOTH_FORMAT_PLY_BINARY : RSMOOTH_FORMAT_PLY_ASCII;
+        rsmooth_mesh *back = write_and_read(m, format);
+        CHECK(memcmp(back->positions, m->positions, 9 * sizeof(double)) == 0);
+        rsmooth_mesh_destroy(back);
+    }
+    rsmooth_mesh_destroy(m);
+    bytes_free(&b);
+}
+
 int main(void) {
+    test_integer_negative_zero();
     test_ascii();
     test_binary();
     test_errors();

@@ -167,6 +167,8 @@ static rsmooth_status read_typed_value(rs_ply_reader *r, ascii_item *item, const
                              "'%.40s')",
                              *value, rs_ply_spelling(rs_ply_canonical_spelling(type)), p->name,
                              item->element->name);
+    if (type != RS_PLY_FLOAT32 && type != RS_PLY_FLOAT64)
+        *value += 0.0; /* an integer has no sign of zero: "-0" is 0, as binary stores it */
     return status;
 }
 
