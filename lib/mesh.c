@@ -203,24 +203,13 @@ static bool overlaps(const void *a, size_t a_size, const void *b, size_t b_size)
     return pa < pb + b_size && pb < pa + a_size;
 }
 
-rsmooth_status rs_check_output_positions(rsmooth_scalar scalar, const void *positions,
-                                         size_t vertex_count, const void *out_positions,
-                                         rsmooth_error *error, const char *where) {
-    if (!out_positions)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_positions is NULL");
-    size_t bytes = vertex_count * 3 * (scalar == RSMOOTH_FLOAT32 ? sizeof(float) : sizeof(double));
-    if (overlaps(positions, bytes, out_positions, bytes))
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "out_positions overlaps positions: smoothing reads all inputs while "
-                       "writing");
-    return RSMOOTH_OK;
-}
-
 rsmooth_status rs_check_outputs(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
                                 const uint32_t *indices, size_t triangle_count,
                                 const float *colors, const void *out_positions,
                                 const float *out_weight, const float *out_confidence,
                                 rsmooth_error *error, const char *where) {
+    if (!out_positions)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_positions is NULL");
     if (rs_mul_overflows(vertex_count, 3 * sizeof(double)) ||
         rs_mul_overflows(triangle_count, 3 * sizeof(uint32_t)))
         return RSMOOTH_OK; /* no such arrays: the count checks refuse the call */
@@ -336,7 +325,8 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
                               &magnitude, error, where);
     if (st != RSMOOTH_OK)
         return st;
-    st = rs_check_output_positions(scalar, positions, vertex_count, out_positions, error, where);
+    st = rs_check_outputs(scalar, positions, vertex_count, indices, triangle_count, p.colors,
+                          out_positions, NULL, NULL, error, where);
     if (st != RSMOOTH_OK)
         return st;
     st = rs_check_colors(p.colors, vertex_count, error, where);

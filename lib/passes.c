@@ -50,10 +50,8 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
         return one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, params,
                         out_positions, out_weight, out_confidence, report, error);
     if ((st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count,
-                                   NULL, error, where)) != RSMOOTH_OK ||
-        (st = rs_check_output_positions(scalar, positions, vertex_count, out_positions, error,
-                                        where)) != RSMOOTH_OK)
-        return st;
+                                   NULL, error, where)) != RSMOOTH_OK)
+        return st; /* (the outputs were checked above) */
 
     /* Fix the sigmas in mesh units once, from the input. */
     double unit = 0;

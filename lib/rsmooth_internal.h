@@ -189,14 +189,9 @@ static inline double rs_coordinate(rsmooth_scalar scalar, const void *positions,
                                      : ((const double *)positions)[i];
 }
 
-/* Checks the output array of a smoothing call: present, and not overlapping the positions it is
- * computed from (every call reads all inputs while writing). */
-rsmooth_status rs_check_output_positions(rsmooth_scalar scalar, const void *positions,
-                                         size_t vertex_count, const void *out_positions,
-                                         rsmooth_error *error, const char *where);
-
-/* Checks every output of a filter call against every input (positions, indices, colours) and
- * against each other: none may share a byte, since the filter reads all inputs while writing. */
+/* Checks the outputs of a smoothing call: out_positions present, and every output (those not
+ * NULL) clear of every input (positions, indices, colours) and of each other: none may share a
+ * byte, since the filter reads all inputs while writing. */
 rsmooth_status rs_check_outputs(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
                                 const uint32_t *indices, size_t triangle_count,
                                 const float *colors, const void *out_positions,

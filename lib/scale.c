@@ -103,28 +103,31 @@ void rs_scale_positions(rsmooth_scalar scalar, const void *positions, size_t cou
         out[i] = rs_coordinate(scalar, positions, i) * scale;
 }
 
-rsmooth_status rs_mesh_scale(rsmooth_scalar scalar, const void *positions,
-                             const uint32_t *indices, size_t triangle_count, double magnitude,
-                             double *scale, rsmooth_error *error, const char *where) {
-    double typical = typical_distance(scalar, positions, triangle_count, triangle_edge, indices);
+/* The scale for a typical length and the largest coordinate, or the refusal naming them. */
+static rsmooth_status scale_for(double typical, double magnitude, const char *owner,
+                                const char *length, double *scale, rsmooth_error *error,
+                                const char *where) {
     *scale = choose_scale(typical, magnitude);
     if (*scale > 0)
         return RSMOOTH_OK;
     return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                   "the mesh's largest coordinate (%g) is more than 1e225 of its typical edge "
-                   "length (%g): beyond what double precision can weigh areas over",
-                   magnitude, typical);
+                   "%s largest coordinate (%g) is more than 1e225 of %s (%g): beyond what "
+                   "double precision can weigh areas over",
+                   owner, magnitude, length, typical);
+}
+
+rsmooth_status rs_mesh_scale(rsmooth_scalar scalar, const void *positions,
+                             const uint32_t *indices, size_t triangle_count, double magnitude,
+                             double *scale, rsmooth_error *error, const char *where) {
+    double typical = typical_distance(scalar, positions, triangle_count, triangle_edge, indices);
+    return scale_for(typical, magnitude, "the mesh's", "its typical edge length", scale, error,
+                     where);
 }
 
 rsmooth_status rs_points_scale(rsmooth_scalar scalar, const void *positions, size_t count,
                                double magnitude, double *scale, rsmooth_error *error,
                                const char *where) {
     double typical = typical_distance(scalar, positions, count, next_point, &count);
-    *scale = choose_scale(typical, magnitude);
-    if (*scale > 0)
-        return RSMOOTH_OK;
-    return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                   "the points' largest coordinate (%g) is more than 1e225 of their typical "
-                   "spacing (%g): beyond what double precision can weigh areas over",
-                   magnitude, typical);
+    return scale_for(typical, magnitude, "the points'", "their typical spacing", scale, error,
+                     where);
 }

@@ -85,9 +85,6 @@ rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const void *position
     rsmooth_status st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices,
                                              triangle_count, NULL, error, where);
     if (st == RSMOOTH_OK)
-        st = rs_check_output_positions(scalar, positions, vertex_count, out_positions, error,
-                                       where);
-    if (st == RSMOOTH_OK)
         st = rs_check_outputs(scalar, positions, vertex_count, indices, triangle_count, NULL,
                               out_positions, NULL, NULL, error, where);
     if (st != RSMOOTH_OK)
