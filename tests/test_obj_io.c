@@ -659,6 +659,35 @@ static void check_faithful_round_trip(const char *input) {
     rsmooth_mesh_destroy(m);
 }
 
+/* A vn line that ends the file without a newline, or with a lone '\r' (fuzz_obj in CI): its
+ * recomputed normals are written one per line, read back, and writing what was read back gives the
+ * same bytes. Before, the normals shared the replaced line's ending: "vn 0 0 0vn ..." on one line,
+ * or one '\r' between them, and the file did not read back. */
+static void test_last_line_normals(void) {
+    static const char *const inputs[] = {
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nvn 0 0 1",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nvn 0 0 1\r",
+        "v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nv 0 0 1\r\nf 1 2 3\r\nf 1 3 4\r\nvn 0 0 1\r",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\r\nv 0 0 1\nf 1 2 3\nvn 0 0 1\r\nf 1 3 4\nvn 1 0 0\r",
+    };
+    for (size_t i = 0; i < sizeof inputs / sizeof inputs[0]; i++) {
+        rsmooth_mesh *m = parse_ok(inputs[i]);
+        size_t size, size2;
+        char *out = mesh_to_memory(m, RSMOOTH_FORMAT_OBJ, &size);
+        rsmooth_mesh *back = parse_n_ok(out, size);
+        CHECK(meshes_equal(m, back, false));
+        static obj_text b;
+        scan_obj(out, &b);
+        CHECK_EQ_INT(b.vn_count, m->vertex_count);
+        char *out2 = mesh_to_memory(back, RSMOOTH_FORMAT_OBJ, &size2);
+        CHECK(size2 == size && memcmp(out, out2, size) == 0);
+        free(out2);
+        rsmooth_mesh_destroy(back);
+        free(out);
+        rsmooth_mesh_destroy(m);
+    }
+}
+
 static void test_faithful(void) {
     check_faithful_round_trip(rich_obj);
     /* The same with CRLF line ends. */
@@ -909,6 +938,7 @@ int main(void) {
     test_files();
     test_create_and_triangulate();
     test_faithful();
+    test_last_line_normals();
     test_write_refusals_and_extremes();
     test_byte_order_mark();
     test_detection_errors();

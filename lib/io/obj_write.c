@@ -141,10 +141,12 @@ static bool write_text(const rsmooth_mesh *mesh, const rs_obj_extras *x, const d
             ok = put_position(stream, mesh, at->v++, at->as_float) &&
                  fwrite(q, 1, (size_t)(content_end - q), stream) == (size_t)(content_end - q);
         } else if (keyword && len == 2 && token[0] == 'v' && token[1] == 'n' && normals) {
+            /* Every vn line ends as the file's first line does: the line replaced may be the
+             * last, without a newline or with a lone '\r', and what follows it must still be a
+             * line of its own when the file is read and written again. */
             if (!at->normals_written)
-                ok = put_normals(stream, mesh, normals,
-                                 ending_len ? ending : (x->crlf ? "\r\n" : "\n"),
-                                 ending_len ? ending_len : (x->crlf ? 2 : 1), at->as_float);
+                ok = put_normals(stream, mesh, normals, x->crlf ? "\r\n" : "\n",
+                                 x->crlf ? 2 : 1, at->as_float);
             at->normals_written = true;
             p = next;
             continue;
