@@ -1,8 +1,9 @@
-/* rsmooth compare: the denoising error of a result mesh against its ground truth. */
+/* rsmooth compare: the denoising error of a result mesh against its ground truth, as the library's
+ * rsmooth_compare computes it. */
 #include "cli_args.h"
 #include "cli_commands.h"
 #include "cli_files.h"
-#include "mesh_metrics.h"
+#include "rsmooth.h"
 #include "rsmooth_io.h"
 
 #include <math.h>
@@ -115,12 +116,16 @@ int cli_compare_main(int argc, char **argv) {
         status = 2;
         goto done;
     }
-    mesh_metrics m;
-    if (mesh_metrics_compute(result->positions, truth->positions, result->vertex_count,
-                             result->triangles, result->triangle_count, &m) != 0) {
-        /* The reader already checked indices and finiteness: what is left is memory. */
-        fprintf(stderr, "rsmooth compare: %s, %s: out of memory\n", paths[0], paths[1]);
-        status = 1;
+    rsmooth_metrics m;
+    rsmooth_error err;
+    rsmooth_status st = rsmooth_compare(RSMOOTH_FLOAT64, result->positions, truth->positions,
+                                        result->vertex_count, result->triangles,
+                                        result->triangle_count, &m, &err);
+    if (st != RSMOOTH_OK) {
+        /* The readers checked indices and coordinates: what is left is mostly memory. */
+        fprintf(stderr, "rsmooth compare: %s, %s: %s\n", paths[0], paths[1],
+                err.message[0] ? err.message : rsmooth_status_str(st));
+        status = st == RSMOOTH_ERROR_INVALID_ARGUMENT ? 2 : 1;
         goto done;
     }
     if (json) {

@@ -6,10 +6,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions,
-                                    size_t vertex_count, const uint32_t *indices,
-                                    size_t triangle_count, double *magnitude,
-                                    rsmooth_error *error, const char *where) {
+rsmooth_status rs_check_mesh_structure(rsmooth_scalar scalar, const void *positions,
+                                       size_t vertex_count, const uint32_t *indices,
+                                       size_t triangle_count, rsmooth_error *error,
+                                       const char *where) {
     if (scalar != RSMOOTH_FLOAT32 && scalar != RSMOOTH_FLOAT64)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "scalar must be RSMOOTH_FLOAT32 or RSMOOTH_FLOAT64 (got %d)", (int)scalar);
@@ -35,6 +35,17 @@ rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                            "triangle %zu: index %u >= vertex count %zu", i / 3, indices[i],
                            vertex_count);
+    return RSMOOTH_OK;
+}
+
+rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions,
+                                    size_t vertex_count, const uint32_t *indices,
+                                    size_t triangle_count, double *magnitude,
+                                    rsmooth_error *error, const char *where) {
+    rsmooth_status st = rs_check_mesh_structure(scalar, positions, vertex_count, indices,
+                                                triangle_count, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
     return rs_check_coordinates(scalar, positions, vertex_count, "vertex", magnitude, error,
                                 where);
 }

@@ -212,6 +212,14 @@ rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions
                                     size_t triangle_count, double *magnitude,
                                     rsmooth_error *error, const char *where);
 
+/* rs_check_mesh_arrays without the coordinates: the scalar type, positions present, the counts,
+ * indices present and in range. For calls that check several position arrays over one index
+ * array (rsmooth_compare), each with rs_check_coordinates naming its own. */
+rsmooth_status rs_check_mesh_structure(rsmooth_scalar scalar, const void *positions,
+                                       size_t vertex_count, const uint32_t *indices,
+                                       size_t triangle_count, rsmooth_error *error,
+                                       const char *where);
+
 /* Mean length of unique undirected edges over `xyz` (double). false on allocation failure. */
 bool rs_mean_edge_length(const double *xyz, size_t vertex_count, const uint32_t *indices,
                          size_t triangle_count, double *out_length);

@@ -162,6 +162,22 @@ ev_after=$(sed -n 's/.*"ev": *\([0-9.eE+-]*\).*/\1/p' out.txt)
 echo "ev before $ev_before, after $ev_after"
 awk -v a="$ev_after" -v b="$ev_before" 'BEGIN { exit !(a > 0 && a < b) }' || fail "ev did not fall"
 expect 2 "$rsmooth" compare noise_a.ply big.ply
+# The figures (the library's rsmooth_compare) are the same at every scale: two triangles with
+# edges of 1e-200 measure as they do at 1, where squared distances would underflow unscaled.
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\n' > unit_truth.obj
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 2\nf 1 2 3\nf 1 2 4\n' > unit_result.obj
+for f in unit_truth unit_result; do
+  awk '/^v / { printf "v %s %s %s\n", $2 * 1e-200, $3 * 1e-200, $4 * 1e-200; next } { print }' \
+    $f.obj > tiny_${f#unit_}.obj
+done
+expect 0 "$rsmooth" compare unit_result.obj unit_truth.obj
+unit=$(cut -d' ' -f1-4 out.txt)
+expect 0 "$rsmooth" compare tiny_result.obj tiny_truth.obj
+tiny=$(cut -d' ' -f1-4 out.txt)
+[ -n "$unit" ] && [ "$unit" = "$tiny" ] ||
+  fail "compare at 1e-200 ($tiny) differs from compare at 1 ($unit)"
+grep -q "mean_edge=1.16569e-200 bbox_diag=1.73205e-200" out.txt ||
+  fail "compare at 1e-200: lengths not in the mesh's units: $(cat out.txt)"
 
 # Pictures: the input, the result and its confidence side by side, as PNG, never clobbered.
 expect 0 "$rsmooth" render noisy.ply smooth.ply conf.ply -o pair.png --size 480x160

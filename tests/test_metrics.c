@@ -1,12 +1,15 @@
-/* Error metrics: exact closest points against brute force, analytic cases, and agreement with the
- * independent oracle ../shared/tools/meshmetrics.py on the benchmark meshes. */
+/* Error metrics (rsmooth_compare): analytic cases, agreement with the independent oracle
+ * ../shared/tools/meshmetrics.py on the benchmark meshes, float32 input, every invalid argument
+ * refused with a message, the inputs left as they were, every scale alike, the same figures with
+ * any thread count and from concurrent calls. The closest points under the figures are checked
+ * against brute force in test_surface_index.c. */
 #define _POSIX_C_SOURCE 200809L
-#include "mesh_metrics.h"
 #include "mesh_shapes.h"
 #include "rsmooth.h"
 #include "rsmooth_io.h"
 #include "test_util.h"
 
+#include <pthread.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <string.h>
@@ -15,228 +18,39 @@
 
 static const double pi = 3.14159265358979323846;
 
-/* xorshift64*: uniform numbers that are the same on every platform. */
-static double uniform(uint64_t *s) {
-    *s ^= *s >> 12;
-    *s ^= *s << 25;
-    *s ^= *s >> 27;
-    return (double)((*s * 2685821657736338717ull) >> 11) * 0x1.0p-53;
+/* rsmooth_compare on float64 arrays, which must succeed. */
+static rsmooth_metrics compare64(const double *result, const double *truth, size_t vertex_count,
+                                 const uint32_t *indices, size_t triangle_count) {
+    rsmooth_metrics m;
+    rsmooth_error err;
+    rsmooth_status s = rsmooth_compare(RSMOOTH_FLOAT64, result, truth, vertex_count, indices,
+                                       triangle_count, &m, &err);
+    if (s != RSMOOTH_OK)
+        fprintf(stderr, "rsmooth_compare: %s\n", err.message);
+    CHECK_STATUS(s, RSMOOTH_OK);
+    CHECK_STATUS(err.status, RSMOOTH_OK);
+    CHECK_EQ_INT(m.vertex_count, vertex_count);
+    CHECK_EQ_INT(m.triangle_count, triangle_count);
+    return m;
 }
 
-static double dist2(const double a[3], const double b[3]) {
-    double x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
-    return x * x + y * y + z * z;
+/* Two figures are the same double, NAN equal to NAN. */
+static bool same(double a, double b) {
+    return (isnan(a) && isnan(b)) || memcmp(&a, &b, sizeof a) == 0;
 }
 
-/* ---- the closest point on one triangle ----------------------------------------------------- */
-
-/* The smallest squared distance from p to n*(n+1)/2 points spread over the triangle: an upper
- * bound on the true one, within (triangle size / n)^2 of it. */
-static double sampled_dist2(const double p[3], const double a[3], const double b[3],
-                            const double c[3], int n) {
-    double best = INFINITY;
-    for (int i = 0; i <= n; i++)
-        for (int j = 0; i + j <= n; j++) {
-            double u = (double)i / n, v = (double)j / n, q[3];
-            for (int k = 0; k < 3; k++)
-                q[k] = a[k] + u * (b[k] - a[k]) + v * (c[k] - a[k]);
-            best = fmin(best, dist2(p, q));
-        }
-    return best;
+static bool same_metrics(const rsmooth_metrics *a, const rsmooth_metrics *b) {
+    return a->vertex_count == b->vertex_count && a->triangle_count == b->triangle_count &&
+           a->theta_count == b->theta_count && same(a->theta, b->theta) && same(a->ev, b->ev) &&
+           same(a->rms_v, b->rms_v) && same(a->hausdorff, b->hausdorff) &&
+           same(a->mean_edge, b->mean_edge) && same(a->bbox_diag, b->bbox_diag);
 }
 
-static void test_triangle(void) {
-    const double a[3] = {0, 0, 0}, b[3] = {2, 0, 0}, c[3] = {0, 2, 0};
-    double q[3];
-    /* Each Voronoi region of the triangle once: interior, three edges, three corners. */
-    struct {
-        double p[3], expect[3];
-    } cases[] = {
-        {{0.5, 0.5, 3}, {0.5, 0.5, 0}}, {{1, -1, 1}, {1, 0, 0}},  {{-1, 1, -1}, {0, 1, 0}},
-        {{2, 2, 0.5}, {1, 1, 0}},       {{-1, -1, 2}, {0, 0, 0}}, {{3, -1, 0}, {2, 0, 0}},
-        {{-1, 3, 0}, {0, 2, 0}},
-    };
-    for (size_t i = 0; i < sizeof cases / sizeof *cases; i++) {
-        double d2 = surface_closest_on_triangle(cases[i].p, a, b, c, q);
-        CHECK_NEAR(d2, dist2(cases[i].p, cases[i].expect), 1e-14);
-        CHECK_NEAR(dist2(q, cases[i].expect), 0, 1e-28);
-    }
-    /* Degenerate triangles are the segments they collapse to: a point near the middle of a
-     * collapsed edge is at its distance from that segment (Ericson's formulas give 0/0 there). */
-    const double p[3] = {1.5, 0.3, 0.1};
-    const double s0[3] = {2, 0, 0}, s1[3] = {1, 0, 0}, s2[3] = {3, 0, 0};
-    double expect = 0.3 * 0.3 + 0.1 * 0.1;
-    CHECK_NEAR(surface_closest_on_triangle(p, s0, s0, s1, q), expect, 1e-15);       /* a == b */
-    CHECK_NEAR(surface_closest_on_triangle(p, s0, s1, s1, q), expect, 1e-15);       /* b == c */
-    CHECK_NEAR(surface_closest_on_triangle(p, s1, s0, s1, q), expect, 1e-15);       /* c == a */
-    CHECK_NEAR(surface_closest_on_triangle(p, s1, s2, s0, q), expect, 1e-15);       /* collinear */
-    CHECK_NEAR(surface_closest_on_triangle(p, s0, s0, s0, q), dist2(p, s0), 1e-15); /* a point */
-
-    /* Random triangles and points: the answer lies on the triangle and is no farther than any
-     * sample of it. */
-    uint64_t s = 0x9e3779b97f4a7c15ull;
-    double worst_gap = 0, worst_off = 0;
-    for (int trial = 0; trial < 400; trial++) {
-        double t[3][3], pt[3];
-        for (int v = 0; v < 3; v++)
-            for (int k = 0; k < 3; k++)
-                t[v][k] = uniform(&s) * 2 - 1;
-        if (trial % 10 == 0) /* some needles and slivers */
-            for (int k = 0; k < 3; k++)
-                t[2][k] = t[0][k] + (t[1][k] - t[0][k]) * 0.7 + 1e-4 * uniform(&s);
-        for (int k = 0; k < 3; k++)
-            pt[k] = uniform(&s) * 4 - 2;
-        double d2 = surface_closest_on_triangle(pt, t[0], t[1], t[2], q);
-        CHECK_NEAR(d2, dist2(pt, q), 1e-12);
-        /* q on the triangle: its distance from it (by the function itself) is ~0, and it lies in
-         * the triangle's plane within the corners' hull. */
-        double off = surface_closest_on_triangle(q, t[0], t[1], t[2], NULL);
-        CHECK_LE(off, 1e-20); /* rounding, largest on the slivers */
-        worst_off = fmax(worst_off, off);
-        double sampled = sampled_dist2(pt, t[0], t[1], t[2], 60);
-        CHECK_LE(d2, sampled + 1e-12);
-        worst_gap = fmax(worst_gap, sampled - d2);
-    }
-    printf("triangle: 7 regions, 5 degenerate cases, 400 random triangles; largest sampled - exact "
-           "squared distance %.3g (>= 0 required); closest points off their triangle by at most "
-           "%.2g (squared)\n",
-           worst_gap, worst_off);
-}
-
-/* ---- the grid against brute force ------------------------------------------------------------ */
-
-static double brute_force(const double *xyz, const uint32_t *tris, size_t tri_count,
-                          const double p[3], size_t *best_tri) {
-    double best = INFINITY;
-    *best_tri = SIZE_MAX;
-    for (size_t t = 0; t < tri_count; t++) {
-        const uint32_t *f = tris + 3 * t;
-        double d = surface_closest_on_triangle(p, xyz + 3 * (size_t)f[0], xyz + 3 * (size_t)f[1],
-                                               xyz + 3 * (size_t)f[2], NULL);
-        if (d < best) { /* the first of equal ones, as the index breaks ties */
-            best = d;
-            *best_tri = t;
-        }
-    }
-    return sqrt(best);
-}
-
-static void check_against_brute_force(const char *name, const double *xyz, size_t vertex_count,
-                                      const uint32_t *tris, size_t tri_count, const double *points,
-                                      size_t point_count) {
-    surface_index *ix = surface_index_build(xyz, vertex_count, tris, tri_count);
-    CHECK(ix != NULL);
-    double max_d = 0;
-    for (size_t i = 0; i < point_count; i++) {
-        size_t t_grid = SIZE_MAX, t_brute;
-        double q[3];
-        double d_grid = surface_index_query(ix, points + 3 * i, q, &t_grid);
-        double d_brute = brute_force(xyz, tris, tri_count, points + 3 * i, &t_brute);
-        if (d_grid != d_brute || t_grid != t_brute) {
-            fprintf(stderr, "%s: point %zu: grid %.17g (triangle %zu), brute force %.17g (%zu)\n",
-                    name, i, d_grid, t_grid, d_brute, t_brute);
-            exit(1);
-        }
-        CHECK_NEAR(sqrt(dist2(points + 3 * i, q)), d_grid, 1e-12 * (1 + d_grid));
-        max_d = fmax(max_d, d_grid);
-    }
-    printf("grid = brute force: %-34s %6zu triangles, %5zu points, all equal (largest distance "
-           "%.3g)\n",
-           name, tri_count, point_count, max_d);
-    surface_index_free(ix);
-}
-
-/* A random soup in the unit cube: `count` triangles of about `size`, a few of them huge or
- * degenerate, so cell sizes and multi-cell triangles get exercised. */
-static void random_soup(uint64_t *s, size_t count, double size, double **xyz, uint32_t **tris) {
-    *xyz = malloc(9 * count * sizeof **xyz);
-    *tris = malloc(3 * count * sizeof **tris);
-    CHECK(*xyz && *tris);
-    for (size_t t = 0; t < count; t++) {
-        double *v = *xyz + 9 * t, centre[3], scale = size;
-        if (t % 97 == 5)
-            scale = 1.0; /* spans much of the cube */
-        for (int k = 0; k < 3; k++)
-            centre[k] = uniform(s);
-        for (int c = 0; c < 3; c++)
-            for (int k = 0; k < 3; k++)
-                v[3 * c + k] = centre[k] + (uniform(s) - 0.5) * scale;
-        if (t % 53 == 7)
-            memcpy(v + 3, v, 3 * sizeof *v); /* two corners coincide */
-        if (t % 61 == 3)
-            for (int k = 0; k < 3; k++)
-                v[6 + k] = 0.5 * (v[k] + v[3 + k]); /* collinear */
-        for (int c = 0; c < 3; c++)
-            (*tris)[3 * t + c] = (uint32_t)(3 * t + (size_t)c);
-    }
-}
-
-static double *random_points(uint64_t *s, size_t count, double lo, double hi) {
-    double *p = malloc(3 * count * sizeof *p);
-    CHECK(p);
-    for (size_t i = 0; i < 3 * count; i++)
-        p[i] = lo + (hi - lo) * uniform(s);
-    return p;
-}
-
-static void test_grid(void) {
-    uint64_t s = 12345;
-    const struct {
-        const char *name;
-        size_t count;
-        double size;
-    } soups[] = {{"soup of small triangles", 3000, 0.05},
-                 {"soup of mid-size triangles", 800, 0.3},
-                 {"sparse soup", 40, 0.1},
-                 {"one triangle", 1, 0.5}};
-    for (size_t i = 0; i < sizeof soups / sizeof *soups; i++) {
-        double *xyz;
-        uint32_t *tris;
-        random_soup(&s, soups[i].count, soups[i].size, &xyz, &tris);
-        double *inside = random_points(&s, 1500, -0.1, 1.1);
-        double *outside = random_points(&s, 300, -5, 6); /* mostly outside the grid */
-        char name[96];
-        snprintf(name, sizeof name, "%s, near", soups[i].name);
-        check_against_brute_force(name, xyz, 3 * soups[i].count, tris, soups[i].count, inside,
-                                  1500);
-        snprintf(name, sizeof name, "%s, far", soups[i].name);
-        check_against_brute_force(name, xyz, 3 * soups[i].count, tris, soups[i].count, outside,
-                                  300);
-        free(xyz);
-        free(tris);
-        free(inside);
-        free(outside);
-    }
-
-    /* A closed surface with points on both sides of it and at its centre (the farthest the shells
-     * ever have to grow from inside), and a flat one (a grid one cell thick). */
-    shape_mesh sphere, plane;
-    CHECK(shape_sphere(&sphere, 4, 1.0) == 0);
-    CHECK(shape_plane(&plane, 30, 20, 0.1) == 0);
-    double *pts = random_points(&s, 2000, -1.3, 1.3);
-    memset(pts, 0, 3 * sizeof *pts);
-    check_against_brute_force("sphere", sphere.xyz, sphere.vertex_count, sphere.indices,
-                              sphere.triangle_count, pts, 2000);
-    for (size_t i = 0; i < 2000; i++) {
-        pts[3 * i] = 3.4 * uniform(&s) - 0.2;
-        pts[3 * i + 1] = 2.4 * uniform(&s) - 0.2;
-        pts[3 * i + 2] = (uniform(&s) - 0.5) * (i % 2 ? 0.02 : 2.0);
-    }
-    check_against_brute_force("plane", plane.xyz, plane.vertex_count, plane.indices,
-                              plane.triangle_count, pts, 2000);
-    free(pts);
-
-    /* Empty index, bad input. */
-    surface_index *empty = surface_index_build(NULL, 0, NULL, 0);
-    CHECK(empty != NULL);
-    const double origin[3] = {0, 0, 0};
-    CHECK(isinf(surface_index_query(empty, origin, NULL, NULL)));
-    surface_index_free(empty);
-    uint32_t bad[3] = {0, 1, (uint32_t)sphere.vertex_count};
-    CHECK(surface_index_build(sphere.xyz, sphere.vertex_count, bad, 1) == NULL);
-    surface_index_free(NULL);
-    shape_free(&sphere);
-    shape_free(&plane);
+static void print_metrics(const char *label, const rsmooth_metrics *m) {
+    printf("%s: theta %.17g (%zu faces) ev %.17g rms_v %.17g hausdorff %.17g mean_edge %.17g "
+           "bbox_diag %.17g\n",
+           label, m->theta, m->theta_count, m->ev, m->rms_v, m->hausdorff, m->mean_edge,
+           m->bbox_diag);
 }
 
 /* Rodrigues' rotation of `mesh` by `angle` about the unit `axis` through the origin, into `out`. */
@@ -258,11 +72,10 @@ static void test_analytic(void) {
     shape_mesh plane, moved;
     CHECK(shape_plane(&plane, 20, 10, 0.5) == 0);
     CHECK(shape_copy(&plane, &moved) == 0);
-    mesh_metrics m;
+    rsmooth_metrics m;
 
     /* Identical meshes. */
-    CHECK(mesh_metrics_compute(plane.xyz, plane.xyz, plane.vertex_count, plane.indices,
-                               plane.triangle_count, &m) == 0);
+    m = compare64(plane.xyz, plane.xyz, plane.vertex_count, plane.indices, plane.triangle_count);
     printf("identical plane: theta %g ev %g rms_v %g hausdorff %g\n", m.theta, m.ev, m.rms_v,
            m.hausdorff);
     CHECK(m.theta == 0 && m.ev == 0 && m.rms_v == 0 && m.hausdorff == 0);
@@ -275,8 +88,7 @@ static void test_analytic(void) {
     const double t = 0.0375;
     for (size_t v = 0; v < moved.vertex_count; v++)
         moved.xyz[3 * v + 2] += t;
-    CHECK(mesh_metrics_compute(moved.xyz, plane.xyz, plane.vertex_count, plane.indices,
-                               plane.triangle_count, &m) == 0);
+    m = compare64(moved.xyz, plane.xyz, plane.vertex_count, plane.indices, plane.triangle_count);
     printf("plane moved by %g: theta %g ev %.12g (expect %.12g) rms_v %.12g (expect %.12g) "
            "hausdorff %.12g\n",
            t, m.theta, m.ev, t / diag * 1e3, m.rms_v, t / edge, m.hausdorff);
@@ -290,8 +102,7 @@ static void test_analytic(void) {
     size_t lifted = 5 * 21 + 7; /* an interior vertex (rows of 21) */
     const double h = 0.2;
     moved.xyz[3 * lifted + 2] += h;
-    CHECK(mesh_metrics_compute(moved.xyz, plane.xyz, plane.vertex_count, plane.indices,
-                               plane.triangle_count, &m) == 0);
+    m = compare64(moved.xyz, plane.xyz, plane.vertex_count, plane.indices, plane.triangle_count);
     printf("one vertex raised by %g: hausdorff %.12g (expect %.12g), ev %.6g, theta %.6g\n", h,
            m.hausdorff, h / diag * 1e3, m.ev, m.theta);
     CHECK_NEAR(m.hausdorff, h / diag * 1e3, 1e-12);
@@ -303,8 +114,7 @@ static void test_analytic(void) {
     const double alpha = 0.7 * pi / 180;
     const double x_axis[3] = {1, 0, 0}, diagonal[3] = {1 / sqrt(3.0), 1 / sqrt(3.0), 1 / sqrt(3.0)};
     rotate(&plane, x_axis, alpha, moved.xyz);
-    CHECK(mesh_metrics_compute(moved.xyz, plane.xyz, plane.vertex_count, plane.indices,
-                               plane.triangle_count, &m) == 0);
+    m = compare64(moved.xyz, plane.xyz, plane.vertex_count, plane.indices, plane.triangle_count);
     printf("plane turned by 0.7 deg about an axis in it: theta %.12g deg\n", m.theta);
     CHECK_NEAR(m.theta, 0.7, 1e-9);
     shape_mesh sphere, turned;
@@ -326,24 +136,21 @@ static void test_analytic(void) {
         expect += 2 * asin(sin_phi * sin(alpha / 2));
     }
     expect = expect / (double)sphere.triangle_count * 180 / pi;
-    CHECK(mesh_metrics_compute(turned.xyz, sphere.xyz, sphere.vertex_count, sphere.indices,
-                               sphere.triangle_count, &m) == 0);
+    m = compare64(turned.xyz, sphere.xyz, sphere.vertex_count, sphere.indices,
+                  sphere.triangle_count);
     printf("sphere turned by 0.7 deg: theta %.12g deg (expect %.12g from the faces' angles to the "
            "axis)\n",
            m.theta, expect);
     CHECK_NEAR(m.theta, expect, 1e-9);
-    memcpy(moved.xyz, plane.xyz, 3 * plane.vertex_count * sizeof *plane.xyz);
 
-    /* Bad input. */
-    CHECK(mesh_metrics_compute(NULL, plane.xyz, plane.vertex_count, plane.indices,
-                               plane.triangle_count, &m) == -1);
-    CHECK(mesh_metrics_compute(plane.xyz, plane.xyz, plane.vertex_count, plane.indices, 0, &m) ==
-          -1);
-    uint32_t bad[3] = {0, 1, (uint32_t)plane.vertex_count};
-    CHECK(mesh_metrics_compute(plane.xyz, plane.xyz, plane.vertex_count, bad, 1, &m) == -1);
-    moved.xyz[4] = NAN;
-    CHECK(mesh_metrics_compute(moved.xyz, plane.xyz, plane.vertex_count, plane.indices,
-                               plane.triangle_count, &m) == -1);
+    /* A truth whose edges all have zero length has no unit for rms_v and no extent for ev and
+     * hausdorff: infinite or NAN figures, not a failure. */
+    double point[9] = {1, 2, 3, 1, 2, 3, 1, 2, 3}, spread[9] = {1, 2, 3, 2, 2, 3, 1, 3, 3};
+    uint32_t tri[3] = {0, 1, 2};
+    m = compare64(spread, point, 3, tri, 1);
+    print_metrics("a triangle against its corners collapsed to one point", &m);
+    CHECK(m.mean_edge == 0 && m.bbox_diag == 0 && m.theta_count == 0 && isnan(m.theta));
+    CHECK(isinf(m.rms_v) && isinf(m.ev) && isinf(m.hausdorff));
     shape_free(&plane);
     shape_free(&moved);
     shape_free(&sphere);
@@ -375,9 +182,8 @@ typedef struct worst {
 static void agree(const char *label, const char *script, const char *result_path,
                   const double *result_xyz, const rsmooth_mesh *truth, const char *truth_path,
                   worst *w) {
-    mesh_metrics m;
-    CHECK(mesh_metrics_compute(result_xyz, truth->positions, truth->vertex_count, truth->triangles,
-                               truth->triangle_count, &m) == 0);
+    rsmooth_metrics m = compare64(result_xyz, truth->positions, truth->vertex_count,
+                                  truth->triangles, truth->triangle_count);
     char command[8400], json[4096] = "";
     snprintf(command, sizeof command, "/usr/bin/python3 '%s' '%s' '%s' --json", script, result_path,
              truth_path);
@@ -433,7 +239,7 @@ static void test_against_script(void) {
 
     static const char *const models[] = {"Fandisk0.3", "Block0.4", "Bunny0.2", "SharpSphere0.3",
                                          "Twelve0.5Impulsive"};
-    printf("meshmetrics.py (script) against mesh_metrics (ours; ev exact), reference filter "
+    printf("meshmetrics.py (script) against rsmooth_compare (ours; ev exact), reference filter "
            "sigma_f 2, sigma_g 0.5:\n");
     printf("%-28s %9s %9s %8s | %8s %8s %8s | %9s %9s %8s | %8s\n", "model", "rms_v py", "ours",
            "rel", "theta py", "ours", "rel", "ev py", "ours", "ours-py", "hausdrff");
@@ -481,10 +287,341 @@ static void test_against_script(void) {
            w.rms_v, w.theta, w.ev, w.mean_edge, w.bbox_diag);
 }
 
+/* ---- float32 input ------------------------------------------------------------------------- */
+
+/* A noisy sphere against the clean one: every figure non-trivial. */
+static void noisy_sphere(int levels, shape_mesh *truth, shape_mesh *noisy) {
+    CHECK(shape_sphere(truth, levels, 1.0) == 0);
+    CHECK(shape_copy(truth, noisy) == 0);
+    CHECK(shape_add_normal_noise(noisy, 0.3, 7) == 0);
+}
+
+/* float32 arrays give exactly the figures of float64 arrays holding the same values. */
+static void check_float32(const char *label, const double *result, const double *truth,
+                          size_t vertex_count, const uint32_t *indices, size_t triangle_count) {
+    size_t n = 3 * vertex_count;
+    float *r32 = malloc(n * sizeof *r32), *t32 = malloc(n * sizeof *t32);
+    double *r64 = malloc(n * sizeof *r64), *t64 = malloc(n * sizeof *t64);
+    CHECK(r32 && t32 && r64 && t64);
+    for (size_t i = 0; i < n; i++) {
+        r32[i] = (float)result[i];
+        t32[i] = (float)truth[i];
+        r64[i] = r32[i];
+        t64[i] = t32[i];
+    }
+    rsmooth_metrics m32, m64 = compare64(r64, t64, vertex_count, indices, triangle_count);
+    rsmooth_error err;
+    CHECK_STATUS(rsmooth_compare(RSMOOTH_FLOAT32, r32, t32, vertex_count, indices, triangle_count,
+                                 &m32, &err),
+                 RSMOOTH_OK);
+    print_metrics(label, &m32);
+    if (!same_metrics(&m32, &m64)) {
+        print_metrics("  float64 of the same values", &m64);
+        CHECK(!"float32 and float64 figures differ");
+    }
+    free(r32);
+    free(t32);
+    free(r64);
+    free(t64);
+}
+
+static void test_float32(void) {
+    shape_mesh sphere, noisy, plane, moved;
+    noisy_sphere(3, &sphere, &noisy);
+    check_float32("float32 = float64: noisy sphere", noisy.xyz, sphere.xyz, sphere.vertex_count,
+                  sphere.indices, sphere.triangle_count);
+    CHECK(shape_plane(&plane, 20, 10, 0.5) == 0);
+    CHECK(shape_copy(&plane, &moved) == 0);
+    for (size_t v = 0; v < moved.vertex_count; v++)
+        moved.xyz[3 * v + 2] += 0.01 * (double)(v % 7); /* 0.01 is no float: rounding shows */
+    check_float32("float32 = float64: rippled plane", moved.xyz, plane.xyz, plane.vertex_count,
+                  plane.indices, plane.triangle_count);
+    shape_free(&sphere);
+    shape_free(&noisy);
+    shape_free(&plane);
+    shape_free(&moved);
+}
+
+/* ---- invalid arguments ---------------------------------------------------------------------- */
+
+static int g_refused;
+
+/* The call is refused as invalid with a message containing `expect`, `out` untouched; the same
+ * without an error record. */
+static void expect_invalid(const char *what, const char *expect, rsmooth_scalar scalar,
+                           const void *result, const void *truth, size_t vertex_count,
+                           const uint32_t *indices, size_t triangle_count, bool with_out) {
+    rsmooth_metrics out, sentinel;
+    memset(&sentinel, 0xA5, sizeof sentinel);
+    memcpy(&out, &sentinel, sizeof out);
+    rsmooth_error err;
+    memset(&err, 0, sizeof err);
+    rsmooth_status s = rsmooth_compare(scalar, result, truth, vertex_count, indices, triangle_count,
+                                       with_out ? &out : NULL, &err);
+    printf("refused: %-40s -> %d \"%s\" (%s)\n", what, (int)s, err.message, err.where);
+    CHECK_STATUS(s, RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK_EQ_INT(err.status, RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK(memchr(err.message, '\0', sizeof err.message) != NULL);
+    if (!strstr(err.message, expect)) {
+        fprintf(stderr, "%s: the message does not say \"%s\"\n", what, expect);
+        exit(1);
+    }
+    CHECK(strcmp(err.where, "rsmooth_compare") == 0);
+    CHECK(memcmp(&out, &sentinel, sizeof out) == 0);
+    s = rsmooth_compare(scalar, result, truth, vertex_count, indices, triangle_count,
+                        with_out ? &out : NULL, NULL);
+    CHECK_STATUS(s, RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK(memcmp(&out, &sentinel, sizeof out) == 0);
+    g_refused++;
+}
+
+static void test_invalid_arguments(void) {
+    shape_mesh plane, moved;
+    CHECK(shape_plane(&plane, 4, 4, 1.0) == 0); /* 25 vertices, 32 triangles */
+    CHECK(shape_copy(&plane, &moved) == 0);
+    moved.xyz[3 * 12 + 2] = 0.25;
+    const size_t vc = plane.vertex_count, tc = plane.triangle_count;
+    const double *r = moved.xyz, *t = plane.xyz;
+    const uint32_t *idx = plane.indices;
+    compare64(r, t, vc, idx, tc); /* the base call is valid */
+
+    expect_invalid("out NULL", "out is NULL", RSMOOTH_FLOAT64, r, t, vc, idx, tc, false);
+    expect_invalid("result NULL", "result_positions is NULL", RSMOOTH_FLOAT64, NULL, t, vc, idx, tc,
+                   true);
+    expect_invalid("truth NULL", "truth_positions is NULL", RSMOOTH_FLOAT64, r, NULL, vc, idx, tc,
+                   true);
+    expect_invalid("indices NULL", "indices is NULL", RSMOOTH_FLOAT64, r, t, vc, NULL, tc, true);
+    expect_invalid("no vertex", "no vertices", RSMOOTH_FLOAT64, r, t, 0, idx, tc, true);
+    expect_invalid("no triangle", "no triangles", RSMOOTH_FLOAT64, r, t, vc, idx, 0, true);
+    expect_invalid("no triangle, indices NULL", "no triangles", RSMOOTH_FLOAT64, r, t, vc, NULL, 0,
+                   true);
+    expect_invalid("scalar 7", "scalar must be", (rsmooth_scalar)7, r, t, vc, idx, tc, true);
+    expect_invalid("vertex count beyond 32 bits", "32-bit", RSMOOTH_FLOAT64, r, t,
+                   (size_t)UINT32_MAX + 2, idx, tc, true);
+    expect_invalid("triangle count overflowing", "too large", RSMOOTH_FLOAT64, r, t, vc, idx,
+                   SIZE_MAX / 4, true);
+
+    uint32_t bad[3 * 32];
+    memcpy(bad, idx, sizeof bad);
+    bad[3 * 17 + 1] = 25;
+    expect_invalid("index out of range", "triangle 17: index 25 >= vertex count 25",
+                   RSMOOTH_FLOAT64, r, t, vc, bad, tc, true);
+    bad[3 * 17 + 1] = UINT32_MAX;
+    expect_invalid("index UINT32_MAX", "triangle 17: index 4294967295", RSMOOTH_FLOAT64, r, t, vc,
+                   bad, tc, true);
+
+    double broken[3 * 25];
+    memcpy(broken, r, sizeof broken);
+    broken[3 * 7 + 1] = NAN;
+    expect_invalid("NaN in the result", "result vertex 7 has a non-finite coordinate",
+                   RSMOOTH_FLOAT64, broken, t, vc, idx, tc, true);
+    expect_invalid("NaN in the truth", "truth vertex 7 has a non-finite coordinate",
+                   RSMOOTH_FLOAT64, t, broken, vc, idx, tc, true);
+    memcpy(broken, r, sizeof broken);
+    broken[3 * 11] = -INFINITY;
+    expect_invalid("infinity in the truth", "truth vertex 11 has a non-finite coordinate",
+                   RSMOOTH_FLOAT64, r, broken, vc, idx, tc, true);
+    memcpy(broken, r, sizeof broken);
+    broken[3 * 3 + 2] = 1e151;
+    expect_invalid("coordinate beyond 1e150", "result vertex 3 has coordinate", RSMOOTH_FLOAT64,
+                   broken, t, vc, idx, tc, true);
+    float broken32[3 * 25], plane32[3 * 25];
+    for (size_t i = 0; i < 3 * vc; i++)
+        broken32[i] = plane32[i] = (float)t[i];
+    broken32[3 * 24] = NAN;
+    expect_invalid("float32 NaN in the truth", "truth vertex 24 has a non-finite coordinate",
+                   RSMOOTH_FLOAT32, plane32, broken32, vc, idx, tc, true);
+
+    /* A truth with edges of 1e-100 and a result vertex at 1e140: no power of two holds both
+     * scales. */
+    double tiny[3 * 25];
+    for (size_t i = 0; i < 3 * vc; i++)
+        tiny[i] = t[i] * 1e-100;
+    memcpy(broken, tiny, sizeof broken);
+    broken[3 * 5] = 1e140;
+    expect_invalid("scales too far apart", "more than 1e225", RSMOOTH_FLOAT64, broken, tiny, vc,
+                   idx, tc, true);
+    printf("invalid arguments: %d calls refused, each naming its problem, out untouched\n",
+           g_refused);
+    shape_free(&plane);
+    shape_free(&moved);
+}
+
+/* ---- the inputs are only read ---------------------------------------------------------------- */
+
+static void test_inputs_unchanged(void) {
+    shape_mesh sphere, noisy;
+    noisy_sphere(2, &sphere, &noisy);
+    size_t n = 3 * sphere.vertex_count, ni = 3 * sphere.triangle_count;
+    double *r = malloc(n * sizeof *r), *t = malloc(n * sizeof *t);
+    float *r32 = malloc(n * sizeof *r32), *t32 = malloc(n * sizeof *t32);
+    uint32_t *idx = malloc(ni * sizeof *idx);
+    CHECK(r && t && r32 && t32 && idx);
+    memcpy(r, noisy.xyz, n * sizeof *r);
+    memcpy(t, sphere.xyz, n * sizeof *t);
+    memcpy(idx, sphere.indices, ni * sizeof *idx);
+    for (size_t i = 0; i < n; i++) {
+        r32[i] = (float)r[i];
+        t32[i] = (float)t[i];
+    }
+    rsmooth_metrics m;
+    CHECK_STATUS(rsmooth_compare(RSMOOTH_FLOAT64, r, t, sphere.vertex_count, idx,
+                                 sphere.triangle_count, &m, NULL),
+                 RSMOOTH_OK);
+    CHECK(memcmp(r, noisy.xyz, n * sizeof *r) == 0);
+    CHECK(memcmp(t, sphere.xyz, n * sizeof *t) == 0);
+    CHECK(memcmp(idx, sphere.indices, ni * sizeof *idx) == 0);
+    float *r32_copy = malloc(n * sizeof *r32), *t32_copy = malloc(n * sizeof *t32);
+    CHECK(r32_copy && t32_copy);
+    memcpy(r32_copy, r32, n * sizeof *r32);
+    memcpy(t32_copy, t32, n * sizeof *t32);
+    CHECK_STATUS(rsmooth_compare(RSMOOTH_FLOAT32, r32, t32, sphere.vertex_count, idx,
+                                 sphere.triangle_count, &m, NULL),
+                 RSMOOTH_OK);
+    CHECK(memcmp(r32, r32_copy, n * sizeof *r32) == 0);
+    CHECK(memcmp(t32, t32_copy, n * sizeof *t32) == 0);
+    CHECK(memcmp(idx, sphere.indices, ni * sizeof *idx) == 0);
+    /* The same array as result and truth is fine: nothing is written. */
+    CHECK_STATUS(rsmooth_compare(RSMOOTH_FLOAT64, t, t, sphere.vertex_count, idx,
+                                 sphere.triangle_count, &m, NULL),
+                 RSMOOTH_OK);
+    CHECK(m.ev == 0 && m.hausdorff == 0 && m.rms_v == 0 && m.theta == 0);
+    CHECK(memcmp(t, sphere.xyz, n * sizeof *t) == 0);
+    printf("inputs unchanged: result, truth and indices, float64 and float32\n");
+    free(r);
+    free(t);
+    free(r32);
+    free(t32);
+    free(r32_copy);
+    free(t32_copy);
+    free(idx);
+    shape_free(&sphere);
+    shape_free(&noisy);
+}
+
+/* ---- every scale alike ------------------------------------------------------------------------
+ */
+
+static void scaled(const double *xyz, size_t n, double factor, double *out) {
+    for (size_t i = 0; i < n; i++)
+        out[i] = xyz[i] * factor;
+}
+
+static void test_scales(void) {
+    shape_mesh sphere, noisy;
+    noisy_sphere(3, &sphere, &noisy);
+    size_t n = 3 * sphere.vertex_count;
+    rsmooth_metrics base = compare64(noisy.xyz, sphere.xyz, sphere.vertex_count, sphere.indices,
+                                     sphere.triangle_count);
+    print_metrics("noisy sphere", &base);
+    double *r = malloc(n * sizeof *r), *t = malloc(n * sizeof *t);
+    CHECK(r && t);
+    /* Powers of two: the same figures bit for bit, lengths times the factor exactly (edges of
+     * 1e-290 and coordinates of 1e148 at the ends, where squared distances would underflow or
+     * overflow without the library's scaling). */
+    const int exponents[] = {-960, -300, -7, 5, 300, 490};
+    for (size_t i = 0; i < sizeof exponents / sizeof *exponents; i++) {
+        double f = ldexp(1.0, exponents[i]);
+        scaled(noisy.xyz, n, f, r);
+        scaled(sphere.xyz, n, f, t);
+        rsmooth_metrics m =
+            compare64(r, t, sphere.vertex_count, sphere.indices, sphere.triangle_count);
+        rsmooth_metrics expect = base;
+        expect.mean_edge *= f;
+        expect.bbox_diag *= f;
+        if (!same_metrics(&m, &expect)) {
+            fprintf(stderr, "scale 2^%d:\n", exponents[i]);
+            print_metrics("  got", &m);
+            print_metrics("  expected", &expect);
+            CHECK(!"figures differ at a power-of-two scale");
+        }
+    }
+    /* Other factors round the coordinates: the figures agree to rounding. */
+    const double factors[] = {1e-200, 3e-7, 1e120};
+    for (size_t i = 0; i < sizeof factors / sizeof *factors; i++) {
+        scaled(noisy.xyz, n, factors[i], r);
+        scaled(sphere.xyz, n, factors[i], t);
+        rsmooth_metrics m =
+            compare64(r, t, sphere.vertex_count, sphere.indices, sphere.triangle_count);
+        CHECK_NEAR(m.theta, base.theta, 1e-9 * base.theta);
+        CHECK_NEAR(m.ev, base.ev, 1e-9 * base.ev);
+        CHECK_NEAR(m.rms_v, base.rms_v, 1e-9 * base.rms_v);
+        CHECK_NEAR(m.hausdorff, base.hausdorff, 1e-9 * base.hausdorff);
+        CHECK_NEAR(m.mean_edge / factors[i], base.mean_edge, 1e-9 * base.mean_edge);
+        CHECK_NEAR(m.bbox_diag / factors[i], base.bbox_diag, 1e-9 * base.bbox_diag);
+    }
+    printf("scales: the same figures at 2^-960 .. 2^490 (bit for bit) and at 1e-200 .. 1e120\n");
+    free(r);
+    free(t);
+    shape_free(&sphere);
+    shape_free(&noisy);
+}
+
+/* ---- threads -----------------------------------------------------------------------------------
+ */
+
+typedef struct compare_call {
+    const shape_mesh *truth, *result;
+    rsmooth_metrics m;
+    rsmooth_status status;
+} compare_call;
+
+static void *run_compare(void *arg) {
+    compare_call *c = arg;
+    c->status =
+        rsmooth_compare(RSMOOTH_FLOAT64, c->result->xyz, c->truth->xyz, c->truth->vertex_count,
+                        c->truth->indices, c->truth->triangle_count, &c->m, NULL);
+    return NULL;
+}
+
+static void test_threads(void) {
+    shape_mesh sphere, noisy;
+    noisy_sphere(5, &sphere, &noisy); /* 10242 vertices: several chunks of queries */
+    const char *saved = getenv("RSMOOTH_HOST_THREADS");
+    char *saved_copy = saved ? strdup(saved) : NULL;
+    rsmooth_metrics first;
+    const char *counts[] = {"1", "2", "3", "8"};
+    for (size_t i = 0; i < sizeof counts / sizeof *counts; i++) {
+        CHECK(setenv("RSMOOTH_HOST_THREADS", counts[i], 1) == 0);
+        rsmooth_metrics m = compare64(noisy.xyz, sphere.xyz, sphere.vertex_count, sphere.indices,
+                                      sphere.triangle_count);
+        if (i == 0)
+            first = m;
+        CHECK(same_metrics(&m, &first));
+    }
+    if (saved_copy) {
+        CHECK(setenv("RSMOOTH_HOST_THREADS", saved_copy, 1) == 0);
+        free(saved_copy);
+    } else {
+        CHECK(unsetenv("RSMOOTH_HOST_THREADS") == 0);
+    }
+    /* Concurrent calls on the same arrays. */
+    enum { CALLS = 4 };
+    compare_call calls[CALLS];
+    pthread_t threads[CALLS];
+    for (int i = 0; i < CALLS; i++) {
+        calls[i] = (compare_call){&sphere, &noisy, {0}, RSMOOTH_ERROR_OPENCL};
+        CHECK(pthread_create(&threads[i], NULL, run_compare, &calls[i]) == 0);
+    }
+    for (int i = 0; i < CALLS; i++) {
+        CHECK(pthread_join(threads[i], NULL) == 0);
+        CHECK_STATUS(calls[i].status, RSMOOTH_OK);
+        CHECK(same_metrics(&calls[i].m, &first));
+    }
+    print_metrics("threads: the same figures with 1, 2, 3 and 8 host threads and from 4 "
+                  "concurrent calls",
+                  &first);
+    shape_free(&sphere);
+    shape_free(&noisy);
+}
+
 int main(void) {
-    test_triangle();
-    test_grid();
     test_analytic();
+    test_float32();
+    test_invalid_arguments();
+    test_inputs_unchanged();
+    test_scales();
+    test_threads();
     test_against_script();
     return 0;
 }

@@ -18,7 +18,8 @@
  * Tukey / Lorentzian / Huber influence functions, a colour term in the influence weight
  * (rsmooth_params), automatic parameters from the estimated noise (rsmooth_params_auto), and
  * point clouds with normals (rsmooth_smooth_points_reference). rsmooth_params_init_best is the
- * most accurate preset measured.
+ * most accurate preset measured. rsmooth_compare measures a result against its ground truth (the
+ * error metrics `rsmooth compare` prints).
  *
  * Usage sketch (arrays in, arrays out; the caller owns every array):
  *
@@ -287,6 +288,59 @@ typedef struct rsmooth_report {
     size_t tiles;                 /* spatial tiles the mesh was cut into to fit the device (1 when
                                      it fitted whole) */
 } rsmooth_report;
+
+/* ---------------------------------------------------------------------------------------------- */
+/* Error metrics                                                                                    */
+/* ---------------------------------------------------------------------------------------------- */
+
+/* How far a result (a denoised mesh) is from its ground truth, both made of the same triangles
+ * over the same vertices: what `rsmooth compare` prints. Lower is better; 0 for identical meshes.
+ * The figures follow ../shared/tools/meshmetrics.py (the independent oracle), except that
+ * distances to a surface here are exact (the closest point over all triangles), where the script
+ * tries only the 24 triangles with the nearest centroids, so its ev can be slightly larger.
+ * (Added in 0.5) */
+typedef struct rsmooth_metrics {
+    size_t vertex_count;
+    size_t triangle_count;
+    double theta;       /* mean angle between corresponding face normals, degrees, over the
+                         * triangles with non-zero area in both meshes (NAN when there is none) */
+    size_t theta_count; /* how many triangles theta averages */
+    double ev;          /* Sun et al. 2007 E_v: sqrt(sum_v A_v d_v^2 / sum_v A_v), A_v the area of
+                         * the result's triangles around v, d_v the distance from result vertex v
+                         * to the ground-truth surface (exact), over vertices with A_v > 0; in
+                         * thousandths of bbox_diag (NAN when no vertex has A_v > 0) */
+    double rms_v;       /* RMS distance between corresponding vertices (all of them), in
+                         * mean_edge (mean edge lengths of the truth) */
+    double hausdorff;   /* symmetric Hausdorff distance sampled at the vertices: the larger of the
+                         * farthest result vertex from the ground-truth surface and the farthest
+                         * ground-truth vertex from the result surface (vertices used by some
+                         * triangle); in thousandths of bbox_diag */
+    double mean_edge;   /* mean length of the truth's unique undirected edges (an edge shared by
+                         * two triangles counts once; a repeated index is no edge), mesh units */
+    double bbox_diag;   /* diagonal of the truth's axis-aligned bounding box (all vertices), mesh
+                         * units */
+} rsmooth_metrics;
+
+/* Compares `result_positions` with `truth_positions` (3 * vertex_count floats or doubles each, as
+ * `scalar` says, finite, magnitude <= 1e150), both meshes made of the same `indices`
+ * (triangle_count triples, each < vertex_count), and writes the figures to `out`. The arrays are
+ * only read. float32 positions give exactly the figures of float64 positions of the same values.
+ * Any scale works alike: the figures are ratios and angles, computed after multiplying both meshes
+ * by one power of two (exact), so a mesh gives the same figures at every scale. A truth with no
+ * edge of non-zero length (mean_edge 0) gives an infinite or NAN rms_v, and one whose vertices all
+ * coincide (bbox_diag 0) an infinite or NAN ev and hausdorff, rather than a failure.
+ * Deterministic with any thread count.
+ *
+ * Errors: RSMOOTH_ERROR_INVALID_ARGUMENT, with `out` untouched and a message naming the problem:
+ * `out` or an array NULL, an invalid scalar, no vertex, no triangle, an index out of range (naming
+ * the triangle and the index), a non-finite or too large coordinate (naming the vertex and whether
+ * it is the result's or the truth's), a mesh whose largest coordinate lies more than 1e225 of the
+ * truth's typical edges from the origin; RSMOOTH_ERROR_OUT_OF_MEMORY. Thread-safe.
+ * (Added in 0.5) */
+RSMOOTH_API rsmooth_status rsmooth_compare(rsmooth_scalar scalar, const void *result_positions,
+                                           const void *truth_positions, size_t vertex_count,
+                                           const uint32_t *indices, size_t triangle_count,
+                                           rsmooth_metrics *out, rsmooth_error *error);
 
 /* ---------------------------------------------------------------------------------------------- */
 /* Layer 1: arrays in, arrays out                                                                   */

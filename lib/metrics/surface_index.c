@@ -1,9 +1,9 @@
-/* Denoising error metrics (face-normal angle, Sun et al. 2007 E_v, RMS displacement, Hausdorff) and
- * the exact closest-point-on-surface grid they rest on. */
-#include "mesh_metrics.h"
-#include "mesh_shapes.h"
+/* Exact closest points on a triangle surface (surface_index.h): Ericson's closest point on a
+ * triangle, and a uniform grid of cubic cells over the triangles searched in shells of cells
+ * around the query point until no unvisited cell can hold a nearer point. */
+#include "metrics/surface_index.h"
+#include "rsmooth_internal.h"
 
-#include <float.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdlib.h>
@@ -11,37 +11,20 @@
 
 /* ---- closest point on a triangle ------------------------------------------------------------- */
 
-static double dot3(const double a[3], const double b[3]) {
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void sub3(double out[3], const double a[3], const double b[3]) {
-    out[0] = a[0] - b[0];
-    out[1] = a[1] - b[1];
-    out[2] = a[2] - b[2];
-}
-
-static void cross3(double out[3], const double a[3], const double b[3]) {
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 static double dist2_3(const double a[3], const double b[3]) {
     double d[3];
-    sub3(d, a, b);
-    return dot3(d, d);
+    rs_sub3(a, b, d);
+    return rs_dot3(d, d);
 }
-
 /* Closest point of segment [a, b] to p; a zero-length segment is the point a. */
 static double closest_on_segment(const double p[3], const double a[3], const double b[3],
                                  double out[3]) {
     double ab[3], ap[3];
-    sub3(ab, b, a);
-    sub3(ap, p, a);
-    double len2 = dot3(ab, ab), t = 0;
+    rs_sub3(b, a, ab);
+    rs_sub3(p, a, ap);
+    double len2 = rs_dot3(ab, ab), t = 0;
     if (len2 > 0) {
-        t = dot3(ap, ab) / len2;
+        t = rs_dot3(ap, ab) / len2;
         t = t < 0 ? 0 : t > 1 ? 1 : t;
     }
     for (int k = 0; k < 3; k++)
@@ -49,17 +32,17 @@ static double closest_on_segment(const double p[3], const double a[3], const dou
     return dist2_3(p, out);
 }
 
-double surface_closest_on_triangle(const double p[3], const double a[3], const double b[3],
-                                   const double c[3], double closest[3]) {
+double rs_closest_on_triangle(const double p[3], const double a[3], const double b[3],
+                              const double c[3], double closest[3]) {
     double ab[3], ac[3], n[3], q[3];
-    sub3(ab, b, a);
-    sub3(ac, c, a);
-    cross3(n, ab, ac);
-    double ab2 = dot3(ab, ab), ac2 = dot3(ac, ac);
+    rs_sub3(b, a, ab);
+    rs_sub3(c, a, ac);
+    rs_cross3(ab, ac, n);
+    double ab2 = rs_dot3(ab, ab), ac2 = rs_dot3(ac, ac);
     /* Ericson's region tests divide by squared edge lengths and |n|^2, which vanish for collinear
      * or coincident corners (0/0 would poison every minimum taken over it); such a triangle is the
      * union of its edges, and a nearly degenerate one is that up to rounding. */
-    if (!(dot3(n, n) > 1e-24 * ab2 * ac2)) {
+    if (!(rs_dot3(n, n) > 1e-24 * ab2 * ac2)) {
         double best = closest_on_segment(p, a, b, q), tmp[3];
         double d = closest_on_segment(p, b, c, tmp);
         if (d < best) {
@@ -76,14 +59,14 @@ double surface_closest_on_triangle(const double p[3], const double a[3], const d
         return best;
     }
     double ap[3], bp[3], cp[3];
-    sub3(ap, p, a);
-    double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
+    rs_sub3(p, a, ap);
+    double d1 = rs_dot3(ab, ap), d2 = rs_dot3(ac, ap);
     if (d1 <= 0 && d2 <= 0) {
         memcpy(q, a, sizeof q);
         goto done;
     }
-    sub3(bp, p, b);
-    double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
+    rs_sub3(p, b, bp);
+    double d3 = rs_dot3(ab, bp), d4 = rs_dot3(ac, bp);
     if (d3 >= 0 && d4 <= d3) {
         memcpy(q, b, sizeof q);
         goto done;
@@ -95,8 +78,8 @@ double surface_closest_on_triangle(const double p[3], const double a[3], const d
             q[k] = a[k] + t * ab[k];
         goto done;
     }
-    sub3(cp, p, c);
-    double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
+    rs_sub3(p, c, cp);
+    double d5 = rs_dot3(ab, cp), d6 = rs_dot3(ac, cp);
     if (d6 >= 0 && d5 <= d6) {
         memcpy(q, c, sizeof q);
         goto done;
@@ -118,7 +101,7 @@ double surface_closest_on_triangle(const double p[3], const double a[3], const d
     {
         /* Inside: the projection onto the plane. Ericson's a + v ab + w ac loses digits on slivers
          * (v and w are ratios of cancelling products), which would put q off the plane. */
-        double s = dot3(ap, n) / dot3(n, n);
+        double s = rs_dot3(ap, n) / rs_dot3(n, n);
         for (int k = 0; k < 3; k++)
             q[k] = p[k] - s * n[k];
     }
@@ -130,7 +113,7 @@ done:
 
 /* ---- the grid -------------------------------------------------------------------------------- */
 
-struct surface_index {
+struct rs_surface_index {
     size_t triangle_count;
     double *corners;          /* 9 per triangle: copies, so queries touch one cache line run */
     double origin[3];         /* lower corner of the grid (the bounding box of all corners) */
@@ -143,7 +126,7 @@ struct surface_index {
 
 /* Cell of coordinate x along an axis, clamped into the grid; the same rule for insertion and
  * queries, so a point of a triangle always lies in a cell that lists the triangle. */
-static long cell_of(const surface_index *ix, int axis, double x) {
+static long cell_of(const rs_surface_index *ix, int axis, double x) {
     double t = (x - ix->origin[axis]) / ix->cell;
     if (!(t >= 0))
         return 0;
@@ -160,7 +143,7 @@ static void triangle_bounds(const double *tri, double lo[3], double hi[3]) {
 }
 
 /* Dimensions for cell size `cell`; false when they exceed `max_cells` in all. */
-static bool set_dims(surface_index *ix, double cell, size_t max_cells) {
+static bool set_dims(rs_surface_index *ix, double cell, size_t max_cells) {
     ix->cell = cell;
     size_t total = 1;
     for (int k = 0; k < 3; k++) {
@@ -176,7 +159,7 @@ static bool set_dims(surface_index *ix, double cell, size_t max_cells) {
 }
 
 /* Triangle-to-cell references for the current cell size, or SIZE_MAX beyond `limit`. */
-static size_t count_references(const surface_index *ix, size_t limit) {
+static size_t count_references(const rs_surface_index *ix, size_t limit) {
     size_t total = 0;
     for (size_t t = 0; t < ix->triangle_count; t++) {
         double lo[3], hi[3];
@@ -191,18 +174,18 @@ static size_t count_references(const surface_index *ix, size_t limit) {
     return total;
 }
 
-surface_index *surface_index_build(const double *xyz, size_t vertex_count,
-                                   const uint32_t *triangles, size_t triangle_count) {
+rs_surface_index *rs_surface_index_build(const double *xyz, size_t vertex_count,
+                                         const uint32_t *triangles, size_t triangle_count) {
     if ((triangle_count > 0 && (!xyz || !triangles)) || triangle_count > UINT32_MAX ||
         triangle_count > SIZE_MAX / (9 * sizeof(double)))
         return NULL;
-    surface_index *ix = calloc(1, sizeof *ix);
+    rs_surface_index *ix = rs_calloc_array(1, sizeof *ix);
     if (!ix)
         return NULL;
     ix->triangle_count = triangle_count;
     if (triangle_count == 0)
         return ix;
-    ix->corners = malloc(triangle_count * 9 * sizeof *ix->corners);
+    ix->corners = rs_alloc_array(triangle_count, 9 * sizeof *ix->corners);
     if (!ix->corners)
         goto fail;
     double extent_sum = 0;
@@ -251,8 +234,8 @@ surface_index *surface_index_build(const double *xyz, size_t vertex_count,
         cell *= 1.25;
     }
     size_t cell_count = (size_t)ix->dims[0] * (size_t)ix->dims[1] * (size_t)ix->dims[2];
-    ix->cell_start = calloc(cell_count + 1, sizeof *ix->cell_start);
-    ix->cell_triangles = malloc((refs ? refs : 1) * sizeof *ix->cell_triangles);
+    ix->cell_start = rs_calloc_array(cell_count + 1, sizeof *ix->cell_start);
+    ix->cell_triangles = rs_alloc_array(refs ? refs : 1, sizeof *ix->cell_triangles);
     if (!ix->cell_start || !ix->cell_triangles)
         goto fail;
     /* Two passes (count, then fill) give compact per-cell lists without per-cell allocations. */
@@ -288,17 +271,17 @@ surface_index *surface_index_build(const double *xyz, size_t vertex_count,
     }
     return ix;
 fail:
-    surface_index_free(ix);
+    rs_surface_index_free(ix);
     return NULL;
 }
 
-void surface_index_free(surface_index *index) {
+void rs_surface_index_free(rs_surface_index *index) {
     if (!index)
         return;
-    free(index->corners);
-    free(index->cell_start);
-    free(index->cell_triangles);
-    free(index);
+    rs_free(index->corners);
+    rs_free(index->cell_start);
+    rs_free(index->cell_triangles);
+    rs_free(index);
 }
 
 typedef struct query_state {
@@ -308,13 +291,13 @@ typedef struct query_state {
     size_t triangle;
 } query_state;
 
-static void visit_cell(const surface_index *ix, long x, long y, long z, query_state *q) {
+static void visit_cell(const rs_surface_index *ix, long x, long y, long z, query_state *q) {
     size_t cidx = ((size_t)z * (size_t)ix->dims[1] + (size_t)y) * (size_t)ix->dims[0] + (size_t)x;
     for (size_t i = ix->cell_start[cidx]; i < ix->cell_start[cidx + 1]; i++) {
         uint32_t t = ix->cell_triangles[i];
         const double *tri = ix->corners + 9 * (size_t)t;
         double c[3];
-        double d = surface_closest_on_triangle(q->p, tri, tri + 3, tri + 6, c);
+        double d = rs_closest_on_triangle(q->p, tri, tri + 3, tri + 6, c);
         /* Ties go to the lower triangle number, so the answer does not depend on visiting order. */
         if (d < q->best || (d == q->best && t < q->triangle)) {
             q->best = d;
@@ -328,8 +311,8 @@ static void visit_cell(const surface_index *ix, long x, long y, long z, query_st
  * Chebyshev distance r of c0 (all of them already visited); -1 when that box is the whole grid. A
  * point of such a cell lies beyond one face of the box along some axis and inside the grid along
  * the others. */
-static double unvisited_bound2(const surface_index *ix, const double p[3], const long c0[3], long r,
-                               const double outside2[3]) {
+static double unvisited_bound2(const rs_surface_index *ix, const double p[3], const long c0[3],
+                               long r, const double outside2[3]) {
     double total_out2 = outside2[0] + outside2[1] + outside2[2], bound2 = -1;
     for (int k = 0; k < 3; k++) {
         double others = total_out2 - outside2[k], face = -1;
@@ -351,12 +334,12 @@ static double unvisited_bound2(const surface_index *ix, const double p[3], const
     return bound2;
 }
 
-double surface_index_query(const surface_index *index, const double point[3], double closest[3],
-                           size_t *triangle) {
+double rs_surface_index_query(const rs_surface_index *index, const double point[3],
+                              double closest[3], size_t *triangle) {
     if (!index || index->triangle_count == 0 || !isfinite(point[0]) || !isfinite(point[1]) ||
         !isfinite(point[2]))
         return INFINITY;
-    const surface_index *ix = index;
+    const rs_surface_index *ix = index;
     query_state q = {point, INFINITY, {0, 0, 0}, SIZE_MAX};
     long c0[3];
     double outside2[3];
@@ -401,106 +384,4 @@ double surface_index_query(const surface_index *index, const double point[3], do
     if (triangle)
         *triangle = q.triangle;
     return sqrt(q.best);
-}
-
-/* ---- metrics --------------------------------------------------------------------------------- */
-
-int mesh_metrics_compute(const double *result_xyz, const double *truth_xyz, size_t vertex_count,
-                         const uint32_t *triangles, size_t triangle_count, mesh_metrics *out) {
-    if (!result_xyz || !truth_xyz || !triangles || !out || vertex_count == 0 ||
-        triangle_count == 0 || vertex_count > UINT32_MAX || triangle_count > SIZE_MAX / 24)
-        return -1;
-    for (size_t i = 0; i < 3 * vertex_count; i++)
-        if (!isfinite(result_xyz[i]) || !isfinite(truth_xyz[i]))
-            return -1;
-    for (size_t i = 0; i < 3 * triangle_count; i++)
-        if (triangles[i] >= vertex_count)
-            return -1;
-
-    int status = -1;
-    double *area = calloc(vertex_count, sizeof *area);
-    bool *used = calloc(vertex_count, sizeof *used);
-    surface_index *truth_surface = NULL, *result_surface = NULL;
-    if (!area || !used)
-        goto done;
-    memset(out, 0, sizeof *out);
-    out->vertex_count = vertex_count;
-    out->triangle_count = triangle_count;
-
-    /* A read-only view: shape_mean_edge_length writes nothing through it. It counts edges as
-     * rsmooth_mean_edge_length does (the unit of the filter's sigmas). */
-    shape_mesh truth = {vertex_count, (double *)truth_xyz, triangle_count, (uint32_t *)triangles};
-    out->mean_edge = shape_mean_edge_length(&truth);
-    if (isnan(out->mean_edge))
-        goto done;
-    double lo[3], hi[3];
-    for (int k = 0; k < 3; k++) {
-        lo[k] = INFINITY;
-        hi[k] = -INFINITY;
-    }
-    double sum2 = 0;
-    for (size_t v = 0; v < vertex_count; v++) {
-        for (int k = 0; k < 3; k++) {
-            lo[k] = fmin(lo[k], truth_xyz[3 * v + k]);
-            hi[k] = fmax(hi[k], truth_xyz[3 * v + k]);
-        }
-        sum2 += dist2_3(result_xyz + 3 * v, truth_xyz + 3 * v);
-    }
-    out->bbox_diag = sqrt(dist2_3(lo, hi));
-    out->rms_v = sqrt(sum2 / (double)vertex_count) / out->mean_edge;
-
-    /* theta with atan2(|n1 x n2|, n1 . n2): exact for small angles, where acos of a dot product
-     * near 1 loses half the digits, and it needs no normalisation. */
-    double angle_sum = 0;
-    size_t angle_count = 0;
-    for (size_t t = 0; t < triangle_count; t++) {
-        const uint32_t *f = triangles + 3 * t;
-        double e1[3], e2[3], nr[3], nt[3], x[3];
-        sub3(e1, result_xyz + 3 * (size_t)f[1], result_xyz + 3 * (size_t)f[0]);
-        sub3(e2, result_xyz + 3 * (size_t)f[2], result_xyz + 3 * (size_t)f[0]);
-        cross3(nr, e1, e2);
-        sub3(e1, truth_xyz + 3 * (size_t)f[1], truth_xyz + 3 * (size_t)f[0]);
-        sub3(e2, truth_xyz + 3 * (size_t)f[2], truth_xyz + 3 * (size_t)f[0]);
-        cross3(nt, e1, e2);
-        double len_r = sqrt(dot3(nr, nr));
-        for (int c = 0; c < 3; c++) {
-            area[f[c]] += 0.5 * len_r;
-            used[f[c]] = true;
-        }
-        if (!(len_r > 0) || !(dot3(nt, nt) > 0))
-            continue; /* no normal: the script's NaN, skipped there too */
-        cross3(x, nr, nt);
-        angle_sum += atan2(sqrt(dot3(x, x)), dot3(nr, nt));
-        angle_count++;
-    }
-    out->theta_count = angle_count;
-    out->theta =
-        angle_count ? angle_sum / (double)angle_count * (180.0 / 3.14159265358979323846) : NAN;
-
-    truth_surface = surface_index_build(truth_xyz, vertex_count, triangles, triangle_count);
-    result_surface = surface_index_build(result_xyz, vertex_count, triangles, triangle_count);
-    if (!truth_surface || !result_surface)
-        goto done;
-    double weighted = 0, weight = 0, farthest = 0;
-    for (size_t v = 0; v < vertex_count; v++) {
-        if (!used[v])
-            continue;
-        double d = surface_index_query(truth_surface, result_xyz + 3 * v, NULL, NULL);
-        farthest = fmax(farthest, d);
-        if (area[v] > 0) {
-            weighted += area[v] * d * d;
-            weight += area[v];
-        }
-        farthest =
-            fmax(farthest, surface_index_query(result_surface, truth_xyz + 3 * v, NULL, NULL));
-    }
-    out->ev = weight > 0 ? sqrt(weighted / weight) / out->bbox_diag * 1e3 : NAN;
-    out->hausdorff = farthest / out->bbox_diag * 1e3;
-    status = 0;
-done:
-    surface_index_free(truth_surface);
-    surface_index_free(result_surface);
-    free(area);
-    free(used);
-    return status;
 }
