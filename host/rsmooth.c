@@ -407,8 +407,16 @@ static int list_devices(void) {
     rsmooth_device_info devices[64];
     size_t n = rsmooth_list_devices(devices, 64);
     if (n == 0) {
-        printf("no OpenCL device (install an OpenCL driver, e.g. pocl-opencl-icd); "
-               "--device reference still works\n");
+        /* why: no OpenCL loader, or a loader without platforms. With no device to build for,
+         * asking for a context fails at once and says which. */
+        rsmooth_context *ctx = NULL;
+        rsmooth_error err;
+        if (rsmooth_context_create("auto", &ctx, &err) == RSMOOTH_ERROR_NO_DEVICE)
+            printf("%s; --device reference still works\n", err.message);
+        else
+            printf("no OpenCL device (install an OpenCL driver, e.g. pocl-opencl-icd); "
+                   "--device reference still works\n");
+        rsmooth_context_destroy(ctx);
         return EXIT_OK;
     }
     printf("%-5s %-5s %-60s %6s %9s  %s\n", "P:D", "type", "name", "units", "memory", "version");

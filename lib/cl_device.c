@@ -110,6 +110,8 @@ static int list_devices(candidate *out, int capacity) {
 }
 
 size_t rsmooth_list_devices(rsmooth_device_info *devices, size_t capacity) {
+    if (rs_cl_load("rsmooth_list_devices", NULL) != RSMOOTH_OK)
+        return 0; /* no loader: no platform either */
     candidate all[MAX_DEVICES];
     int n = list_devices(all, MAX_DEVICES);
     for (int i = 0; i < n && devices && (size_t)i < capacity; i++) {
@@ -297,8 +299,11 @@ rsmooth_status rsmooth_context_create(const char *device, rsmooth_context **out,
         device = getenv("RSMOOTH_DEVICE");
     if (!device)
         device = "auto";
+    rsmooth_status st = rs_cl_load(where, error);
+    if (st != RSMOOTH_OK)
+        return st;
     candidate chosen;
-    rsmooth_status st = pick_device(device, &chosen, error);
+    st = pick_device(device, &chosen, error);
     if (st != RSMOOTH_OK)
         return st;
     rsmooth_context *ctx = new_context();
@@ -341,6 +346,10 @@ rsmooth_status rsmooth_context_create_from_queue(cl_command_queue queue, rsmooth
     *out = NULL;
     if (!queue)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "queue is NULL");
+    /* the caller's queue came from a loader it linked: the same library, opened once more */
+    rsmooth_status st = rs_cl_load(where, error);
+    if (st != RSMOOTH_OK)
+        return st;
     cl_context context = NULL;
     cl_device_id device = NULL;
     cl_int err = clGetCommandQueueInfo(queue, CL_QUEUE_CONTEXT, sizeof context, &context, NULL);
@@ -368,7 +377,7 @@ rsmooth_status rsmooth_context_create_from_queue(cl_command_queue queue, rsmooth
     clGetPlatformInfo(platform, CL_PLATFORM_NAME, sizeof platform_name - 1, platform_name, NULL);
     clGetDeviceInfo(device, CL_DEVICE_NAME, sizeof device_name - 1, device_name, NULL);
     snprintf(ctx->device_name, sizeof ctx->device_name, "%s / %s", platform_name, device_name);
-    rsmooth_status st = read_memory_limits(ctx, error);
+    st = read_memory_limits(ctx, error);
     if (st == RSMOOTH_OK)
         st = rs_cl_build_program(ctx, error);
     if (st != RSMOOTH_OK) {

@@ -11,6 +11,7 @@
 #define CL_TARGET_OPENCL_VERSION 120
 #endif
 #include <CL/cl.h>
+#include "cl_loader.h" /* the cl* calls below go to the loader opened at run time */
 #include <pthread.h>
 
 /* Vertices per block: the vector width the kernels use across vertices (float8, kernels/common.cl). */

@@ -78,7 +78,8 @@ typedef enum rsmooth_status {
     RSMOOTH_ERROR_OUT_OF_MEMORY = 2,    /* host allocation failed, or a size overflows size_t */
     RSMOOTH_ERROR_IO = 3,               /* a file could not be opened, read or written */
     RSMOOTH_ERROR_PARSE = 4,            /* a mesh file is malformed */
-    RSMOOTH_ERROR_NO_DEVICE = 5,        /* no OpenCL platform, or no device matches the choice */
+    RSMOOTH_ERROR_NO_DEVICE = 5,        /* no OpenCL loader or platform, or no device matches the
+                                         * choice */
     RSMOOTH_ERROR_KERNEL_BUILD = 6,     /* the OpenCL program failed to build (see build_log) */
     RSMOOTH_ERROR_OPENCL = 7,           /* an OpenCL call failed (see cl_error and where) */
     RSMOOTH_ERROR_UNSUPPORTED = 8,      /* valid request this build or device cannot do */
@@ -462,6 +463,10 @@ typedef struct rsmooth_context rsmooth_context;
  * The program is built here (PoCL caches binaries on disk in POCL_CACHE_DIR). Developers may set
  * RSMOOTH_KERNEL_DIR to load kernels/ *.cl from a directory instead of the embedded copies, and
  * RSMOOTH_BUILD_OPTIONS to append OpenCL build options.
+ * The OpenCL loader is opened on the first call that needs it (the library does not link it):
+ * RSMOOTH_OPENCL_LIBRARY names its file when set and non-empty, else libOpenCL.so.1 (OpenCL.dll,
+ * the OpenCL framework); where it cannot be opened, this returns RSMOOTH_ERROR_NO_DEVICE saying
+ * so and rsmooth_list_devices 0, while the reference path works.
  * Returns RSMOOTH_ERROR_NO_DEVICE, RSMOOTH_ERROR_KERNEL_BUILD, RSMOOTH_ERROR_OPENCL, ... with *ctx
  * set to NULL on failure. Thread-safe. A context may be shared by threads: its calls are
  * serialised (each holds the context while it runs), so threads sharing one wait for each other;
