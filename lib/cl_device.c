@@ -12,6 +12,8 @@
 #define MAX_DEVICES 64
 
 rsmooth_status rs_cl_fail(rsmooth_error *error, cl_int code, const char *call, const char *what) {
+    if (code == RS_CL_CANCELLED)
+        return rs_cancelled(error, "rsmooth_smooth");
     rsmooth_status st =
         rs_fail(error, RSMOOTH_ERROR_OPENCL, call, "%s failed with %s (%d)%s%s", call,
                 rs_cl_error_name(code), (int)code, what ? ": " : "", what ? what : "");
@@ -125,7 +127,11 @@ size_t rsmooth_list_devices(rsmooth_device_info *devices, size_t capacity) {
                            : (all[i].type & CL_DEVICE_TYPE_ACCELERATOR) ? "accel"
                                                                         : "other";
         snprintf(d->type, sizeof d->type, "%s", type);
-        clGetDeviceInfo(all[i].device, CL_DEVICE_VERSION, sizeof d->version - 1, d->version, NULL);
+        /* PoCL's version ("OpenCL 3.0 PoCL HSTR: pthread-x86_64-...") outgrows the field: a
+         * short buffer is CL_INVALID_VALUE and an empty version, so read it whole and cut */
+        char version[1024] = "";
+        clGetDeviceInfo(all[i].device, CL_DEVICE_VERSION, sizeof version - 1, version, NULL);
+        snprintf(d->version, sizeof d->version, "%s", version);
         cl_uint units = 0;
         cl_ulong memory = 0;
         clGetDeviceInfo(all[i].device, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof units, &units, NULL);

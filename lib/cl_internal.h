@@ -104,6 +104,10 @@ rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *problem,
 /* Builds the program from the embedded kernels (or RSMOOTH_KERNEL_DIR) and creates the kernels. */
 rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error);
 
+/* What rs_cl_run_1d returns when the caller's progress_cancel asked to stop: positive, so never
+ * an OpenCL code; rs_cl_fail turns it into RSMOOTH_ERROR_CANCELLED. */
+#define RS_CL_CANCELLED 1
+
 /* Records an OpenCL failure: status RSMOOTH_ERROR_OPENCL with the raw code and failing call. */
 rsmooth_status rs_cl_fail(rsmooth_error *error, cl_int code, const char *call, const char *what);
 

@@ -307,7 +307,8 @@ static rsmooth_status build_grid(const rs_problem *pb, rs_grid *grid, rsmooth_er
 cl_int rs_cl_run_1d(rsmooth_context *ctx, const rs_problem *pb, cl_kernel kernel, size_t count,
                     double from, double to) {
     size_t local = ctx->local_size;
-    size_t slices = pb->progress && count > PROGRESS_SLICES * local ? PROGRESS_SLICES : 1;
+    bool reports = pb->progress || pb->progress_cancel;
+    size_t slices = reports && count > PROGRESS_SLICES * local ? PROGRESS_SLICES : 1;
     size_t slice = (count + slices - 1) / slices;
     slice = (slice + local - 1) / local * local;
     cl_event done[PROGRESS_SLICES];
@@ -327,11 +328,16 @@ cl_int rs_cl_run_1d(rsmooth_context *ctx, const rs_problem *pb, cl_kernel kernel
     for (size_t i = 0; i < enqueued; i++) {
         if (err == CL_SUCCESS)
             err = clWaitForEvents(1, &done[i]);
-        if (err == CL_SUCCESS)
-            rs_progress(pb, from + (to - from) * (double)ends[i] / (double)count);
+        /* the last slice reports `to` itself, so the next launch's first report never lies
+         * below it by a rounding */
+        double at = ends[i] == count ? to : from + (to - from) * ((double)ends[i] / (double)count);
+        if (err == CL_SUCCESS && !rs_progress(pb, at))
+            err = RS_CL_CANCELLED;
         clReleaseEvent(done[i]);
     }
-    return err == CL_SUCCESS ? clFinish(ctx->queue) : err;
+    /* the slices still queued after a cancel finish before their buffers are released */
+    cl_int finished = clFinish(ctx->queue);
+    return err == CL_SUCCESS ? finished : err;
 }
 
 typedef struct result_job {

@@ -432,6 +432,7 @@ void rs_problem_apply_params(rs_problem *problem, const rsmooth_params *p, doubl
     problem->colors = isinf(p->sigma_c) ? NULL : p->colors; /* +INFINITY: the factor is 1 */
     problem->sigma_c = p->sigma_c;
     problem->progress = p->progress;
+    problem->progress_cancel = p->progress_cancel;
     problem->progress_user = p->progress_user;
     if (!(problem->sigma_f > 0) || !isfinite(problem->radius) || !isfinite(problem->normal_radius))
         problem->facet_count = 0; /* no edge of non-zero length: nothing can move */

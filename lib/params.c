@@ -30,6 +30,7 @@ rsmooth_status rsmooth_params_init(rsmooth_params *params) {
     params->pass_confidence = 0.0;
     params->colors = NULL;
     params->sigma_c = 0.1;
+    params->progress_cancel = NULL;
     return RSMOOTH_OK;
 }
 

@@ -7,9 +7,17 @@
 #include <math.h>
 #include <string.h>
 
-void rs_report_pass_progress(void *user, double fraction) {
+int rs_report_pass_progress(void *user, double fraction) {
     const rs_pass_progress *pp = user;
-    pp->progress(pp->user, ((double)pp->pass + fraction) / (double)pp->count);
+    double whole = ((double)pp->pass + fraction) / (double)pp->count;
+    if (pp->progress)
+        pp->progress(pp->user, whole);
+    return pp->cancel ? pp->cancel(pp->user, whole) : 0;
+}
+
+rsmooth_status rs_cancelled(rsmooth_error *error, const char *where) {
+    return rs_fail(error, RSMOOTH_ERROR_CANCELLED, where,
+                   "cancelled: the progress_cancel callback asked to stop");
 }
 
 void rs_add_pass_report(rsmooth_report *sum, const rsmooth_report *pass) {
@@ -68,10 +76,10 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
     }
     int passes = p.passes;
     p.passes = 1;
-    rs_pass_progress pp = {params ? params->progress : NULL, params ? params->progress_user : NULL, 0,
-                        passes};
-    if (pp.progress) {
-        p.progress = rs_report_pass_progress;
+    rs_pass_progress pp = {p.progress, p.progress_cancel, p.progress_user, 0, passes};
+    if (pp.progress || pp.cancel) {
+        p.progress = NULL;
+        p.progress_cancel = rs_report_pass_progress;
         p.progress_user = &pp;
     }
     if (passes == 1)

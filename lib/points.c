@@ -224,15 +224,18 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
     double unit = 0, input_spacing = 0;
     if (p.mollify) /* the one normal filter points have */
         p.normal_filter = RSMOOTH_NORMALS_BILATERAL;
-    rs_pass_progress pp = {p.progress, p.progress_user, 0, p.passes};
+    rs_pass_progress pp = {p.progress, p.progress_cancel, p.progress_user, 0, p.passes};
+    bool reports = p.progress || p.progress_cancel;
     rsmooth_report sum, one;
     memset(&sum, 0, sizeof sum);
     size_t weighted_points = 0;
     for (int pass = 0; pass < p.passes; pass++) {
         double t_pass = rs_now_ms();
         pp.pass = pass;
-        if (pp.progress)
-            pp.progress(pp.user, (double)pass / (double)p.passes);
+        if (reports && rs_report_pass_progress(&pp, 0) != 0) {
+            st = rs_cancelled(error, where);
+            goto done;
+        }
         if (!rs_kdtree_build(&tree, a.xyz, n))
             goto fail_memory;
         double spacing = point_spacings(&tree, a.spacing);
@@ -263,7 +266,8 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
         pb.mean_area = area_sum / (double)n;
         rs_problem_apply_params(&pb, &p, unit);
         pb.facet_color = pb.colors ? a.color : NULL;
-        pb.progress = pp.progress ? rs_report_pass_progress : NULL;
+        pb.progress = NULL;
+        pb.progress_cancel = reports ? rs_report_pass_progress : NULL;
         pb.progress_user = &pp;
         rs_kdtree_free(&tree);
 

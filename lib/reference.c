@@ -323,8 +323,9 @@ rsmooth_status rs_reference_solve(const rs_problem *problem, rsmooth_scalar scal
             if (!gather(&pb, &grid, pb.xyz + 3 * v, pb.mollify_radius, &nb))
                 goto fail_memory;
             mollify_vertex(&pb, &nb, pb.xyz + 3 * v, mollified + 3 * v);
-            if (v % PROGRESS_STEP == 0)
-                rs_progress(&pb, MOLLIFY_SHARE * (double)v / (double)vertex_count);
+            if (v % PROGRESS_STEP == 0 &&
+                !rs_progress(&pb, MOLLIFY_SHARE * (double)v / (double)vertex_count))
+                goto cancelled;
         }
         t_mollify = rs_now_ms();
         for (size_t q = 0; q < pb.facet_count; q++)
@@ -342,8 +343,9 @@ rsmooth_status rs_reference_solve(const rs_problem *problem, rsmooth_scalar scal
         const double *p = pb.xyz + 3 * v;
         if (!gather(&pb, &grid, p, pb.radius, &nb))
             goto fail_memory;
-        if (v % PROGRESS_STEP == 0)
-            rs_progress(&pb, robust_start + (1 - robust_start) * (double)v / (double)vertex_count);
+        if (v % PROGRESS_STEP == 0 &&
+            !rs_progress(&pb, robust_start + (1 - robust_start) * (double)v / (double)vertex_count))
+            goto cancelled;
         double disp[3], k, kf;
         const float *color = pb.facet_color ? pb.colors + 3 * v : NULL;
         estimate_vertex(&pb, &nb, normals, p, color, disp, &k, &kf);
@@ -371,6 +373,9 @@ done:
     st = RSMOOTH_OK;
     goto cleanup;
 
+cancelled:
+    st = rs_cancelled(error, where);
+    goto cleanup;
 fail_memory:
     st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "out of memory");
 fail:

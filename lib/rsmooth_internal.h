@@ -121,14 +121,21 @@ typedef struct rs_problem {
                                   * facet data (reference path), owned */
     double sigma_c;              /* colour width, finite when colors is not NULL */
     rsmooth_progress_fn progress; /* optional, from the params */
+    rsmooth_progress_cancel_fn progress_cancel; /* optional, from the params */
     void *progress_user;
 } rs_problem;
 
-/* Reports progress `fraction` if the caller asked for it. */
-static inline void rs_progress(const rs_problem *problem, double fraction) {
+/* Reports progress `fraction` to whichever callbacks the caller gave; false when the caller asks
+ * to stop (then the path returns rs_cancelled's status). */
+static inline bool rs_progress(const rs_problem *problem, double fraction) {
     if (problem->progress)
         problem->progress(problem->progress_user, fraction);
+    return !problem->progress_cancel ||
+           problem->progress_cancel(problem->progress_user, fraction) == 0;
 }
+
+/* RSMOOTH_ERROR_CANCELLED, said so in `error`. */
+rsmooth_status rs_cancelled(rsmooth_error *error, const char *where);
 
 /* Checks every argument of a smoothing call (nothing is written on failure), converts positions to
  * double, finds the facets, computes the mean edge length and area and the absolute parameters,
@@ -334,10 +341,12 @@ rsmooth_status rs_reference_solve(const rs_problem *problem, rsmooth_scalar scal
  * is the callback to give the pass, with this as its user pointer). */
 typedef struct rs_pass_progress {
     rsmooth_progress_fn progress;
+    rsmooth_progress_cancel_fn cancel;
     void *user;
     int pass, count;
 } rs_pass_progress;
-void rs_report_pass_progress(void *user, double fraction);
+/* A progress_cancel callback: forwards to both of the caller's, the fraction rescaled. */
+int rs_report_pass_progress(void *user, double fraction);
 
 /* Adds one pass's stage times and work to `sum`, the passes' so far (all zero before the first):
  * counts, sigmas and device from the last pass, the facet count from the first. */

@@ -27,6 +27,8 @@ const char *rsmooth_status_str(rsmooth_status status) {
         return "unsupported";
     case RSMOOTH_ERROR_NUMERICAL:
         return "result not representable";
+    case RSMOOTH_ERROR_CANCELLED:
+        return "cancelled";
     }
     return "unknown status";
 }

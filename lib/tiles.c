@@ -33,14 +33,13 @@ typedef struct tiler {
 
 /* A tile's progress mapped into the whole call's. */
 typedef struct tile_progress {
-    rsmooth_progress_fn fn;
-    void *user;
+    const rs_problem *whole;
     double from, span;
 } tile_progress;
 
-static void report_tile_progress(void *user, double fraction) {
+static int report_tile_progress(void *user, double fraction) {
     const tile_progress *tp = user;
-    tp->fn(tp->user, tp->from + tp->span * fraction);
+    return !rs_progress(tp->whole, tp->from + tp->span * fraction);
 }
 
 static double halo_radius(const rs_problem *pb, double reach);
@@ -151,11 +150,11 @@ static rsmooth_status run_tile(tiler *t, const uint32_t *verts, size_t n, const 
     sub.indices = indices;
     sub.triangle_count = sub.facet_count = m;
 
-    tile_progress tp = {w->progress, w->progress_user,
-                        (double)t->vertices_done / (double)w->vertex_count,
+    tile_progress tp = {w, (double)t->vertices_done / (double)w->vertex_count,
                         (double)n / (double)w->vertex_count};
-    if (w->progress) {
-        sub.progress = report_tile_progress;
+    if (w->progress || w->progress_cancel) {
+        sub.progress = NULL;
+        sub.progress_cancel = report_tile_progress;
         sub.progress_user = &tp;
     }
     rs_result_sink sink = *t->sink;

@@ -47,8 +47,8 @@
 #include <stdint.h>
 
 #define RSMOOTH_VERSION_MAJOR 0
-#define RSMOOTH_VERSION_MINOR 4
-#define RSMOOTH_VERSION_PATCH 1
+#define RSMOOTH_VERSION_MINOR 5
+#define RSMOOTH_VERSION_PATCH 0
 
 #if defined(_WIN32)
 #if defined(RSMOOTH_BUILDING_LIBRARY) && defined(RSMOOTH_SHARED)
@@ -83,10 +83,12 @@ typedef enum rsmooth_status {
     RSMOOTH_ERROR_KERNEL_BUILD = 6,     /* the OpenCL program failed to build (see build_log) */
     RSMOOTH_ERROR_OPENCL = 7,           /* an OpenCL call failed (see cl_error and where) */
     RSMOOTH_ERROR_UNSUPPORTED = 8,      /* valid request this build or device cannot do */
-    RSMOOTH_ERROR_NUMERICAL = 9         /* a result would not be finite in the output's type (a
+    RSMOOTH_ERROR_NUMERICAL = 9,        /* a result would not be finite in the output's type (a
                                          * float32 position beyond FLT_MAX, k(p) beyond float's
                                          * range): nothing non-finite is ever returned as OK.
                                          * (Added in 0.4.1) */
+    RSMOOTH_ERROR_CANCELLED = 10        /* the caller's progress_cancel callback asked to stop
+                                         * (Added in 0.5) */
 } rsmooth_status;
 
 /* Static, human-readable text for a status. Never NULL; thread-safe. */
@@ -117,6 +119,13 @@ typedef enum rsmooth_scalar {
  * the calling thread between pieces of work (the OpenCL path then launches its kernels in slices,
  * which does not change the result). */
 typedef void (*rsmooth_progress_fn)(void *user, double fraction);
+
+/* The same report, answered: return 0 to go on, non-zero to stop the call, which then returns
+ * RSMOOTH_ERROR_CANCELLED at once (the OpenCL path after the kernel slice under way; reports come
+ * every 1/32 of a kernel launch, every 4096 vertices on the reference path). The outputs are
+ * then undefined: they may be partly written. This is how a host application offers a Cancel
+ * button, or a Python binding lets Ctrl-C through. Called on the calling thread. */
+typedef int (*rsmooth_progress_cancel_fn)(void *user, double fraction);
 
 /* What each nearby triangle q predicts for a vertex p. */
 typedef enum rsmooth_predictor {
@@ -201,6 +210,9 @@ typedef struct rsmooth_params {
     double sigma_c;               /* colour width, in the colours' units, > 0; +INFINITY turns the
                                    * colour factor off (the result is then exactly that of colors
                                    * = NULL). Default 0.1 */
+    rsmooth_progress_cancel_fn progress_cancel; /* optional (NULL, default): progress reports that
+                                   * may stop the call (see the type); called with progress_user,
+                                   * after `progress` when both are set. (Added in 0.5) */
 } rsmooth_params;
 
 /* Fills `params` with the defaults above. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if params is NULL. */
