@@ -8,7 +8,7 @@ FUZZ_SECONDS ?= 60
 FUZZ_BUILD ?= $(BUILD)-fuzz
 FUZZERS = obj ply off stl auto
 
-.PHONY: all deps configure build demo experiments check sanitize fuzz install clean
+.PHONY: all deps configure build demo experiments check python-check sanitize fuzz install clean
 
 all: build
 
@@ -39,6 +39,13 @@ experiments: build
 
 check: build
 	cd $(BUILD) && ctest --output-on-failure
+
+# The Python package (pyproject.toml, python/): `pip install .` into a fresh virtual environment,
+# the pytest suite tests/python/ against the command just built, and the wheel from `pip wheel`
+# in a second environment (.ci/python-check.sh; PyPI must be reachable).
+python-check: build
+	@.ci/install-deps.sh python
+	.ci/python-check.sh python3 $(BUILD) $(WERROR)
 
 # The whole suite again under AddressSanitizer and UndefinedBehaviorSanitizer (Debug build).
 sanitize: deps
@@ -75,4 +82,4 @@ install: build
 	cmake --install $(BUILD)
 
 clean:
-	rm -rf $(BUILD) $(BUILD)-sanitize $(FUZZ_BUILD) out
+	rm -rf $(BUILD) $(BUILD)-sanitize $(BUILD)-python $(FUZZ_BUILD) out

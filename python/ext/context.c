@@ -1,0 +1,92 @@
+/* OpenCL devices and contexts. A context lives in a capsule that destroys it when the last
+ * reference goes; the library serialises calls on one context, so threads may share it. */
+#include "ext.h"
+
+#include <stdlib.h>
+
+static const char capsule_name[] = "rsmooth.context";
+
+static void destroy_capsule(PyObject *capsule) {
+    rsmooth_context_destroy(PyCapsule_GetPointer(capsule, capsule_name));
+}
+
+rsmooth_context *ext_context_from(PyObject *obj) {
+    if (!PyCapsule_IsValid(obj, capsule_name)) {
+        PyErr_SetString(PyExc_TypeError, "context: expected an rsmooth context capsule");
+        return NULL;
+    }
+    return PyCapsule_GetPointer(obj, capsule_name);
+}
+
+/* _context_create(device or None) -> capsule. Builds the kernels (seconds on a cold cache) with
+ * the GIL released. */
+PyObject *ext_context_create(PyObject *self, PyObject *args) {
+    (void)self;
+    const char *device = NULL;
+    if (!PyArg_ParseTuple(args, "z", &device))
+        return NULL;
+    rsmooth_context *ctx = NULL;
+    rsmooth_error err;
+    rsmooth_status st;
+    Py_BEGIN_ALLOW_THREADS
+    st = rsmooth_context_create(device, &ctx, &err);
+    Py_END_ALLOW_THREADS
+    if (st != RSMOOTH_OK)
+        return ext_raise(st, &err);
+    PyObject *capsule = PyCapsule_New(ctx, capsule_name, destroy_capsule);
+    if (!capsule)
+        rsmooth_context_destroy(ctx);
+    return capsule;
+}
+
+/* _context_info(capsule) -> (device name, build ms, memory budget bytes). */
+PyObject *ext_context_info(PyObject *self, PyObject *args) {
+    (void)self;
+    PyObject *capsule;
+    if (!PyArg_ParseTuple(args, "O", &capsule))
+        return NULL;
+    rsmooth_context *ctx = ext_context_from(capsule);
+    if (!ctx)
+        return NULL;
+    return Py_BuildValue("(sdK)", rsmooth_context_device_name(ctx), rsmooth_context_build_ms(ctx),
+                         (unsigned long long)rsmooth_context_memory_budget(ctx));
+}
+
+/* _devices() -> list of dicts, one per OpenCL device ([] without OpenCL). */
+PyObject *ext_devices(PyObject *self, PyObject *args) {
+    (void)self;
+    (void)args;
+    size_t count;
+    Py_BEGIN_ALLOW_THREADS
+    count = rsmooth_list_devices(NULL, 0);
+    Py_END_ALLOW_THREADS
+    rsmooth_device_info *info = count ? calloc(count, sizeof *info) : NULL;
+    if (count && !info)
+        return PyErr_NoMemory();
+    if (count) {
+        Py_BEGIN_ALLOW_THREADS
+        size_t again = rsmooth_list_devices(info, count);
+        count = again < count ? again : count;
+        Py_END_ALLOW_THREADS
+    }
+    PyObject *list = PyList_New(0);
+    for (size_t i = 0; list && i < count; i++) {
+        const rsmooth_device_info *d = info + i;
+        PyObject *item = Py_BuildValue(
+            "{s:s,s:i,s:i,s:s,s:s,s:I,s:K}", "id", "", "platform", d->platform_index, "device",
+            d->device_index, "name", d->name, "type", d->type, "compute_units", d->compute_units,
+            "global_memory", (unsigned long long)d->global_memory);
+        PyObject *id = item ? PyUnicode_FromFormat("%d:%d", d->platform_index, d->device_index)
+                            : NULL;
+        PyObject *version = item ? PyUnicode_FromString(d->version) : NULL;
+        if (!id || !version || PyDict_SetItemString(item, "id", id) != 0 ||
+            PyDict_SetItemString(item, "version", version) != 0 || PyList_Append(list, item) != 0) {
+            Py_CLEAR(list);
+        }
+        Py_XDECREF(id);
+        Py_XDECREF(version);
+        Py_XDECREF(item);
+    }
+    free(info);
+    return list;
+}

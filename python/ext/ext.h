@@ -1,0 +1,77 @@
+/* The rsmooth extension module (rsmooth._rsmooth): shared declarations. The module is built on
+ * the stable ABI (Py_LIMITED_API, set by python/CMakeLists.txt) and reads arrays through the
+ * buffer protocol, so it needs no numpy headers and one wheel serves every CPython from 3.11.
+ * The Python layer (python/rsmooth/__init__.py) converts dtypes, strides and index types and
+ * validates faces before it calls in; the functions here still check every buffer they get. */
+#ifndef RSMOOTH_EXT_H
+#define RSMOOTH_EXT_H
+
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include "rsmooth.h"
+
+/* rsmooth.DeviceError (a RuntimeError): the OpenCL device failed or is missing. */
+extern PyObject *ext_device_error;
+
+/* Raises the exception a failed call's status calls for, with the library's message; returns
+ * NULL. A pending Python exception (the progress callback raised, Ctrl-C) wins. */
+PyObject *ext_raise(rsmooth_status status, const rsmooth_error *error);
+
+/* ---- arrays (buffers.c) ---------------------------------------------------------------------- */
+
+typedef enum ext_kind {
+    EXT_FLOAT32, /* 'f' */
+    EXT_FLOAT64, /* 'd' */
+    EXT_REAL,    /* either of the two (which one goes to ext_array.scalar) */
+    EXT_UINT32   /* 'I' (or 'L' where that is 4 bytes) */
+} ext_kind;
+
+/* A C-contiguous array of `rows` x `cols` items held through the buffer protocol. */
+typedef struct ext_array {
+    Py_buffer view;
+    int held;
+    Py_ssize_t rows;
+    rsmooth_scalar scalar; /* EXT_REAL arrays */
+} ext_array;
+
+/* Acquires `obj` as a C-contiguous array of `cols` columns (cols 0: one dimension) of `kind`,
+ * writable if asked. None gives an empty array when `optional`. Returns 0, or -1 with TypeError
+ * or ValueError naming `name`. */
+int ext_array_get(PyObject *obj, const char *name, ext_kind kind, Py_ssize_t cols, int writable,
+                  int optional, ext_array *a);
+
+/* Releases the buffer (if held). */
+void ext_array_release(ext_array *a);
+
+/* ---- module functions ------------------------------------------------------------------------ */
+
+PyObject *ext_smooth(PyObject *self, PyObject *args, PyObject *kwargs);        /* filter.c */
+PyObject *ext_smooth_points(PyObject *self, PyObject *args, PyObject *kwargs); /* filter.c */
+PyObject *ext_taubin(PyObject *self, PyObject *args, PyObject *kwargs);        /* filter.c */
+PyObject *ext_default_params(PyObject *self, PyObject *args);                  /* params.c */
+PyObject *ext_params_auto(PyObject *self, PyObject *args);                     /* params.c */
+PyObject *ext_estimate_noise(PyObject *self, PyObject *args);                  /* measure.c */
+PyObject *ext_mean_edge_length(PyObject *self, PyObject *args);                /* measure.c */
+PyObject *ext_point_spacing(PyObject *self, PyObject *args);                   /* measure.c */
+PyObject *ext_compare(PyObject *self, PyObject *args);                         /* measure.c */
+PyObject *ext_devices(PyObject *self, PyObject *args);                         /* context.c */
+PyObject *ext_context_create(PyObject *self, PyObject *args);                  /* context.c */
+PyObject *ext_context_info(PyObject *self, PyObject *args);                    /* context.c */
+
+/* The rsmooth_context a capsule from ext_context_create holds; NULL with TypeError if `obj` is
+ * not one. */
+rsmooth_context *ext_context_from(PyObject *obj);
+
+/* ---- parameters (params.c) ------------------------------------------------------------------- */
+
+/* Fills `p` from a dict holding rsmooth_params' fields by name (every key must be one; missing
+ * keys keep rsmooth_params_init's values). Returns 0, or -1 with ValueError/TypeError. `colors`
+ * receives the held buffer of a "colors" entry (released by the caller). */
+int ext_params_from_dict(PyObject *dict, Py_ssize_t vertex_count, rsmooth_params *p,
+                         ext_array *colors);
+
+/* The dict of `p`'s fields (colors and callbacks left out). */
+PyObject *ext_params_to_dict(const rsmooth_params *p);
+
+#endif

@@ -1,0 +1,190 @@
+/* The filters, with the GIL released while they run. The library reports progress on the calling
+ * thread (rsmooth_progress_cancel_fn), so each report takes the GIL back for a moment: it runs
+ * Python's signal handlers (Ctrl-C raises KeyboardInterrupt there) and the caller's progress
+ * callable, and either raising stops the filter with RSMOOTH_ERROR_CANCELLED. */
+#include "ext.h"
+
+#include <string.h>
+
+typedef struct call_state {
+    PyThreadState *thread; /* saved while the library runs */
+    PyObject *progress;    /* callable(fraction) or NULL */
+} call_state;
+
+static int report(void *user, double fraction) {
+    call_state *c = user;
+    PyEval_RestoreThread(c->thread);
+    int stop = PyErr_CheckSignals() != 0;
+    if (!stop && c->progress) {
+        PyObject *r = PyObject_CallFunction(c->progress, "d", fraction);
+        stop = r == NULL;
+        Py_XDECREF(r);
+    }
+    c->thread = PyEval_SaveThread();
+    return stop;
+}
+
+static PyObject *report_dict(const rsmooth_report *r) {
+    return Py_BuildValue(
+        "{s:n,s:n,s:n,s:d,s:d,s:d,s:d,s:s,s:d,s:d,s:d,s:d,s:d,s:d,s:n}", "vertex_count",
+        (Py_ssize_t)r->vertex_count, "triangle_count", (Py_ssize_t)r->triangle_count,
+        "facet_count", (Py_ssize_t)r->facet_count, "mean_edge_length", r->mean_edge_length,
+        "sigma_f", r->sigma_f, "sigma_g", r->sigma_g, "radius", r->radius, "device", r->device,
+        "ms_setup", r->ms_setup, "ms_grid", r->ms_grid, "ms_mollify", r->ms_mollify,
+        "ms_robust", r->ms_robust, "ms_download", r->ms_download, "ms_total", r->ms_total,
+        "tiles", (Py_ssize_t)r->tiles);
+}
+
+/* _smooth(context, vertices, faces, out, confidence, params, progress) -> report dict.
+ * context: a capsule from _context_create, or None for the reference path. vertices and out:
+ * (n, 3) of one float type; faces (m, 3) uint32; confidence (n,) float32 or None. */
+PyObject *ext_smooth(PyObject *self, PyObject *args, PyObject *kwargs) {
+    (void)self;
+    static char *keywords[] = {"context", "vertices", "faces", "out", "confidence", "params",
+                               "progress", NULL};
+    PyObject *cobj, *vobj, *fobj, *oobj, *kobj, *pobj, *progress;
+    if (!PyArg_ParseTupleAndKeywords(args, kwargs, "OOOOOOO", keywords, &cobj, &vobj, &fobj,
+                                     &oobj, &kobj, &pobj, &progress))
+        return NULL;
+    rsmooth_context *ctx = NULL;
+    if (cobj != Py_None && !(ctx = ext_context_from(cobj)))
+        return NULL;
+    ext_array v, f, out, conf, colors;
+    memset(&f, 0, sizeof f);
+    memset(&out, 0, sizeof out);
+    memset(&conf, 0, sizeof conf);
+    memset(&colors, 0, sizeof colors);
+    PyObject *result = NULL;
+    if (ext_array_get(vobj, "vertices", EXT_REAL, 3, 0, 0, &v) != 0)
+        return NULL;
+    rsmooth_params p;
+    if (ext_array_get(fobj, "faces", EXT_UINT32, 3, 0, 0, &f) != 0 ||
+        ext_array_get(oobj, "out", v.scalar == RSMOOTH_FLOAT32 ? EXT_FLOAT32 : EXT_FLOAT64, 3, 1,
+                      0, &out) != 0 ||
+        ext_array_get(kobj, "confidence", EXT_FLOAT32, 0, 1, 1, &conf) != 0 ||
+        ext_params_from_dict(pobj, v.rows, &p, &colors) != 0)
+        goto done;
+    if (out.rows != v.rows || (conf.held && conf.rows != v.rows)) {
+        PyErr_SetString(PyExc_ValueError, "outputs must have a row per vertex");
+        goto done;
+    }
+    call_state call = {NULL, progress == Py_None ? NULL : progress};
+    p.progress_cancel = report;
+    p.progress_user = &call;
+    rsmooth_report rep;
+    rsmooth_error err;
+    rsmooth_status st;
+    call.thread = PyEval_SaveThread();
+    if (ctx)
+        st = rsmooth_smooth(ctx, v.scalar, v.view.buf, (size_t)v.rows, f.view.buf, (size_t)f.rows,
+                            &p, out.view.buf, NULL, conf.held ? conf.view.buf : NULL, &rep, &err);
+    else
+        st = rsmooth_smooth_reference(v.scalar, v.view.buf, (size_t)v.rows, f.view.buf,
+                                      (size_t)f.rows, &p, out.view.buf, NULL,
+                                      conf.held ? conf.view.buf : NULL, &rep, &err);
+    PyEval_RestoreThread(call.thread);
+    result = st == RSMOOTH_OK ? report_dict(&rep) : ext_raise(st, &err);
+done:
+    ext_array_release(&colors);
+    ext_array_release(&conf);
+    ext_array_release(&out);
+    ext_array_release(&f);
+    ext_array_release(&v);
+    return result;
+}
+
+/* _smooth_points(points, normals, out, out_normals, confidence, params, progress) -> report.
+ * points, normals, out, out_normals: (n, 3) of one float type; confidence (n,) float32 or None. */
+PyObject *ext_smooth_points(PyObject *self, PyObject *args, PyObject *kwargs) {
+    (void)self;
+    static char *keywords[] = {"points", "normals", "out", "out_normals", "confidence",
+                               "params", "progress", NULL};
+    PyObject *vobj, *nobj, *oobj, *onobj, *kobj, *pobj, *progress;
+    if (!PyArg_ParseTupleAndKeywords(args, kwargs, "OOOOOOO", keywords, &vobj, &nobj, &oobj,
+                                     &onobj, &kobj, &pobj, &progress))
+        return NULL;
+    ext_array v, n, out, out_n, conf, colors;
+    memset(&n, 0, sizeof n);
+    memset(&out, 0, sizeof out);
+    memset(&out_n, 0, sizeof out_n);
+    memset(&conf, 0, sizeof conf);
+    memset(&colors, 0, sizeof colors);
+    PyObject *result = NULL;
+    if (ext_array_get(vobj, "points", EXT_REAL, 3, 0, 0, &v) != 0)
+        return NULL;
+    ext_kind same = v.scalar == RSMOOTH_FLOAT32 ? EXT_FLOAT32 : EXT_FLOAT64;
+    rsmooth_params p;
+    if (ext_array_get(nobj, "normals", same, 3, 0, 0, &n) != 0 ||
+        ext_array_get(oobj, "out", same, 3, 1, 0, &out) != 0 ||
+        ext_array_get(onobj, "out_normals", same, 3, 1, 1, &out_n) != 0 ||
+        ext_array_get(kobj, "confidence", EXT_FLOAT32, 0, 1, 1, &conf) != 0 ||
+        ext_params_from_dict(pobj, v.rows, &p, &colors) != 0)
+        goto done;
+    if (n.rows != v.rows || out.rows != v.rows || (out_n.held && out_n.rows != v.rows) ||
+        (conf.held && conf.rows != v.rows)) {
+        PyErr_SetString(PyExc_ValueError, "normals and outputs must have a row per point");
+        goto done;
+    }
+    call_state call = {NULL, progress == Py_None ? NULL : progress};
+    p.progress_cancel = report;
+    p.progress_user = &call;
+    rsmooth_report rep;
+    rsmooth_error err;
+    call.thread = PyEval_SaveThread();
+    rsmooth_status st = rsmooth_smooth_points_reference(
+        v.scalar, v.view.buf, n.view.buf, (size_t)v.rows, &p, out.view.buf,
+        out_n.held ? out_n.view.buf : NULL, conf.held ? conf.view.buf : NULL, &rep, &err);
+    PyEval_RestoreThread(call.thread);
+    result = st == RSMOOTH_OK ? report_dict(&rep) : ext_raise(st, &err);
+done:
+    ext_array_release(&colors);
+    ext_array_release(&conf);
+    ext_array_release(&out_n);
+    ext_array_release(&out);
+    ext_array_release(&n);
+    ext_array_release(&v);
+    return result;
+}
+
+/* _taubin(vertices, faces, out, lam, mu, iterations) -> None: rsmooth_smooth_taubin. */
+PyObject *ext_taubin(PyObject *self, PyObject *args, PyObject *kwargs) {
+    (void)self;
+    static char *keywords[] = {"vertices", "faces", "out", "lam", "mu", "iterations", NULL};
+    PyObject *vobj, *fobj, *oobj;
+    double lam, mu;
+    unsigned int iterations;
+    if (!PyArg_ParseTupleAndKeywords(args, kwargs, "OOOddI", keywords, &vobj, &fobj, &oobj, &lam,
+                                     &mu, &iterations))
+        return NULL;
+    ext_array v, f, out;
+    memset(&f, 0, sizeof f);
+    memset(&out, 0, sizeof out);
+    PyObject *result = NULL;
+    if (ext_array_get(vobj, "vertices", EXT_REAL, 3, 0, 0, &v) != 0)
+        return NULL;
+    if (ext_array_get(fobj, "faces", EXT_UINT32, 3, 0, 0, &f) != 0 ||
+        ext_array_get(oobj, "out", v.scalar == RSMOOTH_FLOAT32 ? EXT_FLOAT32 : EXT_FLOAT64, 3, 1,
+                      0, &out) != 0)
+        goto done;
+    if (out.rows != v.rows) {
+        PyErr_SetString(PyExc_ValueError, "out must have a row per vertex");
+        goto done;
+    }
+    rsmooth_error err;
+    rsmooth_status st;
+    Py_BEGIN_ALLOW_THREADS
+    st = rsmooth_smooth_taubin(v.scalar, v.view.buf, (size_t)v.rows, f.view.buf, (size_t)f.rows,
+                               lam, mu, iterations, out.view.buf, &err);
+    Py_END_ALLOW_THREADS
+    if (st == RSMOOTH_OK) {
+        Py_INCREF(Py_None);
+        result = Py_None;
+    } else {
+        ext_raise(st, &err);
+    }
+done:
+    ext_array_release(&out);
+    ext_array_release(&f);
+    ext_array_release(&v);
+    return result;
+}

@@ -1,0 +1,170 @@
+/* rsmooth_params to and from a dict of its fields by name: the Python layer speaks in keywords,
+ * the library in the struct. The defaults come from the library (rsmooth_params_init and
+ * rsmooth_params_init_best), never from a copy here. */
+#include "ext.h"
+
+#include <stddef.h>
+#include <string.h>
+
+typedef enum field_type { FIELD_DOUBLE, FIELD_INT } field_type;
+
+typedef struct field {
+    const char *name;
+    size_t offset;
+    field_type type;
+} field;
+
+#define DOUBLE_FIELD(f) {#f, offsetof(rsmooth_params, f), FIELD_DOUBLE}
+#define INT_FIELD(f) {#f, offsetof(rsmooth_params, f), FIELD_INT}
+
+static const field fields[] = {
+    DOUBLE_FIELD(sigma_f),         DOUBLE_FIELD(sigma_g),        INT_FIELD(absolute),
+    DOUBLE_FIELD(cutoff),          DOUBLE_FIELD(mollify_cutoff), INT_FIELD(mollify),
+    INT_FIELD(predictor),          INT_FIELD(normal_filter),     DOUBLE_FIELD(normal_sigma_s),
+    DOUBLE_FIELD(normal_sigma_n),  INT_FIELD(normal_iterations), INT_FIELD(influence),
+    INT_FIELD(passes),             DOUBLE_FIELD(pass_confidence), DOUBLE_FIELD(sigma_c),
+};
+#define FIELD_COUNT (sizeof fields / sizeof fields[0])
+
+static int set_field(rsmooth_params *p, const field *f, PyObject *value) {
+    char *at = (char *)p + f->offset;
+    if (f->type == FIELD_DOUBLE) {
+        double v = PyFloat_AsDouble(value);
+        if (v == -1.0 && PyErr_Occurred())
+            return -1;
+        memcpy(at, &v, sizeof v);
+        return 0;
+    }
+    long v = PyLong_AsLong(value);
+    if (v == -1 && PyErr_Occurred())
+        return -1;
+    if (v < -1000000 || v > 1000000) { /* every int field is a small count, flag or enum */
+        PyErr_Format(PyExc_ValueError, "%s: %ld is out of range", f->name, v);
+        return -1;
+    }
+    int iv = (int)v;
+    memcpy(at, &iv, sizeof iv);
+    return 0;
+}
+
+int ext_params_from_dict(PyObject *dict, Py_ssize_t vertex_count, rsmooth_params *p,
+                         ext_array *colors) {
+    rsmooth_params_init(p);
+    memset(colors, 0, sizeof *colors);
+    if (dict == Py_None)
+        return 0;
+    if (!PyDict_Check(dict)) {
+        PyErr_SetString(PyExc_TypeError, "params: expected a dict");
+        return -1;
+    }
+    PyObject *key, *value;
+    Py_ssize_t pos = 0;
+    while (PyDict_Next(dict, &pos, &key, &value)) {
+        const char *name = PyUnicode_Check(key) ? PyUnicode_AsUTF8AndSize(key, NULL) : NULL;
+        if (!name) {
+            if (!PyErr_Occurred())
+                PyErr_SetString(PyExc_TypeError, "params: keys must be strings");
+            goto fail;
+        }
+        if (strcmp(name, "colors") == 0) {
+            if (ext_array_get(value, "colors", EXT_FLOAT32, 3, 0, 1, colors) != 0)
+                goto fail;
+            if (colors->held && colors->rows != vertex_count) {
+                PyErr_Format(PyExc_ValueError, "colors: %zd rows for %zd vertices",
+                             colors->rows, vertex_count);
+                goto fail;
+            }
+            p->colors = colors->held ? colors->view.buf : NULL;
+            continue;
+        }
+        size_t i = 0;
+        while (i < FIELD_COUNT && strcmp(fields[i].name, name) != 0)
+            i++;
+        if (i == FIELD_COUNT) {
+            PyErr_Format(PyExc_ValueError, "params: unknown field '%s'", name);
+            goto fail;
+        }
+        if (set_field(p, fields + i, value) != 0)
+            goto fail;
+    }
+    return 0;
+fail:
+    ext_array_release(colors);
+    return -1;
+}
+
+PyObject *ext_params_to_dict(const rsmooth_params *p) {
+    PyObject *dict = PyDict_New();
+    for (size_t i = 0; dict && i < FIELD_COUNT; i++) {
+        const char *at = (const char *)p + fields[i].offset;
+        PyObject *value;
+        if (fields[i].type == FIELD_DOUBLE) {
+            double v;
+            memcpy(&v, at, sizeof v);
+            value = PyFloat_FromDouble(v);
+        } else {
+            int v;
+            memcpy(&v, at, sizeof v);
+            value = PyLong_FromLong(v);
+        }
+        if (!value || PyDict_SetItemString(dict, fields[i].name, value) != 0) {
+            Py_XDECREF(value);
+            Py_DECREF(dict);
+            return NULL;
+        }
+        Py_DECREF(value);
+    }
+    return dict;
+}
+
+/* _default_params(best) -> dict: rsmooth_params_init's fields, or rsmooth_params_init_best's. */
+PyObject *ext_default_params(PyObject *self, PyObject *args) {
+    (void)self;
+    int best = 0;
+    if (!PyArg_ParseTuple(args, "p", &best))
+        return NULL;
+    rsmooth_params p;
+    if (best)
+        rsmooth_params_init_best(&p);
+    else
+        rsmooth_params_init(&p);
+    return ext_params_to_dict(&p);
+}
+
+/* _params_auto(vertices, faces, params) -> (params, noise): rsmooth_params_auto's rule for the
+ * mesh, starting from `params` (whose normal_filter picks the rule). */
+PyObject *ext_params_auto(PyObject *self, PyObject *args) {
+    (void)self;
+    PyObject *vobj, *fobj, *pobj;
+    if (!PyArg_ParseTuple(args, "OOO", &vobj, &fobj, &pobj))
+        return NULL;
+    ext_array v, f, colors;
+    if (ext_array_get(vobj, "vertices", EXT_REAL, 3, 0, 0, &v) != 0)
+        return NULL;
+    if (ext_array_get(fobj, "faces", EXT_UINT32, 3, 0, 0, &f) != 0) {
+        ext_array_release(&v);
+        return NULL;
+    }
+    PyObject *result = NULL;
+    rsmooth_params p;
+    if (ext_params_from_dict(pobj, v.rows, &p, &colors) == 0) {
+        double noise = 0;
+        rsmooth_error err;
+        rsmooth_status st;
+        Py_BEGIN_ALLOW_THREADS
+        st = rsmooth_params_auto(v.scalar, v.view.buf, (size_t)v.rows, f.view.buf,
+                                 (size_t)f.rows, &p, &noise, &err);
+        Py_END_ALLOW_THREADS
+        if (st != RSMOOTH_OK) {
+            ext_raise(st, &err);
+        } else {
+            PyObject *dict = ext_params_to_dict(&p);
+            if (dict)
+                result = Py_BuildValue("(Nd)", dict, noise);
+        }
+        ext_array_release(&colors);
+    }
+    ext_array_release(&f);
+    ext_array_release(&v);
+    return result;
+}
