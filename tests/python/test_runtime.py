@@ -123,6 +123,44 @@ def test_no_loader():
     assert "cpu: DeviceError:" in r.stdout and "loader" in r.stdout.split("cpu:")[1]
 
 
+def _installed_loader():
+    import subprocess
+
+    try:
+        out = subprocess.run(["ldconfig", "-p"], capture_output=True, text=True).stdout
+    except OSError:
+        return None
+    for line in out.splitlines():
+        if line.strip().startswith("libOpenCL.so.1 ") and "=>" in line:
+            return os.path.realpath(line.split("=>")[1].strip())
+    return None
+
+
+def test_loader_really_absent(tmp_path):
+    """The installed loader hidden (/dev/null bound over it in a user namespace, where the system
+    allows one): the same as no loader at all."""
+    import shutil
+    import subprocess
+    import sys
+
+    loader = _installed_loader()
+    if not loader or not shutil.which("unshare") or \
+            subprocess.run(["unshare", "-r", "-m", "true"], capture_output=True).returncode:
+        pytest.skip("no installed loader, or no user namespaces to hide it in")
+    script = tmp_path / "script.py"
+    script.write_text(SCRIPT)
+    env = dict(os.environ, RSMOOTH_DEVICE="")
+    env.pop("RSMOOTH_OPENCL_LIBRARY", None)
+    r = subprocess.run(
+        ["unshare", "-r", "-m", "sh", "-c", 'mount --bind /dev/null "$1" && exec "$2" "$3"', "sh",
+         loader, sys.executable, str(script)],
+        env=env, cwd="/", capture_output=True, text=True, timeout=300,
+    )
+    assert r.returncode == 0, r.stderr
+    assert "libOpenCL.so.1 could not be loaded" in r.stdout, r.stdout
+    assert "devices: []" in r.stdout and "cpu: DeviceError:" in r.stdout
+
+
 def test_module_links_no_opencl():
     import pathlib
     import subprocess

@@ -1,0 +1,58 @@
+"""Arrays in: numpy converts dtypes, strides and index types and checks faces here, so the C
+extension only ever sees C-contiguous float32/float64 (n, 3) and uint32 (m, 3) arrays."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+
+def _vertices(array: Any, name: str = "vertices") -> np.ndarray:
+    """(n, 3) float32 or float64, C-contiguous (a copy only when the input is not)."""
+    a = np.asarray(array)
+    if a.dtype not in (np.float32, np.float64):
+        if a.dtype.kind in "iub" or a.dtype == np.float16:
+            raise TypeError(
+                f"{name}: dtype {a.dtype} is not float32 or float64 "
+                f"(convert first, e.g. {name}.astype(np.float64))"
+            )
+        raise TypeError(f"{name}: expected a float32 or float64 array, got dtype {a.dtype}")
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise ValueError(f"{name}: expected shape (n, 3), got {a.shape}")
+    if a.shape[0] == 0:
+        raise ValueError(f"{name}: no vertices")
+    if a.shape[0] >= 2**32:
+        raise ValueError(f"{name}: {a.shape[0]} vertices; at most 2**32 - 1")
+    return np.ascontiguousarray(a)
+
+
+def _faces(array: Any, vertex_count: int, name: str = "faces") -> np.ndarray:
+    """(m, 3) uint32, every index checked against vertex_count first."""
+    f = np.asarray(array)
+    if f.size == 0:
+        return np.zeros((0, 3), dtype=np.uint32)
+    if f.dtype.kind not in "iu":
+        raise TypeError(f"{name}: expected an integer array, got dtype {f.dtype}")
+    if f.ndim != 2 or f.shape[1] != 3:
+        raise ValueError(
+            f"{name}: expected shape (m, 3) of triangles, got {f.shape}"
+            + (" (triangulate polygons first)" if f.ndim == 2 else "")
+        )
+    bad = (f < 0) | (f >= vertex_count)
+    if bad.any():
+        face, corner = (int(i) for i in np.argwhere(bad)[0])
+        raise ValueError(
+            f"{name}: face {face} has index {int(f[face, corner])} at corner {corner}, "
+            f"outside 0..{vertex_count - 1}"
+        )
+    return np.ascontiguousarray(f, dtype=np.uint32)
+
+
+def _colors(array: Any, vertex_count: int) -> np.ndarray:
+    c = np.asarray(array)
+    if c.ndim != 2 or c.shape != (vertex_count, 3):
+        raise ValueError(f"colors: expected shape ({vertex_count}, 3), got {c.shape}")
+    if c.dtype == np.uint8:  # 0..255 to [0, 1], the units sigma_c is given in
+        c = c / 255.0
+    return np.ascontiguousarray(c, dtype=np.float32)

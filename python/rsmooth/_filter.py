@@ -1,0 +1,244 @@
+"""The filter on meshes and point clouds: device choice and fallback, then one call into the C
+extension with the GIL released."""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any, Optional
+
+import numpy as np
+
+from . import _rsmooth
+from ._arrays import _colors, _faces, _vertices
+from ._context import Context
+from ._options import _METHODS, Progress, _params, _progress_callable
+from ._rsmooth import DeviceError
+
+
+def smooth(
+    vertices: Any,
+    faces: Any,
+    *,
+    sigma_f: Optional[float] = None,
+    sigma_g: Optional[float] = None,
+    absolute: bool = False,
+    cutoff: Optional[float] = None,
+    mollify: bool = True,
+    device: Optional[str] = "auto",
+    confidence: bool = False,
+    best: bool = False,
+    auto: bool = False,
+    normal_filter: Optional[str] = None,
+    normal_sigma_s: Optional[float] = None,
+    normal_sigma_n: Optional[float] = None,
+    normal_iterations: Optional[int] = None,
+    influence: Optional[str] = None,
+    passes: Optional[int] = None,
+    pass_confidence: Optional[float] = None,
+    predictor: Optional[str] = None,
+    mollify_cutoff: Optional[float] = None,
+    colors: Any = None,
+    sigma_c: Optional[float] = None,
+    method: str = "robust",
+    iterations: int = 10,
+    lam: float = 0.5,
+    mu: float = -0.53,
+    progress: Progress = False,
+) -> Any:
+    """Removes noise from a triangle mesh and keeps its sharp edges (Jones et al. 2003).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float32 or float64 array-like, any strides or order.
+    faces : (m, 3) integer array-like (int32, int64, uint32...). A negative or out-of-range index
+        raises ValueError naming the face.
+    sigma_f : spatial width: how far around a vertex triangles are consulted (ignored beyond
+        ``cutoff * sigma_f``). Mean edge lengths unless ``absolute``. Default 2 (``best``: 0.8).
+    sigma_g : influence width: how far a triangle's plane may lie from the vertex before it
+        counts as the other side of a feature; ``float("inf")`` turns it off. Default 0.5
+        (``best``: 0.3). The paper's rule: raise both until smooth enough, then lower sigma_g
+        until the edges come back.
+    absolute : sigmas in the mesh's own units instead of mean edge lengths.
+    cutoff : triangles beyond ``cutoff * sigma_f`` are ignored, (0, 5]. Default 2.
+    mollify : predict with mollified normals (the paper); False uses the raw ones.
+    device : "auto", "gpu", "cpu", "P:D", part of a device name, or "reference" (double
+        precision on one CPU thread, no OpenCL). "auto" falls back to "reference" with a
+        RuntimeWarning where no OpenCL device exists. Use :class:`Context` to build the kernels
+        once for many calls.
+    confidence : also return the per-vertex confidence k(p) / sum a f in [0, 1] (float32, the
+        paper's Fig. 10): low at features and outliers.
+    best : rsmooth's most accurate mode (bilateral normals, 3 passes at sigma_f 0.8,
+        sigma_g 0.3); other keywords still apply on top.
+    auto : estimate the noise (:func:`estimate_noise`) and pick the sigmas from it (with
+        ``best`` also the rounds and passes). Keywords given explicitly win over the rule.
+    normal_filter : "mollify" (the paper) or "bilateral" (keeps creases the Gaussian rounds).
+    normal_sigma_s, normal_sigma_n, normal_iterations : the bilateral normal filter's spatial
+        width (units of sigma_f, default 1), width on normal differences ((0, 2], default 0.35)
+        and rounds (default 5).
+    influence : the robust weight: "gaussian" (the paper), "tukey", "lorentzian" or "huber".
+    passes : run the filter this many times, each from the previous result (default 1).
+    pass_confidence : passes after the first move only vertices whose confidence was below it.
+    predictor : "projection" (the paper) or "centroid".
+    mollify_cutoff : mollification reach in units of sigma_f, (0, cutoff]; default: cutoff.
+    colors : (n, 3) per-vertex colours (floats in [0, 1], or uint8 0..255) weighing each
+        triangle by its colour difference too, so colour edges stay sharp; width ``sigma_c``
+        (default 0.1).
+    method : "robust" (the filter), or the isotropic smoothers it is measured against:
+        "gaussian" (one Gaussian-weighted pass of centroids, width sigma_f), "laplacian" and
+        "taubin" (``iterations`` umbrella steps by ``lam``, Taubin's each followed by one by
+        ``mu``; these need connected faces and run on the CPU).
+    progress : True shows a tqdm progress bar (when tqdm is installed); a callable is called
+        with the fraction done, and may raise to stop the call.
+
+    Returns
+    -------
+    The smoothed vertices, a new array of the input's dtype and shape; with ``confidence=True``
+    the tuple ``(vertices, confidence)``.
+
+    Raises
+    ------
+    ValueError : bad arrays or parameters (the library's message).
+    DeviceError : the OpenCL device is missing or failed (names the device and the error).
+    KeyboardInterrupt : Ctrl-C during the call.
+    """
+    options = dict(
+        sigma_f=sigma_f, sigma_g=sigma_g, absolute=absolute, cutoff=cutoff, mollify=mollify,
+        confidence=confidence, best=best, auto=auto, normal_filter=normal_filter,
+        normal_sigma_s=normal_sigma_s, normal_sigma_n=normal_sigma_n,
+        normal_iterations=normal_iterations, influence=influence, passes=passes,
+        pass_confidence=pass_confidence, predictor=predictor, mollify_cutoff=mollify_cutoff,
+        colors=colors, sigma_c=sigma_c, method=method, iterations=iterations, lam=lam, mu=mu,
+        progress=progress,
+    )
+    if device == "reference" or method in ("laplacian", "taubin"):
+        return _smooth(None, vertices, faces, **options)
+    try:
+        context = Context(device)
+    except DeviceError as e:
+        if device not in ("auto", None) or not _no_opencl(e):
+            raise
+        warnings.warn(
+            f"rsmooth: no OpenCL device ({e}); using the reference path (double precision, "
+            "one CPU thread)",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+        return _smooth(None, vertices, faces, **options)
+    with context:
+        return _smooth(context, vertices, faces, **options)
+
+
+def _no_opencl(error: DeviceError) -> bool:
+    """Whether `auto` found no OpenCL at all (no loader, no platform, no device), rather than a
+    device that failed."""
+    text = str(error).lower()
+    return any(s in text for s in ("loader", "no opencl", "platform", "no device", "no gpu"))
+
+
+def _smooth(
+    context: Optional[Context],
+    vertices: Any,
+    faces: Any,
+    *,
+    confidence: bool = False,
+    best: bool = False,
+    auto: bool = False,
+    colors: Any = None,
+    method: str = "robust",
+    iterations: int = 10,
+    lam: float = 0.5,
+    mu: float = -0.53,
+    progress: Progress = False,
+    **overrides: Any,
+) -> Any:
+    shape_in = np.shape(vertices)
+    v = _vertices(vertices)
+    f = _faces(faces, v.shape[0])
+    if method not in _METHODS:
+        raise ValueError(f"method: expected one of {', '.join(_METHODS)}, got {method!r}")
+    out = np.empty_like(v)
+    if method in ("laplacian", "taubin"):
+        if confidence:
+            raise ValueError(f"method {method!r} gives no confidence")
+        _rsmooth._taubin(v, f, out, float(lam), float(mu) if method == "taubin" else 0.0,
+                         int(iterations))
+        return out.reshape(shape_in)
+    if method == "gaussian":  # the isotropic baseline: centroids, no influence weight
+        overrides.update(predictor="centroid", sigma_g=float("inf"), mollify=False)
+    params, _ = _params(v, f, best=best, auto=auto, overrides=overrides)
+    if colors is not None:
+        params["colors"] = _colors(colors, v.shape[0])
+    conf = np.empty(v.shape[0], dtype=np.float32) if confidence else None
+    call, bar = _progress_callable(progress)
+    try:
+        report = _rsmooth._smooth(
+            context._capsule if context is not None else None, v, f, out, conf, params, call
+        )
+    finally:
+        if bar is not None:
+            bar.close()
+    if context is not None:
+        context.last_report = report
+    out = out.reshape(shape_in)
+    return (out, conf) if confidence else out
+
+
+def smooth_points(
+    points: Any,
+    normals: Any,
+    *,
+    sigma_f: Optional[float] = None,
+    sigma_g: Optional[float] = None,
+    absolute: bool = False,
+    cutoff: Optional[float] = None,
+    mollify: bool = True,
+    confidence: bool = False,
+    return_normals: bool = False,
+    best: bool = False,
+    normal_sigma_s: Optional[float] = None,
+    normal_sigma_n: Optional[float] = None,
+    normal_iterations: Optional[int] = None,
+    influence: Optional[str] = None,
+    passes: Optional[int] = None,
+    pass_confidence: Optional[float] = None,
+    predictor: Optional[str] = None,
+    colors: Any = None,
+    sigma_c: Optional[float] = None,
+    progress: Progress = False,
+) -> Any:
+    """The filter on a point cloud with normals: each point is its own facet, its plane the
+    tangent plane through it, its area from the spacing of its 6 nearest neighbours.
+
+    ``points`` and ``normals``: (n, 3), float32 or float64 (normals of any non-zero length,
+    consistently oriented). Sigmas are in point spacings (:func:`point_spacing`) unless
+    ``absolute``. With ``mollify`` (default) the normals are smoothed by the bilateral normal
+    filter first. Runs on the CPU reference path (double precision).
+
+    Returns the filtered points (the input's dtype), or a tuple adding the filtered unit normals
+    (``return_normals``) and the confidence (``confidence``), in that order.
+    """
+    p = _vertices(points, "points")
+    n = _vertices(normals, "normals").astype(p.dtype, copy=False)
+    if n.shape != p.shape:
+        raise ValueError(f"normals: shape {n.shape} for points of shape {p.shape}")
+    overrides = dict(
+        sigma_f=sigma_f, sigma_g=sigma_g, absolute=absolute, cutoff=cutoff, mollify=mollify,
+        normal_sigma_s=normal_sigma_s, normal_sigma_n=normal_sigma_n,
+        normal_iterations=normal_iterations, influence=influence, passes=passes,
+        pass_confidence=pass_confidence, predictor=predictor, sigma_c=sigma_c,
+    )
+    no_faces = np.zeros((0, 3), dtype=np.uint32)
+    params, _ = _params(p, no_faces, best=best, auto=False, overrides=overrides)
+    if colors is not None:
+        params["colors"] = _colors(colors, p.shape[0])
+    out = np.empty_like(p)
+    out_n = np.empty_like(p) if return_normals else None
+    conf = np.empty(p.shape[0], dtype=np.float32) if confidence else None
+    call, bar = _progress_callable(progress)
+    try:
+        _rsmooth._smooth_points(p, np.ascontiguousarray(n), out, out_n, conf, params, call)
+    finally:
+        if bar is not None:
+            bar.close()
+    result = (out,) + ((out_n,) if return_normals else ()) + ((conf,) if confidence else ())
+    return result if len(result) > 1 else out

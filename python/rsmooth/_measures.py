@@ -1,0 +1,47 @@
+"""Measures of meshes and point sets: noise, edge length, spacing, and the error against a ground
+truth (the library's rsmooth_compare)."""
+
+from __future__ import annotations
+
+from typing import Any, Dict
+
+from . import _rsmooth
+from ._arrays import _faces, _vertices
+
+
+def estimate_noise(vertices: Any, faces: Any) -> float:
+    """The mesh's noise: the standard deviation of its vertices' displacement along the surface
+    normal, in mean edge lengths, from the geometry alone (quadric fits, robust to sharp edges).
+    Gaussian noise of 0.1 to 0.7 mean edge lengths reads within about 5% on meshes of a few
+    thousand vertices or more. 0 for a mesh too small to fit."""
+    v = _vertices(vertices)
+    return _rsmooth._estimate_noise(v, _faces(faces, v.shape[0]))
+
+
+def mean_edge_length(vertices: Any, faces: Any) -> float:
+    """Mean length of the mesh's unique undirected edges, in its units: the unit of relative
+    sigmas."""
+    v = _vertices(vertices)
+    return _rsmooth._mean_edge_length(v, _faces(faces, v.shape[0]))
+
+
+def point_spacing(points: Any) -> float:
+    """Mean over the points of each one's mean distance to its 6 nearest others: the unit of
+    :func:`smooth_points`' relative sigmas."""
+    return _rsmooth._point_spacing(_vertices(points, "points"))
+
+
+def compare(result: Any, truth: Any, faces: Any) -> Dict[str, float]:
+    """Error of a denoised mesh against its ground truth (same vertices and faces).
+
+    Returns a dict: ``theta`` (mean angle between corresponding face normals, degrees), ``ev``
+    (Sun et al.'s area-weighted vertex-to-surface distance E_v, in thousandths of the truth's
+    bounding-box diagonal), ``rms_v`` (RMS distance between corresponding vertices, in the
+    truth's mean edge lengths), ``hausdorff`` (symmetric, sampled at the vertices, thousandths
+    of the diagonal), and ``theta_count``, ``mean_edge``, ``bbox_diag``, ``vertex_count``,
+    ``triangle_count``. Distances to surfaces are exact."""
+    r = _vertices(result, "result")
+    t = _vertices(truth, "truth")
+    if t.shape != r.shape:
+        raise ValueError(f"truth: shape {t.shape} for a result of shape {r.shape}")
+    return _rsmooth._compare(r, t.astype(r.dtype, copy=False), _faces(faces, r.shape[0]))
