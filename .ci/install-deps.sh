@@ -12,7 +12,7 @@ if [ "${1:-}" = fuzz ] || [ "${FUZZ:-0}" = 1 ]; then
   packages+=("${fuzz_packages[@]}")
 fi
 if [ "${1:-}" = python ]; then
-  packages+=(python3 python3-dev python3-venv binutils)
+  packages+=(python3 python3-dev python3-venv binutils libusb-1.0-0) # libusb: Open3D's wheel
 fi
 if [ "${1:-}" = experiments ]; then
   packages+=(python3 python3-numpy python3-scipy python3-matplotlib)
