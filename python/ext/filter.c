@@ -83,7 +83,8 @@ PyObject *ext_smooth(PyObject *self, PyObject *args, PyObject *kwargs) {
                                       (size_t)f.rows, &p, out.view.buf, NULL,
                                       conf.held ? conf.view.buf : NULL, &rep, &err);
     PyEval_RestoreThread(call.thread);
-    result = st == RSMOOTH_OK ? report_dict(&rep) : ext_raise(st, &err);
+    /* a report the library does not act on (the last, at 1) may still have raised */
+    result = st == RSMOOTH_OK && !PyErr_Occurred() ? report_dict(&rep) : ext_raise(st, &err);
 done:
     ext_array_release(&colors);
     ext_array_release(&conf);
@@ -135,7 +136,8 @@ PyObject *ext_smooth_points(PyObject *self, PyObject *args, PyObject *kwargs) {
         v.scalar, v.view.buf, n.view.buf, (size_t)v.rows, &p, out.view.buf,
         out_n.held ? out_n.view.buf : NULL, conf.held ? conf.view.buf : NULL, &rep, &err);
     PyEval_RestoreThread(call.thread);
-    result = st == RSMOOTH_OK ? report_dict(&rep) : ext_raise(st, &err);
+    /* a report the library does not act on (the last, at 1) may still have raised */
+    result = st == RSMOOTH_OK && !PyErr_Occurred() ? report_dict(&rep) : ext_raise(st, &err);
 done:
     ext_array_release(&colors);
     ext_array_release(&conf);

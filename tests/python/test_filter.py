@@ -147,6 +147,20 @@ def test_progress_callable(mesh):
     assert seen and seen[-1] == 1.0 and seen == sorted(seen)
 
 
+def test_progress_raising_at_the_end(mesh):
+    """The last report (1.0) comes after the work; an exception raised there still propagates."""
+    v, f = mesh
+
+    def progress(fraction):
+        if fraction == 1.0:
+            raise RuntimeError("at the end")
+
+    with pytest.raises(RuntimeError, match="at the end"):
+        rsmooth.smooth(v, f, device="reference", progress=progress)
+    with pytest.raises(RuntimeError, match="at the end"):
+        rsmooth.smooth_points(v, v, progress=progress)
+
+
 def test_progress_bar(mesh):
     pytest.importorskip("tqdm")
     v, f = mesh
