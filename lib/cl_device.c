@@ -129,9 +129,10 @@ size_t rsmooth_list_devices(rsmooth_device_info *devices, size_t capacity) {
         snprintf(d->type, sizeof d->type, "%s", type);
         /* PoCL's version ("OpenCL 3.0 PoCL HSTR: pthread-x86_64-...") outgrows the field: a
          * short buffer is CL_INVALID_VALUE and an empty version, so read it whole and cut */
-        char version[1024] = "";
+        char version[1024] = ""; /* zeros past the text, so its head copies whole */
         clGetDeviceInfo(all[i].device, CL_DEVICE_VERSION, sizeof version - 1, version, NULL);
-        snprintf(d->version, sizeof d->version, "%s", version);
+        version[sizeof d->version - 1] = '\0';
+        memcpy(d->version, version, sizeof d->version);
         cl_uint units = 0;
         cl_ulong memory = 0;
         clGetDeviceInfo(all[i].device, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof units, &units, NULL);
