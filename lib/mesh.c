@@ -216,7 +216,7 @@ static bool overlaps(const void *a, size_t a_size, const void *b, size_t b_size)
 
 rsmooth_status rs_check_outputs(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
                                 const uint32_t *indices, size_t triangle_count,
-                                const float *colors, const void *out_positions,
+                                const rsmooth_params *params, const void *out_positions,
                                 const float *out_weight, const float *out_confidence,
                                 rsmooth_error *error, const char *where) {
     if (!out_positions)
@@ -232,7 +232,8 @@ rsmooth_status rs_check_outputs(rsmooth_scalar scalar, const void *positions, si
         size_t bytes;
     } in[] = {{"positions", positions, xyz},
               {"indices", indices, triangle_count * 3 * sizeof(uint32_t)},
-              {"params->colors", colors, 3 * per_vertex}},
+              {"params->colors", params ? params->colors : NULL, 3 * per_vertex},
+              {"params->move_mask", params ? params->move_mask : NULL, vertex_count}},
       out[] = {{"out_positions", out_positions, xyz},
                {"out_weight", out_weight, per_vertex},
                {"out_confidence", out_confidence, per_vertex}};
@@ -336,7 +337,7 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
                               &magnitude, error, where);
     if (st != RSMOOTH_OK)
         return st;
-    st = rs_check_outputs(scalar, positions, vertex_count, indices, triangle_count, p.colors,
+    st = rs_check_outputs(scalar, positions, vertex_count, indices, triangle_count, &p,
                           out_positions, NULL, NULL, error, where);
     if (st != RSMOOTH_OK)
         return st;

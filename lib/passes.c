@@ -38,6 +38,16 @@ void rs_add_pass_report(rsmooth_report *sum, const rsmooth_report *pass) {
         sum->facet_count = keep.facet_count;
 }
 
+/* The vertices params->move_mask holds still get their input position back, byte for byte. */
+static void keep_unselected(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
+                            const uint8_t *mask, void *out_positions) {
+    size_t record = 3 * (scalar == RSMOOTH_FLOAT32 ? sizeof(float) : sizeof(double));
+    for (size_t v = 0; mask && v < vertex_count; v++)
+        if (!mask[v])
+            memcpy((char *)out_positions + v * record, (const char *)positions + v * record,
+                   record);
+}
+
 static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar scalar,
                                     const void *positions, size_t vertex_count,
                                     const uint32_t *indices, size_t triangle_count,
@@ -50,13 +60,17 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
     rsmooth_params p;
     rsmooth_status st = rs_params_resolve(params, &p, error, where);
     if (st == RSMOOTH_OK)
-        st = rs_check_outputs(scalar, positions, vertex_count, indices, triangle_count, p.colors,
+        st = rs_check_outputs(scalar, positions, vertex_count, indices, triangle_count, &p,
                               out_positions, out_weight, out_confidence, error, where);
     if (st != RSMOOTH_OK)
         return st;
-    if (p.passes == 1) /* the paper's single pass, exactly as it was */
-        return one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, params,
-                        out_positions, out_weight, out_confidence, report, error);
+    if (p.passes == 1) { /* the paper's single pass, exactly as it was */
+        st = one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, params,
+                      out_positions, out_weight, out_confidence, report, error);
+        if (st == RSMOOTH_OK)
+            keep_unselected(scalar, positions, vertex_count, p.move_mask, out_positions);
+        return st;
+    }
     if ((st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count,
                                    NULL, error, where)) != RSMOOTH_OK)
         return st; /* (the outputs were checked above) */
@@ -82,9 +96,13 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
         p.progress_cancel = rs_report_pass_progress;
         p.progress_user = &pp;
     }
-    if (passes == 1)
-        return one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, &p,
-                        out_positions, out_weight, out_confidence, report, error);
+    if (passes == 1) {
+        st = one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, &p,
+                      out_positions, out_weight, out_confidence, report, error);
+        if (st == RSMOOTH_OK)
+            keep_unselected(scalar, positions, vertex_count, p.move_mask, out_positions);
+        return st;
+    }
 
     double *cur = rs_alloc_array(vertex_count, 3 * sizeof(double));
     double *next = rs_alloc_array(vertex_count, 3 * sizeof(double));
@@ -118,6 +136,10 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                     confidence[v] = prev_confidence[v];
                 }
         }
+        for (size_t v = 0; p.move_mask && v < vertex_count; v++)
+            if (!p.move_mask[v]) /* held still: each pass sees it where the input has it */
+                for (int k = 0; k < 3; k++)
+                    next[3 * v + (size_t)k] = rs_coordinate(scalar, positions, 3 * v + (size_t)k);
         double *t = cur;
         cur = next;
         next = t;
@@ -134,6 +156,7 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
         if (out_confidence)
             out_confidence[v] = prev_confidence[v];
     }
+    keep_unselected(scalar, positions, vertex_count, p.move_mask, out_positions);
     if (report) {
         *report = sum;
         report->mean_edge_length = unit; /* the input's, the unit of its sigmas */

@@ -295,6 +295,11 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
                     a.confidence[v] = a.prev_confidence[v];
                 }
         }
+        for (size_t v = 0; p.move_mask && v < n; v++)
+            if (!p.move_mask[v]) /* held still (scaled by a power of two: exact both ways) */
+                for (int k = 0; k < 3; k++)
+                    a.next[3 * v + (size_t)k] =
+                        rs_coordinate(scalar, positions, 3 * v + (size_t)k) * scale;
         /* the next pass starts from these positions; its output replaces these normals */
         double *t = a.xyz;
         a.xyz = a.next;

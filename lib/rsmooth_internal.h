@@ -197,11 +197,12 @@ static inline double rs_coordinate(rsmooth_scalar scalar, const void *positions,
 }
 
 /* Checks the outputs of a smoothing call: out_positions present, and every output (those not
- * NULL) clear of every input (positions, indices, colours) and of each other: none may share a
- * byte, since the filter reads all inputs while writing. */
+ * NULL) clear of every input (positions, indices, and the params' colours and move mask when
+ * params is not NULL) and of each other: none may share a byte, since the filter reads all inputs
+ * while writing. */
 rsmooth_status rs_check_outputs(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
                                 const uint32_t *indices, size_t triangle_count,
-                                const float *colors, const void *out_positions,
+                                const rsmooth_params *params, const void *out_positions,
                                 const float *out_weight, const float *out_confidence,
                                 rsmooth_error *error, const char *where);
 

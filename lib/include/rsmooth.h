@@ -94,6 +94,12 @@ typedef enum rsmooth_status {
 /* Static, human-readable text for a status. Never NULL; thread-safe. */
 RSMOOTH_API const char *rsmooth_status_str(rsmooth_status status);
 
+/* The version of the library actually loaded, "MAJOR.MINOR.PATCH" (compare with the
+ * RSMOOTH_VERSION_* macros of the header a program was built with: while the major version is 0,
+ * a different MINOR means a different ABI). Writes the three numbers to those pointers that are
+ * not NULL. Thread-safe. (Added in 0.5) */
+RSMOOTH_API const char *rsmooth_version(int *major, int *minor, int *patch);
+
 /* Optional detail of a failure, filled by any call given a non-NULL pointer to one. On success it is
  * reset (status RSMOOTH_OK, empty strings). The library never prints: callers show these fields. */
 typedef struct rsmooth_error {
@@ -213,6 +219,11 @@ typedef struct rsmooth_params {
     rsmooth_progress_cancel_fn progress_cancel; /* optional (NULL, default): progress reports that
                                    * may stop the call (see the type); called with progress_user,
                                    * after `progress` when both are set. (Added in 0.5) */
+    const uint8_t *move_mask;     /* NULL (default): every vertex moves. Else vertex_count bytes
+                                   * (points: point_count): a vertex whose byte is 0 keeps its
+                                   * input position bit for bit in every pass, while its triangles
+                                   * still support the others (smoothing a selection). Its weight
+                                   * and confidence are still computed. Borrowed. (Added in 0.5) */
 } rsmooth_params;
 
 /* Fills `params` with the defaults above. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if params is NULL. */
@@ -534,6 +545,52 @@ RSMOOTH_API rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar s
                                           const rsmooth_params *params, void *out_positions,
                                           float *out_weight, float *out_confidence,
                                           rsmooth_report *report, rsmooth_error *error);
+
+/* ---------------------------------------------------------------------------------------------- */
+/* Meshes as host applications hold them: strided vertices, any index type                          */
+/* ---------------------------------------------------------------------------------------------- */
+
+/* The type of a mesh view's indices. */
+typedef enum rsmooth_index_type {
+    RSMOOTH_INDEX_UINT32 = 0, /* rsmooth's own, OpenGL's, meshoptimizer's */
+    RSMOOTH_INDEX_INT32 = 1,  /* Open3D's triangles */
+    RSMOOTH_INDEX_INT64 = 2   /* numpy's default integers (trimesh's faces) */
+} rsmooth_index_type;
+
+/* A mesh where the host keeps it: vertex v's x, y, z are the three `scalar`s at byte
+ * v * position_stride of `positions` (an interleaved vertex buffer: position, normal, uv...), and
+ * triangle t's three indices of `index_type` at byte t * index_stride of `indices`. Strides of 0
+ * mean packed. Nothing need be aligned. (Added in 0.5) */
+typedef struct rsmooth_mesh_view {
+    size_t struct_size;            /* sizeof(rsmooth_mesh_view): set by rsmooth_mesh_view_init */
+    rsmooth_scalar scalar;
+    const void *positions;
+    size_t position_stride;        /* bytes; 0, or >= 3 * sizeof(scalar) */
+    size_t vertex_count;
+    const void *indices;           /* may be NULL only when triangle_count is 0 */
+    int index_type;                /* an rsmooth_index_type */
+    size_t index_stride;           /* bytes; 0, or >= 3 * sizeof(index) */
+    size_t triangle_count;
+} rsmooth_mesh_view;
+
+/* Sets struct_size and packed float32 with uint32 indices, everything else 0 / NULL. Returns
+ * RSMOOTH_ERROR_INVALID_ARGUMENT if view is NULL. */
+RSMOOTH_API rsmooth_status rsmooth_mesh_view_init(rsmooth_mesh_view *view);
+
+/* The filter on a mesh view: on `ctx`'s device, or the reference path when ctx is NULL. The view is
+ * read whole (into packed arrays; the packed calls above avoid that copy) before any output is
+ * written, so out_positions may be the view's own vertex buffer: vertex v's result goes to the three
+ * scalars at byte v * out_stride of out_positions (0: packed), the bytes between them untouched.
+ * out_weight and out_confidence are packed floats, as for rsmooth_smooth. Indices are checked
+ * first: a negative one, or one >= vertex_count, is RSMOOTH_ERROR_INVALID_ARGUMENT naming the
+ * triangle and corner, with nothing written; so are outputs that overlap each other. Otherwise the
+ * same arguments, results (bit for bit those of the packed call on the same values), errors and
+ * thread-safety as rsmooth_smooth and rsmooth_smooth_reference. (Added in 0.5) */
+RSMOOTH_API rsmooth_status rsmooth_smooth_view(rsmooth_context *ctx, const rsmooth_mesh_view *mesh,
+                                               const rsmooth_params *params, void *out_positions,
+                                               size_t out_stride, float *out_weight,
+                                               float *out_confidence, rsmooth_report *report,
+                                               rsmooth_error *error);
 
 #ifdef __cplusplus
 }

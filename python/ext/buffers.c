@@ -21,6 +21,8 @@ static char format_char(const char *format) {
 
 static int kind_matches(ext_kind kind, char c, Py_ssize_t itemsize, rsmooth_scalar *scalar) {
     switch (kind) {
+    case EXT_UINT8:
+        return (c == 'B' || c == '?') && itemsize == 1;
     case EXT_FLOAT32:
         return c == 'f' && itemsize == 4;
     case EXT_FLOAT64:
@@ -41,6 +43,8 @@ static int kind_matches(ext_kind kind, char c, Py_ssize_t itemsize, rsmooth_scal
 
 static const char *kind_name(ext_kind kind) {
     switch (kind) {
+    case EXT_UINT8:
+        return "uint8";
     case EXT_FLOAT32:
         return "float32";
     case EXT_FLOAT64:

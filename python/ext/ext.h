@@ -21,6 +21,7 @@ PyObject *ext_raise(rsmooth_status status, const rsmooth_error *error);
 /* ---- arrays (buffers.c) ---------------------------------------------------------------------- */
 
 typedef enum ext_kind {
+    EXT_UINT8,   /* 'B' */
     EXT_FLOAT32, /* 'f' */
     EXT_FLOAT64, /* 'd' */
     EXT_REAL,    /* either of the two (which one goes to ext_array.scalar) */
@@ -65,11 +66,18 @@ rsmooth_context *ext_context_from(PyObject *obj);
 
 /* ---- parameters (params.c) ------------------------------------------------------------------- */
 
+/* The arrays a params dict may hold ("colors": (n, 3) float32, "move_mask": (n,) uint8), held
+ * while the call runs. */
+typedef struct ext_param_arrays {
+    ext_array colors, mask;
+} ext_param_arrays;
+
 /* Fills `p` from a dict holding rsmooth_params' fields by name (every key must be one; missing
- * keys keep rsmooth_params_init's values). Returns 0, or -1 with ValueError/TypeError. `colors`
- * receives the held buffer of a "colors" entry (released by the caller). */
+ * keys keep rsmooth_params_init's values). Returns 0, or -1 with ValueError/TypeError. `held`
+ * receives the arrays (release them with ext_param_arrays_release, also after a failure). */
 int ext_params_from_dict(PyObject *dict, Py_ssize_t vertex_count, rsmooth_params *p,
-                         ext_array *colors);
+                         ext_param_arrays *held);
+void ext_param_arrays_release(ext_param_arrays *held);
 
 /* The dict of `p`'s fields (colors and callbacks left out). */
 PyObject *ext_params_to_dict(const rsmooth_params *p);

@@ -49,11 +49,12 @@ PyObject *ext_smooth(PyObject *self, PyObject *args, PyObject *kwargs) {
     rsmooth_context *ctx = NULL;
     if (cobj != Py_None && !(ctx = ext_context_from(cobj)))
         return NULL;
-    ext_array v, f, out, conf, colors;
+    ext_array v, f, out, conf;
+    ext_param_arrays held;
     memset(&f, 0, sizeof f);
     memset(&out, 0, sizeof out);
     memset(&conf, 0, sizeof conf);
-    memset(&colors, 0, sizeof colors);
+    memset(&held, 0, sizeof held);
     PyObject *result = NULL;
     if (ext_array_get(vobj, "vertices", EXT_REAL, 3, 0, 0, &v) != 0)
         return NULL;
@@ -62,7 +63,7 @@ PyObject *ext_smooth(PyObject *self, PyObject *args, PyObject *kwargs) {
         ext_array_get(oobj, "out", v.scalar == RSMOOTH_FLOAT32 ? EXT_FLOAT32 : EXT_FLOAT64, 3, 1,
                       0, &out) != 0 ||
         ext_array_get(kobj, "confidence", EXT_FLOAT32, 0, 1, 1, &conf) != 0 ||
-        ext_params_from_dict(pobj, v.rows, &p, &colors) != 0)
+        ext_params_from_dict(pobj, v.rows, &p, &held) != 0)
         goto done;
     if (out.rows != v.rows || (conf.held && conf.rows != v.rows)) {
         PyErr_SetString(PyExc_ValueError, "outputs must have a row per vertex");
@@ -86,7 +87,7 @@ PyObject *ext_smooth(PyObject *self, PyObject *args, PyObject *kwargs) {
     /* a report the library does not act on (the last, at 1) may still have raised */
     result = st == RSMOOTH_OK && !PyErr_Occurred() ? report_dict(&rep) : ext_raise(st, &err);
 done:
-    ext_array_release(&colors);
+    ext_param_arrays_release(&held);
     ext_array_release(&conf);
     ext_array_release(&out);
     ext_array_release(&f);
@@ -104,12 +105,13 @@ PyObject *ext_smooth_points(PyObject *self, PyObject *args, PyObject *kwargs) {
     if (!PyArg_ParseTupleAndKeywords(args, kwargs, "OOOOOOO", keywords, &vobj, &nobj, &oobj,
                                      &onobj, &kobj, &pobj, &progress))
         return NULL;
-    ext_array v, n, out, out_n, conf, colors;
+    ext_array v, n, out, out_n, conf;
+    ext_param_arrays held;
     memset(&n, 0, sizeof n);
     memset(&out, 0, sizeof out);
     memset(&out_n, 0, sizeof out_n);
     memset(&conf, 0, sizeof conf);
-    memset(&colors, 0, sizeof colors);
+    memset(&held, 0, sizeof held);
     PyObject *result = NULL;
     if (ext_array_get(vobj, "points", EXT_REAL, 3, 0, 0, &v) != 0)
         return NULL;
@@ -119,7 +121,7 @@ PyObject *ext_smooth_points(PyObject *self, PyObject *args, PyObject *kwargs) {
         ext_array_get(oobj, "out", same, 3, 1, 0, &out) != 0 ||
         ext_array_get(onobj, "out_normals", same, 3, 1, 1, &out_n) != 0 ||
         ext_array_get(kobj, "confidence", EXT_FLOAT32, 0, 1, 1, &conf) != 0 ||
-        ext_params_from_dict(pobj, v.rows, &p, &colors) != 0)
+        ext_params_from_dict(pobj, v.rows, &p, &held) != 0)
         goto done;
     if (n.rows != v.rows || out.rows != v.rows || (out_n.held && out_n.rows != v.rows) ||
         (conf.held && conf.rows != v.rows)) {
@@ -139,7 +141,7 @@ PyObject *ext_smooth_points(PyObject *self, PyObject *args, PyObject *kwargs) {
     /* a report the library does not act on (the last, at 1) may still have raised */
     result = st == RSMOOTH_OK && !PyErr_Occurred() ? report_dict(&rep) : ext_raise(st, &err);
 done:
-    ext_array_release(&colors);
+    ext_param_arrays_release(&held);
     ext_array_release(&conf);
     ext_array_release(&out_n);
     ext_array_release(&out);

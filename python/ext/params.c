@@ -47,10 +47,24 @@ static int set_field(rsmooth_params *p, const field *f, PyObject *value) {
     return 0;
 }
 
+/* Holds the array `value` under `name` in *a and returns its buffer; NULL with an exception set
+ * on a wrong type or shape (or for None: the field's default, no exception). */
+static const void *hold(PyObject *value, const char *name, ext_kind kind, Py_ssize_t cols,
+                        Py_ssize_t rows, ext_array *a) {
+    ext_array_release(a);
+    if (ext_array_get(value, name, kind, cols, 0, 1, a) != 0 || !a->held)
+        return NULL;
+    if (a->rows != rows) {
+        PyErr_Format(PyExc_ValueError, "%s: %zd rows for %zd vertices", name, a->rows, rows);
+        return NULL;
+    }
+    return a->view.buf;
+}
+
 int ext_params_from_dict(PyObject *dict, Py_ssize_t vertex_count, rsmooth_params *p,
-                         ext_array *colors) {
+                         ext_param_arrays *held) {
     rsmooth_params_init(p);
-    memset(colors, 0, sizeof *colors);
+    memset(held, 0, sizeof *held);
     if (dict == Py_None)
         return 0;
     if (!PyDict_Check(dict)) {
@@ -64,17 +78,18 @@ int ext_params_from_dict(PyObject *dict, Py_ssize_t vertex_count, rsmooth_params
         if (!name) {
             if (!PyErr_Occurred())
                 PyErr_SetString(PyExc_TypeError, "params: keys must be strings");
-            goto fail;
+            return -1;
         }
         if (strcmp(name, "colors") == 0) {
-            if (ext_array_get(value, "colors", EXT_FLOAT32, 3, 0, 1, colors) != 0)
-                goto fail;
-            if (colors->held && colors->rows != vertex_count) {
-                PyErr_Format(PyExc_ValueError, "colors: %zd rows for %zd vertices",
-                             colors->rows, vertex_count);
-                goto fail;
-            }
-            p->colors = colors->held ? colors->view.buf : NULL;
+            p->colors = hold(value, name, EXT_FLOAT32, 3, vertex_count, &held->colors);
+            if (PyErr_Occurred())
+                return -1;
+            continue;
+        }
+        if (strcmp(name, "move_mask") == 0) {
+            p->move_mask = hold(value, name, EXT_UINT8, 0, vertex_count, &held->mask);
+            if (PyErr_Occurred())
+                return -1;
             continue;
         }
         size_t i = 0;
@@ -82,15 +97,17 @@ int ext_params_from_dict(PyObject *dict, Py_ssize_t vertex_count, rsmooth_params
             i++;
         if (i == FIELD_COUNT) {
             PyErr_Format(PyExc_ValueError, "params: unknown field '%s'", name);
-            goto fail;
+            return -1;
         }
         if (set_field(p, fields + i, value) != 0)
-            goto fail;
+            return -1;
     }
     return 0;
-fail:
-    ext_array_release(colors);
-    return -1;
+}
+
+void ext_param_arrays_release(ext_param_arrays *held) {
+    ext_array_release(&held->colors);
+    ext_array_release(&held->mask);
 }
 
 PyObject *ext_params_to_dict(const rsmooth_params *p) {
@@ -138,7 +155,8 @@ PyObject *ext_params_auto(PyObject *self, PyObject *args) {
     PyObject *vobj, *fobj, *pobj;
     if (!PyArg_ParseTuple(args, "OOO", &vobj, &fobj, &pobj))
         return NULL;
-    ext_array v, f, colors;
+    ext_array v, f;
+    ext_param_arrays held;
     if (ext_array_get(vobj, "vertices", EXT_REAL, 3, 0, 0, &v) != 0)
         return NULL;
     if (ext_array_get(fobj, "faces", EXT_UINT32, 3, 0, 0, &f) != 0) {
@@ -147,7 +165,7 @@ PyObject *ext_params_auto(PyObject *self, PyObject *args) {
     }
     PyObject *result = NULL;
     rsmooth_params p;
-    if (ext_params_from_dict(pobj, v.rows, &p, &colors) == 0) {
+    if (ext_params_from_dict(pobj, v.rows, &p, &held) == 0) {
         double noise = 0;
         rsmooth_error err;
         rsmooth_status st;
@@ -162,8 +180,8 @@ PyObject *ext_params_auto(PyObject *self, PyObject *args) {
             if (dict)
                 result = Py_BuildValue("(Nd)", dict, noise);
         }
-        ext_array_release(&colors);
     }
+    ext_param_arrays_release(&held);
     ext_array_release(&f);
     ext_array_release(&v);
     return result;

@@ -49,6 +49,14 @@ def _faces(array: Any, vertex_count: int, name: str = "faces") -> np.ndarray:
     return np.ascontiguousarray(f, dtype=np.uint32)
 
 
+def _mask(array: Any, vertex_count: int) -> np.ndarray:
+    """(n,) selection, any dtype (non-zero or True: the vertex moves), as uint8."""
+    m = np.asarray(array)
+    if m.shape != (vertex_count,):
+        raise ValueError(f"mask: expected shape ({vertex_count},), got {m.shape}")
+    return np.ascontiguousarray(m != 0, dtype=np.uint8)
+
+
 def _colors(array: Any, vertex_count: int) -> np.ndarray:
     c = np.asarray(array)
     if c.ndim != 2 or c.shape != (vertex_count, 3):

@@ -9,7 +9,7 @@ from typing import Any, Optional
 import numpy as np
 
 from . import _rsmooth
-from ._arrays import _colors, _faces, _vertices
+from ._arrays import _colors, _faces, _mask, _vertices
 from ._context import Context
 from ._options import _METHODS, Progress, _params, _progress_callable
 from ._rsmooth import DeviceError
@@ -39,6 +39,7 @@ def smooth(
     mollify_cutoff: Optional[float] = None,
     colors: Any = None,
     sigma_c: Optional[float] = None,
+    mask: Any = None,
     method: str = "robust",
     iterations: int = 10,
     lam: float = 0.5,
@@ -83,6 +84,9 @@ def smooth(
     colors : (n, 3) per-vertex colours (floats in [0, 1], or uint8 0..255) weighing each
         triangle by its colour difference too, so colour edges stay sharp; width ``sigma_c``
         (default 0.1).
+    mask : (n,) selection (bool or integers): only the vertices where it is true move; the others
+        keep their input position bit for bit, and every triangle still supports the selected
+        ones (the robust filter only).
     method : "robust" (the filter), or the isotropic smoothers it is measured against:
         "gaussian" (one Gaussian-weighted pass of centroids, width sigma_f), "laplacian" and
         "taubin" (``iterations`` umbrella steps by ``lam``, Taubin's each followed by one by
@@ -107,8 +111,8 @@ def smooth(
         normal_sigma_s=normal_sigma_s, normal_sigma_n=normal_sigma_n,
         normal_iterations=normal_iterations, influence=influence, passes=passes,
         pass_confidence=pass_confidence, predictor=predictor, mollify_cutoff=mollify_cutoff,
-        colors=colors, sigma_c=sigma_c, method=method, iterations=iterations, lam=lam, mu=mu,
-        progress=progress,
+        colors=colors, sigma_c=sigma_c, mask=mask, method=method, iterations=iterations,
+        lam=lam, mu=mu, progress=progress,
     )
     if device == "reference" or method in ("laplacian", "taubin"):
         return _smooth(None, vertices, faces, **options)
@@ -144,6 +148,7 @@ def _smooth(
     best: bool = False,
     auto: bool = False,
     colors: Any = None,
+    mask: Any = None,
     method: str = "robust",
     iterations: int = 10,
     lam: float = 0.5,
@@ -158,8 +163,8 @@ def _smooth(
         raise ValueError(f"method: expected one of {', '.join(_METHODS)}, got {method!r}")
     out = np.empty_like(v)
     if method in ("laplacian", "taubin"):
-        if confidence:
-            raise ValueError(f"method {method!r} gives no confidence")
+        if confidence or mask is not None:
+            raise ValueError(f"method {method!r} takes no confidence and no mask")
         _rsmooth._taubin(v, f, out, float(lam), float(mu) if method == "taubin" else 0.0,
                          int(iterations))
         return out.reshape(shape_in)
@@ -168,6 +173,8 @@ def _smooth(
     params, _ = _params(v, f, best=best, auto=auto, overrides=overrides)
     if colors is not None:
         params["colors"] = _colors(colors, v.shape[0])
+    if mask is not None:
+        params["move_mask"] = _mask(mask, v.shape[0])
     conf = np.empty(v.shape[0], dtype=np.float32) if confidence else None
     call, bar = _progress_callable(progress)
     try:
@@ -204,6 +211,7 @@ def smooth_points(
     predictor: Optional[str] = None,
     colors: Any = None,
     sigma_c: Optional[float] = None,
+    mask: Any = None,
     progress: Progress = False,
 ) -> Any:
     """The filter on a point cloud with normals: each point is its own facet, its plane the
@@ -231,6 +239,8 @@ def smooth_points(
     params, _ = _params(p, no_faces, best=best, auto=False, overrides=overrides)
     if colors is not None:
         params["colors"] = _colors(colors, p.shape[0])
+    if mask is not None:
+        params["move_mask"] = _mask(mask, p.shape[0])
     out = np.empty_like(p)
     out_n = np.empty_like(p) if return_normals else None
     conf = np.empty(p.shape[0], dtype=np.float32) if confidence else None

@@ -181,3 +181,20 @@ def test_points():
     o32 = rsmooth.smooth_points(pts.astype(np.float32), normals.astype(np.float32))
     assert o32.dtype == np.float32 and np.max(np.abs(o32 - out)) < 1e-5
     assert rsmooth.point_spacing(truth) > 0
+
+
+def test_mask(mesh):
+    """Only the selected vertices move; with one pass they move exactly as without a mask."""
+    v, f = mesh
+    selected = v[:, 0] > 0
+    full = rsmooth.smooth(v, f, device="reference")
+    out = rsmooth.smooth(v, f, device="reference", mask=selected)
+    assert np.array_equal(out[~selected], v[~selected])
+    assert np.array_equal(out[selected], full[selected])
+    out32 = rsmooth.smooth(v.astype(np.float32), f, device="reference", mask=selected.astype(int),
+                           best=True)
+    assert np.array_equal(out32[~selected], v.astype(np.float32)[~selected])
+    pts = rsmooth.smooth_points(v, v / np.linalg.norm(v, axis=1, keepdims=True), mask=selected)
+    assert np.array_equal(pts[~selected], v[~selected])
+    with pytest.raises(ValueError, match="mask"):
+        rsmooth.smooth(v, f, device="reference", mask=selected[:-1])
