@@ -14,17 +14,21 @@
 
 int cli_read_mesh(const char *path, cli_progress *bar, rsmooth_mesh **mesh) {
     *mesh = NULL;
-    FILE *f = fopen(path, "rb");
+    bool standard_input = !strcmp(path, "-");
+    FILE *f = standard_input ? stdin : fopen(path, "rb");
+    if (standard_input)
+        path = "<stdin>"; /* in messages */
     struct stat st;
     if (!f || fstat(fileno(f), &st) != 0) {
         fprintf(stderr, "rsmooth: %s: cannot open: %s\n", path, strerror(errno));
-        if (f)
+        if (f && !standard_input)
             fclose(f);
         return EXIT_USAGE;
     }
     if (S_ISDIR(st.st_mode)) {
         fprintf(stderr, "rsmooth: %s: is a directory, not a mesh file\n", path);
-        fclose(f);
+        if (!standard_input)
+            fclose(f);
         return EXIT_USAGE;
     }
     size_t expected = S_ISREG(st.st_mode) ? (size_t)st.st_size : 0;
@@ -56,7 +60,8 @@ int cli_read_mesh(const char *path, cli_progress *bar, rsmooth_mesh **mesh) {
             break;
         }
     }
-    fclose(f);
+    if (!standard_input)
+        fclose(f);
     if (!data) {
         fprintf(stderr, "rsmooth: %s: out of memory reading it\n", path);
         return EXIT_OTHER;
@@ -96,7 +101,8 @@ rsmooth_format cli_output_format(const char *path, bool ascii) {
     return format;
 }
 
-int cli_check_output(const char *path, const char *input, bool force, bool in_place) {
+int cli_check_output(const char *path, const char *input, bool force, bool in_place,
+                     bool format_given) {
     if (!in_place && cli_same_file(path, input)) {
         fprintf(stderr, "rsmooth: %s: refusing to overwrite the input file (use --in-place)\n",
                 path);
@@ -105,7 +111,7 @@ int cli_check_output(const char *path, const char *input, bool force, bool in_pl
     int code = cli_check_output_path(path, force || in_place);
     if (code >= 0)
         return code;
-    if (cli_output_format(path, false) == RSMOOTH_FORMAT_AUTO) {
+    if (!format_given && cli_output_format(path, false) == RSMOOTH_FORMAT_AUTO) {
         fprintf(stderr, "rsmooth: %s: unknown output format (use .obj, .ply, .off or .stl)\n",
                 path);
         return EXIT_USAGE;
@@ -139,5 +145,13 @@ int cli_check_writable(const rsmooth_mesh *mesh, const char *path, rsmooth_forma
 int cli_write_mesh(const rsmooth_mesh *mesh, const char *path, rsmooth_format format, bool replace,
                    bool quiet) {
     mesh_write w = {mesh, format};
-    return cli_write_atomically(path, replace, quiet, write_mesh_stream, &w);
+    if (strcmp(path, "-") != 0)
+        return cli_write_atomically(path, replace, quiet, write_mesh_stream, &w);
+    char message[256] = "";
+    if (write_mesh_stream(stdout, &w, message, sizeof message) != 0 ||
+        (fflush(stdout) != 0 && snprintf(message, sizeof message, "%s", strerror(errno)) > 0)) {
+        fprintf(stderr, "rsmooth: <stdout>: cannot write: %s\n", message);
+        return EXIT_OTHER;
+    }
+    return EXIT_OK;
 }

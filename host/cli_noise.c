@@ -186,7 +186,7 @@ int cli_noise_main(int argc, char **argv) {
     if (code >= 0)
         return code;
     /* Before reading, so a typo in OUTPUT costs no time on a large INPUT. */
-    if ((code = cli_check_output(a.output, a.input, a.force, false)) >= 0)
+    if ((code = cli_check_output(a.output, a.input, a.force, false, false)) >= 0)
         return code;
 
     rsmooth_mesh *mesh = NULL;

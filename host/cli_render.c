@@ -3,6 +3,7 @@
 #include "cli_args.h"
 #include "cli_commands.h"
 #include "cli_files.h"
+#include "cli_getopt.h"
 #include "cli_output.h"
 #include "mesh_render.h"
 #include "png_write.h"
@@ -29,7 +30,8 @@ static const char render_usage[] =
     "\n"
     "Options:\n"
     "  -o, --output FILE   the PNG to write (required)\n"
-    "  --size WxH          picture size in pixels (default 800 x 800 per panel)\n"
+    "  --size WxH          each panel's size in pixels (default 800x800); the picture is the\n"
+    "                      panels side by side, 6 pixels apart\n"
     "  --azimuth DEG       camera angle about the up axis; 0 looks along -z (default 35)\n"
     "  --elevation DEG     camera angle above the horizon, in (-90, 90) (default 25)\n"
     "  --orthographic      parallel projection instead of perspective\n"
@@ -39,6 +41,8 @@ static const char render_usage[] =
     "\n"
     "Example:\n"
     "  rsmooth render noisy.ply smooth.ply conf.ply -o compare.png\n"
+    "\n"
+    "Options take values as --name VALUE or --name=VALUE, before or after the files.\n"
     "\n"
     "Exit status: 0 success, 2 bad usage, an unreadable or malformed input or an OUT that may\n"
     "not be written, 1 other.\n";
@@ -83,41 +87,42 @@ int cli_render_main(int argc, char **argv) {
     }
     size_t input_count = 0;
     int status = 0;
-    for (int i = 1; i < argc && status == 0; i++) {
-        const char *a = argv[i];
-        bool takes_value = !strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--size") ||
-                           !strcmp(a, "--azimuth") || !strcmp(a, "--elevation");
-        if (takes_value && i + 1 >= argc) {
-            status = cli_usage_error("render", "missing value after %s", a);
-            break;
-        }
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+    enum { R_HELP = 1, R_OUTPUT, R_SIZE, R_AZIMUTH, R_ELEVATION, R_ORTHOGRAPHIC, R_FORCE };
+    static const cli_option table[] = {
+        {"help", 'h', false, R_HELP},       {"output", 'o', true, R_OUTPUT},
+        {"size", 0, true, R_SIZE},          {"azimuth", 0, true, R_AZIMUTH},
+        {"elevation", 0, true, R_ELEVATION}, {"orthographic", 0, false, R_ORTHOGRAPHIC},
+        {"force", 'f', false, R_FORCE},     {NULL, 0, false, 0}};
+    cli_getopt_state s;
+    cli_getopt_init(&s, argc, argv, "render", table);
+    const char *value;
+    int id;
+    while (status == 0 && (id = cli_getopt(&s, &value)) != CLI_GETOPT_END) {
+        if (id == CLI_GETOPT_ERROR) {
+            status = 2;
+        } else if (id == R_HELP) {
             fputs(render_usage, stdout);
             free(inputs);
             return 0;
-        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-            output = argv[++i];
-        } else if (!strcmp(a, "--size")) {
-            if (!parse_size(argv[++i], &width, &height))
-                status =
-                    cli_usage_error("render", "--size wants WxH, each 1 to 16384: %s", argv[i]);
-        } else if (!strcmp(a, "--azimuth")) {
-            if (!cli_parse_number(argv[++i], &options.azimuth_deg) ||
-                !isfinite(options.azimuth_deg))
-                status = cli_usage_error("render", "--azimuth wants degrees: %s", argv[i]);
-        } else if (!strcmp(a, "--elevation")) {
-            if (!cli_parse_number(argv[++i], &options.elevation_deg) ||
+        } else if (id == R_OUTPUT) {
+            output = value;
+        } else if (id == R_SIZE) {
+            if (!parse_size(value, &width, &height))
+                status = cli_usage_error("render", "--size wants WxH, each 1 to 16384: %s", value);
+        } else if (id == R_AZIMUTH) {
+            if (!cli_parse_number(value, &options.azimuth_deg) || !isfinite(options.azimuth_deg))
+                status = cli_usage_error("render", "--azimuth wants degrees: %s", value);
+        } else if (id == R_ELEVATION) {
+            if (!cli_parse_number(value, &options.elevation_deg) ||
                 !(options.elevation_deg > -90 && options.elevation_deg < 90))
                 status = cli_usage_error("render", "--elevation wants degrees in (-90, 90): %s",
-                                         argv[i]);
-        } else if (!strcmp(a, "--orthographic")) {
+                                         value);
+        } else if (id == R_ORTHOGRAPHIC) {
             options.orthographic = true;
-        } else if (!strcmp(a, "-f") || !strcmp(a, "--force")) {
+        } else if (id == R_FORCE) {
             force = true;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            status = cli_usage_error("render", "unknown option: %s", a);
         } else {
-            inputs[input_count++] = a;
+            inputs[input_count++] = value;
         }
     }
     if (status == 0 && input_count == 0)
@@ -128,16 +133,20 @@ int cli_render_main(int argc, char **argv) {
         free(inputs);
         return status;
     }
-    if (width == 0) { /* default: square panels side by side */
-        width = (int)(input_count * DEFAULT_PANEL + (input_count - 1) * (size_t)options.gap);
-        height = DEFAULT_PANEL;
-        if (input_count > MAX_SIDE / DEFAULT_PANEL)
-            width = MAX_SIDE;
-    }
-    if ((size_t)width < input_count * 8 + (input_count - 1) * (size_t)options.gap) {
+    /* --size is each panel's (the default 800 x 800): the picture is the panels side by side */
+    int panel_width = width ? width : DEFAULT_PANEL, panel_height = width ? height : DEFAULT_PANEL;
+    size_t total = input_count * (size_t)panel_width + (input_count - 1) * (size_t)options.gap;
+    if (total > MAX_SIDE && !width && input_count * 8 + (input_count - 1) * (size_t)options.gap <=
+                                          MAX_SIDE) {
+        total = MAX_SIDE; /* many meshes: narrower panels by default */
+    } else if (total > MAX_SIDE) {
         free(inputs);
-        return cli_usage_error("render", "--size is too narrow for that many panels");
+        return cli_usage_error("render", "%zu panels of %d pixels make a picture wider than %d: "
+                                         "give a smaller --size", input_count, panel_width,
+                               MAX_SIDE);
     }
+    width = (int)total;
+    height = panel_height;
     for (size_t i = 0; i < input_count; i++) {
         if (cli_same_file(output, inputs[i])) {
             fprintf(stderr, "rsmooth render: %s: refusing to overwrite an input file\n", output);

@@ -3,6 +3,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "rsmooth.h"
 #include "cli_args.h"
+#include "cli_options.h"
 #include "cli_commands.h"
 #include "cli_files.h"
 #include "cli_output.h"
@@ -17,391 +18,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-
-static const char usage_text[] =
-    "usage: rsmooth INPUT -o OUTPUT [options]\n"
-    "       rsmooth INPUT --in-place [options]\n"
-    "       rsmooth --list-devices\n"
-    "       rsmooth compare RESULT TRUTH [--json]       (errors against a ground truth)\n"
-    "       rsmooth noise IN OUT --sigma S [options]    (reproducible noise for experiments)\n"
-    "       rsmooth render IN... -o OUT.png [options]   (flat-shaded pictures side by side)\n"
-    "\n"
-    "Removes noise from a triangle mesh while keeping its sharp edges and corners, with the\n"
-    "non-iterative filter of Jones, Durand & Desbrun (SIGGRAPH 2003). Each vertex moves to a\n"
-    "weighted average of its projections onto the planes of nearby triangles; triangles whose\n"
-    "plane would pull the vertex far (across a sharp edge) get little weight. One pass, and no\n"
-    "connectivity needed: triangle soups, cracked and non-manifold scans work.\n"
-    "\n"
-    "Files: OBJ, PLY (ascii, binary), OFF and STL, by content on input and by extension on "
-    "output.\n"
-    "Vertex order, faces and everything else the file holds (colours, texture coordinates,\n"
-    "groups, materials, other PLY properties and elements) are kept when the output has the\n"
-    "input's format; vertex normals are recomputed. Converting says on stderr what it drops.\n"
-    "Point clouds: a file with vertex normals and no faces (PLY nx ny nz, NOFF, OBJ vn) is\n"
-    "filtered as points, each predicting with its tangent plane (sigmas in point spacings: the\n"
-    "mean distance to the 6 nearest points); the filtered positions and normals are written.\n"
-    "Reference path only (CPU) for now.\n"
-    "\n"
-    "The two widths, in mean edge lengths of the input (a scan's point spacing):\n"
-    "  --sigma-f X     spatial width: how far around a vertex triangles are consulted (they are\n"
-    "                  ignored beyond 2 X). Larger removes coarser noise and costs more time.\n"
-    "                  Default 2.\n"
-    "  --sigma-g Y     influence width: how far a triangle's plane may be from the vertex before\n"
-    "                  it counts as the other side of a feature. Larger smooths more and rounds\n"
-    "                  edges; smaller keeps edges and leaves more noise. 'inf' turns it off\n"
-    "                  (plain Gaussian-weighted smoothing). Default 0.5.\n"
-    "  Rule of thumb (the paper's): raise both until the surface is smooth enough, then lower\n"
-    "  --sigma-g until the sharp features come back.\n"
-    "\n"
-    "Beyond the paper (the defaults above are the paper's filter, unchanged):\n"
-    "  --best                the most accurate mode measured (docs/experiments.md): bilateral\n"
-    "                        normals, then 3 passes at sigma-f 0.8, sigma-g 0.3. Options\n"
-    "                        after it still apply, e.g. --best --passes 4\n"
-    "  --normals F           how the predicting planes' normals are smoothed: mollify (default,\n"
-    "                        the paper's) or bilateral (keeps creases the Gaussian rounds)\n"
-    "  --normal-sigma-s X    bilateral: spatial width, in the units of sigma-f (default 1)\n"
-    "  --normal-sigma-n X    bilateral: width on the difference of unit normals, (0, 2]; smaller\n"
-    "                        keeps more creases (default 0.35)\n"
-    "  --normal-iterations K bilateral: rounds (default 5)\n"
-    "  --influence G         the robust weight on a prediction's distance: gaussian (default),\n"
-    "                        tukey (zero beyond 2.24 sigma-g), lorentzian or huber (heavier tails)\n"
-    "  --auto                estimate the input's noise and pick the sigmas from it (with\n"
-    "                        --best also the rounds and passes); it prints the estimate. Options\n"
-    "                        given explicitly (e.g. --sigma-g) win over the rule\n"
-    "  --passes N            run the filter N times, each from the previous result (default 1)\n"
-    "  --pass-confidence C   passes after the first move only vertices whose confidence was\n"
-    "                        below C: more smoothing at features and outliers only. In [0, 1];\n"
-    "                        0 (the default) moves every vertex in every pass\n"
-    "  --sigma-c X           colour in the weight: a triangle pulls a vertex by exp(-|dC|^2 / 2\n"
-    "                        X^2) less, dC the difference between its mean vertex colour and the\n"
-    "                        vertex's (RGB in [0, 1]), so colour edges stay sharp. Needs an input\n"
-    "                        with vertex colours (PLY red green blue, OBJ v x y z r g b, COFF);\n"
-    "                        e.g. 0.1\n"
-    "\n"
-    "Options:\n"
-    "  -o, --output FILE     result mesh (.obj, .ply, .off, .stl); refuses to replace an existing\n"
-    "                        file without --force, and never writes the input (see Output files)\n"
-    "  --in-place            replace the input with the result (atomically; instead of -o)\n"
-    "  --absolute            read --sigma-f and --sigma-g in the mesh's own units\n"
-    "  --cutoff C            ignore triangles farther than C * sigma-f (default 2, range (0, 5])\n"
-    "  --no-mollify          predict with the raw (noisy) normals: the paper's ablation, worse\n"
-    "  --method M            robust (default): the filter above. For comparison, the isotropic\n"
-    "                        smoothers it improves on, which round sharp edges:\n"
-    "                          gaussian   Gaussian-weighted average of triangle centroids\n"
-    "                                     (width --sigma-f; no influence weight, one pass)\n"
-    "                          laplacian  --iterations steps towards the mean of the edge\n"
-    "                                     neighbours, by --lambda (default 0.5); shrinks\n"
-    "                          taubin     Taubin's lambda|mu: each step followed by one back\n"
-    "                                     by --mu (default -0.53); keeps the size\n"
-    "                        laplacian and taubin need connected faces (a soup does not move),\n"
-    "                        run on the CPU and write no --confidence.\n"
-    "  --iterations N        laplacian and taubin steps (default 10)\n"
-    "  --device D            auto (default: first GPU, else CPU; falls back to the reference path\n"
-    "                        with a warning when no OpenCL exists), gpu, cpu, reference (double\n"
-    "                        precision on one CPU thread), P:D (platform and device index), or a\n"
-    "                        part of the device name. Also read from RSMOOTH_DEVICE.\n"
-    "  --confidence FILE     also write the mesh with its confidence k(p) / sum a f in [0, 1]\n"
-    "                        (PLY: 'quality' property) and coloured by it, normalised to the\n"
-    "                        mesh's range: red its lowest (few triangles agreed: sharp edges,\n"
-    "                        outliers, sparse parts), blue its highest. OBJ: colours only.\n"
-    "  --ascii               write PLY and STL as ascii (default binary little-endian)\n"
-    "  --memory-budget SIZE  device memory one run may hold (e.g. 256M, 2G; above 0; default:\n"
-    "                        most of the device's). A mesh that needs more is filtered in spatial\n"
-    "                        tiles, with the same result to float rounding. Also read from\n"
-    "                        RSMOOTH_MEMORY_BUDGET (the option wins); for the default leave both\n"
-    "                        out.\n"
-    "  --list-devices        list the OpenCL devices and how --device names them, then exit\n"
-    "  --stats               print statistics of the mesh and of what the filter did\n"
-    "  --json                print one JSON object of counts, sigmas, device and stage times (ms)\n"
-    "                        on stdout\n"
-    "  -f, --force           replace existing output files (see Output files)\n"
-    "  -q, --quiet           print nothing but errors (no summary, warnings or progress bar)\n"
-    "  --version             print the version\n"
-    "  -h, --help            print this help\n"
-    "\n"
-    "Output files:\n"
-    "  The result goes to a temporary file in the output's folder that is put in place only\n"
-    "  when complete: neither the output nor a file it replaces is ever seen half-written. The\n"
-    "  temporary is unnamed where the system allows (O_TMPFILE), so even kill -9 leaves nothing\n"
-    "  behind; elsewhere it is .rsmooth-XXXXXX, removed on an error or Ctrl-C.\n"
-    "  Without --force nothing is ever replaced, not even by a concurrent run writing the same\n"
-    "  new file: one of them writes it, the other exits 2 ('already exists').\n"
-    "  A file replaced (--force, --in-place) keeps its permissions, owner and group; a user who\n"
-    "  is not root cannot give a file away, so then the result is theirs and a warning says so.\n"
-    "  A symbolic link is written through: --in-place on a link, or -o naming a link with\n"
-    "  --force, replaces the file it names and leaves the link as it is. A link to a missing\n"
-    "  file, a directory or another special file is never written. A file with other hard\n"
-    "  links is replaced under this name only (a warning says so).\n"
-    "\n"
-    "Examples:\n"
-    "  rsmooth scan.ply -o smooth.ply\n"
-    "  rsmooth part.stl -o part-smooth.stl --sigma-f 3 --sigma-g 0.4 --confidence conf.ply\n"
-    "  rsmooth scan.obj --in-place --device gpu --stats\n"
-    "\n"
-    "Exit status: 0 success, 2 bad usage (also a --device that names no device here), a bad\n"
-    "input file or an output that may not be written (it exists, or appeared while this run\n"
-    "worked), 3 an OpenCL device that fails, 1 other (a result not finite in the output\n"
-    "file's number type is one: nothing non-finite is ever written).\n";
-
-/* --method: the filter, or a baseline to compare it with. */
-typedef enum method { METHOD_ROBUST, METHOD_GAUSSIAN, METHOD_LAPLACIAN, METHOD_TAUBIN } method;
-static const char *const method_names[] = {"robust", "gaussian", "laplacian", "taubin"};
-
-/* --normals and --influence values, in enum order. */
-static const char *const normal_filter_names[] = {"mollify", "bilateral"};
-static const char *const influence_names[] = {"gaussian", "tukey", "lorentzian", "huber"};
-
-/* Laplacian and Taubin iterate on the mesh's edges (rsmooth_smooth_taubin): no sigmas, no
- * confidence. */
-static bool method_uses_edges(method m) {
-    return m == METHOD_LAPLACIAN || m == METHOD_TAUBIN;
-}
-
-typedef struct options {
-    const char *input, *output, *confidence, *device;
-    rsmooth_params params;
-    method method;
-    double lambda, mu;
-    unsigned iterations;
-    uint64_t memory_budget; /* 0: the library's default */
-    bool colors;            /* --sigma-c: the input's vertex colours in the weight */
-    bool sigma_g_given, umbrella_given; /* for consistency checks against --method */
-    bool ascii, json, force, quiet, in_place, stats, list_devices, best;
-    bool auto_params;       /* --auto */
-    unsigned given;         /* GIVEN_* bits: parameters set on the command line */
-    double noise;           /* --auto's estimate */
-} options;
-
-/* Parameters the command line set explicitly: --auto leaves them as given. */
-enum {
-    GIVEN_SIGMA_F = 1u << 0,
-    GIVEN_SIGMA_G = 1u << 1,
-    GIVEN_NORMAL_SIGMA_S = 1u << 2,
-    GIVEN_NORMAL_SIGMA_N = 1u << 3,
-    GIVEN_NORMAL_ITERATIONS = 1u << 4,
-    GIVEN_PASSES = 1u << 5,
-    GIVEN_INFLUENCE = 1u << 6
-};
-
-/* Returns -1 when the program should go on, else the exit status. */
-static int parse_args(int argc, char **argv, options *opt) {
-    memset(opt, 0, sizeof *opt);
-    rsmooth_params_init(&opt->params);
-    opt->lambda = 0.5;
-    opt->mu = -0.53;
-    opt->iterations = 10;
-    for (int i = 1; i < argc; i++)
-        if (!strcmp(argv[i], "--best")) {
-            rsmooth_params_init_best(&opt->params);
-            opt->best = true;
-        }
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *value = i + 1 < argc ? argv[i + 1] : NULL;
-        double x;
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-            fputs(usage_text, stdout);
-            return EXIT_OK;
-        } else if (!strcmp(a, "--version")) {
-            printf("rsmooth %d.%d.%d\n", RSMOOTH_VERSION_MAJOR, RSMOOTH_VERSION_MINOR,
-                   RSMOOTH_VERSION_PATCH);
-            return EXIT_OK;
-        } else if (!strcmp(a, "-o") || !strcmp(a, "--output") || !strcmp(a, "--confidence") ||
-                   !strcmp(a, "--device")) {
-            if (!value)
-                return cli_usage_error(NULL, "%s needs a value", a);
-            if (!strcmp(a, "--confidence"))
-                opt->confidence = value;
-            else if (!strcmp(a, "--device"))
-                opt->device = value;
-            else
-                opt->output = value;
-            i++;
-        } else if (!strcmp(a, "--memory-budget")) {
-            if (!value)
-                return cli_usage_error(NULL, "%s needs a value", a);
-            if (!cli_parse_bytes(value, &opt->memory_budget) || opt->memory_budget == 0)
-                return cli_usage_error(NULL, "--memory-budget: '%s' is not a byte count above 0 "
-                                             "(examples: 256M, 1.5G; leave it out for most of "
-                                             "the device's memory)", value);
-            i++;
-        } else if (!strcmp(a, "--method")) {
-            if (!value)
-                return cli_usage_error(NULL, "%s needs a value", a);
-            int m = METHOD_TAUBIN;
-            while (m >= 0 && strcmp(value, method_names[m]) != 0)
-                m--;
-            if (m < 0)
-                return cli_usage_error(
-                    NULL, "--method: '%s' is not robust, gaussian, laplacian or taubin", value);
-            opt->method = (method)m;
-            i++;
-        } else if (!strcmp(a, "--lambda") || !strcmp(a, "--mu") || !strcmp(a, "--iterations")) {
-            if (!value)
-                return cli_usage_error(NULL, "%s needs a value", a);
-            if (!cli_parse_number(value, &x))
-                return cli_usage_error(NULL, "%s: not a number: '%s'", a, value);
-            if (!strcmp(a, "--lambda"))
-                opt->lambda = x;
-            else if (!strcmp(a, "--mu"))
-                opt->mu = x;
-            else if (!(x >= 0 && x <= 1e6 && x == floor(x)))
-                return cli_usage_error(NULL, "--iterations must be a whole number in [0, 1e6] "
-                                             "(got '%s')", value);
-            else
-                opt->iterations = (unsigned)x;
-            opt->umbrella_given = true;
-            i++;
-        } else if (!strcmp(a, "--sigma-f") || !strcmp(a, "--sigma-g") || !strcmp(a, "--cutoff")) {
-            if (!value)
-                return cli_usage_error(NULL, "%s needs a value", a);
-            if (!cli_parse_number(value, &x))
-                return cli_usage_error(NULL, "%s: not a number: '%s'", a, value);
-            if (!strcmp(a, "--sigma-f"))
-                opt->params.sigma_f = x, opt->given |= GIVEN_SIGMA_F;
-            else if (!strcmp(a, "--sigma-g"))
-                opt->params.sigma_g = x, opt->sigma_g_given = true, opt->given |= GIVEN_SIGMA_G;
-            else
-                opt->params.cutoff = x;
-            i++;
-        } else if (!strcmp(a, "--normals") || !strcmp(a, "--influence")) {
-            if (!value)
-                return cli_usage_error(NULL, "%s needs a value", a);
-            bool normals = !strcmp(a, "--normals");
-            const char *const *names = normals ? normal_filter_names : influence_names;
-            int count = normals ? 2 : 4, k = 0;
-            while (k < count && strcmp(value, names[k]) != 0)
-                k++;
-            if (k == count)
-                return cli_usage_error(NULL, normals ? "--normals: '%s' is not mollify or bilateral"
-                                                     : "--influence: '%s' is not gaussian, tukey, "
-                                                       "lorentzian or huber",
-                                       value);
-            if (normals) {
-                opt->params.normal_filter = k;
-            } else {
-                opt->params.influence = k;
-                opt->given |= GIVEN_INFLUENCE;
-            }
-            i++;
-        } else if (!strcmp(a, "--normal-sigma-s") || !strcmp(a, "--normal-sigma-n") ||
-                   !strcmp(a, "--pass-confidence")) {
-            if (!value)
-                return cli_usage_error(NULL, "%s needs a value", a);
-            if (!cli_parse_number(value, &x))
-                return cli_usage_error(NULL, "%s: not a number: '%s'", a, value);
-            if (!strcmp(a, "--normal-sigma-s"))
-                opt->params.normal_sigma_s = x, opt->given |= GIVEN_NORMAL_SIGMA_S;
-            else if (!strcmp(a, "--normal-sigma-n"))
-                opt->params.normal_sigma_n = x, opt->given |= GIVEN_NORMAL_SIGMA_N;
-            else
-                opt->params.pass_confidence = x;
-            i++;
-        } else if (!strcmp(a, "--sigma-c")) {
-            if (!value)
-                return cli_usage_error(NULL, "%s needs a value", a);
-            if (!cli_parse_number(value, &x) || !(x > 0))
-                return cli_usage_error(NULL, "--sigma-c must be a positive number (got '%s')",
-                                       value);
-            opt->params.sigma_c = x;
-            opt->colors = true;
-            i++;
-        } else if (!strcmp(a, "--normal-iterations") || !strcmp(a, "--passes")) {
-            if (!value)
-                return cli_usage_error(NULL, "%s needs a value", a);
-            if (!cli_parse_number(value, &x) || !(x >= 1 && x <= 100 && x == floor(x)))
-                return cli_usage_error(NULL, "%s must be a whole number in [1, 100] (got '%s')", a,
-                                       value);
-            if (!strcmp(a, "--passes"))
-                opt->params.passes = (int)x, opt->given |= GIVEN_PASSES;
-            else
-                opt->params.normal_iterations = (int)x, opt->given |= GIVEN_NORMAL_ITERATIONS;
-            i++;
-        } else if (!strcmp(a, "--auto")) {
-            opt->auto_params = true;
-        } else if (!strcmp(a, "--best")) {
-            /* applied before the loop, so the options after it can change its settings */
-        } else if (!strcmp(a, "--absolute")) {
-            opt->params.absolute = 1;
-        } else if (!strcmp(a, "--no-mollify")) {
-            opt->params.mollify = 0;
-        } else if (!strcmp(a, "--ascii")) {
-            opt->ascii = true;
-        } else if (!strcmp(a, "--json")) {
-            opt->json = true;
-        } else if (!strcmp(a, "--stats")) {
-            opt->stats = true;
-        } else if (!strcmp(a, "--in-place")) {
-            opt->in_place = true;
-        } else if (!strcmp(a, "--list-devices")) {
-            opt->list_devices = true;
-        } else if (!strcmp(a, "-f") || !strcmp(a, "--force")) {
-            opt->force = true;
-        } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
-            opt->quiet = true;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return cli_usage_error(NULL, "unknown option '%s'", a);
-        } else if (!opt->input) {
-            opt->input = a;
-        } else {
-            return cli_usage_error(NULL, "unexpected argument '%s' (one input file only)", a);
-        }
-    }
-    if (opt->list_devices)
-        return -1;
-    if (!opt->input)
-        return cli_usage_error(NULL, "no input file");
-    if (opt->in_place && opt->output)
-        return cli_usage_error(NULL, "give either -o OUTPUT or --in-place, not both");
-    if (opt->in_place)
-        opt->output = opt->input;
-    if (!opt->output)
-        return cli_usage_error(NULL, "no output file (-o OUTPUT, or --in-place)");
-    /* Checked here so a typo is a usage error before any file is read. */
-    const rsmooth_params *p = &opt->params;
-    if (!(p->sigma_f > 0) || !isfinite(p->sigma_f))
-        return cli_usage_error(NULL, "--sigma-f must be a positive number (got %g)", p->sigma_f);
-    if (!(p->sigma_g > 0))
-        return cli_usage_error(NULL, "--sigma-g must be positive, or 'inf' (got %g)", p->sigma_g);
-    if (!(p->cutoff > 0 && p->cutoff <= 5))
-        return cli_usage_error(NULL, "--cutoff must be in (0, 5] (got %g)", p->cutoff);
-    if (!(p->normal_sigma_s > 0) || !isfinite(p->normal_sigma_s))
-        return cli_usage_error(NULL, "--normal-sigma-s must be a positive number (got %g)",
-                               p->normal_sigma_s);
-    if (!(p->normal_sigma_n > 0 && p->normal_sigma_n <= 2))
-        return cli_usage_error(NULL, "--normal-sigma-n must be in (0, 2] (got %g)",
-                               p->normal_sigma_n);
-    if (!(p->pass_confidence >= 0 && p->pass_confidence <= 1))
-        return cli_usage_error(NULL, "--pass-confidence must be in [0, 1] (got %g)",
-                               p->pass_confidence);
-    bool umbrella = method_uses_edges(opt->method);
-    if (opt->umbrella_given && !umbrella)
-        return cli_usage_error(NULL, "--lambda, --mu and --iterations need --method laplacian "
-                                     "or taubin");
-    if (umbrella && opt->confidence)
-        return cli_usage_error(NULL, "--method %s has no confidence to write",
-                               method_names[opt->method]);
-    if (umbrella && opt->colors)
-        return cli_usage_error(NULL, "--method %s has no weights for --sigma-c",
-                               method_names[opt->method]);
-    if (opt->auto_params && opt->method != METHOD_ROBUST)
-        return cli_usage_error(NULL, "--auto picks the robust filter's sigmas: drop --method %s",
-                               method_names[opt->method]);
-    if (opt->method == METHOD_GAUSSIAN) {
-        if (opt->sigma_g_given)
-            return cli_usage_error(NULL, "--method gaussian has no influence weight: drop "
-                                         "--sigma-g");
-        opt->params.predictor = RSMOOTH_PREDICT_CENTROID;
-        opt->params.sigma_g = INFINITY;
-    }
-    if (opt->method == METHOD_LAPLACIAN)
-        opt->mu = 0;
-    if (umbrella && !(opt->lambda > 0 && opt->lambda <= 1))
-        return cli_usage_error(NULL, "--lambda must be in (0, 1] (got %g)", opt->lambda);
-    if (opt->method == METHOD_TAUBIN && !(opt->mu >= -1 && opt->mu < 0))
-        return cli_usage_error(NULL, "--mu must be in [-1, 0) (got %g)", opt->mu);
-    return -1;
-}
 
 static int list_devices(void) {
     rsmooth_device_info devices[64];
@@ -449,8 +65,8 @@ static void print_json(const rsmooth_report *r, const options *opt, double ms_re
     cli_print_json_string(opt->input);
     printf(",\"output\":");
     cli_print_json_string(opt->output);
-    printf(",\"method\":\"%s\"", method_names[opt->method]);
-    if (method_uses_edges(opt->method))
+    printf(",\"method\":\"%s\"", cli_method_names[opt->method]);
+    if (cli_method_uses_edges(opt->method))
         printf(",\"lambda\":%.9g,\"mu\":%.9g,\"iterations\":%u", opt->lambda, opt->mu,
                opt->iterations);
     else {
@@ -461,7 +77,7 @@ static void print_json(const rsmooth_report *r, const options *opt, double ms_re
         int filter = points ? RSMOOTH_NORMALS_BILATERAL : p->normal_filter;
         if (points)
             printf(",\"point_cloud\":true");
-        printf(",\"normals\":\"%s\"", p->mollify ? normal_filter_names[filter] : "input");
+        printf(",\"normals\":\"%s\"", p->mollify ? cli_normal_filter_names[filter] : "input");
         if (p->mollify && filter == RSMOOTH_NORMALS_BILATERAL)
             printf(",\"normal_sigma_s\":%.9g,\"normal_sigma_n\":%.9g,\"normal_iterations\":%d",
                    p->normal_sigma_s, p->normal_sigma_n, p->normal_iterations);
@@ -470,7 +86,7 @@ static void print_json(const rsmooth_report *r, const options *opt, double ms_re
         else
             printf(",\"sigma_c\":null");
         printf(",\"influence\":\"%s\",\"passes\":%d,\"pass_confidence\":%.9g",
-               influence_names[p->influence], p->passes, p->pass_confidence);
+               cli_influence_names[p->influence], p->passes, p->pass_confidence);
         if (opt->auto_params)
             printf(",\"noise_estimate\":%.9g", opt->noise);
     }
@@ -595,14 +211,14 @@ static int smooth_umbrella(const options *opt, const rsmooth_mesh *mesh, double 
     report->vertex_count = mesh->vertex_count;
     report->triangle_count = mesh->triangle_count;
     snprintf(report->device, sizeof report->device, "%s, %u iterations (double, 1 thread)",
-             method_names[opt->method], opt->iterations);
+             cli_method_names[opt->method], opt->iterations);
     return EXIT_OK;
 }
 
 /* Runs the filter on the chosen device; prints what fails. */
 static int smooth(const options *opt, const rsmooth_mesh *mesh, double *out, float *confidence,
                   rsmooth_report *report, cli_progress *bar) {
-    if (method_uses_edges(opt->method))
+    if (cli_method_uses_edges(opt->method))
         return smooth_umbrella(opt, mesh, out, report);
     const char *device = opt->device ? opt->device : getenv("RSMOOTH_DEVICE");
     bool reference = device && strcmp(device, "reference") == 0;
@@ -678,16 +294,18 @@ static int check_point_cloud(const options *opt, const rsmooth_mesh *mesh) {
     if (!mesh->vertex_normals) {
         /* what is missing would come after everything the file holds: name its end */
         struct stat st;
-        long long end = stat(opt->input, &st) == 0 ? (long long)st.st_size : -1;
+        char end[64] = ""; /* (standard input has no size to name) */
+        if (stat(opt->input, &st) == 0)
+            snprintf(end, sizeof end, " byte %lld (the end):", (long long)st.st_size);
         fprintf(stderr,
-                "rsmooth: %s: byte %lld (the end): %zu vertices but no faces and no vertex "
-                "normals: a mesh needs faces, a point cloud normals (nx, ny, nz)\n",
+                "rsmooth: %s:%s %zu vertices but no faces and no vertex normals: a mesh needs "
+                "faces, a point cloud normals (nx, ny, nz)\n",
                 opt->input, end, mesh->vertex_count);
         return EXIT_USAGE;
     }
-    if (method_uses_edges(opt->method)) {
+    if (cli_method_uses_edges(opt->method)) {
         fprintf(stderr, "rsmooth: %s is a point cloud (no faces): --method %s needs edges\n",
-                opt->input, method_names[opt->method]);
+                opt->input, cli_method_names[opt->method]);
         return EXIT_USAGE;
     }
     return EXIT_OK;
@@ -773,7 +391,8 @@ static int write_confidence(rsmooth_mesh *mesh, const options *opt, float *confi
 /* Whether the output files' formats can hold the input (the result has its scale): refused before
  * any filtering. The confidence mesh is written without the input's extras, so checked so. */
 static int check_outputs_hold(const options *opt, rsmooth_mesh *mesh) {
-    int code = cli_check_writable(mesh, opt->output, cli_output_format(opt->output, opt->ascii),
+    int code = cli_check_writable(mesh, strcmp(opt->output, "-") ? opt->output : "<stdout>",
+                                  cli_result_format(opt, opt->output, mesh->source_format),
                                   opt->input);
     if (code >= 0 || !opt->confidence)
         return code >= 0 ? code : EXIT_OK;
@@ -847,20 +466,13 @@ static int choose_params(options *opt, const rsmooth_mesh *mesh, bool points) {
     return EXIT_OK;
 }
 
-int main(int argc, char **argv) {
-    if (argc >= 2 && !strcmp(argv[1], "compare"))
-        return cli_compare_main(argc - 1, argv + 1);
-    if (argc >= 2 && !strcmp(argv[1], "noise"))
-        return cli_noise_main(argc - 1, argv + 1);
-    if (argc >= 2 && !strcmp(argv[1], "render"))
-        return cli_render_main(argc - 1, argv + 1);
-    options opt;
-    int code = parse_args(argc, argv, &opt);
-    if (code >= 0 || (code = cli_check_environment()) >= 0)
-        return code;
-    if (opt.list_devices)
-        return list_devices();
-    if ((code = cli_check_output(opt.output, opt.input, opt.force, opt.in_place)) >= 0)
+/* Smooths `path` (opt->input names it in messages) into opt->output: one file's whole run. */
+static int smooth_file(const options *job, const char *path) {
+    options opt = *job; /* --auto changes the parameters for this file only */
+    int code;
+    bool to_stdout = !strcmp(opt.output, "-");
+    if (!to_stdout && (code = cli_check_output(opt.output, path, opt.force, opt.in_place,
+                                               opt.format != RSMOOTH_FORMAT_AUTO)) >= 0)
         return code;
     if (opt.confidence) {
         if (!strcmp(opt.confidence, opt.output) || cli_same_file(opt.confidence, opt.output)) {
@@ -868,7 +480,7 @@ int main(int argc, char **argv) {
                     opt.confidence);
             return EXIT_USAGE;
         }
-        if ((code = cli_check_output(opt.confidence, opt.input, opt.force, false)) >= 0)
+        if ((code = cli_check_output(opt.confidence, path, opt.force, false, false)) >= 0)
             return code;
     }
 
@@ -877,7 +489,7 @@ int main(int argc, char **argv) {
     cli_progress_stage(&bar, "reading", 0, 0.1);
     rsmooth_mesh *mesh = NULL;
     double t0 = cli_now_ms();
-    if ((code = cli_read_mesh(opt.input, &bar, &mesh)) != EXIT_OK)
+    if ((code = cli_read_mesh(path, &bar, &mesh)) != EXIT_OK)
         return code;
     double ms_read = cli_now_ms() - t0;
     bool points = mesh->triangle_count == 0; /* a point cloud: its points and normals filtered */
@@ -904,7 +516,7 @@ int main(int argc, char **argv) {
     size_t nv = mesh->vertex_count;
     double *out = malloc(nv * 3 * sizeof *out);
     double *out_normals = points ? malloc(nv * 3 * sizeof *out_normals) : NULL;
-    bool umbrella = method_uses_edges(opt.method);
+    bool umbrella = cli_method_uses_edges(opt.method);
     bool want_confidence = opt.confidence || (opt.stats && !umbrella);
     float *confidence = want_confidence ? malloc(nv * sizeof *confidence) : NULL;
     rsmooth_report report;
@@ -926,9 +538,10 @@ int main(int argc, char **argv) {
     mesh->positions = out;
     if (points)
         mesh->vertex_normals = out_normals; /* written in place of recomputed ones */
-    rsmooth_format format = cli_output_format(opt.output, opt.ascii);
+    rsmooth_format format = cli_result_format(&opt, opt.output, mesh->source_format);
     cli_progress_clear(&bar);
-    warn_losses(mesh, opt.output, format, opt.quiet);
+    const char *wrote = to_stdout ? "<stdout>" : opt.output;
+    warn_losses(mesh, wrote, format, opt.quiet);
     code = cli_write_mesh(mesh, opt.output, format, opt.force || opt.in_place, opt.quiet);
     if (code == EXIT_OK && opt.confidence)
         code = write_confidence(mesh, &opt, confidence);
@@ -946,20 +559,20 @@ int main(int argc, char **argv) {
     if (!opt.quiet && umbrella)
         fprintf(stderr, "rsmooth: %s: %zu vertices, %zu triangles; %s: %.1f ms; wrote %s\n",
                 opt.input, report.vertex_count, report.triangle_count, report.device,
-                report.ms_total, opt.output);
+                report.ms_total, wrote);
     else if (!opt.quiet && points)
         fprintf(stderr,
                 "rsmooth: %s: %zu points with normals, spacing %.6g; sigma_f %.6g, sigma_g "
                 "%.6g (cloud units) on %s: filter %.1f ms; wrote %s%s%s\n",
                 opt.input, report.vertex_count, report.mean_edge_length, report.sigma_f,
-                report.sigma_g, report.device, report.ms_total, opt.output,
+                report.sigma_g, report.device, report.ms_total, wrote,
                 opt.confidence ? " and " : "", opt.confidence ? opt.confidence : "");
     else if (!opt.quiet)
         fprintf(stderr,
                 "rsmooth: %s: %zu vertices, %zu triangles, mean edge %.6g; sigma_f %.6g, "
                 "sigma_g %.6g (mesh units) on %s: filter %.1f ms; wrote %s%s%s\n",
                 opt.input, report.vertex_count, report.triangle_count, report.mean_edge_length,
-                report.sigma_f, report.sigma_g, report.device, report.ms_total, opt.output,
+                report.sigma_f, report.sigma_g, report.device, report.ms_total, wrote,
                 opt.confidence ? " and " : "", opt.confidence ? opt.confidence : "");
 
 cleanup:
@@ -969,5 +582,68 @@ cleanup:
     free(out_normals);
     free(confidence);
     free(colors);
+    return code;
+}
+
+/* Several inputs: each smoothed in turn, going on past one that fails; a summary at the end. */
+static int smooth_files(options *opt) {
+    size_t failed = 0;
+    char *failures = NULL; /* "a.ply, b.obj" */
+    for (size_t i = 0; i < opt->input_count; i++) {
+        char output[4096];
+        options job = *opt;
+        job.input = opt->inputs[i];
+        job.output = output;
+        cli_output_for(opt, job.input, output, sizeof output); /* checked to fit */
+        if (smooth_file(&job, job.input) == EXIT_OK)
+            continue;
+        failed++;
+        size_t length = strlen(job.input), used = failures ? strlen(failures) : 0;
+        char *grown = realloc(failures, used + length + 3);
+        if (grown) {
+            failures = grown;
+            snprintf(failures + used, length + 3, "%s%s", used ? ", " : "", job.input);
+        }
+    }
+    size_t n = opt->input_count;
+    if (failed)
+        fprintf(stderr, "rsmooth: %zu files: %zu smoothed, %zu failed (%s)\n", n, n - failed,
+                failed, failures ? failures : "out of memory for their names");
+    else if (!opt->quiet)
+        fprintf(stderr, "rsmooth: %zu files: %zu smoothed\n", n, n);
+    free(failures);
+    return failed ? EXIT_USAGE : EXIT_OK;
+}
+
+int main(int argc, char **argv) {
+    if (argc >= 2 && !strcmp(argv[1], "compare"))
+        return cli_compare_main(argc - 1, argv + 1);
+    if (argc >= 2 && !strcmp(argv[1], "noise"))
+        return cli_noise_main(argc - 1, argv + 1);
+    if (argc >= 2 && !strcmp(argv[1], "render"))
+        return cli_render_main(argc - 1, argv + 1);
+    options opt;
+    int code = cli_options_parse(argc, argv, &opt);
+    if (code >= 0)
+        return code;
+    if ((code = cli_check_environment()) >= 0) {
+        cli_options_free(&opt);
+        return code;
+    }
+    if (opt.list_devices) {
+        cli_options_free(&opt);
+        return list_devices();
+    }
+    if (opt.input_count == 1) {
+        char output[4096];
+        const char *path = opt.inputs[0];
+        opt.input = strcmp(path, "-") ? path : "<stdin>";
+        opt.output = output;
+        cli_output_for(&opt, path, output, sizeof output); /* checked to fit */
+        code = smooth_file(&opt, path);
+    } else {
+        code = smooth_files(&opt);
+    }
+    cli_options_free(&opt);
     return code;
 }

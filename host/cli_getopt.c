@@ -1,0 +1,92 @@
+/* Command-line options the Unix way (see cli_getopt.h for what is accepted, and why this is not
+ * getopt_long). */
+#include "cli_getopt.h"
+#include "cli_args.h"
+
+#include <stdio.h>
+#include <string.h>
+
+void cli_getopt_init(cli_getopt_state *s, int argc, char **argv, const char *command,
+                     const cli_option *table) {
+    memset(s, 0, sizeof *s);
+    s->argc = argc;
+    s->argv = argv;
+    s->command = command;
+    s->table = table;
+    s->next = 1;
+}
+
+/* The value of an option that takes one: `attached` (after '=' or the letter), else the next
+ * argument, whatever it looks like. */
+static int take_value(cli_getopt_state *s, const cli_option *o, const char *attached,
+                      const char **value) {
+    if (attached) {
+        *value = attached;
+    } else if (s->next < s->argc) {
+        *value = s->argv[s->next++];
+    } else {
+        cli_usage_error(s->command, "%s needs a value", s->spelled);
+        return CLI_GETOPT_ERROR;
+    }
+    return o->id;
+}
+
+static int short_option(cli_getopt_state *s, const char **value) {
+    char letter = *s->cluster++;
+    const cli_option *o = s->table;
+    while (o->name && o->letter != letter)
+        o++;
+    snprintf(s->spelled, sizeof s->spelled, "-%c", letter);
+    if (!o->name) {
+        s->cluster = NULL;
+        cli_usage_error(s->command, "unknown option '-%c'", letter);
+        return CLI_GETOPT_ERROR;
+    }
+    if (!o->takes_value) {
+        if (!*s->cluster)
+            s->cluster = NULL;
+        return o->id;
+    }
+    const char *attached = *s->cluster ? s->cluster : NULL; /* -oFILE */
+    s->cluster = NULL;
+    return take_value(s, o, attached, value);
+}
+
+int cli_getopt(cli_getopt_state *s, const char **value) {
+    *value = NULL;
+    if (s->cluster)
+        return short_option(s, value);
+    if (s->next >= s->argc)
+        return CLI_GETOPT_END;
+    const char *a = s->argv[s->next++];
+    if (s->operands_only || a[0] != '-' || a[1] == '\0') { /* a lone "-" is an operand */
+        *value = a;
+        return CLI_GETOPT_OPERAND;
+    }
+    if (a[1] != '-') { /* -o FILE, -oFILE, -fq */
+        s->cluster = a + 1;
+        return short_option(s, value);
+    }
+    if (a[2] == '\0') { /* "--": operands only from here */
+        s->operands_only = true;
+        return cli_getopt(s, value);
+    }
+    const char *name = a + 2, *eq = strchr(name, '=');
+    size_t length = eq ? (size_t)(eq - name) : strlen(name);
+    const cli_option *o = s->table;
+    while (o->name && !(strlen(o->name) == length && !strncmp(o->name, name, length)))
+        o++;
+    snprintf(s->spelled, sizeof s->spelled, "--%.*s", (int)(length < 60 ? length : 60), name);
+    if (!o->name) {
+        cli_usage_error(s->command, "unknown option '%.*s'", (int)(length + 2), a);
+        return CLI_GETOPT_ERROR;
+    }
+    if (!o->takes_value) {
+        if (eq) {
+            cli_usage_error(s->command, "%s takes no value (got '%s')", s->spelled, a);
+            return CLI_GETOPT_ERROR;
+        }
+        return o->id;
+    }
+    return take_value(s, o, eq ? eq + 1 : NULL, value);
+}

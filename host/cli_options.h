@@ -1,0 +1,82 @@
+/* The rsmooth command's options: what the command line asked for (cli_options.c reads it through
+ * the option table, cli_options_check.c refuses what cannot work together and names each input's
+ * output), and the help text (cli_help.c). */
+#ifndef RSMOOTH_CLI_OPTIONS_H
+#define RSMOOTH_CLI_OPTIONS_H
+
+#include "rsmooth.h"
+#include "rsmooth_io.h"
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+/* rsmooth --help. */
+extern const char cli_usage_text[];
+
+/* --method: the filter, or a baseline to compare it with. */
+typedef enum method { METHOD_ROBUST, METHOD_GAUSSIAN, METHOD_LAPLACIAN, METHOD_TAUBIN } method;
+extern const char *const cli_method_names[4];
+/* --normals and --influence values, in enum order. */
+extern const char *const cli_normal_filter_names[2];
+extern const char *const cli_influence_names[4];
+
+/* Laplacian and Taubin iterate on the mesh's edges (rsmooth_smooth_taubin): no sigmas, no
+ * confidence. */
+bool cli_method_uses_edges(method m);
+
+/* Parameters the command line set explicitly: --auto leaves them as given. */
+enum {
+    GIVEN_SIGMA_F = 1u << 0,
+    GIVEN_SIGMA_G = 1u << 1,
+    GIVEN_NORMAL_SIGMA_S = 1u << 2,
+    GIVEN_NORMAL_SIGMA_N = 1u << 3,
+    GIVEN_NORMAL_ITERATIONS = 1u << 4,
+    GIVEN_PASSES = 1u << 5,
+    GIVEN_INFLUENCE = 1u << 6
+};
+
+typedef struct options {
+    const char **inputs;    /* the operands (argv's strings), input_count of them; "-": stdin */
+    size_t input_count;
+    const char *input, *output; /* the file being worked on and its output ("-": stdout) */
+    const char *output_option;  /* -o as given */
+    const char *confidence, *device;
+    const char *suffix;     /* --suffix: each result beside its input, the name + suffix */
+    bool output_dir;        /* -o names a folder (ends in '/' or is one): results go in there */
+    rsmooth_format format;  /* --format: AUTO when not given (then the extension, or for -o -
+                             * the input's format) */
+    rsmooth_params params;
+    method method;
+    double lambda, mu;
+    unsigned iterations;
+    uint64_t memory_budget; /* 0: the library's default */
+    bool colors;            /* --sigma-c: the input's vertex colours in the weight */
+    bool sigma_g_given, umbrella_given; /* for consistency checks against --method */
+    bool ascii, json, force, quiet, in_place, stats, list_devices, best;
+    bool auto_params;       /* --auto */
+    unsigned given;         /* GIVEN_* bits: parameters set on the command line */
+    double noise;           /* --auto's estimate */
+} options;
+
+/* Reads the command line into `opt` and checks it (cli_options_check). Returns -1 when the
+ * program should go on, else the exit status (0 after --help or --version; 2 after a usage
+ * error, printed). On -1, cli_options_free releases what it holds. */
+int cli_options_parse(int argc, char **argv, options *opt);
+void cli_options_free(options *opt);
+
+/* The checks of ranges and combinations, made before any file is read so that a typo is a usage
+ * error at once; also decides opt->output_dir. -1 or the usage exit status (printed). */
+int cli_options_check(options *opt);
+
+/* The output path for `input` (`size` bytes at `out`): -o's, the input itself (--in-place), or
+ * named after the input (in -o's folder, with --suffix, with --format's extension). Returns
+ * false when it does not fit. */
+bool cli_output_for(const options *opt, const char *input, char *out, size_t size);
+
+/* The format a result is written in: --format (ascii with --ascii), else by the output's
+ * extension; for standard output the input's format (`source`), written as a file named with
+ * its extension would be (PLY and STL binary unless --ascii). */
+rsmooth_format cli_result_format(const options *opt, const char *output, rsmooth_format source);
+
+#endif
