@@ -3,6 +3,7 @@
 #include "cli_args.h"
 #include "cli_commands.h"
 #include "cli_files.h"
+#include "cli_getopt.h"
 #include "rsmooth.h"
 #include "rsmooth_io.h"
 
@@ -60,15 +61,20 @@ int cli_compare_main(int argc, char **argv) {
     const char *paths[2] = {NULL, NULL};
     size_t path_count = 0;
     bool json = false;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+    static const cli_option table[] = {
+        {"help", 'h', false, 1}, {"json", 0, false, 2}, {NULL, 0, false, 0}};
+    cli_getopt_state s;
+    cli_getopt_init(&s, argc, argv, "compare", table);
+    const char *a;
+    int id;
+    while ((id = cli_getopt(&s, &a)) != CLI_GETOPT_END) {
+        if (id == CLI_GETOPT_ERROR) {
+            return 2;
+        } else if (id == 1) {
             fputs(compare_usage, stdout);
             return 0;
-        } else if (!strcmp(a, "--json")) {
+        } else if (id == 2) {
             json = true;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            return cli_usage_error("compare", "unknown option: %s", a);
         } else if (path_count < 2) {
             paths[path_count++] = a;
         } else {

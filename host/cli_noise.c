@@ -2,6 +2,7 @@
 #include "cli_args.h"
 #include "cli_commands.h"
 #include "cli_files.h"
+#include "cli_getopt.h"
 #include "mesh_noise.h"
 #include "rsmooth_io.h"
 
@@ -88,19 +89,28 @@ static int parse_noise_args(int argc, char **argv, noise_args *a) {
     memset(a, 0, sizeof *a);
     a->noise.direction = MESH_NOISE_NORMAL;
     a->noise.seed = DEFAULT_SEED;
-    for (int i = 1; i < argc; i++) {
-        const char *arg = argv[i];
-        const char *value = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(arg, "-h") || !strcmp(arg, "--help")) {
+    enum { N_HELP = 1, N_SIGMA, N_IMPULSIVE, N_DIRECTION, N_SEED, N_ASCII, N_FORCE, N_QUIET };
+    static const cli_option table[] = {
+        {"help", 'h', false, N_HELP},          {"sigma", 0, true, N_SIGMA},
+        {"impulsive", 0, true, N_IMPULSIVE},   {"direction", 0, true, N_DIRECTION},
+        {"seed", 0, true, N_SEED},             {"ascii", 0, false, N_ASCII},
+        {"force", 'f', false, N_FORCE},        {"quiet", 'q', false, N_QUIET},
+        {NULL, 0, false, 0}};
+    cli_getopt_state s;
+    cli_getopt_init(&s, argc, argv, "noise", table);
+    const char *value;
+    int id;
+    while ((id = cli_getopt(&s, &value)) != CLI_GETOPT_END) {
+        double x;
+        if (id == CLI_GETOPT_ERROR) {
+            return EXIT_USAGE;
+        } else if (id == N_HELP) {
             fputs(noise_usage_text, stdout);
             return EXIT_OK;
-        } else if (!strcmp(arg, "--sigma") || !strcmp(arg, "--impulsive")) {
-            double x;
-            if (!value)
-                return cli_usage_error("noise", "%s needs a value", arg);
+        } else if (id == N_SIGMA || id == N_IMPULSIVE) {
             if (!cli_parse_number(value, &x))
-                return cli_usage_error("noise", "%s: not a number: '%s'", arg, value);
-            if (!strcmp(arg, "--sigma")) {
+                return cli_usage_error("noise", "%s: not a number: '%s'", s.spelled, value);
+            if (id == N_SIGMA) {
                 if (!(x >= 0 && x <= MAX_SIGMA))
                     return cli_usage_error("noise",
                                            "--sigma must be in [0, %g] mean edge lengths "
@@ -119,38 +129,29 @@ static int parse_noise_args(int argc, char **argv, noise_args *a) {
                 a->noise.impulsive_fraction = x;
                 a->impulsive = true;
             }
-            i++;
-        } else if (!strcmp(arg, "--direction")) {
-            if (!value)
-                return cli_usage_error("noise", "--direction needs a value (normal or random)");
+        } else if (id == N_DIRECTION) {
             if (!strcmp(value, "normal"))
                 a->noise.direction = MESH_NOISE_NORMAL;
             else if (!strcmp(value, "random"))
                 a->noise.direction = MESH_NOISE_RANDOM;
             else
                 return cli_usage_error("noise", "--direction: '%s' is not normal or random", value);
-            i++;
-        } else if (!strcmp(arg, "--seed")) {
-            if (!value)
-                return cli_usage_error("noise", "--seed needs a value");
+        } else if (id == N_SEED) {
             if (!parse_seed(value, &a->noise.seed))
                 return cli_usage_error("noise", "--seed: not an integer in [0, 2^64): '%s'", value);
-            i++;
-        } else if (!strcmp(arg, "--ascii")) {
+        } else if (id == N_ASCII) {
             a->ascii = true;
-        } else if (!strcmp(arg, "-f") || !strcmp(arg, "--force")) {
+        } else if (id == N_FORCE) {
             a->force = true;
-        } else if (!strcmp(arg, "-q") || !strcmp(arg, "--quiet")) {
+        } else if (id == N_QUIET) {
             a->quiet = true;
-        } else if (arg[0] == '-' && arg[1] != '\0') {
-            return cli_usage_error("noise", "unknown option '%s'", arg);
         } else if (!a->input) {
-            a->input = arg;
+            a->input = value;
         } else if (!a->output) {
-            a->output = arg;
+            a->output = value;
         } else {
             return cli_usage_error("noise", "unexpected argument '%s' (INPUT and OUTPUT only)",
-                                   arg);
+                                   value);
         }
     }
     if (!a->input)

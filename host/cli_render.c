@@ -42,7 +42,7 @@ static const char render_usage[] =
     "Example:\n"
     "  rsmooth render noisy.ply smooth.ply conf.ply -o compare.png\n"
     "\n"
-    "Options take values as --name VALUE or --name=VALUE, before or after the files.\n"
+    "Options take values as --size 400x300 or --size=400x300, before or after the files.\n"
     "\n"
     "Exit status: 0 success, 2 bad usage, an unreadable or malformed input or an OUT that may\n"
     "not be written, 1 other.\n";
