@@ -268,6 +268,24 @@ void rsmooth_context_set_memory_budget(rsmooth_context *ctx, uint64_t bytes) {
     rs_context_unlock(ctx);
 }
 
+void rsmooth_context_set_host_threads(rsmooth_context *ctx, unsigned threads) {
+    if (!ctx)
+        return;
+    rs_context_lock(ctx);
+    ctx->host_threads = threads;
+    rs_context_unlock(ctx);
+}
+
+unsigned rsmooth_context_host_threads(const rsmooth_context *ctx) {
+    if (!ctx)
+        return 0;
+    rsmooth_context *shared = (rsmooth_context *)ctx; /* the lock is the one mutable part */
+    rs_context_lock(shared);
+    unsigned threads = ctx->host_threads;
+    rs_context_unlock(shared);
+    return threads;
+}
+
 uint64_t rsmooth_context_memory_budget(const rsmooth_context *ctx) {
     if (!ctx)
         return 0;

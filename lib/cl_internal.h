@@ -38,6 +38,7 @@ struct rsmooth_context {
     uint64_t global_memory;   /* CL_DEVICE_GLOBAL_MEM_SIZE */
     uint64_t max_allocation;  /* CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest one buffer may be */
     uint64_t memory_budget;   /* caller's or RSMOOTH_MEMORY_BUDGET's limit; 0: the device's */
+    unsigned host_threads;    /* threads of the host stages of its calls; 0: every core */
 };
 
 /* A context's calls hold its lock while they use it: threads sharing one run one at a time. */

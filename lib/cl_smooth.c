@@ -672,9 +672,11 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_smooth", "ctx is NULL");
     /* the kernels' arguments and the queue are the context's: one call at a time */
     rs_context_lock(ctx);
+    size_t threads_before = rs_set_call_threads(ctx->host_threads);
     rsmooth_status st = rs_filter_passes(cl_pass, ctx, scalar, positions, vertex_count, indices,
                                          triangle_count, params, out_positions, out_weight,
                                          out_confidence, report, error, "rsmooth_smooth");
+    rs_set_call_threads(threads_before);
     rs_context_unlock(ctx);
     return st;
 }

@@ -11,7 +11,18 @@
 
 #define MAX_THREADS 64
 
+/* Per calling thread, so that two contexts with their own settings may run at once. */
+static _Thread_local size_t call_threads;
+
+size_t rs_set_call_threads(size_t threads) {
+    size_t before = call_threads;
+    call_threads = threads;
+    return before;
+}
+
 size_t rs_host_threads(void) {
+    if (call_threads)
+        return call_threads > MAX_THREADS ? MAX_THREADS : call_threads;
     const char *forced = getenv("RSMOOTH_HOST_THREADS");
     long n = forced ? atol(forced) : sysconf(_SC_NPROCESSORS_ONLN);
     return n < 1 ? 1 : n > MAX_THREADS ? MAX_THREADS : (size_t)n;

@@ -56,8 +56,13 @@ double rs_now_ms(void);
 /* Elements [begin, end) of a loop, as chunk number `chunk` (chunks are contiguous and in order). */
 typedef void (*rs_range_fn)(void *ctx, size_t begin, size_t end, size_t chunk);
 
-/* Threads host loops use: the online cores, or RSMOOTH_HOST_THREADS; at most 64. */
+/* Threads host loops use: the calling thread's setting (rs_set_call_threads), else
+ * RSMOOTH_HOST_THREADS, else the online cores; at most 64. */
 size_t rs_host_threads(void);
+
+/* Sets the host threads of the calling thread's rsmooth calls (0: the default above) and returns
+ * the setting it replaces: a context's calls run with its rsmooth_context_set_host_threads. */
+size_t rs_set_call_threads(size_t threads);
 
 /* How many chunks rs_parallel_for cuts `count` elements into (at least min_per_chunk each). */
 size_t rs_parallel_chunks(size_t count, size_t min_per_chunk);

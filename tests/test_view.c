@@ -6,7 +6,8 @@
  * - params.move_mask: unselected vertices keep their input bit for bit; with one pass the selected
  *   ones equal the unmasked result, with two they equal two single passes composed by hand (each
  *   restoring the unselected), the oracle; point clouds likewise;
- * - rsmooth_version agrees with the header. */
+ * - rsmooth_version agrees with the header; a context's host-thread setting reads back and does
+ *   not change the result. */
 #include "mesh_shapes.h"
 #include "rsmooth.h"
 #include "test_cl_util.h"
@@ -271,6 +272,33 @@ static void check_points_mask(const shape_mesh *m) {
     free(mask);
 }
 
+/* The context's host threads: the setting reads back, and 1, 3 or every core give the same bits. */
+static void check_host_threads(rsmooth_context *ctx, const shape_mesh *m) {
+    size_t bytes = m->vertex_count * 3 * sizeof(double);
+    double *base = malloc(bytes), *other = malloc(bytes);
+    CHECK(base && other);
+    rsmooth_params p;
+    rsmooth_params_init_best(&p);
+    rsmooth_error err;
+    CHECK_EQ_INT(rsmooth_context_host_threads(ctx), 0);
+    CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                m->triangle_count, &p, base, NULL, NULL, NULL, &err),
+                 RSMOOTH_OK);
+    unsigned counts[] = {1, 3};
+    for (int i = 0; i < 2; i++) {
+        rsmooth_context_set_host_threads(ctx, counts[i]);
+        CHECK_EQ_INT(rsmooth_context_host_threads(ctx), counts[i]);
+        CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                    m->triangle_count, &p, other, NULL, NULL, NULL, &err),
+                     RSMOOTH_OK);
+        CHECK(memcmp(base, other, bytes) == 0);
+    }
+    rsmooth_context_set_host_threads(ctx, 0);
+    printf("host threads 1 and 3: the same bits as every core\n");
+    free(base);
+    free(other);
+}
+
 int main(void) {
     int major = -1, minor = -1, patch = -1;
     const char *version = rsmooth_version(&major, &minor, &patch);
@@ -295,6 +323,7 @@ int main(void) {
     rsmooth_context *ctx = open_test_context();
     check_view_equals_packed(ctx, &m, 0, "OpenCL, stride 32, int64 indices:");
     check_mask(ctx, &m, "OpenCL mask:");
+    check_host_threads(ctx, &m);
     rsmooth_context_destroy(ctx);
     shape_free(&m);
     printf("view: all checks passed\n");

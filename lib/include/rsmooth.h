@@ -534,6 +534,13 @@ RSMOOTH_API void rsmooth_context_set_memory_budget(rsmooth_context *ctx, uint64_
 /* The bytes one filter call may hold on the device now: the budget, else the device's share. */
 RSMOOTH_API uint64_t rsmooth_context_memory_budget(const rsmooth_context *ctx);
 
+/* Threads the host stages of the context's calls use (facet data, grid, packing, results): 0 (the
+ * default) means every online core, or RSMOOTH_HOST_THREADS when set; at most 64 run. A host
+ * application with its own thread pool sets 1, or its share. The result does not depend on it (bit
+ * for bit). Thread-safe: waits for a running call on the context. (Added in 0.5) */
+RSMOOTH_API void rsmooth_context_set_host_threads(rsmooth_context *ctx, unsigned threads);
+RSMOOTH_API unsigned rsmooth_context_host_threads(const rsmooth_context *ctx);
+
 /* The filter on the context's device, float32 arithmetic in cell-local coordinates (so meshes far
  * from the origin lose nothing). Same arguments, outputs and argument errors as
  * rsmooth_smooth_reference; the result agrees with it to about 1e-4 mean edge lengths, and two
