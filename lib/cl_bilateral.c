@@ -137,7 +137,9 @@ static cl_int run_bilateral_lists(rsmooth_context *ctx, const rs_problem *pb, co
     /* A device that shares the host's memory gets it from rs_alloc_array, which asks for huge
      * pages: faulting in tens of megabytes 4 KiB at a time costs more than filling them. */
     cl_bool unified = CL_FALSE;
-    clGetDeviceInfo(ctx->device, CL_DEVICE_HOST_UNIFIED_MEMORY, sizeof unified, &unified, NULL);
+    if (clGetDeviceInfo(ctx->device, CL_DEVICE_HOST_UNIFIED_MEMORY, sizeof unified, &unified,
+                        NULL) != CL_SUCCESS)
+        unified = CL_FALSE;
     cl_mem_flags flags = CL_MEM_READ_WRITE;
     if (unified) {
         l.facet = rs_alloc_array((size_t)rows, sizeof(cl_uint));

@@ -79,6 +79,51 @@ typedef struct candidate {
     char name[256]; /* "platform / device" */
 } candidate;
 
+/* The head of `text` that fits `size` bytes with its terminator. */
+static void copy_cut(const char *text, char *out, size_t size) {
+    size_t n = strlen(text);
+    if (n >= size)
+        n = size - 1;
+    memcpy(out, text, n);
+    out[n] = '\0';
+}
+
+/* A string property, its size asked first so a long one (PoCL's 65-character version) is read
+ * whole, then cut to `out`; "" when a query fails. */
+static void device_string(cl_device_id device, cl_device_info param, char *out, size_t size) {
+    size_t need = 0;
+    out[0] = '\0';
+    if (clGetDeviceInfo(device, param, 0, NULL, &need) != CL_SUCCESS || need == 0)
+        return;
+    char *text = malloc(need + 1);
+    if (text && clGetDeviceInfo(device, param, need, text, NULL) == CL_SUCCESS) {
+        text[need] = '\0';
+        copy_cut(text, out, size);
+    }
+    free(text);
+}
+
+static void platform_string(cl_platform_id platform, cl_platform_info param, char *out,
+                            size_t size) {
+    size_t need = 0;
+    out[0] = '\0';
+    if (clGetPlatformInfo(platform, param, 0, NULL, &need) != CL_SUCCESS || need == 0)
+        return;
+    char *text = malloc(need + 1);
+    if (text && clGetPlatformInfo(platform, param, need, text, NULL) == CL_SUCCESS) {
+        text[need] = '\0';
+        copy_cut(text, out, size);
+    }
+    free(text);
+}
+
+/* A fixed-size property, `fallback` when the query fails. */
+static cl_ulong device_ulong(cl_device_id device, cl_device_info param, cl_ulong fallback) {
+    cl_ulong value = 0;
+    return clGetDeviceInfo(device, param, sizeof value, &value, NULL) == CL_SUCCESS ? value
+                                                                                   : fallback;
+}
+
 /* Every device of every platform, in clGetPlatformIDs / clGetDeviceIDs order. */
 static int list_devices(candidate *out, int capacity) {
     cl_platform_id platforms[MAX_PLATFORMS];
@@ -92,19 +137,19 @@ static int list_devices(candidate *out, int capacity) {
         if (clGetDeviceIDs(platforms[p], CL_DEVICE_TYPE_ALL, MAX_DEVICES, devices, &device_count) !=
             CL_SUCCESS)
             continue;
-        char platform_name[96] = "";
-        clGetPlatformInfo(platforms[p], CL_PLATFORM_NAME, sizeof platform_name - 1, platform_name,
-                          NULL);
+        char platform_name[96];
+        platform_string(platforms[p], CL_PLATFORM_NAME, platform_name, sizeof platform_name);
         for (cl_uint d = 0; d < device_count && d < MAX_DEVICES && n < capacity; d++) {
             candidate *c = &out[n++];
             c->platform = platforms[p];
             c->device = devices[d];
             c->platform_index = (int)p;
             c->device_index = (int)d;
-            c->type = 0;
-            clGetDeviceInfo(devices[d], CL_DEVICE_TYPE, sizeof c->type, &c->type, NULL);
-            char device_name[128] = "";
-            clGetDeviceInfo(devices[d], CL_DEVICE_NAME, sizeof device_name - 1, device_name, NULL);
+            if (clGetDeviceInfo(devices[d], CL_DEVICE_TYPE, sizeof c->type, &c->type, NULL) !=
+                CL_SUCCESS)
+                c->type = 0;
+            char device_name[128];
+            device_string(devices[d], CL_DEVICE_NAME, device_name, sizeof device_name);
             snprintf(c->name, sizeof c->name, "%s / %s", platform_name, device_name);
         }
     }
@@ -127,18 +172,13 @@ size_t rsmooth_list_devices(rsmooth_device_info *devices, size_t capacity) {
                            : (all[i].type & CL_DEVICE_TYPE_ACCELERATOR) ? "accel"
                                                                         : "other";
         snprintf(d->type, sizeof d->type, "%s", type);
-        /* PoCL's version ("OpenCL 3.0 PoCL HSTR: pthread-x86_64-...") outgrows the field: a
-         * short buffer is CL_INVALID_VALUE and an empty version, so read it whole and cut */
-        char version[1024] = ""; /* zeros past the text, so its head copies whole */
-        clGetDeviceInfo(all[i].device, CL_DEVICE_VERSION, sizeof version - 1, version, NULL);
-        version[sizeof d->version - 1] = '\0';
-        memcpy(d->version, version, sizeof d->version);
+        device_string(all[i].device, CL_DEVICE_VERSION, d->version, sizeof d->version);
         cl_uint units = 0;
-        cl_ulong memory = 0;
-        clGetDeviceInfo(all[i].device, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof units, &units, NULL);
-        clGetDeviceInfo(all[i].device, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof memory, &memory, NULL);
+        if (clGetDeviceInfo(all[i].device, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof units, &units,
+                            NULL) != CL_SUCCESS)
+            units = 0;
         d->compute_units = units;
-        d->global_memory = memory;
+        d->global_memory = device_ulong(all[i].device, CL_DEVICE_GLOBAL_MEM_SIZE, 0);
     }
     return (size_t)n;
 }
@@ -202,8 +242,10 @@ static rsmooth_status pick_device(const char *spec, candidate *chosen, rsmooth_e
 
 /* Work-group size: 64 where the device allows it (an explicit size helps PoCL vectorize). */
 static size_t choose_local_size(cl_device_id device) {
-    size_t max_size = 1;
-    clGetDeviceInfo(device, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof max_size, &max_size, NULL);
+    size_t max_size = 1; /* what every device takes, should the query fail */
+    if (clGetDeviceInfo(device, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof max_size, &max_size, NULL) !=
+        CL_SUCCESS)
+        max_size = 1;
     size_t local = 64;
     while (local > max_size)
         local /= 2;
@@ -237,9 +279,8 @@ bool rs_parse_bytes(const char *text, uint64_t *bytes) {
 
 /* Reads the device's memory limits and the RSMOOTH_MEMORY_BUDGET override. */
 static rsmooth_status read_memory_limits(rsmooth_context *ctx, rsmooth_error *error) {
-    cl_ulong global = 0, max_alloc = 0;
-    clGetDeviceInfo(ctx->device, CL_DEVICE_GLOBAL_MEM_SIZE, sizeof global, &global, NULL);
-    clGetDeviceInfo(ctx->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof max_alloc, &max_alloc, NULL);
+    cl_ulong global = device_ulong(ctx->device, CL_DEVICE_GLOBAL_MEM_SIZE, 0);
+    cl_ulong max_alloc = device_ulong(ctx->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, 0);
     ctx->global_memory = global ? global : (uint64_t)1 << 30;
     ctx->max_allocation = max_alloc ? max_alloc : ctx->global_memory / 4;
     const char *budget = getenv("RSMOOTH_MEMORY_BUDGET");
@@ -397,10 +438,10 @@ rsmooth_status rsmooth_context_create_from_queue(cl_command_queue queue, rsmooth
     ctx->device = device;
     ctx->local_size = choose_local_size(device);
     cl_platform_id platform = NULL;
-    char platform_name[96] = "", device_name[128] = "";
-    clGetDeviceInfo(device, CL_DEVICE_PLATFORM, sizeof platform, &platform, NULL);
-    clGetPlatformInfo(platform, CL_PLATFORM_NAME, sizeof platform_name - 1, platform_name, NULL);
-    clGetDeviceInfo(device, CL_DEVICE_NAME, sizeof device_name - 1, device_name, NULL);
+    char platform_name[96] = "", device_name[128];
+    if (clGetDeviceInfo(device, CL_DEVICE_PLATFORM, sizeof platform, &platform, NULL) == CL_SUCCESS)
+        platform_string(platform, CL_PLATFORM_NAME, platform_name, sizeof platform_name);
+    device_string(device, CL_DEVICE_NAME, device_name, sizeof device_name);
     snprintf(ctx->device_name, sizeof ctx->device_name, "%s / %s", platform_name, device_name);
     st = read_memory_limits(ctx, error);
     if (st == RSMOOTH_OK)
