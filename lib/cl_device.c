@@ -156,14 +156,25 @@ static int list_devices(candidate *out, int capacity) {
     return n;
 }
 
+void rsmooth_device_info_init(rsmooth_device_info *info) {
+    if (!info)
+        return;
+    memset(info, 0, sizeof *info);
+    info->struct_size = sizeof *info;
+}
+
 size_t rsmooth_list_devices(rsmooth_device_info *devices, size_t capacity) {
     if (rs_cl_load("rsmooth_list_devices", NULL) != RSMOOTH_OK)
         return 0; /* no loader: no platform either */
     candidate all[MAX_DEVICES];
     int n = list_devices(all, MAX_DEVICES);
     for (int i = 0; i < n && devices && (size_t)i < capacity; i++) {
+        /* entries of this version's size: the only size with struct_size so far, whatever the
+         * first entry says (see rsmooth.h) */
         rsmooth_device_info *d = &devices[i];
+        size_t caller_size = d->struct_size;
         memset(d, 0, sizeof *d);
+        d->struct_size = caller_size;
         d->platform_index = all[i].platform_index;
         d->device_index = all[i].device_index;
         snprintf(d->name, sizeof d->name, "%s", all[i].name);

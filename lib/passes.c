@@ -179,9 +179,12 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar
                                 const rsmooth_params *params, void *out_positions,
                                 float *out_weight, float *out_confidence, rsmooth_report *report,
                                 rsmooth_error *error, const char *where) {
+    size_t caller_size = report ? report->struct_size : 0; /* the report's fillers reset it */
     rsmooth_status st = filter_passes(one_pass, ctx, scalar, positions, vertex_count, indices,
                                       triangle_count, params, out_positions, out_weight,
                                       out_confidence, report, error, where);
+    if (report)
+        report->struct_size = caller_size;
     if (st != RSMOOTH_OK)
         return st;
     return rs_check_results(scalar, out_positions, out_weight, out_confidence, vertex_count,

@@ -152,11 +152,30 @@ static void free_arrays(point_arrays *a) {
     rs_free(a->color);
 }
 
+static rsmooth_status smooth_points(rsmooth_scalar scalar, const void *positions,
+                                    const void *normals, size_t point_count,
+                                    const rsmooth_params *params, void *out_positions,
+                                    void *out_normals, float *out_confidence,
+                                    rsmooth_report *report, rsmooth_error *error);
+
 rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void *positions,
                                                const void *normals, size_t point_count,
                                                const rsmooth_params *params, void *out_positions,
                                                void *out_normals, float *out_confidence,
                                                rsmooth_report *report, rsmooth_error *error) {
+    size_t caller_size = report ? report->struct_size : 0; /* the report's fillers reset it */
+    rsmooth_status st = smooth_points(scalar, positions, normals, point_count, params,
+                                      out_positions, out_normals, out_confidence, report, error);
+    if (report)
+        report->struct_size = caller_size;
+    return st;
+}
+
+static rsmooth_status smooth_points(rsmooth_scalar scalar, const void *positions,
+                                    const void *normals, size_t point_count,
+                                    const rsmooth_params *params, void *out_positions,
+                                    void *out_normals, float *out_confidence,
+                                    rsmooth_report *report, rsmooth_error *error) {
     double t_start = rs_now_ms();
     rs_error_clear(error);
     rsmooth_params p;

@@ -70,6 +70,13 @@ rsmooth_status rs_check_results(rsmooth_scalar scalar, const void *out_positions
     return RSMOOTH_OK;
 }
 
+void rsmooth_report_init(rsmooth_report *report) {
+    if (!report)
+        return;
+    memset(report, 0, sizeof *report);
+    report->struct_size = sizeof *report;
+}
+
 void rs_report_problem(rsmooth_report *report, const rs_problem *problem, size_t cell_count,
                        const char *device) {
     memset(report, 0, sizeof *report);

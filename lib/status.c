@@ -33,10 +33,21 @@ const char *rsmooth_status_str(rsmooth_status status) {
     return "unknown status";
 }
 
-void rs_error_clear(rsmooth_error *error) {
+void rsmooth_error_init(rsmooth_error *error) {
     if (!error)
         return;
     memset(error, 0, sizeof *error);
+    error->struct_size = sizeof *error;
+    error->line = -1;
+    error->byte_offset = -1;
+}
+
+void rs_error_clear(rsmooth_error *error) {
+    if (!error)
+        return;
+    size_t caller_size = error->struct_size; /* the caller's, never the library's to change */
+    memset(error, 0, sizeof *error);
+    error->struct_size = caller_size;
     error->line = -1;
     error->byte_offset = -1;
 }

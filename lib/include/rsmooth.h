@@ -100,9 +100,18 @@ RSMOOTH_API const char *rsmooth_status_str(rsmooth_status status);
  * not NULL. Thread-safe. (Added in 0.5) */
 RSMOOTH_API const char *rsmooth_version(int *major, int *minor, int *patch);
 
+/* Structs the caller allocates and the library fills (rsmooth_error, rsmooth_report,
+ * rsmooth_device_info) start with struct_size, as rsmooth_params does: set it with the struct's
+ * _init function (or to sizeof the struct), and a later version of the library writes only the
+ * fields a struct of that size has, so a program built against this header keeps working with a
+ * newer library of the same soname. The library never changes struct_size. A value that is no
+ * size any version had (a struct never initialised) is taken as this version's layout, 0.5's, the
+ * first with struct_size. (Added in 0.5) */
+
 /* Optional detail of a failure, filled by any call given a non-NULL pointer to one. On success it is
  * reset (status RSMOOTH_OK, empty strings). The library never prints: callers show these fields. */
 typedef struct rsmooth_error {
+    size_t struct_size;    /* sizeof(rsmooth_error): rsmooth_error_init */
     rsmooth_status status;
     int cl_error;          /* raw cl_int of the failing OpenCL call, 0 if none */
     char where[64];        /* failing function, OpenCL call or kernel, e.g. "clEnqueueNDRangeKernel" */
@@ -111,6 +120,9 @@ typedef struct rsmooth_error {
     int64_t byte_offset;   /* parse errors: byte offset of the offending token, else -1 */
     char build_log[2048];  /* kernel build failures: the head of the OpenCL build log */
 } rsmooth_error;
+
+/* Zeroes `error` and sets its struct_size. Accepts NULL. (Added in 0.5) */
+RSMOOTH_API void rsmooth_error_init(rsmooth_error *error);
 
 /* ---------------------------------------------------------------------------------------------- */
 /* Parameters                                                                                       */
@@ -285,6 +297,7 @@ RSMOOTH_API rsmooth_status rsmooth_params_auto(rsmooth_scalar scalar, const void
 /* Figures of one filter run, filled when a non-NULL pointer is passed. Times in milliseconds;
  * stages a path does not have are 0. */
 typedef struct rsmooth_report {
+    size_t struct_size;           /* sizeof(rsmooth_report): rsmooth_report_init (added in 0.5) */
     size_t vertex_count;
     size_t triangle_count;        /* triangles given */
     size_t facet_count;           /* triangles with non-zero area: the ones that carry weight */
@@ -312,6 +325,9 @@ typedef struct rsmooth_report {
     size_t tiles;                 /* spatial tiles the mesh was cut into to fit the device (1 when
                                      it fitted whole) */
 } rsmooth_report;
+
+/* Zeroes `report` and sets its struct_size. Accepts NULL. (Added in 0.5) */
+RSMOOTH_API void rsmooth_report_init(rsmooth_report *report);
 
 /* ---------------------------------------------------------------------------------------------- */
 /* Error metrics                                                                                    */
@@ -500,6 +516,8 @@ RSMOOTH_API rsmooth_status rsmooth_context_create(const char *device, rsmooth_co
 
 /* One OpenCL device as rsmooth_list_devices reports it. */
 typedef struct rsmooth_device_info {
+    size_t struct_size;      /* sizeof(rsmooth_device_info), rsmooth_device_info_init: the first
+                              * entry's says how large every entry of the array is (added in 0.5) */
     int platform_index;      /* the P of a "P:D" device choice */
     int device_index;        /* the D */
     char name[256];          /* "platform name / device name", what a name choice matches */
@@ -508,6 +526,9 @@ typedef struct rsmooth_device_info {
     unsigned compute_units;
     uint64_t global_memory;  /* bytes */
 } rsmooth_device_info;
+
+/* Zeroes `info` and sets its struct_size. Accepts NULL. (Added in 0.5) */
+RSMOOTH_API void rsmooth_device_info_init(rsmooth_device_info *info);
 
 /* Fills up to `capacity` entries of `devices` (may be NULL when capacity is 0) with every OpenCL
  * device of every platform, in the order "P:D" choices count them, and returns how many there are
