@@ -78,8 +78,11 @@ fuzz:
 	if [ -n "$$failed" ]; then echo "fuzzing failed:$$failed (inputs in $(FUZZ_BUILD)/artifacts)"; \
 	  exit 1; fi
 
+# `make install PREFIX=/opt/rsmooth` installs the command (bin/rsmooth), the libraries, headers,
+# CMake package and pkg-config files under PREFIX (without PREFIX: CMAKE_INSTALL_PREFIX, by
+# default /usr/local). The installed command finds its libraries relative to itself.
 install: build
-	cmake --install $(BUILD)
+	cmake --install $(BUILD)$(if $(PREFIX), --prefix $(abspath $(PREFIX)))
 
 clean:
 	rm -rf $(BUILD) $(BUILD)-sanitize $(BUILD)-python $(FUZZ_BUILD) out

@@ -10,9 +10,9 @@
 #ifndef RSMOOTH_CL_H
 #define RSMOOTH_CL_H
 
-#ifndef CL_TARGET_OPENCL_VERSION
-#define CL_TARGET_OPENCL_VERSION 120
-#endif
+/* The OpenCL version is the includer's choice: define CL_TARGET_OPENCL_VERSION (e.g. 120, 200, 300)
+ * before this header as before <CL/cl.h>; this header defines none. rsmooth needs only OpenCL 1.2's
+ * types. */
 
 #include "rsmooth.h"
 
