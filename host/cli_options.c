@@ -205,7 +205,9 @@ int cli_options_parse(int argc, char **argv, options *opt) {
     opt->iterations = 10;
     /* Read whole first (every option with its value, in order), then applied: --best sets the
      * defaults the options given with it change, wherever it stands. */
-    size_t n = argc > 0 ? (size_t)argc : 1;
+    size_t n = 1; /* a bound on the options: grouped flags ("-fq") are several in one argument */
+    for (int i = 0; i < argc; i++)
+        n += strlen(argv[i]);
     struct given_option {
         const cli_option *option;
         const char *value;

@@ -16,6 +16,8 @@ expect 0 "$rsmooth" --sigma-f=1.5 -oequals.ply --passes=2 --device=reference -q 
 cmp -s spaced.ply equals.ply || fail "--opt=value forms give another result than --opt value"
 expect 0 "$rsmooth" -qf noisy.ply --output=equals.ply --sigma-f=1.5 --sigma-g=0.4 --passes=2 $ref
 cmp -s spaced.ply equals.ply || fail "-qf and --output= give another result"
+expect 0 "$rsmooth" -fqfqfqfqfqfqfqfq noisy.ply -o equals.ply --sigma-f=1.5 --sigma-g=0.4 --passes=2 $ref
+cmp -s spaced.ply equals.ply || fail "many grouped flags give another result"
 expect 0 "$rsmooth" noisy.ply -o neg.ply --method=taubin --mu=-0.45 --iterations=3 -q
 expect 2 "$rsmooth" noisy.ply -o x.ply --sigma-f=abc
 grep -q -- "--sigma-f: not a number: 'abc'" err.txt || fail "bad --sigma-f= value: $(cat err.txt)"
