@@ -23,7 +23,7 @@ enum {
     OPT_SIGMA_G, OPT_CUTOFF, OPT_NORMALS, OPT_INFLUENCE, OPT_NORMAL_SIGMA_S, OPT_NORMAL_SIGMA_N,
     OPT_PASS_CONFIDENCE, OPT_SIGMA_C, OPT_NORMAL_ITERATIONS, OPT_PASSES, OPT_AUTO, OPT_BEST,
     OPT_ABSOLUTE, OPT_NO_MOLLIFY, OPT_ASCII, OPT_JSON, OPT_STATS, OPT_LIST_DEVICES, OPT_FORCE,
-    OPT_QUIET
+    OPT_QUIET, OPT_MASK
 };
 
 static const cli_option table[] = {
@@ -49,6 +49,7 @@ static const cli_option table[] = {
     {"normal-sigma-n", 0, true, OPT_NORMAL_SIGMA_N},
     {"pass-confidence", 0, true, OPT_PASS_CONFIDENCE},
     {"sigma-c", 0, true, OPT_SIGMA_C},
+    {"mask", 0, true, OPT_MASK},
     {"normal-iterations", 0, true, OPT_NORMAL_ITERATIONS},
     {"passes", 0, true, OPT_PASSES},
     {"auto", 0, false, OPT_AUTO},
@@ -87,6 +88,7 @@ static int apply(options *opt, int id, const char *name, const char *value) {
         return EXIT_OK;
     case OPT_OUTPUT: opt->output_option = value; break;
     case OPT_CONFIDENCE: opt->confidence = value; break;
+    case OPT_MASK: opt->mask = value; break;
     case OPT_DEVICE: opt->device = value; break;
     case OPT_SUFFIX:
         if (!*value || strchr(value, '/'))

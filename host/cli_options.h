@@ -42,6 +42,7 @@ typedef struct options {
     const char *input, *output; /* the file being worked on and its output ("-": stdout) */
     const char *output_option;  /* -o as given */
     const char *confidence, *device;
+    const char *mask;       /* --mask: a file of the vertex indices that may move */
     const char *suffix;     /* --suffix: each result beside its input, the name + suffix */
     bool output_dir;        /* -o names a folder (ends in '/' or is one): results go in there */
     rsmooth_format format;  /* --format: AUTO when not given (then the extension, or for -o -

@@ -42,6 +42,9 @@ static int check_method(options *opt) {
         return cli_usage_error(NULL, "--method %s has no confidence to write", name);
     if (umbrella && opt->colors)
         return cli_usage_error(NULL, "--method %s has no weights for --sigma-c", name);
+    if (umbrella && opt->mask)
+        return cli_usage_error(NULL, "--method %s moves every vertex: --mask is for the filter",
+                               name);
     if (opt->auto_params && opt->method != METHOD_ROBUST)
         return cli_usage_error(NULL, "--auto picks the robust filter's sigmas: drop --method %s",
                                name);

@@ -9,6 +9,7 @@
 #include "cli_options.h"
 #include "cli_commands.h"
 #include "cli_files.h"
+#include "cli_mask.h"
 #include "cli_output.h"
 #include "cli_progress.h"
 #include "cli_report.h"
@@ -339,9 +340,17 @@ static int smooth_file(const options *job, const char *path) {
         return code;
     }
     opt.params.colors = colors;
+    uint8_t *mask = NULL; /* --mask */
+    if (opt.mask && (code = cli_read_mask(opt.mask, mesh->vertex_count, path, &mask)) != EXIT_OK) {
+        rsmooth_mesh_destroy(mesh);
+        free(colors);
+        return code;
+    }
+    opt.params.move_mask = mask;
     if (opt.auto_params && (code = choose_params(&opt, mesh, points)) != EXIT_OK) {
         rsmooth_mesh_destroy(mesh);
         free(colors);
+        free(mask);
         return code;
     }
 
@@ -414,6 +423,7 @@ cleanup:
     free(out_normals);
     free(confidence);
     free(colors);
+    free(mask);
     return code;
 }
 

@@ -105,5 +105,36 @@ expect 0 "$rsmooth" render noisy.ply file.ply -o two.png --size=100x80
 size=$(od -An -tu1 -j16 -N8 two.png | tr -s ' ')
 [ "$size" = " 0 0 0 206 0 0 0 80" ] || fail "render --size 100x80 of 2 panels is not 206x80: $size"
 
+# --mask FILE: the listed vertices move, the others keep their input bit for bit; on the
+# listed ones the result is the unmasked one (one pass: every triangle still supports them)
+expect 0 "$shape" make mnoisy.obj mtruth.obj --noise 0.3 --triangles 1500
+expect 0 "$rsmooth" mnoisy.obj -o plain.obj $ref -q
+printf '# every third vertex\n' > mask.txt
+awk '$1 == "v" { n++ } END { for (i = 0; i < n; i += 3) printf "%d%s", i, (i % 30 == 27 ? "\n" : ", ") }' \
+  mnoisy.obj >> mask.txt
+expect 0 "$rsmooth" mnoisy.obj -o masked.obj --mask=mask.txt $ref -q
+awk 'FNR == 1 { file++ } $1 == "v" { v[file, n[file]++] = $2 " " $3 " " $4 }
+     END {
+       bad = 0
+       for (i = 0; i < n[1]; i++) {
+         want = (i % 3 == 0) ? v[2, i] : v[3, i]   # listed: the unmasked result; else the input
+         split(want, w); split(v[1, i], g)
+         if (g[1] != w[1] || g[2] != w[2] || g[3] != w[3]) bad++
+       }
+       moved = 0
+       for (i = 0; i < n[1]; i += 3) { split(v[1, i], g); split(v[3, i], w); moved += g[1] != w[1] }
+       if (bad || n[1] != n[2] || n[1] != n[3] || moved < n[1] / 6) {
+         print bad " of " n[1] " vertices wrong, " moved " listed moved"; exit 1 }
+     }' masked.obj plain.obj mnoisy.obj ||
+  fail "--mask: the listed vertices are not the unmasked result or the others moved"
+printf '3\n12 x\n' > badmask.txt
+expect 2 "$rsmooth" noisy.ply -o x.obj --mask badmask.txt $ref
+grep -q "badmask.txt:2: 'x' is not a vertex index" err.txt || fail "bad --mask token: $(cat err.txt)"
+printf '99999999\n' > farmask.txt
+expect 2 "$rsmooth" noisy.ply -o x.obj --mask farmask.txt $ref
+grep -q "farmask.txt:1: vertex 99999999 is beyond" err.txt || fail "far --mask: $(cat err.txt)"
+expect 2 "$rsmooth" noisy.ply -o x.obj --mask mask.txt --method taubin
+[ -e x.obj ] && fail "an output written after a bad --mask"
+
 [ "$failures" -eq 0 ] && echo "command (unix): all checks passed" || echo "$failures failure(s)"
 exit $((failures > 0))
