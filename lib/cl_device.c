@@ -88,29 +88,23 @@ static void copy_cut(const char *text, char *out, size_t size) {
     out[n] = '\0';
 }
 
-/* A string property, its size asked first so a long one (PoCL's 65-character version) is read
- * whole, then cut to `out`; "" when a query fails. */
-static void device_string(cl_device_id device, cl_device_info param, char *out, size_t size) {
+/* A string property of `device` (or of `platform` when device is NULL), its size asked first so
+ * a long one (PoCL's 65-character version) is read whole, then cut to `out`; "" when a query
+ * fails. */
+static void info_string(cl_platform_id platform, cl_device_id device, cl_uint param, char *out,
+                        size_t size) {
     size_t need = 0;
     out[0] = '\0';
-    if (clGetDeviceInfo(device, param, 0, NULL, &need) != CL_SUCCESS || need == 0)
+    cl_int err = device ? clGetDeviceInfo(device, param, 0, NULL, &need)
+                        : clGetPlatformInfo(platform, param, 0, NULL, &need);
+    if (err != CL_SUCCESS || need == 0)
         return;
     char *text = malloc(need + 1);
-    if (text && clGetDeviceInfo(device, param, need, text, NULL) == CL_SUCCESS) {
-        text[need] = '\0';
-        copy_cut(text, out, size);
-    }
-    free(text);
-}
-
-static void platform_string(cl_platform_id platform, cl_platform_info param, char *out,
-                            size_t size) {
-    size_t need = 0;
-    out[0] = '\0';
-    if (clGetPlatformInfo(platform, param, 0, NULL, &need) != CL_SUCCESS || need == 0)
+    if (!text)
         return;
-    char *text = malloc(need + 1);
-    if (text && clGetPlatformInfo(platform, param, need, text, NULL) == CL_SUCCESS) {
+    err = device ? clGetDeviceInfo(device, param, need, text, NULL)
+                 : clGetPlatformInfo(platform, param, need, text, NULL);
+    if (err == CL_SUCCESS) {
         text[need] = '\0';
         copy_cut(text, out, size);
     }
@@ -138,7 +132,7 @@ static int list_devices(candidate *out, int capacity) {
             CL_SUCCESS)
             continue;
         char platform_name[96];
-        platform_string(platforms[p], CL_PLATFORM_NAME, platform_name, sizeof platform_name);
+        info_string(platforms[p], NULL, CL_PLATFORM_NAME, platform_name, sizeof platform_name);
         for (cl_uint d = 0; d < device_count && d < MAX_DEVICES && n < capacity; d++) {
             candidate *c = &out[n++];
             c->platform = platforms[p];
@@ -149,7 +143,7 @@ static int list_devices(candidate *out, int capacity) {
                 CL_SUCCESS)
                 c->type = 0;
             char device_name[128];
-            device_string(devices[d], CL_DEVICE_NAME, device_name, sizeof device_name);
+            info_string(NULL, devices[d], CL_DEVICE_NAME, device_name, sizeof device_name);
             snprintf(c->name, sizeof c->name, "%s / %s", platform_name, device_name);
         }
     }
@@ -183,7 +177,7 @@ size_t rsmooth_list_devices(rsmooth_device_info *devices, size_t capacity) {
                            : (all[i].type & CL_DEVICE_TYPE_ACCELERATOR) ? "accel"
                                                                         : "other";
         snprintf(d->type, sizeof d->type, "%s", type);
-        device_string(all[i].device, CL_DEVICE_VERSION, d->version, sizeof d->version);
+        info_string(NULL, all[i].device, CL_DEVICE_VERSION, d->version, sizeof d->version);
         cl_uint units = 0;
         if (clGetDeviceInfo(all[i].device, CL_DEVICE_MAX_COMPUTE_UNITS, sizeof units, &units,
                             NULL) != CL_SUCCESS)
@@ -451,8 +445,8 @@ rsmooth_status rsmooth_context_create_from_queue(cl_command_queue queue, rsmooth
     cl_platform_id platform = NULL;
     char platform_name[96] = "", device_name[128];
     if (clGetDeviceInfo(device, CL_DEVICE_PLATFORM, sizeof platform, &platform, NULL) == CL_SUCCESS)
-        platform_string(platform, CL_PLATFORM_NAME, platform_name, sizeof platform_name);
-    device_string(device, CL_DEVICE_NAME, device_name, sizeof device_name);
+        info_string(platform, NULL, CL_PLATFORM_NAME, platform_name, sizeof platform_name);
+    info_string(NULL, device, CL_DEVICE_NAME, device_name, sizeof device_name);
     snprintf(ctx->device_name, sizeof ctx->device_name, "%s / %s", platform_name, device_name);
     st = read_memory_limits(ctx, error);
     if (st == RSMOOTH_OK)
