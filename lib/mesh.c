@@ -208,12 +208,6 @@ void rs_problem_free(rs_problem *problem) {
     memset(problem, 0, sizeof *problem);
 }
 
-/* Ranges overlap when neither ends before the other begins. */
-static bool overlaps(const void *a, size_t a_size, const void *b, size_t b_size) {
-    const char *pa = a, *pb = b;
-    return pa < pb + b_size && pb < pa + a_size;
-}
-
 rsmooth_status rs_check_outputs(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
                                 const uint32_t *indices, size_t triangle_count,
                                 const rsmooth_params *params, const void *out_positions,
@@ -224,7 +218,7 @@ rsmooth_status rs_check_outputs(rsmooth_scalar scalar, const void *positions, si
     if (rs_mul_overflows(vertex_count, 3 * sizeof(double)) ||
         rs_mul_overflows(triangle_count, 3 * sizeof(uint32_t)))
         return RSMOOTH_OK; /* no such arrays: the count checks refuse the call */
-    size_t xyz = vertex_count * 3 * (scalar == RSMOOTH_FLOAT32 ? sizeof(float) : sizeof(double));
+    size_t xyz = vertex_count * rs_vertex_bytes(scalar);
     size_t per_vertex = vertex_count * sizeof(float);
     const struct {
         const char *name;
@@ -245,7 +239,7 @@ rsmooth_status rs_check_outputs(rsmooth_scalar scalar, const void *positions, si
             const char *name = i < ins ? in[i].name : out[i - ins].name;
             const void *at = i < ins ? in[i].at : out[i - ins].at;
             size_t bytes = i < ins ? in[i].bytes : out[i - ins].bytes;
-            if (at && overlaps(out[o].at, out[o].bytes, at, bytes))
+            if (rs_ranges_overlap(out[o].at, out[o].bytes, at, bytes))
                 return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                                "%s overlaps %s: smoothing reads every input while writing, and "
                                "each output needs its own memory",

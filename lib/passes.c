@@ -15,10 +15,6 @@ int rs_report_pass_progress(void *user, double fraction) {
     return pp->cancel ? pp->cancel(pp->user, whole) : 0;
 }
 
-rsmooth_status rs_cancelled(rsmooth_error *error, const char *where) {
-    return rs_fail(error, RSMOOTH_ERROR_CANCELLED, where,
-                   "cancelled: the progress_cancel callback asked to stop");
-}
 
 void rs_add_pass_report(rsmooth_report *sum, const rsmooth_report *pass) {
     rsmooth_report keep = *sum;
@@ -41,7 +37,7 @@ void rs_add_pass_report(rsmooth_report *sum, const rsmooth_report *pass) {
 /* The vertices params->move_mask holds still get their input position back, byte for byte. */
 static void keep_unselected(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
                             const uint8_t *mask, void *out_positions) {
-    size_t record = 3 * (scalar == RSMOOTH_FLOAT32 ? sizeof(float) : sizeof(double));
+    size_t record = rs_vertex_bytes(scalar);
     for (size_t v = 0; mask && v < vertex_count; v++)
         if (!mask[v])
             memcpy((char *)out_positions + v * record, (const char *)positions + v * record,
@@ -54,23 +50,20 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                                     const rsmooth_params *params, void *out_positions,
                                     float *out_weight, float *out_confidence,
                                     rsmooth_report *report, rsmooth_error *error,
-                                    const char *where) {
+                                    const char *where, const uint8_t **move_mask) {
     double t_start = rs_now_ms();
     rs_error_clear(error);
     rsmooth_params p;
     rsmooth_status st = rs_params_resolve(params, &p, error, where);
+    *move_mask = p.move_mask; /* the caller restores the unselected vertices at the end */
     if (st == RSMOOTH_OK)
         st = rs_check_outputs(scalar, positions, vertex_count, indices, triangle_count, &p,
                               out_positions, out_weight, out_confidence, error, where);
     if (st != RSMOOTH_OK)
         return st;
-    if (p.passes == 1) { /* the paper's single pass, exactly as it was */
-        st = one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, params,
-                      out_positions, out_weight, out_confidence, report, error);
-        if (st == RSMOOTH_OK)
-            keep_unselected(scalar, positions, vertex_count, p.move_mask, out_positions);
-        return st;
-    }
+    if (p.passes == 1) /* the paper's single pass, exactly as it was */
+        return one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, params,
+                        out_positions, out_weight, out_confidence, report, error);
     if ((st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count,
                                    NULL, error, where)) != RSMOOTH_OK)
         return st; /* (the outputs were checked above) */
@@ -96,13 +89,9 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
         p.progress_cancel = rs_report_pass_progress;
         p.progress_user = &pp;
     }
-    if (passes == 1) {
-        st = one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, &p,
-                      out_positions, out_weight, out_confidence, report, error);
-        if (st == RSMOOTH_OK)
-            keep_unselected(scalar, positions, vertex_count, p.move_mask, out_positions);
-        return st;
-    }
+    if (passes == 1)
+        return one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, &p,
+                        out_positions, out_weight, out_confidence, report, error);
 
     double *cur = rs_alloc_array(vertex_count, 3 * sizeof(double));
     double *next = rs_alloc_array(vertex_count, 3 * sizeof(double));
@@ -156,7 +145,6 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
         if (out_confidence)
             out_confidence[v] = prev_confidence[v];
     }
-    keep_unselected(scalar, positions, vertex_count, p.move_mask, out_positions);
     if (report) {
         *report = sum;
         report->mean_edge_length = unit; /* the input's, the unit of its sigmas */
@@ -180,13 +168,16 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar
                                 float *out_weight, float *out_confidence, rsmooth_report *report,
                                 rsmooth_error *error, const char *where) {
     size_t caller_size = report ? report->struct_size : 0; /* the report's fillers reset it */
+    const uint8_t *move_mask = NULL;
     rsmooth_status st = filter_passes(one_pass, ctx, scalar, positions, vertex_count, indices,
                                       triangle_count, params, out_positions, out_weight,
-                                      out_confidence, report, error, where);
+                                      out_confidence, report, error, where, &move_mask);
     if (report)
         report->struct_size = caller_size;
     if (st != RSMOOTH_OK)
         return st;
+    /* every pass held them still; their final bytes are the input's own */
+    keep_unselected(scalar, positions, vertex_count, move_mask, out_positions);
     return rs_check_results(scalar, out_positions, out_weight, out_confidence, vertex_count,
                             "vertex", error, where);
 }

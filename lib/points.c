@@ -94,12 +94,6 @@ static const char *unit_normal(rsmooth_scalar scalar, const void *normals, size_
     return NULL;
 }
 
-/* Ranges overlap when neither ends before the other begins (NULL overlaps nothing). */
-static bool overlaps(const void *a, size_t a_size, const void *b, size_t b_size) {
-    const char *pa = a, *pb = b;
-    return pa && pb && pa < pb + b_size && pb < pa + a_size;
-}
-
 rsmooth_status rsmooth_point_spacing(rsmooth_scalar scalar, const void *positions,
                                      size_t point_count, double *out_spacing,
                                      rsmooth_error *error) {
@@ -203,11 +197,11 @@ static rsmooth_status smooth_points(rsmooth_scalar scalar, const void *positions
     /* Every input is read before any output is written, so outputs may be the inputs; but two
      * outputs in one place would mix. */
     size_t vec_bytes =
-        point_count * 3 * (scalar == RSMOOTH_FLOAT32 ? sizeof(float) : sizeof(double));
+        point_count * rs_vertex_bytes(scalar);
     size_t conf_bytes = point_count * sizeof(float);
-    if (overlaps(out_positions, vec_bytes, out_normals, vec_bytes) ||
-        overlaps(out_positions, vec_bytes, out_confidence, conf_bytes) ||
-        overlaps(out_normals, vec_bytes, out_confidence, conf_bytes))
+    if (rs_ranges_overlap(out_positions, vec_bytes, out_normals, vec_bytes) ||
+        rs_ranges_overlap(out_positions, vec_bytes, out_confidence, conf_bytes) ||
+        rs_ranges_overlap(out_normals, vec_bytes, out_confidence, conf_bytes))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "out_positions, out_normals and out_confidence overlap");
 

@@ -195,6 +195,18 @@ static inline void rs_facet_centroid(const rs_problem *problem, size_t q, double
 }
 void rs_problem_free(rs_problem *problem);
 
+/* Bytes of one vertex's x, y, z in the caller's scalar type. */
+static inline size_t rs_vertex_bytes(rsmooth_scalar scalar) {
+    return 3 * (scalar == RSMOOTH_FLOAT32 ? sizeof(float) : sizeof(double));
+}
+
+/* Whether two byte ranges overlap: neither ends before the other begins (NULL overlaps nothing).
+ * Outputs against inputs and each other. */
+static inline bool rs_ranges_overlap(const void *a, size_t a_size, const void *b, size_t b_size) {
+    const char *pa = a, *pb = b;
+    return pa && pb && pa < pb + b_size && pb < pa + a_size;
+}
+
 /* Coordinate i (x, y, z of vertex i / 3) of the caller's positions, as a double. */
 static inline double rs_coordinate(rsmooth_scalar scalar, const void *positions, size_t i) {
     return scalar == RSMOOTH_FLOAT32 ? (double)((const float *)positions)[i]

@@ -72,6 +72,11 @@ rsmooth_status rs_fail(rsmooth_error *error, rsmooth_status status, const char *
     return status;
 }
 
+rsmooth_status rs_cancelled(rsmooth_error *error, const char *where) {
+    return rs_fail(error, RSMOOTH_ERROR_CANCELLED, where,
+                   "cancelled: the progress_cancel callback asked to stop");
+}
+
 rsmooth_status rs_fail_parse(rsmooth_error *error, int64_t line, int64_t byte_offset,
                              const char *where, const char *format, ...) {
     va_list args;

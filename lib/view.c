@@ -20,12 +20,6 @@ static size_t index_size(int type) {
     return type == RSMOOTH_INDEX_INT64 ? 8 : 4;
 }
 
-/* Ranges overlap when neither ends before the other begins (NULL or empty overlaps nothing). */
-static bool overlaps(const void *a, size_t a_size, const void *b, size_t b_size) {
-    const char *pa = a, *pb = b;
-    return pa && pb && a_size && b_size && pa < pb + b_size && pb < pa + a_size;
-}
-
 /* Bytes a strided array of `count` records of `record` bytes spans. */
 static size_t span(size_t count, size_t stride, size_t record) {
     return count ? (count - 1) * stride + record : 0;
@@ -76,7 +70,7 @@ static rsmooth_status check_view(const rsmooth_mesh_view *m, size_t *pstride, si
         m->index_type != RSMOOTH_INDEX_INT64)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "mesh->index_type %d is unknown", m->index_type);
-    size_t record = 3 * (m->scalar == RSMOOTH_FLOAT32 ? sizeof(float) : sizeof(double));
+    size_t record = rs_vertex_bytes(m->scalar);
     size_t triple = 3 * index_size(m->index_type);
     *pstride = m->position_stride ? m->position_stride : record;
     *istride = m->index_stride ? m->index_stride : triple;
@@ -109,7 +103,7 @@ rsmooth_status rsmooth_smooth_view(rsmooth_context *ctx, const rsmooth_mesh_view
     if (st != RSMOOTH_OK)
         return st;
     size_t n = mesh->vertex_count;
-    size_t record = 3 * (mesh->scalar == RSMOOTH_FLOAT32 ? sizeof(float) : sizeof(double));
+    size_t record = rs_vertex_bytes(mesh->scalar);
     size_t ostride = out_stride ? out_stride : record;
     if (!out_positions)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_positions is NULL");
@@ -118,9 +112,9 @@ rsmooth_status rsmooth_smooth_view(rsmooth_context *ctx, const rsmooth_mesh_view
                        "out_stride %zu is smaller than a vertex (%zu bytes) or overflows",
                        ostride, record);
     size_t out_span = span(n, ostride, record), per_vertex = n * sizeof(float);
-    if (overlaps(out_positions, out_span, out_weight, per_vertex) ||
-        overlaps(out_positions, out_span, out_confidence, per_vertex) ||
-        overlaps(out_weight, per_vertex, out_confidence, per_vertex))
+    if (rs_ranges_overlap(out_positions, out_span, out_weight, per_vertex) ||
+        rs_ranges_overlap(out_positions, out_span, out_confidence, per_vertex) ||
+        rs_ranges_overlap(out_weight, per_vertex, out_confidence, per_vertex))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "out_positions, out_weight and out_confidence overlap");
 
