@@ -35,6 +35,23 @@ static PyObject *report_dict(const rsmooth_report *r) {
         "tiles", (Py_ssize_t)r->tiles);
 }
 
+/* Hands the library `progress` through p's progress_cancel and lets go of the GIL: the filter
+ * call follows, then finish_call. */
+static void start_call(call_state *c, PyObject *progress, rsmooth_params *p) {
+    c->progress = progress == Py_None ? NULL : progress;
+    p->progress_cancel = report;
+    p->progress_user = c;
+    c->thread = PyEval_SaveThread();
+}
+
+/* Takes the GIL back; the run's report, or the exception its status (or a pending one: a report
+ * the library does not act on, the last at 1, may still have raised) calls for. */
+static PyObject *finish_call(call_state *c, rsmooth_status st, const rsmooth_report *rep,
+                             const rsmooth_error *err) {
+    PyEval_RestoreThread(c->thread);
+    return st == RSMOOTH_OK && !PyErr_Occurred() ? report_dict(rep) : ext_raise(st, err);
+}
+
 /* _smooth(context, vertices, faces, out, confidence, params, progress) -> report dict.
  * context: a capsule from _context_create, or None for the reference path. vertices and out:
  * (n, 3) of one float type; faces (m, 3) uint32; confidence (n,) float32 or None. */
@@ -69,13 +86,11 @@ PyObject *ext_smooth(PyObject *self, PyObject *args, PyObject *kwargs) {
         PyErr_SetString(PyExc_ValueError, "outputs must have a row per vertex");
         goto done;
     }
-    call_state call = {NULL, progress == Py_None ? NULL : progress};
-    p.progress_cancel = report;
-    p.progress_user = &call;
+    call_state call;
     rsmooth_report rep;
     rsmooth_error err;
     rsmooth_status st;
-    call.thread = PyEval_SaveThread();
+    start_call(&call, progress, &p);
     if (ctx)
         st = rsmooth_smooth(ctx, v.scalar, v.view.buf, (size_t)v.rows, f.view.buf, (size_t)f.rows,
                             &p, out.view.buf, NULL, conf.held ? conf.view.buf : NULL, &rep, &err);
@@ -83,9 +98,7 @@ PyObject *ext_smooth(PyObject *self, PyObject *args, PyObject *kwargs) {
         st = rsmooth_smooth_reference(v.scalar, v.view.buf, (size_t)v.rows, f.view.buf,
                                       (size_t)f.rows, &p, out.view.buf, NULL,
                                       conf.held ? conf.view.buf : NULL, &rep, &err);
-    PyEval_RestoreThread(call.thread);
-    /* a report the library does not act on (the last, at 1) may still have raised */
-    result = st == RSMOOTH_OK && !PyErr_Occurred() ? report_dict(&rep) : ext_raise(st, &err);
+    result = finish_call(&call, st, &rep, &err);
 done:
     ext_param_arrays_release(&held);
     ext_array_release(&conf);
@@ -128,18 +141,14 @@ PyObject *ext_smooth_points(PyObject *self, PyObject *args, PyObject *kwargs) {
         PyErr_SetString(PyExc_ValueError, "normals and outputs must have a row per point");
         goto done;
     }
-    call_state call = {NULL, progress == Py_None ? NULL : progress};
-    p.progress_cancel = report;
-    p.progress_user = &call;
+    call_state call;
     rsmooth_report rep;
     rsmooth_error err;
-    call.thread = PyEval_SaveThread();
+    start_call(&call, progress, &p);
     rsmooth_status st = rsmooth_smooth_points_reference(
         v.scalar, v.view.buf, n.view.buf, (size_t)v.rows, &p, out.view.buf,
         out_n.held ? out_n.view.buf : NULL, conf.held ? conf.view.buf : NULL, &rep, &err);
-    PyEval_RestoreThread(call.thread);
-    /* a report the library does not act on (the last, at 1) may still have raised */
-    result = st == RSMOOTH_OK && !PyErr_Occurred() ? report_dict(&rep) : ext_raise(st, &err);
+    result = finish_call(&call, st, &rep, &err);
 done:
     ext_param_arrays_release(&held);
     ext_array_release(&conf);
