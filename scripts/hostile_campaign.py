@@ -820,7 +820,6 @@ def rms_z(verts, scale):
 def category_scale(c):
     n = 10
     base_v, base_f = noisy_grid(n, seed=c.seed)
-    base_mel = mean_edge(base_v, base_f)
     exps = list(range(-300, 150))
 
     def make(k):
@@ -878,14 +877,14 @@ def category_scale(c):
 
     sweep = []
 
-    def one(k):
-        _, s, verts, rel = grids[k]
-        mel = mean_edge(verts, base_f, s)
+    def both_devices(label, kind, rel, outrel_of, verts, s, mel, scale_check, sweep_into=None):
+        """Smooths `rel` on each device: each result checked (verdict, against the unit result
+        when scale_check), OpenCL against the reference; (k, difference) to sweep_into."""
         res = {}
         cases = []
         for dev in (["reference", "cpu"] if c.have_cpu else ["reference"]):
-            case = c.new_case("scale", "grid 10x10 spacing 1e%d --device %s" % (k, dev), [rel])
-            outrel = "outputs/scale/grid_1e%+04d_%s.obj" % (k, dev)
+            case = c.new_case("scale", "%s --device %s" % (label, dev), [rel])
+            outrel = outrel_of(dev)
             r = c.attach(case, smooth(rel, dev, outrel))
             out = None
             if r["rc"] == 0:
@@ -893,19 +892,29 @@ def category_scale(c):
                 if out is not None:
                     c.reread(case, outrel, len(verts))
             elif not r["timeout"] and not c.crash_of(r):
-                case["other"].append("exit %s at a supported scale: %s" % (r["rc"], r["stderr"].strip()[-300:]))
-            verdict(case, verts, s, out, mel=mel)
+                case["other"].append("exit %s at a supported %s: %s" % (
+                    r["rc"], kind, r["stderr"].strip()[-300:]))
+            verdict(case, verts, s, out, mel=mel if scale_check else None)
             res[dev] = out
             cases.append(case)
         if len(cases) == 2 and res.get("reference") is not None and res.get("cpu") is not None:
             d = max_dist(res["reference"], res["cpu"], s) / mel
-            sweep.append((k, d))
+            if sweep_into is not None:
+                sweep_into.append(d)
             if not d <= CL_TOLERANCE:
                 cases[1]["wrong"].append("OpenCL differs from the reference by %.3g mean edge lengths" % d)
             if max_dist(verts, res["cpu"], s) == 0.0 and max_dist(verts, res["reference"], s) > 0.0:
                 cases[1]["wrong"].append("OpenCL moved nothing while the reference moved the grid")
         for case in cases:
             c.record(case)
+
+    def one(k):
+        _, s, verts, rel = grids[k]
+        found = []
+        both_devices("grid 10x10 spacing 1e%d" % k, "scale", rel,
+                     lambda dev: "outputs/scale/grid_1e%+04d_%s.obj" % (k, dev), verts, s,
+                     mean_edge(verts, base_f, s), True, found)
+        sweep.extend((k, d) for d in found)
 
     c.pool_map(one, exps)
     if sweep:
@@ -916,41 +925,15 @@ def category_scale(c):
 
     # float32 (binary PLY float) from 1e-36 to 1e36
     f32_exps = list(range(-36, 37))
-    f32_base = [struct.unpack("<3f", struct.pack("<3f", *v)) for v in base_v]
 
     def f32_one(k):
         s = float("1e%d" % k)
         verts = [struct.unpack("<3f", struct.pack("<3f", x * s, y * s, z * s)) for x, y, z in base_v]
         data, _ = write_format("ply_le", verts, base_f)
         rel = c.write("inputs/scale/grid_f32_1e%+03d.ply" % k, data)
-        mel = mean_edge(verts, base_f, s)
-        res = {}
-        cases = []
-        for dev in (["reference", "cpu"] if c.have_cpu else ["reference"]):
-            case = c.new_case("scale", "float32 PLY grid spacing 1e%d --device %s" % (k, dev), [rel])
-            outrel = "outputs/scale/grid_f32_1e%+03d_%s.ply" % (k, dev)
-            r = c.attach(case, smooth(rel, dev, outrel))
-            out = None
-            if r["rc"] == 0:
-                out = load(case, outrel, len(verts))
-                if out is not None:
-                    c.reread(case, outrel, len(verts))
-                    if max_dist(verts, out, s) == 0.0:
-                        case["wrong"].append("nothing moved (output equals input)")
-                    if not rms_z(out, s) < smooth_limit * rms_z(verts, s):
-                        case["wrong"].append("not smoothed: rms height %.4g -> %.4g spacings" % (
-                            rms_z(verts, s), rms_z(out, s)))
-            elif not r["timeout"] and not c.crash_of(r):
-                case["other"].append("exit %s at a supported float32 scale: %s" % (
-                    r["rc"], r["stderr"].strip()[-300:]))
-            res[dev] = out
-            cases.append(case)
-        if len(cases) == 2 and res.get("reference") is not None and res.get("cpu") is not None:
-            d = max_dist(res["reference"], res["cpu"], s) / mel
-            if not d <= CL_TOLERANCE:
-                cases[1]["wrong"].append("OpenCL differs from the reference by %.3g mean edge lengths" % d)
-        for case in cases:
-            c.record(case)
+        both_devices("float32 PLY grid spacing 1e%d" % k, "float32 scale", rel,
+                     lambda dev: "outputs/scale/grid_f32_1e%+03d_%s.ply" % (k, dev), verts, s,
+                     mean_edge(verts, base_f, s), False)
 
     c.pool_map(f32_one, f32_exps)
 
@@ -1166,7 +1149,6 @@ def category_truncation(c):
         cap = 10 ** 9 if c.full else 300
         for L in sample_prefixes(len(data), cap, rng, oracle):
             jobs.append((fmt, data, oracle, L))
-    counter = {"i": 0}
 
     def one(job_i):
         i, (fmt, data, oracle, L) = job_i
@@ -1789,7 +1771,7 @@ class FileScenarios:
             r = self.run(case, d, ["in.obj", "-o", "out" + ext, "--device", "reference", "-q"] + args)
             after = snapshot(d)
             if r["rc"] == 0:
-                m = self.smoothed_ok(case, d, "out" + ext, count=4 if ext == ".ply" else 12)
+                self.smoothed_ok(case, d, "out" + ext, count=4 if ext == ".ply" else 12)
                 case["lost"] += diff_snap(before, after, allowed_new=("out" + ext,))
             else:
                 if ext == ".ply" or "--ascii" in args:
@@ -1844,7 +1826,7 @@ class FileScenarios:
         for i in range(racers):
             vv, _ = noisy_grid(30, seed=c.seed + 100 + i)
             self.put(d, "in%d.obj" % i, obj_text(vv, f, num=fmt_fixed))
-            r = c.run(["in%d.obj" % i, "-o", "solo%d.obj" % i, "--device", "reference", "-q", "--force"], cwd=d)
+            c.run(["in%d.obj" % i, "-o", "solo%d.obj" % i, "--device", "reference", "-q", "--force"], cwd=d)
             with open(os.path.join(d, "solo%d.obj" % i), "rb") as fh:
                 inputs.append(fh.read())
         for k in range(count):
