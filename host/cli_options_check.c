@@ -78,9 +78,13 @@ static int check_files(options *opt) {
         return cli_usage_error(NULL, "give -o OUTPUT, --suffix or --in-place, not two of them");
     if (opt->in_place && stdin_count)
         return cli_usage_error(NULL, "--in-place cannot replace standard input");
+    /* -o DIR/ is always a folder; an existing folder named without the '/' only with several
+     * inputs: for one input it stays the mistake the writer refuses ("is a directory"), rather
+     * than a result left inside the folder by surprise */
     struct stat st;
     opt->output_dir = out && strcmp(out, "-") != 0 &&
-                      (out[strlen(out) - 1] == '/' || (stat(out, &st) == 0 && S_ISDIR(st.st_mode)));
+                      (out[strlen(out) - 1] == '/' ||
+                       (opt->input_count > 1 && stat(out, &st) == 0 && S_ISDIR(st.st_mode)));
     if (opt->output_dir && !(stat(out, &st) == 0 && S_ISDIR(st.st_mode)))
         return cli_usage_error(NULL, "-o %s: no such folder (results go into an existing one)",
                                out);

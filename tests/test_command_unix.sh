@@ -81,6 +81,14 @@ expect 2 "$rsmooth" a.obj c.ply -o out $ref
 grep -q "out/a.obj: already exists" err.txt || fail "existing output replaced: $(cat err.txt)"
 expect 0 "$rsmooth" a.obj c.ply -o out --force $ref -q
 [ -s err.txt ] && fail "-q printed: $(cat err.txt)"
+# one input and an existing folder named without the '/': the mistake it always was (nothing
+# written into the folder); with the '/' it is the folder
+mkdir one
+expect 2 "$rsmooth" a.obj -o one $ref -q
+grep -q "one: is a directory" err.txt || fail "-o FOLDER for one input: $(cat err.txt)"
+[ -z "$(ls one)" ] || fail "-o FOLDER for one input wrote into it: $(ls one)"
+expect 0 "$rsmooth" a.obj -o one/ $ref -q
+[ -s one/a.obj ] || fail "-o FOLDER/ for one input did not write one/a.obj"
 expect 2 "$rsmooth" a.obj c.ply -o one.ply
 grep -q "2 inputs: -o must be a folder" err.txt || fail "two inputs to one file: $(cat err.txt)"
 expect 2 "$rsmooth" a.obj out/../a.obj -o out/
