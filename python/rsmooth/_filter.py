@@ -3,6 +3,8 @@ extension with the GIL released."""
 
 from __future__ import annotations
 
+import functools
+import os
 import warnings
 from typing import Any, Optional
 
@@ -64,8 +66,9 @@ def smooth(
     mollify : predict with mollified normals (the paper); False uses the raw ones.
     device : "auto", "gpu", "cpu", "P:D", part of a device name, or "reference" (double
         precision on one CPU thread, no OpenCL). "auto" falls back to "reference" with a
-        RuntimeWarning where no OpenCL device exists. Use :class:`Context` to build the kernels
-        once for many calls.
+        RuntimeWarning where no OpenCL device exists. The kernels are built once per device
+        choice and process, on the first call; a :class:`Context` of your own sets its lifetime
+        and gives the run's report.
     confidence : also return the per-vertex confidence k(p) / sum a f in [0, 1] (float32, the
         paper's Fig. 10): low at features and outliers.
     best : rsmooth's most accurate mode (bilateral normals, 3 passes at sigma_f 0.8,
@@ -117,7 +120,8 @@ def smooth(
     if device == "reference" or method in ("laplacian", "taubin"):
         return _smooth(None, vertices, faces, **options)
     try:
-        context = Context(device)
+        environment = os.environ.get("RSMOOTH_DEVICE") if device is None else None
+        context = _shared_context(device, environment)
     except DeviceError as e:
         # only where no OpenCL device exists at all (no loader, no platform): a device that
         # exists and fails is the caller's to know about
@@ -130,8 +134,15 @@ def smooth(
             stacklevel=2,
         )
         return _smooth(None, vertices, faces, **options)
-    with context:
-        return _smooth(context, vertices, faces, **options)
+    return _smooth(context, vertices, faces, **options)
+
+
+@functools.lru_cache(maxsize=8)
+def _shared_context(device: Optional[str], environment: Optional[str]) -> Context:
+    """The context rsmooth.smooth uses for `device` (with device None: for RSMOOTH_DEVICE's value,
+    `environment`), built once per process: building the kernels costs more than filtering a small
+    mesh, and a loop of smooth() calls should not pay it each time. A failure is not cached."""
+    return Context(device)
 
 
 def _smooth(

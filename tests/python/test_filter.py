@@ -60,6 +60,19 @@ def test_opencl_agrees_with_reference_and_repeats(mesh):
     assert np.max(np.linalg.norm(best_cl - best_ref, axis=1)) <= 1e-3 * edge(v, f)
 
 
+def test_kernels_built_once(mesh):
+    """rsmooth.smooth keeps one context per device choice: the second call builds nothing."""
+    require_opencl()
+    from rsmooth import _filter
+
+    v, f = mesh
+    first = rsmooth.smooth(v, f, device="auto")
+    before = _filter._shared_context.cache_info()
+    assert np.array_equal(rsmooth.smooth(v, f, device="auto"), first)
+    after = _filter._shared_context.cache_info()
+    assert after.hits == before.hits + 1 and after.misses == before.misses
+
+
 @pytest.mark.parametrize("dtype", [np.float32, np.float64])
 def test_dtype_shape_and_strides(mesh, dtype):
     v64, f = mesh
