@@ -35,10 +35,29 @@
  * side of a crease instead of screening read 5-10% high at low noise: the choice depends on the
  * neighbours' noise.
  *
+ * 5. Unit (lib/noise_estimate.h): the level is in mean edge lengths of the CLEAN mesh, which noise
+ *    lengthens (E|e'|^2 = |e|^2 + 2 tr Cov per edge). Each sampled vertex's mesh edges are
+ *    measured in its frame: the tangential part as it is, the normal part from the quadric (less
+ *    its own noise, s^2 (a_u - a_0)^T M^-1 (a_u - a_0)): the normal noise drops out. The
+ *    tangential noise (6) is then taken out of the mean square (4 t^2 per edge, t per axis), the
+ *    mean scaled as the root mean square, and the ratio to the same edges' raw mean scales the
+ *    whole mesh's mean edge.
+ * 6. Tangential noise: the umbrella offset of a vertex from its ring's centroid, in the tangent
+ *    plane, over (1 + 1/k): t^2 = median / (2 ln 2) (a chi-square of 2 degrees). A clean mesh's own
+ *    irregularity reads 0.03-0.15 edges here (a floor, not subtracted).
+ * 7. Level: the rms of the screened standardised residuals within TRIM robust sigmas (the median
+ *    alone reads random-direction noise's normal part 33% low: g cos(theta) is heavy-tailed).
+ * 8. Impulsive: a tail beyond 4 robust sigmas over 1% of the screened samples and a tangential
+ *    level below half the displaced vertices' (which random-direction noise has); the level and the
+ *    share displaced from a two-normal mixture fitted by EM (impulsive_mixture).
+ * No constant was fitted in 5-8 (TRIM 5, MIX_SCREEN 2, IMPULSIVE_TANGENTIAL 0.5 chosen, not
+ * fitted); scripts/noise_accuracy.py measures the table (docs/results/noise_accuracy.json).
+ *
  * Exact duplicate positions are welded first (a triangle soup's corners), so a vertex's copies are
  * not its neighbours. Up to MAX_SAMPLES vertices are used, at a fixed stride; each sample depends on
  * the positions alone and the medians on the samples alone, so the result is the same on every
  * run and for any thread count. */
+#include "noise_estimate.h"
 #include "spatial.h"
 
 #include <math.h>
@@ -195,11 +214,17 @@ static int compare_keyed(const void *pa, const void *pb) {
     return (a->v > b->v) - (a->v < b->v);
 }
 
+static void free_points(point_set *points) {
+    rs_free(points->xyz);
+    rs_free(points->normal);
+    memset(points, 0, sizeof *points);
+}
+
 /* The vertices some non-degenerate triangle uses, exact duplicates merged (their area-weighted
  * normals summed; copies whose normals cancel, both sides of a sheet, are dropped). false when out
  * of memory. */
 static bool build_points(const double *xyz, size_t vertex_count, const uint32_t *indices,
-                         size_t triangle_count, point_set *out) {
+                         size_t triangle_count, point_set *out, uint32_t *point_of) {
     memset(out, 0, sizeof *out);
     double *normal = rs_calloc_array(vertex_count, 3 * sizeof *normal);
     keyed_vertex *order = rs_alloc_array(vertex_count, sizeof *order);
@@ -225,6 +250,8 @@ static bool build_points(const double *xyz, size_t vertex_count, const uint32_t 
     }
     size_t used = 0;
     for (size_t v = 0; v < vertex_count; v++)
+        point_of[v] = UINT32_MAX;
+    for (size_t v = 0; v < vertex_count; v++)
         if (rs_dot3(normal + 3 * v, normal + 3 * v) > 0) {
             memcpy(order[used].p, xyz + 3 * v, sizeof order[used].p);
             order[used++].v = (uint32_t)v;
@@ -241,13 +268,23 @@ static bool build_points(const double *xyz, size_t vertex_count, const uint32_t 
         }
         for (int k = 0; k < 3; k++)
             out->normal[3 * (count - 1) + k] += n[k];
+        point_of[order[i].v] = (uint32_t)(count - 1);
     }
     size_t kept = 0;
+    rs_free(order);
+    uint32_t *renumber = rs_alloc_array(count ? count : 1, sizeof *renumber);
+    if (!renumber) {
+        rs_free(normal);
+        free_points(out);
+        return false;
+    }
     for (size_t i = 0; i < count; i++) {
         const double *n = out->normal + 3 * i;
         double len = sqrt(rs_dot3(n, n));
+        renumber[i] = UINT32_MAX;
         if (!(len > 0))
             continue;
+        renumber[i] = (uint32_t)kept;
         for (int k = 0; k < 3; k++) {
             out->xyz[3 * kept + k] = out->xyz[3 * i + k];
             out->normal[3 * kept + k] = n[k] / len;
@@ -255,15 +292,12 @@ static bool build_points(const double *xyz, size_t vertex_count, const uint32_t 
         kept++;
     }
     out->count = kept;
+    for (size_t v = 0; v < vertex_count; v++)
+        if (point_of[v] != UINT32_MAX)
+            point_of[v] = renumber[point_of[v]];
     rs_free(normal);
-    rs_free(order);
+    rs_free(renumber);
     return true;
-}
-
-static void free_points(point_set *points) {
-    rs_free(points->xyz);
-    rs_free(points->normal);
-    memset(points, 0, sizeof *points);
 }
 
 /* Reorders the points as the grid's facet_order lists them (by cell), so that a cell's points are
@@ -287,11 +321,77 @@ static bool sort_points(point_set *points, const uint32_t *order) {
     return true;
 }
 
+/* The mesh's edges between points, both ways, as lists per point (start has count + 1 entries),
+ * duplicates removed; false when out of memory. point_of maps vertices to points (UINT32_MAX: none). */
+static bool build_rings(const uint32_t *indices, size_t triangle_count, const uint32_t *point_of,
+                        size_t count, uint32_t **start_out, uint32_t **ring_out) {
+    uint32_t *start = rs_calloc_array(count + 1, sizeof *start);
+    uint32_t *ring = rs_alloc_array(triangle_count ? 6 * triangle_count : 1, sizeof *ring);
+    if (!start || !ring) {
+        rs_free(start);
+        rs_free(ring);
+        return false;
+    }
+    for (int pass = 0; pass < 2; pass++) {
+        for (size_t t = 0; t < triangle_count; t++)
+            for (int e = 0; e < 3; e++) {
+                uint32_t a = point_of[indices[3 * t + e]], b = point_of[indices[3 * t + (e + 1) % 3]];
+                if (a == UINT32_MAX || b == UINT32_MAX || a == b)
+                    continue;
+                if (pass == 0) {
+                    start[a + 1]++;
+                    start[b + 1]++;
+                } else {
+                    ring[start[a]++] = b;
+                    ring[start[b]++] = a;
+                }
+            }
+        if (pass == 0)
+            for (size_t i = 0; i < count; i++)
+                start[i + 1] += start[i];
+        else {
+            for (size_t i = count; i > 0; i--)
+                start[i] = start[i - 1];
+            start[0] = 0;
+        }
+    }
+    /* duplicates out (each edge comes once per triangle that has it), compacting in place */
+    uint32_t kept = 0;
+    for (size_t i = 0; i < count; i++) {
+        uint32_t begin = start[i], end = start[i + 1];
+        start[i] = kept;
+        for (uint32_t j = begin; j < end; j++) {
+            bool seen = false;
+            for (uint32_t k = start[i]; k < kept && !seen; k++)
+                seen = ring[k] == ring[j];
+            if (!seen)
+                ring[kept++] = ring[j];
+        }
+    }
+    start[count] = kept;
+    *start_out = start;
+    *ring_out = ring;
+    return true;
+}
+
 /* ---- per-sample residuals -------------------------------------------------------------------- */
+
+/* What a sample's mesh edges say about the clean mesh's edge lengths and the tangential noise
+ * (header comment, 5 and 6). */
+typedef struct edge_sums {
+    double raw;       /* sum of the edges' lengths as they are */
+    double raw2;      /* ... of their squares */
+    double clean;     /* sum of the lengths with the normal noise taken out */
+    double clean2;    /* ... of their squares */
+    double umbrella;  /* |tangential offset from the ring's centroid|^2 / (1 + 1/k); NAN: none */
+    uint32_t edges;
+} edge_sums;
 
 typedef struct sample_job {
     const point_set *points;
     const rs_grid *grid;
+    const uint32_t *ring_start, *ring; /* the mesh's edges, per point */
+    edge_sums *edges;     /* per sample */
     double unit;          /* mean edge length */
     size_t sample_count;
     double *residual;     /* per sample: standardised |residual|, mesh units, or NAN (no fit) */
@@ -385,7 +485,7 @@ static bool ball_frame(const double *d, size_t n, const double centre[3], double
 /* The standardised |residual| of point v and its fit's residual variance (mesh units); false when
  * no fit is possible (too few neighbours). *failed when out of memory. */
 static bool sample_residual(const sample_job *job, size_t v, workspace *w, bool *failed,
-                            double *residual, double *variance) {
+                            double *residual, double *variance, edge_sums *es) {
     const double unit = job->unit, radius = RADIUS * unit, slab = SLAB * unit;
     size_t n = gather(job, v, hypot(radius, slab) + MARGIN * unit, w);
     if (n == SIZE_MAX) {
@@ -445,6 +545,34 @@ static bool sample_residual(const sample_job *job, size_t v, workspace *w, bool 
     double factor = 1 + inverse_diagonal(l, inv, 0);
     *residual = fabs(beta[0]) / sqrt((1 + g2) * factor);
     *variance = s2;
+    /* the mesh edges at v: in the frame, their tangential part as it is and their normal part from
+     * the fit (less the fit's own noise, s2 (a_u - a_0)^T M^-1 (a_u - a_0)) */
+    const double *p = job->points->xyz + 3 * v;
+    double cx = 0, cy = 0;
+    for (uint32_t j = job->ring_start[v]; j < job->ring_start[v + 1]; j++) {
+        double d[3];
+        rs_sub3(job->points->xyz + 3 * (size_t)job->ring[j], p, d);
+        double x = rs_dot3(d, t1), yt = rs_dot3(d, t2), len2 = rs_dot3(d, d);
+        double xe = x / unit, ye = yt / unit;
+        const double a[TERMS] = {0, xe, ye, xe * xe, xe * ye, ye * ye};
+        double dz = 0, ya[TERMS], q = 0;
+        for (int r = 1; r < TERMS; r++)
+            dz += beta[r] * a[r];
+        forward6(l, inv, a, 1, ya);
+        for (int r = 1; r < TERMS; r++)
+            q += ya[r] * ya[r];
+        double clean2 = x * x + yt * yt + dz * dz - s2 * q;
+        es->raw += sqrt(len2);
+        es->raw2 += len2;
+        es->clean += sqrt(clean2 > 0 ? clean2 : 0);
+        es->clean2 += clean2;
+        es->edges++;
+        cx += x;
+        cy += yt;
+    }
+    uint32_t k = es->edges;
+    es->umbrella = k >= 3 ? (cx * cx + cy * cy) / ((double)k * (double)k) / (1 + 1 / (double)k)
+                          : NAN;
     return true;
 }
 
@@ -457,7 +585,9 @@ static void sample_range(void *ctx, size_t begin, size_t end, size_t chunk) {
         /* a fixed stride over the points in cell order (all of them when there are few enough) */
         size_t v = (size_t)((double)s * (double)count / (double)job->sample_count);
         v = v < count ? v : count - 1;
-        if (!sample_residual(job, v, &w, &failed, &job->residual[s], &job->variance[s]))
+        memset(&job->edges[s], 0, sizeof job->edges[s]);
+        if (!sample_residual(job, v, &w, &failed, &job->residual[s], &job->variance[s],
+                             &job->edges[s]))
             job->residual[s] = job->variance[s] = NAN;
     }
     job->failed[chunk] = failed;
@@ -505,6 +635,7 @@ static double robust_sigma(const double *residual, const double *variance, size_
  * Impulsive 0.03, a sphere with half its vertices moved 0.08). */
 #define TAIL_SIGMAS 4.0
 #define IMPULSIVE_TAIL 0.01
+#define IMPULSIVE_TANGENTIAL 0.5
 
 static double tail_share(const double *residual, const double *variance, size_t n,
                          double sigma) {
@@ -515,6 +646,145 @@ static double tail_share(const double *residual, const double *variance, size_t 
             far += fabs(residual[s]) > TAIL_SIGMAS * sigma;
         }
     return kept ? (double)far / (double)kept : 0;
+}
+
+/* The rms of the screened residuals within TRIM robust sigmas: the standard deviation itself, not
+ * a Gaussian's from its median (noise whose normal component is not Gaussian, as a random
+ * direction's, reads right). */
+#define TRIM 5.0
+static double trimmed_rms(const double *residual, const double *variance, size_t n, double sigma) {
+    double sum = 0;
+    size_t kept = 0;
+    for (size_t s = 0; s < n; s++)
+        if (variance[s] <= KAPPA * sigma * sigma && fabs(residual[s]) <= TRIM * sigma) {
+            sum += residual[s] * residual[s];
+            kept++;
+        }
+    return kept ? sqrt(sum / (double)kept) : sigma;
+}
+
+/* Impulsive noise: the screened residuals (fits whose residual variance is at most MIX_SCREEN
+ * times the median: away from edges, with no regard to the sample's own noise) as a mixture of
+ * two zero-mean normals, (1 - w) N(0, a^2) + w N(0, b^2), by EM: the exact vertices, whose residual
+ * is the prediction's error, and the displaced ones. scratch holds n doubles. */
+#define MIX_SCREEN 2.0
+#define MIX_ROUNDS 60
+static void impulsive_mixture(const double *residual, const double *variance, size_t n,
+                              double *scratch, double *w_out, double *a_out, double *b_out) {
+    memcpy(scratch, variance, n * sizeof *scratch);
+    double cut = MIX_SCREEN * median(scratch, n);
+    size_t m = 0;
+    for (size_t s = 0; s < n; s++)
+        if (variance[s] <= cut)
+            scratch[m++] = residual[s] * residual[s];
+    *w_out = 1;
+    *a_out = *b_out = 0;
+    if (m < 20)
+        return;
+    /* start: a from the median, b and w from what lies beyond 3 a */
+    double sum = 0;
+    size_t far = 0;
+    double *sq = scratch + 0; /* squared residuals, m of them */
+    double a2 = 0, b2 = 0, w = 0;
+    {
+        double *tmp = rs_alloc_array(m, sizeof *tmp);
+        if (!tmp)
+            return;
+        memcpy(tmp, sq, m * sizeof *tmp);
+        a2 = median(tmp, m) / 0.45493642311957283; /* chi-square 1: median 0.4549 */
+        rs_free(tmp);
+    }
+    for (size_t s = 0; s < m; s++)
+        if (sq[s] > 9 * a2) {
+            sum += sq[s];
+            far++;
+        }
+    w = far ? (double)far / (double)m : 0.01;
+    b2 = far ? sum / (double)far : 9 * a2;
+    if (!(a2 > 0)) {
+        *w_out = 1;
+        return;
+    }
+    for (int round = 0; round < MIX_ROUNDS; round++) {
+        double sw = 0, sw2 = 0, sa2 = 0;
+        for (size_t s = 0; s < m; s++) {
+            /* responsibilities, with the exponent's difference only (no overflow) */
+            double la = -0.5 * sq[s] / a2 - 0.5 * log(a2) + log(1 - w);
+            double lb = -0.5 * sq[s] / b2 - 0.5 * log(b2) + log(w);
+            double rb = 1 / (1 + exp(la - lb));
+            sw += rb;
+            sw2 += rb * sq[s];
+            sa2 += (1 - rb) * sq[s];
+        }
+        double wn = sw / (double)m;
+        if (!(wn > 1e-6) || !(wn < 1 - 1e-6))
+            break;
+        w = wn;
+        b2 = sw2 / sw;
+        a2 = sa2 / ((double)m - sw);
+        if (!(a2 > 0) || !(b2 > 0))
+            break;
+    }
+    if (b2 < a2) { /* the components are named by size */
+        double t = a2;
+        a2 = b2;
+        b2 = t;
+        w = 1 - w;
+    }
+    *w_out = w;
+    *a_out = sqrt(a2);
+    *b_out = sqrt(b2);
+}
+
+/* The figures from the samples (valid of them, compacted), into out. */
+static void summarise(const sample_job *job, size_t valid, double unit, double scale,
+                      double *scratch, rs_noise_details *out) {
+    double sigma_mad = robust_sigma(job->residual, job->variance, valid, scratch);
+    double sigma = trimmed_rms(job->residual, job->variance, valid, sigma_mad);
+    /* tangential noise: the umbrella offsets' median, a chi-square of 2 degrees (median 2 ln 2) */
+    size_t k = 0;
+    for (size_t s = 0; s < valid; s++)
+        if (!isnan(job->edges[s].umbrella))
+            scratch[k++] = job->edges[s].umbrella;
+    double tangential2 = k ? median(scratch, k) / (2 * 0.6931471805599453) : NAN;
+    /* the clean mesh's mean edge */
+    double raw = 0, clean = 0, clean2 = 0, edges = 0;
+    for (size_t s = 0; s < valid; s++) {
+        raw += job->edges[s].raw;
+        clean += job->edges[s].clean;
+        clean2 += job->edges[s].clean2;
+        edges += job->edges[s].edges;
+    }
+    double ratio = 1;
+    if (edges > 0 && raw > 0) {
+        double m1n = clean / edges, m2n = clean2 / edges;
+        double t2 = isnan(tangential2) ? 0 : tangential2;
+        double m2 = m2n - 4 * t2;
+        /* the tangential noise out of the mean square; the mean from it as the noisy edges'
+         * mean is from their mean square */
+        double m1 = m2n > 0 && m2 > 0 ? m1n * sqrt(m2 / m2n) : m1n;
+        ratio = m1 / (raw / edges);
+        if (!(ratio > 0.05) || !(ratio <= 1.5))
+            ratio = ratio > 1.5 ? 1.5 : 0.05; /* not a mesh of edges with noise: bounded */
+    }
+    double clean_unit = unit * ratio;
+    out->mean_edge_clean = clean_unit / scale;
+    out->level = sigma / clean_unit;
+    out->overall_level = sigma / clean_unit;
+    out->tangential_level = isnan(tangential2) ? NAN : sqrt(tangential2) / clean_unit;
+    out->tail_share = tail_share(job->residual, job->variance, valid, sigma_mad);
+    out->samples = valid;
+    out->mean_edge_noisy = unit / scale;
+    double w, a, b;
+    impulsive_mixture(job->residual, job->variance, valid, scratch, &w, &a, &b);
+    /* impulsive: a heavy tail beyond 4 robust sigmas, and no tangential noise of the displaced
+     * vertices' size (random-direction noise has a heavy tail along the normal too) */
+    out->impulsive = sigma > 0 && out->tail_share > IMPULSIVE_TAIL && b > a &&
+                     !(out->tangential_level >= IMPULSIVE_TANGENTIAL * b / clean_unit);
+    if (out->impulsive) {
+        out->level = sqrt(b * b - a * a) / clean_unit; /* less the prediction's own error */
+        out->impulsive_fraction = w;
+    }
 }
 
 rsmooth_status rsmooth_estimate_noise(rsmooth_scalar scalar, const void *positions,
@@ -536,6 +806,20 @@ rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positi
                                        size_t vertex_count, const uint32_t *indices,
                                        size_t triangle_count, rs_noise_stats *out,
                                        rsmooth_error *error, const char *caller) {
+    rs_noise_details details;
+    rsmooth_status st = rs_estimate_noise_details(scalar, positions, vertex_count, indices,
+                                                  triangle_count, &details, error, caller);
+    if (st == RSMOOTH_OK) {
+        out->noise = details.level;
+        out->impulsive = details.impulsive;
+    }
+    return st;
+}
+
+rsmooth_status rs_estimate_noise_details(rsmooth_scalar scalar, const void *positions,
+                                         size_t vertex_count, const uint32_t *indices,
+                                         size_t triangle_count, rs_noise_details *out,
+                                         rsmooth_error *error, const char *caller) {
     double magnitude = 0, scale = 1;
     rsmooth_status st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices,
                                              triangle_count, &magnitude, error, caller);
@@ -545,7 +829,8 @@ rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positi
     if (st != RSMOOTH_OK)
         return st;
     memset(out, 0, sizeof *out);
-    double *out_noise = &out->noise;
+    out->impulsive_fraction = 1;
+    out->tangential_level = NAN;
     double *xyz = rs_alloc_array(vertex_count, 3 * sizeof *xyz);
     if (!xyz)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, caller, "no memory for positions");
@@ -560,22 +845,40 @@ rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positi
         return RSMOOTH_OK;
     }
     point_set pts;
-    bool ok = build_points(xyz, vertex_count, indices, triangle_count, &pts);
+    uint32_t *point_of = rs_alloc_array(vertex_count, sizeof *point_of);
+    bool ok = point_of && build_points(xyz, vertex_count, indices, triangle_count, &pts, point_of);
     rs_free(xyz);
-    if (!ok)
+    if (!ok) {
+        rs_free(point_of);
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, caller,
                        "no memory for %zu vertex normals", vertex_count);
+    }
     if (pts.count <= MIN_POINTS) { /* too few vertices for any fit: nothing measurable */
+        rs_free(point_of);
         free_points(&pts);
+        out->mean_edge_noisy = out->mean_edge_clean = unit / scale;
         return RSMOOTH_OK;
     }
     rs_grid grid;
     st = rs_grid_build(&grid, pts.xyz, pts.count, (hypot(RADIUS, SLAB) + MARGIN) * unit, error);
     if (st != RSMOOTH_OK) {
+        rs_free(point_of);
         free_points(&pts);
         return st;
     }
-    if (!sort_points(&pts, grid.facet_order)) {
+    uint32_t *ring_start = NULL, *ring = NULL, *sorted_of = rs_alloc_array(pts.count, sizeof *sorted_of);
+    ok = sorted_of && sort_points(&pts, grid.facet_order);
+    if (ok) { /* the vertices' points in the sorted order, then the rings */
+        for (size_t i = 0; i < pts.count; i++)
+            sorted_of[grid.facet_order[i]] = (uint32_t)i;
+        for (size_t v = 0; v < vertex_count; v++)
+            if (point_of[v] != UINT32_MAX)
+                point_of[v] = sorted_of[point_of[v]];
+        ok = build_rings(indices, triangle_count, point_of, pts.count, &ring_start, &ring);
+    }
+    rs_free(sorted_of);
+    rs_free(point_of);
+    if (!ok) {
         rs_grid_free(&grid);
         free_points(&pts);
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, caller, "no memory for %zu points",
@@ -585,12 +888,15 @@ rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positi
     memset(&job, 0, sizeof job);
     job.points = &pts;
     job.grid = &grid;
+    job.ring_start = ring_start;
+    job.ring = ring;
     job.unit = unit;
     job.sample_count = pts.count < MAX_SAMPLES ? pts.count : MAX_SAMPLES;
     job.residual = rs_alloc_array(job.sample_count, sizeof *job.residual);
     job.variance = rs_alloc_array(job.sample_count, sizeof *job.variance);
+    job.edges = rs_alloc_array(job.sample_count, sizeof *job.edges);
     double *scratch = rs_alloc_array(job.sample_count, sizeof *scratch);
-    if (!job.residual || !job.variance || !scratch) {
+    if (!job.residual || !job.variance || !job.edges || !scratch) {
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, caller, "no memory for %zu samples",
                      job.sample_count);
     } else {
@@ -605,17 +911,18 @@ rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positi
         for (size_t s = 0; s < job.sample_count; s++)
             if (!isnan(job.residual[s])) {
                 job.residual[valid] = job.residual[s];
-                job.variance[valid++] = job.variance[s];
+                job.variance[valid] = job.variance[s];
+                job.edges[valid++] = job.edges[s];
             }
-        if (valid > 0) {
-            double sigma = robust_sigma(job.residual, job.variance, valid, scratch);
-            *out_noise = sigma / unit;
-            out->impulsive =
-                sigma > 0 && tail_share(job.residual, job.variance, valid, sigma) > IMPULSIVE_TAIL;
-        }
+        out->mean_edge_noisy = out->mean_edge_clean = unit / scale;
+        if (valid > 0)
+            summarise(&job, valid, unit, scale, scratch, out);
     }
     rs_free(job.residual);
     rs_free(job.variance);
+    rs_free(job.edges);
+    rs_free(ring_start);
+    rs_free(ring);
     rs_free(scratch);
     rs_grid_free(&grid);
     free_points(&pts);

@@ -71,8 +71,8 @@ static double mean_edge(const double *xyz, size_t nv, const uint32_t *tri, size_
 }
 
 /* The true noise of `noisy` against `clean` (same vertices and triangles): the standard deviation
- * of the displacement along the clean mesh's vertex normals, in mean edge lengths of the noisy
- * mesh (the unit the estimate is in). */
+ * of the displacement along the clean mesh's vertex normals, in mean edge lengths of the clean
+ * mesh (the unit the estimate is in: lib/noise_estimate.h). */
 static double true_noise(const shape_mesh *clean, const double *noisy) {
     size_t nv = clean->vertex_count;
     double *normal = malloc(3 * nv * sizeof *normal);
@@ -93,7 +93,7 @@ static double true_noise(const shape_mesh *clean, const double *noisy) {
     CHECK(n > 1);
     double mean = sum / (double)n, var = (sum2 - (double)n * mean * mean) / (double)(n - 1);
     return sqrt(var > 0 ? var : 0) /
-           mean_edge(noisy, nv, clean->indices, clean->triangle_count);
+           mean_edge(clean->xyz, nv, clean->indices, clean->triangle_count);
 }
 
 /* Noise of `sigma` (mean edge lengths of the clean shape) along the normals: the estimate against
@@ -172,6 +172,41 @@ static void generated_shapes(void) {
         }
     free(xyz);
     for (int s = 0; s < 4; s++)
+        shape_free(&shapes[s]);
+}
+
+/* Gaussian noise in random directions (rsmooth noise --direction random): the estimate reads its
+ * normal component (sigma / sqrt 3 in expectation), in the clean mesh's mean edge lengths, and the
+ * noise is not taken for impulsive (its normal component's tail is heavier than a Gaussian's). */
+#define RANDOM_TOLERANCE 0.12 /* reads 0.90-1.00 of the truth here */
+static void random_directions(void) {
+    shape_mesh shapes[3];
+    const char *names[3] = {"sphere", "cube", "cylinder"};
+    CHECK_EQ_INT(shape_sphere(&shapes[0], 5, 1.0), 0);
+    CHECK_EQ_INT(shape_cube(&shapes[1], 40, 1.0), 0);
+    CHECK_EQ_INT(shape_capped_cylinder(&shapes[2], 1.0, 2.0, 20000), 0);
+    const double levels[] = {0.2, 0.5, 0.7};
+    double worst = 0;
+    for (int s = 0; s < 3; s++) {
+        size_t nv = shapes[s].vertex_count, nt = shapes[s].triangle_count;
+        for (size_t l = 0; l < sizeof levels / sizeof *levels; l++) {
+            double *noisy = malloc(3 * nv * sizeof *noisy);
+            CHECK(noisy);
+            memcpy(noisy, shapes[s].xyz, 3 * nv * sizeof *noisy);
+            mesh_noise_options o = {levels[l], MESH_NOISE_RANDOM, 0, 300 + l};
+            CHECK_EQ_INT(mesh_add_noise(noisy, nv, shapes[s].indices, nt, &o), 0);
+            double truth = true_noise(&shapes[s], noisy), est = estimate(noisy, nv, shapes[s].indices, nt);
+            printf("%-9s random directions %.1f: truth (normal part) %.4f  estimate %.4f  ratio "
+                   "%.3f\n", names[s], levels[l], truth, est, est / truth);
+            CHECK_NEAR(est / truth, 1, RANDOM_TOLERANCE);
+            worst = fmax(worst, fabs(est / truth - 1));
+            check_auto(names[s], noisy, nv, shapes[s].indices, nt, false);
+            free(noisy);
+        }
+    }
+    printf("random directions: worst |estimate / truth - 1| = %.3f (tolerance %.2f)\n", worst,
+           RANDOM_TOLERANCE);
+    for (int s = 0; s < 3; s++)
         shape_free(&shapes[s]);
 }
 
@@ -314,6 +349,7 @@ int main(void) {
     check_edge_cases();
     check_invariance();
     generated_shapes();
+    random_directions();
     check_sampled();
     benchmark_meshes();
     return 0;
