@@ -435,7 +435,9 @@ def main():
         want = args.only.split(",")
         cases = [c for c in cases if c["name"] in want]
     first = args.first_sources.split(",")
-    cases.sort(key=lambda c: 0 if c.get("source") in first else 1)
+    # the named sources first, then the rest, smaller meshes first
+    cases.sort(key=lambda c: (0 if c.get("source") in first else 1,
+                              0 if c.get("source") in first else os.path.getsize(c["noisy"])))
 
     ctx = Ctx(args)
     res = {"grids": {}, "cases": {}}
