@@ -23,7 +23,8 @@ enum {
     OPT_SIGMA_G, OPT_CUTOFF, OPT_NORMALS, OPT_INFLUENCE, OPT_NORMAL_SIGMA_S, OPT_NORMAL_SIGMA_N,
     OPT_PASS_CONFIDENCE, OPT_SIGMA_C, OPT_NORMAL_ITERATIONS, OPT_PASSES, OPT_AUTO, OPT_BEST,
     OPT_ABSOLUTE, OPT_NO_MOLLIFY, OPT_ASCII, OPT_JSON, OPT_STATS, OPT_LIST_DEVICES, OPT_FORCE,
-    OPT_QUIET, OPT_MASK
+    OPT_QUIET, OPT_MASK, OPT_VERTEX_UPDATES, OPT_GUIDED_SIGMA_S, OPT_GUIDED_SIGMA_N,
+    OPT_GUIDED_ROUNDS
 };
 
 static const cli_option table[] = {
@@ -52,6 +53,10 @@ static const cli_option table[] = {
     {"mask", 0, true, OPT_MASK},
     {"normal-iterations", 0, true, OPT_NORMAL_ITERATIONS},
     {"passes", 0, true, OPT_PASSES},
+    {"vertex-updates", 0, true, OPT_VERTEX_UPDATES},
+    {"guided-sigma-s", 0, true, OPT_GUIDED_SIGMA_S},
+    {"guided-sigma-n", 0, true, OPT_GUIDED_SIGMA_N},
+    {"guided-rounds", 0, true, OPT_GUIDED_ROUNDS},
     {"auto", 0, false, OPT_AUTO},
     {"best", 0, false, OPT_BEST},
     {"absolute", 0, false, OPT_ABSOLUTE},
@@ -169,14 +174,34 @@ static int apply(options *opt, int id, const char *name, const char *value) {
         opt->params.sigma_c = x;
         opt->colors = true;
         break;
-    case OPT_NORMAL_ITERATIONS: case OPT_PASSES:
-        if (!number || !(x >= 1 && x <= 100 && x == floor(x)))
-            return cli_usage_error(NULL, "%s must be a whole number in [1, 100] (got '%s')", name,
-                                   value);
+    case OPT_NORMAL_ITERATIONS: case OPT_PASSES: /* passes 0: --vertex-updates alone */
+        if (!number || !(x >= (id == OPT_PASSES ? 0 : 1) && x <= 100 && x == floor(x)))
+            return cli_usage_error(NULL, "%s must be a whole number in [%d, 100] (got '%s')",
+                                   name, id == OPT_PASSES ? 0 : 1, value);
         if (id == OPT_PASSES)
             opt->params.passes = (int)x, opt->given |= GIVEN_PASSES;
         else
             opt->params.normal_iterations = (int)x, opt->given |= GIVEN_NORMAL_ITERATIONS;
+        break;
+    case OPT_VERTEX_UPDATES: case OPT_GUIDED_ROUNDS:
+        if (!number || !(x >= (id == OPT_VERTEX_UPDATES ? 0 : 1) &&
+                         x <= (id == OPT_VERTEX_UPDATES ? 1000 : 100) && x == floor(x)))
+            return cli_usage_error(NULL, "%s must be a whole number in [%d, %d] (got '%s')", name,
+                                   id == OPT_VERTEX_UPDATES ? 0 : 1,
+                                   id == OPT_VERTEX_UPDATES ? 1000 : 100, value);
+        if (id == OPT_VERTEX_UPDATES)
+            opt->params.vertex_updates = (int)x, opt->given |= GIVEN_VERTEX_UPDATES;
+        else
+            opt->params.guided_rounds = (int)x, opt->given |= GIVEN_GUIDED_ROUNDS;
+        break;
+    case OPT_GUIDED_SIGMA_S: case OPT_GUIDED_SIGMA_N:
+        if (!number || !(x > 0 && isfinite(x)) || (id == OPT_GUIDED_SIGMA_N && !(x <= 2)))
+            return cli_usage_error(NULL, "%s must be a positive number%s (got '%s')", name,
+                                   id == OPT_GUIDED_SIGMA_N ? " in (0, 2]" : "", value);
+        if (id == OPT_GUIDED_SIGMA_S)
+            opt->params.guided_sigma_s = x, opt->given |= GIVEN_GUIDED_SIGMA_S;
+        else
+            opt->params.guided_sigma_n = x, opt->given |= GIVEN_GUIDED_SIGMA_N;
         break;
     case OPT_AUTO: opt->auto_params = true; break;
     case OPT_BEST: break; /* applied before the others, so the options after it can change it */

@@ -33,7 +33,11 @@ enum {
     GIVEN_NORMAL_SIGMA_N = 1u << 3,
     GIVEN_NORMAL_ITERATIONS = 1u << 4,
     GIVEN_PASSES = 1u << 5,
-    GIVEN_INFLUENCE = 1u << 6
+    GIVEN_INFLUENCE = 1u << 6,
+    GIVEN_VERTEX_UPDATES = 1u << 7,
+    GIVEN_GUIDED_SIGMA_S = 1u << 8,
+    GIVEN_GUIDED_SIGMA_N = 1u << 9,
+    GIVEN_GUIDED_ROUNDS = 1u << 10
 };
 
 typedef struct options {

@@ -288,6 +288,14 @@ static int choose_params(options *opt, const rsmooth_mesh *mesh, bool points) {
         chosen.passes = given->passes;
     if (opt->given & GIVEN_INFLUENCE)
         chosen.influence = given->influence;
+    if (opt->given & GIVEN_VERTEX_UPDATES)
+        chosen.vertex_updates = given->vertex_updates;
+    if (opt->given & GIVEN_GUIDED_SIGMA_S)
+        chosen.guided_sigma_s = given->guided_sigma_s;
+    if (opt->given & GIVEN_GUIDED_SIGMA_N)
+        chosen.guided_sigma_n = given->guided_sigma_n;
+    if (opt->given & GIVEN_GUIDED_ROUNDS)
+        chosen.guided_rounds = given->guided_rounds;
     if (opt->given & (GIVEN_SIGMA_F | GIVEN_SIGMA_G))
         chosen.absolute = given->absolute;
     opt->params = chosen;

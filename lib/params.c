@@ -31,6 +31,10 @@ rsmooth_status rsmooth_params_init(rsmooth_params *params) {
     params->colors = NULL;
     params->sigma_c = 0.1;
     params->progress_cancel = NULL;
+    params->vertex_updates = 0;
+    params->guided_sigma_s = 1.5;
+    params->guided_sigma_n = 0.35;
+    params->guided_rounds = 5;
     return RSMOOTH_OK;
 }
 
@@ -101,9 +105,25 @@ rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *o
     if (out->influence < RSMOOTH_INFLUENCE_GAUSSIAN || out->influence > RSMOOTH_INFLUENCE_HUBER)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "influence must be an rsmooth_influence, 0 to 3 (got %d)", out->influence);
-    if (out->passes < 1 || out->passes > RS_MAX_ROUNDS)
+    if (out->vertex_updates < 0 || out->vertex_updates > RS_MAX_UPDATES)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "passes must be in [1, %d] (got %d)", RS_MAX_ROUNDS, out->passes);
+                       "vertex_updates must be in [0, %d] (got %d)", RS_MAX_UPDATES,
+                       out->vertex_updates);
+    if (out->passes < (out->vertex_updates > 0 ? 0 : 1) || out->passes > RS_MAX_ROUNDS)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "passes must be in [%d, %d] (got %d)%s", out->vertex_updates > 0 ? 0 : 1,
+                       RS_MAX_ROUNDS, out->passes,
+                       out->vertex_updates > 0 ? "" : "; 0 needs vertex_updates > 0");
+    if (!(out->guided_sigma_s > 0) || !isfinite(out->guided_sigma_s))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "guided_sigma_s must be positive and finite (got %g)", out->guided_sigma_s);
+    if (!(out->guided_sigma_n > 0) || !(out->guided_sigma_n <= 2))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "guided_sigma_n must be in (0, 2] (got %g)", out->guided_sigma_n);
+    if (out->guided_rounds < 1 || out->guided_rounds > RS_MAX_ROUNDS)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "guided_rounds must be in [1, %d] (got %d)", RS_MAX_ROUNDS,
+                       out->guided_rounds);
     if (!(out->pass_confidence >= 0) || !(out->pass_confidence <= 1))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "pass_confidence must be in [0, 1] (got %g)", out->pass_confidence);

@@ -2,9 +2,10 @@
  * output, optionally only where the previous pass had low confidence. Each pass recomputes facet
  * data, normals and the grid from the previous positions; the sigmas stay those the input's mean
  * edge length gave, so later passes do not shrink their reach as the mesh smooths. */
-#include "rsmooth_internal.h"
+#include "normal_update.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 int rs_report_pass_progress(void *user, double fraction) {
@@ -50,6 +51,91 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                                     const rsmooth_params *params, void *out_positions,
                                     float *out_weight, float *out_confidence,
                                     rsmooth_report *report, rsmooth_error *error,
+                                    const char *where, const uint8_t **move_mask);
+
+/* The normal update stage (normal_update.h) on a double copy of the input, then the passes from
+ * its result, in the caller's scalar type (params resolved and outputs checked). */
+static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar scalar,
+                                    const void *positions, size_t vertex_count,
+                                    const uint32_t *indices, size_t triangle_count,
+                                    const rsmooth_params *resolved, void *out_positions,
+                                    float *out_weight, float *out_confidence,
+                                    rsmooth_report *report, rsmooth_error *error,
+                                    const char *where) {
+    double t_start = rs_now_ms();
+    rsmooth_status st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices,
+                                             triangle_count, NULL, error, where);
+    double unit = 0;
+    if (st == RSMOOTH_OK)
+        st = rsmooth_mean_edge_length(scalar, positions, vertex_count, indices, triangle_count,
+                                      &unit, error);
+    if (st != RSMOOTH_OK)
+        return st;
+    rsmooth_params p = *resolved;
+    if (!p.absolute) { /* the input's unit for the stage and every pass after it */
+        p.sigma_f *= unit;
+        p.sigma_g *= unit;
+        p.normal_sigma_s *= unit;
+        p.guided_sigma_s *= unit;
+        p.absolute = 1;
+    }
+    double *staged = rs_alloc_array(vertex_count ? vertex_count : 1, 3 * sizeof(double));
+    if (!staged)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where,
+                       "no memory for the normal update stage");
+    for (size_t i = 0; i < 3 * vertex_count; i++)
+        staged[i] = rs_coordinate(scalar, positions, i);
+    if (unit > 0) /* no edge: nothing to filter */
+        st = rs_normal_update_stage(staged, vertex_count, indices, triangle_count,
+                                    p.guided_sigma_s, p.guided_sigma_n, p.guided_rounds,
+                                    p.vertex_updates, p.move_mask, error, where);
+    double t_stage = rs_now_ms();
+    if (st == RSMOOTH_OK && p.passes == 0) { /* the stage alone */
+        for (size_t v = 0; v < vertex_count; v++) {
+            rs_store_position(scalar, out_positions, v, staged + 3 * v, 1);
+            if (out_weight)
+                out_weight[v] = 0;
+            if (out_confidence)
+                out_confidence[v] = 1;
+        }
+        if (report) {
+            rsmooth_report_init(report);
+            report->vertex_count = vertex_count;
+            report->triangle_count = triangle_count;
+            report->mean_edge_length = unit;
+            snprintf(report->device, sizeof report->device, "host (double, %zu threads)",
+                     rs_host_threads());
+        }
+    } else if (st == RSMOOTH_OK) {
+        /* the passes read the stage's result in the caller's type (a float32 caller's outputs
+         * are float32 anyway) */
+        void *from = staged;
+        if (scalar == RSMOOTH_FLOAT32) {
+            float *f = (float *)staged; /* narrowing in place: element i never overtakes 3v+k */
+            for (size_t i = 0; i < 3 * vertex_count; i++)
+                f[i] = (float)staged[i];
+            from = f;
+        }
+        p.vertex_updates = 0;
+        const uint8_t *unused_mask;
+        st = filter_passes(one_pass, ctx, scalar, from, vertex_count, indices, triangle_count, &p,
+                           out_positions, out_weight, out_confidence, report, error, where,
+                           &unused_mask);
+    }
+    if (st == RSMOOTH_OK && report) {
+        report->ms_normals += t_stage - t_start; /* the stage counts as normal filtering */
+        report->ms_total = rs_now_ms() - t_start;
+    }
+    rs_free(staged);
+    return st;
+}
+
+static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar scalar,
+                                    const void *positions, size_t vertex_count,
+                                    const uint32_t *indices, size_t triangle_count,
+                                    const rsmooth_params *params, void *out_positions,
+                                    float *out_weight, float *out_confidence,
+                                    rsmooth_report *report, rsmooth_error *error,
                                     const char *where, const uint8_t **move_mask) {
     double t_start = rs_now_ms();
     rs_error_clear(error);
@@ -61,6 +147,10 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                               out_positions, out_weight, out_confidence, error, where);
     if (st != RSMOOTH_OK)
         return st;
+    if (p.vertex_updates > 0)
+        return staged_passes(one_pass, ctx, scalar, positions, vertex_count, indices,
+                             triangle_count, &p, out_positions, out_weight, out_confidence,
+                             report, error, where);
     if (p.passes == 1) /* the paper's single pass, exactly as it was */
         return one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, params,
                         out_positions, out_weight, out_confidence, report, error);

@@ -82,6 +82,8 @@ bool rs_radix_sort_u64(uint64_t *keys, uint32_t *values, size_t count);
 
 /* Most bilateral rounds and filter passes one call may ask for. */
 #define RS_MAX_ROUNDS 100
+/* Most normal-stage vertex updates one call may ask for. */
+#define RS_MAX_UPDATES 1000
 
 /* Copies the caller's params (NULL: defaults) into `out`, filling fields newer than the caller's
  * struct_size with defaults, and checks every value. */

@@ -206,7 +206,8 @@ typedef struct rsmooth_params {
                                    * RSMOOTH_INFLUENCE_GAUSSIAN (the paper's) */
     int passes;                   /* the whole filter this many times, [1, 100], each pass from the
                                    * previous pass's positions (sigmas stay those of the input).
-                                   * Default 1 */
+                                   * Default 1. 0 only with vertex_updates > 0: the normal update
+                                   * stage alone (then weights are 0 and confidences 1) */
     double pass_confidence;       /* 0 (default): every pass moves every vertex. In (0, 1]: passes
                                    * after the first move only the vertices whose confidence in the
                                    * previous pass was below this (low confidence: features and
@@ -236,6 +237,19 @@ typedef struct rsmooth_params {
                                    * input position bit for bit in every pass, while its triangles
                                    * still support the others (smoothing a selection). Its weight
                                    * and confidence are still computed. Borrowed. (Added in 0.5) */
+    /* The normal update stage (added in 0.6; off by default, so older callers and the paper's
+     * filter are unchanged). With vertex_updates > 0, before the passes: the facet normals are
+     * filtered by guided normal filtering (Zhang et al. 2015: a joint bilateral filter whose range
+     * weight compares the mean normals of each facet's most consistent nearby patch, so creases
+     * survive heavy noise), guided_rounds times, and then the vertices are moved to agree with
+     * those normals by Sun et al. 2007's iterative update, vertex_updates times. The passes then
+     * start from the updated positions. Runs on the host's cores, in double precision. */
+    int vertex_updates;           /* 0 (default): no stage. [1, 1000]: update iterations */
+    double guided_sigma_s;        /* spatial width of the guided filter, in the units of sigma_f.
+                                   * > 0. Default 1.5 */
+    double guided_sigma_n;        /* width on the difference of guidance normals, (0, 2].
+                                   * Default 0.35 */
+    int guided_rounds;            /* guided filter rounds, [1, 100]. Default 5 */
 } rsmooth_params;
 
 /* Fills `params` with the defaults above. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if params is NULL. */
