@@ -37,7 +37,8 @@ enum {
     GIVEN_VERTEX_UPDATES = 1u << 7,
     GIVEN_GUIDED_SIGMA_S = 1u << 8,
     GIVEN_GUIDED_SIGMA_N = 1u << 9,
-    GIVEN_GUIDED_ROUNDS = 1u << 10
+    GIVEN_GUIDED_ROUNDS = 1u << 10,
+    GIVEN_STAGE_REPEATS = 1u << 11
 };
 
 typedef struct options {

@@ -266,9 +266,11 @@ static int choose_params(options *opt, const rsmooth_mesh *mesh, bool points) {
     }
     rsmooth_params chosen = opt->params;
     rsmooth_error err;
-    if (rsmooth_params_auto(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
-                            mesh->triangles, mesh->triangle_count, &chosen, &opt->noise,
-                            &err) != RSMOOTH_OK) {
+    rsmooth_noise_report report;
+    rsmooth_noise_report_init(&report);
+    if (rsmooth_params_auto_report(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
+                                   mesh->triangles, mesh->triangle_count, &chosen, &report,
+                                   &err) != RSMOOTH_OK) {
         fprintf(stderr, "rsmooth: %s: --auto: %s\n", opt->input, err.message);
         return EXIT_USAGE;
     }
@@ -296,14 +298,15 @@ static int choose_params(options *opt, const rsmooth_mesh *mesh, bool points) {
         chosen.guided_sigma_n = given->guided_sigma_n;
     if (opt->given & GIVEN_GUIDED_ROUNDS)
         chosen.guided_rounds = given->guided_rounds;
+    if (opt->given & GIVEN_STAGE_REPEATS)
+        chosen.stage_repeats = given->stage_repeats;
     if (opt->given & (GIVEN_SIGMA_F | GIVEN_SIGMA_G))
         chosen.absolute = given->absolute;
     opt->params = chosen;
+    opt->noise = report.level;
     if (!opt->quiet)
-        fprintf(stderr, "rsmooth: %s: noise estimate %.3g mean edge lengths: sigma_f %.3g, "
-                        "sigma_g %.3g%s\n", opt->input, opt->noise, chosen.sigma_f,
-                chosen.sigma_g,
-                chosen.normal_filter == RSMOOTH_NORMALS_BILATERAL ? " (best mode)" : "");
+        fprintf(stderr, "rsmooth: %s: --auto: %s -> %s (sigma_f %.3g, sigma_g %.3g)\n",
+                opt->input, report.reason, report.preset, chosen.sigma_f, chosen.sigma_g);
     return EXIT_OK;
 }
 
@@ -369,7 +372,7 @@ static int smooth_file(const options *job, const char *path) {
     bool want_confidence = opt.confidence || (opt.stats && !umbrella);
     float *confidence = want_confidence ? malloc(nv * sizeof *confidence) : NULL;
     rsmooth_report report;
-    memset(&report, 0, sizeof report);
+    rsmooth_report_init(&report);
     code = EXIT_OTHER;
     if (!out || (points && !out_normals) || (want_confidence && !confidence)) {
         fprintf(stderr, "rsmooth: %s: out of memory\n", opt.input);
@@ -401,6 +404,12 @@ static int smooth_file(const options *job, const char *path) {
     if (code != EXIT_OK)
         goto cleanup;
 
+    if (!opt.quiet && report.discrepancy_iterations > 0)
+        fprintf(stderr, "rsmooth: %s: --auto: the filter moved the vertices more than 1.1 times "
+                        "the noise it estimated, so it was removing the shape's own detail (a "
+                        "mesh coarse for its curvature): Taubin smoothing, %d iterations, until "
+                        "they moved as far as the noise, instead\n",
+                opt.input, report.discrepancy_iterations);
     if (opt.json)
         cli_print_json(&report, &opt, ms_read, ms_write);
     if (opt.stats)

@@ -32,9 +32,11 @@ rsmooth_status rsmooth_params_init(rsmooth_params *params) {
     params->sigma_c = 0.1;
     params->progress_cancel = NULL;
     params->vertex_updates = 0;
-    params->guided_sigma_s = 1.5;
-    params->guided_sigma_n = 0.35;
-    params->guided_rounds = 5;
+    params->guided_sigma_s = 2.0;
+    params->guided_sigma_n = 0.2;
+    params->guided_rounds = 20;
+    params->discrepancy_level = 0.0;
+    params->stage_repeats = 1;
     return RSMOOTH_OK;
 }
 
@@ -47,7 +49,8 @@ rsmooth_status rsmooth_params_init_best(rsmooth_params *params) {
     params->normal_sigma_s = 1.0;
     params->normal_sigma_n = 0.45;
     params->normal_iterations = 5;
-    params->passes = 3;
+    params->passes = 1;
+    params->vertex_updates = 25; /* the normal update stage first (issue 15) */
     return RSMOOTH_OK;
 }
 
@@ -120,6 +123,14 @@ rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *o
     if (!(out->guided_sigma_n > 0) || !(out->guided_sigma_n <= 2))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "guided_sigma_n must be in (0, 2] (got %g)", out->guided_sigma_n);
+    if (out->stage_repeats < 1 || out->stage_repeats > RS_MAX_ROUNDS)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "stage_repeats must be in [1, %d] (got %d)", RS_MAX_ROUNDS,
+                       out->stage_repeats);
+    if (!(out->discrepancy_level >= 0) || !isfinite(out->discrepancy_level))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "discrepancy_level must be 0 (off) or positive and finite (got %g)",
+                       out->discrepancy_level);
     if (out->guided_rounds < 1 || out->guided_rounds > RS_MAX_ROUNDS)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "guided_rounds must be in [1, %d] (got %d)", RS_MAX_ROUNDS,

@@ -5,6 +5,7 @@
 #include "normal_update.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -85,7 +86,7 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                        "no memory for the normal update stage");
     for (size_t i = 0; i < 3 * vertex_count; i++)
         staged[i] = rs_coordinate(scalar, positions, i);
-    if (unit > 0) /* no edge: nothing to filter */
+    for (int r = 0; unit > 0 && st == RSMOOTH_OK && r < p.stage_repeats; r++) /* no edge: none */
         st = rs_normal_update_stage(staged, vertex_count, indices, triangle_count,
                                     p.guided_sigma_s, p.guided_sigma_n, p.guided_rounds,
                                     p.vertex_updates, p.move_mask, error, where);
@@ -250,6 +251,60 @@ done:
     return st;
 }
 
+/* params.discrepancy_level's guard: when the result moved the vertices more than DISCREPANCY_RATIO
+ * times the noise level (RMS, mean edge lengths of the input), the filter removed the shape's own
+ * detail too; Taubin's smoothing run until the vertices moved as far as the noise replaces it.
+ * The ratio was chosen on the calibration cases leaving whole meshes out (scripts/calibrate.py,
+ * docs/experiments.md section 7): the best mode moves vertices 0.8-1.0 times the noise on meshes
+ * it restores well, and 1.2-1.4 times on coarse organic meshes, where Taubin wins. */
+#define DISCREPANCY_RATIO 1.1
+#define DISCREPANCY_MAX_ITERATIONS 200
+
+static rsmooth_status discrepancy_guard(rsmooth_scalar scalar, const void *positions,
+                                        size_t vertex_count, const uint32_t *indices,
+                                        size_t triangle_count, const rsmooth_params *params,
+                                        void *out_positions, rsmooth_report *report,
+                                        size_t caller_size, rsmooth_error *error,
+                                        const char *where) {
+    rsmooth_params p;
+    if (rs_params_resolve(params, &p, error, where) != RSMOOTH_OK || !(p.discrepancy_level > 0) ||
+        vertex_count == 0)
+        return RSMOOTH_OK; /* (resolved before: cannot fail now) */
+    bool reports = report && caller_size >= offsetof(rsmooth_report, discrepancy_iterations) +
+                                                 sizeof report->discrepancy_iterations;
+    if (reports)
+        report->discrepancy_iterations = 0;
+    double unit = 0, sum = 0;
+    rsmooth_status st = rsmooth_mean_edge_length(scalar, positions, vertex_count, indices,
+                                                 triangle_count, &unit, error);
+    if (st != RSMOOTH_OK || !(unit > 0))
+        return st;
+    for (size_t i = 0; i < 3 * vertex_count; i++) {
+        double d = rs_coordinate(scalar, out_positions, i) - rs_coordinate(scalar, positions, i);
+        sum += d * d;
+    }
+    double move = sqrt(sum / (double)vertex_count) / unit;
+    if (!(move > DISCREPANCY_RATIO * p.discrepancy_level))
+        return RSMOOTH_OK;
+    double *xyz = rs_alloc_array(vertex_count, 3 * sizeof *xyz);
+    if (!xyz)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the guard");
+    for (size_t i = 0; i < 3 * vertex_count; i++)
+        xyz[i] = rs_coordinate(scalar, positions, i);
+    int iterations = rs_taubin_until(xyz, vertex_count, indices, triangle_count, 0.5, -0.53,
+                                     p.discrepancy_level * unit, DISCREPANCY_MAX_ITERATIONS);
+    if (iterations > 0) { /* 0: no edge moves anything (a soup): keep the filter's result */
+        for (size_t v = 0; v < vertex_count; v++)
+            rs_store_position(scalar, out_positions, v, xyz + 3 * v, 1);
+        if (reports)
+            report->discrepancy_iterations = iterations;
+    }
+    rs_free(xyz);
+    return iterations < 0 ? rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where,
+                                    "no memory for the guard")
+                          : RSMOOTH_OK;
+}
+
 /* The passes, then the last check of what they wrote (results.c): never a non-finite OK. */
 rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar scalar,
                                 const void *positions, size_t vertex_count,
@@ -264,6 +319,10 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar
                                       out_confidence, report, error, where, &move_mask);
     if (report)
         report->struct_size = caller_size;
+    if (st != RSMOOTH_OK)
+        return st;
+    st = discrepancy_guard(scalar, positions, vertex_count, indices, triangle_count, params,
+                           out_positions, report, caller_size, error, where);
     if (st != RSMOOTH_OK)
         return st;
     /* every pass held them still; their final bytes are the input's own */

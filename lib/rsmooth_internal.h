@@ -347,6 +347,15 @@ rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positi
                                        size_t triangle_count, rs_noise_stats *out,
                                        rsmooth_error *error, const char *caller);
 
+/* ---- taubin.c --------------------------------------------------------------------------------- */
+
+/* Taubin's lambda|mu smoothing of xyz (double, in place) until the RMS distance of the vertices
+ * from where they started reaches target_move (mesh units), or max_iterations; returns the
+ * iterations run, -1 when out of memory (xyz unchanged). */
+int rs_taubin_until(double *xyz, size_t vertex_count, const uint32_t *indices,
+                    size_t triangle_count, double lambda, double mu, double target_move,
+                    int max_iterations);
+
 /* ---- reference.c / passes.c: the filter on a prepared problem, and repeated passes ----------- */
 
 /* The reference filter on a prepared problem (with its facet data kept), written to the caller's

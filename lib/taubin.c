@@ -5,6 +5,7 @@
 #include "rsmooth_internal.h"
 
 #include <math.h>
+#include <string.h>
 
 /* Edge neighbours of every vertex, compressed: those of v are neighbour[first[v] .. first[v+1]). */
 typedef struct adjacency {
@@ -122,4 +123,33 @@ rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const void *position
     adjacency_free(&adj);
     return rs_check_results(scalar, out_positions, NULL, NULL, vertex_count, "vertex", error,
                             where);
+}
+
+int rs_taubin_until(double *xyz, size_t vertex_count, const uint32_t *indices,
+                    size_t triangle_count, double lambda, double mu, double target_move,
+                    int max_iterations) {
+    double *origin = rs_alloc_array(vertex_count, 3 * sizeof *origin);
+    double *next = rs_alloc_array(vertex_count, 3 * sizeof *next);
+    adjacency adj = {NULL, NULL};
+    if (!origin || !next || !adjacency_build(&adj, vertex_count, indices, triangle_count)) {
+        rs_free(origin);
+        rs_free(next);
+        return -1;
+    }
+    memcpy(origin, xyz, vertex_count * 3 * sizeof *xyz);
+    int it = 0;
+    double move = 0;
+    while (it < max_iterations && move < target_move) {
+        umbrella_step(&adj, vertex_count, lambda, xyz, next);
+        umbrella_step(&adj, vertex_count, mu, next, xyz);
+        it++;
+        double sum = 0;
+        for (size_t i = 0; i < 3 * vertex_count; i++)
+            sum += (xyz[i] - origin[i]) * (xyz[i] - origin[i]);
+        move = vertex_count ? sqrt(sum / (double)vertex_count) : 0;
+    }
+    rs_free(origin);
+    rs_free(next);
+    adjacency_free(&adj);
+    return it;
 }

@@ -628,13 +628,15 @@ model. Tuned Taubin λ|μ smoothing gets lower E_v and θ than the paper's singl
 models (it averages away the smooth parts well and its iteration count was tuned against the
 truth).
 
-**Beyond the paper: `--best`** (bilateral normals, then several robust passes; section 6 of
-docs/experiments.md), tuned per model, against the anchors of issue 6 (Open3D Taubin and
-MeshLab TwoStep, each tuned per model):
+**The bilateral best mode of version 0.5** (bilateral normals, then several robust passes;
+section 6 of docs/experiments.md; `--best` before issue 15), tuned per model, against the anchor
+figures issue 6 gave (Open3D Taubin and MeshLab TwoStep). Those anchors were under-tuned, and the
+mode was tuned on these five models: see [Accuracy on meshes it never saw](#accuracy-on-meshes-it-never-saw)
+for the anchors re-measured, the stronger ones, and the figures of meshes left out of every fit:
 
 {b_anchors}
 
-With no tuning, `--best --auto` (σ's from the estimated noise) and the preset `--best`:
+With no tuning, 0.5's `--best --auto` (σ's from the estimated noise) and its preset `--best`:
 
 {b_detail}
 

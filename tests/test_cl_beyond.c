@@ -208,6 +208,16 @@ static void compare_modes(rsmooth_context *ctx, const char *mesh_name, const mes
             compare_searching(ctx, name, m, &p);
         }
     }
+    /* the best mode: the normal update stage (host code both paths share), then a robust pass
+     * on each path; and the stage alone, which both paths must give bit for bit */
+    rsmooth_params_init_best(&p);
+    snprintf(name, sizeof name, "%s, best preset (stage + 1 pass)", mesh_name);
+    compare(ctx, name, m, &p, 0);
+    if (!quick) {
+        p.passes = 0;
+        snprintf(name, sizeof name, "%s, the normal update stage alone", mesh_name);
+        compare(ctx, name, m, &p, 0);
+    }
     for (size_t i = 0; i < sizeof influences / sizeof *influences; i++) {
         rsmooth_params_init(&p);
         p.influence = influences[i].influence;

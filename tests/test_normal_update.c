@@ -2,7 +2,8 @@
  * against a brute-force evaluation of its equations over every facet pair (no grid, no threads, no
  * welding shortcuts), a clean mesh as a fixed point, a soup equal to its indexed mesh, the same bytes
  * for any thread count, a noisy cube restored better than by the paper's filter with its edges
- * kept, and the stage's parameters checked. */
+ * kept, repeats equal to chained calls, the discrepancy guard against Taubin's own smoothing, the
+ * automatic choice's report, and the stage's parameters checked. */
 #include "mesh_shapes.h"
 #include "normal_update.h"
 #include "test_util.h"
@@ -304,12 +305,16 @@ static void test_parameters_checked(void) {
     double *out = malloc(cube.vertex_count * 3 * sizeof(double));
     CHECK(out);
     struct {
-        int passes, updates, rounds;
-        double s, n;
-    } bad[] = {{0, 0, 5, 1, 0.3},  {1, -1, 5, 1, 0.3},    {1, 1001, 5, 1, 0.3},
-               {1, 5, 0, 1, 0.3},  {1, 5, 101, 1, 0.3},   {1, 5, 5, 0, 0.3},
-               {1, 5, 5, NAN, 0.3}, {1, 5, 5, INFINITY, 0.3}, {1, 5, 5, 1, 0},
-               {1, 5, 5, 1, 2.5}};
+        int passes, updates, rounds, repeats;
+        double s, n, level;
+    } bad[] = {{0, 0, 5, 1, 1, 0.3, 0},        {1, -1, 5, 1, 1, 0.3, 0},
+               {1, 1001, 5, 1, 1, 0.3, 0},     {1, 5, 0, 1, 1, 0.3, 0},
+               {1, 5, 101, 1, 1, 0.3, 0},      {1, 5, 5, 1, 0, 0.3, 0},
+               {1, 5, 5, 1, NAN, 0.3, 0},      {1, 5, 5, 1, INFINITY, 0.3, 0},
+               {1, 5, 5, 1, 1, 0, 0},          {1, 5, 5, 1, 1, 2.5, 0},
+               {1, 5, 5, 0, 1, 0.3, 0},        {1, 5, 5, 101, 1, 0.3, 0},
+               {1, 5, 5, 1, 1, 0.3, -1},       {1, 5, 5, 1, 1, 0.3, NAN},
+               {1, 5, 5, 1, 1, 0.3, INFINITY}};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         rsmooth_params p;
         rsmooth_params_init(&p);
@@ -318,6 +323,8 @@ static void test_parameters_checked(void) {
         p.guided_rounds = bad[i].rounds;
         p.guided_sigma_s = bad[i].s;
         p.guided_sigma_n = bad[i].n;
+        p.stage_repeats = bad[i].repeats;
+        p.discrepancy_level = bad[i].level;
         CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count,
                                               cube.indices, cube.triangle_count, &p, out, NULL,
                                               NULL, NULL, NULL),
@@ -327,11 +334,144 @@ static void test_parameters_checked(void) {
     shape_free(&cube);
 }
 
+
+/* stage_repeats R is R chained calls of the stage alone (absolute widths: the same in each). */
+static void test_repeats_chain(void) {
+    shape_mesh cube;
+    CHECK(shape_cube(&cube, 6, 1.0) == 0);
+    CHECK(shape_add_normal_noise(&cube, 0.4, 5) == 0);
+    size_t n = 3 * cube.vertex_count;
+    double *once = malloc(n * sizeof(double)), *twice = malloc(n * sizeof(double));
+    double *chained = malloc(n * sizeof(double));
+    CHECK(once && twice && chained);
+    rsmooth_params p;
+    rsmooth_params_init(&p);
+    p.absolute = 1;
+    p.passes = 0;
+    p.vertex_updates = 7;
+    p.guided_rounds = 3;
+    p.guided_sigma_s = 0.3;
+    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count,
+                                          cube.indices, cube.triangle_count, &p, once, NULL, NULL,
+                                          NULL, NULL), RSMOOTH_OK);
+    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, once, cube.vertex_count, cube.indices,
+                                          cube.triangle_count, &p, chained, NULL, NULL, NULL,
+                                          NULL), RSMOOTH_OK);
+    p.stage_repeats = 2;
+    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count,
+                                          cube.indices, cube.triangle_count, &p, twice, NULL, NULL,
+                                          NULL, NULL), RSMOOTH_OK);
+    CHECK(memcmp(twice, chained, n * sizeof(double)) == 0);
+    CHECK(memcmp(twice, once, n * sizeof(double)) != 0);
+    free(once);
+    free(twice);
+    free(chained);
+    shape_free(&cube);
+}
+
+static double rms_move(const double *a, const double *b, size_t nv) {
+    double sum = 0;
+    for (size_t i = 0; i < 3 * nv; i++)
+        sum += (a[i] - b[i]) * (a[i] - b[i]);
+    return sqrt(sum / (double)nv);
+}
+
+/* The guard: a level far below what the filter moves gives Taubin's smoothing of the input (the
+ * public rsmooth_smooth_taubin with the iterations reported, bit for bit), the first iteration
+ * count that moves the vertices that far; a level far above keeps the filter's result. */
+static void test_discrepancy_guard(void) {
+    shape_mesh sphere;
+    CHECK(shape_sphere(&sphere, 3, 1.0) == 0);
+    CHECK(shape_add_normal_noise(&sphere, 0.3, 9) == 0);
+    size_t nv = sphere.vertex_count, n = 3 * nv;
+    double edge = shape_mean_edge_length(&sphere);
+    double *plain = malloc(n * sizeof(double)), *guarded = malloc(n * sizeof(double));
+    double *taubin = malloc(n * sizeof(double)), *fewer = malloc(n * sizeof(double));
+    CHECK(plain && guarded && taubin && fewer);
+    rsmooth_params p;
+    rsmooth_params_init_best(&p);
+    rsmooth_report r;
+    rsmooth_report_init(&r);
+    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, sphere.xyz, nv, sphere.indices,
+                                          sphere.triangle_count, &p, plain, NULL, NULL, &r, NULL),
+                 RSMOOTH_OK);
+    CHECK_EQ_INT(r.discrepancy_iterations, 0);
+    p.discrepancy_level = 1e3; /* never reached: the filter's result stays */
+    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, sphere.xyz, nv, sphere.indices,
+                                          sphere.triangle_count, &p, guarded, NULL, NULL, &r,
+                                          NULL), RSMOOTH_OK);
+    CHECK_EQ_INT(r.discrepancy_iterations, 0);
+    CHECK(memcmp(plain, guarded, n * sizeof(double)) == 0);
+    double level = 0.6 * rms_move(plain, sphere.xyz, nv) / edge;
+    p.discrepancy_level = level; /* the filter moved 1.7 times this */
+    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, sphere.xyz, nv, sphere.indices,
+                                          sphere.triangle_count, &p, guarded, NULL, NULL, &r,
+                                          NULL), RSMOOTH_OK);
+    int k = r.discrepancy_iterations;
+    CHECK(k >= 2);
+    CHECK_STATUS(rsmooth_smooth_taubin(RSMOOTH_FLOAT64, sphere.xyz, nv, sphere.indices,
+                                       sphere.triangle_count, 0.5, -0.53, (unsigned)k, taubin,
+                                       NULL), RSMOOTH_OK);
+    CHECK(memcmp(guarded, taubin, n * sizeof(double)) == 0);
+    double unit = 0;
+    CHECK_STATUS(rsmooth_mean_edge_length(RSMOOTH_FLOAT64, sphere.xyz, nv, sphere.indices,
+                                          sphere.triangle_count, &unit, NULL), RSMOOTH_OK);
+    CHECK(rms_move(guarded, sphere.xyz, nv) >= level * unit);
+    CHECK_STATUS(rsmooth_smooth_taubin(RSMOOTH_FLOAT64, sphere.xyz, nv, sphere.indices,
+                                       sphere.triangle_count, 0.5, -0.53, (unsigned)k - 1, fewer,
+                                       NULL), RSMOOTH_OK);
+    CHECK(rms_move(fewer, sphere.xyz, nv) < level * unit);
+    printf("guard: the filter moved %.3f edge lengths; at level %.3f, Taubin %d iterations\n",
+           rms_move(plain, sphere.xyz, nv) / unit, level, k);
+    free(plain);
+    free(guarded);
+    free(taubin);
+    free(fewer);
+    shape_free(&sphere);
+}
+
+/* rsmooth_params_auto_report on Gaussian noise: what it read and chose. */
+static void test_auto_report(void) {
+    shape_mesh sphere;
+    CHECK(shape_sphere(&sphere, 5, 1.0) == 0);
+    CHECK(shape_add_normal_noise(&sphere, 0.3, 21) == 0);
+    rsmooth_params p;
+    rsmooth_params_init_best(&p);
+    rsmooth_noise_report r;
+    rsmooth_noise_report_init(&r);
+    CHECK_STATUS(rsmooth_params_auto_report(RSMOOTH_FLOAT64, sphere.xyz, sphere.vertex_count,
+                                            sphere.indices, sphere.triangle_count, &p, &r, NULL),
+                 RSMOOTH_OK);
+    printf("auto: level %.3f, kind %d, preset '%s': %s\n", r.level, r.kind, r.preset, r.reason);
+    CHECK_EQ_INT(r.kind, RSMOOTH_NOISE_GAUSSIAN);
+    CHECK_NEAR(r.level, 0.3, 0.045);
+    CHECK(strncmp(r.preset, "best: ", 6) == 0);
+    CHECK(strstr(r.reason, "noise estimate") != NULL);
+    CHECK_NEAR(p.discrepancy_level, r.level, 1e-12);
+    CHECK(p.vertex_updates > 0);
+    rsmooth_params paper;
+    rsmooth_params_init(&paper);
+    CHECK_STATUS(rsmooth_params_auto_report(RSMOOTH_FLOAT64, sphere.xyz, sphere.vertex_count,
+                                            sphere.indices, sphere.triangle_count, &paper, &r,
+                                            NULL), RSMOOTH_OK);
+    CHECK(strcmp(r.preset, "paper") == 0);
+    CHECK_EQ_INT(paper.vertex_updates, 0);
+    CHECK(paper.discrepancy_level == 0);
+    r.struct_size = 8; /* an uninitialised report is refused */
+    CHECK_STATUS(rsmooth_params_auto_report(RSMOOTH_FLOAT64, sphere.xyz, sphere.vertex_count,
+                                            sphere.indices, sphere.triangle_count, &paper, &r,
+                                            NULL), RSMOOTH_ERROR_INVALID_ARGUMENT);
+    shape_free(&sphere);
+}
+
 int main(void) {
     test_against_brute_force();
     test_clean_stays();
     test_soup_equals_mesh_and_threads();
     test_restores_cube();
+    test_repeats_chain();
+    test_discrepancy_guard();
+    test_auto_report();
     test_parameters_checked();
     printf("normal_update: all checks passed\n");
     return 0;

@@ -245,19 +245,35 @@ typedef struct rsmooth_params {
      * those normals by Sun et al. 2007's iterative update, vertex_updates times. The passes then
      * start from the updated positions. Runs on the host's cores, in double precision. */
     int vertex_updates;           /* 0 (default): no stage. [1, 1000]: update iterations */
-    double guided_sigma_s;        /* spatial width of the guided filter, in the units of sigma_f.
-                                   * > 0. Default 1.5 */
+    double guided_sigma_s;        /* spatial width of the guided filter's Gaussian, in the units
+                                   * of sigma_f, > 0; its reach is fixed at twice the mean
+                                   * distance between the centroids of facets sharing an edge (the
+                                   * paper's), so 2 (default) weighs that reach nearly evenly */
     double guided_sigma_n;        /* width on the difference of guidance normals, (0, 2].
-                                   * Default 0.35 */
-    int guided_rounds;            /* guided filter rounds, [1, 100]. Default 5 */
+                                   * Default 0.2 */
+    int guided_rounds;            /* guided filter rounds, [1, 100]. Default 20 */
+    int stage_repeats;            /* the stage (guided rounds, then vertex updates) this many
+                                   * times, [1, 100], each from the facets of the positions the
+                                   * one before left: a vertex thrown far (impulsive noise) comes
+                                   * back over several repeats. Default 1 */
+    double discrepancy_level;     /* 0 (default): off. > 0: the noise level, in mean edge lengths,
+                                   * the result is checked against (rsmooth_params_auto sets it to
+                                   * the estimate in the best mode). When the filter moved the
+                                   * vertices (RMS, in mean edge lengths of the input) more than
+                                   * 1.1 times this, it removed the shape's own detail, not only
+                                   * noise (a mesh coarse for its curvature): the result is then
+                                   * Taubin's lambda|mu smoothing (0.5, -0.53) of the input, run
+                                   * until the vertices moved this far (the discrepancy principle).
+                                   * Needs connected triangles (a soup keeps the filter's result) */
 } rsmooth_params;
 
 /* Fills `params` with the defaults above. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if params is NULL. */
 RSMOOTH_API rsmooth_status rsmooth_params_init(rsmooth_params *params);
 
-/* Fills `params` with rsmooth's most accurate mode, beyond the paper: bilateral normals, then
- * several robust passes (settings measured on the benchmark models, docs/experiments.md). The
- * sigmas suit noise of about 0.3 mean edge lengths; rsmooth_params_auto fits them to a mesh. */
+/* Fills `params` with rsmooth's most accurate mode, beyond the paper: the normal update stage
+ * (guided normal filtering, 20 rounds, then 25 vertex updates), then one robust pass with
+ * bilateral normals at sigma_f 0.8, sigma_g 0.3 (chosen on noisy meshes with a ground truth,
+ * docs/experiments.md section 7). rsmooth_params_auto fits its strength to a mesh's noise. */
 RSMOOTH_API rsmooth_status rsmooth_params_init_best(rsmooth_params *params);
 
 /* Mean length of the mesh's unique undirected edges (an edge shared by two triangles counts once),
@@ -291,22 +307,55 @@ RSMOOTH_API rsmooth_status rsmooth_estimate_noise(rsmooth_scalar scalar, const v
                                                   rsmooth_error *error);
 
 /* Automatic parameters: estimates the mesh's noise (rsmooth_estimate_noise) and sets the fields
- * of `params` the rules measured in docs/experiments.md give for it. `params` must be initialised
- * first; its normal_filter picks the rule:
- *   RSMOOTH_NORMALS_MOLLIFY (rsmooth_params_init, the paper's filter): sigma_f = 0.92 + 0.81 n,
- *     sigma_g = 3.1 n for noise n in mean edge lengths (section 3, Fig. 5(a));
- *   RSMOOTH_NORMALS_BILATERAL (rsmooth_params_init_best): from gentle (n <= 0.2: 3 bilateral
- *     rounds of width 1, normal_sigma_n 0.6, 2 passes, sigma_g 0.3) to strong (n >= 0.4: 8
- *     rounds of width 1.5, 0.3, 6 passes, Huber, sigma_g 0.1); impulsive noise (a heavy tail of
- *     vertices thrown far, which the estimate detects and reads low) gets the strong end with 16
- *     rounds of width 2 (section 6; calibrated on the five benchmark models).
+ * of `params` the rules chosen in docs/experiments.md (section 7; cross-validated, whole meshes
+ * left out) give for it. `params` must be initialised first; it picks the rule:
+ *   the paper's filter (rsmooth_params_init: normal_filter RSMOOTH_NORMALS_MOLLIFY and no
+ *     vertex_updates): sigma_f = 0.9 + 0.8 n, sigma_g = 3 n for noise n in mean edge lengths;
+ *   otherwise the best mode (rsmooth_params_init_best's setting): the guided filter's rounds by
+ *     noise class (gentle, medium, strong; impulsive noise its own).
  * Sigmas are relative (absolute = 0 after the call). Other fields are left as they are. Writes
  * the estimate to *out_noise when not NULL. Fails like rsmooth_estimate_noise, and on invalid
- * params; then `params` is unchanged. Thread-safe. */
+ * params; then `params` is unchanged. Thread-safe. rsmooth_params_auto_report also says what it
+ * read and chose. */
 RSMOOTH_API rsmooth_status rsmooth_params_auto(rsmooth_scalar scalar, const void *positions,
                                                size_t vertex_count, const uint32_t *indices,
                                                size_t triangle_count, rsmooth_params *params,
                                                double *out_noise, rsmooth_error *error);
+
+/* What rsmooth_params_auto_report read from a mesh and chose (added in 0.6). */
+typedef enum rsmooth_noise_kind {
+    RSMOOTH_NOISE_NONE = 0,      /* nothing measurable (too few vertices, no edge) */
+    RSMOOTH_NOISE_GAUSSIAN = 1,  /* every vertex displaced */
+    RSMOOTH_NOISE_IMPULSIVE = 2  /* a share of the vertices thrown, the others (nearly) exact */
+} rsmooth_noise_kind;
+
+typedef struct rsmooth_noise_report {
+    size_t struct_size;        /* sizeof(rsmooth_noise_report): rsmooth_noise_report_init */
+    double level;              /* rsmooth_estimate_noise's figure: the standard deviation of the
+                                * displacement along the surface normal, in mean edge lengths of
+                                * the clean mesh (impulsive: of the displaced vertices) */
+    int kind;                  /* an rsmooth_noise_kind */
+    double impulsive_fraction; /* the share of vertices displaced: 1 unless impulsive */
+    double tangential_level;   /* the displacement's standard deviation along one tangent
+                                * direction, same unit (about `level` for noise in random
+                                * directions, near 0 along the normals); NAN when not measured */
+    double mean_edge_length;   /* the clean mesh's, as estimated, in the mesh's units */
+    char preset[32];           /* the setting the rule chose, e.g. "best: strong" */
+    char reason[192];          /* why, in words, for printing */
+} rsmooth_noise_report;
+
+/* Sets struct_size and clears the rest. */
+RSMOOTH_API void rsmooth_noise_report_init(rsmooth_noise_report *report);
+
+/* rsmooth_params_auto, also saying what it read and chose in *report (when not NULL; initialise
+ * it with rsmooth_noise_report_init). (Added in 0.6.) */
+RSMOOTH_API rsmooth_status rsmooth_params_auto_report(rsmooth_scalar scalar,
+                                                      const void *positions, size_t vertex_count,
+                                                      const uint32_t *indices,
+                                                      size_t triangle_count,
+                                                      rsmooth_params *params,
+                                                      rsmooth_noise_report *report,
+                                                      rsmooth_error *error);
 
 /* Figures of one filter run, filled when a non-NULL pointer is passed. Times in milliseconds;
  * stages a path does not have are 0. */
@@ -338,6 +387,9 @@ typedef struct rsmooth_report {
                                      within reach or not: the grid's waste is counted) */
     size_t tiles;                 /* spatial tiles the mesh was cut into to fit the device (1 when
                                      it fitted whole) */
+    int discrepancy_iterations;   /* params.discrepancy_level's guard: the Taubin iterations that
+                                   * replaced the filter's result, 0 when it was kept (added in
+                                   * 0.6) */
 } rsmooth_report;
 
 /* Zeroes `report` and sets its struct_size. Accepts NULL. (Added in 0.5) */
