@@ -23,6 +23,8 @@ static const field fields[] = {
     INT_FIELD(predictor),          INT_FIELD(normal_filter),     DOUBLE_FIELD(normal_sigma_s),
     DOUBLE_FIELD(normal_sigma_n),  INT_FIELD(normal_iterations), INT_FIELD(influence),
     INT_FIELD(passes),             DOUBLE_FIELD(pass_confidence), DOUBLE_FIELD(sigma_c),
+    INT_FIELD(vertex_updates),     DOUBLE_FIELD(guided_sigma_s), DOUBLE_FIELD(guided_sigma_n),
+    INT_FIELD(guided_rounds),
 };
 #define FIELD_COUNT (sizeof fields / sizeof fields[0])
 
@@ -148,8 +150,22 @@ PyObject *ext_default_params(PyObject *self, PyObject *args) {
     return ext_params_to_dict(&p);
 }
 
-/* _params_auto(vertices, faces, params) -> (params, noise): rsmooth_params_auto's rule for the
- * mesh, starting from `params` (whose normal_filter picks the rule). */
+/* The noise report as a dict: level, kind ("none", "gaussian" or "impulsive"),
+ * impulsive_fraction, tangential_level (NaN when not measured), mean_edge_length, preset,
+ * reason. */
+static PyObject *noise_report_to_dict(const rsmooth_noise_report *r) {
+    const char *kind = r->kind == RSMOOTH_NOISE_GAUSSIAN    ? "gaussian"
+                       : r->kind == RSMOOTH_NOISE_IMPULSIVE ? "impulsive"
+                                                            : "none";
+    return Py_BuildValue("{sd,ss,sd,sd,sd,ss,ss}", "level", r->level, "kind", kind,
+                         "impulsive_fraction", r->impulsive_fraction, "tangential_level",
+                         r->tangential_level, "mean_edge_length", r->mean_edge_length, "preset",
+                         r->preset, "reason", r->reason);
+}
+
+/* _params_auto(vertices, faces, params) -> (params, report): rsmooth_params_auto_report's rule
+ * for the mesh, starting from `params` (whose normal_filter and vertex_updates pick the rule),
+ * and what it read and chose (noise_report_to_dict). */
 PyObject *ext_params_auto(PyObject *self, PyObject *args) {
     (void)self;
     PyObject *vobj, *fobj, *pobj;
@@ -166,19 +182,23 @@ PyObject *ext_params_auto(PyObject *self, PyObject *args) {
     PyObject *result = NULL;
     rsmooth_params p;
     if (ext_params_from_dict(pobj, v.rows, &p, &held) == 0) {
-        double noise = 0;
+        rsmooth_noise_report report;
+        rsmooth_noise_report_init(&report);
         rsmooth_error err;
         rsmooth_status st;
         Py_BEGIN_ALLOW_THREADS
-        st = rsmooth_params_auto(v.scalar, v.view.buf, (size_t)v.rows, f.view.buf,
-                                 (size_t)f.rows, &p, &noise, &err);
+        st = rsmooth_params_auto_report(v.scalar, v.view.buf, (size_t)v.rows, f.view.buf,
+                                        (size_t)f.rows, &p, &report, &err);
         Py_END_ALLOW_THREADS
         if (st != RSMOOTH_OK) {
             ext_raise(st, &err);
         } else {
             PyObject *dict = ext_params_to_dict(&p);
-            if (dict)
-                result = Py_BuildValue("(Nd)", dict, noise);
+            PyObject *said = dict ? noise_report_to_dict(&report) : NULL;
+            if (said)
+                result = Py_BuildValue("(NN)", dict, said);
+            else
+                Py_XDECREF(dict);
         }
     }
     ext_param_arrays_release(&held);

@@ -26,7 +26,7 @@ from __future__ import annotations
 from . import _rsmooth
 from ._context import Context, devices
 from ._filter import smooth, smooth_points
-from ._measures import compare, estimate_noise, mean_edge_length, point_spacing
+from ._measures import auto_params, compare, estimate_noise, mean_edge_length, point_spacing
 from ._rsmooth import DeviceError
 
 __version__: str = _rsmooth.__version__
@@ -35,6 +35,7 @@ __all__ = [
     "smooth",
     "smooth_points",
     "estimate_noise",
+    "auto_params",
     "mean_edge_length",
     "point_spacing",
     "compare",

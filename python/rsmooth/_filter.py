@@ -37,6 +37,10 @@ def smooth(
     influence: Optional[str] = None,
     passes: Optional[int] = None,
     pass_confidence: Optional[float] = None,
+    vertex_updates: Optional[int] = None,
+    guided_sigma_s: Optional[float] = None,
+    guided_sigma_n: Optional[float] = None,
+    guided_rounds: Optional[int] = None,
     predictor: Optional[str] = None,
     mollify_cutoff: Optional[float] = None,
     colors: Any = None,
@@ -71,17 +75,26 @@ def smooth(
         and gives the run's report.
     confidence : also return the per-vertex confidence k(p) / sum a f in [0, 1] (float32, the
         paper's Fig. 10): low at features and outliers.
-    best : rsmooth's most accurate mode (bilateral normals, 3 passes at sigma_f 0.8,
-        sigma_g 0.3); other keywords still apply on top.
-    auto : estimate the noise (:func:`estimate_noise`) and pick the sigmas from it (with
-        ``best`` also the rounds and passes). Keywords given explicitly win over the rule.
+    best : rsmooth's most accurate mode (the normal update stage, then one robust pass with
+        bilateral normals at sigma_f 0.8, sigma_g 0.3); other keywords still apply on top.
+    auto : estimate the noise and pick the sigmas from it (with ``best`` the normal update
+        stage's strength); :func:`auto_params` says what it read and chose. Keywords given
+        explicitly win over the rule.
     normal_filter : "mollify" (the paper) or "bilateral" (keeps creases the Gaussian rounds).
     normal_sigma_s, normal_sigma_n, normal_iterations : the bilateral normal filter's spatial
         width (units of sigma_f, default 1), width on normal differences ((0, 2], default 0.35)
         and rounds (default 5).
     influence : the robust weight: "gaussian" (the paper), "tukey", "lorentzian" or "huber".
-    passes : run the filter this many times, each from the previous result (default 1).
+    passes : run the filter this many times, each from the previous result (default 1); 0
+        with ``vertex_updates`` runs the normal update stage alone.
     pass_confidence : passes after the first move only vertices whose confidence was below it.
+    vertex_updates : the normal update stage, before the passes: guided normal filtering
+        (Zhang et al. 2015) of the facet normals, then Sun et al. 2007's vertex update, this
+        many iterations ([0, 1000]) moving the vertices to agree with the filtered normals.
+        Default 0 (off; ``best``: 25). Runs on the CPU's cores in double precision.
+    guided_sigma_s, guided_sigma_n, guided_rounds : the guided filter's spatial width (units of
+        sigma_f, default 2), width on guidance-normal differences ((0, 2], default 0.2) and
+        rounds ([1, 100], default 20).
     predictor : "projection" (the paper) or "centroid".
     mollify_cutoff : mollification reach in units of sigma_f, (0, cutoff]; default: cutoff.
     colors : (n, 3) per-vertex colours (floats in [0, 1], or uint8 0..255) weighing each
@@ -113,7 +126,9 @@ def smooth(
         confidence=confidence, best=best, auto=auto, normal_filter=normal_filter,
         normal_sigma_s=normal_sigma_s, normal_sigma_n=normal_sigma_n,
         normal_iterations=normal_iterations, influence=influence, passes=passes,
-        pass_confidence=pass_confidence, predictor=predictor, mollify_cutoff=mollify_cutoff,
+        pass_confidence=pass_confidence, vertex_updates=vertex_updates,
+        guided_sigma_s=guided_sigma_s, guided_sigma_n=guided_sigma_n,
+        guided_rounds=guided_rounds, predictor=predictor, mollify_cutoff=mollify_cutoff,
         colors=colors, sigma_c=sigma_c, mask=mask, method=method, iterations=iterations,
         lam=lam, mu=mu, progress=progress,
     )

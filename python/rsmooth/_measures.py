@@ -1,5 +1,5 @@
-"""Measures of meshes and point sets: noise, edge length, spacing, and the error against a ground
-truth (the library's rsmooth_compare)."""
+"""Measures of meshes and point sets: noise (and the parameters ``auto`` picks from it), edge
+length, spacing, and the error against a ground truth (the library's rsmooth_compare)."""
 
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ from typing import Any, Dict
 
 from . import _rsmooth
 from ._arrays import _faces, _vertices
+from ._options import _keywords, _params
 
 
 def estimate_noise(vertices: Any, faces: Any) -> float:
@@ -16,6 +17,27 @@ def estimate_noise(vertices: Any, faces: Any) -> float:
     thousand vertices or more. 0 for a mesh too small to fit."""
     v = _vertices(vertices)
     return _rsmooth._estimate_noise(v, _faces(faces, v.shape[0]))
+
+
+def auto_params(vertices: Any, faces: Any, *, best: bool = False) -> Dict[str, Any]:
+    """What ``rsmooth.smooth(vertices, faces, auto=True, best=best)`` reads from the mesh and
+    chooses (the library's rsmooth_params_auto_report).
+
+    Returns a dict: ``level`` (the noise's standard deviation along the surface normal, in mean
+    edge lengths of the clean mesh; for impulsive noise that of the displaced vertices),
+    ``kind`` ("gaussian": every vertex displaced, "impulsive": a share of them thrown and the
+    others nearly exact, "none": nothing measurable), ``impulsive_fraction`` (the share
+    displaced: 1 unless impulsive), ``tangential_level`` (the displacement along one tangent
+    direction, same unit; NaN when not measured), ``mean_edge_length`` (the clean mesh's, as
+    estimated, in the mesh's units), ``preset`` (the setting chosen, e.g. "paper" or
+    "best: strong"), ``reason`` (why, in words), and ``params``: the chosen setting as
+    keywords, so that ``rsmooth.smooth(vertices, faces, **report["params"])`` runs it."""
+    v = _vertices(vertices)
+    f = _faces(faces, v.shape[0])
+    params, report = _params(v, f, best=best, auto=True, overrides={})
+    assert report is not None
+    report["params"] = _keywords(params)
+    return report
 
 
 def mean_edge_length(vertices: Any, faces: Any) -> float:

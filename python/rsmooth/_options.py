@@ -31,9 +31,10 @@ def _params(
     best: bool,
     auto: bool,
     overrides: Dict[str, Any],
-) -> Tuple[Dict[str, Any], Optional[float]]:
+) -> Tuple[Dict[str, Any], Optional[Dict[str, Any]]]:
     """The library's parameters: the preset (paper or best), the noise rule when `auto`, then
-    every keyword given explicitly (explicit ones win over the rule, as on the command line)."""
+    every keyword given explicitly (explicit ones win over the rule, as on the command line).
+    Also the rule's noise report when `auto` (else None)."""
     params = _rsmooth._default_params(bool(best))
     given = {k: v for k, v in overrides.items() if v is not None}
     for key, table in (
@@ -46,14 +47,29 @@ def _params(
     for key in ("absolute", "mollify"):
         if key in given:
             given[key] = int(bool(given[key]))
-    noise = None
+    report = None
     if auto:
         rule = dict(params)
-        if "normal_filter" in given:
-            rule["normal_filter"] = given["normal_filter"]
-        params, noise = _rsmooth._params_auto(vertices, faces, rule)
+        for key in ("normal_filter", "vertex_updates"):  # these pick the rule (paper or best)
+            if key in given:
+                rule[key] = given[key]
+        params, report = _rsmooth._params_auto(vertices, faces, rule)
     params.update(given)
-    return params, noise
+    return params, report
+
+
+def _keywords(params: Dict[str, Any]) -> Dict[str, Any]:
+    """The library's parameters as rsmooth.smooth's keywords (choices by name, flags as bools)."""
+    out = dict(params)
+    for key, table in (
+        ("normal_filter", _NORMAL_FILTERS),
+        ("influence", _INFLUENCES),
+        ("predictor", _PREDICTORS),
+    ):
+        out[key] = next(name for name, value in table.items() if value == out[key])
+    for key in ("absolute", "mollify"):
+        out[key] = bool(out[key])
+    return out
 
 
 def _progress_callable(progress: Progress) -> Tuple[Optional[Callable[[float], Any]], Any]:

@@ -1,0 +1,165 @@
+"""The normal update stage (guided normal filtering, then Sun et al.'s vertex update) through the
+keywords, and auto_params: what ``auto=True`` reads from a mesh and chooses."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import rsmooth
+
+from conftest import box, noisy, roof
+
+
+@pytest.fixture(scope="module")
+def cube():
+    truth, f = box(16)
+    return truth, noisy(truth, f, 0.3, seed=7), f
+
+
+def stage(v, f, **kwargs):
+    return rsmooth.smooth(v, f, device="reference", vertex_updates=20, passes=0, **kwargs)
+
+
+def test_stage_alone_moves_and_helps(cube):
+    truth, v, f = cube
+    out, conf = stage(v, f, confidence=True)
+    assert out.shape == v.shape and out.dtype == v.dtype and np.all(np.isfinite(out))
+    assert not np.array_equal(out, v)
+    before, after = rsmooth.compare(v, truth, f), rsmooth.compare(out, truth, f)
+    # the guided filter keeps the cube's creases: far lower normal error, and closer vertices
+    assert after["theta"] < 0.4 * before["theta"], (before, after)
+    assert after["ev"] < 0.7 * before["ev"], (before, after)
+    assert np.all(conf == 1)  # the stage alone: confidences 1
+    # float32 in, float32 out, close to the float64 result
+    out32 = stage(v.astype(np.float32), f)
+    assert out32.dtype == np.float32
+    assert np.allclose(out32, out, atol=1e-4)
+
+
+def test_stage_then_passes_differs_from_stage_alone(cube):
+    _, v, f = cube
+    alone = stage(v, f)
+    with_pass = rsmooth.smooth(v, f, device="reference", vertex_updates=20, passes=1)
+    assert not np.array_equal(alone, with_pass)
+
+
+def test_guided_keywords_reach_the_library(cube):
+    _, v, f = cube
+    base = stage(v, f)
+    for kwargs in (
+        dict(guided_sigma_s=1.0), dict(guided_sigma_n=0.35), dict(guided_rounds=5),
+    ):
+        assert not np.array_equal(stage(v, f, **kwargs), base), kwargs
+    assert not np.array_equal(rsmooth.smooth(v, f, device="reference", vertex_updates=5,
+                                             passes=0), base)
+
+
+def test_none_means_the_modes_default(cube):
+    _, v, f = cube
+    # the library's defaults: guided_sigma_s 2, guided_sigma_n 0.2, guided_rounds 20
+    assert np.array_equal(
+        stage(v, f, guided_sigma_s=None, guided_sigma_n=None, guided_rounds=None),
+        stage(v, f, guided_sigma_s=2.0, guided_sigma_n=0.2, guided_rounds=20),
+    )
+    # best: the stage with 25 updates, then one pass; vertex_updates=None keeps them
+    best = rsmooth.smooth(v, f, device="reference", best=True, vertex_updates=None)
+    assert np.array_equal(
+        best, rsmooth.smooth(v, f, device="reference", best=True, vertex_updates=25, passes=1)
+    )
+    assert not np.array_equal(
+        best, rsmooth.smooth(v, f, device="reference", best=True, vertex_updates=0)
+    )
+    # off by default: vertex_updates=0 is the paper's filter
+    assert np.array_equal(
+        rsmooth.smooth(v, f, device="reference", vertex_updates=0),
+        rsmooth.smooth(v, f, device="reference"),
+    )
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(vertex_updates=-1), "vertex_updates"),
+        (dict(vertex_updates=1001), "vertex_updates"),
+        (dict(passes=0), "passes"),  # 0 needs vertex_updates > 0
+        (dict(vertex_updates=5, passes=-1), "passes"),
+        (dict(vertex_updates=5, guided_sigma_s=0.0), "guided_sigma_s"),
+        (dict(vertex_updates=5, guided_sigma_s=math.inf), "guided_sigma_s"),
+        (dict(vertex_updates=5, guided_sigma_n=0.0), "guided_sigma_n"),
+        (dict(vertex_updates=5, guided_sigma_n=2.5), "guided_sigma_n"),
+        (dict(vertex_updates=5, guided_sigma_n=math.nan), "guided_sigma_n"),
+        (dict(vertex_updates=5, guided_rounds=0), "guided_rounds"),
+        (dict(vertex_updates=5, guided_rounds=101), "guided_rounds"),
+    ],
+)
+def test_bad_values(kwargs, match):
+    v, f = roof(8)
+    with pytest.raises(ValueError, match=match):
+        rsmooth.smooth(v, f, device="reference", **kwargs)
+
+
+def test_auto_params_reads_gaussian_noise():
+    truth, f = box(30)
+    v = noisy(truth, f, 0.3, seed=3)
+    paper = rsmooth.auto_params(v, f)
+    assert paper["kind"] == "gaussian", paper
+    assert paper["impulsive_fraction"] == 1.0
+    assert 0.2 < paper["level"] < 0.4, paper
+    # noise in every direction: the tangential part about the normal one
+    assert 0.15 < paper["tangential_level"] < 0.45, paper
+    edge = rsmooth.mean_edge_length(truth, f)
+    assert paper["mean_edge_length"] == pytest.approx(edge, rel=0.1)
+    assert paper["preset"] == "paper"
+    assert "Gaussian" in paper["reason"] and "sigma_f" in paper["reason"]
+    assert paper["params"]["sigma_f"] == pytest.approx(0.9 + 0.8 * paper["level"])
+    assert paper["params"]["sigma_g"] == pytest.approx(3.0 * paper["level"])
+    assert paper["params"]["vertex_updates"] == 0
+
+    best = rsmooth.auto_params(v.astype(np.float32), f, best=True)
+    assert best["kind"] == "gaussian"
+    assert best["preset"].startswith("best"), best
+    assert best["params"]["vertex_updates"] > 0
+    assert best["params"]["normal_filter"] == "bilateral"
+
+    # the chosen keywords are exactly what auto=True runs
+    for report, mode in ((paper, dict()), (best, dict(best=True))):
+        assert np.array_equal(
+            rsmooth.smooth(v, f, device="reference", **report["params"]),
+            rsmooth.smooth(v, f, device="reference", auto=True, **mode),
+        ), report["preset"]
+    # vertex_updates given with auto picks the best mode's rule (as --vertex-updates does), and
+    # wins over it
+    assert np.array_equal(
+        rsmooth.smooth(v, f, device="reference", auto=True, vertex_updates=10),
+        rsmooth.smooth(v, f, device="reference", **dict(best["params"], vertex_updates=10)),
+    )
+
+
+def test_auto_params_reads_impulsive_noise():
+    # half the vertices thrown along their side's normal by 0.5 mean edge lengths, the others
+    # exact (as rsmooth noise --impulsive 0.5 does; the setting the C suite asserts)
+    truth, f = box(40)
+    rng = np.random.default_rng(11)
+    edge = rsmooth.mean_edge_length(truth, f)
+    axis = np.argmax(np.abs(truth), axis=1)
+    thrown = np.nonzero(rng.random(len(truth)) < 0.5)[0]
+    v = truth.copy()
+    v[thrown, axis[thrown]] += rng.normal(0.0, 0.5 * edge, len(thrown))
+    report = rsmooth.auto_params(v, f, best=True)
+    assert report["kind"] == "impulsive", report
+    assert 0.3 < report["impulsive_fraction"] < 0.8, report
+    assert report["preset"] == "best: impulsive"
+    assert "impulsive" in report["reason"]
+
+
+def test_auto_params_errors():
+    v, f = roof(8)
+    with pytest.raises(ValueError, match="vertex 2"):
+        bad = v.copy()
+        bad[2, 0] = np.inf
+        rsmooth.auto_params(bad, f)
+    with pytest.raises(TypeError):
+        rsmooth.auto_params(v, f, True)  # best is keyword-only
