@@ -30,7 +30,8 @@ typedef struct rs_noise_details {
     /* The standard deviation of all vertices' normal displacement (clean mean edge lengths): equal
      * to level for Gaussian noise, about sqrt(fraction) x level for impulsive noise. */
     double overall_level;
-    /* Share of the screened residuals beyond 4 robust sigmas (a Gaussian: 6e-5). */
+    /* Share of the samples whose robust residual exceeds 6 times their refit's inlier scatter
+     * (noise_estimate.c, outlier_share): above 0.006 the noise reads impulsive. */
     double tail_share;
     /* Vertices whose residual was measured. */
     size_t samples;

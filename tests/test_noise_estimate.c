@@ -36,8 +36,7 @@ static double estimate(const double *xyz, size_t nv, const uint32_t *tri, size_t
 }
 
 /* rsmooth_params_auto on a mesh: the paper's rule takes its sigmas from the estimate, and the
- * best mode goes from gentle to strong with the noise, and to its impulsive setting (normal
- * filter twice as wide) exactly when the noise is impulsive. */
+ * best mode takes its impulsive preset exactly when the noise reads impulsive. */
 static void check_auto(const char *name, const double *xyz, size_t nv, const uint32_t *tri,
                        size_t nt, bool expect_impulsive) {
     double noise = estimate(xyz, nv, tri, nt), got = -1;
@@ -47,19 +46,16 @@ static void check_auto(const char *name, const double *xyz, size_t nv, const uin
     CHECK_STATUS(rsmooth_params_auto(RSMOOTH_FLOAT64, xyz, nv, tri, nt, &paper, &got, NULL),
                  RSMOOTH_OK);
     CHECK(got == noise);
-    CHECK_NEAR(paper.sigma_f, 0.92 + 0.81 * noise, 1e-12);
-    CHECK_NEAR(paper.sigma_g, 3.1 * noise, 1e-12);
-    CHECK_STATUS(rsmooth_params_auto(RSMOOTH_FLOAT64, xyz, nv, tri, nt, &best, NULL, NULL),
+    CHECK_NEAR(paper.sigma_f, 0.9 + 0.8 * noise, 1e-12); /* lib/params_auto.c's paper rule */
+    CHECK_NEAR(paper.sigma_g, 3.0 * noise, 1e-12);
+    rsmooth_noise_report r;
+    rsmooth_noise_report_init(&r);
+    CHECK_STATUS(rsmooth_params_auto_report(RSMOOTH_FLOAT64, xyz, nv, tri, nt, &best, &r, NULL),
                  RSMOOTH_OK);
-    CHECK(best.normal_filter == RSMOOTH_NORMALS_BILATERAL);
-    CHECK_EQ_INT(best.normal_sigma_s == 2.0, expect_impulsive);
-    double n = expect_impulsive ? fmax(noise, 0.4) : noise;
-    CHECK_EQ_INT(best.passes, n <= 0.2 ? 2 : n >= 0.4 ? 6 : best.passes);
-    CHECK(best.passes >= 2 && best.passes <= 6);
-    CHECK(best.normal_sigma_n >= 0.3 && best.normal_sigma_n <= 0.6);
-    printf("%s: auto: noise %.4f -> paper sigma_f %.3f sigma_g %.3f; best %d rounds of width "
-           "%.2f, %d passes, %s\n", name, noise, paper.sigma_f, paper.sigma_g,
-           best.normal_iterations, best.normal_sigma_s, best.passes,
+    CHECK_EQ_INT(r.kind == RSMOOTH_NOISE_IMPULSIVE, expect_impulsive);
+    CHECK_EQ_INT(strcmp(r.preset, "best: impulsive") == 0, expect_impulsive);
+    printf("%s: auto: noise %.4f -> paper sigma_f %.3f sigma_g %.3f; best preset '%s', %s\n", name,
+           noise, paper.sigma_f, paper.sigma_g, r.preset,
            expect_impulsive ? "impulsive" : "Gaussian");
 }
 
@@ -210,6 +206,61 @@ static void random_directions(void) {
         shape_free(&shapes[s]);
 }
 
+/* The kind the estimate reads (rsmooth_params_auto_report): Gaussian noise, along the normals or
+ * in random directions, at any level from 0.05 to 1 mean edge lengths, is never taken for
+ * impulsive; impulsive noise (a share F of the vertices displaced, the rest exact) is, at F 0.05
+ * and 0.1 and levels 0.3 to 1. */
+static bool reads_impulsive(const shape_mesh *m, const double *xyz) {
+    rsmooth_params p;
+    rsmooth_params_init(&p);
+    rsmooth_noise_report r;
+    rsmooth_noise_report_init(&r);
+    rsmooth_error err;
+    CHECK_STATUS(rsmooth_params_auto_report(RSMOOTH_FLOAT64, xyz, m->vertex_count, m->indices,
+                                            m->triangle_count, &p, &r, &err),
+                 RSMOOTH_OK);
+    return r.kind == RSMOOTH_NOISE_IMPULSIVE;
+}
+
+static void check_kind(void) {
+    shape_mesh shapes[3];
+    const char *names[3] = {"sphere", "cube", "cylinder"};
+    CHECK_EQ_INT(shape_sphere(&shapes[0], 5, 1.0), 0);
+    CHECK_EQ_INT(shape_cube(&shapes[1], 40, 1.0), 0);
+    CHECK_EQ_INT(shape_capped_cylinder(&shapes[2], 1.0, 2.0, 20000), 0);
+    const double gaussian[] = {0.05, 0.2, 0.5, 1.0}, impulsive[] = {0.3, 0.5, 1.0};
+    const double fractions[] = {0.05, 0.1};
+    for (int s = 0; s < 3; s++) {
+        size_t nv = shapes[s].vertex_count, nt = shapes[s].triangle_count;
+        double *noisy = malloc(3 * nv * sizeof *noisy);
+        CHECK(noisy);
+        for (int d = 0; d < 2; d++)
+            for (size_t l = 0; l < sizeof gaussian / sizeof *gaussian; l++) {
+                memcpy(noisy, shapes[s].xyz, 3 * nv * sizeof *noisy);
+                mesh_noise_options o = {gaussian[l], d ? MESH_NOISE_RANDOM : MESH_NOISE_NORMAL, 0,
+                                        400 + 10 * (uint64_t)d + l};
+                CHECK_EQ_INT(mesh_add_noise(noisy, nv, shapes[s].indices, nt, &o), 0);
+                bool imp = reads_impulsive(&shapes[s], noisy);
+                printf("%-9s Gaussian %s %.2f: %s\n", names[s], d ? "random" : "normal",
+                       gaussian[l], imp ? "IMPULSIVE (wrong)" : "Gaussian");
+                CHECK(!imp);
+            }
+        for (size_t f = 0; f < sizeof fractions / sizeof *fractions; f++)
+            for (size_t l = 0; l < sizeof impulsive / sizeof *impulsive; l++) {
+                memcpy(noisy, shapes[s].xyz, 3 * nv * sizeof *noisy);
+                mesh_noise_options o = {impulsive[l], MESH_NOISE_NORMAL, fractions[f],
+                                        500 + 10 * (uint64_t)f + l};
+                CHECK_EQ_INT(mesh_add_noise(noisy, nv, shapes[s].indices, nt, &o), 0);
+                bool imp = reads_impulsive(&shapes[s], noisy);
+                printf("%-9s impulsive F %.2f %.1f: %s\n", names[s], fractions[f], impulsive[l],
+                       imp ? "impulsive" : "GAUSSIAN (wrong)");
+                CHECK(imp);
+            }
+        free(noisy);
+        shape_free(&shapes[s]);
+    }
+}
+
 /* Same result every run, with any thread count, for float32 and for the same surface as a soup. */
 static void check_invariance(void) {
     shape_mesh m, soup;
@@ -348,6 +399,7 @@ static void benchmark_meshes(void) {
 int main(void) {
     check_edge_cases();
     check_invariance();
+    check_kind();
     generated_shapes();
     random_directions();
     check_sampled();
