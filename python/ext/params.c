@@ -24,7 +24,7 @@ static const field fields[] = {
     DOUBLE_FIELD(normal_sigma_n),  INT_FIELD(normal_iterations), INT_FIELD(influence),
     INT_FIELD(passes),             DOUBLE_FIELD(pass_confidence), DOUBLE_FIELD(sigma_c),
     INT_FIELD(vertex_updates),     DOUBLE_FIELD(guided_sigma_s), DOUBLE_FIELD(guided_sigma_n),
-    INT_FIELD(guided_rounds),
+    INT_FIELD(guided_rounds),      INT_FIELD(stage_repeats),     DOUBLE_FIELD(discrepancy_level),
 };
 #define FIELD_COUNT (sizeof fields / sizeof fields[0])
 

@@ -41,6 +41,8 @@ def smooth(
     guided_sigma_s: Optional[float] = None,
     guided_sigma_n: Optional[float] = None,
     guided_rounds: Optional[int] = None,
+    stage_repeats: Optional[int] = None,
+    discrepancy_level: Optional[float] = None,
     predictor: Optional[str] = None,
     mollify_cutoff: Optional[float] = None,
     colors: Any = None,
@@ -95,6 +97,14 @@ def smooth(
     guided_sigma_s, guided_sigma_n, guided_rounds : the guided filter's spatial width (units of
         sigma_f, default 2), width on guidance-normal differences ((0, 2], default 0.2) and
         rounds ([1, 100], default 20).
+    stage_repeats : the whole stage (guided rounds, then vertex updates) this many times, each
+        from the positions the one before left ([1, 100], default 1): a vertex thrown far
+        (impulsive noise) comes back over several repeats.
+    discrepancy_level : 0 (default): off. A noise level, in mean edge lengths (``auto`` with
+        ``best`` sets the estimate): when the filter moved the vertices (RMS) more than 1.1
+        times it, it removed the shape's own detail, and the result is instead Taubin
+        smoothing of the input run until the vertices moved that far (the report's
+        ``discrepancy_iterations`` says how many; 0 when the filter's result was kept).
     predictor : "projection" (the paper) or "centroid".
     mollify_cutoff : mollification reach in units of sigma_f, (0, cutoff]; default: cutoff.
     colors : (n, 3) per-vertex colours (floats in [0, 1], or uint8 0..255) weighing each
@@ -128,7 +138,8 @@ def smooth(
         normal_iterations=normal_iterations, influence=influence, passes=passes,
         pass_confidence=pass_confidence, vertex_updates=vertex_updates,
         guided_sigma_s=guided_sigma_s, guided_sigma_n=guided_sigma_n,
-        guided_rounds=guided_rounds, predictor=predictor, mollify_cutoff=mollify_cutoff,
+        guided_rounds=guided_rounds, stage_repeats=stage_repeats,
+        discrepancy_level=discrepancy_level, predictor=predictor, mollify_cutoff=mollify_cutoff,
         colors=colors, sigma_c=sigma_c, mask=mask, method=method, iterations=iterations,
         lam=lam, mu=mu, progress=progress,
     )

@@ -10,7 +10,7 @@ import pytest
 
 import rsmooth
 
-from conftest import box, noisy, roof
+from conftest import box, noisy, require_opencl, roof
 
 
 @pytest.fixture(scope="module")
@@ -57,6 +57,44 @@ def test_guided_keywords_reach_the_library(cube):
                                              passes=0), base)
 
 
+def test_stage_repeats_chain_the_stage(cube):
+    _, v, f = cube
+    # absolute widths: the same in each repeat, so two repeats are two chained calls
+    width = dict(absolute=True, guided_sigma_s=0.3, guided_rounds=5)
+    once = stage(v, f, **width)
+    twice = stage(v, f, stage_repeats=2, **width)
+    assert not np.array_equal(twice, once)
+    assert np.array_equal(twice, stage(once, f, **width))
+
+
+def test_discrepancy_guard():
+    truth, f = box(12)
+    v = noisy(truth, f, 0.3, seed=9)
+    off = rsmooth.smooth(v, f, device="reference", best=True)
+    # a level far above what the filter moves keeps its result
+    kept = rsmooth.smooth(v, f, device="reference", best=True, discrepancy_level=100.0)
+    assert np.array_equal(kept, off)
+    # one below it replaces the result by Taubin smoothing run until the vertices moved that far
+    def moved(out):
+        return np.sqrt(np.mean(np.sum((out - v) ** 2, axis=1))) / rsmooth.mean_edge_length(v, f)
+
+    level = 0.5 * moved(off)
+    guarded = rsmooth.smooth(v, f, device="reference", best=True, discrepancy_level=level)
+    assert not np.array_equal(guarded, off)
+    assert level <= moved(guarded) < moved(off), (level, moved(guarded), moved(off))
+
+
+def test_discrepancy_iterations_in_the_report():
+    require_opencl()
+    truth, f = box(8)
+    v = noisy(truth, f, 0.3, seed=2)
+    with rsmooth.Context() as ctx:
+        ctx.smooth(v, f, best=True, discrepancy_level=0.01)
+        assert ctx.last_report["discrepancy_iterations"] >= 1
+        ctx.smooth(v, f, best=True)
+        assert ctx.last_report["discrepancy_iterations"] == 0
+
+
 def test_none_means_the_modes_default(cube):
     _, v, f = cube
     # the library's defaults: guided_sigma_s 2, guided_sigma_n 0.2, guided_rounds 20
@@ -93,6 +131,10 @@ def test_none_means_the_modes_default(cube):
         (dict(vertex_updates=5, guided_sigma_n=math.nan), "guided_sigma_n"),
         (dict(vertex_updates=5, guided_rounds=0), "guided_rounds"),
         (dict(vertex_updates=5, guided_rounds=101), "guided_rounds"),
+        (dict(vertex_updates=5, stage_repeats=0), "stage_repeats"),
+        (dict(vertex_updates=5, stage_repeats=101), "stage_repeats"),
+        (dict(discrepancy_level=-1.0), "discrepancy_level"),
+        (dict(discrepancy_level=math.inf), "discrepancy_level"),
     ],
 )
 def test_bad_values(kwargs, match):
