@@ -78,6 +78,13 @@ void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read,
             printf(",\"sigma_c\":null");
         printf(",\"influence\":\"%s\",\"passes\":%d,\"pass_confidence\":%.9g",
                cli_influence_names[p->influence], p->passes, p->pass_confidence);
+        printf(",\"vertex_updates\":%d", p->vertex_updates);
+        if (p->vertex_updates > 0)
+            printf(",\"guided_sigma_s\":%.9g,\"guided_sigma_n\":%.9g,\"guided_rounds\":%d,"
+                   "\"stage_repeats\":%d,\"discrepancy_level\":%.9g,"
+                   "\"discrepancy_iterations\":%d",
+                   p->guided_sigma_s, p->guided_sigma_n, p->guided_rounds, p->stage_repeats,
+                   p->discrepancy_level, r->discrepancy_iterations);
         if (opt->auto_params)
             printf(",\"noise_estimate\":%.9g", opt->noise);
     }

@@ -405,10 +405,10 @@ static int smooth_file(const options *job, const char *path) {
         goto cleanup;
 
     if (!opt.quiet && report.discrepancy_iterations > 0)
-        fprintf(stderr, "rsmooth: %s: --auto: the filter moved the vertices more than 1.1 times "
-                        "the noise it estimated, so it was removing the shape's own detail (a "
-                        "mesh coarse for its curvature): Taubin smoothing, %d iterations, until "
-                        "they moved as far as the noise, instead\n",
+        fprintf(stderr, "rsmooth: %s: --auto: the result is curved at the scale of its "
+                        "triangles (an organic mesh coarse for its curvature, where low-pass "
+                        "smoothing restores the surface better): Taubin smoothing instead, %d "
+                        "iterations, until the vertices moved as far as the noise\n",
                 opt.input, report.discrepancy_iterations);
     if (opt.json)
         cli_print_json(&report, &opt, ms_read, ms_write);

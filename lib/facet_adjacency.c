@@ -3,6 +3,7 @@
  * soup is filtered as the mesh it was cut from. */
 #include "normal_update.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -79,4 +80,42 @@ void rs_adjacency_free(rs_adjacency *adj) {
     rs_free(adj->start);
     rs_free(adj->facet);
     memset(adj, 0, sizeof *adj);
+}
+
+double rs_flat_share(const double *xyz, size_t vertex_count, const uint32_t *indices,
+                     size_t triangle_count, double max_angle) {
+    rs_facets facets;
+    rs_adjacency adj;
+    if (!rs_facets_build(&facets, xyz, indices, triangle_count))
+        return -1;
+    if (!rs_adjacency_build(&adj, xyz, vertex_count, indices, &facets)) {
+        rs_facets_free(&facets);
+        return -1;
+    }
+    double cos_max = cos(max_angle);
+    size_t pairs = 0, flat = 0;
+    /* each pair of facets sharing an edge is met at both of its welded vertices; it is counted
+     * at the lower one */
+    for (size_t r = 0; r < vertex_count; r++)
+        for (size_t i = adj.start[r]; i < adj.start[r + 1]; i++)
+            for (size_t j = i + 1; j < adj.start[r + 1]; j++) {
+                uint32_t f = adj.facet[i], g = adj.facet[j];
+                const uint32_t *tf = indices + 3 * (size_t)facets.triangle[f];
+                const uint32_t *tg = indices + 3 * (size_t)facets.triangle[g];
+                uint32_t other = UINT32_MAX; /* the second welded vertex they share */
+                for (int a = 0; a < 3; a++)
+                    for (int b = 0; b < 3; b++) {
+                        uint32_t ra = adj.rep[tf[a]];
+                        if (ra == adj.rep[tg[b]] && ra != r)
+                            other = ra;
+                    }
+                if (other == UINT32_MAX || other < r)
+                    continue;
+                pairs++;
+                flat += rs_dot3(facets.normal + 3 * (size_t)f, facets.normal + 3 * (size_t)g) >=
+                        cos_max;
+            }
+    rs_adjacency_free(&adj);
+    rs_facets_free(&facets);
+    return pairs ? (double)flat / (double)pairs : 1;
 }

@@ -37,6 +37,13 @@ bool rs_adjacency_build(rs_adjacency *adj, const double *xyz, size_t vertex_coun
                         const uint32_t *indices, const rs_facets *facets);
 void rs_adjacency_free(rs_adjacency *adj);
 
+/* The share of the pairs of facets sharing an edge (welded) whose normals are within max_angle
+ * (radians) of each other: near 1 on a mesh of flat parts and creases (a machined part), low on
+ * one curved at the scale of its triangles. 1 when no facets share an edge; -1 when out of
+ * memory. */
+double rs_flat_share(const double *xyz, size_t vertex_count, const uint32_t *indices,
+                     size_t triangle_count, double max_angle);
+
 /* Guided normal filtering (Zhang et al. 2015), `rounds` rounds, spatial width sigma_s (absolute)
  * and guidance width sigma_n; writes 3 doubles per facet to `normals`. false when out of memory. */
 bool rs_guided_normals(const rs_facets *facets, const rs_adjacency *adj, const uint32_t *indices,

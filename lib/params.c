@@ -50,7 +50,10 @@ rsmooth_status rsmooth_params_init_best(rsmooth_params *params) {
     params->normal_sigma_n = 0.45;
     params->normal_iterations = 5;
     params->passes = 1;
-    params->vertex_updates = 25; /* the normal update stage first (issue 15) */
+    /* the normal update stage first (issue 15): 4 guided rounds and 10 vertex updates, 5 times */
+    params->vertex_updates = 10;
+    params->guided_rounds = 4;
+    params->stage_repeats = 5;
     return RSMOOTH_OK;
 }
 

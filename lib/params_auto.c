@@ -29,10 +29,9 @@ typedef struct best_preset {
 
 static const best_preset GAUSSIAN_PRESETS[] = {
     {"best: gentle", 0.25, 0.15, 5, 25, 1},
-    {"best: medium", 0.45, 0.2, 10, 25, 1},
-    {"best: strong", INFINITY, 0.2, 20, 25, 1},
+    {"best: strong", INFINITY, 0.2, 4, 10, 5},
 };
-static const best_preset IMPULSIVE_PRESET = {"best: impulsive", INFINITY, 0.2, 5, 10, 20};
+static const best_preset IMPULSIVE_PRESET = {"best: impulsive", INFINITY, 0.2, 4, 10, 5};
 #define TANGENTIAL_SHARE 0.5 /* tangential / normal level above which noise reads as random
                               * in direction (for the report only) */
 
@@ -101,7 +100,7 @@ static void choose(rsmooth_params *params, const rs_noise_details *d, char *pres
     params->vertex_updates = b->vertex_updates;
     params->stage_repeats = b->stage_repeats;
     params->passes = best.passes;
-    params->discrepancy_level = n;
+    params->discrepancy_level = d->impulsive ? d->overall_level : n; /* all vertices' rms */
     snprintf(preset, preset_size, "%s", b->name);
     char stage[96];
     snprintf(stage, sizeof stage, "%s%d guided rounds of width %.2g, %d vertex updates",

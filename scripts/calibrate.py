@@ -13,6 +13,12 @@ et al. 2007, as the papers run it: rsmooth's stage with --passes 0, no robust pa
 truth per case, by coordinate descent on GUIDED_LATTICE from two starts, once for E_v and once for
 theta; an optimum on a lattice edge that is not the parameter's least value is recorded.
 
+`final` runs, for every case, the settings its fold chose (from `fit`'s JSON) with the command as
+a user would: `--best --auto` with the fold's stage options spelled out (so the discrepancy guard
+of --auto acts as it does for users), the paper's filter at the fold's sigmas, the preset `--best`
+and the paper's defaults, recording E_v, theta, and the filter's own time (`--json` ms.filter:
+no file reading or writing, no noise estimate) beside the whole command's wall time.
+
 `run` fills a cache (--cache, JSON) with E_v, theta and the wall time of each (case, setting):
 rerunning skips what is there. `fit` reads it and, for each group of cases (one underlying
 model), chooses the rule's settings on the other groups only and applies them to the left-out
@@ -33,18 +39,18 @@ import sys
 import tempfile
 import time
 
-PAPER_SF = [1.0, 1.5, 2.0, 2.5, 3.0, 4.0]
-PAPER_SG = [0.15, 0.25, 0.35, 0.5, 0.75, 1.1, 1.6]
+PAPER_SF = [0.6, 0.8, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0]
+PAPER_SG = [0.15, 0.25, 0.35, 0.5, 0.75, 1.1, 1.6, 2.2, 3.0]
 STAGE = [("--guided-sigma-s", [2.0]), ("--guided-sigma-n", [0.15, 0.2, 0.3]),
          ("--guided-rounds", [5, 10, 20, 40])]
 # After the stage, one robust pass of the previous best mode (bilateral normals, sigma_f 0.8,
 # sigma_g 0.3): on the six benchmark/train pairs it beat the stage alone in 34 of 36 settings.
 JONES_AFTER = {"best1": ["--best", "--passes", "1"]}
-REPEATED = [(3, 4, 0.2), (5, 4, 0.2), (10, 4, 0.2), (20, 5, 0.2), (5, 4, 0.3)]
+REPEATED = [(5, 4, 0.2), (10, 4, 0.2)]
 LEVEL_BOUNDS = [0.25, 0.45]
 # rsmooth_params_init_best's setting, as the command spells it (`--best` alone)
-PRESET = ("--best --passes 1 --vertex-updates 25 --guided-sigma-s 2.0 --guided-sigma-n 0.2 "
-          "--guided-rounds 20")  # low < 0.25 <= mid < 0.45 <= high (estimated level)
+PRESET = ("--best --passes 1 --vertex-updates 10 --guided-sigma-s 2.0 --guided-sigma-n 0.2 "
+          "--guided-rounds 4 --stage-repeats 5")  # low < 0.25 <= mid < 0.45 <= high (estimated level)
 
 
 def paper_settings():
@@ -182,6 +188,54 @@ def cmd_guided(args, cases):
                 entry["theta_opt"]["theta"], entry["theta_opt"]["params"]), flush=True)
 
 
+def run_timed(rsmooth, case, opts, tmp):
+    """E_v, theta, the filter's ms (--json) and the command's wall seconds."""
+    out = os.path.join(tmp, "final.obj")
+    t0 = time.perf_counter()
+    p = subprocess.run([rsmooth, case["noisy"], "-o", out, "-f", "--json"] + opts,
+                       capture_output=True, text=True, check=True)
+    wall = time.perf_counter() - t0
+    report = json.loads(p.stdout.strip().splitlines()[-1])
+    m = json.loads(subprocess.run([rsmooth, "compare", out, case["truth"], "--json"],
+                                  capture_output=True, text=True, check=True).stdout)
+    return {"ev": m["ev"], "theta": m["theta"], "ms_filter": report["ms"]["filter"],
+            "s": round(wall, 3), "guard_iterations": report.get("discrepancy_iterations", 0),
+            "stderr": p.stderr.strip().splitlines()[0] if p.stderr.strip() else ""}
+
+
+def cmd_final(args, cases):
+    fit = json.load(open(args.fit))
+    rows = {r["case"]: r for r in fit["rows"]}
+    out = load(args.out)
+    with tempfile.TemporaryDirectory() as tmp:
+        for c in cases:
+            r = rows.get(c["name"])
+            if r is None or c["name"] in out:
+                continue
+            a, b, cc = r["paper_rule"]
+            n = r["estimate"]
+            stage = r["best_auto"]["setting"].split()
+            stage = stage[stage.index("--passes") + 2:]  # the stage options after --passes 1
+            res = {"best_auto": run_timed(args.rsmooth, c, ["--best", "--auto"] + stage, tmp),
+                   "best_preset": run_timed(args.rsmooth, c, ["--best"], tmp),
+                   "paper_auto": run_timed(args.rsmooth, c, [
+                       "--sigma-f", "%.6g" % (a + b * n), "--sigma-g", "%.6g" % max(cc * n, 1e-3)],
+                       tmp),
+                   "paper_defaults": run_timed(args.rsmooth, c, [], tmp),
+                   "fold": {"paper_rule": r["paper_rule"], "stage": " ".join(stage)},
+                   "estimate": n, "estimated_kind": r["estimated_kind"],
+                   "paper_oracle": r["paper_oracle"], "best_oracle": r["best_oracle"]}
+            out[c["name"]] = res
+            with open(args.out, "w") as f:
+                json.dump(out, f, indent=1)
+            print("%-22s best auto %.3f/%.2f (%s ms, guard %d) preset %.3f paper auto %.3f "
+                  "defaults %.3f (%s ms)" % (
+                      c["name"], res["best_auto"]["ev"], res["best_auto"]["theta"],
+                      res["best_auto"]["ms_filter"], res["best_auto"]["guard_iterations"],
+                      res["best_preset"]["ev"], res["paper_auto"]["ev"],
+                      res["paper_defaults"]["ev"], res["paper_defaults"]["ms_filter"]), flush=True)
+
+
 def level_class(level, kind):
     if kind == "impulsive":
         return "impulsive"
@@ -217,8 +271,8 @@ def cmd_fit(args, cases):
                     "--sigma-g", str(snap(c * n, PAPER_SG))])
 
     paper_keys = [key(o) for o in paper_settings()]
-    rules = [(a, b, c) for a in (0.6, 0.9, 1.2, 1.5) for b in (0.4, 0.8, 1.2, 1.6, 2.4)
-             for c in (1.5, 2.0, 2.5, 3.0, 3.5)]
+    rules = [(a, b, c) for a in (0.3, 0.45, 0.6, 0.75, 0.9, 1.2, 1.5)
+             for b in (0.4, 0.8, 1.2, 1.6, 2.0, 2.4, 3.0) for c in (1.5, 2.0, 2.5, 3.0, 3.5, 4.0)]
 
     def paper_loss(rule, train):
         return statistics.mean(ev(c, paper_key(rule, est[c["name"]][0])) /
@@ -274,7 +328,8 @@ def cmd_fit(args, cases):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("command", choices=["run", "fit", "guided"])
+    ap.add_argument("command", choices=["run", "fit", "guided", "final"])
+    ap.add_argument("--fit", default="docs/results/calibration.json", help="final: fit's JSON")
     ap.add_argument("--cases", required=True)
     ap.add_argument("--rsmooth", default="build/rsmooth")
     ap.add_argument("--cache", default="/tmp/rsmooth-calibration-cache.json")
@@ -282,7 +337,8 @@ def main():
     ap.add_argument("--out", default="docs/results/calibration.json")
     args = ap.parse_args()
     cases = json.load(open(args.cases))["cases"]
-    {"run": cmd_run, "fit": cmd_fit, "guided": cmd_guided}[args.command](args, cases)
+    {"run": cmd_run, "fit": cmd_fit, "guided": cmd_guided, "final": cmd_final}[args.command](
+        args, cases)
 
 
 if __name__ == "__main__":

@@ -702,8 +702,10 @@ int main(void) {
                 p.passes = 3;
                 break;
             case 17:
-                what = "best preset (bilateral, 3 passes)";
+                what = "0.5's best preset (bilateral, 3 passes)";
                 rsmooth_params_init_best(&p);
+                p.vertex_updates = 0; /* the stage has its own oracle (test_normal_update) */
+                p.passes = 3;
                 break;
             case 18:
                 what = "4 passes where confidence < 0.6, Huber";
@@ -745,8 +747,10 @@ int main(void) {
                 p.sigma_g = INFINITY; /* the Gaussian then, with the colour exponent alone */
                 break;
             case 24:
-                what = "colour 0.1, best preset";
+                what = "colour 0.1, 0.5's best preset";
                 rsmooth_params_init_best(&p);
+                p.vertex_updates = 0;
+                p.passes = 3;
                 p.colors = colors;
                 p.sigma_c = 0.1;
                 break;

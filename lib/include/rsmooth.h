@@ -256,14 +256,14 @@ typedef struct rsmooth_params {
                                    * times, [1, 100], each from the facets of the positions the
                                    * one before left: a vertex thrown far (impulsive noise) comes
                                    * back over several repeats. Default 1 */
-    double discrepancy_level;     /* 0 (default): off. > 0: the noise level, in mean edge lengths,
-                                   * the result is checked against (rsmooth_params_auto sets it to
-                                   * the estimate in the best mode). When the filter moved the
-                                   * vertices (RMS, in mean edge lengths of the input) more than
-                                   * 1.1 times this, it removed the shape's own detail, not only
-                                   * noise (a mesh coarse for its curvature): the result is then
-                                   * Taubin's lambda|mu smoothing (0.5, -0.53) of the input, run
-                                   * until the vertices moved this far (the discrepancy principle).
+    double discrepancy_level;     /* 0 (default): off. > 0: the noise level, in mean edge lengths
+                                   * of the input (rsmooth_params_auto sets it to the estimate in
+                                   * the best mode). When the result is curved at the scale of its
+                                   * triangles (fewer than 52% of the facet pairs sharing an edge
+                                   * within 2 degrees: an organic mesh coarse for its curvature,
+                                   * where low-pass smoothing wins), it is replaced by Taubin's
+                                   * lambda|mu smoothing (0.5, -0.53) of the input, run until the
+                                   * vertices moved (RMS) this far: the discrepancy principle.
                                    * Needs connected triangles (a soup keeps the filter's result) */
 } rsmooth_params;
 
@@ -271,7 +271,8 @@ typedef struct rsmooth_params {
 RSMOOTH_API rsmooth_status rsmooth_params_init(rsmooth_params *params);
 
 /* Fills `params` with rsmooth's most accurate mode, beyond the paper: the normal update stage
- * (guided normal filtering, 20 rounds, then 25 vertex updates), then one robust pass with
+ * (4 guided normal filtering rounds of width 0.2, then 10 vertex updates, 5 times), then one
+ * robust pass with
  * bilateral normals at sigma_f 0.8, sigma_g 0.3 (chosen on noisy meshes with a ground truth,
  * docs/experiments.md section 7). rsmooth_params_auto fits its strength to a mesh's noise. */
 RSMOOTH_API rsmooth_status rsmooth_params_init_best(rsmooth_params *params);
