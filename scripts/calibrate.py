@@ -10,7 +10,7 @@ leaves whole meshes out.
 
 `guided` tunes the anchor "guided normal filtering + vertex update" (Zhang et al. 2015 then Sun
 et al. 2007, as the papers run it: rsmooth's stage with --passes 0, no robust pass) against the
-truth per case, by coordinate descent on GUIDED_LATTICE from two starts, once for E_v and once for
+truth per case, by coordinate descent on GUIDED_LATTICE from GUIDED_STARTS, once for E_v and once for
 theta; an optimum on a lattice edge that is not the parameter's least value is recorded.
 
 `final` runs, for every case, the settings its fold chose (from `fit`'s JSON) with the command as
@@ -76,8 +76,7 @@ def best_settings():
 GUIDED_LATTICE = {"--guided-sigma-n": [0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.55],
                   "--guided-rounds": [2, 5, 10, 20, 40, 80],
                   "--vertex-updates": [5, 10, 25, 50, 100]}
-GUIDED_STARTS = [{"--guided-sigma-n": 0.2, "--guided-rounds": 20, "--vertex-updates": 25},
-                 {"--guided-sigma-n": 0.3, "--guided-rounds": 5, "--vertex-updates": 10}]
+GUIDED_STARTS = [{"--guided-sigma-n": 0.2, "--guided-rounds": 20, "--vertex-updates": 25}]
 
 
 def guided_opts(cfg):

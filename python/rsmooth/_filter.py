@@ -93,7 +93,8 @@ def smooth(
     vertex_updates : the normal update stage, before the passes: guided normal filtering
         (Zhang et al. 2015) of the facet normals, then Sun et al. 2007's vertex update, this
         many iterations ([0, 1000]) moving the vertices to agree with the filtered normals.
-        Default 0 (off; ``best``: 25). Runs on the CPU's cores in double precision.
+        Default 0 (off; ``best``: 10, the stage repeated 5 times). Runs on the CPU's cores in
+        double precision.
     guided_sigma_s, guided_sigma_n, guided_rounds : the guided filter's spatial width (units of
         sigma_f, default 2), width on guidance-normal differences ((0, 2], default 0.2) and
         rounds ([1, 100], default 20).
@@ -101,9 +102,10 @@ def smooth(
         from the positions the one before left ([1, 100], default 1): a vertex thrown far
         (impulsive noise) comes back over several repeats.
     discrepancy_level : 0 (default): off. A noise level, in mean edge lengths (``auto`` with
-        ``best`` sets the estimate): when the filter moved the vertices (RMS) more than 1.1
-        times it, it removed the shape's own detail, and the result is instead Taubin
-        smoothing of the input run until the vertices moved that far (the report's
+        ``best`` sets the estimate): when the result is curved at the scale of its triangles
+        (fewer than 52% of the facet pairs sharing an edge within 2 degrees: an organic mesh
+        coarse for its curvature), it is instead Taubin smoothing of the input run until the
+        vertices moved (RMS) that far (the report's
         ``discrepancy_iterations`` says how many; 0 when the filter's result was kept).
     predictor : "projection" (the paper) or "centroid".
     mollify_cutoff : mollification reach in units of sigma_f, (0, cutoff]; default: cutoff.

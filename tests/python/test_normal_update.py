@@ -67,29 +67,45 @@ def test_stage_repeats_chain_the_stage(cube):
     assert np.array_equal(twice, stage(once, f, **width))
 
 
+def ball(n: int = 10):
+    """The box's vertices pushed onto its circumscribed sphere: curved at the scale of its
+    triangles everywhere, where the guard hands over to Taubin smoothing."""
+    v, f = box(n)
+    c = v.mean(axis=0)
+    d = v - c
+    return c + d / np.linalg.norm(d, axis=1, keepdims=True), f
+
+
 def test_discrepancy_guard():
+    def moved(out, v, f):
+        return np.sqrt(np.mean(np.sum((out - v) ** 2, axis=1))) / rsmooth.mean_edge_length(v, f)
+
+    # a part of flat faces and creases keeps the filter's result, whatever the level
     truth, f = box(12)
     v = noisy(truth, f, 0.3, seed=9)
     off = rsmooth.smooth(v, f, device="reference", best=True)
-    # a level far above what the filter moves keeps its result
-    kept = rsmooth.smooth(v, f, device="reference", best=True, discrepancy_level=100.0)
+    kept = rsmooth.smooth(v, f, device="reference", best=True, discrepancy_level=0.3)
     assert np.array_equal(kept, off)
-    # one below it replaces the result by Taubin smoothing run until the vertices moved that far
-    def moved(out):
-        return np.sqrt(np.mean(np.sum((out - v) ** 2, axis=1))) / rsmooth.mean_edge_length(v, f)
-
-    level = 0.5 * moved(off)
-    guarded = rsmooth.smooth(v, f, device="reference", best=True, discrepancy_level=level)
+    # a ball: Taubin smoothing of the input, run until the vertices moved as far as the level
+    truth, f = ball(10)
+    v = noisy(truth, f, 0.3, seed=9)
+    off = rsmooth.smooth(v, f, device="reference", best=True)
+    guarded = rsmooth.smooth(v, f, device="reference", best=True, discrepancy_level=0.3)
     assert not np.array_equal(guarded, off)
-    assert level <= moved(guarded) < moved(off), (level, moved(guarded), moved(off))
+    assert moved(guarded, v, f) >= 0.3 * 0.999, moved(guarded, v, f)
+    k = 1
+    while not np.array_equal(rsmooth.smooth(v, f, method="taubin", iterations=k), guarded):
+        k += 1
+        assert k <= 200
+    assert moved(rsmooth.smooth(v, f, method="taubin", iterations=k - 1), v, f) < 0.3
 
 
 def test_discrepancy_iterations_in_the_report():
     require_opencl()
-    truth, f = box(8)
+    truth, f = ball(8)
     v = noisy(truth, f, 0.3, seed=2)
     with rsmooth.Context() as ctx:
-        ctx.smooth(v, f, best=True, discrepancy_level=0.01)
+        ctx.smooth(v, f, best=True, discrepancy_level=0.1)
         assert ctx.last_report["discrepancy_iterations"] >= 1
         ctx.smooth(v, f, best=True)
         assert ctx.last_report["discrepancy_iterations"] == 0
@@ -102,10 +118,11 @@ def test_none_means_the_modes_default(cube):
         stage(v, f, guided_sigma_s=None, guided_sigma_n=None, guided_rounds=None),
         stage(v, f, guided_sigma_s=2.0, guided_sigma_n=0.2, guided_rounds=20),
     )
-    # best: the stage with 25 updates, then one pass; vertex_updates=None keeps them
+    # best: the stage (10 updates after 4 guided rounds, 5 times), then one pass; None keeps them
     best = rsmooth.smooth(v, f, device="reference", best=True, vertex_updates=None)
     assert np.array_equal(
-        best, rsmooth.smooth(v, f, device="reference", best=True, vertex_updates=25, passes=1)
+        best, rsmooth.smooth(v, f, device="reference", best=True, vertex_updates=10,
+                             guided_rounds=4, stage_repeats=5, passes=1)
     )
     assert not np.array_equal(
         best, rsmooth.smooth(v, f, device="reference", best=True, vertex_updates=0)
