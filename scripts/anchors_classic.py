@@ -133,6 +133,26 @@ def off_vertex_count(path):
     return -1
 
 
+def read_off_vertices(path):
+    with open(path) as fh:
+        tok = []
+        for line in fh:
+            line = line.split("#")[0].strip()
+            if line:
+                tok += line.split()
+            if len(tok) >= 4:
+                break
+        nv = int(tok[1])
+        rows = []
+        for line in fh:
+            line = line.split("#")[0].strip()
+            if line:
+                rows.append([float(x) for x in line.split()[:3]])
+                if len(rows) == nv:
+                    break
+    return np.array(rows)
+
+
 class Ctx:
     def __init__(self, args):
         self.args = args
@@ -270,10 +290,23 @@ class MeshlabTwoStep:
     def __init__(self, ctx, case):
         self.ctx, self.case = ctx, case
         ctx.ensure_display()
-        self.off = os.path.join(ctx.work, "off", case["name"] + ".off")
+        # MeshLab's TwoStep throws vcg::MissingCompactnessException on a mesh with
+        # vertices no face uses (stanford-bunny has ~1100): such a mesh is given to MeshLab
+        # without them, and they are put back, unmoved, in the input's order afterwards
+        # (as rsmooth's Taubin leaves them).
+        self.v, self.f = read_obj(case["noisy"])
+        used = np.zeros(len(self.v), bool)
+        used[self.f.ravel()] = True
+        self.used = None if used.all() else np.nonzero(used)[0]
+        self.off = os.path.join(ctx.work, "off", case["name"] +
+                                (".off" if self.used is None else ".compact.off"))
         if not os.path.exists(self.off):
-            v, f = read_obj(case["noisy"])
-            write_off(self.off + ".tmp", v, f)
+            if self.used is None:
+                write_off(self.off + ".tmp", self.v, self.f)
+            else:
+                remap = np.full(len(self.v), -1, np.int64)
+                remap[self.used] = np.arange(len(self.used))
+                write_off(self.off + ".tmp", self.v[self.used], remap[self.f])
             os.replace(self.off + ".tmp", self.off)
         self.nv = off_vertex_count(self.off)
 
@@ -296,6 +329,10 @@ class MeshlabTwoStep:
         nv = off_vertex_count(out)
         if nv != self.nv:
             raise RuntimeError("meshlab changed the vertex count %d -> %d" % (self.nv, nv))
+        if self.used is not None:
+            full = self.v.copy()
+            full[self.used] = read_off_vertices(out)
+            write_off(out, full, self.f)
         return dt
 
     def evaluate(self, p):
