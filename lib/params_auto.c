@@ -11,9 +11,9 @@
 
 /* The paper's filter: sigma_f = A + B n, sigma_g = C n for noise n (scripts/calibrate.py fit,
  * the lattice rule with the lowest mean ratio to each case's best sigmas). */
-#define PAPER_SIGMA_F_AT_0 0.9
-#define PAPER_SIGMA_F_PER_NOISE 0.8
-#define PAPER_SIGMA_G_PER_NOISE 3.0
+#define PAPER_SIGMA_F_AT_0 0.6
+#define PAPER_SIGMA_F_PER_NOISE 1.6
+#define PAPER_SIGMA_G_PER_NOISE 4.0
 
 /* The best mode: the normal update stage (guided normals, then the vertex update, repeated) and
  * one robust pass with bilateral normals, its strength by noise class; then the discrepancy guard

@@ -264,7 +264,10 @@ done:
  * 0.51 on the organic meshes where Taubin wins. */
 #define FLAT_SHARE_MIN 0.52
 #define FLAT_ANGLE (2.0 * 3.14159265358979323846 / 180)
-#define DISCREPANCY_MAX_ITERATIONS 200
+#define DISCREPANCY_MAX_ITERATIONS 40 /* tuned Taubin needed 5-50 on the calibration meshes; at
+                                     * high noise the move saturates below the level and more
+                                     * iterations only shrink detail (the Stanford bunny at 0.5:
+                                     * E_v 0.93 at 40, 1.35 at 200) */
 
 static rsmooth_status discrepancy_guard(rsmooth_scalar scalar, const void *positions,
                                         size_t vertex_count, const uint32_t *indices,

@@ -263,7 +263,8 @@ typedef struct rsmooth_params {
                                    * within 2 degrees: an organic mesh coarse for its curvature,
                                    * where low-pass smoothing wins), it is replaced by Taubin's
                                    * lambda|mu smoothing (0.5, -0.53) of the input, run until the
-                                   * vertices moved (RMS) this far: the discrepancy principle.
+                                   * vertices moved (RMS) this far (the discrepancy principle), at
+                                   * most 40 iterations.
                                    * Needs connected triangles (a soup keeps the filter's result) */
 } rsmooth_params;
 
@@ -311,7 +312,7 @@ RSMOOTH_API rsmooth_status rsmooth_estimate_noise(rsmooth_scalar scalar, const v
  * of `params` the rules chosen in docs/experiments.md (section 7; cross-validated, whole meshes
  * left out) give for it. `params` must be initialised first; it picks the rule:
  *   the paper's filter (rsmooth_params_init: normal_filter RSMOOTH_NORMALS_MOLLIFY and no
- *     vertex_updates): sigma_f = 0.9 + 0.8 n, sigma_g = 3 n for noise n in mean edge lengths;
+ *     vertex_updates): sigma_f = 0.6 + 1.6 n, sigma_g = 4 n for noise n in mean edge lengths;
  *   otherwise the best mode (rsmooth_params_init_best's setting): the guided filter's rounds by
  *     noise class (gentle, medium, strong; impulsive noise its own).
  * Sigmas are relative (absolute = 0 after the call). Other fields are left as they are. Writes
