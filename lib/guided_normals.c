@@ -97,23 +97,6 @@ static bool share_edge(const guided_job *job, uint32_t a, uint32_t b) {
     return shared >= 2;
 }
 
-/* Mean distance between the centroids of edge-adjacent facets (each pair once), in facet order. */
-static double adjacent_distance(const guided_job *job) {
-    uint32_t member[PATCH_MAX];
-    double sum = 0;
-    size_t pairs = 0;
-    for (size_t j = 0; j < job->facets->count; j++) {
-        size_t m = patch_of(job, j, member);
-        for (size_t k = 1; k < m; k++)
-            if (member[k] > j && share_edge(job, (uint32_t)j, member[k])) {
-                sum += sqrt(gap2(job->facets->centroid + 3 * j,
-                                 job->facets->centroid + 3 * (size_t)member[k]));
-                pairs++;
-            }
-    }
-    return pairs ? sum / (double)pairs : 0;
-}
-
 /* Appends to a growing array; false when out of memory. */
 static bool push(void **array, size_t *capacity, size_t count, size_t size, const void *item) {
     if (count == *capacity) {
@@ -139,32 +122,63 @@ static void lists_free(guided_lists *l) {
     memset(l, 0, sizeof *l);
 }
 
-/* The lists, one facet after another (their order fixes the sums' order: deterministic). */
-static bool lists_build(guided_job *job) {
+/* Each facet's patch and the patch's interior edges, one facet after another (their order fixes
+ * the sums' order: deterministic). */
+static bool patch_lists_build(guided_job *job) {
     guided_lists *l = &job->lists;
-    size_t nf = job->facets->count, np = 0, ne = 0, nn = 0, cp = 0, ce = 0, cn = 0, cw = 0;
+    size_t nf = job->facets->count, np = 0, ne = 0, cp = 0, ce = 0;
     l->patch_start = rs_alloc_array(nf + 1, sizeof(size_t));
     l->edge_start = rs_alloc_array(nf + 1, sizeof(size_t));
-    l->near_start = rs_alloc_array(nf + 1, sizeof(size_t));
-    if (!l->patch_start || !l->edge_start || !l->near_start)
+    if (!l->patch_start || !l->edge_start)
         return false;
     uint32_t member[PATCH_MAX];
-    const rs_grid *grid = job->grid;
     for (size_t f = 0; f < nf; f++) {
         l->patch_start[f] = np;
         l->edge_start[f] = ne;
-        l->near_start[f] = nn;
         size_t m = patch_of(job, f, member);
         for (size_t a = 0; a < m; a++) {
             if (!push((void **)&l->patch, &cp, np++, sizeof *l->patch, &member[a]))
                 return false;
             for (size_t b = a + 1; b < m; b++)
                 if (share_edge(job, member[a], member[b])) {
-                    if (!push((void **)&l->edge, &ce, ne++, sizeof *l->edge, &member[a]) ||
-                        !push((void **)&l->edge, &ce, ne++, sizeof *l->edge, &member[b]))
+                    if (!push((void **)&l->edge, &ce, 2 * ne, sizeof *l->edge, &member[a]) ||
+                        !push((void **)&l->edge, &ce, 2 * ne + 1, sizeof *l->edge, &member[b]))
                         return false;
+                    ne++;
                 }
         }
+    }
+    l->patch_start[nf] = np;
+    l->edge_start[nf] = ne;
+    return true;
+}
+
+/* Mean distance between the centroids of edge-adjacent facets, each pair once: the edges of
+ * facet f's patch that have f on one side (listed first, f being its patch's first facet). */
+static double adjacent_distance(const guided_job *job) {
+    const guided_lists *l = &job->lists;
+    double sum = 0;
+    size_t pairs = 0;
+    for (size_t f = 0; f < job->facets->count; f++)
+        for (size_t e = l->edge_start[f]; e < l->edge_start[f + 1] && l->edge[2 * e] == f; e++)
+            if (l->edge[2 * e + 1] > f) {
+                sum += sqrt(gap2(job->facets->centroid + 3 * f,
+                                 job->facets->centroid + 3 * (size_t)l->edge[2 * e + 1]));
+                pairs++;
+            }
+    return pairs ? sum / (double)pairs : 0;
+}
+
+/* Each facet's neighbours within the filter's reach, with their fixed weights, through the grid. */
+static bool near_lists_build(guided_job *job) {
+    guided_lists *l = &job->lists;
+    size_t nf = job->facets->count, nn = 0, cn = 0, cw = 0;
+    l->near_start = rs_alloc_array(nf + 1, sizeof(size_t));
+    if (!l->near_start)
+        return false;
+    const rs_grid *grid = job->grid;
+    for (size_t f = 0; f < nf; f++) {
+        l->near_start[f] = nn;
         const double *cf = job->facets->centroid + 3 * f;
         int32_t cc[3];
         rs_grid_cell_of(grid, cf, cc);
@@ -179,19 +193,14 @@ static bool lists_build(guided_job *job) {
                         if (d2 > job->reach * job->reach)
                             continue;
                         double w = job->facets->area[q] * exp(-d2 * job->inv_2s2);
-                        if (!push((void **)&l->near, &cn, nn, sizeof *l->near, &q))
-                            return false;
-                        if (!push((void **)&l->near_weight, &cw, nn, sizeof *l->near_weight, &w))
+                        if (!push((void **)&l->near, &cn, nn, sizeof *l->near, &q) ||
+                            !push((void **)&l->near_weight, &cw, nn, sizeof *l->near_weight, &w))
                             return false;
                         nn++;
                     }
                 }
     }
-    l->patch_start[nf] = np;
-    l->edge_start[nf] = ne / 2;
     l->near_start[nf] = nn;
-    for (size_t f = 0; f < nf; f++)
-        l->edge_start[f] /= 2;
     return true;
 }
 
@@ -275,9 +284,6 @@ bool rs_guided_normals(const rs_facets *facets, const rs_adjacency *adj, const u
     job.indices = indices;
     job.inv_2s2 = 1 / (2 * sigma_s * sigma_s);
     job.inv_2t2 = 1 / (2 * sigma_n * sigma_n);
-    job.reach = REACH_ADJACENT * adjacent_distance(&job);
-    if (!(job.reach > 0)) /* no two facets share an edge: nothing to filter across */
-        return true;
     rs_grid grid;
     memset(&grid, 0, sizeof grid);
     double *prev = rs_alloc_array(nf, 3 * sizeof(double));
@@ -285,13 +291,16 @@ bool rs_guided_normals(const rs_facets *facets, const rs_adjacency *adj, const u
     double *score = rs_alloc_array(nf, sizeof(double));
     double *guide = rs_alloc_array(nf, 3 * sizeof(double));
     job.grid = &grid;
-    bool ok = prev && mean && score && guide &&
-              rs_grid_build(&grid, facets->centroid, nf, job.reach, NULL) == RSMOOTH_OK &&
-              lists_build(&job);
+    bool ok = prev && mean && score && guide && patch_lists_build(&job);
+    job.reach = ok ? REACH_ADJACENT * adjacent_distance(&job) : 0;
+    bool filter = job.reach > 0; /* else no two facets share an edge: the input's normals stay */
+    if (ok && filter)
+        ok = rs_grid_build(&grid, facets->centroid, nf, job.reach, NULL) == RSMOOTH_OK &&
+             near_lists_build(&job);
     job.patch_mean = mean;
     job.patch_score = score;
     job.guidance = guide;
-    for (int round = 0; ok && round < rounds; round++) {
+    for (int round = 0; ok && filter && round < rounds; round++) {
         memcpy(prev, normals, nf * 3 * sizeof(double));
         job.normal = prev;
         job.out = normals;
