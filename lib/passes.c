@@ -52,7 +52,7 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                                     const rsmooth_params *params, void *out_positions,
                                     float *out_weight, float *out_confidence,
                                     rsmooth_report *report, rsmooth_error *error,
-                                    const char *where, const uint8_t **move_mask);
+                                    const char *where, rsmooth_params *resolved);
 
 /* The normal update stage (normal_update.h) on a double copy of the input, then the passes from
  * its result, in the caller's scalar type (params resolved and outputs checked). */
@@ -118,10 +118,10 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
             from = f;
         }
         p.vertex_updates = 0;
-        const uint8_t *unused_mask;
+        rsmooth_params unused;
         st = filter_passes(one_pass, ctx, scalar, from, vertex_count, indices, triangle_count, &p,
                            out_positions, out_weight, out_confidence, report, error, where,
-                           &unused_mask);
+                           &unused);
     }
     if (st == RSMOOTH_OK && report) {
         report->ms_normals += t_stage - t_start; /* the stage counts as normal filtering */
@@ -138,12 +138,12 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                                     const rsmooth_params *params, void *out_positions,
                                     float *out_weight, float *out_confidence,
                                     rsmooth_report *report, rsmooth_error *error,
-                                    const char *where, const uint8_t **move_mask) {
+                                    const char *where, rsmooth_params *resolved) {
     double t_start = rs_now_ms();
     rs_error_clear(error);
     rsmooth_params p;
     rsmooth_status st = rs_params_resolve(params, &p, error, where);
-    *move_mask = p.move_mask; /* the caller restores the unselected vertices at the end */
+    *resolved = p; /* the caller's mask and guard act at the end */
     if (st == RSMOOTH_OK)
         st = rs_check_outputs(scalar, positions, vertex_count, indices, triangle_count, &p,
                               out_positions, out_weight, out_confidence, error, where);
@@ -258,10 +258,10 @@ done:
  * low-pass smoothing restores the surface better than feature-preserving filtering does: tuned
  * Taubin smoothing won on every such calibration mesh but one. The result is then Taubin's
  * smoothing of the input run until the vertices moved (RMS) as far as the noise did: the
- * discrepancy principle, which needs no truth to choose the iterations. FLAT_SHARE_MIN was
- * chosen on the calibration cases leaving whole meshes out (scripts/calibrate.py, docs/accuracy.md):
- * the best mode's results have 0.53-0.86 on the parts and smooth car body it restores best, 0.16-
- * 0.51 on the organic meshes where Taubin wins. */
+ * discrepancy principle, which needs no truth to choose the iterations. FLAT_SHARE_MIN was read
+ * off scripts/discrepancy_study.py over all 30 calibration cases (not cross-validated;
+ * docs/accuracy.md): the best mode's results have 0.53-0.86 on the parts and the smooth car body
+ * it restores best, 0.16-0.51 on the organic meshes where Taubin wins. */
 #define FLAT_SHARE_MIN 0.52
 #define FLAT_ANGLE (2.0 * 3.14159265358979323846 / 180)
 #define DISCREPANCY_MAX_ITERATIONS 40 /* tuned Taubin needed 5-50 on the calibration meshes; at
@@ -269,53 +269,31 @@ done:
                                      * iterations only shrink detail (the Stanford bunny at 0.5:
                                      * E_v 0.93 at 40, 1.35 at 200) */
 
-static rsmooth_status discrepancy_guard(rsmooth_scalar scalar, const void *positions,
-                                        size_t vertex_count, const uint32_t *indices,
-                                        size_t triangle_count, const rsmooth_params *params,
-                                        void *out_positions, rsmooth_report *report,
-                                        size_t caller_size, rsmooth_error *error,
-                                        const char *where) {
-    rsmooth_params p;
-    if (rs_params_resolve(params, &p, error, where) != RSMOOTH_OK || !(p.discrepancy_level > 0) ||
-        vertex_count == 0)
-        return RSMOOTH_OK; /* (resolved before: cannot fail now) */
-    bool reports = report && caller_size >= offsetof(rsmooth_report, discrepancy_iterations) +
-                                                 sizeof report->discrepancy_iterations;
-    if (reports)
-        report->discrepancy_iterations = 0;
-    double unit = 0;
-    rsmooth_status st = rsmooth_mean_edge_length(scalar, positions, vertex_count, indices,
-                                                 triangle_count, &unit, error);
-    if (st != RSMOOTH_OK || !(unit > 0))
-        return st;
-    double *result = rs_alloc_array(vertex_count, 3 * sizeof *result);
-    if (!result)
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the guard");
-    for (size_t i = 0; i < 3 * vertex_count; i++)
-        result[i] = rs_coordinate(scalar, out_positions, i);
-    double flat = rs_flat_share(result, vertex_count, indices, triangle_count, FLAT_ANGLE);
-    rs_free(result);
-    if (flat < 0)
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the guard");
-    if (!(flat < FLAT_SHARE_MIN))
-        return RSMOOTH_OK;
+/* Taubin's iterations that replace the result (0: it stays), or -1 when out of memory. */
+static int discrepancy_guard(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
+                             const uint32_t *indices, size_t triangle_count, double level,
+                             void *out_positions) {
     double *xyz = rs_alloc_array(vertex_count, 3 * sizeof *xyz);
     if (!xyz)
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the guard");
+        return -1;
     for (size_t i = 0; i < 3 * vertex_count; i++)
-        xyz[i] = rs_coordinate(scalar, positions, i);
-    int iterations = rs_taubin_until(xyz, vertex_count, indices, triangle_count, 0.5, -0.53,
-                                     p.discrepancy_level * unit, DISCREPANCY_MAX_ITERATIONS);
-    if (iterations > 0) { /* 0: no edge moves anything (a soup): keep the filter's result */
-        for (size_t v = 0; v < vertex_count; v++)
+        xyz[i] = rs_coordinate(scalar, out_positions, i);
+    double flat = rs_flat_share(xyz, vertex_count, indices, triangle_count, FLAT_ANGLE);
+    int iterations = 0;
+    if (flat >= 0 && flat < FLAT_SHARE_MIN) { /* Taubin from the input, in its edge lengths */
+        for (size_t i = 0; i < 3 * vertex_count; i++)
+            xyz[i] = rs_coordinate(scalar, positions, i);
+        double unit = 0;
+        if (!rs_mean_edge_length(xyz, vertex_count, indices, triangle_count, &unit))
+            flat = -1;
+        else if (unit > 0)
+            iterations = rs_taubin_until(xyz, vertex_count, indices, triangle_count, 0.5, -0.53,
+                                         level * unit, DISCREPANCY_MAX_ITERATIONS);
+        for (size_t v = 0; iterations > 0 && v < vertex_count; v++)
             rs_store_position(scalar, out_positions, v, xyz + 3 * v, 1);
-        if (reports)
-            report->discrepancy_iterations = iterations;
     }
     rs_free(xyz);
-    return iterations < 0 ? rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where,
-                                    "no memory for the guard")
-                          : RSMOOTH_OK;
+    return flat < 0 || iterations < 0 ? -1 : iterations; /* 0: no edge moves anything (a soup) */
 }
 
 /* The passes, then the last check of what they wrote (results.c): never a non-finite OK. */
@@ -326,20 +304,25 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar
                                 float *out_weight, float *out_confidence, rsmooth_report *report,
                                 rsmooth_error *error, const char *where) {
     size_t caller_size = report ? report->struct_size : 0; /* the report's fillers reset it */
-    const uint8_t *move_mask = NULL;
+    rsmooth_params p;
     rsmooth_status st = filter_passes(one_pass, ctx, scalar, positions, vertex_count, indices,
                                       triangle_count, params, out_positions, out_weight,
-                                      out_confidence, report, error, where, &move_mask);
+                                      out_confidence, report, error, where, &p);
     if (report)
         report->struct_size = caller_size;
     if (st != RSMOOTH_OK)
         return st;
-    st = discrepancy_guard(scalar, positions, vertex_count, indices, triangle_count, params,
-                           out_positions, report, caller_size, error, where);
-    if (st != RSMOOTH_OK)
-        return st;
+    if (p.discrepancy_level > 0 && vertex_count > 0) {
+        int iterations = discrepancy_guard(scalar, positions, vertex_count, indices,
+                                           triangle_count, p.discrepancy_level, out_positions);
+        if (iterations < 0)
+            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the guard");
+        if (report && caller_size >= offsetof(rsmooth_report, discrepancy_iterations) +
+                                         sizeof report->discrepancy_iterations)
+            report->discrepancy_iterations = iterations;
+    }
     /* every pass held them still; their final bytes are the input's own */
-    keep_unselected(scalar, positions, vertex_count, move_mask, out_positions);
+    keep_unselected(scalar, positions, vertex_count, p.move_mask, out_positions);
     return rs_check_results(scalar, out_positions, out_weight, out_confidence, vertex_count,
                             "vertex", error, where);
 }
