@@ -530,6 +530,20 @@ static double select_kth(double *a, size_t n, size_t k) {
     return a[k];
 }
 
+/* The quadric's terms at (x, y) into row, and its height there for coefficients beta (NULL: 0). */
+static double quadric_at(double x, double y, const double *beta, double row[TERMS]) {
+    row[0] = 1;
+    row[1] = x;
+    row[2] = y;
+    row[3] = x * x;
+    row[4] = x * y;
+    row[5] = y * y;
+    double f = 0;
+    for (int r = 0; beta && r < TERMS; r++)
+        f += row[r] * beta[r];
+    return f;
+}
+
 /* The prediction error at v of a robust refit: the cylinder's points (w->c, count of them) whose
  * residual from the fit beta exceeds ROBUST_CUT robust sigmas (1.4826 x their median |residual|)
  * are left out and the quadric refitted, ROBUST_ROUNDS times; |b0| / sqrt(1 + (M^-1)_00), mesh
@@ -547,11 +561,8 @@ static double robust_residual(workspace *w, size_t count, const double beta_ls[T
     for (int round = 0; round < ROBUST_ROUNDS; round++) {
         for (size_t j = 0; j < count; j++) {
             const double *c = w->c + 3 * j;
-            const double row[TERMS] = {1, c[0], c[1], c[0] * c[0], c[0] * c[1], c[1] * c[1]};
-            double f = 0;
-            for (int r = 0; r < TERMS; r++)
-                f += row[r] * beta[r];
-            w->e[j] = fabs(c[2] - f);
+            double row[TERMS];
+            w->e[j] = fabs(c[2] - quadric_at(c[0], c[1], beta, row));
         }
         double cut = ROBUST_CUT * MAD_TO_SIGMA * select_kth(w->e, count, count / 2);
         cut = cut > 1e-9 * unit ? cut : 1e-9 * unit;
@@ -559,11 +570,8 @@ static double robust_residual(workspace *w, size_t count, const double beta_ls[T
         size_t kept = 0;
         for (size_t j = 0; j < count; j++) {
             const double *c = w->c + 3 * j;
-            const double row[TERMS] = {1, c[0], c[1], c[0] * c[0], c[0] * c[1], c[1] * c[1]};
-            double f = 0;
-            for (int r = 0; r < TERMS; r++)
-                f += row[r] * beta[r];
-            if (!(fabs(c[2] - f) <= cut))
+            double row[TERMS];
+            if (!(fabs(c[2] - quadric_at(c[0], c[1], beta, row)) <= cut))
                 continue;
             for (int r = 0; r < TERMS; r++) {
                 b[r] += row[r] * c[2];
@@ -588,11 +596,8 @@ static double robust_residual(workspace *w, size_t count, const double beta_ls[T
             double ss = 0;
             for (size_t j = 0; j < count; j++) {
                 const double *c = w->c + 3 * j;
-                const double row[TERMS] = {1, c[0], c[1], c[0] * c[0], c[0] * c[1], c[1] * c[1]};
-                double f = 0;
-                for (int r = 0; r < TERMS; r++)
-                    f += row[r] * beta[r];
-                double e = c[2] - f;
+                double row[TERMS];
+                double e = c[2] - quadric_at(c[0], c[1], beta, row);
                 if (fabs(e) <= cut)
                     ss += e * e;
             }
@@ -637,7 +642,8 @@ static bool sample_residual(const sample_job *job, size_t v, workspace *w, bool 
         w->c[3 * count] = x;
         w->c[3 * count + 1] = y;
         w->c[3 * count + 2] = z;
-        const double row[TERMS] = {1, x, y, x * x, x * y, y * y};
+        double row[TERMS];
+        quadric_at(x, y, NULL, row);
         for (int r = 0; r < TERMS; r++) {
             b[r] += row[r] * z;
             for (int c = 0; c <= r; c++)
