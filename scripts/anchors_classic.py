@@ -54,10 +54,10 @@ import json
 import os
 import statistics
 import subprocess
-import sys
 import time
 
 import numpy as np
+from obj_mesh import read_obj, write_obj  # scripts/obj_mesh.py
 
 TAUBIN_GRID = [1, 2, 3, 4, 5, 7, 10, 14, 20, 30, 40, 50, 70, 100, 140, 200, 300]
 TAUBIN_EXT = [400, 500, 700, 1000, 1400, 2000, 3000, 5000]
@@ -88,29 +88,6 @@ TS_MLX = """<!DOCTYPE FilterScript>
  </filter>
 </FilterScript>
 """
-
-
-def read_obj(path):
-    vs, fs = [], []
-    with open(path) as fh:
-        for line in fh:
-            if line.startswith("v "):
-                p = line.split()
-                vs.append((float(p[1]), float(p[2]), float(p[3])))
-            elif line.startswith("f "):
-                idx = [int(t.split("/")[0]) for t in line.split()[1:]]
-                for i in range(1, len(idx) - 1):  # fan (all are triangles here)
-                    fs.append((idx[0], idx[i], idx[i + 1]))
-    v = np.array(vs, dtype=np.float64)
-    f = np.array(fs, dtype=np.int64)
-    f = np.where(f < 0, f + len(v), f - 1)
-    return v, f
-
-
-def write_obj(path, v, f):
-    with open(path, "w") as fh:
-        fh.write("".join("v %.10g %.10g %.10g\n" % tuple(p) for p in v))
-        fh.write("".join("f %d %d %d\n" % (a + 1, b + 1, c + 1) for a, b, c in f))
 
 
 def write_off(path, v, f):
@@ -236,7 +213,7 @@ class Open3DTaubin:
         rv = np.asarray(r.vertices)
         assert rv.shape == self.v.shape, "open3d changed the vertex count"
         if out:
-            write_obj(out, rv, self.f)
+            write_obj(out, rv, self.f, digits=10)
         return t1 - t0, c1 - c0
 
     def evaluate(self, k):

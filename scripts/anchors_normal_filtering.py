@@ -48,10 +48,10 @@ for _k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 import argparse
 import json
 import subprocess
-import sys
 import time
 
 import numpy as np
+from obj_mesh import read_obj, write_obj  # scripts/obj_mesh.py
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
@@ -74,29 +74,6 @@ EPS_R = 1e-9
 
 
 # ---------------------------------------------------------------------------------------- I/O
-def load_obj(path):
-    vs, fs = [], []
-    with open(path) as fh:
-        for line in fh:
-            if line.startswith("v "):
-                p = line.split()
-                vs.append((float(p[1]), float(p[2]), float(p[3])))
-            elif line.startswith("f "):
-                idx = [int(t.split("/")[0]) for t in line.split()[1:]]
-                for k in range(1, len(idx) - 1):  # fan, should a polygon appear
-                    fs.append((idx[0], idx[k], idx[k + 1]))
-    V = np.array(vs, dtype=np.float64)
-    F = np.array(fs, dtype=np.int64)
-    F = np.where(F < 0, F + len(V), F - 1)
-    return V, F
-
-
-def save_obj(path, V, F):
-    with open(path, "w") as fh:
-        fh.write("".join("v %.17g %.17g %.17g\n" % tuple(v) for v in V))
-        fh.write("".join("f %d %d %d\n" % tuple(f) for f in (F + 1)))
-
-
 def rsmooth_compare(binary, result, truth):
     out = subprocess.run([binary, "compare", result, truth, "--json"], check=True,
                          capture_output=True, text=True).stdout
@@ -347,8 +324,8 @@ def extend(lst, kind):
 
 def tune_case(case, method, args, cache):
     """Coordinate descent; returns (best_ev_entry, best_theta_entry, grids used)."""
-    V, F = load_obj(case["noisy"])
-    T, FT = load_obj(case["truth"])
+    V, F = read_obj(case["noisy"])
+    T, FT = read_obj(case["truth"])
     assert np.array_equal(F, FT), "noisy and truth faces differ"
     mesh = Mesh(V, F)
     metric = FastMetrics(T, F)
@@ -456,7 +433,7 @@ def tune_case(case, method, args, cache):
         X = denoise(mesh, method, p["sigma_s_mult"], p["sigma_r"], p["normal_iters"],
                     p["vertex_iters"])
         path = os.path.join(args.work, "%s_%s_%s.obj" % (case["name"], method, name))
-        save_obj(path, X, F)
+        write_obj(path, X, F)
         m = rsmooth_compare(args.rsmooth, path, case["truth"])
         out[name]["ev"] = m["ev"]
         out[name]["theta"] = m["theta"]

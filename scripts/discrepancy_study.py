@@ -17,25 +17,9 @@ import re
 import subprocess
 import tempfile
 
+from obj_mesh import read_obj  # scripts/obj_mesh.py
+
 TAUBIN = [1, 2, 3, 5, 7, 10, 14, 20, 30, 40, 60]
-
-
-def read_vertices(path):
-    out = []
-    with open(path) as f:
-        for line in f:
-            if line.startswith("v "):
-                out.append([float(x) for x in line.split()[1:4]])
-    return out
-
-
-def read_faces(path):
-    out = []
-    with open(path) as f:
-        for line in f:
-            if line.startswith("f "):
-                out.append([int(t.split("/")[0]) - 1 for t in line.split()[1:4]])
-    return out
 
 
 def flat_share(v, faces, degrees=2.0):
@@ -85,7 +69,7 @@ def main():
         for c in cases:
             if c["name"] in result:
                 continue
-            noisy = read_vertices(c["noisy"])
+            noisy, _ = read_obj(c["noisy"])
             unit = json.loads(subprocess.run([args.rsmooth, "compare", c["noisy"], c["noisy"],
                                               "--json"], capture_output=True, text=True,
                                              check=True).stdout)["mean_edge"]
@@ -95,8 +79,8 @@ def main():
                                    capture_output=True, text=True, check=True)
                 m = json.loads(subprocess.run([args.rsmooth, "compare", out, c["truth"], "--json"],
                                               capture_output=True, text=True, check=True).stdout)
-                result = read_vertices(out)
-                share, median = flat_share(result, read_faces(out))
+                result, faces = read_obj(out)
+                share, median = flat_share(result, faces)
                 return {"ev": m["ev"], "theta": m["theta"], "move": rms_move(result, noisy, unit),
                         "flat_share": share, "median_dihedral_deg": median}, p.stderr
 
