@@ -86,10 +86,19 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                        "no memory for the normal update stage");
     for (size_t i = 0; i < 3 * vertex_count; i++)
         staged[i] = rs_coordinate(scalar, positions, i);
-    for (int r = 0; unit > 0 && st == RSMOOTH_OK && r < p.stage_repeats; r++) /* no edge: none */
+    /* Progress: the stage is the first half, reported after each repeat (and the caller may stop
+     * it there); the passes the second half, through the same rescaling as repeated passes. */
+    int halves = p.passes > 0 ? 2 : 1;
+    rs_pass_progress pp = {p.progress, p.progress_cancel, p.progress_user, 0, halves};
+    bool reports = pp.progress || pp.cancel;
+    for (int r = 0; unit > 0 && st == RSMOOTH_OK && r < p.stage_repeats; r++) { /* no edge: none */
         st = rs_normal_update_stage(staged, vertex_count, indices, triangle_count,
                                     p.guided_sigma_s, p.guided_sigma_n, p.guided_rounds,
                                     p.vertex_updates, p.move_mask, error, where);
+        if (st == RSMOOTH_OK && reports &&
+            rs_report_pass_progress(&pp, (double)(r + 1) / p.stage_repeats) != 0)
+            st = rs_cancelled(error, where);
+    }
     double t_stage = rs_now_ms();
     if (st == RSMOOTH_OK && p.passes == 0) { /* the stage alone */
         for (size_t v = 0; v < vertex_count; v++) {
@@ -118,6 +127,12 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
             from = f;
         }
         p.vertex_updates = 0;
+        if (reports) {
+            pp.pass = 1;
+            p.progress = NULL;
+            p.progress_cancel = rs_report_pass_progress;
+            p.progress_user = &pp;
+        }
         rsmooth_params unused;
         st = filter_passes(one_pass, ctx, scalar, from, vertex_count, indices, triangle_count, &p,
                            out_positions, out_weight, out_confidence, report, error, where,

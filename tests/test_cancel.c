@@ -1,7 +1,8 @@
 /* progress_cancel: a callback that never asks to stop changes nothing (bit for bit against a run
  * without it) and sees fractions that rise to 1; one that asks to stop after its k-th report ends
  * the call with RSMOOTH_ERROR_CANCELLED at once (no report after it), on every path: reference
- * and OpenCL, one pass and several, the bilateral normal filter, spatial tiles, point clouds. */
+ * and OpenCL, one pass and several, the bilateral normal filter, the best mode's normal update
+ * stage (reported, and stoppable, after each of its repeats), spatial tiles, point clouds. */
 #include "mesh_shapes.h"
 #include "rsmooth.h"
 #include "test_cl_util.h"
@@ -117,7 +118,7 @@ int main(void) {
     rsmooth_params_init_best(&best);
     CHECK_EQ_INT(paper.progress_cancel == NULL, 1);
     check_path("reference, paper", run_reference, NULL, &m, &paper);
-    check_path("reference, best (3 passes, bilateral)", run_reference, NULL, &m, &best);
+    check_path("reference, best (stage, 1 pass)", run_reference, NULL, &m, &best);
     check_path("points, best", run_points, NULL, &m, &best);
 
     /* A status of its own, with text. */
@@ -125,7 +126,7 @@ int main(void) {
 
     rsmooth_context *ctx = open_test_context();
     check_path("OpenCL, paper", run_opencl, ctx, &m, &paper);
-    check_path("OpenCL, best (3 passes, bilateral)", run_opencl, ctx, &m, &best);
+    check_path("OpenCL, best (stage, 1 pass)", run_opencl, ctx, &m, &best);
     rsmooth_context_set_memory_budget(ctx, 1u << 20); /* tiles */
     rsmooth_report report;
     rsmooth_error err;
