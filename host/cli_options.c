@@ -24,7 +24,7 @@ enum {
     OPT_PASS_CONFIDENCE, OPT_SIGMA_C, OPT_NORMAL_ITERATIONS, OPT_PASSES, OPT_AUTO, OPT_BEST,
     OPT_ABSOLUTE, OPT_NO_MOLLIFY, OPT_ASCII, OPT_JSON, OPT_STATS, OPT_LIST_DEVICES, OPT_FORCE,
     OPT_QUIET, OPT_MASK, OPT_VERTEX_UPDATES, OPT_GUIDED_SIGMA_S, OPT_GUIDED_SIGMA_N,
-    OPT_GUIDED_ROUNDS, OPT_STAGE_REPEATS
+    OPT_GUIDED_ROUNDS, OPT_STAGE_REPEATS, OPT_MAX_MEMORY, OPT_TMPDIR
 };
 
 static const cli_option table[] = {
@@ -37,6 +37,8 @@ static const cli_option table[] = {
     {"confidence", 0, true, OPT_CONFIDENCE},
     {"device", 0, true, OPT_DEVICE},
     {"memory-budget", 0, true, OPT_MEMORY_BUDGET},
+    {"max-memory", 0, true, OPT_MAX_MEMORY},
+    {"tmpdir", 0, true, OPT_TMPDIR},
     {"method", 0, true, OPT_METHOD},
     {"lambda", 0, true, OPT_LAMBDA},
     {"mu", 0, true, OPT_MU},
@@ -117,6 +119,16 @@ static int apply(options *opt, int id, const char *name, const char *value) {
             return cli_usage_error(NULL, "--memory-budget: '%s' is not a byte count above 0 "
                                          "(examples: 256M, 1.5G; leave it out for most of "
                                          "the device's memory)", value);
+        break;
+    case OPT_MAX_MEMORY:
+        if (!cli_parse_bytes(value, &opt->max_memory) || opt->max_memory == 0)
+            return cli_usage_error(NULL, "--max-memory: '%s' is not a byte count above 0 "
+                                         "(examples: 512M, 2G)", value);
+        break;
+    case OPT_TMPDIR:
+        if (!*value)
+            return cli_usage_error(NULL, "--tmpdir: an empty folder name");
+        opt->tmpdir = value;
         break;
     case OPT_METHOD: {
         int m = find_name(value, cli_method_names, 4);

@@ -57,6 +57,8 @@ typedef struct options {
     double lambda, mu;
     unsigned iterations;
     uint64_t memory_budget; /* 0: the library's default */
+    uint64_t max_memory;    /* --max-memory: stream the file under this cap (0: in memory) */
+    const char *tmpdir;     /* --tmpdir: the streaming path's temporary files */
     bool colors;            /* --sigma-c: the input's vertex colours in the weight */
     bool sigma_g_given, umbrella_given; /* for consistency checks against --method */
     bool ascii, json, force, quiet, in_place, stats, list_devices, best;

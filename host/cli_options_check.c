@@ -4,6 +4,7 @@
 #include "cli_options.h"
 #include "cli_args.h"
 #include "cli_files.h"
+#include "cli_stream.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -129,9 +130,10 @@ int cli_options_check(options *opt) {
     if (opt->list_devices)
         return -1;
     int code;
-    if ((code = check_files(opt)) >= 0 || (code = check_params(opt)) >= 0)
+    if ((code = check_files(opt)) >= 0 || (code = check_params(opt)) >= 0 ||
+        (code = check_method(opt)) >= 0)
         return code;
-    return check_method(opt);
+    return cli_stream_check(opt);
 }
 
 /* The file extension --format writes. */

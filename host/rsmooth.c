@@ -13,6 +13,8 @@
 #include "cli_output.h"
 #include "cli_progress.h"
 #include "cli_report.h"
+#include "cli_device.h"
+#include "cli_stream.h"
 #include "rsmooth_io.h"
 
 #include <errno.h>
@@ -53,45 +55,14 @@ static int smooth(const options *opt, const rsmooth_mesh *mesh, double *out, flo
                   rsmooth_report *report, cli_progress *bar) {
     if (cli_method_uses_edges(opt->method))
         return smooth_umbrella(opt, mesh, out, report);
-    const char *device = opt->device ? opt->device : getenv("RSMOOTH_DEVICE");
-    bool reference = device && strcmp(device, "reference") == 0;
     rsmooth_context *ctx = NULL;
     rsmooth_error err;
     rsmooth_status st;
     double ms_setup = 0;
-    if (!reference) {
-        /* the option wins over the environment, as --device over RSMOOTH_DEVICE */
-        if (opt->memory_budget)
-            unsetenv("RSMOOTH_MEMORY_BUDGET");
-        double t = cli_now_ms();
-        st = rsmooth_context_create(device, &ctx, &err);
-        ms_setup = cli_now_ms() - t;
-        if (st == RSMOOTH_OK && opt->memory_budget)
-            rsmooth_context_set_memory_budget(ctx, opt->memory_budget);
-        bool automatic = !device || strcmp(device, "auto") == 0;
-        if (st == RSMOOTH_ERROR_NO_DEVICE && automatic) {
-            if (!opt->quiet)
-                fprintf(stderr, "rsmooth: warning: %s; using the reference path (slower)\n",
-                        err.message);
-            reference = true;
-        } else if (st == RSMOOTH_ERROR_INVALID_ARGUMENT) { /* a setting: RSMOOTH_MEMORY_BUDGET */
-            cli_progress_clear(bar);
-            fprintf(stderr, "rsmooth: %s\n", err.message);
-            return EXIT_USAGE;
-        } else if (st != RSMOOTH_OK) {
-            cli_progress_clear(bar);
-            fprintf(stderr, "rsmooth: device '%s'%s: %s: %s\n", device ? device : "auto",
-                    opt->device || !device ? "" : " (from RSMOOTH_DEVICE)",
-                    rsmooth_status_str(st), err.message);
-            if (err.build_log[0])
-                fprintf(stderr, "%s\n", err.build_log);
-            if (st == RSMOOTH_ERROR_NO_DEVICE) { /* the choice names nothing here: a usage error */
-                fprintf(stderr, "rsmooth: --list-devices shows what --device can name\n");
-                return EXIT_USAGE;
-            }
-            return st == RSMOOTH_ERROR_OUT_OF_MEMORY ? EXIT_OTHER : EXIT_DEVICE;
-        }
-    }
+    int code = cli_open_device(opt, bar, &ctx, &ms_setup);
+    if (code >= 0)
+        return code;
+    bool reference = ctx == NULL;
     rsmooth_params params = opt->params;
     if (bar->enabled) { /* progress slices the kernel launches: only when a bar can show */
         params.progress = cli_progress_callback;
@@ -105,7 +76,7 @@ static int smooth(const options *opt, const rsmooth_mesh *mesh, double *out, flo
         st = rsmooth_smooth(ctx, RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
                             mesh->triangles, mesh->triangle_count, &params, out, NULL, confidence,
                             report, &err);
-    int code = EXIT_OK;
+    code = EXIT_OK;
     if (st != RSMOOTH_OK) {
         cli_progress_clear(bar);
         if (st == RSMOOTH_ERROR_OPENCL)
@@ -328,6 +299,8 @@ static int smooth_file(const options *job, const char *path) {
             return code;
     }
 
+    if (opt.max_memory)
+        return cli_stream_file(&opt, path);
     cli_progress bar;
     cli_progress_init(&bar, opt.quiet);
     cli_progress_stage(&bar, "reading", 0, 0.1);

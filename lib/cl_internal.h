@@ -102,6 +102,11 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *problem, const 
 rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *problem,
                             const rs_result_sink *sink, rs_run_stats *stats, rsmooth_error *error);
 
+/* Fills a report from a run's problem and stats (t_start: the call's start; t_facets: when its
+ * facet data was ready). */
+void rs_cl_report(rsmooth_report *report, const rs_problem *pb, const rs_run_stats *stats,
+                  const char *device, double t_start, double t_facets);
+
 /* Builds the program from the embedded kernels (or RSMOOTH_KERNEL_DIR) and creates the kernels. */
 rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error);
 

@@ -47,7 +47,7 @@ static void packed_free(packed *pk) {
 static cl_float4 local_point(const rs_grid *grid, const double p[3], const int32_t cell[3]) {
     cl_float4 out;
     for (int k = 0; k < 3; k++) {
-        double corner = grid->origin[k] + (double)cell[k] * grid->cell_size;
+        double corner = (grid->origin_cell[k] + (double)cell[k]) * grid->cell_size;
         double x = (p[k] - corner) * grid->inv_cell_size;
         out.s[k] = (float)(x < -LOCAL_CLAMP ? -LOCAL_CLAMP : x > LOCAL_CLAMP ? LOCAL_CLAMP : x);
     }
@@ -615,6 +615,23 @@ cleanup:
     return st;
 }
 
+void rs_cl_report(rsmooth_report *report, const rs_problem *pb, const rs_run_stats *stats,
+                  const char *device, double t_start, double t_facets) {
+    rs_report_problem(report, pb, 0, device);
+    report->grid_cell_count = stats->cells;
+    report->ms_facets = t_facets - t_start;
+    report->ms_grid = stats->ms_grid;
+    report->ms_upload = stats->ms_upload;
+    report->ms_mollify = stats->ms_mollify;
+    report->ms_normals = stats->ms_normals;
+    report->ms_robust = stats->ms_robust;
+    report->ms_download = stats->ms_download;
+    report->ms_total = rs_now_ms() - t_start;
+    report->pairs_mollify = stats->pairs_mollify;
+    report->pairs_robust = stats->pairs_robust;
+    report->tiles = stats->tiles > 0 ? stats->tiles : 1; /* no facet: one trivial run */
+}
+
 /* One pass of the filter on the device (rs_filter_passes repeats it). */
 static rsmooth_status cl_pass(void *context, rsmooth_scalar scalar, const void *positions,
                               size_t vertex_count, const uint32_t *indices, size_t triangle_count,
@@ -642,21 +659,8 @@ static rsmooth_status cl_pass(void *context, rsmooth_scalar scalar, const void *
     }
     if (st == RSMOOTH_OK) {
         rs_progress(&pb, 1.0);
-        if (report) {
-            rs_report_problem(report, &pb, 0, ctx->device_name);
-            report->grid_cell_count = stats.cells;
-            report->ms_facets = t_facets - t_start;
-            report->ms_grid = stats.ms_grid;
-            report->ms_upload = stats.ms_upload;
-            report->ms_mollify = stats.ms_mollify;
-            report->ms_normals = stats.ms_normals;
-            report->ms_robust = stats.ms_robust;
-            report->ms_download = stats.ms_download;
-            report->ms_total = rs_now_ms() - t_start;
-            report->pairs_mollify = stats.pairs_mollify;
-            report->pairs_robust = stats.pairs_robust;
-            report->tiles = stats.tiles > 0 ? stats.tiles : 1; /* no facet: one trivial run */
-        }
+        if (report)
+            rs_cl_report(report, &pb, &stats, ctx->device_name, t_start, t_facets);
     }
     rs_problem_free(&pb);
     rs_release_free_memory();

@@ -23,7 +23,7 @@ void rs_grid_free(rs_grid *grid) {
 void rs_grid_cell_of(const rs_grid *grid, const double p[3], int32_t cell[3]) {
     int32_t m = grid->split + 1;
     for (int k = 0; k < 3; k++) {
-        double c = floor((p[k] - grid->origin[k]) * grid->inv_cell_size);
+        double c = floor(p[k] * grid->inv_cell_size) - grid->origin_cell[k];
         double lo = -m, hi = (double)grid->dims[k] + m - 1;
         cell[k] = (int32_t)(c < lo ? lo : c > hi ? hi : c);
     }
@@ -192,11 +192,17 @@ static rsmooth_status sort_into_cells(rs_grid *grid, const double *points, size_
     for (int k = 0; k < 3; k++)
         if ((hi[k] - lo[k]) / h > MAX_CELLS_PER_AXIS - 2)
             h = (hi[k] - lo[k]) / (MAX_CELLS_PER_AXIS - 2);
-    memcpy(grid->origin, lo, 3 * sizeof *lo);
+    /* Cells on the lattice of h from 0: any subset of the facets (a tile, a piece of a larger
+     * mesh) sees the same cells, and its vertices the same float coordinates within them, as the
+     * whole mesh (scaled by a power of two, the lattice scales exactly). */
     grid->cell_size = h;
     grid->inv_cell_size = 1 / h;
-    for (int k = 0; k < 3; k++)
-        grid->dims[k] = (int32_t)floor((hi[k] - lo[k]) / h) + 1;
+    for (int k = 0; k < 3; k++) {
+        grid->origin_cell[k] = floor(lo[k] * grid->inv_cell_size);
+        grid->origin[k] = grid->origin_cell[k] * h;
+        grid->dims[k] =
+            (int32_t)(floor(hi[k] * grid->inv_cell_size) - grid->origin_cell[k]) + 1;
+    }
 
     uint64_t *keys = rs_alloc_array(count, sizeof *keys);
     grid->facet_order = rs_alloc_array(count, sizeof *grid->facet_order);

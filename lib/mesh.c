@@ -315,6 +315,8 @@ static void store_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
     }
 }
 
+const char rs_unchecked_output[1];
+
 rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
                                   const void *positions, size_t vertex_count,
                                   const uint32_t *indices, size_t triangle_count,
@@ -331,8 +333,9 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
                               &magnitude, error, where);
     if (st != RSMOOTH_OK)
         return st;
-    st = rs_check_outputs(scalar, positions, vertex_count, indices, triangle_count, &p,
-                          out_positions, NULL, NULL, error, where);
+    if (out_positions != RS_UNCHECKED_OUTPUT)
+        st = rs_check_outputs(scalar, positions, vertex_count, indices, triangle_count, &p,
+                              out_positions, NULL, NULL, error, where);
     if (st != RSMOOTH_OK)
         return st;
     st = rs_check_colors(p.colors, vertex_count, error, where);

@@ -144,6 +144,11 @@ static inline bool rs_progress(const rs_problem *problem, double fraction) {
 /* RSMOOTH_ERROR_CANCELLED, said so in `error`. */
 rsmooth_status rs_cancelled(rsmooth_error *error, const char *where);
 
+/* Given as out_positions to rs_problem_prepare by a caller that checked its own outputs (a piece
+ * writes fewer vertices than it reads). */
+extern const char rs_unchecked_output[1];
+#define RS_UNCHECKED_OUTPUT ((const void *)rs_unchecked_output)
+
 /* Checks every argument of a smoothing call (nothing is written on failure), converts positions to
  * double, finds the facets, computes the mean edge length and area and the absolute parameters,
  * and with keep_facet_data the facets' centroids, normals and areas. */

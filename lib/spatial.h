@@ -11,7 +11,10 @@
  * components cost no empty cells. Cell edge >= reach / split, so a vertex's neighbours lie within
  * `split` cells of its own (the 27 around it when split is 1). */
 typedef struct rs_grid {
-    double origin[3];        /* minimum corner of the centroids' bounding box */
+    double origin[3];        /* origin_cell * cell_size: at or below the centroids' minimum */
+    double origin_cell[3];   /* whole numbers: the cells count from this one of the lattice of
+                              * cell_size from 0, so a subset of the points (a tile, a piece of a
+                              * larger mesh) sees the same cells and corners as the whole */
     double cell_size;        /* h >= reach / split */
     double inv_cell_size;    /* 1 / h: cells are found by multiplying (the margin in h absorbs
                                 the rounding) */

@@ -27,7 +27,7 @@ typedef struct tiler {
     double halo;
     uint64_t budget;
     uint32_t *sub_index; /* whole vertex -> its index in the current tile, ABSENT elsewhere */
-    size_t vertices_done;
+    size_t vertices_done, vertices_total; /* of the core vertices the call solves */
     rsmooth_error *error;
 } tiler;
 
@@ -150,8 +150,8 @@ static rsmooth_status run_tile(tiler *t, const uint32_t *verts, size_t n, const 
     sub.indices = indices;
     sub.triangle_count = sub.facet_count = m;
 
-    tile_progress tp = {w, (double)t->vertices_done / (double)w->vertex_count,
-                        (double)n / (double)w->vertex_count};
+    tile_progress tp = {w, (double)t->vertices_done / (double)t->vertices_total,
+                        (double)n / (double)t->vertices_total};
     if (w->progress || w->progress_cancel) {
         sub.progress = NULL;
         sub.progress_cancel = report_tile_progress;
@@ -260,11 +260,12 @@ rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *pb, const rs
             reach = fmax(reach, sqrt(rs_dot3(d, d)));
         }
     }
-    /* Tiles write to scratch first, so a tile that fails leaves the caller's arrays untouched. */
-    size_t nv = pb->vertex_count;
-    uint32_t *verts = rs_alloc_array(nv, sizeof *verts);
+    /* Tiles write to scratch first, so a tile that fails leaves the caller's arrays untouched.
+     * Only the sink's core vertices are solved (a piece of a larger mesh: its first ones). */
+    size_t nv = sink->core_count < pb->vertex_count ? sink->core_count : pb->vertex_count;
+    uint32_t *verts = rs_alloc_array(nv ? nv : 1, sizeof *verts);
     uint32_t *facets = rs_alloc_array(pb->facet_count, sizeof *facets);
-    uint32_t *sub_index = rs_alloc_array(nv, sizeof *sub_index);
+    uint32_t *sub_index = rs_alloc_array(pb->vertex_count, sizeof *sub_index);
     double *positions = rs_alloc_array(nv, 3 * sizeof *positions);
     float *weight = sink->weight ? rs_alloc_array(nv, sizeof *weight) : NULL;
     float *confidence = sink->confidence ? rs_alloc_array(nv, sizeof *confidence) : NULL;
@@ -274,16 +275,16 @@ rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *pb, const rs
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth",
                      "no memory to plan tiles");
     } else {
-        for (size_t v = 0; v < nv; v++) {
+        for (size_t v = 0; v < nv; v++)
             verts[v] = (uint32_t)v;
+        for (size_t v = 0; v < pb->vertex_count; v++)
             sub_index[v] = ABSENT;
-        }
         for (size_t q = 0; q < pb->facet_count; q++)
             facets[q] = (uint32_t)q;
         /* a little extra: a facet exactly at the halo must not round out of it */
         double halo = halo_radius(pb, reach) * (1 + 1e-6);
         rs_result_sink scratch = {RSMOOTH_FLOAT64, positions, weight, confidence, NULL, nv};
-        tiler t = {ctx, pb, &scratch, stats, halo, budget, sub_index, 0, error};
+        tiler t = {ctx, pb, &scratch, stats, halo, budget, sub_index, 0, nv, error};
         st = solve_region(&t, verts, nv, facets, pb->facet_count, 0);
     }
     for (size_t v = 0; st == RSMOOTH_OK && v < nv; v++) {

@@ -47,7 +47,7 @@
 #include <stdint.h>
 
 #define RSMOOTH_VERSION_MAJOR 0
-#define RSMOOTH_VERSION_MINOR 6
+#define RSMOOTH_VERSION_MINOR 7
 #define RSMOOTH_VERSION_PATCH 0
 
 #if defined(_WIN32)
@@ -687,6 +687,45 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_view(rsmooth_context *ctx, const rsmoo
                                                size_t out_stride, float *out_weight,
                                                float *out_confidence, rsmooth_report *report,
                                                rsmooth_error *error);
+
+/* ---------------------------------------------------------------------------------------------- */
+/* Pieces of a larger mesh (out-of-core and distributed filtering)                                 */
+/* ---------------------------------------------------------------------------------------------- */
+
+/* What a piece of a larger mesh is filtered with, besides its own arrays. (Added in 0.7) */
+typedef struct rsmooth_piece_info {
+    size_t struct_size;      /* sizeof(rsmooth_piece_info): set by rsmooth_piece_info_init */
+    size_t core_count;       /* the piece's first core_count vertices are solved */
+    double mean_edge_length; /* of the whole mesh, caller's units (as rsmooth_mean_edge_length) */
+    double mean_area;        /* of the whole mesh's triangles of non-zero area, caller's units */
+} rsmooth_piece_info;
+
+/* Sets struct_size and zeroes the rest. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if info is NULL. */
+RSMOOTH_API rsmooth_status rsmooth_piece_info_init(rsmooth_piece_info *info);
+
+/* How far from a vertex the centroids of the triangles that move it may lie, in the caller's
+ * units: the halo a piece must carry around its core vertices. `reach` is the whole mesh's largest
+ * distance from a triangle's centroid to its corners. Checks params as the filter does; params
+ * that need the whole mesh (passes above 1, the normal update stage, colours, a move mask) are
+ * RSMOOTH_ERROR_UNSUPPORTED naming the field. (Added in 0.7) */
+RSMOOTH_API rsmooth_status rsmooth_piece_halo(const rsmooth_params *params,
+                                              double mean_edge_length, double reach,
+                                              double *out_halo, rsmooth_error *error);
+
+/* The filter on a piece of a larger mesh: its first info->core_count vertices move as they would
+ * in a run on the whole mesh, provided the piece holds every triangle whose centroid lies within
+ * rsmooth_piece_halo of them (more do no harm). Positions are double, packed; out_positions
+ * receives 3 * core_count values. The whole mesh's mean edge length and mean facet area stand in
+ * for the piece's own, so results match the whole run's to float32 rounding on a device, bit for
+ * bit on the reference path (ctx NULL). Params as rsmooth_piece_halo accepts them. Errors as
+ * rsmooth_smooth, nothing written on failure. Thread-safety as rsmooth_smooth. (Added in 0.7) */
+RSMOOTH_API rsmooth_status rsmooth_smooth_piece(rsmooth_context *ctx, const double *positions,
+                                                size_t vertex_count, const uint32_t *indices,
+                                                size_t triangle_count,
+                                                const rsmooth_piece_info *info,
+                                                const rsmooth_params *params,
+                                                double *out_positions, rsmooth_report *report,
+                                                rsmooth_error *error);
 
 #ifdef __cplusplus
 }

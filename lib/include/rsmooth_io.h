@@ -195,6 +195,74 @@ RSMOOTH_API rsmooth_status rsmooth_mesh_vertex_normals(const rsmooth_mesh *mesh,
 /* Frees the mesh and everything it owns (extras included). Accepts NULL. */
 RSMOOTH_API void rsmooth_mesh_destroy(rsmooth_mesh *mesh);
 
+/* ---------------------------------------------------------------------------------------------- */
+/* Streaming: meshes larger than memory (added in 0.7)                                             */
+/* ---------------------------------------------------------------------------------------------- */
+
+/* How rsmooth_stream_smooth may use memory, disk and other processes. */
+typedef struct rsmooth_stream_options {
+    size_t struct_size;    /* sizeof(rsmooth_stream_options): set by rsmooth_stream_options_init */
+    uint64_t max_memory;   /* bytes the call may hold at its peak, besides the OpenCL runtime's
+                            * own (docs: README "Large meshes"); 0: 1 GiB */
+    const char *tmpdir;    /* folder of the temporary files (all unnamed: nothing is left behind,
+                            * however the process ends); NULL: the output's folder */
+    int replace;           /* non-zero: an existing output is replaced (atomically) */
+    /* Several processes sharing the pieces (the MPI driver): each calls with the same arguments,
+     * its own rank in [0, ranks), and `sync`, which every rank calls at the same points and which
+     * returns the worst (largest) status any rank passed (an all-reduce). ranks 0 or 1: alone. */
+    int rank, ranks;
+    int (*sync)(void *user, int status);
+    void *sync_user;
+} rsmooth_stream_options;
+
+/* Sets struct_size and the defaults (zeroes). Returns RSMOOTH_ERROR_INVALID_ARGUMENT on NULL. */
+RSMOOTH_API rsmooth_status rsmooth_stream_options_init(rsmooth_stream_options *options);
+
+/* What a streaming call did. */
+typedef struct rsmooth_stream_report {
+    size_t struct_size;        /* sizeof(rsmooth_stream_report): rsmooth_stream_report_init */
+    uint64_t vertex_count, face_count, triangle_count, facet_count;
+    double mean_edge_length;   /* of the input, its units: the unit of the relative sigmas */
+    double halo;               /* how far around a piece its facets reach, mesh units */
+    size_t pieces;             /* pieces the mesh was cut into (all ranks) */
+    size_t pieces_here;        /* of them, those this rank filtered */
+    uint64_t piece_facets_max; /* facets of the largest piece, its halo's included */
+    uint64_t facets_filtered;  /* facets this rank's pieces held, halos included */
+    uint64_t memory_planned;   /* the peak this call planned for, bytes (<= max_memory) */
+    uint64_t temporary_bytes;  /* disk the temporary files took at their largest */
+    double ms_read, ms_statistics, ms_buckets, ms_copy, ms_filter, ms_write, ms_total;
+    char device[128];
+} rsmooth_stream_report;
+
+/* Zeroes `report` and sets its struct_size. Accepts NULL. */
+RSMOOTH_API void rsmooth_stream_report_init(rsmooth_stream_report *report);
+
+/* The filter of rsmooth_smooth on the mesh in file `input`, written to `output`, holding at most
+ * options->max_memory bytes at a time (the OpenCL runtime's own memory aside): one pass over the
+ * input gathers the mesh's figures (mean edge length and area in the order the in-memory path
+ * sums them, so the sigmas are the same bits) and writes its triangles, cut into spatial pieces
+ * with their halos (rsmooth_piece_halo), to temporary files; each piece is filtered
+ * (rsmooth_smooth_piece, on `ctx`'s device, or the reference path when ctx is NULL); results go
+ * into a copy of the input at their vertices' places, so the output is the input byte for byte
+ * (header, comments, other properties and elements, faces) but for x, y and z. Results match an
+ * in-memory run to float32 rounding (about 1e-7 mean edge lengths). The output appears whole and
+ * at once, or not at all.
+ *
+ * What streams: binary PLY (either byte order) with float or double x, y, z, faces of any size
+ * (fanned into triangles as the reader does), up to 2^32 - 1 vertices and any number of faces.
+ * Memory: the vertex positions stay in memory (12 bytes per vertex for float files, 24 for
+ * double), the rest scales with the cap. Refused with RSMOOTH_ERROR_UNSUPPORTED and a message:
+ * other formats, vertex normals in the file (the in-memory path recomputes them), params that need
+ * the whole mesh (see rsmooth_piece_halo). RSMOOTH_ERROR_OUT_OF_MEMORY names the cap needed when
+ * max_memory cannot hold the positions and one piece. Progress and cancellation through params'
+ * callbacks. */
+RSMOOTH_API rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input,
+                                                 const char *output,
+                                                 const rsmooth_params *params,
+                                                 const rsmooth_stream_options *options,
+                                                 rsmooth_stream_report *report,
+                                                 rsmooth_error *error);
+
 #ifdef __cplusplus
 }
 #endif

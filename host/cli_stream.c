@@ -1,0 +1,148 @@
+/* The rsmooth command under --max-memory (see cli_stream.h). */
+#include "cli_stream.h"
+#include "cli_args.h"
+#include "cli_device.h"
+#include "cli_files.h"
+#include "cli_progress.h"
+
+#include <stdio.h>
+#include <string.h>
+
+/* The option that needs the whole mesh in memory, or NULL. */
+static const char *whole_mesh_option(const options *opt) {
+    const rsmooth_params *p = &opt->params;
+    return opt->best                                         ? "--best"
+           : opt->auto_params                                ? "--auto"
+           : p->vertex_updates > 0                           ? "--vertex-updates"
+           : p->passes != 1                                  ? "--passes"
+           : opt->colors                                     ? "--sigma-c"
+           : opt->mask                                       ? "--mask"
+           : opt->confidence                                 ? "--confidence"
+           : opt->stats                                      ? "--stats"
+           : cli_method_uses_edges(opt->method)              ? "--method"
+                                                             : NULL;
+}
+
+int cli_stream_check(const options *opt) {
+    if (!opt->max_memory) {
+        if (opt->tmpdir)
+            return cli_usage_error(NULL, "--tmpdir holds --max-memory's temporary files: give "
+                                         "--max-memory too");
+        return -1;
+    }
+    const char *option = whole_mesh_option(opt);
+    if (option)
+        return cli_usage_error(NULL, "--max-memory filters each piece of the mesh in one pass "
+                                     "from the pieces around it: %s needs the whole mesh in "
+                                     "memory (drop one of them)", option);
+    bool std_stream = opt->output_option && !strcmp(opt->output_option, "-");
+    for (size_t i = 0; i < opt->input_count; i++)
+        std_stream = std_stream || !strcmp(opt->inputs[i], "-");
+    if (std_stream)
+        return cli_usage_error(NULL, "--max-memory reads its input several times and writes "
+                                     "its output in place: give files, not '-'");
+    if (opt->ascii || (opt->format != RSMOOTH_FORMAT_AUTO &&
+                       opt->format != RSMOOTH_FORMAT_PLY_BINARY))
+        return cli_usage_error(NULL, "--max-memory writes the input's own binary PLY: drop "
+                                     "--ascii and --format");
+    return -1;
+}
+
+int cli_stream_exit_code(rsmooth_status st) {
+    switch (st) {
+    case RSMOOTH_ERROR_INVALID_ARGUMENT:
+    case RSMOOTH_ERROR_UNSUPPORTED:
+    case RSMOOTH_ERROR_PARSE:
+    case RSMOOTH_ERROR_IO:
+        return EXIT_USAGE;
+    case RSMOOTH_ERROR_OPENCL:
+    case RSMOOTH_ERROR_KERNEL_BUILD:
+        return EXIT_DEVICE;
+    default:
+        return EXIT_OTHER;
+    }
+}
+
+static void print_json_string(const char *s) {
+    putchar('"');
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            printf("\\%c", c);
+        else if (c < 0x20)
+            printf("\\u%04x", c);
+        else
+            putchar(c);
+    }
+    putchar('"');
+}
+
+void cli_stream_print_json(const rsmooth_stream_report *r, const options *opt, int ranks) {
+    printf("{\"input\":");
+    print_json_string(opt->input);
+    printf(",\"output\":");
+    print_json_string(opt->output);
+    printf(",\"streamed\":true,\"ranks\":%d,\"max_memory\":%llu,\"memory_planned\":%llu", ranks,
+           (unsigned long long)opt->max_memory, (unsigned long long)r->memory_planned);
+    printf(",\"vertex_count\":%llu,\"face_count\":%llu,\"triangle_count\":%llu,"
+           "\"facet_count\":%llu,\"mean_edge_length\":%.17g,\"halo\":%.17g",
+           (unsigned long long)r->vertex_count, (unsigned long long)r->face_count,
+           (unsigned long long)r->triangle_count, (unsigned long long)r->facet_count,
+           r->mean_edge_length, r->halo);
+    printf(",\"pieces\":%zu,\"pieces_here\":%zu,\"piece_facets_max\":%llu,"
+           "\"facets_filtered\":%llu,\"temporary_bytes\":%llu,\"device\":",
+           r->pieces, r->pieces_here, (unsigned long long)r->piece_facets_max,
+           (unsigned long long)r->facets_filtered, (unsigned long long)r->temporary_bytes);
+    print_json_string(r->device);
+    printf(",\"ms\":{\"read\":%.3f,\"statistics\":%.3f,\"pieces\":%.3f,\"copy\":%.3f,"
+           "\"filter\":%.3f,\"write\":%.3f,\"total\":%.3f}}\n",
+           r->ms_read, r->ms_statistics, r->ms_buckets, r->ms_copy, r->ms_filter, r->ms_write,
+           r->ms_total);
+}
+
+int cli_stream_file(const options *opt, const char *path) {
+    cli_progress bar;
+    cli_progress_init(&bar, opt->quiet);
+    cli_progress_stage(&bar, "streaming", 0, 1);
+    rsmooth_context *ctx = NULL;
+    double ms_setup = 0;
+    int code = cli_open_device(opt, &bar, &ctx, &ms_setup);
+    if (code >= 0)
+        return code;
+    rsmooth_stream_options so;
+    rsmooth_stream_options_init(&so);
+    so.max_memory = opt->max_memory;
+    so.tmpdir = opt->tmpdir;
+    so.replace = opt->force || opt->in_place;
+    rsmooth_params params = opt->params;
+    if (bar.enabled) {
+        params.progress = cli_progress_callback;
+        params.progress_user = &bar;
+    }
+    rsmooth_stream_report rep;
+    rsmooth_stream_report_init(&rep);
+    rsmooth_error err;
+    rsmooth_status st = rsmooth_stream_smooth(ctx, path, opt->output, &params, &so, &rep, &err);
+    cli_progress_clear(&bar);
+    rsmooth_context_destroy(ctx);
+    if (st != RSMOOTH_OK) {
+        fprintf(stderr, "rsmooth: %s\n", err.message);
+        return cli_stream_exit_code(st);
+    }
+    if (opt->json)
+        cli_stream_print_json(&rep, opt, 1);
+    if (!opt->quiet)
+        fprintf(stderr,
+                "rsmooth: %s: %llu vertices, %llu triangles, mean edge %.6g; streamed in %zu "
+                "pieces (the largest %llu facets with its halo) under --max-memory %llu MB on "
+                "%s: read %.1f s, statistics %.1f s, pieces %.1f s, copy %.1f s, filter %.1f s, "
+                "write %.1f s; wrote %s\n",
+                opt->input, (unsigned long long)rep.vertex_count,
+                (unsigned long long)rep.triangle_count, rep.mean_edge_length, rep.pieces,
+                (unsigned long long)rep.piece_facets_max,
+                (unsigned long long)(opt->max_memory >> 20),
+                rep.device[0] ? rep.device : "no device (no facets)", rep.ms_read / 1000,
+                rep.ms_statistics / 1000, rep.ms_buckets / 1000, rep.ms_copy / 1000,
+                rep.ms_filter / 1000, rep.ms_write / 1000, opt->output);
+    return EXIT_OK;
+}

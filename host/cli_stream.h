@@ -1,0 +1,22 @@
+/* The rsmooth command under --max-memory: the file streamed through rsmooth_stream_smooth. */
+#ifndef RSMOOTH_CLI_STREAM_H
+#define RSMOOTH_CLI_STREAM_H
+
+#include "cli_options.h"
+#include "rsmooth_io.h"
+
+/* Refuses (printed; the usage exit status) the options streaming cannot honour, and --tmpdir
+ * without --max-memory; -1 when all is well. */
+int cli_stream_check(const options *opt);
+
+/* Smooths `path` into opt->output under opt->max_memory (the output already checked); prints the
+ * status line (and --json); returns the exit status. */
+int cli_stream_file(const options *opt, const char *path);
+
+/* The exit status for a streaming failure. */
+int cli_stream_exit_code(rsmooth_status st);
+
+/* --json for a streaming run: one object on stdout. */
+void cli_stream_print_json(const rsmooth_stream_report *r, const options *opt, int ranks);
+
+#endif

@@ -1,0 +1,196 @@
+/* rsmooth-mpi: the streaming filter (rsmooth --max-memory) with its pieces shared among MPI
+ * ranks, each on its own device, all writing their vertices' rows into one output file.
+ *
+ *     mpirun -n N rsmooth-mpi IN.ply -o OUT.ply [--max-memory SIZE] [--device D] [options]
+ *
+ * Every rank reads the input (a shared file system), computes the same plan, and filters the
+ * pieces the plan gives it (by facet count, the largest first to the least loaded rank); rank 0
+ * makes the output's copy and names it when every rank is done. The result is the single-process
+ * streaming result, bit for bit: the same pieces, filtered by the same code. "%l" in --device is
+ * replaced by the rank's index on its node (e.g. --device 0:%l, one GPU per local rank). */
+#define _POSIX_C_SOURCE 200809L
+#include "cli_args.h"
+#include "cli_device.h"
+#include "cli_files.h"
+#include "cli_options.h"
+#include "cli_stream.h"
+#include "rsmooth_io.h"
+
+#include <mpi.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define DEFAULT_MAX_MEMORY (1ull << 30)
+
+/* The partial output, removed if a signal ends the run while it exists. */
+static char partial[4200];
+
+static void remove_partial_and_exit(int signal_number) {
+    if (partial[0])
+        unlink(partial);
+    signal(signal_number, SIG_DFL);
+    raise(signal_number);
+}
+
+/* rsmooth_stream_options.sync: every rank's worst status. */
+static int all_reduce(void *user, int status) {
+    (void)user;
+    int worst = status;
+    MPI_Allreduce(&status, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    return worst;
+}
+
+static int worst_code(int code) {
+    int worst = code;
+    MPI_Allreduce(&code, &worst, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    return worst;
+}
+
+/* --device with "%l" replaced by the local rank. */
+static const char *device_for_rank(const char *device, int local_rank, char *buf, size_t size) {
+    const char *mark = device ? strstr(device, "%l") : NULL;
+    if (!mark)
+        return device;
+    snprintf(buf, size, "%.*s%d%s", (int)(mark - device), device, local_rank, mark + 2);
+    return buf;
+}
+
+/* Parses the command line (only rank 0 prints what is wrong with it). */
+static int parse(int argc, char **argv, int rank, options *opt) {
+    int saved = -1, saved_out = -1;
+    if (rank != 0) { /* one copy of a usage error or of --help, not one per rank */
+        fflush(stderr);
+        fflush(stdout);
+        saved = dup(STDERR_FILENO);
+        saved_out = dup(STDOUT_FILENO);
+        FILE *null = fopen("/dev/null", "w");
+        if (null) {
+            dup2(fileno(null), STDERR_FILENO);
+            dup2(fileno(null), STDOUT_FILENO);
+            fclose(null);
+        }
+    }
+    int code = cli_options_parse(argc, argv, opt);
+    if (code < 0 && (opt->input_count != 1 || !opt->output_option || opt->output_dir ||
+                     opt->suffix || opt->list_devices)) {
+        code = cli_usage_error(NULL, "rsmooth-mpi smooths one input into one output: "
+                                     "rsmooth-mpi IN.ply -o OUT.ply [options]");
+        cli_options_free(opt);
+    }
+    if (code < 0 && !opt->max_memory) {
+        opt->max_memory = DEFAULT_MAX_MEMORY; /* each rank streams: the cap always holds */
+        code = cli_stream_check(opt);
+        if (code >= 0)
+            cli_options_free(opt);
+    }
+    if (saved >= 0) {
+        fflush(stderr);
+        fflush(stdout);
+        dup2(saved, STDERR_FILENO);
+        dup2(saved_out, STDOUT_FILENO);
+        close(saved);
+        close(saved_out);
+    }
+    return code;
+}
+
+int main(int argc, char **argv) {
+    MPI_Init(&argc, &argv);
+    int rank = 0, ranks = 1, local_rank = 0;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+    MPI_Comm node;
+    MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, &node);
+    MPI_Comm_rank(node, &local_rank);
+    MPI_Comm_free(&node);
+
+    options opt;
+    int code = parse(argc, argv, rank, &opt);
+    if (code >= 0) { /* --help, --version or a usage error: the same on every rank */
+        MPI_Finalize();
+        return code;
+    }
+    opt.input = opt.inputs[0];
+    opt.output = opt.output_option;
+    if (opt.in_place)
+        opt.output = opt.input;
+    code = -1;
+    if (rank == 0)
+        code = cli_check_output(opt.output, opt.input, opt.force, opt.in_place,
+                                opt.format != RSMOOTH_FORMAT_AUTO);
+    MPI_Bcast(&code, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (code >= 0) {
+        cli_options_free(&opt);
+        MPI_Finalize();
+        return code;
+    }
+    char device[256];
+    opt.device = device_for_rank(opt.device ? opt.device : getenv("RSMOOTH_DEVICE"), local_rank,
+                                 device, sizeof device);
+    bool quiet = opt.quiet;
+    if (rank != 0)
+        opt.quiet = true; /* one warning about a missing device, not one per rank */
+    cli_progress bar;
+    cli_progress_init(&bar, true);
+    rsmooth_context *ctx = NULL;
+    double ms_setup = 0;
+    code = worst_code(cli_open_device(&opt, &bar, &ctx, &ms_setup));
+    if (code >= 0) {
+        rsmooth_context_destroy(ctx);
+        cli_options_free(&opt);
+        MPI_Finalize();
+        return code;
+    }
+    snprintf(partial, sizeof partial, "%s.rsmooth-partial", opt.output);
+    signal(SIGINT, remove_partial_and_exit);
+    signal(SIGTERM, remove_partial_and_exit);
+    signal(SIGHUP, remove_partial_and_exit);
+
+    rsmooth_stream_options so;
+    rsmooth_stream_options_init(&so);
+    so.max_memory = opt.max_memory;
+    so.tmpdir = opt.tmpdir;
+    so.replace = opt.force || opt.in_place;
+    so.rank = rank;
+    so.ranks = ranks;
+    so.sync = all_reduce;
+    rsmooth_stream_report rep;
+    rsmooth_stream_report_init(&rep);
+    rsmooth_error err;
+    rsmooth_status st =
+        rsmooth_stream_smooth(ctx, opt.input, opt.output, &opt.params, &so, &rep, &err);
+    partial[0] = 0;
+    /* a rank that failed says why; the others only that they stopped with it */
+    bool own = st != RSMOOTH_OK && strstr(err.message, "another rank failed") == NULL;
+    if (own)
+        fprintf(stderr, "rsmooth-mpi: rank %d: %s\n", rank, err.message);
+    code = st == RSMOOTH_OK ? EXIT_OK : cli_stream_exit_code(st);
+    if (st == RSMOOTH_OK && !quiet)
+        fprintf(stderr, "rsmooth-mpi: rank %d of %d on %s: %zu pieces, %llu facets with halos, "
+                        "filter %.1f s, write %.1f s\n",
+                rank, ranks, rep.device[0] ? rep.device : "no device (no pieces)",
+                rep.pieces_here, (unsigned long long)rep.facets_filtered, rep.ms_filter / 1000,
+                rep.ms_write / 1000);
+    MPI_Barrier(MPI_COMM_WORLD); /* the ranks' lines before the summary */
+    if (st == RSMOOTH_OK && rank == 0) {
+        if (opt.json)
+            cli_stream_print_json(&rep, &opt, ranks);
+        if (!quiet)
+            fprintf(stderr,
+                    "rsmooth-mpi: %s: %llu vertices, %llu triangles, mean edge %.6g; %zu pieces "
+                    "over %d ranks under --max-memory %llu MB each: read %.1f s, statistics "
+                    "%.1f s, pieces %.1f s, copy %.1f s, total %.1f s; wrote %s\n",
+                    opt.input, (unsigned long long)rep.vertex_count,
+                    (unsigned long long)rep.triangle_count, rep.mean_edge_length, rep.pieces,
+                    ranks, (unsigned long long)(opt.max_memory >> 20), rep.ms_read / 1000,
+                    rep.ms_statistics / 1000, rep.ms_buckets / 1000, rep.ms_copy / 1000,
+                    rep.ms_total / 1000, opt.output);
+    }
+    rsmooth_context_destroy(ctx);
+    cli_options_free(&opt);
+    MPI_Finalize();
+    return code;
+}

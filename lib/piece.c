@@ -1,0 +1,182 @@
+/* Pieces of a larger mesh: the filter on a few of its vertices, with the whole mesh's figures.
+ *
+ * The filter reads the whole mesh in two numbers only: the mean edge length (the unit of the
+ * sigmas) and the mean facet area (the scale of every area weight). Everything else is local:
+ * vertex p moves by the facets whose centroids lie within the halo of rsmooth_piece_halo. So a
+ * piece holding its core vertices and every facet within that halo, given the two numbers,
+ * computes its core vertices as the whole run would. This is what streaming (rsmooth_io's
+ * rsmooth_stream_smooth) and the MPI driver cut a mesh into. */
+#include "cl_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+static const char where[] = "rsmooth_smooth_piece";
+
+rsmooth_status rsmooth_piece_info_init(rsmooth_piece_info *info) {
+    if (!info)
+        return RSMOOTH_ERROR_INVALID_ARGUMENT;
+    memset(info, 0, sizeof *info);
+    info->struct_size = sizeof *info;
+    return RSMOOTH_OK;
+}
+
+/* The params a piece can honour: one pass of the filter, nothing that reads the whole mesh. */
+static rsmooth_status check_piece_params(const rsmooth_params *params, rsmooth_params *p,
+                                         rsmooth_error *error, const char *caller) {
+    rsmooth_status st = rs_params_resolve(params, p, error, caller);
+    if (st != RSMOOTH_OK)
+        return st;
+    const char *field = p->passes != 1            ? "passes (other than 1)"
+                        : p->vertex_updates != 0   ? "vertex_updates (the normal update stage)"
+                        : p->colors                ? "colors"
+                        : p->move_mask             ? "move_mask"
+                        : p->discrepancy_level > 0 ? "discrepancy_level"
+                                                   : NULL;
+    if (field)
+        return rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, caller,
+                       "%s: a piece is filtered in one pass from local data only", field);
+    return RSMOOTH_OK;
+}
+
+rsmooth_status rsmooth_piece_halo(const rsmooth_params *params, double mean_edge_length,
+                                  double reach, double *out_halo, rsmooth_error *error) {
+    static const char caller[] = "rsmooth_piece_halo";
+    rs_error_clear(error);
+    if (!out_halo)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller, "out_halo is NULL");
+    if (!(mean_edge_length >= 0) || !isfinite(mean_edge_length) || !(reach >= 0) ||
+        !isfinite(reach))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller,
+                       "mean_edge_length %g and reach %g must be finite and >= 0",
+                       mean_edge_length, reach);
+    rsmooth_params p;
+    rsmooth_status st = check_piece_params(params, &p, error, caller);
+    if (st != RSMOOTH_OK)
+        return st;
+    rs_problem pb;
+    memset(&pb, 0, sizeof pb);
+    rs_problem_apply_params(&pb, &p, p.absolute ? 1 : mean_edge_length);
+    /* tiles.c's halo: the robust reach, plus the normals' (bilateral rounds, or mollification of
+     * facets whose corners lie up to `reach` from their centroids) */
+    *out_halo = pb.bilateral ? pb.radius + pb.normal_iterations * pb.normal_radius
+                             : pb.radius + (pb.mollify ? pb.mollify_radius + reach : 0);
+    return RSMOOTH_OK;
+}
+
+static rsmooth_status check_info(const rsmooth_piece_info *info, size_t vertex_count,
+                                 rsmooth_error *error) {
+    if (!info)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "info is NULL");
+    if (info->struct_size < sizeof *info)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "info->struct_size %zu: call rsmooth_piece_info_init first",
+                       info->struct_size);
+    if (info->core_count > vertex_count)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "core_count %zu exceeds the piece's %zu vertices", info->core_count,
+                       vertex_count);
+    if (!(info->mean_edge_length >= 0) || !isfinite(info->mean_edge_length) ||
+        !(info->mean_area >= 0) || !isfinite(info->mean_area))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "mean_edge_length %g and mean_area %g must be finite and >= 0",
+                       info->mean_edge_length, info->mean_area);
+    return RSMOOTH_OK;
+}
+
+/* The piece's problem with the whole mesh's unit and mean area in place of its own. */
+static rsmooth_status prepare_piece(rs_problem *pb, const double *positions, size_t vertex_count,
+                                   const uint32_t *indices, size_t triangle_count,
+                                   const rsmooth_piece_info *info, const rsmooth_params *params,
+                                   double *out_positions, bool keep, rsmooth_error *error) {
+    rsmooth_params p;
+    rsmooth_status st = check_piece_params(params, &p, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
+    if (!out_positions)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_positions is NULL");
+    size_t out_bytes = info->core_count * 3 * sizeof(double);
+    if (!rs_mul_overflows(vertex_count, 3 * sizeof(double)) &&
+        !rs_mul_overflows(triangle_count, 3 * sizeof(uint32_t)) &&
+        (rs_ranges_overlap(out_positions, out_bytes, positions,
+                           vertex_count * 3 * sizeof(double)) ||
+         rs_ranges_overlap(out_positions, out_bytes, indices,
+                           triangle_count * 3 * sizeof(uint32_t))))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "out_positions overlaps the piece's positions or indices");
+    st = rs_problem_prepare(pb, RSMOOTH_FLOAT64, positions, vertex_count, indices, triangle_count,
+                            &p, RS_UNCHECKED_OUTPUT, keep, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
+    /* the scale is a power of two: these products are exact, as the whole run's own are */
+    pb->mean_edge_length = info->mean_edge_length * pb->scale;
+    pb->mean_area = info->mean_area * pb->scale * pb->scale;
+    size_t facets = pb->facet_count;
+    rs_problem_apply_params(pb, &p, p.absolute ? pb->scale : pb->mean_edge_length);
+    if (pb->facet_count > 0)
+        pb->facet_count = facets;
+    return RSMOOTH_OK;
+}
+
+/* The reference path on the whole piece, its core vertices kept. */
+static rsmooth_status solve_reference(const rs_problem *pb, size_t core, double *out,
+                                      rsmooth_report *report, double t_start,
+                                      rsmooth_error *error) {
+    double *all = rs_alloc_array(pb->vertex_count, 3 * sizeof *all);
+    if (!all)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the piece");
+    rsmooth_status st = rs_reference_solve(pb, RSMOOTH_FLOAT64, all, NULL, NULL, NULL, report,
+                                           t_start, error, where);
+    if (st == RSMOOTH_OK)
+        memcpy(out, all, core * 3 * sizeof *out);
+    rs_free(all);
+    return st;
+}
+
+rsmooth_status rsmooth_smooth_piece(rsmooth_context *ctx, const double *positions,
+                                    size_t vertex_count, const uint32_t *indices,
+                                    size_t triangle_count, const rsmooth_piece_info *info,
+                                    const rsmooth_params *params, double *out_positions,
+                                    rsmooth_report *report, rsmooth_error *error) {
+    double t_start = rs_now_ms();
+    rs_error_clear(error);
+    rsmooth_status st = check_info(info, vertex_count, error);
+    if (st != RSMOOTH_OK)
+        return st;
+    if (ctx) {
+        rs_context_lock(ctx);
+        size_t threads_before = rs_set_call_threads(ctx->host_threads);
+        rs_problem pb;
+        st = prepare_piece(&pb, positions, vertex_count, indices, triangle_count, info, params,
+                           out_positions, false, error);
+        double t_facets = rs_now_ms();
+        rs_run_stats stats;
+        memset(&stats, 0, sizeof stats);
+        if (st == RSMOOTH_OK && pb.facet_count == 0) {
+            for (size_t v = 0; v < info->core_count; v++)
+                rs_store_position(RSMOOTH_FLOAT64, out_positions, v, pb.xyz + 3 * v,
+                                  1 / pb.scale);
+        } else if (st == RSMOOTH_OK && info->core_count > 0) {
+            rs_result_sink sink = {RSMOOTH_FLOAT64, out_positions, NULL, NULL, NULL,
+                                   info->core_count};
+            st = rs_cl_filter(ctx, &pb, &sink, &stats, error);
+        }
+        if (st == RSMOOTH_OK && report)
+            rs_cl_report(report, &pb, &stats, ctx->device_name, t_start, t_facets);
+        if (st == RSMOOTH_OK)
+            st = rs_check_results(RSMOOTH_FLOAT64, out_positions, NULL, NULL, info->core_count,
+                                  "vertex", error, where);
+        rs_problem_free(&pb);
+        rs_set_call_threads(threads_before);
+        rs_context_unlock(ctx);
+    } else {
+        rs_problem pb;
+        st = prepare_piece(&pb, positions, vertex_count, indices, triangle_count, info, params,
+                           out_positions, true, error);
+        if (st == RSMOOTH_OK)
+            st = solve_reference(&pb, info->core_count, out_positions, report, t_start, error);
+        rs_problem_free(&pb);
+    }
+    rs_release_free_memory();
+    return st;
+}

@@ -1,0 +1,394 @@
+/* Spatial pieces of a mesh on disk. A grid of cells no smaller than the halo counts the vertices;
+ * boxes of cells are halved (at the median count, along their longest side) until each holds at
+ * most the vertices a piece may have. A piece's core vertices are those in its box; its facets
+ * are every triangle of non-zero area whose centroid lies within the halo of the box, so it holds
+ * every facet its vertices' results depend on (piece.c). Pieces go to ranks by their facet counts
+ * (the longest first, each to the least loaded rank), the same on every rank. */
+#include "stream/stream_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define READ_BUFFER (1u << 20)
+#define MAX_CELLS (1u << 21)
+
+typedef struct cell_grid {
+    double lo[3], size[3];
+    int32_t dims[3];
+    uint32_t *count;  /* vertices per cell */
+    int32_t *piece;   /* per cell: its piece, -1 for none */
+} cell_grid;
+
+typedef struct box {
+    int32_t a[3], b[3]; /* cells [a, b) */
+} box;
+
+static size_t cell_index(const cell_grid *g, const int32_t c[3]) {
+    return ((size_t)c[2] * (size_t)g->dims[1] + (size_t)c[1]) * (size_t)g->dims[0] + (size_t)c[0];
+}
+
+static int32_t cell_coordinate(const cell_grid *g, double x, int k) {
+    double c = floor((x - g->lo[k]) / g->size[k]);
+    return c < 0 ? 0 : c >= g->dims[k] ? g->dims[k] - 1 : (int32_t)c;
+}
+
+static void cell_of(const cell_grid *g, const double p[3], int32_t c[3]) {
+    for (int k = 0; k < 3; k++)
+        c[k] = cell_coordinate(g, p[k], k);
+}
+
+static bool grid_init(cell_grid *g, const rs_stream_stats *stats, double halo, size_t max_cells) {
+    memset(g, 0, sizeof *g);
+    double dims[3];
+    for (int k = 0; k < 3; k++) {
+        double extent = stats->hi[k] - stats->lo[k];
+        dims[k] = halo > 0 && extent > 0 ? floor(extent / halo) : 1;
+        dims[k] = dims[k] < 1 ? 1 : dims[k] > 4096 ? 4096 : dims[k];
+    }
+    while (dims[0] * dims[1] * dims[2] > (double)max_cells) { /* coarser where longest */
+        int k = dims[0] >= dims[1] && dims[0] >= dims[2] ? 0 : dims[1] >= dims[2] ? 1 : 2;
+        dims[k] = floor(dims[k] / 2);
+    }
+    for (int k = 0; k < 3; k++) {
+        double extent = stats->hi[k] - stats->lo[k];
+        g->dims[k] = (int32_t)dims[k];
+        g->lo[k] = stats->lo[k];
+        g->size[k] = extent > 0 ? extent / dims[k] : 1;
+    }
+    size_t cells = (size_t)g->dims[0] * (size_t)g->dims[1] * (size_t)g->dims[2];
+    g->count = rs_calloc_array(cells, sizeof *g->count);
+    g->piece = rs_alloc_array(cells, sizeof *g->piece);
+    if (!g->count || !g->piece)
+        return false;
+    for (size_t i = 0; i < cells; i++)
+        g->piece[i] = -1;
+    return true;
+}
+
+static uint64_t box_count(const cell_grid *g, const box *bx) {
+    uint64_t n = 0;
+    int32_t c[3];
+    for (c[2] = bx->a[2]; c[2] < bx->b[2]; c[2]++)
+        for (c[1] = bx->a[1]; c[1] < bx->b[1]; c[1]++)
+            for (c[0] = bx->a[0]; c[0] < bx->b[0]; c[0]++)
+                n += g->count[cell_index(g, c)];
+    return n;
+}
+
+typedef struct cutter {
+    cell_grid *grid;
+    uint64_t target;
+    rs_piece *pieces;
+    box *boxes;
+    size_t count, capacity;
+} cutter;
+
+/* Halves `bx` until each part holds at most `target` vertices (or is one cell). */
+static bool cut(cutter *ct, box bx, uint64_t n) {
+    cell_grid *g = ct->grid;
+    if (n == 0)
+        return true;
+    int axis = -1;
+    double longest = 0;
+    for (int k = 0; k < 3; k++) {
+        double side = (double)(bx.b[k] - bx.a[k]) * g->size[k];
+        if (bx.b[k] - bx.a[k] >= 2 && side > longest) {
+            longest = side;
+            axis = k;
+        }
+    }
+    if (n <= ct->target || axis < 0) { /* a piece */
+        if (ct->count == ct->capacity) {
+            size_t cap = ct->capacity ? 2 * ct->capacity : 64;
+            rs_piece *p = rs_realloc_array(ct->pieces, cap, sizeof *p);
+            if (!p)
+                return false;
+            ct->pieces = p;
+            box *b = rs_realloc_array(ct->boxes, cap, sizeof *b);
+            if (!b)
+                return false;
+            ct->boxes = b;
+            ct->capacity = cap;
+        }
+        int32_t id = (int32_t)ct->count;
+        memset(&ct->pieces[ct->count], 0, sizeof *ct->pieces);
+        ct->pieces[ct->count].vertex_count = n;
+        ct->boxes[ct->count++] = bx;
+        int32_t c[3];
+        for (c[2] = bx.a[2]; c[2] < bx.b[2]; c[2]++)
+            for (c[1] = bx.a[1]; c[1] < bx.b[1]; c[1]++)
+                for (c[0] = bx.a[0]; c[0] < bx.b[0]; c[0]++)
+                    g->piece[cell_index(g, c)] = id;
+        return true;
+    }
+    /* the slice where the count passes half */
+    uint64_t below = 0;
+    int32_t split = bx.a[axis] + 1;
+    for (int32_t s = bx.a[axis]; s < bx.b[axis] - 1; s++) {
+        box slice = bx;
+        slice.a[axis] = s;
+        slice.b[axis] = s + 1;
+        below += box_count(g, &slice);
+        split = s + 1;
+        if (2 * below >= n)
+            break;
+    }
+    box left = bx, right = bx;
+    left.b[axis] = split;
+    right.a[axis] = split;
+    uint64_t n_left = box_count(g, &left);
+    return cut(ct, left, n_left) && cut(ct, right, n - n_left);
+}
+
+/* The pieces whose boxes lie within `halo` of point c (at most `max` of them), in `out`. */
+static size_t pieces_near(const cell_grid *g, const box *boxes, const double c[3], double halo,
+                          int32_t *out, size_t max) {
+    int32_t a[3], b[3];
+    for (int k = 0; k < 3; k++) {
+        a[k] = cell_coordinate(g, c[k] - halo, k);
+        b[k] = cell_coordinate(g, c[k] + halo, k);
+    }
+    size_t n = 0;
+    int32_t q[3];
+    for (q[2] = a[2]; q[2] <= b[2]; q[2]++)
+        for (q[1] = a[1]; q[1] <= b[1]; q[1]++)
+            for (q[0] = a[0]; q[0] <= b[0]; q[0]++) {
+                int32_t id = g->piece[cell_index(g, q)];
+                if (id < 0)
+                    continue;
+                bool seen = false;
+                for (size_t i = 0; i < n && !seen; i++)
+                    seen = out[i] == id;
+                if (seen)
+                    continue;
+                const box *bx = &boxes[id];
+                bool inside = true; /* the box's own bounds, grown by the halo */
+                for (int k = 0; k < 3 && inside; k++) {
+                    double lo = bx->a[k] == 0 ? -INFINITY : g->lo[k] + bx->a[k] * g->size[k];
+                    double hi = bx->b[k] == g->dims[k] ? INFINITY
+                                                       : g->lo[k] + bx->b[k] * g->size[k];
+                    inside = c[k] >= lo - halo && c[k] <= hi + halo;
+                }
+                if (inside && n < max)
+                    out[n++] = id;
+            }
+    return n;
+}
+
+static bool facet_centroid(const rs_stream_positions *pos, const uint32_t tri[3], double scale,
+                           double c[3]) {
+    double p[3][3];
+    for (int i = 0; i < 3; i++)
+        rs_stream_position(pos, tri[i], p[i]);
+    double e1[3], e2[3];
+    for (int k = 0; k < 3; k++) {
+        e1[k] = (p[1][k] - p[0][k]) * scale;
+        e2[k] = (p[2][k] - p[0][k]) * scale;
+        c[k] = (p[0][k] + p[1][k] + p[2][k]) / 3.0;
+    }
+    double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                   e1[0] * e2[1] - e1[1] * e2[0]};
+    double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    return len > 0 && isfinite(len); /* zero-area triangles weigh nothing anywhere */
+}
+
+/* One pass over the triangles: counts each piece's facets (writer NULL), or writes this rank's
+ * pieces' facet records. */
+static rsmooth_status facet_pass(const rs_stream_positions *pos, int fd, uint64_t triangles,
+                                 const cell_grid *g, const box *boxes, rs_piece *pieces,
+                                 double scale, double halo, int rank, rs_region_writer *writer,
+                                 rsmooth_error *error) {
+    rs_stream_reader r;
+    if (!rs_stream_reader_open(&r, fd, "triangles", 0, triangles * 12, READ_BUFFER))
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
+    enum { MAX_NEAR = 512 };
+    int32_t near[MAX_NEAR];
+    for (uint64_t t = 0; t < triangles; t++) {
+        const unsigned char *rec = rs_stream_read(&r, 12);
+        if (!rec) {
+            rs_stream_reader_close(&r);
+            return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                           "cannot read the temporary triangle file");
+        }
+        uint32_t tri[3];
+        memcpy(tri, rec, sizeof tri);
+        double c[3];
+        if (!facet_centroid(pos, tri, scale, c))
+            continue;
+        size_t n = pieces_near(g, boxes, c, halo, near, MAX_NEAR);
+        for (size_t i = 0; i < n; i++) {
+            rs_piece *p = &pieces[near[i]];
+            if (!writer) {
+                p->facet_count++;
+            } else if (p->rank == rank && !rs_region_append(writer, (size_t)near[i], tri)) {
+                rs_stream_reader_close(&r);
+                return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                               "cannot write a temporary file (disk full?)");
+            }
+        }
+    }
+    rs_stream_reader_close(&r);
+    return RSMOOTH_OK;
+}
+
+/* Longest processing time first: each piece, by facets, to the rank with the least so far. */
+static bool share(rs_piece *pieces, size_t count, int ranks) {
+    size_t *order = rs_alloc_array(count ? count : 1, sizeof *order);
+    uint64_t *load = rs_calloc_array((size_t)ranks, sizeof *load);
+    if (!order || !load) {
+        rs_free(order);
+        rs_free(load);
+        return false;
+    }
+    for (size_t i = 0; i < count; i++)
+        order[i] = i;
+    for (size_t i = 1; i < count; i++) { /* insertion sort: pieces are few */
+        size_t x = order[i], j = i;
+        uint64_t cx = pieces[x].facet_count + pieces[x].vertex_count;
+        while (j > 0 && pieces[order[j - 1]].facet_count + pieces[order[j - 1]].vertex_count < cx)
+            order[j] = order[j - 1], j--;
+        order[j] = x;
+    }
+    for (size_t i = 0; i < count; i++) {
+        int best = 0;
+        for (int r = 1; r < ranks; r++)
+            if (load[r] < load[best])
+                best = r;
+        rs_piece *p = &pieces[order[i]];
+        p->rank = best;
+        load[best] += p->facet_count + p->vertex_count;
+    }
+    rs_free(order);
+    rs_free(load);
+    return true;
+}
+
+static rsmooth_status no_memory(rsmooth_error *error) {
+    return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "no memory for pieces");
+}
+
+rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int triangles_fd,
+                                      uint64_t triangle_count, const rs_stream_stats *stats,
+                                      double halo, uint64_t piece_vertices, size_t buffer_memory,
+                                      int rank, int ranks, const char *dir,
+                                      rs_stream_pieces *out, rsmooth_error *error) {
+    memset(out, 0, sizeof *out);
+    out->vertex_fd = out->facet_fd = -1;
+    cell_grid g;
+    cutter ct = {&g, piece_vertices ? piece_vertices : 1, NULL, NULL, 0, 0};
+    rs_region_writer vw, fw;
+    memset(&vw, 0, sizeof vw);
+    memset(&fw, 0, sizeof fw);
+    uint64_t *starts = NULL;
+    rsmooth_status st = RSMOOTH_OK;
+    size_t max_cells = buffer_memory / 8 < MAX_CELLS ? buffer_memory / 8 : MAX_CELLS;
+    if (!grid_init(&g, stats, halo, max_cells < 1 ? 1 : max_cells)) {
+        st = no_memory(error);
+        goto done;
+    }
+    for (uint64_t v = 0; v < positions->count; v++) {
+        double p[3];
+        int32_t c[3];
+        rs_stream_position(positions, v, p);
+        cell_of(&g, p, c);
+        g.count[cell_index(&g, c)]++;
+    }
+    box all = {{0, 0, 0}, {g.dims[0], g.dims[1], g.dims[2]}};
+    if (!cut(&ct, all, positions->count)) {
+        st = no_memory(error);
+        goto done;
+    }
+    /* a little beyond the halo: a facet exactly at it must not round out (as tiles.c) */
+    double reach = halo * (1 + 1e-6);
+    st = facet_pass(positions, triangles_fd, triangle_count, &g, ct.boxes, ct.pieces,
+                    stats->scale, reach, rank, NULL, error);
+    if (st != RSMOOTH_OK)
+        goto done;
+    if (!share(ct.pieces, ct.count, ranks < 1 ? 1 : ranks)) {
+        st = no_memory(error);
+        goto done;
+    }
+    starts = rs_alloc_array(ct.count ? ct.count : 1, sizeof *starts);
+    out->vertex_fd = rs_stream_temporary(dir);
+    out->facet_fd = rs_stream_temporary(dir);
+    if (!starts) {
+        st = no_memory(error);
+        goto done;
+    }
+    if (out->vertex_fd < 0 || out->facet_fd < 0) {
+        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                     "cannot create a temporary file in %s", dir);
+        goto done;
+    }
+    uint64_t vertices = 0, facets = 0; /* this rank's pieces' lists, one after another */
+    for (size_t i = 0; i < ct.count; i++) {
+        rs_piece *p = &ct.pieces[i];
+        p->vertex_start = vertices;
+        p->facet_start = facets;
+        if (p->rank == rank) {
+            vertices += p->vertex_count;
+            facets += p->facet_count;
+        }
+    }
+    out->temporary_bytes = 4 * vertices + 12 * facets;
+    for (size_t i = 0; i < ct.count; i++)
+        starts[i] = ct.pieces[i].vertex_start;
+    if (!rs_region_writer_init(&vw, out->vertex_fd, ct.count, 4, starts, buffer_memory)) {
+        st = no_memory(error);
+        goto done;
+    }
+    for (uint64_t v = 0; v < positions->count; v++) {
+        double p[3];
+        int32_t c[3];
+        rs_stream_position(positions, v, p);
+        cell_of(&g, p, c);
+        int32_t id = g.piece[cell_index(&g, c)];
+        uint32_t v32 = (uint32_t)v;
+        if (ct.pieces[id].rank == rank && !rs_region_append(&vw, (size_t)id, &v32)) {
+            st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                         "cannot write a temporary file in %s (disk full?)", dir);
+            goto done;
+        }
+    }
+    if (!rs_region_writer_finish(&vw)) {
+        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                     "cannot write a temporary file in %s (disk full?)", dir);
+        goto done;
+    }
+    for (size_t i = 0; i < ct.count; i++)
+        starts[i] = ct.pieces[i].facet_start;
+    if (!rs_region_writer_init(&fw, out->facet_fd, ct.count, 12, starts, buffer_memory)) {
+        st = no_memory(error);
+        goto done;
+    }
+    st = facet_pass(positions, triangles_fd, triangle_count, &g, ct.boxes, ct.pieces,
+                    stats->scale, reach, rank, &fw, error);
+    if (st == RSMOOTH_OK && !rs_region_writer_finish(&fw))
+        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                     "cannot write a temporary file in %s (disk full?)", dir);
+
+done:
+    rs_region_writer_free(&vw);
+    rs_region_writer_free(&fw);
+    rs_free(starts);
+    rs_free(g.count);
+    rs_free(g.piece);
+    rs_free(ct.boxes);
+    out->pieces = ct.pieces;
+    out->count = ct.count;
+    if (st != RSMOOTH_OK)
+        rs_stream_pieces_free(out);
+    return st;
+}
+
+void rs_stream_pieces_free(rs_stream_pieces *pieces) {
+    rs_free(pieces->pieces);
+    if (pieces->vertex_fd >= 0)
+        close(pieces->vertex_fd);
+    if (pieces->facet_fd >= 0)
+        close(pieces->facet_fd);
+    memset(pieces, 0, sizeof *pieces);
+    pieces->vertex_fd = pieces->facet_fd = -1;
+}

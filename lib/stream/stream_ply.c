@@ -1,0 +1,395 @@
+/* A binary PLY read in pieces: the header through the in-memory reader's own parser, then the
+ * vertex block and the faces front to back, and results written back into a copy at their rows. */
+#define _GNU_SOURCE
+#include "stream/stream_internal.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#define READ_BUFFER (1u << 20)
+/* A header longer than this is refused (comments of megabytes are not a mesh). */
+#define MAX_HEADER (64u << 20)
+
+static rsmooth_status io_fail(const char *path, const char *what, rsmooth_error *error) {
+    return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "%s: %s: %s", path, what,
+                   strerror(errno));
+}
+
+static rsmooth_status unsupported(const char *path, const char *why, rsmooth_error *error) {
+    return rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, RS_STREAM_WHERE,
+                   "%s: streaming %s; without --max-memory the file is read whole", path, why);
+}
+
+/* A value of type t stored in the file's byte order. */
+static double value_at(const unsigned char *p, rs_ply_type t, bool swap) {
+    if (!swap)
+        return rs_ply_host_value(p, t);
+    unsigned char b[8];
+    size_t n = rs_ply_type_size(t);
+    for (size_t i = 0; i < n; i++)
+        b[i] = p[n - 1 - i];
+    return rs_ply_host_value(b, t);
+}
+
+/* Reads the header bytes (up to and past 'end_header') into a buffer the parser reads. */
+static rsmooth_status read_header(rs_stream_ply *ply, rsmooth_error *error) {
+    size_t want = 1u << 20;
+    for (;;) {
+        if ((uint64_t)want > ply->size)
+            want = (size_t)ply->size;
+        char *buf = rs_alloc_array(want + 1, 1);
+        if (!buf)
+            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "PLY header");
+        if (!rs_stream_pread(ply->fd, buf, want, 0)) {
+            rs_free(buf);
+            return io_fail(ply->path, "cannot read", error);
+        }
+        buf[want] = 0;
+        bool found = false;
+        for (const char *p = buf; !found && (p = memmem(p, (size_t)(buf + want - p),
+                                                         "end_header", 10)) != NULL;
+             p++)
+            found = memchr(p, '\n', (size_t)(buf + want - p)) != NULL;
+        if (found || (uint64_t)want == ply->size || want >= MAX_HEADER) {
+            ply->header.data = buf;
+            ply->header.size = want;
+            return RSMOOTH_OK;
+        }
+        rs_free(buf);
+        want *= 4;
+    }
+}
+
+/* Bytes of one item of an element without lists. */
+static size_t row_bytes(const rs_ply_element *e, bool *has_list) {
+    size_t n = 0;
+    *has_list = false;
+    for (size_t k = 0; k < e->property_count; k++) {
+        if (e->properties[k].count_type != RS_PLY_NONE)
+            *has_list = true;
+        else
+            n += rs_ply_type_size(e->properties[k].type);
+    }
+    return n;
+}
+
+/* Walks the items of an element with lists, returning where it ends (or 0 on a short file). */
+static uint64_t skip_element(rs_stream_ply *ply, const rs_ply_element *e, uint64_t start,
+                             rsmooth_error *error, rsmooth_status *st) {
+    rs_stream_reader r;
+    if (!rs_stream_reader_open(&r, ply->fd, ply->path, start, ply->size, READ_BUFFER)) {
+        *st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
+        return 0;
+    }
+    for (uint64_t i = 0; i < e->count; i++)
+        for (size_t k = 0; k < e->property_count; k++) {
+            const rs_ply_property *p = &e->properties[k];
+            size_t n = 1;
+            if (p->count_type != RS_PLY_NONE) {
+                const unsigned char *c = rs_stream_read(&r, rs_ply_type_size(p->count_type));
+                if (!c)
+                    goto short_file;
+                n = (size_t)value_at(c, p->count_type, ply->swap);
+            }
+            for (size_t j = 0; j < n; j++)
+                if (!rs_stream_read(&r, rs_ply_type_size(p->type)))
+                    goto short_file;
+        }
+    uint64_t end = rs_stream_reader_offset(&r);
+    rs_stream_reader_close(&r);
+    return end;
+short_file:
+    rs_stream_reader_close(&r);
+    *st = rs_fail_parse(error, -1, (int64_t)rs_stream_reader_offset(&r), RS_STREAM_WHERE,
+                        "%s: the file ends inside element '%s'", ply->path, e->name);
+    return 0;
+}
+
+/* Where the vertex and face blocks start; what streaming cannot do is refused. */
+static rsmooth_status find_layout(rs_stream_ply *ply, rsmooth_error *error) {
+    rs_ply_reader *h = &ply->header;
+    if (h->encoding == RS_PLY_ASCII)
+        return unsupported(ply->path, "reads binary PLY only (this one is ascii)", error);
+    if (h->normals)
+        return unsupported(ply->path,
+                           "does not recompute vertex normals (nx ny nz), as the in-memory path "
+                           "does",
+                           error);
+    ply->swap = h->swap;
+    const rs_ply_element *v = h->vertex_element;
+    ply->vertex_count = v->count;
+    ply->face_count = h->face_element ? h->face_element->count : 0;
+    bool list = false;
+    ply->vertex_stride = row_bytes(v, &list);
+    if (list)
+        return unsupported(ply->path, "needs vertices of fixed size (this vertex has a list)",
+                           error);
+    size_t offset = 0;
+    for (size_t k = 0; k < v->property_count; k++) {
+        const rs_ply_property *p = &v->properties[k];
+        if (p->role >= RS_PLY_X && p->role <= RS_PLY_Z) {
+            ply->xyz_offset[p->role - RS_PLY_X] = offset;
+            if (p->type != RS_PLY_FLOAT32 && p->type != RS_PLY_FLOAT64)
+                return unsupported(ply->path, "writes float or double x, y, z only", error);
+            if (ply->xyz_type != RS_PLY_NONE && ply->xyz_type != p->type)
+                return unsupported(ply->path, "needs x, y and z of one type", error);
+            ply->xyz_type = p->type;
+        }
+        offset += rs_ply_type_size(p->type);
+    }
+    uint64_t at = h->pos;
+    rsmooth_status st = RSMOOTH_OK;
+    bool face_seen = false;
+    for (size_t ei = 0; ei < h->x->element_count && !face_seen; ei++) {
+        const rs_ply_element *e = &h->x->elements[ei];
+        if (e == h->vertex_element)
+            ply->vertex_start = at;
+        if (e == h->face_element) {
+            ply->face_start = at;
+            face_seen = true;
+            continue;
+        }
+        size_t bytes = row_bytes(e, &list);
+        if (list) {
+            at = skip_element(ply, e, at, error, &st);
+            if (st != RSMOOTH_OK)
+                return st;
+        } else {
+            if (bytes && e->count > (ply->size - at) / bytes)
+                return rs_fail_parse(error, e->header_line, -1, RS_STREAM_WHERE,
+                                     "%s: %llu '%s' items of %zu bytes do not fit in the file",
+                                     ply->path, (unsigned long long)e->count, e->name, bytes);
+            at += e->count * bytes;
+        }
+    }
+    return RSMOOTH_OK;
+}
+
+rsmooth_status rs_stream_ply_open(rs_stream_ply *ply, const char *path, rsmooth_error *error) {
+    memset(ply, 0, sizeof *ply);
+    ply->path = path;
+    ply->fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (ply->fd < 0)
+        return io_fail(path, "cannot open", error);
+    struct stat sb;
+    if (fstat(ply->fd, &sb) != 0)
+        return io_fail(path, "cannot stat", error);
+    if (!S_ISREG(sb.st_mode))
+        return unsupported(path, "needs a regular file (it reads the file more than once)",
+                           error);
+    ply->size = (uint64_t)sb.st_size;
+    if (ply->size < 4)
+        return rs_fail_parse(error, 1, 0, RS_STREAM_WHERE, "%s: not a PLY file", path);
+    rsmooth_status st = read_header(ply, error);
+    if (st != RSMOOTH_OK)
+        return st;
+    ply->header.precision = RSMOOTH_FLOAT32;
+    ply->header.x = rs_calloc_array(1, sizeof *ply->header.x);
+    if (!ply->header.x)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "PLY header");
+    ply->header.x->vertex_element = ply->header.x->face_element = SIZE_MAX;
+    rsmooth_error detail;
+    st = rs_ply_parse_header(&ply->header, &detail);
+    if (st == RSMOOTH_OK)
+        st = rs_ply_find_elements(&ply->header, &detail);
+    if (st == RSMOOTH_OK)
+        st = rs_ply_assign_roles(&ply->header, &detail);
+    if (st != RSMOOTH_OK) { /* the reader's message, with the file named */
+        rs_fail_parse(error, detail.line, detail.byte_offset, RS_STREAM_WHERE, "%s: %s", path,
+                      detail.message);
+        return st;
+    }
+    return find_layout(ply, error);
+}
+
+void rs_stream_ply_close(rs_stream_ply *ply) {
+    if (ply->fd >= 0)
+        close(ply->fd);
+    rs_free((char *)ply->header.data);
+    rs_io_ply_extras_free(ply->header.x);
+    memset(ply, 0, sizeof *ply);
+}
+
+rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz, double *magnitude,
+                                           rsmooth_error *error) {
+    uint64_t end = ply->vertex_start + ply->vertex_count * ply->vertex_stride;
+    if (end > ply->size)
+        return rs_fail_parse(error, -1, (int64_t)ply->size, RS_STREAM_WHERE,
+                             "%s: the file ends inside the vertex block", ply->path);
+    rs_stream_reader r;
+    if (!rs_stream_reader_open(&r, ply->fd, ply->path, ply->vertex_start, end, READ_BUFFER))
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
+    bool f32 = ply->xyz_type == RS_PLY_FLOAT32;
+    double largest = 0;
+    for (uint64_t i = 0; i < ply->vertex_count; i++) {
+        const unsigned char *row = rs_stream_read(&r, ply->vertex_stride);
+        if (!row) {
+            rs_stream_reader_close(&r);
+            return io_fail(ply->path, "cannot read the vertices", error);
+        }
+        for (int k = 0; k < 3; k++) {
+            double c = value_at(row + ply->xyz_offset[k], ply->xyz_type, ply->swap);
+            if (!rs_io_coordinate_ok(c)) {
+                rs_stream_reader_close(&r);
+                return rs_fail_parse(error, -1,
+                                     (int64_t)(ply->vertex_start + i * ply->vertex_stride),
+                                     RS_STREAM_WHERE,
+                                     "%s: vertex %llu has coordinate %g (finite values up to "
+                                     "1e150 are supported)",
+                                     ply->path, (unsigned long long)i, c);
+            }
+            largest = fmax(largest, fabs(c));
+            if (f32)
+                ((float *)xyz)[3 * i + (uint64_t)k] = (float)c;
+            else
+                ((double *)xyz)[3 * i + (uint64_t)k] = c;
+        }
+    }
+    rs_stream_reader_close(&r);
+    *magnitude = largest;
+    return RSMOOTH_OK;
+}
+
+rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_fd,
+                                             uint64_t *triangle_count, rsmooth_error *error) {
+    *triangle_count = 0;
+    const rs_ply_element *f = ply->header.face_element;
+    if (!f || f->count == 0)
+        return RSMOOTH_OK;
+    rs_stream_reader r;
+    if (!rs_stream_reader_open(&r, ply->fd, ply->path, ply->face_start, ply->size, READ_BUFFER))
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
+    enum { OUT_TRIANGLES = 1 << 16 };
+    uint32_t *out = rs_alloc_array(OUT_TRIANGLES, 3 * sizeof *out);
+    if (!out) {
+        rs_stream_reader_close(&r);
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "face buffer");
+    }
+    size_t buffered = 0;
+    uint64_t written = 0;
+    rsmooth_status st = RSMOOTH_OK;
+    for (uint64_t i = 0; i < f->count && st == RSMOOTH_OK; i++) {
+        for (size_t k = 0; k < f->property_count && st == RSMOOTH_OK; k++) {
+            const rs_ply_property *p = &f->properties[k];
+            uint64_t at = rs_stream_reader_offset(&r);
+            uint64_t n = 1;
+            if (p->count_type != RS_PLY_NONE) {
+                const unsigned char *c = rs_stream_read(&r, rs_ply_type_size(p->count_type));
+                double count = c ? value_at(c, p->count_type, ply->swap) : 0;
+                if (!c || !(count >= 0)) {
+                    st = c ? rs_fail_parse(error, -1, (int64_t)at, RS_STREAM_WHERE,
+                                           "%s: face %llu: negative list count", ply->path,
+                                           (unsigned long long)i)
+                           : rs_fail_parse(error, -1, (int64_t)at, RS_STREAM_WHERE,
+                                           "%s: the file ends inside face %llu", ply->path,
+                                           (unsigned long long)i);
+                    break;
+                }
+                n = (uint64_t)count;
+            }
+            size_t item = rs_ply_type_size(p->type);
+            if (p->role != RS_PLY_FACE_LIST) {
+                for (uint64_t j = 0; j < n && st == RSMOOTH_OK; j++)
+                    if (!rs_stream_read(&r, item))
+                        st = rs_fail_parse(error, -1, (int64_t)at, RS_STREAM_WHERE,
+                                           "%s: the file ends inside face %llu", ply->path,
+                                           (unsigned long long)i);
+                continue;
+            }
+            if (n < 3) {
+                st = rs_fail_parse(error, -1, (int64_t)at, RS_STREAM_WHERE,
+                                   "%s: face %llu has %llu vertices (at least 3 needed)",
+                                   ply->path, (unsigned long long)i, (unsigned long long)n);
+                break;
+            }
+            uint32_t first = 0, previous = 0;
+            for (uint64_t j = 0; j < n; j++) {
+                uint64_t item_at = rs_stream_reader_offset(&r);
+                const unsigned char *c = rs_stream_read(&r, item);
+                double v = c ? value_at(c, p->type, ply->swap) : -1;
+                if (!c || !(v >= 0 && v < (double)ply->vertex_count && v == floor(v))) {
+                    st = !c ? rs_fail_parse(error, -1, (int64_t)item_at, RS_STREAM_WHERE,
+                                            "%s: the file ends inside face %llu", ply->path,
+                                            (unsigned long long)i)
+                            : rs_fail_parse(error, -1, (int64_t)item_at, RS_STREAM_WHERE,
+                                            "%s: face %llu: index %.17g out of range (%llu "
+                                            "vertices)",
+                                            ply->path, (unsigned long long)i, v,
+                                            (unsigned long long)ply->vertex_count);
+                    break;
+                }
+                uint32_t index = (uint32_t)v;
+                if (j == 0)
+                    first = index;
+                if (j >= 2) { /* the fan the in-memory reader makes: (v0, v[j-1], v[j]) */
+                    uint32_t *t = out + 3 * buffered++;
+                    t[0] = first;
+                    t[1] = previous;
+                    t[2] = index;
+                    if (buffered == OUT_TRIANGLES) {
+                        if (!rs_stream_pwrite(triangles_fd, out, buffered * 3 * sizeof *out,
+                                              written * 3 * sizeof *out))
+                            st = io_fail("temporary file", "cannot write", error);
+                        written += buffered;
+                        buffered = 0;
+                    }
+                }
+                previous = index;
+            }
+        }
+    }
+    if (st == RSMOOTH_OK && buffered > 0 &&
+        !rs_stream_pwrite(triangles_fd, out, buffered * 3 * sizeof *out,
+                          written * 3 * sizeof *out))
+        st = io_fail("temporary file", "cannot write", error);
+    written += buffered;
+    rs_free(out);
+    rs_stream_reader_close(&r);
+    *triangle_count = written;
+    return st;
+}
+
+/* A double as the file stores it: its type, its byte order. */
+static void put_value(unsigned char *p, double x, rs_ply_type t, bool swap) {
+    unsigned char b[8];
+    size_t n = rs_ply_type_size(t);
+    if (t == RS_PLY_FLOAT32) {
+        float f = (float)x;
+        memcpy(b, &f, 4);
+    } else {
+        memcpy(b, &x, 8);
+    }
+    for (size_t i = 0; i < n; i++)
+        p[i] = swap ? b[n - 1 - i] : b[i];
+}
+
+bool rs_stream_ply_write_positions(const rs_stream_ply *ply, int out_fd, const uint32_t *ids,
+                                   size_t n, const double *xyz) {
+    enum { RUN_ROWS = 4096 };
+    size_t stride = ply->vertex_stride;
+    /* rows holding only x, y, z need not be read first: every byte of them is written */
+    bool whole_rows = stride == 3 * rs_ply_type_size(ply->xyz_type);
+    unsigned char *rows = rs_alloc_array(RUN_ROWS, stride);
+    if (!rows)
+        return false;
+    bool ok = true;
+    for (size_t i = 0; ok && i < n;) {
+        size_t run = 1; /* consecutive ids: one read and one write */
+        while (i + run < n && run < RUN_ROWS && ids[i + run] == ids[i] + run)
+            run++;
+        uint64_t at = ply->vertex_start + (uint64_t)ids[i] * stride;
+        ok = whole_rows || rs_stream_pread(out_fd, rows, run * stride, at);
+        for (size_t j = 0; ok && j < run; j++)
+            for (int k = 0; k < 3; k++)
+                put_value(rows + j * stride + ply->xyz_offset[k], xyz[3 * (i + j) + (size_t)k],
+                          ply->xyz_type, ply->swap);
+        ok = ok && rs_stream_pwrite(out_fd, rows, run * stride, at);
+        i += run;
+    }
+    rs_free(rows);
+    return ok;
+}

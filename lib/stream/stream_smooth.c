@@ -1,0 +1,482 @@
+/* rsmooth_stream_smooth: the filter on a mesh file larger than memory.
+ *
+ *   1. the vertex block into memory (the one array that grows with the mesh), the faces fanned
+ *      into triangles on disk;
+ *   2. the mesh's figures (stream_stats.c) and the halo of a piece (rsmooth_piece_halo);
+ *   3. the pieces and their lists on disk (stream_pieces.c), sized to the memory cap;
+ *   4. the output: a copy of the input, unnamed until it is complete;
+ *   5. each piece (this rank's) filtered (rsmooth_smooth_piece) and its core vertices written
+ *      into the copy at their rows;
+ *   6. the copy named as the output, atomically.
+ * Ranks (the MPI driver) run 1-3 alike, rank 0 makes the copy, and each writes its own pieces'
+ * rows: disjoint bytes of one file. */
+#define _GNU_SOURCE /* O_TMPFILE, linkat, renameat2 */
+#include "stream/stream_internal.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <libgen.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#define DEFAULT_MAX_MEMORY (1ull << 30)
+/* What a piece holds per core vertex at its peak: its lists, its arrays, the filter's packed
+ * facets and device buffers (a CPU device's are host memory), for about two facets per vertex
+ * and their halo. Measured peak over the cap's share on the demo shapes: see README "Large
+ * meshes". */
+#define PIECE_BYTES_PER_VERTEX 1200
+/* Working memory besides the positions and the pieces: read buffers of 1 MB, the cell grid
+ * (GRID_BYTES) and the lists' write buffers (as much again). */
+#define GRID_BYTES (2ull << 20)
+#define FIXED_BYTES (8ull << 20)
+/* The smallest piece worth its halo. */
+#define MIN_PIECE_VERTICES 1024
+
+rsmooth_status rsmooth_stream_options_init(rsmooth_stream_options *options) {
+    if (!options)
+        return RSMOOTH_ERROR_INVALID_ARGUMENT;
+    memset(options, 0, sizeof *options);
+    options->struct_size = sizeof *options;
+    return RSMOOTH_OK;
+}
+
+void rsmooth_stream_report_init(rsmooth_stream_report *report) {
+    if (!report)
+        return;
+    memset(report, 0, sizeof *report);
+    report->struct_size = sizeof *report;
+}
+
+typedef struct stream_call {
+    rsmooth_context *ctx;
+    const char *input, *output;
+    rsmooth_params params; /* the caller's, progress taken out (pieces report through us) */
+    const rsmooth_params *caller_params;
+    rsmooth_stream_options opt;
+    rsmooth_stream_report rep;
+    char dir[4096];        /* temporaries */
+    rs_stream_ply ply;
+    void *xyz;
+    rs_stream_positions positions;
+    int triangles_fd, out_fd;
+    uint64_t triangle_count;
+    rs_stream_stats stats;
+    double halo;
+    uint64_t piece_vertices;
+    rs_stream_pieces pieces;
+    char partial[4200];    /* the named partial output of several ranks */
+} stream_call;
+
+static double now_ms(void) {
+    return rs_now_ms();
+}
+
+static int sync_ranks(const stream_call *c, int status) {
+    return c->opt.ranks > 1 && c->opt.sync ? c->opt.sync(c->opt.sync_user, status) : status;
+}
+
+static bool report_progress(const stream_call *c, double fraction) {
+    const rsmooth_params *p = c->caller_params;
+    if (!p)
+        return true;
+    if (p->progress)
+        p->progress(p->progress_user, fraction);
+    return !p->progress_cancel || p->progress_cancel(p->progress_user, fraction) == 0;
+}
+
+/* The output's folder, for the temporaries and the partial output. */
+static void output_dir(const char *output, char *dir, size_t size) {
+    snprintf(dir, size, "%s", output);
+    char *slash = strrchr(dir, '/');
+    if (!slash)
+        snprintf(dir, size, ".");
+    else if (slash == dir)
+        dir[1] = 0;
+    else
+        *slash = 0;
+}
+
+static rsmooth_status check_arguments(stream_call *c, const rsmooth_params *params,
+                                      const rsmooth_stream_options *options,
+                                      rsmooth_error *error) {
+    if (!c->input || !c->output)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, RS_STREAM_WHERE,
+                       "%s is NULL", c->input ? "output" : "input");
+    rsmooth_stream_options_init(&c->opt);
+    if (options) {
+        if (options->struct_size < sizeof *options)
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, RS_STREAM_WHERE,
+                           "options->struct_size %zu: call rsmooth_stream_options_init first",
+                           options->struct_size);
+        c->opt = *options;
+    }
+    if (c->opt.ranks < 0 || (c->opt.ranks > 1 && (c->opt.rank < 0 || c->opt.rank >= c->opt.ranks)))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, RS_STREAM_WHERE,
+                       "rank %d of %d ranks", c->opt.rank, c->opt.ranks);
+    if (c->opt.ranks <= 1) {
+        c->opt.ranks = 1;
+        c->opt.rank = 0;
+    }
+    if (c->opt.max_memory == 0)
+        c->opt.max_memory = DEFAULT_MAX_MEMORY;
+    double halo = 0; /* the params' checks, before any file is read */
+    rsmooth_status st = rsmooth_piece_halo(params, 1, 0, &halo, error);
+    if (st != RSMOOTH_OK)
+        return st;
+    c->caller_params = params;
+    if (params)
+        c->params = *params;
+    else
+        rsmooth_params_init(&c->params);
+    c->params.progress = NULL;
+    c->params.progress_cancel = NULL;
+    struct stat sb;
+    if (!c->opt.replace && lstat(c->output, &sb) == 0)
+        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                       "%s exists (replace it with options->replace)", c->output);
+    if (c->opt.tmpdir)
+        snprintf(c->dir, sizeof c->dir, "%s", c->opt.tmpdir);
+    else
+        output_dir(c->output, c->dir, sizeof c->dir);
+    return RSMOOTH_OK;
+}
+
+/* Steps 1-3: everything before the output is touched. */
+static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
+    double t0 = now_ms();
+    rsmooth_status st = rs_stream_ply_open(&c->ply, c->input, error);
+    if (st != RSMOOTH_OK)
+        return st;
+    c->rep.vertex_count = c->ply.vertex_count;
+    c->rep.face_count = c->ply.face_count;
+    bool f32 = c->ply.xyz_type == RS_PLY_FLOAT32;
+    uint64_t position_bytes = c->ply.vertex_count * 3 * (f32 ? 4 : 8);
+    uint64_t cap = c->opt.max_memory;
+    uint64_t least = position_bytes + FIXED_BYTES + MIN_PIECE_VERTICES * PIECE_BYTES_PER_VERTEX;
+    if (cap < least)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
+                       "%s: a memory cap of %llu MB is too small: its %llu vertex positions "
+                       "alone take %llu MB; give at least %llu MB",
+                       c->input, (unsigned long long)(cap >> 20),
+                       (unsigned long long)c->ply.vertex_count,
+                       (unsigned long long)(position_bytes >> 20),
+                       (unsigned long long)((least >> 20) + 1));
+    c->xyz = rs_alloc_array((size_t)c->ply.vertex_count, 3 * (f32 ? 4 : 8));
+    if (!c->xyz)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
+                       "no memory for %llu vertex positions",
+                       (unsigned long long)c->ply.vertex_count);
+    c->positions = (rs_stream_positions){c->xyz, f32, c->ply.vertex_count};
+    double magnitude = 0;
+    st = rs_stream_ply_read_vertices(&c->ply, c->xyz, &magnitude, error);
+    if (st != RSMOOTH_OK)
+        return st;
+    if (!report_progress(c, 0.03))
+        return rs_fail(error, RSMOOTH_ERROR_CANCELLED, RS_STREAM_WHERE, "cancelled");
+    c->triangles_fd = rs_stream_temporary(c->dir);
+    if (c->triangles_fd < 0)
+        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                       "cannot create a temporary file in %s: %s", c->dir, strerror(errno));
+    st = rs_stream_ply_write_triangles(&c->ply, c->triangles_fd, &c->triangle_count, error);
+    if (st != RSMOOTH_OK)
+        return st;
+    c->rep.triangle_count = c->triangle_count;
+    c->rep.ms_read = now_ms() - t0;
+    if (!report_progress(c, 0.08))
+        return rs_fail(error, RSMOOTH_ERROR_CANCELLED, RS_STREAM_WHERE, "cancelled");
+
+    double t1 = now_ms();
+    uint64_t work = cap - position_bytes - FIXED_BYTES / 2;
+    st = rs_stream_statistics(&c->positions, c->triangles_fd, c->triangle_count, magnitude, work,
+                              &c->stats, error);
+    if (st != RSMOOTH_OK)
+        return st;
+    c->rep.mean_edge_length = c->stats.mean_edge_length;
+    c->rep.facet_count = c->stats.facet_count;
+    st = rsmooth_piece_halo(&c->params, c->stats.mean_edge_length, c->stats.reach, &c->halo,
+                            error);
+    if (st != RSMOOTH_OK)
+        return st;
+    c->rep.halo = c->halo;
+    c->rep.ms_statistics = now_ms() - t1;
+    if (!report_progress(c, 0.15))
+        return rs_fail(error, RSMOOTH_ERROR_CANCELLED, RS_STREAM_WHERE, "cancelled");
+
+    double t2 = now_ms();
+    c->piece_vertices = (cap - position_bytes - FIXED_BYTES) / PIECE_BYTES_PER_VERTEX;
+    c->rep.memory_planned = position_bytes + FIXED_BYTES +
+                            c->piece_vertices * PIECE_BYTES_PER_VERTEX;
+    st = rs_stream_pieces_build(&c->positions, c->triangles_fd, c->triangle_count, &c->stats,
+                                c->halo, c->piece_vertices, GRID_BYTES, c->opt.rank,
+                                c->opt.ranks, c->dir, &c->pieces, error);
+    if (st != RSMOOTH_OK)
+        return st;
+    c->rep.pieces = c->pieces.count;
+    c->rep.temporary_bytes = 12 * c->triangle_count + c->pieces.temporary_bytes;
+    c->rep.ms_buckets = now_ms() - t2;
+    return report_progress(c, 0.2)
+               ? RSMOOTH_OK
+               : rs_fail(error, RSMOOTH_ERROR_CANCELLED, RS_STREAM_WHERE, "cancelled");
+}
+
+/* Step 4: the copy of the input the results go into. Alone: unnamed (O_TMPFILE) until step 6.
+ * Ranks: named <output>.rsmooth-partial, made by rank 0, so the others can open it. */
+static rsmooth_status make_copy(stream_call *c, rsmooth_error *error) {
+    if (c->opt.ranks > 1) {
+        c->out_fd = open(c->partial, O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (c->out_fd < 0)
+            return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                           "cannot create %s: %s%s", c->partial, strerror(errno),
+                           errno == EEXIST ? " (left by a run that was killed: remove it)" : "");
+    } else {
+        c->out_fd = -1;
+#ifdef O_TMPFILE
+        char dir[4096];
+        output_dir(c->output, dir, sizeof dir);
+        c->out_fd = open(dir, O_TMPFILE | O_RDWR | O_CLOEXEC, 0666);
+#endif
+        if (c->out_fd < 0)
+            return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                           "cannot create the output in the folder of %s: %s", c->output,
+                           strerror(errno));
+    }
+    if (!rs_stream_copy(c->ply.fd, c->out_fd, c->ply.size))
+        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",
+                       c->output, strerror(errno));
+    return RSMOOTH_OK;
+}
+
+/* LSD radix sort of 32-bit keys (tmp: scratch of the same size). */
+static void radix_sort(uint32_t *keys, uint32_t *tmp, size_t n) {
+    for (int shift = 0; shift < 32; shift += 8) {
+        size_t count[257] = {0};
+        for (size_t i = 0; i < n; i++)
+            count[((keys[i] >> shift) & 255) + 1]++;
+        for (int b = 0; b < 256; b++)
+            count[b + 1] += count[b];
+        for (size_t i = 0; i < n; i++)
+            tmp[count[(keys[i] >> shift) & 255]++] = keys[i];
+        memcpy(keys, tmp, n * sizeof *keys);
+    }
+}
+
+static size_t find_u32(const uint32_t *sorted, size_t n, uint32_t key) {
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (sorted[mid] < key)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* Step 5 for one piece: its lists read, its vertices numbered core first, filtered, written. */
+static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error *error) {
+    size_t n = (size_t)p->vertex_count, m = (size_t)p->facet_count, all = n + 3 * m;
+    uint32_t *core = rs_alloc_array(n ? n : 1, sizeof *core);
+    uint32_t *tri = rs_alloc_array(m ? m : 1, 3 * sizeof *tri);
+    uint32_t *ids = rs_alloc_array(all ? all : 1, sizeof *ids);
+    uint32_t *tmp = rs_alloc_array(all ? all : 1, sizeof *tmp);
+    double *xyz = NULL, *out = NULL;
+    rsmooth_status st = RSMOOTH_OK;
+    if (!core || !tri || !ids || !tmp) {
+        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
+                     "no memory for a piece of %zu facets", m);
+        goto done;
+    }
+    if (!rs_stream_pread(c->pieces.vertex_fd, core, n * 4, p->vertex_start * 4) ||
+        !rs_stream_pread(c->pieces.facet_fd, tri, m * 12, p->facet_start * 12)) {
+        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                     "cannot read a temporary file: %s", strerror(errno));
+        goto done;
+    }
+    memcpy(ids, core, n * sizeof *ids);
+    memcpy(ids + n, tri, 3 * m * sizeof *ids);
+    radix_sort(ids, tmp, all);
+    size_t k = 0; /* unique ids */
+    for (size_t i = 0; i < all; i++)
+        if (k == 0 || ids[i] != ids[k - 1])
+            ids[k++] = ids[i];
+    uint32_t *local = tmp; /* per unique id: core vertices first, in their order, then the rest */
+    for (size_t i = 0, j = 0, others = 0; i < k; i++)
+        local[i] = j < n && core[j] == ids[i] ? (uint32_t)j++ : (uint32_t)(n + others++);
+    xyz = rs_alloc_array(k ? k : 1, 3 * sizeof *xyz);
+    out = rs_alloc_array(n ? n : 1, 3 * sizeof *out);
+    if (!xyz || !out) {
+        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
+                     "no memory for a piece of %zu vertices", k);
+        goto done;
+    }
+    for (size_t i = 0; i < k; i++)
+        rs_stream_position(&c->positions, ids[i], xyz + 3 * (size_t)local[i]);
+    for (size_t i = 0; i < 3 * m; i++)
+        tri[i] = local[find_u32(ids, k, tri[i])];
+    rsmooth_piece_info info;
+    rsmooth_piece_info_init(&info);
+    info.core_count = n;
+    info.mean_edge_length = c->stats.mean_edge_length;
+    info.mean_area = c->stats.mean_area;
+    rsmooth_report rep;
+    rsmooth_report_init(&rep);
+    st = rsmooth_smooth_piece(c->ctx, xyz, k, tri, m, &info, &c->params, out, &rep, error);
+    if (st != RSMOOTH_OK)
+        goto done;
+    if (!c->rep.device[0])
+        snprintf(c->rep.device, sizeof c->rep.device, "%s", rep.device);
+    double t = now_ms();
+    if (!rs_stream_ply_write_positions(&c->ply, c->out_fd, core, n, out))
+        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",
+                     c->output, strerror(errno));
+    c->rep.ms_write += now_ms() - t;
+done:
+    rs_free(core);
+    rs_free(tri);
+    rs_free(ids);
+    rs_free(tmp);
+    rs_free(xyz);
+    rs_free(out);
+    return st;
+}
+
+static rsmooth_status run_pieces(stream_call *c, rsmooth_error *error) {
+    double t0 = now_ms();
+    uint64_t total = 0, done = 0;
+    for (size_t i = 0; i < c->pieces.count; i++)
+        if (c->pieces.pieces[i].rank == c->opt.rank)
+            total += c->pieces.pieces[i].facet_count + c->pieces.pieces[i].vertex_count;
+    for (size_t i = 0; i < c->pieces.count; i++) {
+        const rs_piece *p = &c->pieces.pieces[i];
+        if (p->rank != c->opt.rank)
+            continue;
+        rsmooth_status st = run_piece(c, p, error);
+        if (st != RSMOOTH_OK)
+            return st;
+        c->rep.pieces_here++;
+        c->rep.facets_filtered += p->facet_count;
+        if (p->facet_count > c->rep.piece_facets_max)
+            c->rep.piece_facets_max = p->facet_count;
+        done += p->facet_count + p->vertex_count;
+        if (!report_progress(c, 0.25 + 0.75 * (double)done / (double)(total ? total : 1)))
+            return rs_fail(error, RSMOOTH_ERROR_CANCELLED, RS_STREAM_WHERE, "cancelled");
+    }
+    c->rep.ms_filter = now_ms() - t0 - c->rep.ms_write;
+    return RSMOOTH_OK;
+}
+
+/* Step 6, alone: the unnamed copy linked under a temporary name beside the output, then renamed
+ * over it (or linked as the output directly, which fails if one appeared meanwhile). */
+static rsmooth_status publish(stream_call *c, rsmooth_error *error) {
+    if (fsync(c->out_fd) != 0)
+        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",
+                       c->output, strerror(errno));
+    if (c->opt.ranks > 1) {
+        if (rename(c->partial, c->output) != 0)
+            return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot rename %s to %s: %s",
+                           c->partial, c->output, strerror(errno));
+        c->partial[0] = 0;
+        return RSMOOTH_OK;
+    }
+    char proc[64], temporary[4200];
+    snprintf(proc, sizeof proc, "/proc/self/fd/%d", c->out_fd);
+    if (!c->opt.replace) {
+        if (linkat(AT_FDCWD, proc, AT_FDCWD, c->output, AT_SYMLINK_FOLLOW) == 0)
+            return RSMOOTH_OK;
+        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",
+                       c->output, strerror(errno));
+    }
+    for (int attempt = 0; attempt < 100; attempt++) {
+        snprintf(temporary, sizeof temporary, "%s.rsmooth-%d-%d", c->output, (int)getpid(),
+                 attempt);
+        if (linkat(AT_FDCWD, proc, AT_FDCWD, temporary, AT_SYMLINK_FOLLOW) == 0) {
+            if (rename(temporary, c->output) == 0)
+                return RSMOOTH_OK;
+            int saved = errno;
+            unlink(temporary);
+            errno = saved;
+            break;
+        }
+        if (errno != EEXIST)
+            break;
+    }
+    return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s", c->output,
+                   strerror(errno));
+}
+
+/* A status that another rank failed with, said so here. */
+static rsmooth_status others_failed(int worst, rsmooth_status mine, rsmooth_error *error) {
+    if (mine != RSMOOTH_OK || worst == RSMOOTH_OK)
+        return mine;
+    return rs_fail(error, (rsmooth_status)worst, RS_STREAM_WHERE,
+                   "another rank failed (%s); its message says why",
+                   rsmooth_status_str((rsmooth_status)worst));
+}
+
+rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input, const char *output,
+                                     const rsmooth_params *params,
+                                     const rsmooth_stream_options *options,
+                                     rsmooth_stream_report *report, rsmooth_error *error) {
+    double t0 = now_ms();
+    rs_error_clear(error);
+    stream_call *c = rs_calloc_array(1, sizeof *c);
+    if (!c)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "call record");
+    c->ctx = ctx;
+    c->input = input;
+    c->output = output;
+    c->triangles_fd = c->out_fd = -1;
+    c->ply.fd = -1;
+    c->pieces.vertex_fd = c->pieces.facet_fd = -1;
+    rsmooth_stream_report_init(&c->rep);
+    rsmooth_status st = check_arguments(c, params, options, error);
+    if (st == RSMOOTH_OK && c->opt.ranks > 1)
+        snprintf(c->partial, sizeof c->partial, "%s.rsmooth-partial", output);
+    if (st == RSMOOTH_OK)
+        st = plan(c, error);
+    st = others_failed(sync_ranks(c, st), st, error);
+    if (st == RSMOOTH_OK && c->opt.rank == 0) {
+        double t = now_ms();
+        st = make_copy(c, error);
+        c->rep.ms_copy = now_ms() - t;
+    }
+    st = others_failed(sync_ranks(c, st), st, error);
+    if (st == RSMOOTH_OK && c->opt.rank != 0) {
+        c->out_fd = open(c->partial, O_RDWR | O_CLOEXEC);
+        if (c->out_fd < 0)
+            st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot open %s: %s",
+                         c->partial, strerror(errno));
+    }
+    if (st == RSMOOTH_OK)
+        st = run_pieces(c, error);
+    if (st == RSMOOTH_OK && c->opt.ranks > 1 && fsync(c->out_fd) != 0)
+        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",
+                     c->partial, strerror(errno));
+    st = others_failed(sync_ranks(c, st), st, error);
+    if (c->opt.rank == 0 && c->out_fd >= 0) {
+        if (st == RSMOOTH_OK)
+            st = publish(c, error);
+        if (st != RSMOOTH_OK && c->partial[0])
+            unlink(c->partial); /* nothing half-written is left */
+    }
+    st = others_failed(sync_ranks(c, st), st, error);
+    if (st == RSMOOTH_OK)
+        report_progress(c, 1.0);
+    c->rep.ms_total = now_ms() - t0;
+    if (report && report->struct_size >= sizeof *report)
+        *report = c->rep;
+    if (c->out_fd >= 0)
+        close(c->out_fd);
+    if (c->triangles_fd >= 0)
+        close(c->triangles_fd);
+    rs_stream_pieces_free(&c->pieces);
+    if (c->ply.fd >= 0)
+        rs_stream_ply_close(&c->ply);
+    rs_free(c->xyz);
+    rs_free(c);
+    return st;
+}
