@@ -94,13 +94,19 @@ void cli_stream_print_json(const rsmooth_stream_report *r, const options *opt, i
            r->pieces, r->pieces_here, (unsigned long long)r->piece_facets_max,
            (unsigned long long)r->facets_filtered, (unsigned long long)r->temporary_bytes);
     print_json_string(r->device);
-    printf(",\"ms\":{\"read\":%.3f,\"statistics\":%.3f,\"pieces\":%.3f,\"copy\":%.3f,"
-           "\"filter\":%.3f,\"write\":%.3f,\"total\":%.3f}}\n",
-           r->ms_read, r->ms_statistics, r->ms_buckets, r->ms_copy, r->ms_filter, r->ms_write,
-           r->ms_total);
+    printf(",\"ms\":{\"read\":%.3f,\"statistics\":%.3f,\"cut\":%.3f,\"copy\":%.3f,"
+           "\"assemble\":%.3f,\"filter\":%.3f,\"write\":%.3f,\"total\":%.3f}}\n",
+           r->ms_read, r->ms_statistics, r->ms_buckets, r->ms_copy, r->ms_assemble, r->ms_filter,
+           r->ms_write, r->ms_total);
 }
 
 int cli_stream_file(const options *opt, const char *path) {
+    if (cli_result_format(opt, opt->output, RSMOOTH_FORMAT_PLY_BINARY) !=
+        RSMOOTH_FORMAT_PLY_BINARY) {
+        fprintf(stderr, "rsmooth: %s: --max-memory writes the input's own binary PLY: name the "
+                        "output .ply\n", opt->output);
+        return EXIT_USAGE;
+    }
     cli_progress bar;
     cli_progress_init(&bar, opt->quiet);
     cli_progress_stage(&bar, "streaming", 0, 1);
@@ -134,15 +140,15 @@ int cli_stream_file(const options *opt, const char *path) {
     if (!opt->quiet)
         fprintf(stderr,
                 "rsmooth: %s: %llu vertices, %llu triangles, mean edge %.6g; streamed in %zu "
-                "pieces (the largest %llu facets with its halo) under --max-memory %llu MB on "
-                "%s: read %.1f s, statistics %.1f s, pieces %.1f s, copy %.1f s, filter %.1f s, "
-                "write %.1f s; wrote %s\n",
+                "piece%s (the largest %llu facets with its halo) under --max-memory %llu MB on "
+                "%s: read %.1f s, statistics %.1f s, cut %.1f s, copy %.1f s, assemble %.1f s, "
+                "filter %.1f s, write %.1f s; wrote %s\n",
                 opt->input, (unsigned long long)rep.vertex_count,
                 (unsigned long long)rep.triangle_count, rep.mean_edge_length, rep.pieces,
-                (unsigned long long)rep.piece_facets_max,
+                rep.pieces == 1 ? "" : "s", (unsigned long long)rep.piece_facets_max,
                 (unsigned long long)(opt->max_memory >> 20),
                 rep.device[0] ? rep.device : "no device (no facets)", rep.ms_read / 1000,
                 rep.ms_statistics / 1000, rep.ms_buckets / 1000, rep.ms_copy / 1000,
-                rep.ms_filter / 1000, rep.ms_write / 1000, opt->output);
+                rep.ms_assemble / 1000, rep.ms_filter / 1000, rep.ms_write / 1000, opt->output);
     return EXIT_OK;
 }

@@ -170,9 +170,10 @@ int main(int argc, char **argv) {
     code = st == RSMOOTH_OK ? EXIT_OK : cli_stream_exit_code(st);
     if (st == RSMOOTH_OK && !quiet)
         fprintf(stderr, "rsmooth-mpi: rank %d of %d on %s: %zu pieces, %llu facets with halos, "
-                        "filter %.1f s, write %.1f s\n",
+                        "assemble %.1f s, filter %.1f s, write %.1f s\n",
                 rank, ranks, rep.device[0] ? rep.device : "no device (no pieces)",
-                rep.pieces_here, (unsigned long long)rep.facets_filtered, rep.ms_filter / 1000,
+                rep.pieces_here, (unsigned long long)rep.facets_filtered, rep.ms_assemble / 1000,
+                rep.ms_filter / 1000,
                 rep.ms_write / 1000);
     MPI_Barrier(MPI_COMM_WORLD); /* the ranks' lines before the summary */
     if (st == RSMOOTH_OK && rank == 0) {
@@ -182,7 +183,7 @@ int main(int argc, char **argv) {
             fprintf(stderr,
                     "rsmooth-mpi: %s: %llu vertices, %llu triangles, mean edge %.6g; %zu pieces "
                     "over %d ranks under --max-memory %llu MB each: read %.1f s, statistics "
-                    "%.1f s, pieces %.1f s, copy %.1f s, total %.1f s; wrote %s\n",
+                    "%.1f s, cut %.1f s, copy %.1f s, total %.1f s; wrote %s\n",
                     opt.input, (unsigned long long)rep.vertex_count,
                     (unsigned long long)rep.triangle_count, rep.mean_edge_length, rep.pieces,
                     ranks, (unsigned long long)(opt.max_memory >> 20), rep.ms_read / 1000,

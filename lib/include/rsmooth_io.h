@@ -230,7 +230,11 @@ typedef struct rsmooth_stream_report {
     uint64_t facets_filtered;  /* facets this rank's pieces held, halos included */
     uint64_t memory_planned;   /* the peak this call planned for, bytes (<= max_memory) */
     uint64_t temporary_bytes;  /* disk the temporary files took at their largest */
-    double ms_read, ms_statistics, ms_buckets, ms_copy, ms_filter, ms_write, ms_total;
+    /* read: the vertex block and the faces; statistics: mean edge length, area, reach; buckets:
+     * the pieces cut and their lists written; copy: the output's copy of the input; assemble:
+     * the pieces' arrays from their lists; filter: rsmooth_smooth_piece; write: results into
+     * the copy */
+    double ms_read, ms_statistics, ms_buckets, ms_copy, ms_assemble, ms_filter, ms_write, ms_total;
     char device[128];
 } rsmooth_stream_report;
 

@@ -159,12 +159,10 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
     uint64_t least = position_bytes + FIXED_BYTES + MIN_PIECE_VERTICES * PIECE_BYTES_PER_VERTEX;
     if (cap < least)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
-                       "%s: a memory cap of %llu MB is too small: its %llu vertex positions "
-                       "alone take %llu MB; give at least %llu MB",
-                       c->input, (unsigned long long)(cap >> 20),
-                       (unsigned long long)c->ply.vertex_count,
-                       (unsigned long long)(position_bytes >> 20),
-                       (unsigned long long)((least >> 20) + 1));
+                       "%s: a memory cap of %.1f MB is too small: its %llu vertex positions "
+                       "alone take %.1f MB; give at least %llu MB",
+                       c->input, (double)cap / (1 << 20), (unsigned long long)c->ply.vertex_count,
+                       (double)position_bytes / (1 << 20), (unsigned long long)((least >> 20) + 1));
     c->xyz = rs_alloc_array((size_t)c->ply.vertex_count, 3 * (f32 ? 4 : 8));
     if (!c->xyz)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
@@ -250,42 +248,52 @@ static rsmooth_status make_copy(stream_call *c, rsmooth_error *error) {
     return RSMOOTH_OK;
 }
 
-/* LSD radix sort of 32-bit keys (tmp: scratch of the same size). */
-static void radix_sort(uint32_t *keys, uint32_t *tmp, size_t n) {
-    for (int shift = 0; shift < 32; shift += 8) {
-        size_t count[257] = {0};
-        for (size_t i = 0; i < n; i++)
-            count[((keys[i] >> shift) & 255) + 1]++;
-        for (int b = 0; b < 256; b++)
-            count[b + 1] += count[b];
-        for (size_t i = 0; i < n; i++)
-            tmp[count[(keys[i] >> shift) & 255]++] = keys[i];
-        memcpy(keys, tmp, n * sizeof *keys);
-    }
+/* Global vertex id -> the piece's own numbering: an open-addressing table, ids as keys. */
+typedef struct id_table {
+    uint32_t *key, *value; /* UINT32_MAX: empty */
+    size_t mask;
+} id_table;
+
+static bool id_table_init(id_table *t, size_t count) {
+    size_t size = 16;
+    while (size < 2 * count)
+        size *= 2;
+    t->mask = size - 1;
+    t->key = rs_alloc_array(size, sizeof *t->key);
+    t->value = rs_alloc_array(size, sizeof *t->value);
+    if (!t->key || !t->value)
+        return false;
+    memset(t->key, 0xff, size * sizeof *t->key);
+    return true;
 }
 
-static size_t find_u32(const uint32_t *sorted, size_t n, uint32_t key) {
-    size_t lo = 0, hi = n;
-    while (lo < hi) {
-        size_t mid = lo + (hi - lo) / 2;
-        if (sorted[mid] < key)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
+static void id_table_free(id_table *t) {
+    rs_free(t->key);
+    rs_free(t->value);
 }
 
-/* Step 5 for one piece: its lists read, its vertices numbered core first, filtered, written. */
+/* The slot of `id`: where it is, or the empty slot where it goes. */
+static size_t id_slot(const id_table *t, uint32_t id) {
+    size_t i = (size_t)((id * 0x9E3779B1u) >> 7) & t->mask;
+    while (t->key[i] != id && t->key[i] != UINT32_MAX)
+        i = (i + 1) & t->mask;
+    return i;
+}
+
+/* Step 5 for one piece: its lists read, its vertices numbered core first (then the others as the
+ * facets first name them), filtered, written. */
 static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error *error) {
-    size_t n = (size_t)p->vertex_count, m = (size_t)p->facet_count, all = n + 3 * m;
+    double t_piece = now_ms();
+    size_t n = (size_t)p->vertex_count, m = (size_t)p->facet_count;
     uint32_t *core = rs_alloc_array(n ? n : 1, sizeof *core);
     uint32_t *tri = rs_alloc_array(m ? m : 1, 3 * sizeof *tri);
-    uint32_t *ids = rs_alloc_array(all ? all : 1, sizeof *ids);
-    uint32_t *tmp = rs_alloc_array(all ? all : 1, sizeof *tmp);
-    double *xyz = NULL, *out = NULL;
+    /* at most n + 3m vertices; a piece's facets share their corners about 6 ways */
+    size_t most = n + 3 * m;
+    double *xyz = rs_alloc_array(most ? most : 1, 3 * sizeof *xyz);
+    double *out = rs_alloc_array(n ? n : 1, 3 * sizeof *out);
+    id_table table = {NULL, NULL, 0};
     rsmooth_status st = RSMOOTH_OK;
-    if (!core || !tri || !ids || !tmp) {
+    if (!core || !tri || !xyz || !out || !id_table_init(&table, n + m)) {
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
                      "no memory for a piece of %zu facets", m);
         goto done;
@@ -296,27 +304,42 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
                      "cannot read a temporary file: %s", strerror(errno));
         goto done;
     }
-    memcpy(ids, core, n * sizeof *ids);
-    memcpy(ids + n, tri, 3 * m * sizeof *ids);
-    radix_sort(ids, tmp, all);
-    size_t k = 0; /* unique ids */
-    for (size_t i = 0; i < all; i++)
-        if (k == 0 || ids[i] != ids[k - 1])
-            ids[k++] = ids[i];
-    uint32_t *local = tmp; /* per unique id: core vertices first, in their order, then the rest */
-    for (size_t i = 0, j = 0, others = 0; i < k; i++)
-        local[i] = j < n && core[j] == ids[i] ? (uint32_t)j++ : (uint32_t)(n + others++);
-    xyz = rs_alloc_array(k ? k : 1, 3 * sizeof *xyz);
-    out = rs_alloc_array(n ? n : 1, 3 * sizeof *out);
-    if (!xyz || !out) {
-        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
-                     "no memory for a piece of %zu vertices", k);
-        goto done;
+    size_t k = 0;
+    for (; k < n; k++) {
+        size_t i = id_slot(&table, core[k]);
+        table.key[i] = core[k];
+        table.value[i] = (uint32_t)k;
+        rs_stream_position(&c->positions, core[k], xyz + 3 * k);
     }
-    for (size_t i = 0; i < k; i++)
-        rs_stream_position(&c->positions, ids[i], xyz + 3 * (size_t)local[i]);
-    for (size_t i = 0; i < 3 * m; i++)
-        tri[i] = local[find_u32(ids, k, tri[i])];
+    for (size_t j = 0; j < 3 * m; j++) {
+        size_t i = id_slot(&table, tri[j]);
+        if (table.key[i] == UINT32_MAX) {
+            if (2 * (k + 1) > table.mask) { /* a piece this connected: grow the table */
+                id_table bigger;
+                if (!id_table_init(&bigger, 2 * (k + 1))) {
+                    st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
+                                 "no memory for a piece of %zu facets", m);
+                    goto done;
+                }
+                for (size_t q = 0; q <= table.mask; q++)
+                    if (table.key[q] != UINT32_MAX) {
+                        size_t b = id_slot(&bigger, table.key[q]);
+                        bigger.key[b] = table.key[q];
+                        bigger.value[b] = table.value[q];
+                    }
+                id_table_free(&table);
+                table = bigger;
+                i = id_slot(&table, tri[j]);
+            }
+            table.key[i] = tri[j];
+            table.value[i] = (uint32_t)k;
+            rs_stream_position(&c->positions, tri[j], xyz + 3 * k);
+            k++;
+        }
+        tri[j] = table.value[i];
+    }
+    id_table_free(&table);
+    table.key = table.value = NULL;
     rsmooth_piece_info info;
     rsmooth_piece_info_init(&info);
     info.core_count = n;
@@ -324,6 +347,8 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
     info.mean_area = c->stats.mean_area;
     rsmooth_report rep;
     rsmooth_report_init(&rep);
+    double t_library = now_ms();
+    c->rep.ms_assemble += t_library - t_piece;
     st = rsmooth_smooth_piece(c->ctx, xyz, k, tri, m, &info, &c->params, out, &rep, error);
     if (st != RSMOOTH_OK)
         goto done;
@@ -335,10 +360,9 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
                      c->output, strerror(errno));
     c->rep.ms_write += now_ms() - t;
 done:
+    id_table_free(&table);
     rs_free(core);
     rs_free(tri);
-    rs_free(ids);
-    rs_free(tmp);
     rs_free(xyz);
     rs_free(out);
     return st;
@@ -365,7 +389,7 @@ static rsmooth_status run_pieces(stream_call *c, rsmooth_error *error) {
         if (!report_progress(c, 0.25 + 0.75 * (double)done / (double)(total ? total : 1)))
             return rs_fail(error, RSMOOTH_ERROR_CANCELLED, RS_STREAM_WHERE, "cancelled");
     }
-    c->rep.ms_filter = now_ms() - t0 - c->rep.ms_write;
+    c->rep.ms_filter = now_ms() - t0 - c->rep.ms_write - c->rep.ms_assemble;
     return RSMOOTH_OK;
 }
 
