@@ -63,25 +63,11 @@ int cli_stream_exit_code(rsmooth_status st) {
     }
 }
 
-static void print_json_string(const char *s) {
-    putchar('"');
-    for (; *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\')
-            printf("\\%c", c);
-        else if (c < 0x20)
-            printf("\\u%04x", c);
-        else
-            putchar(c);
-    }
-    putchar('"');
-}
-
 void cli_stream_print_json(const rsmooth_stream_report *r, const options *opt, int ranks) {
     printf("{\"input\":");
-    print_json_string(opt->input);
+    cli_print_json_string(opt->input);
     printf(",\"output\":");
-    print_json_string(opt->output);
+    cli_print_json_string(opt->output);
     printf(",\"streamed\":true,\"ranks\":%d,\"max_memory\":%llu,\"memory_planned\":%llu", ranks,
            (unsigned long long)opt->max_memory, (unsigned long long)r->memory_planned);
     printf(",\"vertex_count\":%llu,\"face_count\":%llu,\"triangle_count\":%llu,"
@@ -93,7 +79,7 @@ void cli_stream_print_json(const rsmooth_stream_report *r, const options *opt, i
            "\"facets_filtered\":%llu,\"temporary_bytes\":%llu,\"device\":",
            r->pieces, r->pieces_here, (unsigned long long)r->piece_facets_max,
            (unsigned long long)r->facets_filtered, (unsigned long long)r->temporary_bytes);
-    print_json_string(r->device);
+    cli_print_json_string(r->device);
     printf(",\"ms\":{\"read\":%.3f,\"statistics\":%.3f,\"cut\":%.3f,\"copy\":%.3f,"
            "\"assemble\":%.3f,\"filter\":%.3f,\"write\":%.3f,\"total\":%.3f}}\n",
            r->ms_read, r->ms_statistics, r->ms_buckets, r->ms_copy, r->ms_assemble, r->ms_filter,

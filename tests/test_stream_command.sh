@@ -84,6 +84,12 @@ if [ -n "$mpi" ]; then
     cmp -s streamed.ply "mpi$n.ply" && echo "rsmooth-mpi on $n ranks: the single process's bytes" ||
       fail "rsmooth-mpi on $n ranks differs from rsmooth --max-memory"
   done
+  # bilateral normals widen the halo: still the single process's bytes
+  expect 0 "$rsmooth" noisy.ply -o bilateral.ply --max-memory 10M --normals bilateral -q
+  expect 0 "$mpirun" -n 3 --oversubscribe "$mpi" noisy.ply -o mpi_bilateral.ply --max-memory 10M \
+    --normals bilateral -q
+  cmp -s bilateral.ply mpi_bilateral.ply ||
+    fail "rsmooth-mpi --normals bilateral differs from rsmooth --max-memory"
   expect 2 "$mpirun" -n 2 --oversubscribe "$mpi" noisy.ply -o refused.ply --best
   grep -q "max-memory" err.txt || fail "rsmooth-mpi --best: $(cat err.txt)"
   ls ./*partial* >/dev/null 2>&1 && fail "a partial output was left behind"

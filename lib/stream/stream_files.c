@@ -56,6 +56,10 @@ const unsigned char *rs_stream_read(rs_stream_reader *r, size_t n) {
     return p;
 }
 
+bool rs_stream_triangles_open(rs_stream_reader *r, int fd, uint64_t triangle_count) {
+    return rs_stream_reader_open(r, fd, "triangles", 0, triangle_count * 12, 1u << 20);
+}
+
 int rs_stream_temporary(const char *dir) {
 #ifdef O_TMPFILE
     int unnamed = open(dir, O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);

@@ -14,6 +14,7 @@
 
 #include <stdbool.h>
 #include <stdint.h>
+#include <string.h>
 
 #define RS_STREAM_WHERE "rsmooth_stream_smooth"
 
@@ -36,6 +37,16 @@ const unsigned char *rs_stream_read(rs_stream_reader *r, size_t n);
 /* Where the next unread byte sits in the file. */
 static inline uint64_t rs_stream_reader_offset(const rs_stream_reader *r) {
     return r->pos - (r->len - r->at);
+}
+
+/* The temporary triangle file (3 uint32 vertex ids per triangle), read front to back. */
+bool rs_stream_triangles_open(rs_stream_reader *r, int fd, uint64_t triangle_count);
+/* The next triangle's ids into tri; false at the end or on a read error. */
+static inline bool rs_stream_next_triangle(rs_stream_reader *r, uint32_t tri[3]) {
+    const unsigned char *rec = rs_stream_read(r, 3 * sizeof(uint32_t));
+    if (rec)
+        memcpy(tri, rec, 3 * sizeof(uint32_t));
+    return rec != NULL;
 }
 
 /* An unnamed temporary file in `dir` (O_TMPFILE, else created and unlinked at once), so that

@@ -11,7 +11,6 @@
 #include <string.h>
 #include <unistd.h>
 
-#define READ_BUFFER (1u << 20)
 #define MAX_CELLS (1u << 21)
 
 typedef struct cell_grid {
@@ -37,6 +36,15 @@ static int32_t cell_coordinate(const cell_grid *g, double x, int k) {
 static void cell_of(const cell_grid *g, const double p[3], int32_t c[3]) {
     for (int k = 0; k < 3; k++)
         c[k] = cell_coordinate(g, p[k], k);
+}
+
+/* The cell index of vertex v. */
+static size_t vertex_cell(const cell_grid *g, const rs_stream_positions *positions, uint64_t v) {
+    double p[3];
+    int32_t c[3];
+    rs_stream_position(positions, v, p);
+    cell_of(g, p, c);
+    return cell_index(g, c);
 }
 
 static bool grid_init(cell_grid *g, const rs_stream_stats *stats, double halo, size_t max_cells) {
@@ -201,19 +209,17 @@ static rsmooth_status facet_pass(const rs_stream_positions *pos, int fd, uint64_
                                  double scale, double halo, int rank, rs_region_writer *writer,
                                  rsmooth_error *error) {
     rs_stream_reader r;
-    if (!rs_stream_reader_open(&r, fd, "triangles", 0, triangles * 12, READ_BUFFER))
+    if (!rs_stream_triangles_open(&r, fd, triangles))
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
     enum { MAX_NEAR = 512 };
     int32_t near[MAX_NEAR];
     for (uint64_t t = 0; t < triangles; t++) {
-        const unsigned char *rec = rs_stream_read(&r, 12);
-        if (!rec) {
+        uint32_t tri[3];
+        if (!rs_stream_next_triangle(&r, tri)) {
             rs_stream_reader_close(&r);
             return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
                            "cannot read the temporary triangle file");
         }
-        uint32_t tri[3];
-        memcpy(tri, rec, sizeof tri);
         double c[3];
         if (!facet_centroid(pos, tri, scale, c))
             continue;
@@ -288,13 +294,8 @@ rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int 
         st = no_memory(error);
         goto done;
     }
-    for (uint64_t v = 0; v < positions->count; v++) {
-        double p[3];
-        int32_t c[3];
-        rs_stream_position(positions, v, p);
-        cell_of(&g, p, c);
-        g.count[cell_index(&g, c)]++;
-    }
+    for (uint64_t v = 0; v < positions->count; v++)
+        g.count[vertex_cell(&g, positions, v)]++;
     box all = {{0, 0, 0}, {g.dims[0], g.dims[1], g.dims[2]}};
     if (!cut(&ct, all, positions->count)) {
         st = no_memory(error);
@@ -340,11 +341,7 @@ rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int 
         goto done;
     }
     for (uint64_t v = 0; v < positions->count; v++) {
-        double p[3];
-        int32_t c[3];
-        rs_stream_position(positions, v, p);
-        cell_of(&g, p, c);
-        int32_t id = g.piece[cell_index(&g, c)];
+        int32_t id = g.piece[vertex_cell(&g, positions, v)];
         uint32_t v32 = (uint32_t)v;
         if (ct.pieces[id].rank == rank && !rs_region_append(&vw, (size_t)id, &v32)) {
             st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,

@@ -14,7 +14,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define READ_BUFFER (1u << 20)
 /* mesh.c's constants: the block of the area sums, the bucket size from which edges are sorted */
 #define GEOMETRY_BLOCK 8192
 #define EDGE_SCAN_LIMIT 32
@@ -47,16 +46,14 @@ static rsmooth_status edge_range(const rs_stream_positions *pos, int fd, uint64_
         if (fill == 0)
             memset(start, 0, (span + 1) * sizeof *start);
         rs_stream_reader r;
-        if (!rs_stream_reader_open(&r, fd, "triangles", 0, triangles * 12, READ_BUFFER))
+        if (!rs_stream_triangles_open(&r, fd, triangles))
             return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
         for (uint64_t t = 0; t < triangles; t++) {
-            const unsigned char *rec = rs_stream_read(&r, 12);
-            if (!rec) {
+            uint32_t tri[3];
+            if (!rs_stream_next_triangle(&r, tri)) {
                 rs_stream_reader_close(&r);
                 return read_fail(error);
             }
-            uint32_t tri[3];
-            memcpy(tri, rec, sizeof tri);
             for (int e = 0; e < 3; e++) {
                 uint32_t a = tri[e], b = tri[(e + 1) % 3];
                 uint32_t low = a < b ? a : b;
@@ -180,18 +177,16 @@ static bool facet_geometry(const double a[3], const double b[3], const double c[
 static rsmooth_status facet_figures(const rs_stream_positions *pos, int fd, uint64_t triangles,
                                     double scale, rs_stream_stats *stats, rsmooth_error *error) {
     rs_stream_reader r;
-    if (!rs_stream_reader_open(&r, fd, "triangles", 0, triangles * 12, READ_BUFFER))
+    if (!rs_stream_triangles_open(&r, fd, triangles))
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
     double area_sum = 0, block_sum = 0, reach = 0;
     uint64_t facets = 0;
     for (uint64_t t = 0; t < triangles; t++) {
-        const unsigned char *rec = rs_stream_read(&r, 12);
-        if (!rec) {
+        uint32_t tri[3];
+        if (!rs_stream_next_triangle(&r, tri)) {
             rs_stream_reader_close(&r);
             return read_fail(error);
         }
-        uint32_t tri[3];
-        memcpy(tri, rec, sizeof tri);
         double p[3][3], area = 0;
         for (int c = 0; c < 3; c++)
             scaled_position(pos, tri[c], scale, p[c]);
