@@ -378,6 +378,12 @@ int main(void) {
     CHECK_STATUS(rsmooth_mesh_write_file(mesh, ascii, RSMOOTH_FORMAT_PLY_ASCII, &err), RSMOOTH_OK);
     rsmooth_mesh_destroy(mesh);
     check_refusal(ctx, ascii, 64u << 20, NULL, RSMOOTH_ERROR_UNSUPPORTED, "binary PLY only");
+    const char *trailing = path_in_dir("trailing.ply"); /* data the header's counts leave out */
+    write_ply(trailing, &small, true, false, false, false);
+    FILE *f = fopen(trailing, "ab");
+    CHECK(f && fputs("left out", f) >= 0 && fclose(f) == 0);
+    check_refusal(ctx, trailing, 64u << 20, NULL, RSMOOTH_ERROR_PARSE,
+                  "after the data the header declares");
     small.indices[7] = (uint32_t)small.vertex_count; /* out of range */
     const char *bad = path_in_dir("bad_index.ply");
     write_ply(bad, &small, false, false, false, false);
@@ -400,8 +406,8 @@ int main(void) {
     shape_free(&small);
 
     /* the folder holds our files only: no temporary survived */
-    printf("files left in %s: %d (the 11 the test wrote)\n", dir, files_in_dir());
-    CHECK_EQ_INT(files_in_dir(), 11);
+    printf("files left in %s: %d (the 12 the test wrote)\n", dir, files_in_dir());
+    CHECK_EQ_INT(files_in_dir(), 12);
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
     CHECK(system(cmd) == 0);

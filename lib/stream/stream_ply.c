@@ -143,18 +143,23 @@ static rsmooth_status find_layout(rs_stream_ply *ply, rsmooth_error *error) {
         }
         offset += rs_ply_type_size(p->type);
     }
+    /* Elements before the later of the two blocks are stepped over (those with lists item by
+     * item: the faces too, in a file that puts them before the vertices). */
     uint64_t at = h->pos;
     rsmooth_status st = RSMOOTH_OK;
-    bool face_seen = false;
-    for (size_t ei = 0; ei < h->x->element_count && !face_seen; ei++) {
+    bool vertex_seen = false, face_seen = h->face_element == NULL;
+    for (size_t ei = 0; ei < h->x->element_count && !(vertex_seen && face_seen); ei++) {
         const rs_ply_element *e = &h->x->elements[ei];
-        if (e == h->vertex_element)
+        if (e == h->vertex_element) {
             ply->vertex_start = at;
+            vertex_seen = true;
+        }
         if (e == h->face_element) {
             ply->face_start = at;
             face_seen = true;
-            continue;
         }
+        if (vertex_seen && face_seen)
+            break;
         size_t bytes = row_bytes(e, &list);
         if (list) {
             at = skip_element(ply, e, at, error, &st);
@@ -258,12 +263,64 @@ rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz, double
     return RSMOOTH_OK;
 }
 
+/* The in-memory reader's last check: after the elements the header declares, blanks only (a
+ * file whose counts leave data out is not what it claims). `at` is where element `next` starts. */
+static rsmooth_status check_end(rs_stream_ply *ply, size_t next, uint64_t at,
+                                rsmooth_error *error) {
+    const rs_ply_reader *h = &ply->header;
+    rsmooth_status st = RSMOOTH_OK;
+    for (size_t ei = next; ei < h->x->element_count; ei++) {
+        const rs_ply_element *e = &h->x->elements[ei];
+        bool list = false;
+        size_t bytes = row_bytes(e, &list);
+        if (list) {
+            at = skip_element(ply, e, at, error, &st);
+            if (st != RSMOOTH_OK)
+                return st;
+        } else if (bytes && e->count > (ply->size - at) / bytes) {
+            return rs_fail_parse(error, e->header_line, -1, RS_STREAM_WHERE,
+                                 "%s: %llu '%s' items of %zu bytes do not fit in the file",
+                                 ply->path, (unsigned long long)e->count, e->name, bytes);
+        } else {
+            at += e->count * bytes;
+        }
+    }
+    rs_stream_reader r;
+    if (!rs_stream_reader_open(&r, ply->fd, ply->path, at, ply->size, READ_BUFFER))
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
+    for (uint64_t p = at; p < ply->size; p++) {
+        const unsigned char *c = rs_stream_read(&r, 1);
+        if (!c) {
+            st = io_fail(ply->path, "cannot read", error);
+            break;
+        }
+        if (!rs_ply_is_space((char)*c)) {
+            st = rs_fail_parse(error, -1, (int64_t)p, RS_STREAM_WHERE,
+                               "%s: %llu bytes after the data the header declares (from byte "
+                               "%llu, 0x%02x): the header's counts leave data out",
+                               ply->path, (unsigned long long)(ply->size - p),
+                               (unsigned long long)p, (unsigned)*c);
+            break;
+        }
+    }
+    rs_stream_reader_close(&r);
+    return st;
+}
+
+/* The index of element e in the header. */
+static size_t element_index(const rs_stream_ply *ply, const rs_ply_element *e) {
+    return (size_t)(e - ply->header.x->elements);
+}
+
 rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_fd,
                                              uint64_t *triangle_count, rsmooth_error *error) {
     *triangle_count = 0;
     const rs_ply_element *f = ply->header.face_element;
-    if (!f || f->count == 0)
-        return RSMOOTH_OK;
+    if (!f) {
+        const rs_ply_element *v = ply->header.vertex_element;
+        return check_end(ply, element_index(ply, v) + 1,
+                         ply->vertex_start + v->count * ply->vertex_stride, error);
+    }
     rs_stream_reader r;
     if (!rs_stream_reader_open(&r, ply->fd, ply->path, ply->face_start, ply->size, READ_BUFFER))
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
@@ -351,9 +408,12 @@ rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_f
                           written * 3 * sizeof *out))
         st = io_fail("temporary file", "cannot write", error);
     written += buffered;
+    uint64_t face_end = rs_stream_reader_offset(&r);
     rs_free(out);
     rs_stream_reader_close(&r);
     *triangle_count = written;
+    if (st == RSMOOTH_OK)
+        st = check_end(ply, element_index(ply, f) + 1, face_end, error);
     return st;
 }
 
