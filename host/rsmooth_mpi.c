@@ -73,6 +73,17 @@ static int parse(int argc, char **argv, int rank, options *opt) {
             fclose(null);
         }
     }
+    for (int i = 1; i < argc && strcmp(argv[i], "--") != 0; i++)
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+            printf("usage: mpirun -n N rsmooth-mpi IN.ply -o OUT.ply [options]\n\n"
+                   "rsmooth --max-memory (a binary PLY streamed in pieces) with the pieces shared\n"
+                   "among MPI ranks: every rank reads the input (a shared file system), makes the\n"
+                   "same plan and filters its share on its own device; the output is the single\n"
+                   "process's byte for byte. --max-memory is each rank's cap (default 1G); '%%l' in\n"
+                   "--device is the rank's index on its node (--device 0:%%l: one GPU per rank).\n"
+                   "The options are rsmooth's:\n\n");
+            break;
+        }
     int code = cli_options_parse(argc, argv, opt);
     if (code < 0 && (opt->input_count != 1 || !opt->output_option || opt->output_dir ||
                      opt->suffix || opt->list_devices)) {

@@ -323,6 +323,24 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
                                   const rsmooth_params *params, const void *out_positions,
                                   bool keep_facet_data, rsmooth_error *error,
                                   const char *where) {
+    return rs_problem_prepare_scaled(problem, scalar, positions, vertex_count, indices,
+                                     triangle_count, params, out_positions, keep_facet_data, 0,
+                                     error, where);
+}
+
+/* Whether `scale` is a power of two that keeps coordinates up to `magnitude` below 2^500. */
+static bool usable_scale(double scale, double magnitude) {
+    int e = 0;
+    return scale > 0 && isfinite(scale) && frexp(scale, &e) == 0.5 &&
+           magnitude * scale < ldexp(1.0, 500);
+}
+
+rsmooth_status rs_problem_prepare_scaled(rs_problem *problem, rsmooth_scalar scalar,
+                                         const void *positions, size_t vertex_count,
+                                         const uint32_t *indices, size_t triangle_count,
+                                         const rsmooth_params *params, const void *out_positions,
+                                         bool keep_facet_data, double given_scale,
+                                         rsmooth_error *error, const char *where) {
     memset(problem, 0, sizeof *problem);
     rsmooth_params p;
     rsmooth_status st = rs_params_resolve(params, &p, error, where);
@@ -341,9 +359,10 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
     st = rs_check_colors(p.colors, vertex_count, error, where);
     if (st != RSMOOTH_OK)
         return st;
-    double scale = 1;
-    st = rs_mesh_scale(scalar, positions, indices, triangle_count, magnitude, &scale, error,
-                       where);
+    double scale = given_scale;
+    if (!usable_scale(scale, magnitude))
+        st = rs_mesh_scale(scalar, positions, indices, triangle_count, magnitude, &scale, error,
+                           where);
     if (st != RSMOOTH_OK)
         return st;
 

@@ -77,10 +77,11 @@ static rsmooth_status check_info(const rsmooth_piece_info *info, size_t vertex_c
                        "core_count %zu exceeds the piece's %zu vertices", info->core_count,
                        vertex_count);
     if (!(info->mean_edge_length >= 0) || !isfinite(info->mean_edge_length) ||
-        !(info->mean_area >= 0) || !isfinite(info->mean_area))
+        !(info->mean_area >= 0) || !isfinite(info->mean_area) || !(info->scale >= 0) ||
+        !isfinite(info->scale))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "mean_edge_length %g and mean_area %g must be finite and >= 0",
-                       info->mean_edge_length, info->mean_area);
+                       "mean_edge_length %g, mean_area %g and scale %g must be finite and >= 0",
+                       info->mean_edge_length, info->mean_area, info->scale);
     return RSMOOTH_OK;
 }
 
@@ -104,8 +105,9 @@ static rsmooth_status prepare_piece(rs_problem *pb, const double *positions, siz
                            triangle_count * 3 * sizeof(uint32_t))))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "out_positions overlaps the piece's positions or indices");
-    st = rs_problem_prepare(pb, RSMOOTH_FLOAT64, positions, vertex_count, indices, triangle_count,
-                            &p, RS_UNCHECKED_OUTPUT, keep, error, where);
+    st = rs_problem_prepare_scaled(pb, RSMOOTH_FLOAT64, positions, vertex_count, indices,
+                                   triangle_count, &p, RS_UNCHECKED_OUTPUT, keep, info->scale,
+                                   error, where);
     if (st != RSMOOTH_OK)
         return st;
     /* the scale is a power of two: these products are exact, as the whole run's own are */

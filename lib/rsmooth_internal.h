@@ -158,6 +158,16 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
                                   const rsmooth_params *params, const void *out_positions,
                                   bool keep_facet_data, rsmooth_error *error, const char *where);
 
+/* rs_problem_prepare in the internal units of `scale` (a power of two; a piece of a larger mesh
+ * works in the whole mesh's) instead of its own choice; 0, or a scale that would put a
+ * coordinate beyond 2^500, chooses as rs_problem_prepare does. */
+rsmooth_status rs_problem_prepare_scaled(rs_problem *problem, rsmooth_scalar scalar,
+                                         const void *positions, size_t vertex_count,
+                                         const uint32_t *indices, size_t triangle_count,
+                                         const rsmooth_params *params, const void *out_positions,
+                                         bool keep_facet_data, double scale,
+                                         rsmooth_error *error, const char *where);
+
 /* The params-to-problem part of rs_problem_prepare: the absolute widths and radii (relative
  * sigmas times `unit`, the mean edge length or, for point clouds, the point spacing; 1 when
  * params->absolute) and the flags, from resolved params. Sets facet_count to 0 when nothing can

@@ -698,6 +698,10 @@ typedef struct rsmooth_piece_info {
     size_t core_count;       /* the piece's first core_count vertices are solved */
     double mean_edge_length; /* of the whole mesh, caller's units (as rsmooth_mean_edge_length) */
     double mean_area;        /* of the whole mesh's triangles of non-zero area, caller's units */
+    double scale;            /* the power of two the whole run multiplies coordinates by inside
+                              * (rsmooth_stream_smooth passes its own); 0: the piece chooses,
+                              * which gives the same bits unless a coordinate lies beyond about
+                              * 1e75 typical edges from the origin */
 } rsmooth_piece_info;
 
 /* Sets struct_size and zeroes the rest. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if info is NULL. */

@@ -182,6 +182,11 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
     st = rs_stream_ply_write_triangles(&c->ply, c->triangles_fd, &c->triangle_count, error);
     if (st != RSMOOTH_OK)
         return st;
+    if (c->ply.face_count == 0) /* what the in-memory reader says: a point cloud needs normals */
+        return rs_fail_parse(error, -1, (int64_t)c->ply.size, RS_STREAM_WHERE,
+                             "%s: %llu vertices but no faces and no vertex normals: a mesh needs "
+                             "faces, a point cloud normals (nx, ny, nz)",
+                             c->input, (unsigned long long)c->ply.vertex_count);
     c->rep.triangle_count = c->triangle_count;
     c->rep.ms_read = now_ms() - t0;
     if (!report_progress(c, 0.08))
@@ -345,6 +350,7 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
     info.core_count = n;
     info.mean_edge_length = c->stats.mean_edge_length;
     info.mean_area = c->stats.mean_area;
+    info.scale = c->stats.scale;
     rsmooth_report rep;
     rsmooth_report_init(&rep);
     double t_library = now_ms();
@@ -491,8 +497,12 @@ rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input, co
     if (st == RSMOOTH_OK)
         report_progress(c, 1.0);
     c->rep.ms_total = now_ms() - t0;
-    if (report && report->struct_size >= sizeof *report)
-        *report = c->rep;
+    if (report && report->struct_size >= sizeof report->struct_size) {
+        /* a caller's older, smaller record gets the fields it has */
+        size_t size = report->struct_size < sizeof *report ? report->struct_size : sizeof *report;
+        memcpy(report, &c->rep, size);
+        report->struct_size = size;
+    }
     if (c->out_fd >= 0)
         close(c->out_fd);
     if (c->triangles_fd >= 0)

@@ -6,8 +6,8 @@
  *     counting sort), a run of vertices at a time when all of them do not fit in memory;
  *   - the mean area: facets summed per block of 8192 triangles, the blocks' sums in order.
  *
- * Both sum at a power-of-two scale, as the in-memory path does at its own: multiplying by a power
- * of two is exact, so the sums divided back are equal whatever power was used. */
+ * Both sum at the in-memory path's own power-of-two scale (scale.c, from the same sampled
+ * triangles), so even where squares under- or overflow at other scales the figures agree. */
 #include "stream/stream_internal.h"
 
 #include <math.h>
@@ -214,14 +214,35 @@ static rsmooth_status facet_figures(const rs_stream_positions *pos, int fd, uint
     return RSMOOTH_OK;
 }
 
+/* The in-memory path's scale (scale.c): from the same sampled triangles (one in every
+ * T / 4096, as rs_mesh_scale strides), read from the triangle file. */
+static rsmooth_status whole_scale(const rs_stream_positions *pos, int fd, uint64_t triangles,
+                                  double magnitude, double *scale, rsmooth_error *error) {
+    enum { SAMPLES = 4096 }; /* scale.c's SCALE_SAMPLES */
+    uint64_t stride = triangles > SAMPLES ? triangles / SAMPLES : 1;
+    size_t count = (size_t)((triangles + stride - 1) / stride);
+    uint32_t *sampled = rs_alloc_array(count ? count : 1, 3 * sizeof *sampled);
+    if (!sampled)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "scale samples");
+    for (size_t i = 0; i < count; i++)
+        if (!rs_stream_pread(fd, sampled + 3 * i, 12, (uint64_t)i * stride * 12)) {
+            rs_free(sampled);
+            return read_fail(error);
+        }
+    rsmooth_status st = rs_mesh_scale(pos->f32 ? RSMOOTH_FLOAT32 : RSMOOTH_FLOAT64, pos->xyz,
+                                      sampled, count, magnitude, scale, error, RS_STREAM_WHERE);
+    rs_free(sampled);
+    return st;
+}
+
 rsmooth_status rs_stream_statistics(const rs_stream_positions *positions, int triangles_fd,
                                     uint64_t triangle_count, double magnitude, uint64_t memory,
                                     rs_stream_stats *stats, rsmooth_error *error) {
     memset(stats, 0, sizeof *stats);
-    int e = 0;
-    if (magnitude > 0)
-        frexp(magnitude, &e);
-    stats->scale = ldexp(1.0, -e); /* coordinates below 1: no square overflows */
+    rsmooth_status st = whole_scale(positions, triangles_fd, triangle_count, magnitude,
+                                    &stats->scale, error);
+    if (st != RSMOOTH_OK)
+        return st;
     for (int k = 0; k < 3; k++) {
         stats->lo[k] = INFINITY;
         stats->hi[k] = -INFINITY;
@@ -234,8 +255,8 @@ rsmooth_status rs_stream_statistics(const rs_stream_positions *positions, int tr
             stats->hi[k] = fmax(stats->hi[k], p[k]);
         }
     }
-    rsmooth_status st = mean_edge_length(positions, triangles_fd, triangle_count, stats->scale,
-                                         memory, &stats->mean_edge_length, error);
+    st = mean_edge_length(positions, triangles_fd, triangle_count, stats->scale, memory,
+                          &stats->mean_edge_length, error);
     if (st != RSMOOTH_OK)
         return st;
     stats->mean_edge_length /= stats->scale;
