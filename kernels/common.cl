@@ -24,7 +24,10 @@
  *                      ends it
  *   column_table[s]    open-addressing hash slot, on (x, y, 0): column index or -1
  *   block_cell[b]      int4 (x, y, z, 0): block b's anchor, the lowest cell its vertices span
- *   block_pos          per block: x, y, z of each lane, local to the anchor
+ *   block_pos          per block: x, y, z of each lane, local to the corner of its own cell
+ *   block_offset       per block, as block_pos: each lane's cell minus the anchor (0 or 1), so
+ *                      that a lane's distance to a facet comes from two cell-local positions and
+ *                      an exact whole number of cells, the same bits in any block
  *   block_pairs[2 b]   facets block b evaluated (times RS_LANES: pairs) in mollification, [2 b + 1]
  *                      in the robust pass: the work done, within reach or not
  */
@@ -128,4 +131,18 @@ inline float axis_gap2(float lo, float hi, int c) {
 /* Component k (0 = x) of the vertex in `slot` of a per-block array of `stride` components. */
 inline float slot_component(__global const float *blocks, uint slot, uint stride, uint k) {
     return blocks[(slot / RS_LANES) * stride * RS_LANES + k * RS_LANES + slot % RS_LANES];
+}
+
+/* Axis k of the lanes' cell offsets from the anchor (block_offset). Whole numbers, and kept
+ * integers: the kernels build a lane's whole-cell distance to a facet's cell in integers, which
+ * -cl-fast-relaxed-math cannot reassociate with the float positions. */
+inline lanei load_offsets(uint k, __global const uchar *offset) {
+    return convert_int8(vload8(k, offset));
+}
+
+/* The cell of the vertex in `slot`: its block's anchor plus its offset. */
+inline int4 slot_cell(__global const int4 *block_cell, __global const uchar *block_offset,
+                      uint slot) {
+    __global const uchar *o = block_offset + (slot / RS_LANES) * 3 * RS_LANES + slot % RS_LANES;
+    return block_cell[slot / RS_LANES] + (int4)(o[0], o[RS_LANES], o[2 * RS_LANES], 0);
 }

@@ -44,7 +44,8 @@ inline __attribute__((always_inline)) lanef influence_weight(lanef u, int influe
  * Inlined, so the flags are constants in each call and the inner loop keeps what it needs in
  * registers. */
 inline __attribute__((always_inline)) robust_acc
-robust_sums(lanef px, lanef py, lanef pz, float3 lo, float3 hi, int4 anchor, float reach2,
+robust_sums(lanef px, lanef py, lanef pz, lanei ox, lanei oy, lanei oz, float3 lo, float3 hi,
+            int4 anchor, float reach2,
             float inv_2sf2, float inv_2sg2, lanef shift, int want_confidence, int predict_centroid,
             int influence, float inv_sg2, int use_color, lanef cr, lanef cg, lanef cb,
             float inv_2sc2, __global const float4 *facet_color,
@@ -55,7 +56,8 @@ robust_sums(lanef px, lanef py, lanef pz, float3 lo, float3 hi, int4 anchor, flo
     robust_acc a;
     a.x = a.y = a.z = a.k = a.kf = 0.0f;
     FOR_EACH_CELL_NEAR(anchor, lo, hi, reach2, cell_coord, column_first, column_table, column_mask, {
-        lanef qx = px - (float)dx, qy = py - (float)dy, qz = pz - (float)dz;
+        lanef qx = px - convert_float8(dx - ox), qy = py - convert_float8(dy - oy),
+              qz = pz - convert_float8(dz - oz);
         uint begin = cell_start[cell], end = cell_start[cell + 1];
         *pairs += end - begin;
         for (uint q = begin; q < end; q++) {
@@ -108,7 +110,8 @@ robust_sums(lanef px, lanef py, lanef pz, float3 lo, float3 hi, int4 anchor, flo
  * the shift that keeps a lane's largest weight near one. Only the rare rescue needs it. With
  * use_color the colour exponent adds to it (inv_2sg2 = 0: the colour exponent alone), and
  * `tukey` leaves out the facets Tukey's weight rejects (x^2 inv_sg2 >= 5). */
-lanef smallest_exponent(lanef px, lanef py, lanef pz, float3 lo, float3 hi, int4 anchor,
+lanef smallest_exponent(lanef px, lanef py, lanef pz, lanei ox, lanei oy, lanei oz, float3 lo,
+                        float3 hi, int4 anchor,
                         float reach2, float inv_2sg2, int predict_centroid, int tukey,
                         float inv_sg2, int use_color,
                         lanef cr, lanef cg, lanef cb, float inv_2sc2,
@@ -119,7 +122,8 @@ lanef smallest_exponent(lanef px, lanef py, lanef pz, float3 lo, float3 hi, int4
                         uint column_mask) {
     lanef e_min = MAXFLOAT;
     FOR_EACH_CELL_NEAR(anchor, lo, hi, reach2, cell_coord, column_first, column_table, column_mask, {
-        lanef qx = px - (float)dx, qy = py - (float)dy, qz = pz - (float)dz;
+        lanef qx = px - convert_float8(dx - ox), qy = py - convert_float8(dy - oy),
+              qz = pz - convert_float8(dz - oz);
         for (uint q = cell_start[cell]; q < cell_start[cell + 1]; q++) {
             float4 c = facet_centroid[q];
             float4 n = normal[q];
@@ -145,7 +149,7 @@ __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float
                            int influence, float inv_sg2, int want_confidence, int predict_centroid,
                            int use_color, float inv_2sc2,
                            __global const float *block_pos, __global const int4 *block_cell,
-                           __global const float *block_color,
+                           __global const uchar *block_offset, __global const float *block_color,
                            __global const float4 *facet_centroid, __global const float4 *normal,
                            __global const float4 *facet_color,
                            __global const int4 *cell_coord, __global const uint *cell_start,
@@ -158,8 +162,12 @@ __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float
         return;
     __global const float *pos = block_pos + 3 * RS_LANES * (size_t)b;
     lanef px = load_lanes(0, pos), py = load_lanes(1, pos), pz = load_lanes(2, pos);
-    float3 lo = (float3)(lane_min(px), lane_min(py), lane_min(pz));
-    float3 hi = (float3)(lane_max(px), lane_max(py), lane_max(pz));
+    __global const uchar *off = block_offset + 3 * RS_LANES * (size_t)b;
+    lanei ox = load_offsets(0, off), oy = load_offsets(1, off), oz = load_offsets(2, off);
+    float3 lo = (float3)(lane_min(px + convert_float8(ox)), lane_min(py + convert_float8(oy)),
+                       lane_min(pz + convert_float8(oz)));
+    float3 hi = (float3)(lane_max(px + convert_float8(ox)), lane_max(py + convert_float8(oy)),
+                       lane_max(pz + convert_float8(oz)));
     int4 anchor = block_cell[b];
     uint pairs = 0, rescue_pairs = 0;
     lanef cr = 0.0f, cg = 0.0f, cb = 0.0f; /* the lanes' colours, when use_color */
@@ -176,37 +184,45 @@ __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float
     /* one specialised copy of the loop per flag combination (the other influence functions
      * always sum a f: it is part of their weight); with colour, one copy for every mode */
     if (use_color)
-        a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f,
+        a = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor,
+                        reach2, inv_2sf2, inv_2sg2, (lanef)0.0f,
                         want_confidence, predict_centroid, influence, inv_sg2, COLOR,
                         facet_centroid, normal, cell_coord, cell_start, column_first,
                         column_table, column_mask, &pairs);
     else if (influence != RS_INFLUENCE_GAUSSIAN && predict_centroid)
-        a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 1,
+        a = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor,
+                        reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 1,
                         influence, inv_sg2, NO_COLOR, facet_centroid, normal, cell_coord,
                         cell_start, column_first, column_table, column_mask, &pairs);
     else if (influence == RS_INFLUENCE_TUKEY)
-        a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 0,
+        a = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor,
+                        reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 0,
                         RS_INFLUENCE_TUKEY, inv_sg2, NO_COLOR, facet_centroid, normal, cell_coord,
                         cell_start, column_first, column_table, column_mask, &pairs);
     else if (influence == RS_INFLUENCE_LORENTZIAN)
-        a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 0,
+        a = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor,
+                        reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 0,
                         RS_INFLUENCE_LORENTZIAN, inv_sg2, NO_COLOR, facet_centroid, normal,
                         cell_coord, cell_start, column_first, column_table, column_mask, &pairs);
     else if (influence == RS_INFLUENCE_HUBER)
-        a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 0,
+        a = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor,
+                        reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 0,
                         RS_INFLUENCE_HUBER, inv_sg2, NO_COLOR, facet_centroid, normal, cell_coord,
                         cell_start, column_first, column_table, column_mask, &pairs);
     else if (predict_centroid)
-        a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f,
+        a = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor,
+                        reach2, inv_2sf2, inv_2sg2, (lanef)0.0f,
                         want_confidence, 1, RS_INFLUENCE_GAUSSIAN, inv_sg2, NO_COLOR,
                         facet_centroid, normal, cell_coord, cell_start, column_first,
                         column_table, column_mask, &pairs);
     else if (want_confidence)
-        a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1,
+        a = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor,
+                        reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1,
                         0, RS_INFLUENCE_GAUSSIAN, inv_sg2, NO_COLOR, facet_centroid, normal,
                         cell_coord, cell_start, column_first, column_table, column_mask, &pairs);
     else
-        a = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 0,
+        a = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor,
+                        reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 0,
                         0, RS_INFLUENCE_GAUSSIAN, inv_sg2, NO_COLOR, facet_centroid, normal,
                         cell_coord, cell_start, column_first, column_table, column_mask, &pairs);
     lanef kf = a.kf;
@@ -219,7 +235,7 @@ __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float
     lanei rescue = gaussian || use_color ? a.k < RS_RESCUE_WEIGHT : (lanei)0;
     lanef shift = 0.0f;
     if (any(rescue)) {
-        lanef e_min = smallest_exponent(px, py, pz, lo, hi, anchor, reach2,
+        lanef e_min = smallest_exponent(px, py, pz, ox, oy, oz, lo, hi, anchor, reach2,
                                         gaussian ? inv_2sg2 : 0.0f, predict_centroid,
                                         influence == RS_INFLUENCE_TUKEY, inv_sg2, use_color,
                                         cr, cg, cb, inv_2sc2,
@@ -230,13 +246,13 @@ __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float
     if (any(shift != 0.0f)) {
         robust_acc r;
         if (use_color)
-            r = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, shift, 0,
-                            predict_centroid, influence, inv_sg2, COLOR,
+            r = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2,
+                            shift, 0, predict_centroid, influence, inv_sg2, COLOR,
                             facet_centroid, normal, cell_coord, cell_start, column_first,
                             column_table, column_mask, &rescue_pairs);
         else
-            r = robust_sums(px, py, pz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2, shift, 0,
-                            predict_centroid, RS_INFLUENCE_GAUSSIAN, inv_sg2, NO_COLOR,
+            r = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2,
+                            shift, 0, predict_centroid, RS_INFLUENCE_GAUSSIAN, inv_sg2, NO_COLOR,
                             facet_centroid, normal, cell_coord, cell_start, column_first,
                             column_table, column_mask, &rescue_pairs);
         lanei redo = shift != 0.0f;

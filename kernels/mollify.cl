@@ -13,6 +13,7 @@
 
 __kernel void mollify_block(uint block_count, float reach2, float inv_2sigma2,
                             __global const float *block_pos, __global const int4 *block_cell,
+                            __global const uchar *block_offset,
                             __global const float4 *facet_centroid,
                             __global const int4 *cell_coord, __global const uint *cell_start,
                             __global const uint *column_first,
@@ -23,13 +24,18 @@ __kernel void mollify_block(uint block_count, float reach2, float inv_2sigma2,
         return;
     __global const float *pos = block_pos + 3 * RS_LANES * (size_t)b;
     lanef px = load_lanes(0, pos), py = load_lanes(1, pos), pz = load_lanes(2, pos);
-    float3 lo = (float3)(lane_min(px), lane_min(py), lane_min(pz));
-    float3 hi = (float3)(lane_max(px), lane_max(py), lane_max(pz));
+    __global const uchar *off = block_offset + 3 * RS_LANES * (size_t)b;
+    lanei ox = load_offsets(0, off), oy = load_offsets(1, off), oz = load_offsets(2, off);
+    float3 lo = (float3)(lane_min(px + convert_float8(ox)), lane_min(py + convert_float8(oy)),
+                       lane_min(pz + convert_float8(oz)));
+    float3 hi = (float3)(lane_max(px + convert_float8(ox)), lane_max(py + convert_float8(oy)),
+                       lane_max(pz + convert_float8(oz)));
     int4 anchor = block_cell[b];
     lanef wsum = 0.0f, ax = 0.0f, ay = 0.0f, az = 0.0f;
     uint pairs = 0;
     FOR_EACH_CELL_NEAR(anchor, lo, hi, reach2, cell_coord, column_first, column_table, column_mask, {
-        lanef qx = px - (float)dx, qy = py - (float)dy, qz = pz - (float)dz;
+        lanef qx = px - convert_float8(dx - ox), qy = py - convert_float8(dy - oy),
+              qz = pz - convert_float8(dz - oz);
         uint begin = cell_start[cell], end = cell_start[cell + 1];
         pairs += end - begin;
         for (uint q = begin; q < end; q++) {
@@ -60,8 +66,8 @@ inline float3 slot_shift(__global const float *block_shift, uint slot) {
 /* The position of the vertex in `slot`, in cells from the corner of cell `origin`: exact in its
  * integer part, so differences between a facet's corners keep float32's full precision. */
 inline float3 slot_position(__global const float *block_pos, __global const int4 *block_cell,
-                            uint slot, int4 origin) {
-    int4 cell = block_cell[slot / RS_LANES] - origin;
+                            __global const uchar *block_offset, uint slot, int4 origin) {
+    int4 cell = slot_cell(block_cell, block_offset, slot) - origin;
     return convert_float3(cell.xyz) +
            (float3)(slot_component(block_pos, slot, 3, 0), slot_component(block_pos, slot, 3, 1),
                     slot_component(block_pos, slot, 3, 2));
@@ -70,17 +76,18 @@ inline float3 slot_position(__global const float *block_pos, __global const int4
 __kernel void mollified_facet_normal(uint facet_count, __global const uint *facet_vertices,
                                      __global const uint *facet_place,
                                      __global const float *block_pos,
-                                     __global const int4 *block_cell, __global float4 *normal,
+                                     __global const int4 *block_cell,
+                                     __global const uchar *block_offset, __global float4 *normal,
                                      __global const float *block_shift) {
     uint q = get_global_id(0); /* the caller's facet order; j is its place in grid order */
     if (q >= facet_count)
         return;
     uint j = facet_place[q];
     uint3 t = vload3(q, facet_vertices);
-    int4 origin = block_cell[t.x / RS_LANES];
-    float3 p0 = slot_position(block_pos, block_cell, t.x, origin);
-    float3 input_e1 = slot_position(block_pos, block_cell, t.y, origin) - p0;
-    float3 input_e2 = slot_position(block_pos, block_cell, t.z, origin) - p0;
+    int4 origin = slot_cell(block_cell, block_offset, t.x);
+    float3 p0 = slot_position(block_pos, block_cell, block_offset, t.x, origin);
+    float3 input_e1 = slot_position(block_pos, block_cell, block_offset, t.y, origin) - p0;
+    float3 input_e2 = slot_position(block_pos, block_cell, block_offset, t.z, origin) - p0;
     float3 input_n = cross(input_e1, input_e2);
     float3 s0 = slot_shift(block_shift, t.x);
     float3 e1 = input_e1 + slot_shift(block_shift, t.y) - s0;

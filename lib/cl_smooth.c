@@ -25,7 +25,10 @@ typedef struct packed {
     cl_uint *facet_place;     /* caller's facet -> its place in grid order */
     size_t block_count;
     cl_int4 *block_cell;      /* per block: its anchor, the lowest cell it spans */
-    cl_float *block_pos;      /* per block: RS_LANES x, then y, then z, local to the anchor */
+    cl_float *block_pos;      /* per block: RS_LANES x, then y, then z, each local to its
+                               * vertex's own cell (so no float depends on the block it is in) */
+    cl_uchar *block_offset;   /* per block, as block_pos: each vertex's cell minus the anchor,
+                               * 0 or 1 per axis */
     uint32_t *slot;           /* caller's vertex index -> block * RS_LANES + lane */
     /* the colour factor's, NULL when it is off */
     cl_float4 *facet_color;   /* in grid order: the mean colour of the facet's corners, 0 */
@@ -39,6 +42,7 @@ static void packed_free(packed *pk) {
     rs_free(pk->facet_place);
     rs_free(pk->block_cell);
     rs_free(pk->block_pos);
+    rs_free(pk->block_offset);
     rs_free(pk->slot);
     rs_free(pk->facet_color);
     rs_free(pk->block_color);
@@ -103,25 +107,33 @@ typedef struct block_job {
     const rs_grid *grid;
     packed *pk;
     const uint32_t *order, *start;
+    const int32_t *cells; /* per grid position: the vertex's cell */
 } block_job;
 
-/* Slots and anchor-local positions of the vertices of blocks [begin, end). */
+/* Slots, positions local to their own cells and cell offsets from the anchor of the vertices of
+ * blocks [begin, end). The kernels subtract the whole-cell distance between a facet's cell and a
+ * vertex's (a small exact integer) from the two local positions, so every difference they compute
+ * is the same bits whichever vertices share the block: a tile or a piece of a larger mesh gets the
+ * whole mesh's results. */
 static void fill_blocks(void *ctx, size_t begin, size_t end, size_t chunk) {
     const block_job *job = ctx;
     packed *pk = job->pk;
     (void)chunk;
     for (size_t b = begin; b < end; b++) {
         cl_float *pos = pk->block_pos + 3 * RS_LANES * b;
+        cl_uchar *offset = pk->block_offset + 3 * RS_LANES * b;
         const cl_int *anchor = pk->block_cell[b].s;
         for (uint32_t i = job->start[b]; i < job->start[b + 1]; i++) {
             uint32_t v = job->order[i], lane = i - job->start[b];
+            const int32_t *cell = job->cells + 3 * (size_t)i;
             pk->slot[v] = (uint32_t)(b * RS_LANES + lane);
-            cl_float4 local = local_point(job->grid, job->pb->xyz + 3 * (size_t)v, anchor);
+            cl_float4 local = local_point(job->grid, job->pb->xyz + 3 * (size_t)v, cell);
             const float *color = job->pb->colors ? job->pb->colors + 3 * (size_t)v : NULL;
             /* lane 0 also fills the unused lanes, so they compute something harmless */
             for (size_t l = lane; l < (lane == 0 ? RS_LANES : lane + 1); l++)
                 for (int k = 0; k < 3; k++) {
                     pos[k * RS_LANES + l] = local.s[k];
+                    offset[k * RS_LANES + l] = (cl_uchar)(cell[k] - anchor[k]); /* 0 or 1 */
                     if (color)
                         pk->block_color[3 * RS_LANES * b + k * RS_LANES + l] = color[k];
                 }
@@ -147,15 +159,17 @@ static rsmooth_status pack_blocks(const rs_problem *pb, const rs_grid *grid, pac
     pk->block_count = blocks;
     pk->block_cell = rs_alloc_array(blocks, sizeof(cl_int4));
     pk->block_pos = rs_alloc_array(blocks, 3 * RS_LANES * sizeof(cl_float));
+    pk->block_offset = rs_alloc_array(blocks, 3 * RS_LANES * sizeof(cl_uchar));
     if (pb->colors)
         pk->block_color = rs_alloc_array(blocks, 3 * RS_LANES * sizeof(cl_float));
     start = rs_alloc_array(blocks + 1, sizeof *start);
-    if (!pk->block_cell || !pk->block_pos || !start || (pb->colors && !pk->block_color)) {
+    if (!pk->block_cell || !pk->block_pos || !pk->block_offset || !start ||
+        (pb->colors && !pk->block_color)) {
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth", "no memory for blocks");
         goto done;
     }
     cut_blocks(cells, nv, start, pk->block_cell);
-    block_job job = {pb, grid, pk, order, start};
+    block_job job = {pb, grid, pk, order, start, cells};
     rs_parallel_for(blocks, PARALLEL_GRAIN / RS_LANES, fill_blocks, &job);
 done:
     rs_free(order);
@@ -420,6 +434,7 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
                               CL_MEM_READ_ONLY},
         [BUF_BLOCK_POS] = {ns * 3 * sizeof(cl_float), pk.block_pos, CL_MEM_READ_ONLY},
         [BUF_BLOCK_CELL] = {nb * sizeof(cl_int4), pk.block_cell, CL_MEM_READ_ONLY},
+        [BUF_BLOCK_OFFSET] = {ns * 3 * sizeof(cl_uchar), pk.block_offset, CL_MEM_READ_ONLY},
         [BUF_BLOCK_SHIFT] = {paper_mollify ? ns * 3 * sizeof(cl_float) : 0, NULL,
                              CL_MEM_READ_WRITE},
         [BUF_BLOCK_RESULT] = {ns * 4 * sizeof(cl_float), NULL, CL_MEM_WRITE_ONLY},
@@ -506,6 +521,7 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
         arg(&s, sizeof inv_2sm2, &inv_2sm2);
         arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_POS]);
         arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_CELL]);
+        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_OFFSET]);
         arg(&s, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
         arg_grid(&s, buf, &mask);
         arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_SHIFT]);
@@ -523,6 +539,7 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
         arg(&s, sizeof(cl_mem), &buf[BUF_FACET_PLACE]);
         arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_POS]);
         arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_CELL]);
+        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_OFFSET]);
         arg(&s, sizeof(cl_mem), &buf[BUF_FACET_NORMAL]);
         arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_SHIFT]);
         err = s.err != CL_SUCCESS
@@ -550,6 +567,7 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     arg(&s, sizeof inv_2sc2, &inv_2sc2);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_POS]);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_CELL]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_OFFSET]);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_COLOR]); /* NULL without colour: never read */
     arg(&s, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
     arg(&s, sizeof(cl_mem), &normals);

@@ -1,6 +1,8 @@
 /* Spatial tiles (lib/tiles.c): with a memory budget far below what a mesh needs, the OpenCL path
- * cuts it into tiles and must still agree with the untiled run and with the double-precision
- * reference path (max deviation <= 1e-3 mean edge lengths, as for untiled runs); a budget too small
+ * cuts it into tiles and must give the untiled run's positions bit for bit (grid cells count from
+ * a lattice fixed in space and the kernels' differences do not depend on which vertices share a
+ * block) and agree with the double-precision reference path (max deviation <= 1e-3 mean edge
+ * lengths, as for untiled runs); a budget too small
  * for any tile fails cleanly with the caller's arrays untouched; RSMOOTH_MEMORY_BUDGET is read. */
 #define _POSIX_C_SOURCE 200809L
 #include "mesh_shapes.h"
@@ -113,7 +115,7 @@ static void check_shape(rsmooth_context *ctx, const char *name, const shape_mesh
            MAX_DEVIATION, conf, k, log.calls, log.last);
     CHECK(tiled.report.tiles >= 4);
     CHECK(tiled.report.pairs_robust > whole.report.pairs_robust); /* halos overlap */
-    CHECK_LE(vs_whole, MAX_DEVIATION);
+    CHECK(vs_whole == 0);
     CHECK_LE(vs_ref, MAX_DEVIATION);
     CHECK_LE(conf, 1e-3);
     CHECK_LE(k, 1e-3);

@@ -1,6 +1,8 @@
 /* Streaming (rsmooth_stream_smooth) against the in-memory filter, the oracle:
  *   - a noisy cylinder of 400k triangles under a memory cap far below what the in-memory run
- *     holds: the same positions to 1e-6 mean edge lengths, on the OpenCL device;
+ *     holds: the same positions bit for bit on the OpenCL device (the issue asks 1e-6 mean edge
+ *     lengths; pieces see the whole mesh's cells, and the kernels' differences do not depend on
+ *     how vertices share blocks);
  *   - the reference path (ctx NULL): the same bits as rsmooth_smooth_reference in memory, and
  *     the same bytes when 3 ranks (threads, synced through a barrier) share the pieces;
  *   - bilateral normals (a wider halo); a float32, big-endian file with colours, a face property
@@ -269,7 +271,7 @@ int main(void) {
     CHECK(rep.pieces >= 10);
     CHECK_LE(rep.memory_planned, cap);
     CHECK(rep.mean_edge_length == edge); /* summed in the same order: the same bits */
-    CHECK_LE(dev, 1e-6);
+    CHECK(dev == 0);
     free(expected);
 
     /* 2. Bilateral normals widen the halo. */
@@ -283,7 +285,7 @@ int main(void) {
     dev = deviation(path_in_dir("bilateral.ply"), expected, edge);
     printf("bilateral: %zu pieces, halo %.4g; deviation %.3g mean edge lengths\n", rep.pieces,
            rep.halo, dev);
-    CHECK_LE(dev, 1e-6);
+    CHECK(dev == 0);
     free(expected);
     shape_free(&cyl);
 
@@ -351,7 +353,7 @@ int main(void) {
            "bytes\n", dev, xyz, other);
     CHECK(a_size == b_size);
     CHECK(xyz > 0 && other == 0);
-    CHECK_LE(dev, 1e-6);
+    CHECK(dev == 0);
     free(a);
     free(b);
     free(expected);

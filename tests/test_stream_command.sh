@@ -25,6 +25,7 @@ worst=$(awk -v h="$hausdorff" -v d="$diag" -v e="$edge" 'BEGIN { printf "%.3g", 
 echo "streamed vs in memory: rms $rms, Hausdorff $worst mean edge lengths"
 awk -v r="$rms" -v w="$worst" 'BEGIN { exit !(r <= 1e-6 && w <= 1e-6) }' ||
   fail "streamed result differs from the in-memory one by more than 1e-6 mean edge lengths"
+cmp -s streamed.ply memory.ply || fail "the streamed file is not the in-memory one byte for byte"
 expect 0 "$rsmooth" noisy.ply -o reference_memory.ply --device reference -q
 expect 0 "$rsmooth" noisy.ply -o reference_streamed.ply --device reference --max-memory 10M -q
 cmp -s reference_memory.ply reference_streamed.ply ||
