@@ -5,7 +5,8 @@
  * come from their own vertices (within `reach`, the mesh's largest centroid-to-vertex distance),
  * which moved by the facets within `mollify_radius` of them. So a tile holding the facets whose
  * centroids lie within radius + reach + mollify_radius of its box computes its vertices as the
- * whole mesh would, up to float32 rounding (coordinates are local to a different grid). The
+ * whole mesh would, bit for bit (cells count from a lattice fixed in space, and the kernels'
+ * differences do not depend on the blocks). The
  * bilateral normal filter instead reads only facets' own centroids, areas and normals: each of its
  * normal_iterations rounds reaches normal_radius further, so the halo is radius +
  * normal_iterations * normal_radius there. Boxes are halved along their longest side until a tile

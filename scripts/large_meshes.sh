@@ -5,13 +5,14 @@
 # streaming run reports, and the capped result against the in-memory one; rsmooth-mpi on 1 and 2
 # ranks at 16M. Figures, not assertions: run it on a quiet machine.
 #
-# usage: scripts/large_meshes.sh BUILD WORKDIR [MAX_TRIANGLES_IN_MEMORY]
+# usage: scripts/large_meshes.sh BUILD WORKDIR [MAX_TRIANGLES_IN_MEMORY ["TRIANGLES:CAP ..."]]
 #   BUILD    the build folder (rsmooth, rsmooth-big-mesh, rsmooth-mpi)
 #   WORKDIR  where the meshes go (about 5 GB free for 100M triangles, 10 GB with the outputs)
 set -euo pipefail
 build=$(cd "$1" && pwd)
 work=$2
 in_memory_max=${3:-16000000}
+sizes=${4:-"4000000:256M 16000000:512M 100000000:2G"}
 here=$(cd "$(dirname "$0")" && pwd)
 mkdir -p "$work"
 cd "$work"
@@ -30,7 +31,7 @@ echo "| --- | --- | --- | --- | --- | --- | --- |"
 "$build/rsmooth-big-mesh" tiny.ply --triangles 1000 --force 2>/dev/null
 read -r wall rss < <(run tiny "$build/rsmooth" tiny.ply -o tiny_out.ply --force --max-memory 64M)
 echo "| 1000 | --max-memory 64M (the runtime's own memory) | $wall | $rss | | | |"
-for spec in 4000000:256M 16000000:512M 100000000:2G; do
+for spec in $sizes; do
   n=${spec%%:*}
   cap=${spec##*:}
   mesh=terrain$n.ply

@@ -616,8 +616,11 @@ RSMOOTH_API double rsmooth_context_build_ms(const rsmooth_context *ctx);
  * default; the environment variable RSMOOTH_MEMORY_BUDGET, e.g. "256M", sets it at creation).
  * Thread-safe: waits for a running call on the context.
  * A mesh that needs more, or a buffer larger than the device's largest allocation, is cut into
- * spatial tiles, each run with the facets within reach of its vertices: results agree with an
- * untiled run to float32 rounding (rsmooth_report.tiles says how many ran). */
+ * spatial tiles, each run with the facets within reach of its vertices: results are an untiled
+ * run's bit for bit (the grid's cells count from a lattice fixed in space, and no float the
+ * kernels compute depends on which vertices share a block; a mesh spanning more than about a
+ * million cells along an axis, where the whole mesh's cells widen, excepted). rsmooth_report.tiles
+ * says how many ran. */
 RSMOOTH_API void rsmooth_context_set_memory_budget(rsmooth_context *ctx, uint64_t bytes);
 
 /* The bytes one filter call may hold on the device now: the budget, else the device's share. */
@@ -719,9 +722,10 @@ RSMOOTH_API rsmooth_status rsmooth_piece_halo(const rsmooth_params *params,
 /* The filter on a piece of a larger mesh: its first info->core_count vertices move as they would
  * in a run on the whole mesh, provided the piece holds every triangle whose centroid lies within
  * rsmooth_piece_halo of them (more do no harm). Positions are double, packed; out_positions
- * receives 3 * core_count values. The whole mesh's mean edge length and mean facet area stand in
- * for the piece's own, so results match the whole run's to float32 rounding on a device, bit for
- * bit on the reference path (ctx NULL). Params as rsmooth_piece_halo accepts them. Errors as
+ * receives 3 * core_count values. The whole mesh's mean edge length, mean facet area and scale
+ * stand in for the piece's own, so results are the whole run's bit for bit, on a device (as tiles
+ * are, see rsmooth_context_set_memory_budget) and on the reference path (ctx NULL). Params as
+ * rsmooth_piece_halo accepts them. Errors as
  * rsmooth_smooth, nothing written on failure. Thread-safety as rsmooth_smooth. (Added in 0.7) */
 RSMOOTH_API rsmooth_status rsmooth_smooth_piece(rsmooth_context *ctx, const double *positions,
                                                 size_t vertex_count, const uint32_t *indices,

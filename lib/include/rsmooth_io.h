@@ -248,9 +248,9 @@ RSMOOTH_API void rsmooth_stream_report_init(rsmooth_stream_report *report);
  * with their halos (rsmooth_piece_halo), to temporary files; each piece is filtered
  * (rsmooth_smooth_piece, on `ctx`'s device, or the reference path when ctx is NULL); results go
  * into a copy of the input at their vertices' places, so the output is the input byte for byte
- * (header, comments, other properties and elements, faces) but for x, y and z. Results match an
- * in-memory run to float32 rounding (about 1e-7 mean edge lengths). The output appears whole and
- * at once, or not at all.
+ * (header, comments, other properties and elements, faces) but for x, y and z. The positions are
+ * an in-memory run's bit for bit, on a device and on the reference path (see
+ * rsmooth_smooth_piece). The output appears whole and at once, or not at all.
  *
  * What streams: binary PLY (either byte order) with float or double x, y, z, faces of any size
  * (fanned into triangles as the reader does), up to 2^32 - 1 vertices and any number of faces.
