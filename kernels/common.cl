@@ -140,6 +140,19 @@ inline lanei load_offsets(uint k, __global const uchar *offset) {
     return convert_int8(vload8(k, offset));
 }
 
+/* Declares the lanes of block b: px, py, pz local to their own cells, ox, oy, oz their cells'
+ * offsets from the anchor, and lo, hi the box they span in cells from the anchor (for the
+ * search; the distances themselves never go through it). */
+#define LOAD_BLOCK_LANES(b, block_pos, block_offset)                                               \
+    __global const float *pos_ = (block_pos) + 3 * RS_LANES * (size_t)(b);                         \
+    lanef px = load_lanes(0, pos_), py = load_lanes(1, pos_), pz = load_lanes(2, pos_);            \
+    __global const uchar *off_ = (block_offset) + 3 * RS_LANES * (size_t)(b);                      \
+    lanei ox = load_offsets(0, off_), oy = load_offsets(1, off_), oz = load_offsets(2, off_);      \
+    lanef ax_ = px + convert_float8(ox), ay_ = py + convert_float8(oy),                            \
+          az_ = pz + convert_float8(oz);                                                           \
+    float3 lo = (float3)(lane_min(ax_), lane_min(ay_), lane_min(az_));                             \
+    float3 hi = (float3)(lane_max(ax_), lane_max(ay_), lane_max(az_))
+
 /* The cell of the vertex in `slot`: its block's anchor plus its offset. */
 inline int4 slot_cell(__global const int4 *block_cell, __global const uchar *block_offset,
                       uint slot) {

@@ -160,14 +160,7 @@ __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float
     uint b = get_global_id(0);
     if (b >= block_count)
         return;
-    __global const float *pos = block_pos + 3 * RS_LANES * (size_t)b;
-    lanef px = load_lanes(0, pos), py = load_lanes(1, pos), pz = load_lanes(2, pos);
-    __global const uchar *off = block_offset + 3 * RS_LANES * (size_t)b;
-    lanei ox = load_offsets(0, off), oy = load_offsets(1, off), oz = load_offsets(2, off);
-    float3 lo = (float3)(lane_min(px + convert_float8(ox)), lane_min(py + convert_float8(oy)),
-                       lane_min(pz + convert_float8(oz)));
-    float3 hi = (float3)(lane_max(px + convert_float8(ox)), lane_max(py + convert_float8(oy)),
-                       lane_max(pz + convert_float8(oz)));
+    LOAD_BLOCK_LANES(b, block_pos, block_offset);
     int4 anchor = block_cell[b];
     uint pairs = 0, rescue_pairs = 0;
     lanef cr = 0.0f, cg = 0.0f, cb = 0.0f; /* the lanes' colours, when use_color */

@@ -22,14 +22,7 @@ __kernel void mollify_block(uint block_count, float reach2, float inv_2sigma2,
     uint b = get_global_id(0);
     if (b >= block_count)
         return;
-    __global const float *pos = block_pos + 3 * RS_LANES * (size_t)b;
-    lanef px = load_lanes(0, pos), py = load_lanes(1, pos), pz = load_lanes(2, pos);
-    __global const uchar *off = block_offset + 3 * RS_LANES * (size_t)b;
-    lanei ox = load_offsets(0, off), oy = load_offsets(1, off), oz = load_offsets(2, off);
-    float3 lo = (float3)(lane_min(px + convert_float8(ox)), lane_min(py + convert_float8(oy)),
-                       lane_min(pz + convert_float8(oz)));
-    float3 hi = (float3)(lane_max(px + convert_float8(ox)), lane_max(py + convert_float8(oy)),
-                       lane_max(pz + convert_float8(oz)));
+    LOAD_BLOCK_LANES(b, block_pos, block_offset);
     int4 anchor = block_cell[b];
     lanef wsum = 0.0f, ax = 0.0f, ay = 0.0f, az = 0.0f;
     uint pairs = 0;
