@@ -102,6 +102,12 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *problem, const 
 rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *problem,
                             const rs_result_sink *sink, rs_run_stats *stats, rsmooth_error *error);
 
+/* How far beyond a set of vertices the centroids of the facets their results depend on may lie
+ * (tiles.c's top explains it): the robust reach, plus the normals' (the bilateral rounds', or the
+ * mollification of facets whose corners lie up to `reach`, the largest centroid-to-corner
+ * distance, from their centroids). Tiles and pieces of a larger mesh (piece.c) both use it. */
+double rs_halo_radius(const rs_problem *pb, double reach);
+
 /* Fills a report from a run's problem and stats (t_start: the call's start; t_facets: when its
  * facet data was ready). */
 void rs_cl_report(rsmooth_report *report, const rs_problem *pb, const rs_run_stats *stats,

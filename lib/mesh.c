@@ -177,25 +177,6 @@ rsmooth_status rsmooth_mean_edge_length(rsmooth_scalar scalar, const void *posit
               : rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for edges");
 }
 
-bool rs_triangle_geometry(const double *xyz, const uint32_t *tri, double centroid[3],
-                          double normal[3], double *area) {
-    const double *a = xyz + 3 * (size_t)tri[0], *b = xyz + 3 * (size_t)tri[1];
-    const double *c = xyz + 3 * (size_t)tri[2];
-    double e1[3], e2[3], n[3];
-    rs_sub3(b, a, e1);
-    rs_sub3(c, a, e2);
-    rs_cross3(e1, e2, n);
-    double len = sqrt(rs_dot3(n, n));
-    if (!(len > 0) || !isfinite(len))
-        return false;
-    rs_triangle_centroid(xyz, tri, centroid);
-    double inv_len = 1 / len;
-    for (int k = 0; k < 3; k++)
-        normal[k] = n[k] * inv_len;
-    *area = 0.5 * len;
-    return true;
-}
-
 void rs_problem_free(rs_problem *problem) {
     if (!problem)
         return;
@@ -323,8 +304,8 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
                                   const rsmooth_params *params, const void *out_positions,
                                   bool keep_facet_data, rsmooth_error *error,
                                   const char *where) {
-    return rs_problem_prepare_scaled(problem, scalar, positions, vertex_count, indices,
-                                     triangle_count, params, out_positions, keep_facet_data, 0,
+    return rs_problem_prepare_within(problem, scalar, positions, vertex_count, indices,
+                                     triangle_count, params, out_positions, keep_facet_data, NULL,
                                      error, where);
 }
 
@@ -335,11 +316,11 @@ static bool usable_scale(double scale, double magnitude) {
            magnitude * scale < ldexp(1.0, 500);
 }
 
-rsmooth_status rs_problem_prepare_scaled(rs_problem *problem, rsmooth_scalar scalar,
+rsmooth_status rs_problem_prepare_within(rs_problem *problem, rsmooth_scalar scalar,
                                          const void *positions, size_t vertex_count,
                                          const uint32_t *indices, size_t triangle_count,
                                          const rsmooth_params *params, const void *out_positions,
-                                         bool keep_facet_data, double given_scale,
+                                         bool keep_facet_data, const rsmooth_piece_info *whole,
                                          rsmooth_error *error, const char *where) {
     memset(problem, 0, sizeof *problem);
     rsmooth_params p;
@@ -359,7 +340,7 @@ rsmooth_status rs_problem_prepare_scaled(rs_problem *problem, rsmooth_scalar sca
     st = rs_check_colors(p.colors, vertex_count, error, where);
     if (st != RSMOOTH_OK)
         return st;
-    double scale = given_scale;
+    double scale = whole ? whole->scale : 0;
     if (!usable_scale(scale, magnitude))
         st = rs_mesh_scale(scalar, positions, indices, triangle_count, magnitude, &scale, error,
                            where);
@@ -412,8 +393,11 @@ rsmooth_status rs_problem_prepare_scaled(rs_problem *problem, rsmooth_scalar sca
     problem->facet_count = f;
     problem->mean_area = f ? area_sum / (double)f : 0;
 
-    if (!rs_mean_edge_length(problem->xyz, vertex_count, indices, triangle_count,
-                             &problem->mean_edge_length)) {
+    if (whole) { /* a power of two: the products are exact, as the whole run's own are */
+        problem->mean_edge_length = whole->mean_edge_length * scale;
+        problem->mean_area = whole->mean_area * scale * scale;
+    } else if (!rs_mean_edge_length(problem->xyz, vertex_count, indices, triangle_count,
+                                    &problem->mean_edge_length)) {
         rs_problem_free(problem);
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for edges");
     }

@@ -57,10 +57,7 @@ rsmooth_status rsmooth_piece_halo(const rsmooth_params *params, double mean_edge
     rs_problem pb;
     memset(&pb, 0, sizeof pb);
     rs_problem_apply_params(&pb, &p, p.absolute ? 1 : mean_edge_length);
-    /* tiles.c's halo: the robust reach, plus the normals' (bilateral rounds, or mollification of
-     * facets whose corners lie up to `reach` from their centroids) */
-    *out_halo = pb.bilateral ? pb.radius + pb.normal_iterations * pb.normal_radius
-                             : pb.radius + (pb.mollify ? pb.mollify_radius + reach : 0);
+    *out_halo = rs_halo_radius(&pb, reach);
     return RSMOOTH_OK;
 }
 
@@ -85,7 +82,7 @@ static rsmooth_status check_info(const rsmooth_piece_info *info, size_t vertex_c
     return RSMOOTH_OK;
 }
 
-/* The piece's problem with the whole mesh's unit and mean area in place of its own. */
+/* The piece's problem with the whole mesh's scale, unit and mean area in place of its own. */
 static rsmooth_status prepare_piece(rs_problem *pb, const double *positions, size_t vertex_count,
                                    const uint32_t *indices, size_t triangle_count,
                                    const rsmooth_piece_info *info, const rsmooth_params *params,
@@ -105,19 +102,9 @@ static rsmooth_status prepare_piece(rs_problem *pb, const double *positions, siz
                            triangle_count * 3 * sizeof(uint32_t))))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "out_positions overlaps the piece's positions or indices");
-    st = rs_problem_prepare_scaled(pb, RSMOOTH_FLOAT64, positions, vertex_count, indices,
-                                   triangle_count, &p, RS_UNCHECKED_OUTPUT, keep, info->scale,
-                                   error, where);
-    if (st != RSMOOTH_OK)
-        return st;
-    /* the scale is a power of two: these products are exact, as the whole run's own are */
-    pb->mean_edge_length = info->mean_edge_length * pb->scale;
-    pb->mean_area = info->mean_area * pb->scale * pb->scale;
-    size_t facets = pb->facet_count;
-    rs_problem_apply_params(pb, &p, p.absolute ? pb->scale : pb->mean_edge_length);
-    if (pb->facet_count > 0)
-        pb->facet_count = facets;
-    return RSMOOTH_OK;
+    return rs_problem_prepare_within(pb, RSMOOTH_FLOAT64, positions, vertex_count, indices,
+                                     triangle_count, &p, RS_UNCHECKED_OUTPUT, keep, info, error,
+                                     where);
 }
 
 /* The reference path on the whole piece, its core vertices kept. */

@@ -158,14 +158,15 @@ rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
                                   const rsmooth_params *params, const void *out_positions,
                                   bool keep_facet_data, rsmooth_error *error, const char *where);
 
-/* rs_problem_prepare in the internal units of `scale` (a power of two; a piece of a larger mesh
- * works in the whole mesh's) instead of its own choice; 0, or a scale that would put a
- * coordinate beyond 2^500, chooses as rs_problem_prepare does. */
-rsmooth_status rs_problem_prepare_scaled(rs_problem *problem, rsmooth_scalar scalar,
+/* rs_problem_prepare for a piece of a larger mesh: the whole mesh's figures stand in for the
+ * problem's own (its mean edge length and mean area are not computed), and its scale is used
+ * unless it is 0 or would put a coordinate beyond 2^500 (then the problem chooses its own, as
+ * rs_problem_prepare does; the figures are converted exactly either way). */
+rsmooth_status rs_problem_prepare_within(rs_problem *problem, rsmooth_scalar scalar,
                                          const void *positions, size_t vertex_count,
                                          const uint32_t *indices, size_t triangle_count,
                                          const rsmooth_params *params, const void *out_positions,
-                                         bool keep_facet_data, double scale,
+                                         bool keep_facet_data, const rsmooth_piece_info *whole,
                                          rsmooth_error *error, const char *where);
 
 /* The params-to-problem part of rs_problem_prepare: the absolute widths and radii (relative

@@ -43,7 +43,6 @@ static int report_tile_progress(void *user, double fraction) {
     return !rs_progress(tp->whole, tp->from + tp->span * fraction);
 }
 
-static double halo_radius(const rs_problem *pb, double reach);
 
 /* Device bytes a tile of `vertices` core vertices and `facets` facets is expected to need (a
  * facet brings about half a vertex of its own). The bilateral rounds' lists are planned for only
@@ -54,7 +53,7 @@ static double halo_radius(const rs_problem *pb, double reach);
  * anyway, planned or not. */
 static uint64_t estimate_bytes(const rs_problem *pb, size_t vertices, size_t facets) {
     size_t v = vertices > facets / 2 ? vertices : facets / 2;
-    double halo = pb->bilateral ? halo_radius(pb, 0) : 0; /* the bilateral halo needs no reach */
+    double halo = pb->bilateral ? rs_halo_radius(pb, 0) : 0; /* the bilateral halo needs no reach */
     bool lists = pb->bilateral && pb->normal_iterations >= 2 && /* one round searches */
                  (uint64_t)facets <= 4 * (uint64_t)vertices &&
                  (double)facets >= 256 * 3.14159 * halo * halo / pb->mean_area;
@@ -67,8 +66,7 @@ static uint64_t estimate_bytes(const rs_problem *pb, size_t vertices, size_t fac
     return (uint64_t)facets * per_facet + (uint64_t)v * per_vertex;
 }
 
-/* How far beyond a tile's vertices the facets its results depend on may lie (see the top). */
-static double halo_radius(const rs_problem *pb, double reach) {
+double rs_halo_radius(const rs_problem *pb, double reach) {
     if (pb->bilateral)
         return pb->radius + pb->normal_iterations * pb->normal_radius;
     return pb->radius + (pb->mollify ? pb->mollify_radius + reach : 0);
@@ -283,7 +281,7 @@ rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *pb, const rs
         for (size_t q = 0; q < pb->facet_count; q++)
             facets[q] = (uint32_t)q;
         /* a little extra: a facet exactly at the halo must not round out of it */
-        double halo = halo_radius(pb, reach) * (1 + 1e-6);
+        double halo = rs_halo_radius(pb, reach) * (1 + 1e-6);
         rs_result_sink scratch = {RSMOOTH_FLOAT64, positions, weight, confidence, NULL, nv};
         tiler t = {ctx, pb, &scratch, stats, halo, budget, sub_index, 0, nv, error};
         st = solve_region(&t, verts, nv, facets, pb->facet_count, 0);

@@ -99,10 +99,16 @@ typedef struct rs_stream_ply {
 rsmooth_status rs_stream_ply_open(rs_stream_ply *ply, const char *path, rsmooth_error *error);
 void rs_stream_ply_close(rs_stream_ply *ply);
 
+/* The vertices' extent: their bounding box and largest |coordinate|. */
+typedef struct rs_stream_extent {
+    double lo[3], hi[3];
+    double magnitude;
+} rs_stream_extent;
+
 /* Reads every vertex's x, y, z into `xyz` (3 per vertex, floats when xyz_type is FLOAT32, else
- * doubles), checking each; *magnitude receives the largest |coordinate|. */
-rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz, double *magnitude,
-                                           rsmooth_error *error);
+ * doubles), checking each, and measures their extent on the way. */
+rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz,
+                                           rs_stream_extent *extent, rsmooth_error *error);
 
 /* Reads the faces, fans each into triangles as the in-memory reader does, and writes their
  * vertex indices (3 uint32 each) to `triangles_fd`; *triangle_count receives how many. */
@@ -129,6 +135,21 @@ static inline void rs_stream_position(const rs_stream_positions *p, uint64_t v, 
                         : ((const double *)p->xyz)[3 * v + (uint64_t)k];
 }
 
+/* rs_triangle_geometry of triangle `tri` with its corners times `scale` (internal units):
+ * whether it is a facet, and then its centroid (scaled) and area. */
+static inline bool rs_stream_facet(const rs_stream_positions *p, const uint32_t tri[3],
+                                   double scale, double corners[9], double centroid[3],
+                                   double *area) {
+    static const uint32_t local[3] = {0, 1, 2};
+    double normal[3];
+    for (int c = 0; c < 3; c++) {
+        rs_stream_position(p, tri[c], corners + 3 * c);
+        for (int k = 0; k < 3; k++)
+            corners[3 * c + k] *= scale;
+    }
+    return rs_triangle_geometry(corners, local, centroid, normal, area);
+}
+
 typedef struct rs_stream_stats {
     double scale;            /* power of two the sums run at (exact; see stream_stats.c) */
     double mean_edge_length; /* caller's units */
@@ -141,8 +162,9 @@ typedef struct rs_stream_stats {
 /* The figures of the mesh whose triangles are in `triangles_fd`, with at most `memory` bytes of
  * working memory for the unique edges. */
 rsmooth_status rs_stream_statistics(const rs_stream_positions *positions, int triangles_fd,
-                                    uint64_t triangle_count, double magnitude, uint64_t memory,
-                                    rs_stream_stats *stats, rsmooth_error *error);
+                                    uint64_t triangle_count, const rs_stream_extent *extent,
+                                    uint64_t memory, rs_stream_stats *stats,
+                                    rsmooth_error *error);
 
 /* ---- stream_pieces.c ----------------------------------------------------------------------- */
 

@@ -185,23 +185,6 @@ static size_t pieces_near(const cell_grid *g, const box *boxes, const double c[3
     return n;
 }
 
-static bool facet_centroid(const rs_stream_positions *pos, const uint32_t tri[3], double scale,
-                           double c[3]) {
-    double p[3][3];
-    for (int i = 0; i < 3; i++)
-        rs_stream_position(pos, tri[i], p[i]);
-    double e1[3], e2[3];
-    for (int k = 0; k < 3; k++) {
-        e1[k] = (p[1][k] - p[0][k]) * scale;
-        e2[k] = (p[2][k] - p[0][k]) * scale;
-        c[k] = (p[0][k] + p[1][k] + p[2][k]) / 3.0;
-    }
-    double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                   e1[0] * e2[1] - e1[1] * e2[0]};
-    double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    return len > 0 && isfinite(len); /* zero-area triangles weigh nothing anywhere */
-}
-
 /* One pass over the triangles: counts each piece's facets (writer NULL), or writes this rank's
  * pieces' facet records. */
 static rsmooth_status facet_pass(const rs_stream_positions *pos, int fd, uint64_t triangles,
@@ -220,9 +203,11 @@ static rsmooth_status facet_pass(const rs_stream_positions *pos, int fd, uint64_
             return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
                            "cannot read the temporary triangle file");
         }
-        double c[3];
-        if (!facet_centroid(pos, tri, scale, c))
-            continue;
+        double corners[9], c[3], area;
+        if (!rs_stream_facet(pos, tri, scale, corners, c, &area))
+            continue; /* zero-area triangles weigh nothing anywhere */
+        for (int k = 0; k < 3; k++)
+            c[k] /= scale; /* exact: a power of two */
         size_t n = pieces_near(g, boxes, c, halo, near, MAX_NEAR);
         for (size_t i = 0; i < n; i++) {
             rs_piece *p = &pieces[near[i]];

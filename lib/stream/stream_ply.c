@@ -79,9 +79,21 @@ static size_t row_bytes(const rs_ply_element *e, bool *has_list) {
     return n;
 }
 
-/* Walks the items of an element with lists, returning where it ends (or 0 on a short file). */
-static uint64_t skip_element(rs_stream_ply *ply, const rs_ply_element *e, uint64_t start,
-                             rsmooth_error *error, rsmooth_status *st) {
+/* Where element e, starting at `start`, ends: its items' fixed size, or (with lists) its items
+ * walked. 0 with *st set when the file is too short for it. */
+static uint64_t step_over(rs_stream_ply *ply, const rs_ply_element *e, uint64_t start,
+                          rsmooth_error *error, rsmooth_status *st) {
+    bool list = false;
+    size_t bytes = row_bytes(e, &list);
+    if (!list) {
+        if (bytes && e->count > (ply->size - start) / bytes) {
+            *st = rs_fail_parse(error, e->header_line, -1, RS_STREAM_WHERE,
+                                "%s: %llu '%s' items of %zu bytes do not fit in the file",
+                                ply->path, (unsigned long long)e->count, e->name, bytes);
+            return 0;
+        }
+        return start + e->count * bytes;
+    }
     rs_stream_reader r;
     if (!rs_stream_reader_open(&r, ply->fd, ply->path, start, ply->size, READ_BUFFER)) {
         *st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
@@ -160,18 +172,9 @@ static rsmooth_status find_layout(rs_stream_ply *ply, rsmooth_error *error) {
         }
         if (vertex_seen && face_seen)
             break;
-        size_t bytes = row_bytes(e, &list);
-        if (list) {
-            at = skip_element(ply, e, at, error, &st);
-            if (st != RSMOOTH_OK)
-                return st;
-        } else {
-            if (bytes && e->count > (ply->size - at) / bytes)
-                return rs_fail_parse(error, e->header_line, -1, RS_STREAM_WHERE,
-                                     "%s: %llu '%s' items of %zu bytes do not fit in the file",
-                                     ply->path, (unsigned long long)e->count, e->name, bytes);
-            at += e->count * bytes;
-        }
+        at = step_over(ply, e, at, error, &st);
+        if (st != RSMOOTH_OK)
+            return st;
     }
     return RSMOOTH_OK;
 }
@@ -223,8 +226,8 @@ void rs_stream_ply_close(rs_stream_ply *ply) {
     memset(ply, 0, sizeof *ply);
 }
 
-rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz, double *magnitude,
-                                           rsmooth_error *error) {
+rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz,
+                                           rs_stream_extent *extent, rsmooth_error *error) {
     uint64_t end = ply->vertex_start + ply->vertex_count * ply->vertex_stride;
     if (end > ply->size)
         return rs_fail_parse(error, -1, (int64_t)ply->size, RS_STREAM_WHERE,
@@ -233,7 +236,11 @@ rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz, double
     if (!rs_stream_reader_open(&r, ply->fd, ply->path, ply->vertex_start, end, READ_BUFFER))
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
     bool f32 = ply->xyz_type == RS_PLY_FLOAT32;
-    double largest = 0;
+    for (int k = 0; k < 3; k++) {
+        extent->lo[k] = INFINITY;
+        extent->hi[k] = -INFINITY;
+    }
+    extent->magnitude = 0;
     for (uint64_t i = 0; i < ply->vertex_count; i++) {
         const unsigned char *row = rs_stream_read(&r, ply->vertex_stride);
         if (!row) {
@@ -251,7 +258,9 @@ rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz, double
                                      "1e150 are supported)",
                                      ply->path, (unsigned long long)i, c);
             }
-            largest = fmax(largest, fabs(c));
+            extent->magnitude = fmax(extent->magnitude, fabs(c));
+            extent->lo[k] = fmin(extent->lo[k], c);
+            extent->hi[k] = fmax(extent->hi[k], c);
             if (f32)
                 ((float *)xyz)[3 * i + (uint64_t)k] = (float)c;
             else
@@ -259,7 +268,6 @@ rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz, double
         }
     }
     rs_stream_reader_close(&r);
-    *magnitude = largest;
     return RSMOOTH_OK;
 }
 
@@ -270,20 +278,9 @@ static rsmooth_status check_end(rs_stream_ply *ply, size_t next, uint64_t at,
     const rs_ply_reader *h = &ply->header;
     rsmooth_status st = RSMOOTH_OK;
     for (size_t ei = next; ei < h->x->element_count; ei++) {
-        const rs_ply_element *e = &h->x->elements[ei];
-        bool list = false;
-        size_t bytes = row_bytes(e, &list);
-        if (list) {
-            at = skip_element(ply, e, at, error, &st);
-            if (st != RSMOOTH_OK)
-                return st;
-        } else if (bytes && e->count > (ply->size - at) / bytes) {
-            return rs_fail_parse(error, e->header_line, -1, RS_STREAM_WHERE,
-                                 "%s: %llu '%s' items of %zu bytes do not fit in the file",
-                                 ply->path, (unsigned long long)e->count, e->name, bytes);
-        } else {
-            at += e->count * bytes;
-        }
+        at = step_over(ply, h->x->elements + ei, at, error, &st);
+        if (st != RSMOOTH_OK)
+            return st;
     }
     rs_stream_reader r;
     if (!rs_stream_reader_open(&r, ply->fd, ply->path, at, ply->size, READ_BUFFER))

@@ -169,8 +169,8 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
                        "no memory for %llu vertex positions",
                        (unsigned long long)c->ply.vertex_count);
     c->positions = (rs_stream_positions){c->xyz, f32, c->ply.vertex_count};
-    double magnitude = 0;
-    st = rs_stream_ply_read_vertices(&c->ply, c->xyz, &magnitude, error);
+    rs_stream_extent extent;
+    st = rs_stream_ply_read_vertices(&c->ply, c->xyz, &extent, error);
     if (st != RSMOOTH_OK)
         return st;
     if (!report_progress(c, 0.03))
@@ -194,7 +194,7 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
 
     double t1 = now_ms();
     uint64_t work = cap - position_bytes - FIXED_BYTES / 2;
-    st = rs_stream_statistics(&c->positions, c->triangles_fd, c->triangle_count, magnitude, work,
+    st = rs_stream_statistics(&c->positions, c->triangles_fd, c->triangle_count, &extent, work,
                               &c->stats, error);
     if (st != RSMOOTH_OK)
         return st;

@@ -156,23 +156,6 @@ static rsmooth_status mean_edge_length(const rs_stream_positions *pos, int fd,
     return RSMOOTH_OK;
 }
 
-/* lib/mesh.c's rs_triangle_geometry: whether a triangle is a facet, and its area and centroid. */
-static bool facet_geometry(const double a[3], const double b[3], const double c[3],
-                           double *area) {
-    double e1[3], e2[3];
-    for (int k = 0; k < 3; k++) {
-        e1[k] = b[k] - a[k];
-        e2[k] = c[k] - a[k];
-    }
-    double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                   e1[0] * e2[1] - e1[1] * e2[0]};
-    double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (!(len > 0) || !isfinite(len))
-        return false;
-    *area = 0.5 * len;
-    return true;
-}
-
 /* Facet count, mean area and reach, in blocks as mesh.c sums them. */
 static rsmooth_status facet_figures(const rs_stream_positions *pos, int fd, uint64_t triangles,
                                     double scale, rs_stream_stats *stats, rsmooth_error *error) {
@@ -187,19 +170,14 @@ static rsmooth_status facet_figures(const rs_stream_positions *pos, int fd, uint
             rs_stream_reader_close(&r);
             return read_fail(error);
         }
-        double p[3][3], area = 0;
-        for (int c = 0; c < 3; c++)
-            scaled_position(pos, tri[c], scale, p[c]);
-        if (facet_geometry(p[0], p[1], p[2], &area)) {
+        double p[9], centroid[3], area = 0;
+        if (rs_stream_facet(pos, tri, scale, p, centroid, &area)) {
             facets++;
             block_sum += area;
             for (int c = 0; c < 3; c++) {
-                double d2 = 0;
-                for (int k = 0; k < 3; k++) {
-                    double d = p[c][k] - (p[0][k] + p[1][k] + p[2][k]) / 3.0;
-                    d2 += d * d;
-                }
-                reach = fmax(reach, sqrt(d2));
+                double d[3];
+                rs_sub3(p + 3 * c, centroid, d);
+                reach = fmax(reach, sqrt(rs_dot3(d, d)));
             }
         }
         if ((t + 1) % GEOMETRY_BLOCK == 0 || t + 1 == triangles) {
@@ -236,25 +214,16 @@ static rsmooth_status whole_scale(const rs_stream_positions *pos, int fd, uint64
 }
 
 rsmooth_status rs_stream_statistics(const rs_stream_positions *positions, int triangles_fd,
-                                    uint64_t triangle_count, double magnitude, uint64_t memory,
-                                    rs_stream_stats *stats, rsmooth_error *error) {
+                                    uint64_t triangle_count, const rs_stream_extent *extent,
+                                    uint64_t memory, rs_stream_stats *stats,
+                                    rsmooth_error *error) {
     memset(stats, 0, sizeof *stats);
-    rsmooth_status st = whole_scale(positions, triangles_fd, triangle_count, magnitude,
+    memcpy(stats->lo, extent->lo, sizeof stats->lo);
+    memcpy(stats->hi, extent->hi, sizeof stats->hi);
+    rsmooth_status st = whole_scale(positions, triangles_fd, triangle_count, extent->magnitude,
                                     &stats->scale, error);
     if (st != RSMOOTH_OK)
         return st;
-    for (int k = 0; k < 3; k++) {
-        stats->lo[k] = INFINITY;
-        stats->hi[k] = -INFINITY;
-    }
-    for (uint64_t v = 0; v < positions->count; v++) {
-        double p[3];
-        rs_stream_position(positions, v, p);
-        for (int k = 0; k < 3; k++) {
-            stats->lo[k] = fmin(stats->lo[k], p[k]);
-            stats->hi[k] = fmax(stats->hi[k], p[k]);
-        }
-    }
     st = mean_edge_length(positions, triangles_fd, triangle_count, stats->scale, memory,
                           &stats->mean_edge_length, error);
     if (st != RSMOOTH_OK)
