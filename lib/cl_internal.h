@@ -34,6 +34,7 @@ struct rsmooth_context {
     cl_kernel kernels[RS_KERNEL_COUNT];
     char device_name[256];
     double build_ms;
+    int program_cache;        /* RS_PROGRAM_CACHE_: whether the program came from rsmooth's cache */
     size_t local_size;        /* work-group size used for every kernel */
     uint64_t global_memory;   /* CL_DEVICE_GLOBAL_MEM_SIZE */
     uint64_t max_allocation;  /* CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest one buffer may be */
@@ -115,6 +116,32 @@ void rs_cl_report(rsmooth_report *report, const rs_problem *pb, const rs_run_sta
 
 /* Builds the program from the embedded kernels (or RSMOOTH_KERNEL_DIR) and creates the kernels. */
 rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error);
+
+/* ---- cl_program_cache.c: rsmooth's cache of program binaries ---------------------------------- */
+
+enum { RS_PROGRAM_CACHE_OFF, RS_PROGRAM_CACHE_MISS, RS_PROGRAM_CACHE_HIT };
+
+/* One program's entry: its file ("" when the cache is off) and the key it must hold. */
+typedef struct rs_program_cache {
+    char path[4096];
+    uint64_t key[2], key_bytes, key_fields;
+} rs_program_cache;
+
+/* Keys the program of the `count` sources (OpenCL's strings and lengths, as passed to
+ * clCreateProgramWithSource) and build `options` for ctx's device, its driver and platform.
+ * false (the cache off) when RSMOOTH_CACHE_DIR is empty or "off", or no directory is known. */
+bool rs_program_cache_open(rs_program_cache *cache, const rsmooth_context *ctx, cl_uint count,
+                           const char *const *sources, const size_t *sizes, const char *options);
+
+/* The program built from the entry's binary with `options`, or NULL (no file, a file that is not
+ * whole and this key's, or a build that fails): then build from source. */
+cl_program rs_program_cache_load(const rs_program_cache *cache, const rsmooth_context *ctx,
+                                 const char *options);
+
+/* Stores the binary of `program`, built from source, for the entry; failures are silent (the
+ * next context builds from source again). Safe against concurrent writers and readers. */
+void rs_program_cache_store(const rs_program_cache *cache, const rsmooth_context *ctx,
+                            cl_program program);
 
 /* What rs_cl_run_1d returns when the caller's progress_cancel asked to stop: positive, so never
  * an OpenCL code; rs_cl_fail turns it into RSMOOTH_ERROR_CANCELLED. */

@@ -33,6 +33,9 @@
       (const cl_context_properties *, cl_uint, const cl_device_id *,                               \
        void(CL_CALLBACK *)(const char *, const void *, size_t, void *), void *, cl_int *))         \
     X(cl_kernel, CreateKernel, (cl_program, const char *, cl_int *))                               \
+    X(cl_program, CreateProgramWithBinary,                                                         \
+      (cl_context, cl_uint, const cl_device_id *, const size_t *, const unsigned char **,          \
+       cl_int *, cl_int *))                                                                        \
     X(cl_program, CreateProgramWithSource,                                                         \
       (cl_context, cl_uint, const char **, const size_t *, cl_int *))                              \
     X(void *, EnqueueMapBuffer,                                                                    \
@@ -54,6 +57,7 @@
     X(cl_int, GetPlatformInfo, (cl_platform_id, cl_platform_info, size_t, void *, size_t *))       \
     X(cl_int, GetProgramBuildInfo,                                                                 \
       (cl_program, cl_device_id, cl_program_build_info, size_t, void *, size_t *))                 \
+    X(cl_int, GetProgramInfo, (cl_program, cl_program_info, size_t, void *, size_t *))             \
     X(cl_int, ReleaseCommandQueue, (cl_command_queue))                                             \
     X(cl_int, ReleaseContext, (cl_context))                                                        \
     X(cl_int, ReleaseEvent, (cl_event))                                                            \
@@ -87,6 +91,7 @@ rsmooth_status rs_cl_load(const char *where, rsmooth_error *error);
 #define clCreateCommandQueue rs_cl_api.CreateCommandQueue
 #define clCreateContext rs_cl_api.CreateContext
 #define clCreateKernel rs_cl_api.CreateKernel
+#define clCreateProgramWithBinary rs_cl_api.CreateProgramWithBinary
 #define clCreateProgramWithSource rs_cl_api.CreateProgramWithSource
 #define clEnqueueMapBuffer rs_cl_api.EnqueueMapBuffer
 #define clEnqueueNDRangeKernel rs_cl_api.EnqueueNDRangeKernel
@@ -100,6 +105,7 @@ rsmooth_status rs_cl_load(const char *where, rsmooth_error *error);
 #define clGetPlatformIDs rs_cl_api.GetPlatformIDs
 #define clGetPlatformInfo rs_cl_api.GetPlatformInfo
 #define clGetProgramBuildInfo rs_cl_api.GetProgramBuildInfo
+#define clGetProgramInfo rs_cl_api.GetProgramInfo
 #define clReleaseCommandQueue rs_cl_api.ReleaseCommandQueue
 #define clReleaseContext rs_cl_api.ReleaseContext
 #define clReleaseEvent rs_cl_api.ReleaseEvent

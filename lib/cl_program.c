@@ -84,14 +84,25 @@ rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error) {
 
     double t0 = rs_now_ms();
     cl_int err = CL_SUCCESS;
+    char options[1024];
+    const char *extra = getenv("RSMOOTH_BUILD_OPTIONS");
+    snprintf(options, sizeof options, "%s %s", default_options, extra ? extra : "");
+    /* rsmooth's binary cache (cl_program_cache.c), keyed by exactly the sources and options the
+     * build from source below takes */
+    rs_program_cache cache;
+    ctx->program_cache = rs_program_cache_open(&cache, ctx, KERNEL_FILES + 1, sources, sizes,
+                                               options)
+                             ? RS_PROGRAM_CACHE_MISS
+                             : RS_PROGRAM_CACHE_OFF;
+    if ((ctx->program = rs_program_cache_load(&cache, ctx, options))) {
+        ctx->program_cache = RS_PROGRAM_CACHE_HIT;
+        goto kernels;
+    }
     ctx->program = clCreateProgramWithSource(ctx->context, KERNEL_FILES + 1, sources, sizes, &err);
     if (err != CL_SUCCESS) {
         st = rs_cl_fail(error, err, "clCreateProgramWithSource", ctx->device_name);
         goto done;
     }
-    char options[1024];
-    const char *extra = getenv("RSMOOTH_BUILD_OPTIONS");
-    snprintf(options, sizeof options, "%s %s", default_options, extra ? extra : "");
     err = clBuildProgram(ctx->program, 1, &ctx->device, options, NULL, NULL);
     if (err != CL_SUCCESS) {
         st = rs_cl_fail(error, err, "clBuildProgram", ctx->device_name);
@@ -113,6 +124,8 @@ rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error) {
         }
         goto done;
     }
+    rs_program_cache_store(&cache, ctx, ctx->program);
+kernels:;
     static const char *const kernel_names[RS_KERNEL_COUNT] = {
         [RS_KERNEL_MOLLIFY] = "mollify_block",
         [RS_KERNEL_NORMALS] = "mollified_facet_normal",

@@ -612,6 +612,15 @@ RSMOOTH_API const char *rsmooth_context_device_name(const rsmooth_context *ctx);
 /* Milliseconds the context's creation spent building the OpenCL program. */
 RSMOOTH_API double rsmooth_context_build_ms(const rsmooth_context *ctx);
 
+/* Where the context's program came from: "hit" (built from the binary in rsmooth's program cache),
+ * "miss" (built from source, its binary then stored) or "off" (no cache: RSMOOTH_CACHE_DIR is empty
+ * or "off", or neither XDG_CACHE_HOME nor HOME is set). The cache is the folder RSMOOTH_CACHE_DIR,
+ * else $XDG_CACHE_HOME/rsmooth, else $HOME/.cache/rsmooth, created (mode 0700) when first written;
+ * one file per device, driver, program source and build options. A file that is damaged, another
+ * key's or fails to build is a miss and is replaced; a folder that cannot be written only means a
+ * build from source each time. Static text; "" for NULL. */
+RSMOOTH_API const char *rsmooth_context_program_cache(const rsmooth_context *ctx);
+
 /* Limits the device memory one filter call holds to `bytes` (0: most of the device's memory, the
  * default; the environment variable RSMOOTH_MEMORY_BUDGET, e.g. "256M", sets it at creation).
  * Thread-safe: waits for a running call on the context.
