@@ -2,9 +2,9 @@
  * ratios measured in one run, and medians).
  *
  *   rsmooth-bench io [--triangles N] [--repeat R] [--dir DIR]
- *     Mesh file speed: writes and reads a binary PLY (and an OBJ) of a generated N-triangle mesh,
- *     beside a raw write and read of the same number of bytes in the same process: the
- *     disk-bound limit. One JSON object on stdout with medians over R repetitions.
+ *     Mesh file speed: writes and reads a binary PLY, an ascii PLY and an OBJ of a generated
+ *     N-triangle mesh, beside a raw write and read of the same number of bytes in the same
+ *     process: the disk-bound limit. One JSON object on stdout with medians over R repetitions.
  *
  *   rsmooth-bench filter [MESH] [--triangles N] [--noise S] [--sigma-f X] [--sigma-g Y]
  *                        [--device D] [--repeat R] [--no-roofline]
@@ -86,9 +86,9 @@ enum { EXIT_OK = 0, EXIT_OTHER = 1, EXIT_USAGE = 2, EXIT_DEVICE = 3 };
 
 static const char io_usage[] =
     "usage: rsmooth-bench io [--triangles N] [--repeat R] [--dir DIR]\n"
-    "  times writing and reading a binary PLY and an OBJ of a generated noisy closed cylinder\n"
-    "  beside a raw write and read of the same bytes (the disk-bound limit); medians over R\n"
-    "  repetitions (JSON)\n"
+    "  times writing and reading a binary PLY, an ascii PLY and an OBJ of a generated noisy\n"
+    "  closed cylinder beside a raw write and read of the same bytes (the disk-bound limit);\n"
+    "  medians over R repetitions (JSON)\n"
     "  --triangles N   about N triangles, at least 100 (default 1000000)\n"
     "  --repeat R      repetitions, 1..99 (default 3)\n"
     "  --dir DIR       where the files are written, then removed (default /tmp)\n";
@@ -149,6 +149,7 @@ static int bench_io(int argc, char **argv) {
         const char *name, *ext;
         rsmooth_format format;
     } formats[] = {{"ply_binary", "ply", RSMOOTH_FORMAT_PLY_BINARY},
+                   {"ply_ascii", "ply", RSMOOTH_FORMAT_PLY_ASCII},
                    {"obj", "obj", RSMOOTH_FORMAT_OBJ}};
     printf("{\"triangles\":%zu,\"vertices\":%zu", mesh->triangle_count, mesh->vertex_count);
     for (size_t f = 0; f < sizeof formats / sizeof *formats; f++) {

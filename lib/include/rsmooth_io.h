@@ -18,8 +18,8 @@
  *
  * What rsmooth writes, rsmooth reads back to the same numbers: writers refuse the values readers
  * refuse (non-finite or beyond 1e150, the magnitude the filter supports) and a mesh a float32 file
- * cannot hold at its own scale, and write every coordinate with the digits (text) or bits (binary)
- * that give it back exactly, as a double or as the float32 the file holds.
+ * cannot hold at its own scale, and write every coordinate with the fewest digits (text) or the
+ * bits (binary) that give it back exactly, as a double or as the float32 the file holds.
  * rsmooth_mesh_check_writable tells beforehand whether a format's writer would refuse a mesh.
  *
  *     rsmooth_mesh *mesh = NULL;

@@ -1,4 +1,5 @@
 /* Stanford PLY writer: ascii or binary little-endian (bytes laid out explicitly for any host). */
+#include "io/float_print.h"
 #include "io/ply_format.h"
 
 #include <errno.h>
@@ -19,7 +20,7 @@ static const char where[] = "rsmooth_mesh_write_stream";
 
 typedef struct out_buffer {
     FILE *stream;
-    unsigned char bytes[1 << 16];
+    unsigned char bytes[1 << 20];
     size_t used;
     bool ok;
 } out_buffer;
@@ -162,34 +163,57 @@ static bool write_binary(const rsmooth_mesh *mesh, const double *normals, FILE *
     return out_close(out);
 }
 
+/* A text value and the separator after it ("%.9g"-style shortest digits: float_print.h). */
+static unsigned char *text_float(unsigned char *p, float v, char sep) {
+    p += rs_io_print_float((char *)p, v);
+    *p++ = (unsigned char)sep;
+    return p;
+}
+
+static unsigned char *text_double(unsigned char *p, double v, char sep) {
+    p += rs_io_print_double((char *)p, v);
+    *p++ = (unsigned char)sep;
+    return p;
+}
+
+static unsigned char *text_u64(unsigned char *p, uint64_t v, char sep) {
+    p += rs_io_print_u64((char *)p, v);
+    *p++ = (unsigned char)sep;
+    return p;
+}
+
 static bool write_ascii(const rsmooth_mesh *mesh, const double *normals, FILE *stream, bool f32) {
-    bool ok = true;
-    for (size_t i = 0; ok && i < mesh->vertex_count; i++) {
-        for (int set = 0; ok && set < (normals ? 2 : 1); set++) {
+    out_buffer *out = out_open(stream);
+    if (!out)
+        return false;
+    for (size_t i = 0; out->ok && i < mesh->vertex_count; i++) {
+        /* 6 values, quality, 3 colours, each with its separator */
+        unsigned char *start = out_reserve(out, 7 * (RS_IO_PRINT_MAX + 1) + 3 * 4);
+        unsigned char *p = start;
+        for (int set = 0; set < (normals ? 2 : 1); set++) {
             const double *xyz = (set == 0 ? mesh->positions : normals) + 3 * i;
-            if (f32)
-                ok = fprintf(stream, "%s%.9g %.9g %.9g", set ? " " : "", (double)(float)xyz[0],
-                             (double)(float)xyz[1], (double)(float)xyz[2]) >= 0;
-            else
-                ok = fprintf(stream, "%s%.17g %.17g %.17g", set ? " " : "", xyz[0], xyz[1],
-                             xyz[2]) >= 0;
+            for (int c = 0; c < 3; c++)
+                p = f32 ? text_float(p, (float)xyz[c], ' ') : text_double(p, xyz[c], ' ');
         }
-        if (ok && mesh->vertex_quality)
-            ok = fprintf(stream, " %.9g", (double)mesh->vertex_quality[i]) >= 0;
-        if (ok && mesh->vertex_colors) {
-            const uint8_t *c = mesh->vertex_colors + 3 * i;
-            ok = fprintf(stream, " %u %u %u", c[0], c[1], c[2]) >= 0;
-        }
-        ok = ok && putc('\n', stream) != EOF;
+        if (mesh->vertex_quality)
+            p = text_float(p, mesh->vertex_quality[i], ' ');
+        if (mesh->vertex_colors)
+            for (int c = 0; c < 3; c++)
+                p = text_u64(p, mesh->vertex_colors[3 * i + (size_t)c], ' ');
+        p[-1] = '\n';
+        out->used += (size_t)(p - start);
     }
-    for (size_t f = 0; ok && f < mesh->face_count; f++) {
+    for (size_t f = 0; out->ok && f < mesh->face_count; f++) {
         uint32_t begin = mesh->face_offsets[f], end = mesh->face_offsets[f + 1];
-        ok = fprintf(stream, "%lu", (unsigned long)(end - begin)) >= 0;
-        for (uint32_t k = begin; ok && k < end; k++)
-            ok = fprintf(stream, " %lu", (unsigned long)mesh->face_indices[k]) >= 0;
-        ok = ok && putc('\n', stream) != EOF;
+        unsigned char *p = out_reserve(out, 11);
+        out->used += (size_t)(text_u64(p, end - begin, ' ') - p);
+        for (uint32_t k = begin; k < end; k++) {
+            p = out_reserve(out, 11);
+            out->used += (size_t)(text_u64(p, mesh->face_indices[k], ' ') - p);
+        }
+        out->bytes[out->used - 1] = '\n';
     }
-    return ok;
+    return out_close(out);
 }
 
 static rsmooth_status write_generic(const rsmooth_mesh *mesh, FILE *stream, bool binary,
@@ -257,17 +281,18 @@ static void emit_double(out_buffer *out, bool binary, rs_ply_type t, double v) {
         out->used += size;
         return;
     }
-    int n;
-    if (t == RS_PLY_FLOAT32)
-        n = snprintf((char *)p, 40, "%.9g ", (double)(float)v);
-    else if (t == RS_PLY_FLOAT64)
-        n = snprintf((char *)p, 40, "%.17g ", v);
-    else
-        n = snprintf((char *)p, 40, "%" PRId64 " ", (int64_t)v);
-    if (n > 0 && n < 40)
-        out->used += (size_t)n;
-    else
-        out->ok = false;
+    unsigned char *end = p;
+    if (t == RS_PLY_FLOAT32) {
+        end = text_float(end, (float)v, ' ');
+    } else if (t == RS_PLY_FLOAT64) {
+        end = text_double(end, v, ' ');
+    } else {
+        int64_t i = (int64_t)v;
+        if (i < 0)
+            *end++ = '-';
+        end = text_u64(end, i < 0 ? 0 - (uint64_t)i : (uint64_t)i, ' ');
+    }
+    out->used += (size_t)(end - p);
 }
 
 /* Writes a kept value (host order) of type t. */
