@@ -18,17 +18,20 @@ typedef struct rs_io_decimal {
 
 /* The decimal with the fewest significant digits that lies in the rounding interval of |v| (so
  * that strtod / strtof, rounding to nearest even, read it back as |v|), the closest to |v| among
- * them (ties to an even last digit). The digits are those of the smallest precision p for which
- * "%.{p}g" reads back as v. v finite and nonzero. */
+ * them (ties to an even last digit). These are the digits of the smallest precision p for which
+ * "%.{p}g" reads back as v, except at some powers of two, whose interval reaches twice as far up
+ * as down: there "%.{p}g" may round down out of it where a decimal one digit shorter above v is
+ * in it. v finite and nonzero. */
 rs_io_decimal rs_io_shortest_double(double v);
 rs_io_decimal rs_io_shortest_float(float v);
 
 /* Writes v (no terminating NUL) and returns the number of bytes, at most RS_IO_PRINT_MAX: the
  * shortest digits above, laid out as "%.{P}g" lays out its digits, P = 15 when they are at most
- * 15 and 17 otherwise (floats: 6 and 9). So the text is "%.15g" (".6g") whenever that reads back
- * as v, and "%.17g" (".9g") with the needless last digit dropped otherwise: plain decimal, or
- * d.ddde+XX beyond P digits or below 1e-4, as C's strtod and every mesh tool read it. Zero is
- * "0" or "-0"; NaN and infinities "nan", "-nan", "inf", "-inf", as glibc prints them. */
+ * 15 and 17 otherwise (floats: 6 and 9): plain decimal, or d.ddde+XX from P digits up or below
+ * 1e-4, as C's strtod and every mesh tool read it. So for a normal v the text is "%.15g"'s
+ * ("%.6g"'s) when that is shortest, "%.17g"'s ("%.9g"'s) when 17 (9) digits are needed, and one
+ * digit shorter than "%.17g"'s when 16 suffice. Zero is "0" or "-0"; NaN and infinities "nan",
+ * "-nan", "inf", "-inf", as glibc prints them. */
 size_t rs_io_print_double(char *out, double v);
 size_t rs_io_print_float(char *out, float v);
 

@@ -9,8 +9,8 @@
 static const char where[] = "rsmooth_mesh_write_stream";
 
 /* Writes " v" so that it reads back as the same value (the same float when `as_float`), in its
- * shortest decimal (float_print.h: "%.15g" whenever that reads back, so unchanged coordinates
- * keep their short form). A value beyond float range is written as the double it is. */
+ * shortest decimal (float_print.h: "%.15g"'s text when that is shortest, so unchanged
+ * coordinates keep their short form). A value beyond float range is written as the double it is. */
 static void put_coord(rs_io_text_out *out, double v, bool as_float) {
     rs_io_text_char(out, ' ');
     if (as_float && isfinite((float)v))

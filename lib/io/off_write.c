@@ -9,8 +9,8 @@
 static const char where[] = "rsmooth_mesh_write_stream";
 
 /* Writes `sep` and v so that v reads back as the same value (the same float when `as_float`), in
- * its shortest decimal (float_print.h: "%.15g" whenever that reads back, so unchanged coordinates
- * keep their short form). */
+ * its shortest decimal (float_print.h: "%.15g"'s text when that is shortest, so unchanged
+ * coordinates keep their short form). */
 static void put_coord(rs_io_text_out *out, bool sep, double v, bool as_float) {
     if (sep)
         rs_io_text_char(out, ' ');
