@@ -147,6 +147,41 @@ static rsmooth_status sort_into_cells(rs_grid *grid, const double *points, size_
                                       double reach, int split, const double lo[3],
                                       const double hi[3], rsmooth_error *error);
 
+/* The occupied cells from the sorted keys, a chunk of facets per thread: each counts the cells
+ * that begin in it, then writes them from where the chunks before it end. */
+typedef struct cell_job {
+    rs_grid *grid;
+    const uint64_t *keys;
+    size_t first[64]; /* per chunk: the cells beginning in it, then the first one's number */
+} cell_job;
+
+static void count_cells(void *ctx, size_t begin, size_t end, size_t chunk) {
+    cell_job *job = ctx;
+    size_t n = 0;
+    for (size_t i = begin; i < end; i++)
+        n += i == 0 || job->keys[i] != job->keys[i - 1];
+    job->first[chunk] = n;
+}
+
+static void store_cells(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const cell_job *job = ctx;
+    rs_grid *grid = job->grid;
+    size_t cell = job->first[chunk];
+    for (size_t i = begin; i < end; i++) {
+        if (i > 0 && job->keys[i] == job->keys[i - 1])
+            continue;
+        int32_t c[3];
+        cell_of_key(grid, job->keys[i], c); /* the clamped cell the key was made from */
+        int32_t *coord = grid->cell_coord + 4 * cell;
+        coord[0] = c[0];
+        coord[1] = c[1];
+        coord[2] = c[2];
+        coord[3] = 0;
+        grid->cell_start[cell] = (uint32_t)i;
+        cell++;
+    }
+}
+
 static rsmooth_status out_of_memory(rs_grid *grid, size_t count, rsmooth_error *error) {
     rs_grid_free(grid);
     return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rs_grid_build",
@@ -213,10 +248,14 @@ static rsmooth_status sort_into_cells(rs_grid *grid, const double *points, size_
     if (!rs_radix_sort_u64(keys, grid->facet_order, count))
         goto fail_memory;
 
-    size_t cells = 0;
-    for (size_t i = 0; i < count; i++)
-        if (i == 0 || keys[i] != keys[i - 1])
-            cells++;
+    cell_job cj = {grid, keys, {0}};
+    size_t chunks = rs_parallel_chunks(count, KEY_GRAIN), cells = 0;
+    rs_parallel_for(count, KEY_GRAIN, count_cells, &cj);
+    for (size_t c = 0; c < chunks; c++) {
+        size_t n = cj.first[c];
+        cj.first[c] = cells;
+        cells += n;
+    }
     grid->cell_count = cells;
     grid->cell_coord = rs_alloc_array(cells, 4 * sizeof(int32_t));
     grid->cell_start = rs_alloc_array(cells + 1, sizeof(uint32_t));
@@ -225,20 +264,7 @@ static rsmooth_status sort_into_cells(rs_grid *grid, const double *points, size_
     if (!grid->cell_coord || !grid->cell_start)
         goto fail_memory;
 
-    size_t cell = 0;
-    for (size_t i = 0; i < count; i++) {
-        if (i > 0 && keys[i] == keys[i - 1])
-            continue;
-        int32_t c[3];
-        cell_of_key(grid, keys[i], c); /* the clamped cell the key was made from */
-        int32_t *coord = grid->cell_coord + 4 * cell;
-        coord[0] = c[0];
-        coord[1] = c[1];
-        coord[2] = c[2];
-        coord[3] = 0;
-        grid->cell_start[cell] = (uint32_t)i;
-        cell++;
-    }
+    rs_parallel_for(count, KEY_GRAIN, store_cells, &cj);
     grid->cell_start[cells] = (uint32_t)count;
     rs_free(keys);
     return RSMOOTH_OK;

@@ -187,6 +187,11 @@ static inline void rs_triangle_color(const float *colors, const uint32_t *tri, d
                   (double)colors[3 * (size_t)tri[2] + k]) / 3.0;
 }
 
+/* Unit normal and area of the triangle with vertex indices tri[0..2] over `xyz`; false (outputs
+ * unset) when its area is zero or not finite. rs_triangle_geometry's, for a caller that has the
+ * centroid already. */
+bool rs_triangle_normal(const double *xyz, const uint32_t *tri, double normal[3], double *area);
+
 /* Centroid, unit normal and area of the triangle with vertex indices tri[0..2] over `xyz`; false
  * (outputs unset) when its area is zero or not finite. The one formula every path uses. */
 bool rs_triangle_geometry(const double *xyz, const uint32_t *tri, double centroid[3],

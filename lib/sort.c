@@ -8,7 +8,7 @@
 
 #define RADIX_BITS 11
 #define RADIX_SIZE (1u << RADIX_BITS)
-#define SORT_GRAIN 65536 /* elements per chunk below which a pass is not worth a thread */
+#define SORT_GRAIN 16384 /* elements per chunk below which a pass is not worth a thread */
 
 typedef struct radix_pass {
     const uint64_t *src_k;
@@ -19,6 +19,19 @@ typedef struct radix_pass {
     int shift;
     size_t *offsets; /* per chunk: RADIX_SIZE counts, then the first slot of each digit */
 } radix_pass;
+
+typedef struct key_bits {
+    const uint64_t *keys;
+    uint64_t any[64]; /* per chunk: its keys or'ed */
+} key_bits;
+
+static void or_keys(void *ctx, size_t begin, size_t end, size_t chunk) {
+    key_bits *job = ctx;
+    uint64_t any = 0;
+    for (size_t i = begin; i < end; i++)
+        any |= job->keys[i];
+    job->any[chunk] = any;
+}
 
 static void count_digits(void *ctx, size_t begin, size_t end, size_t chunk) {
     const radix_pass *p = ctx;
@@ -41,13 +54,15 @@ static void scatter(void *ctx, size_t begin, size_t end, size_t chunk) {
 bool rs_radix_sort_u64(uint64_t *keys, uint32_t *values, size_t count) {
     if (count < 2)
         return true;
+    size_t chunks = rs_parallel_chunks(count, SORT_GRAIN);
+    key_bits kb = {keys, {0}};
+    rs_parallel_for(count, SORT_GRAIN, or_keys, &kb);
     uint64_t max_key = 0;
-    for (size_t i = 0; i < count; i++)
-        max_key |= keys[i];
+    for (size_t c = 0; c < chunks; c++)
+        max_key |= kb.any[c];
     int bits = 0;
     while (bits < 64 && (max_key >> bits) != 0)
         bits++;
-    size_t chunks = rs_parallel_chunks(count, SORT_GRAIN);
     uint64_t *key_tmp = rs_alloc_array(count, sizeof *key_tmp);
     uint32_t *val_tmp = rs_alloc_array(count, sizeof *val_tmp);
     size_t *offsets = rs_alloc_array(chunks * RADIX_SIZE, sizeof *offsets);

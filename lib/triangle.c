@@ -5,8 +5,7 @@
 
 #include <math.h>
 
-bool rs_triangle_geometry(const double *xyz, const uint32_t *tri, double centroid[3],
-                          double normal[3], double *area) {
+bool rs_triangle_normal(const double *xyz, const uint32_t *tri, double normal[3], double *area) {
     const double *a = xyz + 3 * (size_t)tri[0], *b = xyz + 3 * (size_t)tri[1];
     const double *c = xyz + 3 * (size_t)tri[2];
     double e1[3], e2[3], n[3];
@@ -16,10 +15,17 @@ bool rs_triangle_geometry(const double *xyz, const uint32_t *tri, double centroi
     double len = sqrt(rs_dot3(n, n));
     if (!(len > 0) || !isfinite(len))
         return false;
-    rs_triangle_centroid(xyz, tri, centroid);
     double inv_len = 1 / len;
     for (int k = 0; k < 3; k++)
         normal[k] = n[k] * inv_len;
     *area = 0.5 * len;
+    return true;
+}
+
+bool rs_triangle_geometry(const double *xyz, const uint32_t *tri, double centroid[3],
+                          double normal[3], double *area) {
+    if (!rs_triangle_normal(xyz, tri, normal, area))
+        return false;
+    rs_triangle_centroid(xyz, tri, centroid);
     return true;
 }
