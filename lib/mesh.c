@@ -6,55 +6,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Elements per chunk of the argument checks below which a chunk is not worth a thread. */
-#define CHECK_GRAIN 65536
-
-/* The argument checks a chunk at a time: each finds its first element that fails (SIZE_MAX when
- * none does) and its largest magnitude; the first failing chunk's gives the message, as a scan in
- * one thread would have. */
-typedef struct check_job {
-    rsmooth_scalar scalar;
-    const void *positions;
-    const uint32_t *indices;
-    size_t vertex_count;
-    size_t bad[64];
-    double largest[64];
-} check_job;
-
-static void check_indices(void *ctx, size_t begin, size_t end, size_t chunk) {
-    check_job *job = ctx;
-    job->bad[chunk] = SIZE_MAX;
-    for (size_t i = begin; i < end; i++)
-        if (job->indices[i] >= job->vertex_count) {
-            job->bad[chunk] = i;
-            break;
-        }
-}
-
-static void check_coordinates(void *ctx, size_t begin, size_t end, size_t chunk) {
-    check_job *job = ctx;
-    double largest = 0;
-    job->bad[chunk] = SIZE_MAX;
-    for (size_t i = begin; i < end; i++) {
-        double x = fabs(rs_coordinate(job->scalar, job->positions, i));
-        if (!(x <= RS_MAX_COORDINATE)) {
-            job->bad[chunk] = i;
-            break;
-        }
-        largest = x > largest ? x : largest;
-    }
-    job->largest[chunk] = largest;
-}
-
-/* The first element any chunk found failing, SIZE_MAX when none. */
-static size_t first_bad(const check_job *job, size_t count) {
-    size_t chunks = rs_parallel_chunks(count, CHECK_GRAIN);
-    for (size_t c = 0; c < chunks; c++)
-        if (job->bad[c] != SIZE_MAX)
-            return job->bad[c];
-    return SIZE_MAX;
-}
-
 rsmooth_status rs_check_mesh_structure(rsmooth_scalar scalar, const void *positions,
                                        size_t vertex_count, const uint32_t *indices,
                                        size_t triangle_count, rsmooth_error *error,
@@ -79,13 +30,11 @@ rsmooth_status rs_check_mesh_structure(rsmooth_scalar scalar, const void *positi
     if (rs_mul_overflows(triangle_count, 3 * sizeof(uint32_t)) || triangle_count > UINT32_MAX)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "triangle count %zu is too large", triangle_count);
-    check_job job = {scalar, positions, indices, vertex_count, {0}, {0}};
-    rs_parallel_for(3 * triangle_count, CHECK_GRAIN, check_indices, &job);
-    size_t i = first_bad(&job, 3 * triangle_count);
-    if (i != SIZE_MAX)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "triangle %zu: index %u >= vertex count %zu", i / 3, indices[i],
-                       vertex_count);
+    for (size_t i = 0; i < 3 * triangle_count; i++)
+        if (indices[i] >= vertex_count)
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                           "triangle %zu: index %u >= vertex count %zu", i / 3, indices[i],
+                           vertex_count);
     return RSMOOTH_OK;
 }
 
@@ -104,20 +53,19 @@ rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions
 rsmooth_status rs_check_coordinates(rsmooth_scalar scalar, const void *positions, size_t count,
                                     const char *noun, double *magnitude, rsmooth_error *error,
                                     const char *where) {
-    check_job job = {scalar, positions, NULL, 0, {0}, {0}};
-    rs_parallel_for(3 * count, CHECK_GRAIN, check_coordinates, &job);
-    size_t i = first_bad(&job, 3 * count);
-    if (i != SIZE_MAX) {
-        if (!isfinite(rs_coordinate(scalar, positions, i)))
-            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                           "%s %zu has a non-finite coordinate", noun, i / 3);
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "%s %zu has coordinate %.17g beyond the supported magnitude %g", noun, i / 3,
-                       rs_coordinate(scalar, positions, i), RS_MAX_COORDINATE);
-    }
     double largest = 0;
-    for (size_t c = 0; c < rs_parallel_chunks(3 * count, CHECK_GRAIN); c++)
-        largest = job.largest[c] > largest ? job.largest[c] : largest;
+    for (size_t i = 0; i < 3 * count; i++) {
+        double x = fabs(rs_coordinate(scalar, positions, i));
+        if (!(x <= RS_MAX_COORDINATE)) {
+            if (!isfinite(x))
+                return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                               "%s %zu has a non-finite coordinate", noun, i / 3);
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                           "%s %zu has coordinate %.17g beyond the supported magnitude %g", noun,
+                           i / 3, rs_coordinate(scalar, positions, i), RS_MAX_COORDINATE);
+        }
+        largest = x > largest ? x : largest;
+    }
     if (magnitude)
         *magnitude = largest;
     return RSMOOTH_OK;
@@ -137,134 +85,68 @@ rsmooth_status rs_check_colors(const float *colors, size_t vertex_count, rsmooth
     return RSMOOTH_OK;
 }
 
-static int compare_u64(const void *a, const void *b) {
-    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+static int compare_u32(const void *a, const void *b) {
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
     return (x > y) - (x < y);
 }
 
 /* Buckets of more edges than this are sorted to find duplicates; smaller ones are scanned. */
 #define EDGE_SCAN_LIMIT 32
 
-/* Vertices per chunk of the edge loops below which a chunk is not worth a thread: each chunk
- * reads every triangle (twice). */
-#define EDGE_GRAIN 65536
-
-typedef struct edge_job {
-    const double *xyz;
-    const uint32_t *indices;
-    size_t triangle_count;
-    size_t *start;     /* per vertex: its bucket's first slot */
-    uint64_t *slot;    /* per edge of a bucket: its upper vertex, then the lengths (as doubles) */
-    size_t base[64];   /* per chunk: its first slot, */
-    size_t total[64];  /* its edges, */
-    size_t unique[64]; /* and its unique ones, whose lengths lie from base on */
-} edge_job;
-
-/* Chunk c owns the buckets of the vertices [begin, end): it reads every triangle and counts the
- * edges whose lower vertex is its own, so no slot is written by two chunks and each bucket keeps
- * the triangles' order (what the sum's order rests on). */
-static void count_edges(void *ctx, size_t begin, size_t end, size_t chunk) {
-    edge_job *job = ctx;
-    size_t *start = job->start;
-    for (size_t t = 0; t < job->triangle_count; t++)
-        for (int e = 0; e < 3; e++) {
-            uint32_t a = job->indices[3 * t + e], b = job->indices[3 * t + (e + 1) % 3];
-            uint32_t low = a < b ? a : b;
-            if (a != b && low >= begin && low < end) /* a repeated index is no edge */
-                start[low]++;
-        }
-    size_t run = 0;
-    for (size_t v = begin; v < end; v++) {
-        size_t n = start[v];
-        start[v] = run;
-        run += n;
-    }
-    job->total[chunk] = run;
-}
-
-static void edge_lengths(void *ctx, size_t begin, size_t end, size_t chunk) {
-    edge_job *job = ctx;
-    size_t *start = job->start, base = job->base[chunk];
-    uint64_t *slot = job->slot;
-    for (size_t v = begin; v < end; v++)
-        start[v] += base;
-    for (size_t t = 0; t < job->triangle_count; t++)
-        for (int e = 0; e < 3; e++) {
-            uint32_t a = job->indices[3 * t + e], b = job->indices[3 * t + (e + 1) % 3];
-            uint32_t low = a < b ? a : b;
-            if (a != b && low >= begin && low < end)
-                slot[start[low]++] = a < b ? b : a;
-        }
-    for (size_t v = end - 1; v > begin; v--) /* the fill moved each start to the next's */
-        start[v] = start[v - 1];
-    start[begin] = base;
-    /* Unique edges, a bucket at a time, their lengths written over the slots already read. */
-    size_t written = base;
-    for (size_t v = begin; v < end; v++) {
-        uint64_t *bucket = slot + start[v];
-        size_t n = (v + 1 < end ? start[v + 1] : base + job->total[chunk]) - start[v];
-        uint64_t small[EDGE_SCAN_LIMIT], previous = 0;
-        if (n > EDGE_SCAN_LIMIT)
-            qsort(bucket, n, sizeof *bucket, compare_u64);
-        else
-            memcpy(small, bucket, n * sizeof *bucket);
-        for (size_t i = 0; i < n; i++) {
-            bool seen = false;
-            uint64_t upper = n > EDGE_SCAN_LIMIT ? bucket[i] : small[i];
-            if (n > EDGE_SCAN_LIMIT)
-                seen = i > 0 && upper == previous;
-            else
-                for (size_t j = 0; j < i && !seen; j++)
-                    seen = small[j] == upper;
-            previous = upper;
-            if (seen)
-                continue;
-            double d[3];
-            rs_sub3(job->xyz + 3 * v, job->xyz + 3 * (size_t)upper, d);
-            double length = sqrt(rs_dot3(d, d));
-            memcpy(slot + written++, &length, sizeof length); /* at or before slot i: read */
-        }
-    }
-    job->unique[chunk] = written - base;
-}
-
 bool rs_mean_edge_length(const double *xyz, size_t vertex_count, const uint32_t *indices,
                          size_t triangle_count, double *out_length) {
     /* Unique edges without a global sort: each edge goes to the bucket of its lower vertex (a
-     * counting sort, linear time), and duplicates are removed within a bucket (a handful). The
-     * buckets are cut by vertex among the threads; the lengths are summed in one thread, lower
-     * vertex by lower vertex, a bucket's in the order the triangles first name them, as the
-     * streamed statistics (stream_stats.c) sum them too. */
+     * counting sort, linear time), and duplicates are removed within a bucket (a handful). */
     *out_length = 0;
-    edge_job *job = rs_calloc_array(1, sizeof *job);
     size_t *start = rs_calloc_array(vertex_count + 1, sizeof *start);
-    uint64_t *slot = rs_alloc_array(triangle_count > 0 ? 3 * triangle_count : 1, sizeof *slot);
-    if (!job || !start || !slot) {
-        rs_free(job);
+    uint32_t *upper = rs_alloc_array(triangle_count > 0 ? 3 * triangle_count : 1, sizeof *upper);
+    if (!start || !upper) {
         rs_free(start);
-        rs_free(slot);
+        rs_free(upper);
         return false;
     }
-    *job = (edge_job){xyz, indices, triangle_count, start, slot, {0}, {0}, {0}};
-    size_t chunks = rs_parallel_chunks(vertex_count, EDGE_GRAIN);
-    rs_parallel_for(vertex_count, EDGE_GRAIN, count_edges, job);
-    for (size_t c = 1; c < chunks; c++)
-        job->base[c] = job->base[c - 1] + job->total[c - 1];
-    rs_parallel_for(vertex_count, EDGE_GRAIN, edge_lengths, job);
+    for (size_t t = 0; t < triangle_count; t++)
+        for (int e = 0; e < 3; e++) {
+            uint32_t a = indices[3 * t + e], b = indices[3 * t + (e + 1) % 3];
+            if (a != b) /* a repeated index is no edge */
+                start[(a < b ? a : b) + 1]++;
+        }
+    for (size_t v = 0; v < vertex_count; v++)
+        start[v + 1] += start[v];
+    for (size_t t = 0; t < triangle_count; t++)
+        for (int e = 0; e < 3; e++) {
+            uint32_t a = indices[3 * t + e], b = indices[3 * t + (e + 1) % 3];
+            if (a != b)
+                upper[start[a < b ? a : b]++] = a < b ? b : a;
+        }
+    for (size_t v = vertex_count; v > 0; v--) /* the fill moved each start to the next's */
+        start[v] = start[v - 1];
+    start[0] = 0;
     double sum = 0;
     size_t unique = 0;
-    for (size_t c = 0; c < chunks; c++) {
-        for (size_t i = 0; i < job->unique[c]; i++) {
-            double length;
-            memcpy(&length, slot + job->base[c] + i, sizeof length);
-            sum += length;
+    for (size_t v = 0; v < vertex_count; v++) {
+        uint32_t *bucket = upper + start[v];
+        size_t n = start[v + 1] - start[v];
+        if (n > EDGE_SCAN_LIMIT)
+            qsort(bucket, n, sizeof *bucket, compare_u32);
+        for (size_t i = 0; i < n; i++) {
+            bool seen = false;
+            if (n > EDGE_SCAN_LIMIT)
+                seen = i > 0 && bucket[i] == bucket[i - 1];
+            else
+                for (size_t j = 0; j < i && !seen; j++)
+                    seen = bucket[j] == bucket[i];
+            if (seen)
+                continue;
+            double d[3];
+            rs_sub3(xyz + 3 * v, xyz + 3 * (size_t)bucket[i], d);
+            sum += sqrt(rs_dot3(d, d));
+            unique++;
         }
-        unique += job->unique[c];
     }
     *out_length = unique ? sum / (double)unique : 0;
-    rs_free(job);
     rs_free(start);
-    rs_free(slot);
+    rs_free(upper);
     return true;
 }
 
