@@ -622,6 +622,11 @@ static int bench_filter(int argc, char **argv) {
            report.radius, report.mollify_radius, report.grid_cell_count, report.tiles,
            (unsigned long long)rsmooth_context_memory_budget(ctx));
     cli_print_json_string(report.device);
+    unsigned lanes = 0;
+    size_t group = 0;
+    rsmooth_context_kernel_shape(ctx, &lanes, &group);
+    printf(",\"kernel_variant\":\"%s\",\"lanes\":%u,\"work_group\":%zu",
+           lanes > 1 ? "block" : "group", lanes, group);
     printf(",\"repeat\":%d,\"context_create_first_ms\":%.1f,\"program_build_first_ms\":%.1f,"
            "\"context_create_cached_ms\":%.1f,\"program_build_cached_ms\":%.1f,"
            "\"program_cache_first\":\"%s\",\"program_cache_cached\":\"%s\","

@@ -111,18 +111,16 @@ __kernel void bilateral_cell_normals(uint cell_count, float reach2, float inv_2s
  * clamp (a weight's exponent is at most log2(a_q / mean area), far below 128). */
 inline lanef bilateral_exp2(lanef x) {
     lanef y = fmax(x, -127.0f);
-    lanei t = convert_int8(y + 128.5f); /* n + 128, n = y rounded to nearest */
-    lanef f = y - (convert_float8(t) - 128.0f);
+    lanei t = convert_lanei(y + 128.5f); /* n + 128, n = y rounded to nearest */
+    lanef f = y - (convert_lanef(t) - 128.0f);
     lanef p = 1.00000012f + f * (0.693146944f + f * (0.240221202f + f * (0.0555071346f +
                                  f * (0.00967554096f + f * 0.00132764666f))));
-    return p * as_float8((t - 1) << 23);
+    return p * as_lanef((t - 1) << 23);
 }
 
-/* 1 where some lane of m is set (true: -1), else 0: any(m) without branches. */
+/* 1 where some lane of m is set, else 0. */
 inline uint some_lane(lanei m) {
-    int4 a = m.lo | m.hi;
-    int2 b = a.lo | a.hi;
-    return (uint)(b.x | b.y) >> 31;
+    return (uint)lane_any(m);
 }
 
 /* The search of bilateral_cell_normals for group g: BODY runs for each facet q of each cell near

@@ -32,10 +32,48 @@
  *                      in the robust pass: the work done, within reach or not
  */
 
-typedef float8 lanef;
-typedef int8 lanei;
-#define load_lanes vload8
-#define store_lanes vstore8
+/* The lane types of RS_LANES vertices (the host picks the width per device: the preferred float
+ * vector width of a CPU device, 1 for the GPU variant, where each work-item is one vertex and the
+ * vector "lanes" are the work-items of a group). Comparisons give -1 per true lane of a vector and
+ * 1 for a scalar: code tests them with select(), lane_any() and &&, never with bit tricks. */
+#define RS_CAT2(a, b) a##b
+#define RS_CAT(a, b) RS_CAT2(a, b)
+#if RS_LANES == 1
+typedef float lanef;
+typedef int lanei;
+#define load_lanes(i, p) ((p)[i])
+#define store_lanes(v, i, p) ((p)[i] = (v))
+#define convert_lanef convert_float
+#define convert_lanei convert_int
+#define as_lanef as_float
+inline int lane_any(lanei m) { return m != 0; }
+inline float lane_min(lanef v) { return v; }
+inline float lane_max(lanef v) { return v; }
+#else
+typedef RS_CAT(float, RS_LANES) lanef;
+typedef RS_CAT(int, RS_LANES) lanei;
+#define load_lanes RS_CAT(vload, RS_LANES)
+#define store_lanes RS_CAT(vstore, RS_LANES)
+#define convert_lanef RS_CAT(convert_float, RS_LANES)
+#define convert_lanei RS_CAT(convert_int, RS_LANES)
+#define as_lanef RS_CAT(as_float, RS_LANES)
+inline int lane_any(lanei m) { return any(m); }
+/* Smallest and largest value over the lanes, halving the vector. */
+inline float min4(float4 m) { float2 n = fmin(m.lo, m.hi); return fmin(n.x, n.y); }
+inline float max4(float4 m) { float2 n = fmax(m.lo, m.hi); return fmax(n.x, n.y); }
+#if RS_LANES == 4
+inline float lane_min(lanef v) { return min4(v); }
+inline float lane_max(lanef v) { return max4(v); }
+#elif RS_LANES == 8
+inline float lane_min(lanef v) { return min4(fmin(v.lo, v.hi)); }
+inline float lane_max(lanef v) { return max4(fmax(v.lo, v.hi)); }
+#elif RS_LANES == 16
+inline float lane_min(lanef v) { float8 m = fmin(v.lo, v.hi); return min4(fmin(m.lo, m.hi)); }
+inline float lane_max(lanef v) { float8 m = fmax(v.lo, v.hi); return max4(fmax(m.lo, m.hi)); }
+#else
+#error "RS_LANES must be 1, 4, 8 or 16"
+#endif
+#endif
 
 /* 2^x per lane, to about 2e-7 relative: 2^n built in the exponent bits times a degree-5 minimax
  * polynomial for 2^f, |f| <= 1/2. Several times cheaper than the exp() PoCL vectorizes; inputs
@@ -44,11 +82,11 @@ typedef int8 lanei;
  * log areas and 1 / 2 sigma^2 by log2 e), which saves a multiply per pair. */
 inline lanef fast_exp2(lanef x) {
     lanef y = clamp(x, -126.0f, 127.0f);
-    lanei n = convert_int8(y + 128.5f) - 128; /* round to nearest, through truncation of y > 0 */
-    lanef f = y - convert_float8(n);          /* |f| <= 1/2 */
+    lanei n = convert_lanei(y + 128.5f) - 128; /* round to nearest, through truncation of y > 0 */
+    lanef f = y - convert_lanef(n);          /* |f| <= 1/2 */
     lanef p = 1.00000012f + f * (0.693146944f + f * (0.240221202f + f * (0.0555071346f +
                                  f * (0.00967554096f + f * 0.00132764666f))));
-    return p * as_float8((n + 127) << 23);
+    return p * as_lanef((n + 127) << 23);
 }
 
 /* The hash the host fills the tables with (rs_grid_hash in lib/rsmooth_internal.h). */
@@ -69,18 +107,6 @@ inline int column_find(__global const int4 *cell_coord, __global const uint *col
             return column;
         slot = (slot + 1) & column_mask;
     }
-}
-
-/* Smallest and largest value over the lanes. */
-inline float lane_min(lanef v) {
-    float4 m = fmin(v.lo, v.hi);
-    float2 n = fmin(m.lo, m.hi);
-    return fmin(n.x, n.y);
-}
-inline float lane_max(lanef v) {
-    float4 m = fmax(v.lo, v.hi);
-    float2 n = fmax(m.lo, m.hi);
-    return fmax(n.x, n.y);
 }
 
 /* Squared distance along one axis from the interval [lo, hi] to the cell [c, c + 1]. */
@@ -137,7 +163,7 @@ inline float slot_component(__global const float *blocks, uint slot, uint stride
  * integers: the kernels build a lane's whole-cell distance to a facet's cell in integers, which
  * -cl-fast-relaxed-math cannot reassociate with the float positions. */
 inline lanei load_offsets(uint k, __global const uchar *offset) {
-    return convert_int8(vload8(k, offset));
+    return convert_lanei(load_lanes(k, offset));
 }
 
 /* Declares the lanes of block b: px, py, pz local to their own cells, ox, oy, oz their cells'
@@ -148,8 +174,8 @@ inline lanei load_offsets(uint k, __global const uchar *offset) {
     lanef px = load_lanes(0, pos_), py = load_lanes(1, pos_), pz = load_lanes(2, pos_);            \
     __global const uchar *off_ = (block_offset) + 3 * RS_LANES * (size_t)(b);                      \
     lanei ox = load_offsets(0, off_), oy = load_offsets(1, off_), oz = load_offsets(2, off_);      \
-    lanef ax_ = px + convert_float8(ox), ay_ = py + convert_float8(oy),                            \
-          az_ = pz + convert_float8(oz);                                                           \
+    lanef ax_ = px + convert_lanef(ox), ay_ = py + convert_lanef(oy),                            \
+          az_ = pz + convert_lanef(oz);                                                           \
     float3 lo = (float3)(lane_min(ax_), lane_min(ay_), lane_min(az_));                             \
     float3 hi = (float3)(lane_max(ax_), lane_max(ay_), lane_max(az_))
 
@@ -159,3 +185,149 @@ inline int4 slot_cell(__global const int4 *block_cell, __global const uchar *blo
     __global const uchar *o = block_offset + (slot / RS_LANES) * 3 * RS_LANES + slot % RS_LANES;
     return block_cell[slot / RS_LANES] + (int4)(o[0], o[RS_LANES], o[2 * RS_LANES], 0);
 }
+
+/* ---- Where a kernel's vertices come from, and the facets near them ---------------------------
+ *
+ * BEGIN_BLOCK declares, for work-item b of a block kernel, the names the searches below use:
+ * px, py, pz (positions local to each lane's own cell), ox, oy, oz (their cells' offsets from
+ * `anchor`, whole numbers) and lo, hi (the box they span, in cells from `anchor`).
+ * FOR_EACH_FACET_NEAR(REACH2, NORMALS, PAIRS, body) then runs `body` for every facet q of every
+ * cell near that box, in the same order in both variants (cells by x, y, z, facets in cell order),
+ * with c = facet_centroid[q], n = NORMALS[q] and qx, qy, qz the lanes' positions seen from q's
+ * cell (a lane's whole-cell distance to it built in integers); PAIRS counts the facets.
+ *
+ * Block variant (RS_LANES > 1, CPU devices): the box is the block's lanes'; facets come straight
+ * from global memory, where the CPU's caches hold them.
+ * Group variant (RS_LANES 1, GPUs): the box is that of the work-group's RS_GROUP vertices, so every
+ * work-item walks the same cells (no divergence). The group loads each candidate facet once,
+ * one per work-item, into local memory, with a flag for whether it lies within reach of the
+ * group's box at all; then every work-item reads the staged facets, skipping flagged ones (a
+ * branch every work-item takes alike). Facets out of a lane's reach give it an exact zero either
+ * way, so both variants compute the same sums. */
+
+/* FOR_EACH_FACET_NEAR's walk for the lanes of one work-item alone, straight from global memory:
+ * the block variant's, and the group variant's rare rescue. */
+#define FOR_EACH_FACET_OWN(REACH2, NORMALS, PAIRS, ...)                                            \
+    FOR_EACH_CELL_NEAR(anchor, lo, hi, REACH2, cell_coord, column_first, column_table,             \
+                       column_mask, {                                                              \
+        lanef qx = px - convert_lanef(dx - ox), qy = py - convert_lanef(dy - oy),                  \
+              qz = pz - convert_lanef(dz - oz);                                                    \
+        uint begin_ = cell_start[cell], end_ = cell_start[cell + 1];                               \
+        (PAIRS) += end_ - begin_;                                                                  \
+        for (uint q = begin_; q < end_; q++) {                                                     \
+            float4 c = facet_centroid[q];                                                          \
+            float4 n = (NORMALS)[q];                                                               \
+            __VA_ARGS__                                                                            \
+        }                                                                                          \
+    })
+
+
+#if RS_LANES == 1
+
+/* The local memory of the group variant, declared at kernel scope (OpenCL C requires it there). */
+#define DECLARE_STAGE                                                                              \
+    __local float4 stage_c[RS_GROUP], stage_n[RS_GROUP];                                           \
+    __local int4 stage_d[RS_GROUP];                                                                \
+    __local uint stage_q[RS_GROUP];                                                                \
+    __local int4 stage_anchor;                                                                     \
+    __local float4 stage_box[2]
+#define STAGE_PARAMS                                                                               \
+    , __local float4 *stage_c, __local float4 *stage_n, __local int4 *stage_d, __local uint *stage_q
+#define STAGE_ARGS , stage_c, stage_n, stage_d, stage_q
+
+/* Work-items past the last vertex repeat it (every work-item must reach the barriers), and their
+ * results are never stored. The group's anchor is its lowest cell; work-item 0 forms the box. */
+#define BEGIN_BLOCK(b, block_count, block_pos, block_cell, block_offset)                          \
+    DECLARE_STAGE;                                                                                 \
+    uint own_ = min((uint)(b), (block_count) - 1), lid_ = get_local_id(0);                         \
+    lanef px = (block_pos)[3 * own_], py = (block_pos)[3 * own_ + 1],                              \
+          pz = (block_pos)[3 * own_ + 2];                                                          \
+    int4 cell_ = (block_cell)[own_];                                                               \
+    stage_d[lid_] = cell_;                                                                         \
+    stage_c[lid_] = (float4)(px, py, pz, 0.0f);                                                    \
+    barrier(CLK_LOCAL_MEM_FENCE);                                                                  \
+    if (lid_ == 0) {                                                                               \
+        int4 a_ = stage_d[0];                                                                      \
+        for (uint i_ = 1; i_ < RS_GROUP; i_++)                                                     \
+            a_ = min(a_, stage_d[i_]);                                                             \
+        float3 l_ = MAXFLOAT, h_ = -MAXFLOAT;                                                      \
+        for (uint i_ = 0; i_ < RS_GROUP; i_++) {                                                   \
+            float3 p_ = convert_float3((stage_d[i_] - a_).xyz) + stage_c[i_].xyz;                  \
+            l_ = fmin(l_, p_);                                                                     \
+            h_ = fmax(h_, p_);                                                                     \
+        }                                                                                          \
+        stage_anchor = a_;                                                                         \
+        stage_box[0] = (float4)(l_, 0.0f);                                                         \
+        stage_box[1] = (float4)(h_, 0.0f);                                                         \
+    }                                                                                              \
+    barrier(CLK_LOCAL_MEM_FENCE);                                                                  \
+    int4 anchor = stage_anchor;                                                                    \
+    float3 lo = stage_box[0].xyz, hi = stage_box[1].xyz;                                           \
+    lanei ox = cell_.x - anchor.x, oy = cell_.y - anchor.y, oz = cell_.z - anchor.z
+
+/* Runs the body over the `filled_` staged facets, between barriers: the first makes the group's
+ * loads visible, the second keeps the next loads from overwriting facets still being read. */
+#define CONSUME_STAGE(PAIRS, ...)                                                                  \
+    barrier(CLK_LOCAL_MEM_FENCE);                                                                  \
+    for (uint i_ = 0; i_ < filled_; i_++) {                                                        \
+        uint q = stage_q[i_];                                                                      \
+        if (q != UINT_MAX) { /* within reach of the group's box: the same for every work-item */  \
+            int4 d_ = stage_d[i_];                                                                 \
+            lanef qx = px - convert_lanef(d_.x - ox), qy = py - convert_lanef(d_.y - oy),          \
+                  qz = pz - convert_lanef(d_.z - oz);                                              \
+            float4 c = stage_c[i_], n = stage_n[i_];                                               \
+            (PAIRS)++;                                                                             \
+            __VA_ARGS__                                                                            \
+        }                                                                                          \
+    }                                                                                              \
+    barrier(CLK_LOCAL_MEM_FENCE);
+
+/* A facet is skipped when its centroid lies farther than the reach from the group's box; the
+ * margin keeps float rounding of that box test from skipping a facet some lane counts. */
+#define FOR_EACH_FACET_NEAR(REACH2, NORMALS, PAIRS, ...)                                           \
+    {                                                                                              \
+        uint filled_ = 0, slot_ = get_local_id(0);                                                 \
+        float cull2_ = (REACH2) * 1.001f + 1e-3f;                                                  \
+        FOR_EACH_CELL_NEAR(anchor, lo, hi, REACH2, cell_coord, column_first, column_table,         \
+                           column_mask, {                                                          \
+            uint next_ = cell_start[cell], end_ = cell_start[cell + 1];                            \
+            while (next_ < end_) {                                                                 \
+                uint take_ = min(end_ - next_, (uint)RS_GROUP - filled_);                          \
+                if (slot_ < take_) {                                                               \
+                    uint q_ = next_ + slot_;                                                       \
+                    float4 c_ = facet_centroid[q_];                                                \
+                    float3 g_ = convert_float3((int3)(dx, dy, dz)) + c_.xyz;                       \
+                    float3 gap_ = fmax((float3)0.0f, fmax(lo - g_, g_ - hi));                      \
+                    float gap2_ = gap_.x * gap_.x + gap_.y * gap_.y + gap_.z * gap_.z;             \
+                    stage_q[filled_ + slot_] = gap2_ <= cull2_ ? q_ : UINT_MAX;                    \
+                    stage_c[filled_ + slot_] = c_;                                                 \
+                    stage_n[filled_ + slot_] = (NORMALS)[q_];                                      \
+                    stage_d[filled_ + slot_] = (int4)(dx, dy, dz, 0);                              \
+                }                                                                                  \
+                filled_ += take_;                                                                  \
+                next_ += take_;                                                                    \
+                if (filled_ == RS_GROUP) {                                                         \
+                    CONSUME_STAGE(PAIRS, __VA_ARGS__)                                              \
+                    filled_ = 0;                                                                   \
+                }                                                                                  \
+            }                                                                                      \
+        })                                                                                         \
+        if (filled_ > 0) {                                                                         \
+            CONSUME_STAGE(PAIRS, __VA_ARGS__)                                                      \
+        }                                                                                          \
+    }
+
+#else /* the block variant */
+
+#define STAGE_PARAMS
+#define STAGE_ARGS
+
+#define BEGIN_BLOCK(b, block_count, block_pos, block_cell, block_offset)                          \
+    if ((b) >= (block_count))                                                                      \
+        return;                                                                                    \
+    LOAD_BLOCK_LANES(b, block_pos, block_offset);                                                  \
+    int4 anchor = (block_cell)[b]
+
+#define FOR_EACH_FACET_NEAR FOR_EACH_FACET_OWN
+
+#endif

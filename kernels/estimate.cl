@@ -42,69 +42,70 @@ inline __attribute__((always_inline)) lanef influence_weight(lanef u, int influe
 /* Sums of Eq. 3 for the lanes at (px, py, pz) (box [lo, hi]) over the facets within reach of the
  * block's anchor, with influence exponents shifted down by `shift`; *pairs counts the facets.
  * Inlined, so the flags are constants in each call and the inner loop keeps what it needs in
- * registers. */
-inline __attribute__((always_inline)) robust_acc
-robust_sums(lanef px, lanef py, lanef pz, lanei ox, lanei oy, lanei oz, float3 lo, float3 hi,
-            int4 anchor, float reach2,
-            float inv_2sf2, float inv_2sg2, lanef shift, int want_confidence, int predict_centroid,
-            int influence, float inv_sg2, int use_color, lanef cr, lanef cg, lanef cb,
-            float inv_2sc2, __global const float4 *facet_color,
-            __global const float4 *facet_centroid, __global const float4 *normal,
-            __global const int4 *cell_coord, __global const uint *cell_start,
-            __global const uint *column_first, __global const int *column_table, uint column_mask,
-            uint *pairs) {
-    robust_acc a;
-    a.x = a.y = a.z = a.k = a.kf = 0.0f;
-    FOR_EACH_CELL_NEAR(anchor, lo, hi, reach2, cell_coord, column_first, column_table, column_mask, {
-        lanef qx = px - convert_float8(dx - ox), qy = py - convert_float8(dy - oy),
-              qz = pz - convert_float8(dz - oz);
-        uint begin = cell_start[cell], end = cell_start[cell + 1];
-        *pairs += end - begin;
-        for (uint q = begin; q < end; q++) {
-            float4 c = facet_centroid[q];
-            float4 n = normal[q];
-            lanef ex = c.x - qx, ey = c.y - qy, ez = c.z - qz;
-            lanef d2 = ex * ex + ey * ey + ez * ez;
-            lanei near = d2 <= reach2;
-            lanef t = n.x * ex + n.y * ey + n.z * ez;
-            /* |prediction - p|^2: t^2 for the projection, d2 for the centroid */
-            lanef x2 = predict_centroid ? d2 : t * t;
-            lanef w, af = 0.0f, ec = 0.0f;
-            if (use_color) { /* the colour exponent */
-                float4 fc = facet_color[q];
-                lanef dr = fc.x - cr, dg = fc.y - cg, db = fc.z - cb;
-                ec = (dr * dr + dg * dg + db * db) * inv_2sc2;
-            }
-            if (influence == RS_INFLUENCE_GAUSSIAN) {
-                lanef e = x2 * inv_2sg2;
-                if (use_color)
-                    e += ec;
-                w = select((lanef)0.0f, fast_exp2(c.w - d2 * inv_2sf2 - (e - shift)), near);
-            } else {
-                af = select((lanef)0.0f, fast_exp2(c.w - d2 * inv_2sf2), near);
-                w = af * influence_weight(x2 * inv_sg2, influence);
-                if (use_color)
-                    w *= fast_exp2(shift - ec); /* shifted by the rescue, as the Gaussian's */
-            }
-            if (predict_centroid) {
-                a.x += w * ex;
-                a.y += w * ey;
-                a.z += w * ez;
-            } else {
-                lanef wt = w * t;
-                a.x += wt * n.x;
-                a.y += wt * n.y;
-                a.z += wt * n.z;
-            }
-            a.k += w;
-            if (influence != RS_INFLUENCE_GAUSSIAN)
-                a.kf += af; /* computed anyway */
-            else if (want_confidence)
-                a.kf += select((lanef)0.0f, fast_exp2(c.w - d2 * inv_2sf2), near);
-        }
-    })
-    return a;
+ * registers. ROBUST_SUMS defines it as NAME, with SEARCH (FOR_EACH_FACET_NEAR or
+ * FOR_EACH_FACET_OWN, common.cl) as its walk over the facets. */
+#define ROBUST_SUMS(NAME, SEARCH, EXTRA_PARAMS)                                                    \
+inline __attribute__((always_inline)) robust_acc                                                   \
+NAME(lanef px, lanef py, lanef pz, lanei ox, lanei oy, lanei oz, float3 lo, float3 hi,             \
+            int4 anchor, float reach2,                                                             \
+            float inv_2sf2, float inv_2sg2, lanef shift, int want_confidence, int predict_centroid,\
+            int influence, float inv_sg2, int use_color, lanef cr, lanef cg, lanef cb,             \
+            float inv_2sc2, __global const float4 *facet_color,                                    \
+            __global const float4 *facet_centroid, __global const float4 *normal,                  \
+            __global const int4 *cell_coord, __global const uint *cell_start,                      \
+            __global const uint *column_first, __global const int *column_table, uint column_mask, \
+            uint *pairs EXTRA_PARAMS) {                                                            \
+    robust_acc a;                                                                                  \
+    a.x = a.y = a.z = a.k = a.kf = 0.0f;                                                           \
+    SEARCH(reach2, normal, *pairs, {                                                               \
+        lanef ex = c.x - qx, ey = c.y - qy, ez = c.z - qz;                                         \
+        lanef d2 = ex * ex + ey * ey + ez * ez;                                                    \
+        lanei near = d2 <= reach2;                                                                 \
+        lanef t = n.x * ex + n.y * ey + n.z * ez;                                                  \
+        /* |prediction - p|^2: t^2 for the projection, d2 for the centroid */                      \
+        lanef x2 = predict_centroid ? d2 : t * t;                                                  \
+        lanef w, af = 0.0f, ec = 0.0f;                                                             \
+        if (use_color) { /* the colour exponent */                                                 \
+            float4 fc = facet_color[q];                                                            \
+            lanef dr = fc.x - cr, dg = fc.y - cg, db = fc.z - cb;                                  \
+            ec = (dr * dr + dg * dg + db * db) * inv_2sc2;                                         \
+        }                                                                                          \
+        if (influence == RS_INFLUENCE_GAUSSIAN) {                                                  \
+            lanef e = x2 * inv_2sg2;                                                               \
+            if (use_color)                                                                         \
+                e += ec;                                                                           \
+            w = select((lanef)0.0f, fast_exp2(c.w - d2 * inv_2sf2 - (e - shift)), near);           \
+        } else {                                                                                   \
+            af = select((lanef)0.0f, fast_exp2(c.w - d2 * inv_2sf2), near);                        \
+            w = af * influence_weight(x2 * inv_sg2, influence);                                    \
+            if (use_color)                                                                         \
+                w *= fast_exp2(shift - ec); /* shifted by the rescue, as the Gaussian's */         \
+        }                                                                                          \
+        if (predict_centroid) {                                                                    \
+            a.x += w * ex;                                                                         \
+            a.y += w * ey;                                                                         \
+            a.z += w * ez;                                                                         \
+        } else {                                                                                   \
+            lanef wt = w * t;                                                                      \
+            a.x += wt * n.x;                                                                       \
+            a.y += wt * n.y;                                                                       \
+            a.z += wt * n.z;                                                                       \
+        }                                                                                          \
+        a.k += w;                                                                                  \
+        if (influence != RS_INFLUENCE_GAUSSIAN)                                                    \
+            a.kf += af; /* computed anyway */                                                      \
+        else if (want_confidence)                                                                  \
+            a.kf += select((lanef)0.0f, fast_exp2(c.w - d2 * inv_2sf2), near);                     \
+    })                                                                                             \
+    return a;                                                                                      \
 }
+
+ROBUST_SUMS(robust_sums, FOR_EACH_FACET_NEAR, STAGE_PARAMS)
+#if RS_LANES == 1
+/* The group variant's rescue: rare, so each work-item walks its own vertex's cells alone (no
+ * barriers under a condition, which PoCL's compiler handles very slowly). */
+ROBUST_SUMS(robust_sums_own, FOR_EACH_FACET_OWN, )
+#endif
 
 /* Per lane, the smallest influence exponent over the facets within reach (MAXFLOAT where none):
  * the shift that keeps a lane's largest weight near one. Only the rare rescue needs it. With
@@ -121,26 +122,21 @@ lanef smallest_exponent(lanef px, lanef py, lanef pz, lanei ox, lanei oy, lanei 
                         __global const uint *column_first, __global const int *column_table,
                         uint column_mask) {
     lanef e_min = MAXFLOAT;
-    FOR_EACH_CELL_NEAR(anchor, lo, hi, reach2, cell_coord, column_first, column_table, column_mask, {
-        lanef qx = px - convert_float8(dx - ox), qy = py - convert_float8(dy - oy),
-              qz = pz - convert_float8(dz - oz);
-        for (uint q = cell_start[cell]; q < cell_start[cell + 1]; q++) {
-            float4 c = facet_centroid[q];
-            float4 n = normal[q];
-            lanef ex = c.x - qx, ey = c.y - qy, ez = c.z - qz;
-            lanef d2 = ex * ex + ey * ey + ez * ez;
-            lanef t = n.x * ex + n.y * ey + n.z * ez;
-            lanef e = (predict_centroid ? d2 : t * t) * inv_2sg2;
-            lanei counts = d2 <= reach2;
-            if (use_color) {
-                float4 fc = facet_color[q];
-                lanef dr = fc.x - cr, dg = fc.y - cg, db = fc.z - cb;
-                e += (dr * dr + dg * dg + db * db) * inv_2sc2;
-            }
-            if (tukey) /* only the facets Tukey's weight does not reject */
-                counts = counts && (predict_centroid ? d2 : t * t) * inv_sg2 < 5.0f;
-            e_min = select(e_min, fmin(e_min, e), counts);
+    uint pairs = 0; /* not counted: the rescue's second pass counts its facets */
+    FOR_EACH_FACET_OWN(reach2, normal, pairs, {
+        lanef ex = c.x - qx, ey = c.y - qy, ez = c.z - qz;
+        lanef d2 = ex * ex + ey * ey + ez * ez;
+        lanef t = n.x * ex + n.y * ey + n.z * ez;
+        lanef e = (predict_centroid ? d2 : t * t) * inv_2sg2;
+        lanei counts = d2 <= reach2;
+        if (use_color) {
+            float4 fc = facet_color[q];
+            lanef dr = fc.x - cr, dg = fc.y - cg, db = fc.z - cb;
+            e += (dr * dr + dg * dg + db * db) * inv_2sc2;
         }
+        if (tukey) /* only the facets Tukey's weight does not reject */
+            counts = counts && (predict_centroid ? d2 : t * t) * inv_sg2 < 5.0f;
+        e_min = select(e_min, fmin(e_min, e), counts);
     })
     return e_min;
 }
@@ -158,14 +154,12 @@ __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float
                            __global float *block_result, __global float *block_extra,
                            __global uint *block_pairs) {
     uint b = get_global_id(0);
-    if (b >= block_count)
-        return;
-    LOAD_BLOCK_LANES(b, block_pos, block_offset);
-    int4 anchor = block_cell[b];
+    BEGIN_BLOCK(b, block_count, block_pos, block_cell, block_offset);
     uint pairs = 0, rescue_pairs = 0;
     lanef cr = 0.0f, cg = 0.0f, cb = 0.0f; /* the lanes' colours, when use_color */
     if (use_color) {
-        __global const float *col = block_color + 3 * RS_LANES * (size_t)b;
+        size_t own = min(b, block_count - 1); /* the group variant's spare work-items */
+        __global const float *col = block_color + 3 * RS_LANES * own;
         cr = load_lanes(0, col);
         cg = load_lanes(1, col);
         cb = load_lanes(2, col);
@@ -174,6 +168,14 @@ __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float
 #define NO_COLOR 0, (lanef)0.0f, (lanef)0.0f, (lanef)0.0f, inv_2sc2, facet_color
 #define COLOR 1, cr, cg, cb, inv_2sc2, facet_color
     robust_acc a;
+#if RS_LANES == 1
+    /* the group variant: one copy, the flags as they come (the same for every work-item, so their
+     * branches never diverge); each copy of a loop with barriers costs PoCL much compile time */
+    a = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2,
+                    (lanef)0.0f, want_confidence, predict_centroid, influence, inv_sg2, use_color,
+                    cr, cg, cb, inv_2sc2, facet_color, facet_centroid, normal, cell_coord,
+                    cell_start, column_first, column_table, column_mask, &pairs STAGE_ARGS);
+#else
     /* one specialised copy of the loop per flag combination (the other influence functions
      * always sum a f: it is part of their weight); with colour, one copy for every mode */
     if (use_color)
@@ -181,43 +183,47 @@ __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float
                         reach2, inv_2sf2, inv_2sg2, (lanef)0.0f,
                         want_confidence, predict_centroid, influence, inv_sg2, COLOR,
                         facet_centroid, normal, cell_coord, cell_start, column_first,
-                        column_table, column_mask, &pairs);
+                        column_table, column_mask, &pairs STAGE_ARGS);
     else if (influence != RS_INFLUENCE_GAUSSIAN && predict_centroid)
         a = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor,
                         reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 1,
                         influence, inv_sg2, NO_COLOR, facet_centroid, normal, cell_coord,
-                        cell_start, column_first, column_table, column_mask, &pairs);
+                        cell_start, column_first, column_table, column_mask, &pairs STAGE_ARGS);
     else if (influence == RS_INFLUENCE_TUKEY)
         a = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor,
                         reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 0,
                         RS_INFLUENCE_TUKEY, inv_sg2, NO_COLOR, facet_centroid, normal, cell_coord,
-                        cell_start, column_first, column_table, column_mask, &pairs);
+                        cell_start, column_first, column_table, column_mask, &pairs STAGE_ARGS);
     else if (influence == RS_INFLUENCE_LORENTZIAN)
         a = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor,
                         reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 0,
                         RS_INFLUENCE_LORENTZIAN, inv_sg2, NO_COLOR, facet_centroid, normal,
-                        cell_coord, cell_start, column_first, column_table, column_mask, &pairs);
+                        cell_coord, cell_start, column_first, column_table, column_mask,
+                        &pairs STAGE_ARGS);
     else if (influence == RS_INFLUENCE_HUBER)
         a = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor,
                         reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1, 0,
                         RS_INFLUENCE_HUBER, inv_sg2, NO_COLOR, facet_centroid, normal, cell_coord,
-                        cell_start, column_first, column_table, column_mask, &pairs);
+                        cell_start, column_first, column_table, column_mask, &pairs STAGE_ARGS);
     else if (predict_centroid)
         a = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor,
                         reach2, inv_2sf2, inv_2sg2, (lanef)0.0f,
                         want_confidence, 1, RS_INFLUENCE_GAUSSIAN, inv_sg2, NO_COLOR,
                         facet_centroid, normal, cell_coord, cell_start, column_first,
-                        column_table, column_mask, &pairs);
+                        column_table, column_mask, &pairs STAGE_ARGS);
     else if (want_confidence)
         a = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor,
                         reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 1,
                         0, RS_INFLUENCE_GAUSSIAN, inv_sg2, NO_COLOR, facet_centroid, normal,
-                        cell_coord, cell_start, column_first, column_table, column_mask, &pairs);
+                        cell_coord, cell_start, column_first, column_table, column_mask,
+                        &pairs STAGE_ARGS);
     else
         a = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor,
                         reach2, inv_2sf2, inv_2sg2, (lanef)0.0f, 0,
                         0, RS_INFLUENCE_GAUSSIAN, inv_sg2, NO_COLOR, facet_centroid, normal,
-                        cell_coord, cell_start, column_first, column_table, column_mask, &pairs);
+                        cell_coord, cell_start, column_first, column_table, column_mask,
+                        &pairs STAGE_ARGS);
+#endif
     lanef kf = a.kf;
     /* A lane whose Gaussian weights (nearly) all underflowed: redo its sums with the exponents
      * shifted by their smallest value, as the reference path does. Shifting never changes the
@@ -227,8 +233,17 @@ __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float
     bool gaussian = influence == RS_INFLUENCE_GAUSSIAN;
     lanei rescue = gaussian || use_color ? a.k < RS_RESCUE_WEIGHT : (lanei)0;
     lanef shift = 0.0f;
-    if (any(rescue)) {
-        lanef e_min = smallest_exponent(px, py, pz, ox, oy, oz, lo, hi, anchor, reach2,
+#if RS_LANES == 1
+    /* the group variant's rescue: each work-item searches around its own vertex alone */
+    float3 own = (float3)(px + (float)ox, py + (float)oy, pz + (float)oz);
+#define RESCUE_BOX own, own
+#define RESCUE_SUMS robust_sums_own
+#else
+#define RESCUE_BOX lo, hi
+#define RESCUE_SUMS robust_sums
+#endif
+    if (lane_any(rescue)) {
+        lanef e_min = smallest_exponent(px, py, pz, ox, oy, oz, RESCUE_BOX, anchor, reach2,
                                         gaussian ? inv_2sg2 : 0.0f, predict_centroid,
                                         influence == RS_INFLUENCE_TUKEY, inv_sg2, use_color,
                                         cr, cg, cb, inv_2sc2,
@@ -236,18 +251,18 @@ __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float
                                         cell_start, column_first, column_table, column_mask);
         shift = select((lanef)0.0f, e_min, rescue && e_min < MAXFLOAT);
     }
-    if (any(shift != 0.0f)) {
+    if (lane_any(shift != 0.0f)) {
         robust_acc r;
         if (use_color)
-            r = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2,
-                            shift, 0, predict_centroid, influence, inv_sg2, COLOR,
+            r = RESCUE_SUMS(px, py, pz, ox, oy, oz, RESCUE_BOX, anchor, reach2, inv_2sf2,
+                            inv_2sg2, shift, 0, predict_centroid, influence, inv_sg2, COLOR,
                             facet_centroid, normal, cell_coord, cell_start, column_first,
                             column_table, column_mask, &rescue_pairs);
         else
-            r = robust_sums(px, py, pz, ox, oy, oz, lo, hi, anchor, reach2, inv_2sf2, inv_2sg2,
-                            shift, 0, predict_centroid, RS_INFLUENCE_GAUSSIAN, inv_sg2, NO_COLOR,
-                            facet_centroid, normal, cell_coord, cell_start, column_first,
-                            column_table, column_mask, &rescue_pairs);
+            r = RESCUE_SUMS(px, py, pz, ox, oy, oz, RESCUE_BOX, anchor, reach2, inv_2sf2,
+                            inv_2sg2, shift, 0, predict_centroid, RS_INFLUENCE_GAUSSIAN, inv_sg2,
+                            NO_COLOR, facet_centroid, normal, cell_coord, cell_start,
+                            column_first, column_table, column_mask, &rescue_pairs);
         lanei redo = shift != 0.0f;
         a.x = select(a.x, r.x, redo);
         a.y = select(a.y, r.y, redo);
@@ -256,6 +271,10 @@ __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float
     }
 #undef NO_COLOR
 #undef COLOR
+#undef RESCUE_BOX
+#undef RESCUE_SUMS
+    if (b >= block_count) /* the group variant's spare work-items */
+        return;
     lanei some = a.k > 0.0f;
     __global float *out = block_result + 4 * RS_LANES * (size_t)b;
     store_lanes(select((lanef)0.0f, a.x / a.k, some), 0, out);

@@ -20,28 +20,20 @@ __kernel void mollify_block(uint block_count, float reach2, float inv_2sigma2,
                            __global const int *column_table, uint column_mask,
                             __global float *block_shift, __global uint *block_pairs) {
     uint b = get_global_id(0);
-    if (b >= block_count)
-        return;
-    LOAD_BLOCK_LANES(b, block_pos, block_offset);
-    int4 anchor = block_cell[b];
+    BEGIN_BLOCK(b, block_count, block_pos, block_cell, block_offset);
     lanef wsum = 0.0f, ax = 0.0f, ay = 0.0f, az = 0.0f;
     uint pairs = 0;
-    FOR_EACH_CELL_NEAR(anchor, lo, hi, reach2, cell_coord, column_first, column_table, column_mask, {
-        lanef qx = px - convert_float8(dx - ox), qy = py - convert_float8(dy - oy),
-              qz = pz - convert_float8(dz - oz);
-        uint begin = cell_start[cell], end = cell_start[cell + 1];
-        pairs += end - begin;
-        for (uint q = begin; q < end; q++) {
-            float4 c = facet_centroid[q];
-            lanef ex = c.x - qx, ey = c.y - qy, ez = c.z - qz;
-            lanef d2 = ex * ex + ey * ey + ez * ez;
-            lanef w = select((lanef)0.0f, fast_exp2(c.w - d2 * inv_2sigma2), d2 <= reach2);
-            ax += w * ex;
-            ay += w * ey;
-            az += w * ez;
-            wsum += w;
-        }
+    FOR_EACH_FACET_NEAR(reach2, facet_centroid, pairs, {
+        lanef ex = c.x - qx, ey = c.y - qy, ez = c.z - qz;
+        lanef d2 = ex * ex + ey * ey + ez * ez;
+        lanef w = select((lanef)0.0f, fast_exp2(c.w - d2 * inv_2sigma2), d2 <= reach2);
+        ax += w * ex;
+        ay += w * ey;
+        az += w * ez;
+        wsum += w;
     })
+    if (b >= block_count) /* the group variant's spare work-items */
+        return;
     lanei some = wsum > 0.0f;
     __global float *out = block_shift + 3 * RS_LANES * (size_t)b;
     store_lanes(select((lanef)0.0f, ax / wsum, some), 0, out);

@@ -61,10 +61,12 @@ static cl_int run_bilateral_lists(rsmooth_context *ctx, const rs_problem *pb, co
     cl_float shift = dot ? 2 * inv_2t2 : 0;
     double share = MOLLIFY_SHARE / (pb->normal_iterations + 2); /* a search costs about a round */
 
-    /* the groups of bilateral_cell_normals: each cell's facets, RS_LANES at a time */
+    /* the groups of bilateral_cell_normals: each cell's facets, ctx->lanes at a time */
+    const size_t lanes_per_group = ctx->lanes;
     size_t groups = 0;
     for (size_t c = 0; c < grid->cell_count; c++)
-        groups += (grid->cell_start[c + 1] - grid->cell_start[c] + RS_LANES - 1) / RS_LANES;
+        groups += (grid->cell_start[c + 1] - grid->cell_start[c] + lanes_per_group - 1) /
+                  lanes_per_group;
     /* what this run holds on the device already, and what the groups add */
     size_t start_bytes = (groups + 1) * sizeof(cl_uint);
     uint64_t held = groups * sizeof(cl_uint4) + start_bytes;
@@ -82,9 +84,10 @@ static cl_int run_bilateral_lists(rsmooth_context *ctx, const rs_problem *pb, co
     if (!(l.info = rs_alloc_array(groups, sizeof *l.info)))
         return CL_SUCCESS; /* no host memory for them: search in each round */
     for (size_t c = 0, g = 0; c < grid->cell_count; c++)
-        for (uint32_t f = grid->cell_start[c]; f < grid->cell_start[c + 1]; f += RS_LANES) {
+        for (uint32_t f = grid->cell_start[c]; f < grid->cell_start[c + 1]; f += lanes_per_group) {
             uint32_t lanes = grid->cell_start[c + 1] - f;
-            l.info[g++] = (cl_uint4){{f, lanes < RS_LANES ? lanes : RS_LANES, (cl_uint)c, 0}};
+            l.info[g++] = (cl_uint4){
+                {f, lanes < lanes_per_group ? lanes : (cl_uint)lanes_per_group, (cl_uint)c, 0}};
         }
 
     cl_uint group_count = (cl_uint)groups;
@@ -130,8 +133,9 @@ static cl_int run_bilateral_lists(rsmooth_context *ctx, const rs_problem *pb, co
     if ((err = clEnqueueUnmapMemObject(ctx->queue, l.list_start, start, 0, NULL, NULL)) !=
         CL_SUCCESS)
         goto done;
-    uint64_t weight_bytes = rows * RS_LANES * sizeof(cl_float);
-    if (rows > UINT32_MAX / RS_LANES || held + rows * sizeof(cl_uint) + weight_bytes > usable ||
+    uint64_t weight_bytes = rows * lanes_per_group * sizeof(cl_float);
+    if (rows > UINT32_MAX / lanes_per_group ||
+        held + rows * sizeof(cl_uint) + weight_bytes > usable ||
         weight_bytes > ctx->max_allocation || weight_bytes > SIZE_MAX)
         goto done; /* no room (err CL_SUCCESS): the rounds search instead */
     /* A device that shares the host's memory gets it from rs_alloc_array, which asks for huge
@@ -143,7 +147,7 @@ static cl_int run_bilateral_lists(rsmooth_context *ctx, const rs_problem *pb, co
     cl_mem_flags flags = CL_MEM_READ_WRITE;
     if (unified) {
         l.facet = rs_alloc_array((size_t)rows, sizeof(cl_uint));
-        l.weight = rs_alloc_array((size_t)rows, RS_LANES * sizeof(cl_float));
+        l.weight = rs_alloc_array((size_t)rows, lanes_per_group * sizeof(cl_float));
         if (!l.facet || !l.weight)
             goto done;
         flags |= CL_MEM_USE_HOST_PTR;
@@ -172,7 +176,7 @@ static cl_int run_bilateral_lists(rsmooth_context *ctx, const rs_problem *pb, co
     *listed = true;
     /* as bilateral_cell_normals counts: every lane of every facet a round reads (the searches
      * that built the lists are not counted) */
-    *pairs = near_rows * RS_LANES * (uint64_t)pb->normal_iterations;
+    *pairs = near_rows * lanes_per_group * (uint64_t)pb->normal_iterations;
 
     cl_mem from = buf[BUF_FACET_NORMAL], to = buf[BUF_FACET_SCRATCH];
     for (int round = 0; round < pb->normal_iterations && err == CL_SUCCESS; round++) {
@@ -249,6 +253,6 @@ cl_int rs_cl_run_bilateral(rsmooth_context *ctx, const rs_problem *pb, const rs_
     uint64_t sum = 0;
     for (size_t c = 0; c < cell_count; c++)
         sum += cell_pairs[c];
-    *pairs = sum * RS_LANES * (uint64_t)pb->normal_iterations;
+    *pairs = sum * ctx->lanes * (uint64_t)pb->normal_iterations;
     return clEnqueueUnmapMemObject(ctx->queue, buf[BUF_CELL_PAIRS], cell_pairs, 0, NULL, NULL);
 }

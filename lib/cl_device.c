@@ -245,18 +245,6 @@ static rsmooth_status pick_device(const char *spec, candidate *chosen, rsmooth_e
     return rs_fail(error, RSMOOTH_ERROR_NO_DEVICE, where, "no OpenCL device found");
 }
 
-/* Work-group size: 64 where the device allows it (an explicit size helps PoCL vectorize). */
-static size_t choose_local_size(cl_device_id device) {
-    size_t max_size = 1; /* what every device takes, should the query fail */
-    if (clGetDeviceInfo(device, CL_DEVICE_MAX_WORK_GROUP_SIZE, sizeof max_size, &max_size, NULL) !=
-        CL_SUCCESS)
-        max_size = 1;
-    size_t local = 64;
-    while (local > max_size)
-        local /= 2;
-    return local ? local : 1;
-}
-
 bool rs_parse_bytes(const char *text, uint64_t *bytes) {
     char *end = NULL;
     double value = strtod(text, &end);
@@ -382,7 +370,9 @@ rsmooth_status rsmooth_context_create(const char *device, rsmooth_context **out,
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the context");
     ctx->device = chosen.device;
     snprintf(ctx->device_name, sizeof ctx->device_name, "%s", chosen.name);
-    ctx->local_size = choose_local_size(chosen.device);
+    st = rs_cl_choose_variant(ctx, error);
+    if (st != RSMOOTH_OK)
+        goto fail;
     cl_context_properties props[] = {CL_CONTEXT_PLATFORM, (cl_context_properties)chosen.platform,
                                      0};
     cl_int err = CL_SUCCESS;
@@ -441,14 +431,15 @@ rsmooth_status rsmooth_context_create_from_queue(cl_command_queue queue, rsmooth
     ctx->queue = queue;
     ctx->context = context;
     ctx->device = device;
-    ctx->local_size = choose_local_size(device);
     cl_platform_id platform = NULL;
     char platform_name[96] = "", device_name[128];
     if (clGetDeviceInfo(device, CL_DEVICE_PLATFORM, sizeof platform, &platform, NULL) == CL_SUCCESS)
         info_string(platform, NULL, CL_PLATFORM_NAME, platform_name, sizeof platform_name);
     info_string(NULL, device, CL_DEVICE_NAME, device_name, sizeof device_name);
     snprintf(ctx->device_name, sizeof ctx->device_name, "%s / %s", platform_name, device_name);
-    st = read_memory_limits(ctx, error);
+    st = rs_cl_choose_variant(ctx, error);
+    if (st == RSMOOTH_OK)
+        st = read_memory_limits(ctx, error);
     if (st == RSMOOTH_OK)
         st = rs_cl_build_program(ctx, error);
     if (st != RSMOOTH_OK) {

@@ -14,8 +14,6 @@
 #include "cl_loader.h" /* the cl* calls below go to the loader opened at run time */
 #include <pthread.h>
 
-/* Vertices per block: the vector width the kernels use across vertices (float8, kernels/common.cl). */
-#define RS_LANES 8
 
 enum {
     RS_KERNEL_MOLLIFY,
@@ -36,11 +34,17 @@ struct rsmooth_context {
     double build_ms;
     int program_cache;        /* RS_PROGRAM_CACHE_: whether the program came from rsmooth's cache */
     size_t local_size;        /* work-group size used for every kernel */
+    unsigned lanes;           /* vertices per block: the kernels' vector width (RS_LANES, see
+                               * cl_variant.c); 1 is the GPU variant, one vertex per work-item */
     uint64_t global_memory;   /* CL_DEVICE_GLOBAL_MEM_SIZE */
     uint64_t max_allocation;  /* CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest one buffer may be */
     uint64_t memory_budget;   /* caller's or RSMOOTH_MEMORY_BUDGET's limit; 0: the device's */
     unsigned host_threads;    /* threads of the host stages of its calls; 0: every core */
 };
+
+/* Picks the kernel variant and vector width for ctx->device (cl_variant.c): sets ctx->lanes and
+ * ctx->local_size. RSMOOTH_KERNEL_VARIANT (cpu, gpu) and RSMOOTH_LANES (4, 8, 16) override it. */
+rsmooth_status rs_cl_choose_variant(rsmooth_context *ctx, rsmooth_error *error);
 
 /* A context's calls hold its lock while they use it: threads sharing one run one at a time. */
 void rs_context_lock(rsmooth_context *ctx);

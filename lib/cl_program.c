@@ -12,7 +12,7 @@ extern const unsigned char rs_kernel_common[], rs_kernel_mollify[], rs_kernel_bi
 extern const size_t rs_kernel_common_size, rs_kernel_mollify_size, rs_kernel_bilateral_size,
     rs_kernel_estimate_size;
 
-/* The kernel files in the order they are compiled, after the prelude. */
+/* The kernel files in the order they are compiled, after the prelude and the device's shape. */
 #define KERNEL_FILES 4
 
 /* Constants the host and kernels must agree on. Runtime values (sigmas, counts) are kernel
@@ -22,7 +22,7 @@ extern const size_t rs_kernel_common_size, rs_kernel_mollify_size, rs_kernel_bil
 #define FLOAT_DEFINE(name, value) "#define " #name " " STRINGIFY(value) "f\n"
 static const char prelude[] = FLOAT_DEFINE(RS_DEGENERATE_SINE, RS_DEGENERATE_SINE)
     FLOAT_DEFINE(RS_DEGENERATE_AREA_RATIO, RS_DEGENERATE_AREA_RATIO)
-    "#define RS_RESCUE_WEIGHT 1e-20f\n" "#define RS_LANES " EXPANDED_STRING(RS_LANES) "\n"
+    "#define RS_RESCUE_WEIGHT 1e-20f\n"
     "#define RS_INFLUENCE_GAUSSIAN 0\n" "#define RS_INFLUENCE_TUKEY 1\n"
     "#define RS_INFLUENCE_LORENTZIAN 2\n" "#define RS_INFLUENCE_HUBER 3\n";
 /* enum constants do not stringify: the values above are written out, and checked here */
@@ -61,10 +61,14 @@ static char *read_text_file(const char *dir, const char *name, size_t *size) {
 rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error) {
     static const char *const names[KERNEL_FILES] = {"common.cl", "mollify.cl", "bilateral.cl",
                                                     "estimate.cl"};
-    const char *sources[KERNEL_FILES + 1] = {
-        prelude, (const char *)rs_kernel_common, (const char *)rs_kernel_mollify,
+    /* the variant this device runs (cl_variant.c): its vector width and work-group size */
+    char shape[96];
+    snprintf(shape, sizeof shape, "#define RS_LANES %u\n#define RS_GROUP %zu\n", ctx->lanes,
+             ctx->local_size);
+    const char *sources[KERNEL_FILES + 2] = {
+        prelude, shape, (const char *)rs_kernel_common, (const char *)rs_kernel_mollify,
         (const char *)rs_kernel_bilateral, (const char *)rs_kernel_estimate};
-    size_t sizes[KERNEL_FILES + 1] = {sizeof prelude - 1, rs_kernel_common_size,
+    size_t sizes[KERNEL_FILES + 2] = {sizeof prelude - 1, strlen(shape), rs_kernel_common_size,
                                       rs_kernel_mollify_size, rs_kernel_bilateral_size,
                                       rs_kernel_estimate_size};
     char *loaded[KERNEL_FILES] = {NULL};
@@ -72,13 +76,13 @@ rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error) {
     const char *dir = getenv("RSMOOTH_KERNEL_DIR");
     if (dir && *dir) {
         for (int i = 0; i < KERNEL_FILES; i++) {
-            loaded[i] = read_text_file(dir, names[i], &sizes[i + 1]);
+            loaded[i] = read_text_file(dir, names[i], &sizes[i + 2]);
             if (!loaded[i]) {
                 st = rs_fail(error, RSMOOTH_ERROR_IO, "RSMOOTH_KERNEL_DIR",
                              "cannot read %s/%s", dir, names[i]);
                 goto done;
             }
-            sources[i + 1] = loaded[i];
+            sources[i + 2] = loaded[i];
         }
     }
 
@@ -90,7 +94,7 @@ rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error) {
     /* rsmooth's binary cache (cl_program_cache.c), keyed by exactly the sources and options the
      * build from source below takes */
     rs_program_cache cache;
-    ctx->program_cache = rs_program_cache_open(&cache, ctx, KERNEL_FILES + 1, sources, sizes,
+    ctx->program_cache = rs_program_cache_open(&cache, ctx, KERNEL_FILES + 2, sources, sizes,
                                                options)
                              ? RS_PROGRAM_CACHE_MISS
                              : RS_PROGRAM_CACHE_OFF;
@@ -98,7 +102,7 @@ rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error) {
         ctx->program_cache = RS_PROGRAM_CACHE_HIT;
         goto kernels;
     }
-    ctx->program = clCreateProgramWithSource(ctx->context, KERNEL_FILES + 1, sources, sizes, &err);
+    ctx->program = clCreateProgramWithSource(ctx->context, KERNEL_FILES + 2, sources, sizes, &err);
     if (err != CL_SUCCESS) {
         st = rs_cl_fail(error, err, "clCreateProgramWithSource", ctx->device_name);
         goto done;

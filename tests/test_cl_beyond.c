@@ -461,7 +461,7 @@ int main(void) {
     uint64_t budget = (uint64_t)rod.triangle_count * 40;
     compare(ctx, "noisy rod, bilateral s=0.5 K=5, tiled", &rod_ref, &p, budget);
     /* Tiles large against their halos (here two bilateral rounds, narrow reaches) plan room for
-     * the rounds' lists: they read them (fewer pairs than the same tiles searching) and still
+     * the rounds' lists: they read them (no more pairs than the same tiles searching) and still
      * equal the reference. */
     rsmooth_params_init(&p);
     p.normal_filter = RSMOOTH_NORMALS_BILATERAL;
@@ -483,7 +483,9 @@ int main(void) {
            (unsigned long long)listed.report.pairs_mollify,
            (unsigned long long)searched.report.pairs_mollify);
     CHECK(listed.report.tiles >= 2 && listed.report.tiles == searched.report.tiles);
-    CHECK(listed.report.pairs_mollify < searched.report.pairs_mollify);
+    /* a list holds only facets near some lane: never more pairs than searching (as many when a
+     * group's lanes cover its whole cell, as 16 lanes at these narrow reaches do) */
+    CHECK(listed.report.pairs_mollify <= searched.report.pairs_mollify);
     result_free(&listed);
     result_free(&searched);
     rsmooth_params_init(&p);

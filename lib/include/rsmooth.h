@@ -621,6 +621,15 @@ RSMOOTH_API double rsmooth_context_build_ms(const rsmooth_context *ctx);
  * build from source each time. Static text; "" for NULL. */
 RSMOOTH_API const char *rsmooth_context_program_cache(const rsmooth_context *ctx);
 
+/* How the context's kernels spread the work on its device: *lanes vertices per work-item (the
+ * block variant, CPU devices: the device's preferred float vector width, 4, 8 or 16) or 1 (the
+ * group variant, GPUs: one vertex per work-item, the work-group's candidate facets staged through
+ * local memory), and *group work-items per work-group. RSMOOTH_KERNEL_VARIANT=cpu|gpu and
+ * RSMOOTH_LANES=4|8|16 (read at creation) override the choice; every variant computes the same
+ * sums (tests compare each with the reference path). Either pointer may be NULL. */
+RSMOOTH_API void rsmooth_context_kernel_shape(const rsmooth_context *ctx, unsigned *lanes,
+                                              size_t *group);
+
 /* Limits the device memory one filter call holds to `bytes` (0: most of the device's memory, the
  * default; the environment variable RSMOOTH_MEMORY_BUDGET, e.g. "256M", sets it at creation).
  * Thread-safe: waits for a running call on the context.
