@@ -192,13 +192,20 @@ static size_t special(char *out, bool negative, bool zero, bool inf, bool nan) {
     return n;
 }
 
-size_t rs_io_print_double(char *out, double v) {
+/* A double's sign and magnitude bits; writes it as special() does when it is one of those. */
+static size_t special_double(char *out, double v, bool *negative, uint64_t *magnitude) {
     uint64_t bits;
     memcpy(&bits, &v, sizeof bits);
-    const bool negative = bits >> 63;
-    const uint64_t magnitude = bits & (UINT64_MAX >> 1);
+    *negative = bits >> 63;
+    *magnitude = bits & (UINT64_MAX >> 1);
     const uint64_t inf_bits = (uint64_t)0x7ff << 52;
-    size_t n = special(out, negative, magnitude == 0, magnitude == inf_bits, magnitude > inf_bits);
+    return special(out, *negative, *magnitude == 0, *magnitude == inf_bits, *magnitude > inf_bits);
+}
+
+size_t rs_io_print_double(char *out, double v) {
+    bool negative;
+    uint64_t magnitude;
+    size_t n = special_double(out, v, &negative, &magnitude);
     return n ? n : layout(out, negative, rs_io_shortest_double(v), 15, 17);
 }
 
@@ -212,12 +219,9 @@ size_t rs_io_print_float(char *out, float v) {
 }
 
 size_t rs_io_print_g9(char *out, double v) {
-    uint64_t bits;
-    memcpy(&bits, &v, sizeof bits);
-    const bool negative = bits >> 63;
-    const uint64_t magnitude = bits & (UINT64_MAX >> 1);
-    const uint64_t inf_bits = (uint64_t)0x7ff << 52;
-    size_t n = special(out, negative, magnitude == 0, magnitude == inf_bits, magnitude > inf_bits);
+    bool negative;
+    uint64_t magnitude;
+    size_t n = special_double(out, v, &negative, &magnitude);
     if (n)
         return n;
     /* A normal v's 9-digit rounding is its shortest decimal's: a 9-digit midpoint strictly
