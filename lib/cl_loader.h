@@ -52,6 +52,8 @@
       (cl_command_queue, cl_command_queue_info, size_t, void *, size_t *))                         \
     X(cl_int, GetDeviceIDs, (cl_platform_id, cl_device_type, cl_uint, cl_device_id *, cl_uint *))  \
     X(cl_int, GetDeviceInfo, (cl_device_id, cl_device_info, size_t, void *, size_t *))             \
+    X(cl_int, GetKernelWorkGroupInfo,                                                              \
+      (cl_kernel, cl_device_id, cl_kernel_work_group_info, size_t, void *, size_t *))              \
     X(cl_int, GetMemObjectInfo, (cl_mem, cl_mem_info, size_t, void *, size_t *))                   \
     X(cl_int, GetPlatformIDs, (cl_uint, cl_platform_id *, cl_uint *))                              \
     X(cl_int, GetPlatformInfo, (cl_platform_id, cl_platform_info, size_t, void *, size_t *))       \
@@ -101,6 +103,7 @@ rsmooth_status rs_cl_load(const char *where, rsmooth_error *error);
 #define clGetCommandQueueInfo rs_cl_api.GetCommandQueueInfo
 #define clGetDeviceIDs rs_cl_api.GetDeviceIDs
 #define clGetDeviceInfo rs_cl_api.GetDeviceInfo
+#define clGetKernelWorkGroupInfo rs_cl_api.GetKernelWorkGroupInfo
 #define clGetMemObjectInfo rs_cl_api.GetMemObjectInfo
 #define clGetPlatformIDs rs_cl_api.GetPlatformIDs
 #define clGetPlatformInfo rs_cl_api.GetPlatformInfo

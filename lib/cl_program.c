@@ -3,6 +3,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "cl_internal.h"
 
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -58,7 +59,7 @@ static char *read_text_file(const char *dir, const char *name, size_t *size) {
     return text;
 }
 
-rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error) {
+static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *error) {
     static const char *const names[KERNEL_FILES] = {"common.cl", "mollify.cl", "bilateral.cl",
                                                     "estimate.cl"};
     /* the variant this device runs (cl_variant.c): its vector width and work-group size */
@@ -146,5 +147,39 @@ kernels:;
 done:
     for (int i = 0; i < KERNEL_FILES; i++)
         rs_free(loaded[i]);
+    return st;
+}
+
+/* The largest work-group every kernel of the program takes (CL_KERNEL_WORK_GROUP_SIZE: a GPU
+ * lowers it for kernels that use many registers), 0 when the query fails. */
+static size_t kernels_group_limit(const rsmooth_context *ctx) {
+    size_t limit = SIZE_MAX;
+    for (int k = 0; k < RS_KERNEL_COUNT; k++) {
+        size_t size = 0;
+        if (clGetKernelWorkGroupInfo(ctx->kernels[k], ctx->device, CL_KERNEL_WORK_GROUP_SIZE,
+                                     sizeof size, &size, NULL) != CL_SUCCESS)
+            return 0;
+        limit = size < limit ? size : limit;
+    }
+    return limit;
+}
+
+rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error) {
+    rsmooth_status st = build_program_once(ctx, error);
+    /* The group variant compiles its work-group size in (local arrays of RS_GROUP facets): where
+     * a kernel takes fewer work-items than that, build again with the largest power of two it
+     * takes, rather than fail at the first launch. */
+    size_t limit = st == RSMOOTH_OK && ctx->lanes == 1 ? kernels_group_limit(ctx) : 0;
+    if (limit > 0 && limit < ctx->local_size) {
+        for (int k = 0; k < RS_KERNEL_COUNT; k++) {
+            clReleaseKernel(ctx->kernels[k]);
+            ctx->kernels[k] = NULL;
+        }
+        clReleaseProgram(ctx->program);
+        ctx->program = NULL;
+        while (ctx->local_size > 1 && ctx->local_size > limit)
+            ctx->local_size /= 2;
+        st = build_program_once(ctx, error);
+    }
     return st;
 }

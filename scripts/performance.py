@@ -5,7 +5,7 @@ Runs build/rsmooth-bench and build/rsmooth on this machine and writes
   docs/results/performance/*.json   each benchmark's JSON, as printed
   README.md                          the table between the "performance" markers
 
-    python3 scripts/performance.py [--build build] [--before OLD_BUILD] [--quick]
+    python3 scripts/performance.py [--build build] [--before OLD_BUILD [--before-label T]] [--quick]
 
 --quick skips the 4M and 16M runs (minutes, several GiB of memory). --before runs the headline
 cases (Bunny, 200k, the command's setup, Fandisk end to end, --best against the paper filter)
@@ -148,6 +148,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--before", help="an older build to compare the headline figures with")
+    ap.add_argument("--before-label", default=None,
+                    help="what the older build is, for the table (default: its path)")
     ap.add_argument("--quick", action="store_true")
     a = ap.parse_args()
     os.makedirs(OUT, exist_ok=True)
@@ -183,8 +185,9 @@ def main():
     lines += [f"Kernels: the {g.get('kernel_variant', 'block')} variant, "
               f"{g.get('lanes', 8)} vertices per work-item, work-groups of "
               f"{g.get('work_group', 64)} (chosen per device; see How it works).", ""]
-    lines += ["Issue 17's targets" + (f", before (`{os.path.relpath(a.before, ROOT)}`) and "
-                                      "after, run one after the other:" if before else ":"), "",
+    label = a.before_label or (a.before and os.path.relpath(a.before, ROOT))
+    lines += ["Issue 17's targets" + (f", before ({label}) and after, run one after the other:"
+                                      if before else ":"), "",
               "| figure | before | after | target | met |", "| --- | --- | --- | --- | --- |"]
     lines += headline_rows(before, after) + [""]
     lines += ["| case | filter total | facets + grid | mollify | robust | useful pairs/s, "
