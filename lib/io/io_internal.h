@@ -176,6 +176,20 @@ bool rs_io_keeps_bom(const rsmooth_mesh *mesh, rsmooth_format format);
  * after their checks, before their first byte. */
 bool rs_io_put_bom(const rsmooth_mesh *mesh, rsmooth_format format, FILE *stream);
 
+/* The body of a text mesh file (OBJ, OFF): writes `mesh` through `out`, with `extras` the format's
+ * record of what the file was read with (NULL: none) and `normals` per-vertex normals (or NULL). */
+struct rs_io_text_out;
+typedef void (*rs_io_text_body)(const rsmooth_mesh *mesh, const void *extras,
+                                const double *normals, bool as_float, struct rs_io_text_out *out);
+
+/* Writes a text mesh file to `stream`: its byte-order mark (rs_io_put_bom), then `body` through a
+ * buffered text writer, then flushes the stream. RSMOOTH_ERROR_IO ("writing NAME: reason") when
+ * any write fails. */
+rsmooth_status rs_io_text_write_mesh(const rsmooth_mesh *mesh, FILE *stream, rsmooth_format format,
+                                     const char *name, rs_io_text_body body, const void *extras,
+                                     const double *normals, const char *where,
+                                     rsmooth_error *error);
+
 /* Each frees its record (accepts NULL). */
 void rs_io_ply_extras_free(rs_ply_extras *extras);
 void rs_io_obj_extras_free(rs_obj_extras *extras);

@@ -122,9 +122,17 @@ rsmooth_status rs_io_off_check(const rsmooth_mesh *mesh, rsmooth_error *error) {
                                                       : RSMOOTH_OK;
 }
 
+/* The file's text: as it was read (faithful) or rsmooth's own layout. */
+static void write_body(const rsmooth_mesh *mesh, const void *extras, const double *normals,
+                       bool as_float, rs_io_text_out *out) {
+    if (extras)
+        write_faithful(mesh, extras, normals, as_float, out);
+    else
+        write_generic(mesh, normals, as_float, out);
+}
+
 rsmooth_status rs_io_off_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_error *error) {
     const rs_off_extras *x = faithful_extras(mesh);
-    const bool faithful = x != NULL;
     bool want_normals = wants_normals(mesh, x);
     double *normals = NULL;
     if (want_normals) {
@@ -132,22 +140,8 @@ rsmooth_status rs_io_off_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_e
         if (status != RSMOOTH_OK)
             return status;
     }
-    const bool as_float = rs_io_float32_holds(mesh);
-    rs_io_text_out out;
-    rs_io_text_open(&out, stream);
-    errno = 0;
-    bool ok = rs_io_put_bom(mesh, RSMOOTH_FORMAT_OFF, stream);
-    if (ok) {
-        if (faithful)
-            write_faithful(mesh, x, normals, as_float, &out);
-        else
-            write_generic(mesh, normals, as_float, &out);
-    }
-    ok = rs_io_text_close(&out) && ok;
+    rsmooth_status status = rs_io_text_write_mesh(mesh, stream, RSMOOTH_FORMAT_OFF, "OFF",
+                                                  write_body, x, normals, where, error);
     rs_free(normals);
-    ok = ok && fflush(stream) == 0 && !ferror(stream);
-    if (!ok)
-        return rs_fail(error, RSMOOTH_ERROR_IO, where, "writing OFF: %s",
-                       errno ? strerror(errno) : "stream error");
-    return RSMOOTH_OK;
+    return status;
 }
