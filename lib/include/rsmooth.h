@@ -47,7 +47,7 @@
 #include <stdint.h>
 
 #define RSMOOTH_VERSION_MAJOR 0
-#define RSMOOTH_VERSION_MINOR 7
+#define RSMOOTH_VERSION_MINOR 8
 #define RSMOOTH_VERSION_PATCH 0
 
 #if defined(_WIN32)
@@ -618,7 +618,7 @@ RSMOOTH_API double rsmooth_context_build_ms(const rsmooth_context *ctx);
  * else $XDG_CACHE_HOME/rsmooth, else $HOME/.cache/rsmooth, created (mode 0700) when first written;
  * one file per device, driver, program source and build options. A file that is damaged, another
  * key's or fails to build is a miss and is replaced; a folder that cannot be written only means a
- * build from source each time. Static text; "" for NULL. */
+ * build from source each time. Static text; "" for NULL. (Added in 0.8) */
 RSMOOTH_API const char *rsmooth_context_program_cache(const rsmooth_context *ctx);
 
 /* How the context's kernels spread the work on its device: *lanes vertices per work-item (the
@@ -626,7 +626,7 @@ RSMOOTH_API const char *rsmooth_context_program_cache(const rsmooth_context *ctx
  * group variant, GPUs: one vertex per work-item, the work-group's candidate facets staged through
  * local memory), and *group work-items per work-group. RSMOOTH_KERNEL_VARIANT=cpu|gpu and
  * RSMOOTH_LANES=4|8|16 (read at creation) override the choice; every variant computes the same
- * sums (tests compare each with the reference path). Either pointer may be NULL. */
+ * sums (tests compare each with the reference path). Either pointer may be NULL. (Added in 0.8) */
 RSMOOTH_API void rsmooth_context_kernel_shape(const rsmooth_context *ctx, unsigned *lanes,
                                               size_t *group);
 
