@@ -205,8 +205,9 @@ static void pack_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
     for (size_t q = begin; q < end; q++) {
         uint32_t j = pk->facet_place[q];
         const double *c = job->centroid + 3 * q;
+        const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
         double n[3], area = 0;
-        rs_triangle_normal(pb->xyz, pb->indices + 3 * (size_t)pb->facet_triangle[q], n, &area);
+        rs_triangle_normal(pb->xyz, tri, n, &area);
         int32_t cell[3];
         rs_grid_facet_cell(job->grid, c, cell);
         cl_float4 cen = local_point(job->grid, c, cell);
@@ -214,7 +215,6 @@ static void pack_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
         cen.s[3] = (float)log2(area / pb->mean_area);
         pk->facet_centroid[j] = cen;
         pk->facet_normal[j] = (cl_float4){{(float)n[0], (float)n[1], (float)n[2], 0}};
-        const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
         if (pb->colors) {
             double color[3];
             rs_triangle_color(pb->colors, tri, color);

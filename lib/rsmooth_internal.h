@@ -103,7 +103,7 @@ typedef struct rs_problem {
     size_t facet_count;
     uint32_t *facet_triangle;    /* triangle index of each facet */
     /* Kept only when asked (the reference path); the OpenCL path computes them where it needs
-     * them (rs_facet_geometry), which saves 56 bytes per triangle. */
+     * them (rs_facet_centroid, rs_triangle_normal), which saves 56 bytes per triangle. */
     double *centroid;            /* 3 per facet: c_q */
     double *normal;              /* 3 per facet: unit n_q of the input */
     double *area;                /* per facet: a_q > 0 */
@@ -206,12 +206,7 @@ static inline void rs_triangle_centroid(const double *xyz, const uint32_t *tri,
         centroid[k] = (a[k] + b[k] + c[k]) / 3.0; /* exact where the coordinates are equal */
 }
 
-/* The same for facet q of a problem. */
-static inline void rs_facet_geometry(const rs_problem *problem, size_t q, double centroid[3],
-                                     double normal[3], double *area) {
-    rs_triangle_geometry(problem->xyz, problem->indices + 3 * (size_t)problem->facet_triangle[q],
-                         centroid, normal, area);
-}
+/* The centroid of facet q of a problem. */
 static inline void rs_facet_centroid(const rs_problem *problem, size_t q, double centroid[3]) {
     rs_triangle_centroid(problem->xyz,
                          problem->indices + 3 * (size_t)problem->facet_triangle[q], centroid);
