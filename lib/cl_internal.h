@@ -38,6 +38,8 @@ struct rsmooth_context {
                                * cl_variant.c); 1 is the GPU variant, one vertex per work-item */
     uint64_t global_memory;   /* CL_DEVICE_GLOBAL_MEM_SIZE */
     uint64_t max_allocation;  /* CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest one buffer may be */
+    bool host_unified;        /* CL_DEVICE_HOST_UNIFIED_MEMORY: the device reads host arrays in
+                               * place (rs_cl_input_flags) */
     uint64_t memory_budget;   /* caller's or RSMOOTH_MEMORY_BUDGET's limit; 0: the device's */
     unsigned host_threads;    /* threads of the host stages of its calls; 0: every core */
 };
@@ -52,6 +54,11 @@ void rs_context_unlock(rsmooth_context *ctx);
 
 /* Bytes one run may hold on the device: the caller's budget, else most of the device's memory. */
 uint64_t rs_cl_usable_memory(const rsmooth_context *ctx);
+
+/* How a buffer whose contents the host filled before creating it gets them: handed over in place
+ * (CL_MEM_USE_HOST_PTR) on a device that shares the host's memory, copied at creation
+ * (CL_MEM_COPY_HOST_PTR) on one that does not, which would copy them at its first use anyway. */
+cl_mem_flags rs_cl_input_flags(const rsmooth_context *ctx);
 
 /* Reads a byte count such as "256M", "1.5G", "4096" (suffixes K, M, G, T: powers of 1024).
  * false when `text` is not one. */
@@ -123,12 +130,15 @@ rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error);
 
 /* ---- cl_program_cache.c: rsmooth's cache of program binaries ---------------------------------- */
 
-enum { RS_PROGRAM_CACHE_OFF, RS_PROGRAM_CACHE_MISS, RS_PROGRAM_CACHE_HIT };
+enum { RS_PROGRAM_CACHE_OFF, RS_PROGRAM_CACHE_MISS, RS_PROGRAM_CACHE_HIT, RS_PROGRAM_CACHE_REFUSED };
 
-/* One program's entry: its file ("" when the cache is off) and the key it must hold. */
+/* One program's entry: where its folder is (`top`, then the folders `below` it that must be the
+ * user's own), the file's name, and the key the file must hold. */
 typedef struct rs_program_cache {
-    char path[4096];
+    char top[4096], below[1024], name[48];
     uint64_t key[2], key_bytes, key_fields;
+    bool enabled; /* a folder and key are known */
+    bool refused; /* the folder or file was refused as another user's (said on stderr) */
 } rs_program_cache;
 
 /* Keys the program of the `count` sources (OpenCL's strings and lengths, as passed to
@@ -138,12 +148,14 @@ bool rs_program_cache_open(rs_program_cache *cache, const rsmooth_context *ctx, 
                            const char *const *sources, const size_t *sizes, const char *options);
 
 /* The program built from the entry's binary with `options`, or NULL (no file, a file that is not
- * whole and this key's, or a build that fails): then build from source. */
-cl_program rs_program_cache_load(const rs_program_cache *cache, const rsmooth_context *ctx,
+ * whole and this key's, a file or folder another user could have written: cache->refused, or a
+ * build that fails): then build from source. */
+cl_program rs_program_cache_load(rs_program_cache *cache, const rsmooth_context *ctx,
                                  const char *options);
 
-/* Stores the binary of `program`, built from source, for the entry; failures are silent (the
- * next context builds from source again). Safe against concurrent writers and readers. */
+/* Stores the binary of `program`, built from source, for the entry, unless the entry was refused;
+ * failures are silent (the next context builds from source again). Safe against concurrent
+ * writers and readers. */
 void rs_program_cache_store(const rs_program_cache *cache, const rsmooth_context *ctx,
                             cl_program program);
 

@@ -103,6 +103,8 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
         ctx->program_cache = RS_PROGRAM_CACHE_HIT;
         goto kernels;
     }
+    if (cache.refused)
+        ctx->program_cache = RS_PROGRAM_CACHE_REFUSED;
     ctx->program = clCreateProgramWithSource(ctx->context, KERNEL_FILES + 2, sources, sizes, &err);
     if (err != CL_SUCCESS) {
         st = rs_cl_fail(error, err, "clCreateProgramWithSource", ctx->device_name);

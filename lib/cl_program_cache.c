@@ -1,34 +1,51 @@
 /* rsmooth's own cache of built OpenCL programs: the binary of a program built from source is kept
  * on disk under a key over the device, its driver and platform, and the complete source and build
  * options; a later context with the same key builds from that binary instead (about 5 ms with
- * PoCL, where a source build costs 30-40 ms even when PoCL's own cache has the kernels). Any
- * doubt about a file (size, magic, key, checksum, a failed build from it) is a miss, never an
- * error, and a directory that cannot be written only means building from source every time.
+ * PoCL, where a source build costs 30-40 ms even when PoCL's own cache has the kernels).
  *
- * A file is a 72-byte header of nine little-endian 64-bit words, the binary, and its checksum:
- *   magic "RSPRGBIN", format version, key hash (2 words), key bytes, key fields, 0 (reserved),
- *   binary size, 0 (reserved); the binary; its checksum (2 words, the key's two hashes).
- * The file's name is the key hash in hex; the words inside catch a collision of the name, and
- * the size and checksum a truncated or damaged file.
+ * A program binary is native code the OpenCL runtime loads and runs, so a cache file is trusted
+ * only as far as its folder is: a file is used only when it, its folder and every folder between
+ * the user's home and it (or the folder RSMOOTH_CACHE_DIR names, alone) belong to the effective
+ * user and are writable by nobody else. Anything else is refused, said once per process on stderr,
+ * and the program built from source. Folders are walked by descriptor with O_NOFOLLOW below the
+ * starting folder, and each checked with fstat on what was opened, so no link or rename between
+ * check and use can swap in another file. The file is opened O_NOFOLLOW | O_NONBLOCK (a FIFO or
+ * device cannot block), must be a regular file of bounded size, and its whole content must match
+ * the BLAKE2b digest in its header; any other doubt (missing, truncated, corrupt, another key, a
+ * build that fails) is a miss, built from source and the file replaced. A folder that cannot be
+ * written only means building from source every time.
+ *
+ * A file is a 96-byte header of eight little-endian 64-bit words and the digest, then the binary:
+ *   magic "RSPRGBIN", format version, key hash (2 words), key bytes, key fields, binary size,
+ *   0 (reserved); BLAKE2b-256 of those 64 bytes and the binary.
+ * The file's name is the key hash in hex; the words inside catch a collision of the name.
  * Writers write a temporary file beside the final one and rename it over it, so readers see a
  * whole file or none, and concurrent writers of one key leave one of their (equal) files. */
 #define _POSIX_C_SOURCE 200809L
 #include "cl_internal.h"
+#include "blake2b.h"
 
 #include <errno.h>
 #include <fcntl.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
-#define FORMAT_VERSION 1
-#define HEADER_WORDS 9
-#define HEADER_BYTES (HEADER_WORDS * 8)
-#define TRAILER_BYTES 16
-/* A program binary larger than this is not cached (PoCL's are a few hundred KiB). */
-#define MAX_BINARY_BYTES ((uint64_t)256 << 20)
+#ifndef O_CLOEXEC
+#define O_CLOEXEC 0
+#endif
+
+#define FORMAT_VERSION 2
+#define HEADER_WORDS 8
+#define DIGEST_BYTES 32
+#define HEADER_BYTES (HEADER_WORDS * 8 + DIGEST_BYTES)
+/* A program binary larger than this is not cached (PoCL's are a few hundred KiB): the most a
+ * cache file makes the library read. */
+#define MAX_BINARY_BYTES ((uint64_t)64 << 20)
 static const char magic[8] = {'R', 'S', 'P', 'R', 'G', 'B', 'I', 'N'};
 
 static void put_u64(unsigned char *out, uint64_t v) {
@@ -43,10 +60,12 @@ static uint64_t get_u64(const unsigned char *in) {
     return v;
 }
 
+/* ---- the key -------------------------------------------------------------------------------- */
+
 /* Two independent 64-bit hashes over the same bytes (multiply-xorshift steps with different
  * constants over little-endian 64-bit words, then the bytes left), and how many bytes and fields
- * went in: a chance collision of all four is out of reach. Words, not bytes: the checksum of a
- * 500 KiB binary costs about 0.1 ms. */
+ * went in: the file's name and the words that must match it. Not a defence (the ownership checks
+ * and the digest are): only a name that no two keys share by chance. */
 typedef struct hash2 {
     uint64_t a, b, bytes, fields;
 } hash2;
@@ -104,53 +123,135 @@ static void hash_info(hash2 *h, cl_platform_id platform, cl_device_id device, cl
     rs_free(text);
 }
 
-/* The directory: RSMOOTH_CACHE_DIR (empty or "off": no cache), else $XDG_CACHE_HOME/rsmooth, else
- * $HOME/.cache/rsmooth. false when there is none, or its path does not fit. */
-static bool cache_dir(char *dir, size_t size) {
-    const char *env = getenv("RSMOOTH_CACHE_DIR");
-    int n;
+/* ---- where the cache is, and whether it can be trusted --------------------------------------- */
+
+/* The folder to start from (`top`, opened following links: the user named it) and the folders
+ * below it down to the cache (`below`, "a/b" or ""), each of which must be the user's own:
+ * RSMOOTH_CACHE_DIR (empty or "off": no cache) alone; else $XDG_CACHE_HOME/rsmooth, from the home
+ * folder when it lies below it; else $HOME/.cache/rsmooth from $HOME. false when there is none, or
+ * its path does not fit. */
+static bool cache_location(rs_program_cache *cache) {
+    const char *env = getenv("RSMOOTH_CACHE_DIR"), *home = getenv("HOME");
+    int n, m = 0;
+    size_t home_length = home ? strlen(home) : 0;
+    while (home_length > 1 && home[home_length - 1] == '/')
+        home_length--;
     if (env) {
         if (!*env || strcmp(env, "off") == 0)
             return false;
-        n = snprintf(dir, size, "%s", env);
+        n = snprintf(cache->top, sizeof cache->top, "%s", env);
     } else if ((env = getenv("XDG_CACHE_HOME")) && env[0] == '/') { /* relative: ignored (spec) */
-        n = snprintf(dir, size, "%s/rsmooth", env);
-    } else if ((env = getenv("HOME")) && *env) {
-        n = snprintf(dir, size, "%s/.cache/rsmooth", env);
+        if (home && home[0] == '/' && home_length > 1 && strncmp(env, home, home_length) == 0 &&
+            env[home_length] == '/') {
+            n = snprintf(cache->top, sizeof cache->top, "%.*s", (int)home_length, home);
+            m = snprintf(cache->below, sizeof cache->below, "%s/rsmooth", env + home_length + 1);
+        } else {
+            n = snprintf(cache->top, sizeof cache->top, "%s/rsmooth", env);
+        }
+    } else if (home && *home) {
+        n = snprintf(cache->top, sizeof cache->top, "%s", home);
+        m = snprintf(cache->below, sizeof cache->below, ".cache/rsmooth");
     } else {
         return false;
     }
-    return n > 0 && (size_t)n < size;
+    return n > 0 && (size_t)n < sizeof cache->top && m >= 0 && (size_t)m < sizeof cache->below;
 }
 
-/* mkdir -p with mode 0700 for what it creates; true when `dir` is then a directory. */
-static bool make_dirs(char *dir) {
+/* Why a folder or file someone else could have written is not to be used, or NULL when it is the
+ * effective user's own and writable by nobody else. */
+static const char *untrusted(const struct stat *st) {
+    if (st->st_uid != geteuid())
+        return "belongs to another user";
+    if (st->st_mode & (S_IWGRP | S_IWOTH))
+        return "is writable by other users";
+    return NULL;
+}
+
+/* The first refusal is said on stderr; later ones (other contexts, other threads) are not. */
+static atomic_flag refusal_said = ATOMIC_FLAG_INIT;
+
+static void say_refusal(const char *what, const char *why, const struct stat *st) {
+    if (atomic_flag_test_and_set(&refusal_said))
+        return;
+    fprintf(stderr,
+            "rsmooth: not using the program cache: %s %s (owner uid %ld, mode %04o; you are uid "
+            "%ld): the OpenCL program is built from source instead. Use a folder of your own "
+            "(RSMOOTH_CACHE_DIR) or turn the cache off (RSMOOTH_CACHE_DIR=off)\n",
+            what, why, (long)st->st_uid, (unsigned)(st->st_mode & 07777), (long)geteuid());
+}
+
+enum { WALK_OK, WALK_MISSING, WALK_REFUSED, WALK_FAILED };
+
+/* Opens the cache folder by descriptor into *dir_fd: `top` following links, then each folder of
+ * `below` with O_NOFOLLOW, creating missing ones (0700) when `create`; each checked to be the
+ * user's own where the rules above ask it. WALK_REFUSED has been said on stderr. */
+static int open_cache_dir(const rs_program_cache *cache, bool create, int *dir_fd) {
+    *dir_fd = -1;
     struct stat st;
-    if (stat(dir, &st) == 0)
-        return S_ISDIR(st.st_mode);
-    for (char *p = dir + 1; *p; p++) {
-        if (*p != '/')
-            continue;
-        *p = '\0';
-        int r = mkdir(dir, 0700);
-        *p = '/';
-        if (r != 0 && errno != EEXIST)
-            return false;
+    if (create && !cache->below[0] && stat(cache->top, &st) != 0 && errno == ENOENT) {
+        /* RSMOOTH_CACHE_DIR or $XDG_CACHE_HOME/rsmooth made with its missing parents, all 0700 */
+        char path[sizeof cache->top];
+        snprintf(path, sizeof path, "%s", cache->top);
+        for (char *p = path + 1; *p; p++)
+            if (*p == '/') {
+                *p = '\0';
+                if (mkdir(path, 0700) != 0 && errno != EEXIST)
+                    return WALK_FAILED;
+                *p = '/';
+            }
+        if (mkdir(path, 0700) != 0 && errno != EEXIST)
+            return WALK_FAILED;
     }
-    if (mkdir(dir, 0700) != 0 && errno != EEXIST)
-        return false;
-    return stat(dir, &st) == 0 && S_ISDIR(st.st_mode);
+    int fd = open(cache->top, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0)
+        return errno == ENOENT ? WALK_MISSING : WALK_FAILED;
+    if (!cache->below[0]) { /* the named folder itself must be the user's */
+        const char *why = fstat(fd, &st) == 0 ? untrusted(&st) : "cannot be examined";
+        if (why) {
+            say_refusal(cache->top, why, &st);
+            close(fd);
+            return WALK_REFUSED;
+        }
+    }
+    char below[sizeof cache->below], path[sizeof cache->top + sizeof cache->below];
+    snprintf(below, sizeof below, "%s", cache->below);
+    snprintf(path, sizeof path, "%s", cache->top);
+    for (char *name = below, *next; name && *name; name = next) {
+        next = strchr(name, '/');
+        if (next)
+            *next++ = '\0';
+        if (!*name)
+            continue;
+        size_t used = strlen(path);
+        snprintf(path + used, sizeof path - used, "/%s", name);
+        const int flags = O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC;
+        int sub = openat(fd, name, flags);
+        if (sub < 0 && errno == ENOENT && create && (mkdirat(fd, name, 0700) == 0 || errno == EEXIST))
+            sub = openat(fd, name, flags);
+        int open_errno = errno;
+        close(fd);
+        if (sub < 0)
+            return open_errno == ENOENT ? WALK_MISSING : WALK_FAILED;
+        fd = sub;
+        const char *why = fstat(fd, &st) == 0 ? untrusted(&st) : "cannot be examined";
+        if (why) {
+            say_refusal(path, why, &st);
+            close(fd);
+            return WALK_REFUSED;
+        }
+    }
+    *dir_fd = fd;
+    return WALK_OK;
 }
 
 bool rs_program_cache_open(rs_program_cache *cache, const rsmooth_context *ctx, cl_uint count,
                            const char *const *sources, const size_t *sizes, const char *options) {
     memset(cache, 0, sizeof *cache);
-    char dir[sizeof cache->path - 64];
-    if (!cache_dir(dir, sizeof dir))
+    if (!cache_location(cache))
         return false;
     hash2 h;
     hash_init(&h);
-    static const char format[] = "rsmooth program cache 1";
+    static const char format[] = "rsmooth program cache 2";
     hash_field(&h, format, sizeof format - 1);
     cl_platform_id platform = NULL;
     if (clGetDeviceInfo(ctx->device, CL_DEVICE_PLATFORM, sizeof platform, &platform, NULL) !=
@@ -170,45 +271,89 @@ bool rs_program_cache_open(rs_program_cache *cache, const rsmooth_context *ctx, 
     cache->key[1] = h.b;
     cache->key_bytes = h.bytes;
     cache->key_fields = h.fields;
-    int n = snprintf(cache->path, sizeof cache->path, "%s/%016llx%016llx.clbin", dir,
-                     (unsigned long long)h.a, (unsigned long long)h.b);
-    return n > 0 && (size_t)n < sizeof cache->path;
+    snprintf(cache->name, sizeof cache->name, "%016llx%016llx.clbin", (unsigned long long)h.a,
+             (unsigned long long)h.b);
+    cache->enabled = true;
+    return true;
 }
 
-/* The binary of a valid file for the key (to rs_free), or NULL. */
-static unsigned char *read_binary(const rs_program_cache *cache, size_t *size) {
-    int fd = open(cache->path, O_RDONLY);
+/* ---- reading ------------------------------------------------------------------------------- */
+
+/* The header's first 64 bytes for this key and binary size. */
+static void header_words(const rs_program_cache *cache, uint64_t binary_size,
+                         unsigned char *header) {
+    const uint64_t words[HEADER_WORDS] = {0,           FORMAT_VERSION,   cache->key[0],
+                                          cache->key[1], cache->key_bytes, cache->key_fields,
+                                          binary_size, 0};
+    memcpy(header, magic, 8);
+    for (int i = 1; i < HEADER_WORDS; i++)
+        put_u64(header + 8 * i, words[i]);
+}
+
+static void digest_of(const unsigned char *header, const unsigned char *binary, size_t size,
+                      unsigned char *digest) {
+    rs_blake2b s;
+    rs_blake2b_init(&s, DIGEST_BYTES);
+    rs_blake2b_update(&s, header, HEADER_WORDS * 8);
+    rs_blake2b_update(&s, binary, size);
+    rs_blake2b_final(&s, digest);
+}
+
+/* Reads exactly `n` bytes; false on a short read or an error. */
+static bool read_all(int fd, unsigned char *data, size_t n) {
+    while (n > 0) {
+        ssize_t r = read(fd, data, n);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r <= 0)
+            return false;
+        data += r;
+        n -= (size_t)r;
+    }
+    return true;
+}
+
+/* The binary of a valid file for the key (to rs_free), or NULL; *refused when the file (or its
+ * folder) was refused as untrusted rather than missing or invalid. */
+static unsigned char *read_binary(const rs_program_cache *cache, size_t *size, bool *refused) {
+    int dir_fd;
+    int walk = open_cache_dir(cache, false, &dir_fd);
+    *refused = walk == WALK_REFUSED;
+    if (walk != WALK_OK)
+        return NULL;
+    int fd = openat(dir_fd, cache->name, O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+    close(dir_fd);
     if (fd < 0)
         return NULL;
-    unsigned char *data = NULL, header[HEADER_BYTES];
+    unsigned char *data = NULL, header[HEADER_BYTES], expected[HEADER_WORDS * 8];
+    unsigned char digest[DIGEST_BYTES];
     struct stat st;
-    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || read(fd, header, sizeof header) !=
-                                                               (ssize_t)sizeof header)
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))
+        goto fail; /* a FIFO, device or folder at the name: a miss, replaced by the store */
+    const char *why = untrusted(&st);
+    if (why) {
+        char what[sizeof cache->top + sizeof cache->below + sizeof cache->name + 2];
+        snprintf(what, sizeof what, "%s%s%s/%s", cache->top, cache->below[0] ? "/" : "",
+                 cache->below, cache->name);
+        say_refusal(what, why, &st);
+        *refused = true;
         goto fail;
-    uint64_t binary_size = get_u64(header + 56);
-    if (memcmp(header, magic, 8) != 0 || get_u64(header + 8) != FORMAT_VERSION ||
-        get_u64(header + 16) != cache->key[0] || get_u64(header + 24) != cache->key[1] ||
-        get_u64(header + 32) != cache->key_bytes || get_u64(header + 40) != cache->key_fields ||
-        binary_size == 0 || binary_size > MAX_BINARY_BYTES ||
-        (uint64_t)st.st_size != HEADER_BYTES + binary_size + TRAILER_BYTES)
-        goto fail;
-    data = rs_alloc_array(binary_size + TRAILER_BYTES, 1);
-    if (!data)
-        goto fail;
-    size_t done = 0, want = binary_size + TRAILER_BYTES;
-    while (done < want) {
-        ssize_t r = read(fd, data + done, want - done);
-        if (r <= 0)
-            goto fail;
-        done += (size_t)r;
     }
-    hash2 check;
-    hash_init(&check);
-    hash_bytes(&check, data, binary_size);
-    if (get_u64(data + binary_size) != check.a || get_u64(data + binary_size + 8) != check.b)
+    if (st.st_size < HEADER_BYTES || (uint64_t)st.st_size > HEADER_BYTES + MAX_BINARY_BYTES ||
+        !read_all(fd, header, sizeof header))
+        goto fail;
+    uint64_t binary_size = (uint64_t)st.st_size - HEADER_BYTES;
+    header_words(cache, binary_size, expected);
+    if (binary_size == 0 || memcmp(header, expected, sizeof expected) != 0)
+        goto fail;
+    data = rs_alloc_array((size_t)binary_size, 1);
+    if (!data || !read_all(fd, data, (size_t)binary_size))
+        goto fail;
+    digest_of(header, data, (size_t)binary_size, digest);
+    if (memcmp(digest, header + HEADER_WORDS * 8, DIGEST_BYTES) != 0)
         goto fail;
     close(fd);
-    *size = binary_size;
+    *size = (size_t)binary_size;
     return data;
 fail:
     rs_free(data);
@@ -216,12 +361,12 @@ fail:
     return NULL;
 }
 
-cl_program rs_program_cache_load(const rs_program_cache *cache, const rsmooth_context *ctx,
+cl_program rs_program_cache_load(rs_program_cache *cache, const rsmooth_context *ctx,
                                  const char *options) {
-    if (!cache->path[0])
+    if (!cache->enabled)
         return NULL;
     size_t size = 0;
-    unsigned char *binary = read_binary(cache, &size);
+    unsigned char *binary = read_binary(cache, &size, &cache->refused);
     if (!binary)
         return NULL;
     const unsigned char *binaries[1] = {binary};
@@ -237,6 +382,8 @@ cl_program rs_program_cache_load(const rs_program_cache *cache, const rsmooth_co
     }
     return program;
 }
+
+/* ---- writing ------------------------------------------------------------------------------- */
 
 /* Writes all of `n` bytes; false on any failure. */
 static bool write_all(int fd, const unsigned char *data, size_t n) {
@@ -288,41 +435,45 @@ static unsigned char *program_binary(const rsmooth_context *ctx, cl_program prog
     return result;
 }
 
+/* A new file "<name>.<random>" in the folder, created exclusively, mode 0600; -1 on failure. */
+static int create_temporary(int dir_fd, const char *name, char *temporary, size_t size) {
+    static _Atomic uint64_t counter;
+    uint64_t state = (uint64_t)time(NULL) ^ ((uint64_t)getpid() << 20) ^
+                     (uint64_t)(uintptr_t)&state ^ (atomic_fetch_add(&counter, 1) << 40);
+    for (int attempt = 0; attempt < 100; attempt++) {
+        state = state * 6364136223846793005u + 1442695040888963407u;
+        snprintf(temporary, size, "%s.%08llx", name, (unsigned long long)(state >> 32));
+        int fd = openat(dir_fd, temporary, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC,
+                        0600);
+        if (fd >= 0 || errno != EEXIST)
+            return fd;
+    }
+    return -1;
+}
+
 void rs_program_cache_store(const rs_program_cache *cache, const rsmooth_context *ctx,
                             cl_program program) {
-    if (!cache->path[0])
+    if (!cache->enabled || cache->refused)
         return;
     size_t size = 0;
     unsigned char *binary = program_binary(ctx, program, &size);
     if (!binary)
         return;
-    char dir[sizeof cache->path], temp[sizeof cache->path + 8];
-    snprintf(dir, sizeof dir, "%s", cache->path);
-    char *slash = strrchr(dir, '/');
-    if (slash && slash != dir)
-        *slash = '\0';
-    int fd = -1;
-    bool ok = (!slash || slash == dir || make_dirs(dir)) &&
-              snprintf(temp, sizeof temp, "%s.XXXXXX", cache->path) < (int)sizeof temp &&
-              (fd = mkstemp(temp)) >= 0;
-    if (ok) {
-        unsigned char header[HEADER_BYTES], trailer[TRAILER_BYTES];
-        const uint64_t words[HEADER_WORDS] = {0, FORMAT_VERSION, cache->key[0], cache->key[1],
-                                              cache->key_bytes, cache->key_fields, 0, size, 0};
-        memcpy(header, magic, 8);
-        for (int i = 1; i < HEADER_WORDS; i++)
-            put_u64(header + 8 * i, words[i]);
-        hash2 check;
-        hash_init(&check);
-        hash_bytes(&check, binary, size);
-        put_u64(trailer, check.a);
-        put_u64(trailer + 8, check.b);
-        ok = write_all(fd, header, sizeof header) && write_all(fd, binary, size) &&
-             write_all(fd, trailer, sizeof trailer);
-        ok = close(fd) == 0 && ok;
-        /* rename replaces the final name at once: readers see the old file or the new one */
-        if (!ok || rename(temp, cache->path) != 0)
-            unlink(temp);
+    int dir_fd = -1;
+    if (open_cache_dir(cache, true, &dir_fd) == WALK_OK) {
+        unsigned char header[HEADER_BYTES];
+        header_words(cache, size, header);
+        digest_of(header, binary, size, header + HEADER_WORDS * 8);
+        char temporary[sizeof cache->name + 16];
+        int fd = create_temporary(dir_fd, cache->name, temporary, sizeof temporary);
+        if (fd >= 0) {
+            bool ok = write_all(fd, header, sizeof header) && write_all(fd, binary, size);
+            ok = close(fd) == 0 && ok;
+            /* rename replaces the final name at once: readers see the old file or the new one */
+            if (!ok || renameat(dir_fd, temporary, dir_fd, cache->name) != 0)
+                unlinkat(dir_fd, temporary, 0);
+        }
+        close(dir_fd);
     }
     rs_free(binary);
 }
@@ -330,7 +481,8 @@ void rs_program_cache_store(const rs_program_cache *cache, const rsmooth_context
 const char *rsmooth_context_program_cache(const rsmooth_context *ctx) {
     if (!ctx)
         return "";
-    return ctx->program_cache == RS_PROGRAM_CACHE_HIT    ? "hit"
-           : ctx->program_cache == RS_PROGRAM_CACHE_MISS ? "miss"
-                                                         : "off";
+    return ctx->program_cache == RS_PROGRAM_CACHE_HIT       ? "hit"
+           : ctx->program_cache == RS_PROGRAM_CACHE_MISS    ? "miss"
+           : ctx->program_cache == RS_PROGRAM_CACHE_REFUSED ? "refused"
+                                                            : "off";
 }

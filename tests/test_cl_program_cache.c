@@ -3,8 +3,13 @@
  * magic, empty, a folder in the file's place) are misses that get rewritten; folders that cannot be
  * made or written, and "off", build from source and leave nothing; the default folders; and
  * processes and threads starting together on an empty folder all succeed and leave one whole file
- * and no temporaries. Everything happens in a fresh folder in the working directory. */
+ * and no temporaries. Then trust (issue 23, item 1): a binary built from modified kernels, planted
+ * under the genuine key with a valid digest, is refused in a folder another user owns or can write,
+ * and in the home chain, said once on stderr, and the results are the genuine program's; a FIFO,
+ * a link or a file of another user at the key's name is never opened as a cache file. Everything
+ * happens in a fresh folder in the working directory. */
 #define _POSIX_C_SOURCE 200809L
+#include "blake2b.h"
 #include "mesh_shapes.h"
 #include "test_cl_util.h"
 
@@ -21,6 +26,10 @@
 
 #define PROCESSES 6
 #define THREADS 4
+/* The file format (lib/cl_program_cache.c): 64 bytes of words, BLAKE2b-256 of them and the
+ * binary, the binary; the binary's size is the word at byte 48. */
+#define HEADER_WORDS_BYTES 64
+#define HEADER_BYTES 96
 
 static char base[256]; /* this run's folder, absolute */
 
@@ -115,11 +124,11 @@ static size_t file_size(const char *path) {
 }
 
 /* Damage kinds, each applied to a valid file. */
-enum { TRUNCATE_HALF, TRUNCATE_HEADER, EMPTY, FLIP_BINARY, FLIP_CHECKSUM, FLIP_KEY, WRONG_MAGIC,
+enum { TRUNCATE_HALF, TRUNCATE_HEADER, EMPTY, FLIP_BINARY, FLIP_DIGEST, FLIP_KEY, WRONG_MAGIC,
        LONGER, DAMAGE_COUNT };
 static const char *const damage_names[DAMAGE_COUNT] = {
     "truncated to half", "truncated in the header", "empty", "a byte of the binary flipped",
-    "a byte of the checksum flipped", "a byte of the key flipped", "wrong magic",
+    "a byte of the digest flipped", "a byte of the key flipped", "wrong magic",
     "a byte appended"};
 
 static void flip(int fd, off_t at) {
@@ -146,8 +155,8 @@ static void damage(const char *path, int kind) {
     case FLIP_BINARY:
         flip(fd, (off_t)(size / 2));
         break;
-    case FLIP_CHECKSUM:
-        flip(fd, (off_t)(size - 3));
+    case FLIP_DIGEST:
+        flip(fd, (off_t)(HEADER_BYTES - 3));
         break;
     case FLIP_KEY:
         flip(fd, 20);
@@ -199,6 +208,272 @@ static void remove_tree(const char *path) {
     } else {
         unlink(path);
     }
+}
+
+/* ---- trust (issue 23, item 1) ------------------------------------------------------------------ */
+
+static unsigned char *read_whole(const char *path, size_t *size) {
+    *size = file_size(path);
+    unsigned char *data = malloc(*size + 1);
+    FILE *f = fopen(path, "rb");
+    CHECK(data && f && fread(data, 1, *size, f) == *size && fclose(f) == 0);
+    data[*size] = 0; /* text files can be searched as strings */
+    return data;
+}
+
+/* Writes `path` anew with exactly `mode` (whatever the umask). */
+static void write_whole(const char *path, const void *data, size_t size, mode_t mode) {
+    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    CHECK(fd >= 0 && write(fd, data, size) == (ssize_t)size && fchmod(fd, mode) == 0);
+    CHECK(close(fd) == 0);
+}
+
+/* A copy of the kernels in `dir` whose fast_exp2 takes a quarter of its argument: Gaussians twice
+ * as wide, so every vertex moves differently. What an attacker's binary would compute. */
+static void modified_kernels(const char *dir) {
+    static const char *const names[] = {"common.cl", "mollify.cl", "bilateral.cl", "estimate.cl"};
+    static const char anchor[] = "inline lanef fast_exp2(lanef x) {";
+    CHECK(mkdir(dir, 0700) == 0);
+    for (int i = 0; i < 4; i++) {
+        char from[1024], to[1024];
+        snprintf(from, sizeof from, "%s/%s", RSMOOTH_KERNEL_SOURCE_DIR, names[i]);
+        snprintf(to, sizeof to, "%s/%s", dir, names[i]);
+        size_t size;
+        unsigned char *text = read_whole(from, &size);
+        FILE *f = fopen(to, "wb");
+        CHECK(f);
+        char *at = i == 0 ? strstr((char *)text, anchor) : NULL;
+        if (i == 0) {
+            CHECK(at && (size_t)(at - (char *)text) < size);
+            size_t head = (size_t)(at - (char *)text) + sizeof anchor - 1;
+            CHECK(fwrite(text, 1, head, f) == head);
+            fputs(" x = 0.25f * x;", f);
+            CHECK(fwrite(text + head, 1, size - head, f) == size - head);
+        } else {
+            CHECK(fwrite(text, 1, size, f) == size);
+        }
+        CHECK(fclose(f) == 0);
+        free(text);
+    }
+}
+
+/* Standard error between capture_begin and capture_count goes to a file. */
+static int saved_stderr = -1;
+static char capture_path[600];
+
+static void capture_begin(void) {
+    fflush(stderr);
+    saved_stderr = dup(2);
+    int fd = open(capture_path, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    CHECK(saved_stderr >= 0 && fd >= 0 && dup2(fd, 2) == 2);
+    close(fd);
+}
+
+/* Ends the capture, prints what was said, and counts the lines that contain `needle`. */
+static int capture_count(const char *needle) {
+    fflush(stderr);
+    CHECK(dup2(saved_stderr, 2) == 2);
+    close(saved_stderr);
+    FILE *f = fopen(capture_path, "r");
+    CHECK(f);
+    char line[2048];
+    int count = 0;
+    while (fgets(line, sizeof line, f)) {
+        printf("  stderr: %s", line);
+        count += strstr(line, needle) != NULL;
+    }
+    fclose(f);
+    return count;
+}
+
+static double max_difference(const double *a, const double *b, size_t n) {
+    double most = 0;
+    for (size_t i = 0; i < n; i++)
+        most = fmax(most, fabs(a[i] - b[i]));
+    return most;
+}
+
+/* A context that must refuse the cache; its results must be the genuine program's. */
+static void expect_refused(const shape_mesh *cube, const double *genuine, double *out) {
+    rsmooth_context *ctx = create("refused");
+    smooth(ctx, cube, out);
+    rsmooth_context_destroy(ctx);
+    CHECK(memcmp(out, genuine, 6 * cube->vertex_count * sizeof *out) == 0);
+}
+
+/* The planted file `payload` at `name` in a fresh folder `folder` (made 0700, then given `mode`). */
+static void plant(char *dir, size_t size, const char *folder, mode_t mode, const char *name,
+                  const unsigned char *payload, size_t payload_size, mode_t file_mode) {
+    make_dir(dir, size, folder);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    write_whole(path, payload, payload_size, file_mode);
+    CHECK(chmod(dir, mode) == 0);
+}
+
+static void trust(const shape_mesh *cube, const double *genuine) {
+    size_t n = 6 * cube->vertex_count;
+    double *out = malloc(n * sizeof *out), *modified = malloc(n * sizeof *modified);
+    char dir[512], path[1024], kernels[512], name[256];
+    CHECK(out && modified);
+    alarm(600); /* a cache read that blocks (a FIFO) fails the test instead of hanging it */
+
+    printf("trust: the genuine file and one built from modified kernels:\n");
+    make_dir(dir, sizeof dir, "trust-genuine");
+    use_dir(dir);
+    create_destroy("miss");
+    the_file(dir, path, sizeof path);
+    snprintf(name, sizeof name, "%s", strrchr(path, '/') + 1);
+    size_t genuine_size, modified_size;
+    unsigned char *genuine_file = read_whole(path, &genuine_size);
+    snprintf(kernels, sizeof kernels, "%s/modified-kernels", base);
+    modified_kernels(kernels);
+    CHECK(setenv("RSMOOTH_KERNEL_DIR", kernels, 1) == 0);
+    make_dir(dir, sizeof dir, "trust-modified");
+    use_dir(dir);
+    rsmooth_context *ctx = create("miss");
+    smooth(ctx, cube, modified);
+    rsmooth_context_destroy(ctx);
+    CHECK(unsetenv("RSMOOTH_KERNEL_DIR") == 0);
+    printf("  modified kernels move vertices up to %.3g from the genuine results\n",
+           max_difference(modified, genuine, n));
+    CHECK(max_difference(modified, genuine, n) > 1e-3);
+    the_file(dir, path, sizeof path);
+    unsigned char *modified_file = read_whole(path, &modified_size);
+
+    /* The attack: the genuine file's key words, the modified binary, a digest made to match. */
+    CHECK(genuine_size > HEADER_BYTES && modified_size > HEADER_BYTES);
+    size_t binary_size = modified_size - HEADER_BYTES, payload_size = modified_size;
+    unsigned char *payload = malloc(payload_size);
+    CHECK(payload);
+    memcpy(payload, genuine_file, HEADER_WORDS_BYTES);
+    for (int i = 0; i < 8; i++)
+        payload[48 + i] = (unsigned char)((uint64_t)binary_size >> (8 * i));
+    memcpy(payload + HEADER_BYTES, modified_file + HEADER_BYTES, binary_size);
+    rs_blake2b digest;
+    CHECK(rs_blake2b_init(&digest, 32));
+    rs_blake2b_update(&digest, payload, HEADER_WORDS_BYTES);
+    rs_blake2b_update(&digest, payload + HEADER_BYTES, binary_size);
+    rs_blake2b_final(&digest, payload + HEADER_WORDS_BYTES);
+
+    printf("in the user's own folder the planted file is a working payload (control):\n");
+    plant(dir, sizeof dir, "trust-own", 0700, name, payload, payload_size, 0600);
+    use_dir(dir);
+    ctx = create("hit");
+    smooth(ctx, cube, out);
+    rsmooth_context_destroy(ctx);
+    CHECK(memcmp(out, modified, n * sizeof *out) == 0);
+    char own_payload[1024];
+    snprintf(own_payload, sizeof own_payload, "%s/%s", dir, name);
+
+    printf("the genuine key with the digest not matching the binary: a miss, replaced:\n");
+    memcpy(payload + HEADER_WORDS_BYTES, genuine_file + HEADER_WORDS_BYTES, 32);
+    plant(dir, sizeof dir, "trust-digest", 0700, name, payload, payload_size, 0600);
+    use_dir(dir);
+    ctx = create("miss");
+    smooth(ctx, cube, out);
+    rsmooth_context_destroy(ctx);
+    CHECK(memcmp(out, genuine, n * sizeof *out) == 0);
+    create_destroy("hit");
+    free(payload);
+    payload = read_whole(own_payload, &payload_size); /* the valid payload again */
+
+    printf("a folder writable by others: refused, said once on stderr, nothing written:\n");
+    snprintf(capture_path, sizeof capture_path, "%s/stderr.txt", base);
+    plant(dir, sizeof dir, "trust-writable", 0777, name, payload, payload_size, 0600);
+    use_dir(dir);
+    capture_begin();
+    ctx = create("refused");
+    rsmooth_context_destroy(ctx);
+    create_destroy("refused");
+    CHECK_EQ_INT(capture_count("not using the program cache"), 1);
+    expect_refused(cube, genuine, out);
+    int files, others;
+    count_files(dir, &files, &others);
+    CHECK_EQ_INT(files, 1);
+    CHECK_EQ_INT(others, 0);
+    size_t after_size;
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    unsigned char *after = read_whole(path, &after_size);
+    CHECK(after_size == payload_size && memcmp(after, payload, payload_size) == 0);
+    free(after);
+    plant(dir, sizeof dir, "trust-group", 0770, name, payload, payload_size, 0600);
+    use_dir(dir);
+    expect_refused(cube, genuine, out);
+
+    printf("a file writable by others in the user's folder: refused:\n");
+    plant(dir, sizeof dir, "trust-file-mode", 0700, name, payload, payload_size, 0666);
+    use_dir(dir);
+    expect_refused(cube, genuine, out);
+
+    if (geteuid() == 0) {
+        printf("a folder, and a file, of another user (uid 65534): refused:\n");
+        plant(dir, sizeof dir, "trust-other-folder", 0700, name, payload, payload_size, 0600);
+        CHECK(chown(dir, 65534, 65534) == 0);
+        use_dir(dir);
+        expect_refused(cube, genuine, out);
+        plant(dir, sizeof dir, "trust-other-file", 0700, name, payload, payload_size, 0600);
+        snprintf(path, sizeof path, "%s/%s", dir, name);
+        CHECK(chown(path, 65534, 65534) == 0);
+        use_dir(dir);
+        expect_refused(cube, genuine, out);
+    } else {
+        printf("(not root: another user's folder and file are not tried)\n");
+    }
+
+    printf("the default folders: a home chain with a folder writable by others: refused:\n");
+    char home[512], sub[700];
+    make_dir(home, sizeof home, "trust-home");
+    snprintf(sub, sizeof sub, "%s/.cache", home);
+    CHECK(mkdir(sub, 0700) == 0);
+    snprintf(sub, sizeof sub, "%s/.cache/rsmooth", home);
+    CHECK(mkdir(sub, 0700) == 0);
+    snprintf(path, sizeof path, "%s/%s", sub, name);
+    write_whole(path, payload, payload_size, 0600);
+    CHECK(setenv("HOME", home, 1) == 0);
+    CHECK(unsetenv("RSMOOTH_CACHE_DIR") == 0 && unsetenv("XDG_CACHE_HOME") == 0);
+    ctx = create("hit"); /* all the user's own: the payload is loaded (control) */
+    rsmooth_context_destroy(ctx);
+    snprintf(sub, sizeof sub, "%s/.cache", home);
+    CHECK(chmod(sub, 0777) == 0);
+    expect_refused(cube, genuine, out);
+    CHECK(chmod(sub, 0700) == 0);
+    snprintf(sub, sizeof sub, "%s/xdg", home); /* $XDG_CACHE_HOME below home: the same rule */
+    CHECK(mkdir(sub, 0777) == 0 && chmod(sub, 0777) == 0);
+    CHECK(setenv("XDG_CACHE_HOME", sub, 1) == 0);
+    snprintf(sub, sizeof sub, "%s/xdg/rsmooth", home);
+    CHECK(mkdir(sub, 0700) == 0);
+    snprintf(path, sizeof path, "%s/%s", sub, name);
+    write_whole(path, payload, payload_size, 0600);
+    expect_refused(cube, genuine, out);
+    CHECK(unsetenv("XDG_CACHE_HOME") == 0 && unsetenv("HOME") == 0);
+
+    printf("a FIFO at the key's name: not opened for long (no hang), replaced by a file:\n");
+    make_dir(dir, sizeof dir, "trust-fifo");
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    CHECK(mkfifo(path, 0600) == 0);
+    use_dir(dir);
+    create_destroy("miss");
+    struct stat st;
+    CHECK(lstat(path, &st) == 0 && S_ISREG(st.st_mode));
+    create_destroy("hit");
+
+    printf("a symbolic link at the key's name (to the working payload): not followed:\n");
+    make_dir(dir, sizeof dir, "trust-link");
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    CHECK(symlink(own_payload, path) == 0);
+    use_dir(dir);
+    ctx = create("miss");
+    smooth(ctx, cube, out);
+    rsmooth_context_destroy(ctx);
+    CHECK(memcmp(out, genuine, n * sizeof *out) == 0);
+    CHECK(lstat(path, &st) == 0 && S_ISREG(st.st_mode)); /* the store replaced the link */
+    alarm(0);
+    free(payload);
+    free(genuine_file);
+    free(modified_file);
+    free(out);
+    free(modified);
 }
 
 int main(int argc, char **argv) {
@@ -344,6 +619,7 @@ int main(int argc, char **argv) {
     CHECK(file_size(path) > 64); /* whole: the next context hits it */
     create_destroy("hit");
 
+    trust(&cube, miss);
     free(miss);
     free(hit);
     shape_free(&cube);

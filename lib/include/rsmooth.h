@@ -613,12 +613,18 @@ RSMOOTH_API const char *rsmooth_context_device_name(const rsmooth_context *ctx);
 RSMOOTH_API double rsmooth_context_build_ms(const rsmooth_context *ctx);
 
 /* Where the context's program came from: "hit" (built from the binary in rsmooth's program cache),
- * "miss" (built from source, its binary then stored) or "off" (no cache: RSMOOTH_CACHE_DIR is empty
- * or "off", or neither XDG_CACHE_HOME nor HOME is set). The cache is the folder RSMOOTH_CACHE_DIR,
- * else $XDG_CACHE_HOME/rsmooth, else $HOME/.cache/rsmooth, created (mode 0700) when first written;
- * one file per device, driver, program source and build options. A file that is damaged, another
- * key's or fails to build is a miss and is replaced; a folder that cannot be written only means a
- * build from source each time. Static text; "" for NULL. (Added in 0.8) */
+ * "miss" (built from source, its binary then stored), "refused" (built from source: the cache
+ * folder or file could have been written by another user, see below) or "off" (no cache:
+ * RSMOOTH_CACHE_DIR is empty or "off", or neither XDG_CACHE_HOME nor HOME is set). The cache is the
+ * folder RSMOOTH_CACHE_DIR, else $XDG_CACHE_HOME/rsmooth, else $HOME/.cache/rsmooth, created (mode
+ * 0700) when first written; one file per device, driver, program source and build options. A
+ * program binary is native code, so a file is used only when it, its folder and every folder
+ * between the home folder and it (or RSMOOTH_CACHE_DIR itself) belong to the effective user and
+ * are writable by nobody else; otherwise the first such context of the process says why on stderr
+ * and builds from source. A file that is damaged (its BLAKE2b digest is checked), another key's,
+ * not a regular file or fails to build is a miss and is replaced; a folder that cannot be written
+ * only means a build from source each time. Static text; "" for NULL. (Added in 0.8; "refused"
+ * in 0.9) */
 RSMOOTH_API const char *rsmooth_context_program_cache(const rsmooth_context *ctx);
 
 /* How the context's kernels spread the work on its device: *lanes vertices per work-item (the
