@@ -12,3 +12,15 @@ expect() {
   local got=$?
   [ "$got" -eq "$want" ] || fail "exit $got (wanted $want): $* -- $(cat err.txt)"
 }
+# expect_within SECONDS STATUS COMMAND...: as expect, and a command still running after SECONDS is
+# killed and counted as a failure (a hang), not left to stall the suite.
+expect_within() {
+  local seconds=$1 want=$2; shift 2
+  timeout -k 5 "$seconds" "$@" >out.txt 2>err.txt
+  local got=$?
+  if [ "$got" -eq 124 ] || [ "$got" -eq 137 ]; then
+    fail "still running after $seconds s (a hang): $*"
+  else
+    [ "$got" -eq "$want" ] || fail "exit $got (wanted $want): $* -- $(cat err.txt)"
+  fi
+}

@@ -26,6 +26,7 @@ for file in "$rsmooth" "$shape" "$@"; do
 done
 
 expect 0 "$shape" make noisy.ply truth.ply --noise 0.3 --triangles 600
+mkdir empty
 
 # No loader at all.
 export RSMOOTH_OPENCL_LIBRARY=$missing
@@ -72,6 +73,28 @@ if [ -n "$loader" ]; then
   cmp -s out.txt default.txt || fail "RSMOOTH_OPENCL_LIBRARY=$loader lists other devices"
 fi
 
+# Named files that must never reach dlopen (issue 23, item 13): a truncated copy of the loader
+# (dlopen maps segments past the file's end: SIGBUS), a FIFO (blocks forever), a device, a folder,
+# a text file. Each refused before dlopen, naming the file and why, within seconds.
+if [ -n "$loader" ]; then
+  real=$(readlink -f "$loader")
+  head -c 30000 "$real" >truncated.so
+  head -c 200 "$real" >headers-only.so
+  mkfifo fifo.so
+  echo "not a library" >text.so
+  for case in "truncated.so:truncated" "headers-only.so:truncated" "fifo.so:not a regular file" \
+              "/dev/zero:not a regular file" "empty:a folder" "text.so:not an ELF file"; do
+    file=${case%%:*} why=${case#*:}
+    [ "${file#/}" = "$file" ] && file=$PWD/$file
+    RSMOOTH_OPENCL_LIBRARY=$file expect_within 20 2 "$rsmooth" noisy.ply -o x.ply --device cpu
+    grep -q "no OpenCL loader: $file (RSMOOTH_OPENCL_LIBRARY) could not be loaded ($why" err.txt ||
+      fail "RSMOOTH_OPENCL_LIBRARY=$file: not refused as '$why': $(cat err.txt)"
+    RSMOOTH_OPENCL_LIBRARY=$file expect_within 20 0 "$rsmooth" noisy.ply -o auto-$$.ply --force
+    grep -q "warning: no OpenCL loader: $file" err.txt ||
+      fail "RSMOOTH_OPENCL_LIBRARY=$file: auto gives no warning: $(cat err.txt)"
+  done
+fi
+
 # Really absent, where a user namespace can hide the installed loader (/dev/null over its file).
 if [ -n "$loader" ] && unshare -r -m true 2>/dev/null; then
   unshare -r -m sh -c 'mount --bind /dev/null "$1" && exec "$2" noisy.ply -o hidden.ply' \
@@ -84,7 +107,6 @@ if [ -n "$loader" ] && unshare -r -m true 2>/dev/null; then
 fi
 
 # A loader without platforms: auto falls back too, saying there is no platform.
-mkdir empty
 OCL_ICD_VENDORS=$PWD/empty OCL_ICD_FILENAMES= expect 0 "$rsmooth" noisy.ply -o none.ply
 grep -q "reference path" err.txt || fail "no platform: no fallback warning: $(cat err.txt)"
 if [ -n "$loader" ]; then
