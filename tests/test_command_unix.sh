@@ -143,6 +143,21 @@ expect 2 "$rsmooth" noisy.ply -o x.obj --mask farmask.txt $ref
 grep -q "farmask.txt:1: vertex 99999999 is beyond" err.txt || fail "far --mask: $(cat err.txt)"
 expect 2 "$rsmooth" noisy.ply -o x.obj --mask mask.txt --method taubin
 [ -e x.obj ] && fail "an output written after a bad --mask"
+# Masks that are not text (issue 23, item 14): a device is refused at once instead of read
+# forever, a NUL byte is an error at its line and column instead of cutting the line, an endless
+# pipe stops at the size bound; a pipe of indices works as the file does.
+expect_within 20 2 "$rsmooth" noisy.ply -o x.obj --mask /dev/zero $ref
+grep -q "mask /dev/zero: is a device or special file" err.txt || fail "--mask /dev/zero: $(cat err.txt)"
+printf '1\0002\n' > nulmask.txt
+expect_within 20 2 "$rsmooth" noisy.ply -o x.obj --mask nulmask.txt $ref
+grep -q "nulmask.txt:1: a NUL byte at column 2" err.txt || fail "NUL in --mask: $(cat err.txt)"
+expect_within 20 2 "$rsmooth" noisy.ply -o x.obj --mask . $ref
+grep -q "mask \.: is a folder" err.txt || fail "--mask of a folder: $(cat err.txt)"
+expect_within 60 2 "$rsmooth" noisy.ply -o x.obj --mask <(yes 1) $ref
+grep -q "longer than .* bytes" err.txt || fail "--mask of an endless pipe: $(cat err.txt)"
+[ -e x.obj ] && fail "an output written after a mask that is not text"
+expect_within 60 0 "$rsmooth" mnoisy.obj -o piped.obj --mask <(cat mask.txt) $ref -q
+cmp -s piped.obj masked.obj || fail "--mask from a pipe differs from the file"
 
 [ "$failures" -eq 0 ] && echo "command (unix): all checks passed" || echo "$failures failure(s)"
 exit $((failures > 0))
