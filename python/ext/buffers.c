@@ -2,6 +2,7 @@
  * handed to the library. */
 #include "ext.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 /* The struct-module type character of a format string ("<d", "=f", "I"...); 0 when the format
@@ -88,11 +89,38 @@ int ext_array_get(PyObject *obj, const char *name, ext_kind kind, Py_ssize_t col
         return -1;
     }
     a->rows = a->view.shape[0];
+    a->data = a->view.buf;
     return 0;
+}
+
+int ext_array_own(ext_array *a, int keep) {
+    if (!a->held)
+        return 0; /* an optional array left out */
+    size_t bytes = (size_t)a->view.len;
+    a->copy = malloc(bytes ? bytes : 1);
+    if (!a->copy) {
+        PyErr_NoMemory();
+        return -1;
+    }
+    memcpy(a->copy, a->view.buf, bytes);
+    a->data = a->copy;
+    if (!keep) {
+        PyBuffer_Release(&a->view);
+        a->held = 0;
+    }
+    return 0;
+}
+
+void ext_array_publish(ext_array *a) {
+    if (a->held && a->copy)
+        memcpy(a->view.buf, a->copy, (size_t)a->view.len);
 }
 
 void ext_array_release(ext_array *a) {
     if (a->held)
         PyBuffer_Release(&a->view);
     a->held = 0;
+    free(a->copy);
+    a->copy = NULL;
+    a->data = NULL;
 }

@@ -23,7 +23,8 @@ rsmooth_context *ext_context_from(PyObject *obj) {
 PyObject *ext_context_create(PyObject *self, PyObject *args) {
     (void)self;
     const char *device = NULL;
-    if (!PyArg_ParseTuple(args, "z", &device))
+    if (!PyArg_ParseTuple(args, "z", &device) ||
+        ext_refuse_inside_context_call("Context() made") != 0) /* (before seconds of build) */
         return NULL;
     rsmooth_context *ctx = NULL;
     rsmooth_error err;
@@ -46,10 +47,16 @@ PyObject *ext_context_info(PyObject *self, PyObject *args) {
     if (!PyArg_ParseTuple(args, "O", &capsule))
         return NULL;
     rsmooth_context *ctx = ext_context_from(capsule);
-    if (!ctx)
+    if (!ctx || ext_refuse_inside_context_call("a Context's figures read") != 0)
         return NULL;
+    /* the budget is read under the context's lock, which a call on another thread may hold
+     * until its progress callable has had the GIL */
+    uint64_t budget;
+    Py_BEGIN_ALLOW_THREADS
+    budget = rsmooth_context_memory_budget(ctx);
+    Py_END_ALLOW_THREADS
     return Py_BuildValue("(sdK)", rsmooth_context_device_name(ctx), rsmooth_context_build_ms(ctx),
-                         (unsigned long long)rsmooth_context_memory_budget(ctx));
+                         (unsigned long long)budget);
 }
 
 /* _devices() -> list of dicts, one per OpenCL device ([] without OpenCL). */

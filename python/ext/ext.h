@@ -34,6 +34,8 @@ typedef struct ext_array {
     int held;
     Py_ssize_t rows;
     rsmooth_scalar scalar; /* EXT_REAL arrays */
+    void *data;            /* what the library gets: the view's items, or `copy` */
+    void *copy;            /* the call's own copy (ext_array_own), or NULL */
 } ext_array;
 
 /* Acquires `obj` as a C-contiguous array of `cols` columns (cols 0: one dimension) of `kind`,
@@ -42,7 +44,19 @@ typedef struct ext_array {
 int ext_array_get(PyObject *obj, const char *name, ext_kind kind, Py_ssize_t cols, int writable,
                   int optional, ext_array *a);
 
-/* Releases the buffer (if held). */
+/* Gives the library (a->data) a copy of the items that only this call can reach, and lets go
+ * of the view unless `keep` (an output: ext_array_publish writes the result back). While the
+ * library runs, Python code runs too (the progress callable, other threads: the GIL is
+ * released), and it may rewrite, resize or free the caller's array; the library reads indices
+ * and positions again long after checking them, so it must never see memory Python can change.
+ * Costs one memcpy of the array, small beside the filter. Returns 0, or -1 with MemoryError. */
+int ext_array_own(ext_array *a, int keep);
+
+/* Copies the call's result (a->copy) into the caller's array, the view kept by
+ * ext_array_own(a, 1). */
+void ext_array_publish(ext_array *a);
+
+/* Releases the buffer (if held) and the copy. */
 void ext_array_release(ext_array *a);
 
 /* ---- module functions ------------------------------------------------------------------------ */
@@ -64,7 +78,23 @@ PyObject *ext_context_info(PyObject *self, PyObject *args);                    /
  * not one. */
 rsmooth_context *ext_context_from(PyObject *obj);
 
+/* Returns 0, or -1 with RuntimeError naming `what` when this thread is inside a call on an
+ * OpenCL context (its progress callable is running): that call holds its context's lock until
+ * it returns, and anything taking a context's lock now could wait for ever (filter.c). */
+int ext_refuse_inside_context_call(const char *what);
+
 /* ---- parameters (params.c) ------------------------------------------------------------------- */
+
+/* The most Laplacian or Taubin steps: the command's bound (--iterations, host/cli_options.c). */
+#define EXT_MAX_ITERATIONS 1000000
+
+/* A whole number in [min, max] (an int or anything with __index__, not a bool): 0 and *out, or
+ * -1 with TypeError or ValueError naming `name` and the range. */
+int ext_whole_arg(PyObject *value, const char *name, long min, long max, long *out);
+
+/* A real number (a float, an int, anything with __float__, not a bool): 0 and *out, or -1 with
+ * TypeError or ValueError naming `name`. The range is the library's to check (NaN included). */
+int ext_real_arg(PyObject *value, const char *name, double *out);
 
 /* The arrays a params dict may hold ("colors": (n, 3) float32, "move_mask": (n,) uint8), held
  * while the call runs. */

@@ -1,7 +1,9 @@
 /* The filters, with the GIL released while they run. The library reports progress on the calling
  * thread (rsmooth_progress_cancel_fn), so each report takes the GIL back for a moment: it runs
  * Python's signal handlers (Ctrl-C raises KeyboardInterrupt there) and the caller's progress
- * callable, and either raising stops the filter with RSMOOTH_ERROR_CANCELLED. */
+ * callable, and either raising stops the filter with RSMOOTH_ERROR_CANCELLED. The library reads
+ * only the call's own copies of the arrays (ext_array_own): what that Python code does to the
+ * caller's arrays cannot reach it. */
 #include "ext.h"
 
 #include <string.h>
@@ -9,7 +11,26 @@
 typedef struct call_state {
     PyThreadState *thread; /* saved while the library runs */
     PyObject *progress;    /* callable(fraction) or NULL */
+    int on_context;        /* the call holds an OpenCL context's lock until it returns */
 } call_state;
+
+/* The calls on an OpenCL context this thread is inside: Python code that runs on it meanwhile
+ * (the progress callable, a signal handler) is inside them too. */
+static _Thread_local int contexts_held;
+
+int ext_refuse_inside_context_call(const char *what) {
+    if (contexts_held == 0)
+        return 0;
+    /* The same context would wait for ever for its own lock, with the GIL held (Ctrl-C could not
+     * stop it); another one could wait for a thread that waits for this one. */
+    PyErr_Format(PyExc_RuntimeError,
+                 "rsmooth: %s from inside a progress callable, while a call on an OpenCL "
+                 "context runs: that call holds its context until it returns, so this one could "
+                 "wait for ever. Call it after that call returns (device=\"reference\" needs no "
+                 "context)",
+                 what);
+    return -1;
+}
 
 static int report(void *user, double fraction) {
     call_state *c = user;
@@ -37,8 +58,10 @@ static PyObject *report_dict(const rsmooth_report *r) {
 
 /* Hands the library `progress` through p's progress_cancel and lets go of the GIL: the filter
  * call follows, then finish_call. */
-static void start_call(call_state *c, PyObject *progress, rsmooth_params *p) {
+static void start_call(call_state *c, PyObject *progress, rsmooth_params *p, int on_context) {
     c->progress = progress == Py_None ? NULL : progress;
+    c->on_context = on_context;
+    contexts_held += on_context;
     p->progress_cancel = report;
     p->progress_user = c;
     c->thread = PyEval_SaveThread();
@@ -49,6 +72,7 @@ static void start_call(call_state *c, PyObject *progress, rsmooth_params *p) {
 static PyObject *finish_call(call_state *c, rsmooth_status st, const rsmooth_report *rep,
                              const rsmooth_error *err) {
     PyEval_RestoreThread(c->thread);
+    contexts_held -= c->on_context;
     return st == RSMOOTH_OK && !PyErr_Occurred() ? report_dict(rep) : ext_raise(st, err);
 }
 
@@ -64,7 +88,8 @@ PyObject *ext_smooth(PyObject *self, PyObject *args, PyObject *kwargs) {
                                      &oobj, &kobj, &pobj, &progress))
         return NULL;
     rsmooth_context *ctx = NULL;
-    if (cobj != Py_None && !(ctx = ext_context_from(cobj)))
+    if (cobj != Py_None && (!(ctx = ext_context_from(cobj)) ||
+                            ext_refuse_inside_context_call("smooth() on an OpenCL context") != 0))
         return NULL;
     ext_array v, f, out, conf;
     ext_param_arrays held;
@@ -86,19 +111,25 @@ PyObject *ext_smooth(PyObject *self, PyObject *args, PyObject *kwargs) {
         PyErr_SetString(PyExc_ValueError, "outputs must have a row per vertex");
         goto done;
     }
+    if (ext_array_own(&v, 0) != 0 || ext_array_own(&f, 0) != 0 || ext_array_own(&out, 1) != 0 ||
+        ext_array_own(&conf, 1) != 0)
+        goto done;
     call_state call;
     rsmooth_report rep;
     rsmooth_error err;
     rsmooth_status st;
-    start_call(&call, progress, &p);
+    start_call(&call, progress, &p, ctx != NULL);
     if (ctx)
-        st = rsmooth_smooth(ctx, v.scalar, v.view.buf, (size_t)v.rows, f.view.buf, (size_t)f.rows,
-                            &p, out.view.buf, NULL, conf.held ? conf.view.buf : NULL, &rep, &err);
+        st = rsmooth_smooth(ctx, v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows, &p,
+                            out.data, NULL, conf.data, &rep, &err);
     else
-        st = rsmooth_smooth_reference(v.scalar, v.view.buf, (size_t)v.rows, f.view.buf,
-                                      (size_t)f.rows, &p, out.view.buf, NULL,
-                                      conf.held ? conf.view.buf : NULL, &rep, &err);
+        st = rsmooth_smooth_reference(v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows,
+                                      &p, out.data, NULL, conf.data, &rep, &err);
     result = finish_call(&call, st, &rep, &err);
+    if (result) {
+        ext_array_publish(&out);
+        ext_array_publish(&conf);
+    }
 done:
     ext_param_arrays_release(&held);
     ext_array_release(&conf);
@@ -141,14 +172,22 @@ PyObject *ext_smooth_points(PyObject *self, PyObject *args, PyObject *kwargs) {
         PyErr_SetString(PyExc_ValueError, "normals and outputs must have a row per point");
         goto done;
     }
+    if (ext_array_own(&v, 0) != 0 || ext_array_own(&n, 0) != 0 || ext_array_own(&out, 1) != 0 ||
+        ext_array_own(&out_n, 1) != 0 || ext_array_own(&conf, 1) != 0)
+        goto done;
     call_state call;
     rsmooth_report rep;
     rsmooth_error err;
-    start_call(&call, progress, &p);
-    rsmooth_status st = rsmooth_smooth_points_reference(
-        v.scalar, v.view.buf, n.view.buf, (size_t)v.rows, &p, out.view.buf,
-        out_n.held ? out_n.view.buf : NULL, conf.held ? conf.view.buf : NULL, &rep, &err);
+    start_call(&call, progress, &p, 0);
+    rsmooth_status st = rsmooth_smooth_points_reference(v.scalar, v.data, n.data, (size_t)v.rows,
+                                                        &p, out.data, out_n.data, conf.data, &rep,
+                                                        &err);
     result = finish_call(&call, st, &rep, &err);
+    if (result) {
+        ext_array_publish(&out);
+        ext_array_publish(&out_n);
+        ext_array_publish(&conf);
+    }
 done:
     ext_param_arrays_release(&held);
     ext_array_release(&conf);
@@ -159,16 +198,27 @@ done:
     return result;
 }
 
-/* _taubin(vertices, faces, out, lam, mu, iterations) -> None: rsmooth_smooth_taubin. */
+/* _taubin(vertices, faces, out, lam, mu, iterations) -> None: rsmooth_smooth_taubin. lam in
+ * (0, 1], mu in [-1, 0] (0: Laplacian), iterations in [0, EXT_MAX_ITERATIONS]. */
 PyObject *ext_taubin(PyObject *self, PyObject *args, PyObject *kwargs) {
     (void)self;
     static char *keywords[] = {"vertices", "faces", "out", "lam", "mu", "iterations", NULL};
-    PyObject *vobj, *fobj, *oobj;
+    PyObject *vobj, *fobj, *oobj, *lobj, *mobj, *iobj;
     double lam, mu;
-    unsigned int iterations;
-    if (!PyArg_ParseTupleAndKeywords(args, kwargs, "OOOddI", keywords, &vobj, &fobj, &oobj, &lam,
-                                     &mu, &iterations))
+    long iterations;
+    if (!PyArg_ParseTupleAndKeywords(args, kwargs, "OOOOOO", keywords, &vobj, &fobj, &oobj,
+                                     &lobj, &mobj, &iobj) ||
+        ext_real_arg(lobj, "lam", &lam) != 0 || ext_real_arg(mobj, "mu", &mu) != 0 ||
+        ext_whole_arg(iobj, "iterations", 0, EXT_MAX_ITERATIONS, &iterations) != 0)
         return NULL;
+    if (!(lam > 0 && lam <= 1)) {
+        PyErr_Format(PyExc_ValueError, "lam must be in (0, 1] (got %R)", lobj);
+        return NULL;
+    }
+    if (!(mu >= -1 && mu <= 0)) {
+        PyErr_Format(PyExc_ValueError, "mu must be in [-1, 0], 0 for Laplacian (got %R)", mobj);
+        return NULL;
+    }
     ext_array v, f, out;
     memset(&f, 0, sizeof f);
     memset(&out, 0, sizeof out);
@@ -183,13 +233,17 @@ PyObject *ext_taubin(PyObject *self, PyObject *args, PyObject *kwargs) {
         PyErr_SetString(PyExc_ValueError, "out must have a row per vertex");
         goto done;
     }
+    /* no progress callable here, but other threads run while the GIL is released */
+    if (ext_array_own(&v, 0) != 0 || ext_array_own(&f, 0) != 0 || ext_array_own(&out, 1) != 0)
+        goto done;
     rsmooth_error err;
     rsmooth_status st;
     Py_BEGIN_ALLOW_THREADS
-    st = rsmooth_smooth_taubin(v.scalar, v.view.buf, (size_t)v.rows, f.view.buf, (size_t)f.rows,
-                               lam, mu, iterations, out.view.buf, &err);
+    st = rsmooth_smooth_taubin(v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows, lam, mu,
+                               (unsigned)iterations, out.data, &err);
     Py_END_ALLOW_THREADS
     if (st == RSMOOTH_OK) {
+        ext_array_publish(&out);
         Py_INCREF(Py_None);
         result = Py_None;
     } else {

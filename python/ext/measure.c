@@ -1,5 +1,6 @@
 /* Measures of a mesh: its noise, its mean edge length, a point set's spacing, and the error of a
- * result against its ground truth (rsmooth_compare). */
+ * result against its ground truth (rsmooth_compare). Each reads its own copies of the arrays
+ * (ext_array_own): other threads run while the GIL is released. */
 #include "ext.h"
 
 #include <string.h>
@@ -20,10 +21,12 @@ static PyObject *measure_mesh(PyObject *args, mesh_measure measure) {
     }
     double value = 0;
     rsmooth_error err;
-    rsmooth_status st;
-    Py_BEGIN_ALLOW_THREADS
-    st = measure(v.scalar, v.view.buf, (size_t)v.rows, f.view.buf, (size_t)f.rows, &value, &err);
-    Py_END_ALLOW_THREADS
+    rsmooth_status st = RSMOOTH_ERROR_OUT_OF_MEMORY;
+    if (ext_array_own(&v, 0) == 0 && ext_array_own(&f, 0) == 0) {
+        Py_BEGIN_ALLOW_THREADS
+        st = measure(v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows, &value, &err);
+        Py_END_ALLOW_THREADS
+    }
     ext_array_release(&f);
     ext_array_release(&v);
     return st == RSMOOTH_OK ? PyFloat_FromDouble(value) : ext_raise(st, &err);
@@ -52,10 +55,12 @@ PyObject *ext_point_spacing(PyObject *self, PyObject *args) {
         return NULL;
     double value = 0;
     rsmooth_error err;
-    rsmooth_status st;
-    Py_BEGIN_ALLOW_THREADS
-    st = rsmooth_point_spacing(v.scalar, v.view.buf, (size_t)v.rows, &value, &err);
-    Py_END_ALLOW_THREADS
+    rsmooth_status st = RSMOOTH_ERROR_OUT_OF_MEMORY;
+    if (ext_array_own(&v, 0) == 0) {
+        Py_BEGIN_ALLOW_THREADS
+        st = rsmooth_point_spacing(v.scalar, v.data, (size_t)v.rows, &value, &err);
+        Py_END_ALLOW_THREADS
+    }
     ext_array_release(&v);
     return st == RSMOOTH_OK ? PyFloat_FromDouble(value) : ext_raise(st, &err);
 }
@@ -80,12 +85,14 @@ PyObject *ext_compare(PyObject *self, PyObject *args) {
         PyErr_Format(PyExc_ValueError, "result has %zd vertices, truth %zd", r.rows, t.rows);
         goto done;
     }
+    if (ext_array_own(&r, 0) != 0 || ext_array_own(&t, 0) != 0 || ext_array_own(&f, 0) != 0)
+        goto done;
     rsmooth_metrics m;
     rsmooth_error err;
     rsmooth_status st;
     Py_BEGIN_ALLOW_THREADS
-    st = rsmooth_compare(r.scalar, r.view.buf, t.view.buf, (size_t)r.rows, f.view.buf,
-                         (size_t)f.rows, &m, &err);
+    st = rsmooth_compare(r.scalar, r.data, t.data, (size_t)r.rows, f.data, (size_t)f.rows, &m,
+                         &err);
     Py_END_ALLOW_THREADS
     if (st != RSMOOTH_OK)
         ext_raise(st, &err);

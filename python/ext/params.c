@@ -12,38 +12,105 @@ typedef struct field {
     const char *name;
     size_t offset;
     field_type type;
+    int min, max; /* FIELD_INT's range */
 } field;
 
-#define DOUBLE_FIELD(f) {#f, offsetof(rsmooth_params, f), FIELD_DOUBLE}
-#define INT_FIELD(f) {#f, offsetof(rsmooth_params, f), FIELD_INT}
+#define DOUBLE_FIELD(f) {#f, offsetof(rsmooth_params, f), FIELD_DOUBLE, 0, 0}
+#define INT_FIELD(f, min, max) {#f, offsetof(rsmooth_params, f), FIELD_INT, min, max}
 
+/* The ranges of the int fields are the command's (host/cli_options.c) and the library's
+ * (RS_MAX_ROUNDS 100 and RS_MAX_UPDATES 1000, lib/params.c): checked here too, so that a
+ * Python int beyond a C int is refused by name and range instead of wrapping. The doubles'
+ * ranges (NaN and infinities included) are the library's to check. */
 static const field fields[] = {
-    DOUBLE_FIELD(sigma_f),         DOUBLE_FIELD(sigma_g),        INT_FIELD(absolute),
-    DOUBLE_FIELD(cutoff),          DOUBLE_FIELD(mollify_cutoff), INT_FIELD(mollify),
-    INT_FIELD(predictor),          INT_FIELD(normal_filter),     DOUBLE_FIELD(normal_sigma_s),
-    DOUBLE_FIELD(normal_sigma_n),  INT_FIELD(normal_iterations), INT_FIELD(influence),
-    INT_FIELD(passes),             DOUBLE_FIELD(pass_confidence), DOUBLE_FIELD(sigma_c),
-    INT_FIELD(vertex_updates),     DOUBLE_FIELD(guided_sigma_s), DOUBLE_FIELD(guided_sigma_n),
-    INT_FIELD(guided_rounds),      INT_FIELD(stage_repeats),     DOUBLE_FIELD(discrepancy_level),
+    DOUBLE_FIELD(sigma_f),
+    DOUBLE_FIELD(sigma_g),
+    INT_FIELD(absolute, 0, 1),
+    DOUBLE_FIELD(cutoff),
+    DOUBLE_FIELD(mollify_cutoff),
+    INT_FIELD(mollify, 0, 1),
+    INT_FIELD(predictor, RSMOOTH_PREDICT_PROJECTION, RSMOOTH_PREDICT_CENTROID),
+    INT_FIELD(normal_filter, RSMOOTH_NORMALS_MOLLIFY, RSMOOTH_NORMALS_BILATERAL),
+    DOUBLE_FIELD(normal_sigma_s),
+    DOUBLE_FIELD(normal_sigma_n),
+    INT_FIELD(normal_iterations, 1, 100),
+    INT_FIELD(influence, RSMOOTH_INFLUENCE_GAUSSIAN, RSMOOTH_INFLUENCE_HUBER),
+    INT_FIELD(passes, 0, 100), /* 0 with vertex_updates only: the library checks that */
+    DOUBLE_FIELD(pass_confidence),
+    DOUBLE_FIELD(sigma_c),
+    INT_FIELD(vertex_updates, 0, 1000),
+    DOUBLE_FIELD(guided_sigma_s),
+    DOUBLE_FIELD(guided_sigma_n),
+    INT_FIELD(guided_rounds, 1, 100),
+    INT_FIELD(stage_repeats, 1, 100),
+    DOUBLE_FIELD(discrepancy_level),
 };
 #define FIELD_COUNT (sizeof fields / sizeof fields[0])
+
+int ext_whole_arg(PyObject *value, const char *name, long min, long max, long *out) {
+    int overflow = 0;
+    long v = -1;
+    int whole = !PyBool_Check(value) && PyIndex_Check(value); /* (a float has no __index__) */
+    if (whole) {
+        v = PyLong_AsLongAndOverflow(value, &overflow);
+        if (v == -1 && !overflow && PyErr_Occurred()) {
+            if (!PyErr_ExceptionMatches(PyExc_TypeError))
+                return -1;
+            PyErr_Clear(); /* an __index__ that refuses: numpy's bool */
+            whole = 0;
+        }
+    }
+    if (!whole) {
+        PyErr_Format(PyExc_TypeError, "%s must be a whole number in [%ld, %ld] (got %R)", name,
+                     min, max, value);
+        return -1;
+    }
+    if (overflow) { /* (no repr: past 4300 digits Python refuses to write one) */
+        PyErr_Format(PyExc_ValueError, "%s must be in [%ld, %ld] (got a number %s)", name, min,
+                     max, overflow > 0 ? "beyond a C long" : "below a C long");
+        return -1;
+    }
+    if (v < min || v > max) {
+        PyErr_Format(PyExc_ValueError, "%s must be in [%ld, %ld] (got %ld)", name, min, max, v);
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+int ext_real_arg(PyObject *value, const char *name, double *out) {
+    if (!PyBool_Check(value)) {
+        double v = PyFloat_AsDouble(value);
+        if (!(v == -1.0 && PyErr_Occurred())) {
+            *out = v;
+            return 0;
+        }
+        if (PyErr_ExceptionMatches(PyExc_OverflowError)) { /* an int past 1.8e308 */
+            PyErr_Clear();
+            PyErr_Format(PyExc_ValueError, "%s: the number given is beyond a double's range",
+                         name);
+            return -1;
+        }
+        if (!PyErr_ExceptionMatches(PyExc_TypeError))
+            return -1;
+        PyErr_Clear();
+    }
+    PyErr_Format(PyExc_TypeError, "%s must be a number (got %R)", name, value);
+    return -1;
+}
 
 static int set_field(rsmooth_params *p, const field *f, PyObject *value) {
     char *at = (char *)p + f->offset;
     if (f->type == FIELD_DOUBLE) {
-        double v = PyFloat_AsDouble(value);
-        if (v == -1.0 && PyErr_Occurred())
+        double v;
+        if (ext_real_arg(value, f->name, &v) != 0)
             return -1;
         memcpy(at, &v, sizeof v);
         return 0;
     }
-    long v = PyLong_AsLong(value);
-    if (v == -1 && PyErr_Occurred())
+    long v;
+    if (ext_whole_arg(value, f->name, f->min, f->max, &v) != 0)
         return -1;
-    if (v < -1000000 || v > 1000000) { /* every int field is a small count, flag or enum */
-        PyErr_Format(PyExc_ValueError, "%s: %ld is out of range", f->name, v);
-        return -1;
-    }
     int iv = (int)v;
     memcpy(at, &iv, sizeof iv);
     return 0;
@@ -60,7 +127,7 @@ static const void *hold(PyObject *value, const char *name, ext_kind kind, Py_ssi
         PyErr_Format(PyExc_ValueError, "%s: %zd rows for %zd vertices", name, a->rows, rows);
         return NULL;
     }
-    return a->view.buf;
+    return ext_array_own(a, 0) == 0 ? a->data : NULL;
 }
 
 int ext_params_from_dict(PyObject *dict, Py_ssize_t vertex_count, rsmooth_params *p,
@@ -181,14 +248,15 @@ PyObject *ext_params_auto(PyObject *self, PyObject *args) {
     }
     PyObject *result = NULL;
     rsmooth_params p;
-    if (ext_params_from_dict(pobj, v.rows, &p, &held) == 0) {
+    if (ext_params_from_dict(pobj, v.rows, &p, &held) == 0 && ext_array_own(&v, 0) == 0 &&
+        ext_array_own(&f, 0) == 0) {
         rsmooth_noise_report report;
         rsmooth_noise_report_init(&report);
         rsmooth_error err;
         rsmooth_status st;
         Py_BEGIN_ALLOW_THREADS
-        st = rsmooth_params_auto_report(v.scalar, v.view.buf, (size_t)v.rows, f.view.buf,
-                                        (size_t)f.rows, &p, &report, &err);
+        st = rsmooth_params_auto_report(v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows,
+                                        &p, &report, &err);
         Py_END_ALLOW_THREADS
         if (st != RSMOOTH_OK) {
             ext_raise(st, &err);

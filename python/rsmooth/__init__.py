@@ -18,7 +18,8 @@ first CPU OpenCL device, and falls back to the double-precision reference path (
 where no OpenCL exists; ``device="reference"`` always runs that path.
 
 The GIL is released while a filter runs, and Ctrl-C stops a long call (KeyboardInterrupt; the
-inputs are untouched and no result is returned).
+inputs are untouched and no result is returned). A call reads its own copies of the arrays, so
+other threads and progress callables may change the caller's meanwhile.
 """
 
 from __future__ import annotations

@@ -18,6 +18,11 @@ def devices() -> List[Dict[str, Any]]:
     return _rsmooth._devices()
 
 
+def _check_device(device: Any) -> None:
+    if device is not None and not isinstance(device, str):
+        raise TypeError(f"device: expected a str or None, got {device!r}")
+
+
 class Context:
     """An OpenCL device with rsmooth's kernels built on it, reusable across calls.
 
@@ -30,6 +35,7 @@ class Context:
     """
 
     def __init__(self, device: Optional[str] = "auto") -> None:
+        _check_device(device)
         if device == "reference":
             raise ValueError(
                 'Context: "reference" is the CPU path without OpenCL; '

@@ -4,6 +4,7 @@ extension with the GIL released."""
 from __future__ import annotations
 
 import functools
+import numbers
 import os
 import warnings
 from typing import Any, Optional
@@ -12,8 +13,8 @@ import numpy as np
 
 from . import _rsmooth
 from ._arrays import _colors, _faces, _mask, _vertices
-from ._context import Context
-from ._options import _METHODS, Progress, _params, _progress_callable
+from ._context import Context, _check_device
+from ._options import _METHODS, Progress, _numpy_bool, _params, _progress_callable
 from ._rsmooth import DeviceError
 
 
@@ -117,10 +118,15 @@ def smooth(
         ones (the robust filter only).
     method : "robust" (the filter), or the isotropic smoothers it is measured against:
         "gaussian" (one Gaussian-weighted pass of centroids, width sigma_f), "laplacian" and
-        "taubin" (``iterations`` umbrella steps by ``lam``, Taubin's each followed by one by
-        ``mu``; these need connected faces and run on the CPU).
+        "taubin" (``iterations`` umbrella steps, [0, 1000000], by ``lam`` in (0, 1], Taubin's
+        each followed by one by ``mu`` in [-1, 0); these need connected faces and run on the CPU,
+        and Ctrl-C waits for them).
     progress : True shows a tqdm progress bar (when tqdm is installed); a callable is called
-        with the fraction done, and may raise to stop the call.
+        with the fraction done, and may raise to stop the call. The call works on copies of the
+        arrays taken when it starts, so a callable (or another thread) changing them changes
+        nothing in it. A callable may not start a call on an OpenCL context or make a Context:
+        that raises RuntimeError, since the running call holds its context until it returns
+        (``device="reference"`` calls work there).
 
     Returns
     -------
@@ -129,7 +135,11 @@ def smooth(
 
     Raises
     ------
-    ValueError : bad arrays or parameters (the library's message).
+    ValueError : bad arrays or parameters, named (the library's message), or a number out of
+        its keyword's range.
+    TypeError : a bool, float or string where a whole number goes, or something that is not a
+        number where a real one does (named).
+    RuntimeError : a call on an OpenCL context from inside another one's progress callable.
     DeviceError : the OpenCL device is missing or failed (names the device and the error).
     KeyboardInterrupt : Ctrl-C during the call.
     """
@@ -145,6 +155,7 @@ def smooth(
         colors=colors, sigma_c=sigma_c, mask=mask, method=method, iterations=iterations,
         lam=lam, mu=mu, progress=progress,
     )
+    _check_device(device)
     if device == "reference" or method in ("laplacian", "taubin"):
         return _smooth(None, vertices, faces, **options)
     try:
@@ -199,8 +210,16 @@ def _smooth(
     if method in ("laplacian", "taubin"):
         if confidence or mask is not None:
             raise ValueError(f"method {method!r} takes no confidence and no mask")
-        _rsmooth._taubin(v, f, out, float(lam), float(mu) if method == "taubin" else 0.0,
-                         int(iterations))
+        lam, mu, iterations = (_numpy_bool(x) for x in (lam, mu, iterations))
+        if method == "taubin" and isinstance(mu, numbers.Real) and not isinstance(mu, bool):
+            try:
+                m: Optional[float] = float(mu)
+            except OverflowError:  # the extension refuses it by name
+                m = None
+            if m is not None and not -1 <= m < 0:  # 0 is Laplacian's; NaN fails too
+                raise ValueError(f"mu must be in [-1, 0) for method 'taubin' (got {m!r})")
+        # lam, mu and iterations go as given: the extension checks their types and ranges
+        _rsmooth._taubin(v, f, out, lam, mu if method == "taubin" else 0.0, iterations)
         return out.reshape(shape_in)
     if method == "gaussian":  # the isotropic baseline: centroids, no influence weight
         overrides.update(predictor="centroid", sigma_g=float("inf"), mollify=False)

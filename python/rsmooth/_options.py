@@ -24,6 +24,12 @@ def _choice(value: Union[str, int], table: Dict[str, int], name: str) -> int:
     raise ValueError(f"{name}: expected one of {', '.join(table)}, got {value!r}")
 
 
+def _numpy_bool(value: Any) -> Any:
+    """numpy's bool as Python's: the extension refuses a bool where a number goes by name, but
+    cannot tell numpy's (which converts to 0.0 and 1.0) from a number."""
+    return bool(value) if isinstance(value, np.bool_) else value
+
+
 def _params(
     vertices: np.ndarray,
     faces: np.ndarray,
@@ -36,7 +42,7 @@ def _params(
     every keyword given explicitly (explicit ones win over the rule, as on the command line).
     Also the rule's noise report when `auto` (else None)."""
     params = _rsmooth._default_params(bool(best))
-    given = {k: v for k, v in overrides.items() if v is not None}
+    given = {k: _numpy_bool(v) for k, v in overrides.items() if v is not None}
     for key, table in (
         ("normal_filter", _NORMAL_FILTERS),
         ("influence", _INFLUENCES),
@@ -74,10 +80,14 @@ def _keywords(params: Dict[str, Any]) -> Dict[str, Any]:
 
 def _progress_callable(progress: Progress) -> Tuple[Optional[Callable[[float], Any]], Any]:
     """(callable for the C layer, bar to close). True: a tqdm bar when tqdm is installed."""
+    if isinstance(progress, np.bool_):
+        progress = bool(progress)
     if progress is None or progress is False:
         return None, None
     if callable(progress):
         return progress, None
+    if progress is not True:
+        raise TypeError(f"progress: expected True, False, None or a callable, got {progress!r}")
     try:
         from tqdm.auto import tqdm
     except ImportError:

@@ -1,6 +1,8 @@
 # Type stub of the C extension rsmooth._rsmooth (python/ext/). These are internal: the package's
 # public functions (rsmooth.smooth, ...) convert and check their arguments, then call these with
 # C-contiguous float32/float64 (n, 3) arrays, uint32 (m, 3) faces and preallocated outputs.
+# They check again what reaches the library (numbers by name and range) and hand it copies of
+# the arrays, so that Python code running during a call cannot change what the call reads.
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
 import numpy as np
