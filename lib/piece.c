@@ -8,10 +8,17 @@
  * rsmooth_stream_smooth) and the MPI driver cut a mesh into. */
 #include "cl_internal.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
 static const char where[] = "rsmooth_smooth_piece";
+
+/* A piece's typical edge in internal units lies in [2^PIECE_EDGE_MIN_LOG2, 2^PIECE_EDGE_MAX_LOG2):
+ * its fourth power (in a facet's normal) is then a double, neither 0 nor infinite. scale.c puts
+ * a whole mesh's within [2^-251, 1); a piece's may be somewhat shorter or longer. */
+#define PIECE_EDGE_MIN_LOG2 (-256)
+#define PIECE_EDGE_MAX_LOG2 250
 
 rsmooth_status rsmooth_piece_info_init(rsmooth_piece_info *info) {
     if (!info)
@@ -57,10 +64,17 @@ rsmooth_status rsmooth_piece_halo(const rsmooth_params *params, double mean_edge
     rs_problem pb;
     memset(&pb, 0, sizeof pb);
     rs_problem_apply_params(&pb, &p, p.absolute ? 1 : mean_edge_length);
-    *out_halo = rs_halo_radius(&pb, reach);
+    double halo = rs_halo_radius(&pb, reach);
+    if (!isfinite(halo)) /* a piece cut with it would hold the whole mesh, or nothing */
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller,
+                       "mean_edge_length %g and reach %g give a halo of %g: beyond double range",
+                       mean_edge_length, reach, halo);
+    *out_halo = halo;
     return RSMOOTH_OK;
 }
 
+/* The fields a caller sets, before anything is read: the whole mesh's figures as the in-memory
+ * path has them (positive wherever a mesh has a facet) and a scale it can choose (scale.c). */
 static rsmooth_status check_info(const rsmooth_piece_info *info, size_t vertex_count,
                                  rsmooth_error *error) {
     if (!info)
@@ -71,14 +85,56 @@ static rsmooth_status check_info(const rsmooth_piece_info *info, size_t vertex_c
                        info->struct_size);
     if (info->core_count > vertex_count)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "core_count %zu exceeds the piece's %zu vertices", info->core_count,
+                       "info->core_count %zu exceeds the piece's %zu vertices", info->core_count,
                        vertex_count);
-    if (!(info->mean_edge_length >= 0) || !isfinite(info->mean_edge_length) ||
-        !(info->mean_area >= 0) || !isfinite(info->mean_area) || !(info->scale >= 0) ||
-        !isfinite(info->scale))
+    if (!(info->mean_edge_length > 0) || !isfinite(info->mean_edge_length))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "mean_edge_length %g, mean_area %g and scale %g must be finite and >= 0",
-                       info->mean_edge_length, info->mean_area, info->scale);
+                       "info->mean_edge_length %g must be finite and > 0",
+                       info->mean_edge_length);
+    if (!(info->mean_area > 0) || !isfinite(info->mean_area))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "info->mean_area %g must be finite and > 0", info->mean_area);
+    if (info->scale != 0 && !rs_scale_possible(info->scale))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "info->scale %g: neither 0 nor a power of two in [2^-500, 2^1000], the "
+                       "scales a whole mesh is given (0: the piece chooses)",
+                       info->scale);
+    return RSMOOTH_OK;
+}
+
+/* In internal units (the figures times the scale) a power of two converts them exactly only
+ * while they stay normal doubles. */
+static bool exact_in_internal_units(double figure) {
+    return isfinite(figure) && figure >= DBL_MIN;
+}
+
+/* The scale given, applied to this piece: its figures and its typical edge must stay where the
+ * whole mesh's own scale keeps a mesh's (scale.c: typical edges in [2^-251, 1)), else the facets'
+ * normals and areas (edge lengths to the fourth power) over- or underflow and every result is
+ * off. A wrong scale is the caller's error; the whole mesh's never trips this. */
+static rsmooth_status check_scale_fits(const rs_problem *pb, const double *positions,
+                                       const uint32_t *indices, size_t triangle_count,
+                                       const rsmooth_piece_info *info, rsmooth_error *error) {
+    if (!exact_in_internal_units(pb->mean_edge_length) ||
+        !exact_in_internal_units(pb->mean_area))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "info->mean_edge_length %g and info->mean_area %g at scale %g are %g and "
+                       "%g internal units, beyond double's normal range: give positions times "
+                       "the scale, the figures likewise, and scale 1",
+                       info->mean_edge_length, info->mean_area, pb->scale, pb->mean_edge_length,
+                       pb->mean_area);
+    if (info->scale == 0 || pb->scale != info->scale)
+        return RSMOOTH_OK; /* the piece's own choice */
+    double typical = rs_typical_edge(RSMOOTH_FLOAT64, positions, indices, triangle_count);
+    int e = 0; /* typical * scale in [2^(e-1), 2^e) */
+    if (typical > 0)
+        frexp(typical * info->scale, &e);
+    if (typical > 0 && (e - 1 < PIECE_EDGE_MIN_LOG2 || e - 1 >= PIECE_EDGE_MAX_LOG2))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "info->scale %g puts the piece's typical edge (%g) at 2^%d internal "
+                       "units, where its facets' areas over- or underflow: not the whole mesh's "
+                       "scale (which keeps typical edges near 1; 0: the piece chooses)",
+                       info->scale, typical, e - 1);
     return RSMOOTH_OK;
 }
 
@@ -102,9 +158,12 @@ static rsmooth_status prepare_piece(rs_problem *pb, const double *positions, siz
                            triangle_count * 3 * sizeof(uint32_t))))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "out_positions overlaps the piece's positions or indices");
-    return rs_problem_prepare_within(pb, RSMOOTH_FLOAT64, positions, vertex_count, indices,
-                                     triangle_count, &p, RS_UNCHECKED_OUTPUT, keep, info, error,
-                                     where);
+    st = rs_problem_prepare_within(pb, RSMOOTH_FLOAT64, positions, vertex_count, indices,
+                                   triangle_count, &p, RS_UNCHECKED_OUTPUT, keep, info, error,
+                                   where);
+    if (st == RSMOOTH_OK)
+        st = check_scale_fits(pb, positions, indices, triangle_count, info, error);
+    return st;
 }
 
 /* The reference path on the whole piece, its core vertices kept. */
@@ -129,13 +188,14 @@ rsmooth_status rsmooth_smooth_piece(rsmooth_context *ctx, const double *position
                                     rsmooth_report *report, rsmooth_error *error) {
     double t_start = rs_now_ms();
     rs_error_clear(error);
+    rs_problem pb; /* freed on every path: empty until prepare_piece fills it */
+    memset(&pb, 0, sizeof pb);
     rsmooth_status st = check_info(info, vertex_count, error);
     if (st != RSMOOTH_OK)
         return st;
     if (ctx) {
         rs_context_lock(ctx);
         size_t threads_before = rs_set_call_threads(ctx->host_threads);
-        rs_problem pb;
         st = prepare_piece(&pb, positions, vertex_count, indices, triangle_count, info, params,
                            out_positions, false, error);
         double t_facets = rs_now_ms();
@@ -155,17 +215,15 @@ rsmooth_status rsmooth_smooth_piece(rsmooth_context *ctx, const double *position
         if (st == RSMOOTH_OK)
             st = rs_check_results(RSMOOTH_FLOAT64, out_positions, NULL, NULL, info->core_count,
                                   "vertex", error, where);
-        rs_problem_free(&pb);
         rs_set_call_threads(threads_before);
         rs_context_unlock(ctx);
     } else {
-        rs_problem pb;
         st = prepare_piece(&pb, positions, vertex_count, indices, triangle_count, info, params,
                            out_positions, true, error);
         if (st == RSMOOTH_OK)
             st = solve_reference(&pb, info->core_count, out_positions, report, t_start, error);
-        rs_problem_free(&pb);
     }
+    rs_problem_free(&pb);
     rs_release_free_memory();
     return st;
 }

@@ -314,6 +314,15 @@ rsmooth_status rs_points_scale(rsmooth_scalar scalar, const void *positions, siz
                                double magnitude, double *scale, rsmooth_error *error,
                                const char *where);
 
+/* Whether `scale` is one rs_mesh_scale can choose: a power of two in [2^-500, 2^1000] (the
+ * exponents its choice spans for coordinates within RS_MAX_COORDINATE). */
+bool rs_scale_possible(double scale);
+
+/* The typical edge length rs_mesh_scale brings near 1: the geometric mean of the (Chebyshev)
+ * lengths of one edge of each sampled triangle, in the caller's units; 0 when all are 0. */
+double rs_typical_edge(rsmooth_scalar scalar, const void *positions, const uint32_t *indices,
+                       size_t triangle_count);
+
 /* Caller's coordinates -> internal units: out[i] = coordinate i times `scale`, i < 3 count. */
 void rs_scale_positions(rsmooth_scalar scalar, const void *positions, size_t count, double scale,
                         double *out);

@@ -116,6 +116,19 @@ static rsmooth_status scale_for(double typical, double magnitude, const char *ow
                    owner, magnitude, length, typical);
 }
 
+/* choose_scale's exponent e (scale 2^-e) is at least -MAX_SCALE_LOG2, and at most that of the
+ * largest typical length: two coordinates within RS_MAX_COORDINATE lie at most twice that apart. */
+bool rs_scale_possible(double scale) {
+    int top = 0, e = 0;
+    (void)frexp(2 * RS_MAX_COORDINATE, &top);
+    return scale > 0 && frexp(scale, &e) == 0.5 && e - 1 <= MAX_SCALE_LOG2 && 1 - e <= top;
+}
+
+double rs_typical_edge(rsmooth_scalar scalar, const void *positions, const uint32_t *indices,
+                       size_t triangle_count) {
+    return typical_distance(scalar, positions, triangle_count, triangle_edge, indices);
+}
+
 rsmooth_status rs_mesh_scale(rsmooth_scalar scalar, const void *positions,
                              const uint32_t *indices, size_t triangle_count, double magnitude,
                              double *scale, rsmooth_error *error, const char *where) {

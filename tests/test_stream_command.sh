@@ -95,5 +95,96 @@ if [ -n "$mpi" ]; then
   grep -q "max-memory" err.txt || fail "rsmooth-mpi --best: $(cat err.txt)"
   ls ./*partial* >/dev/null 2>&1 && fail "a partial output was left behind"
 fi
+
+# ---- Issue 23, items 4 and 15: the streamed file is the in-memory command's, byte for byte, and
+# what the in-memory writer refuses is refused with its status and message, nothing written.
+# header_end FILE: bytes up to and with the 'end_header' line
+header_end() { echo $(($(grep -a -b -m1 '^end_header' "$1" | cut -d: -f1) + 11)); }
+# agree NAME INPUT [OPTIONS]: both runs exit 0 and write the same bytes
+agree() {
+  local name=$1 input=$2; shift 2
+  rm -f "agree_$name.memory.ply" "agree_$name.streamed.ply"
+  expect 0 "$rsmooth" "$input" -o "agree_$name.memory.ply" -q "$@"
+  expect 0 "$rsmooth" "$input" -o "agree_$name.streamed.ply" --max-memory 10M -q "$@"
+  cmp -s "agree_$name.memory.ply" "agree_$name.streamed.ply" &&
+    echo "$name: streamed = in memory, $(wc -c < "agree_$name.memory.ply") bytes" ||
+    fail "$name: the streamed file differs from the in-memory one"
+}
+# grid_ply OUT TYPE SCALE COMMENT [TOP]: an ascii PLY of a 24 x 24 grid with bumps, coordinates
+# times SCALE, of TYPE (float, double), with a comment line when COMMENT is 1; TOP: a plateau at
+# that height with a third of its vertices 10% lower (the tilted planes of their triangles reach
+# past it), made binary by 'rsmooth noise --sigma 0' (positions as read)
+grid_ply() {
+  awk -v type="$2" -v s="$3" -v comment="$4" -v top="${5:-0}" 'BEGIN {
+    n = 24; print "ply"; print "format ascii 1.0"; if (comment) print "comment grid"
+    print "element vertex " n * n
+    print "property " type " x"; print "property " type " y"; print "property " type " z"
+    print "element face " 2 * (n - 1) * (n - 1); print "property list uchar int vertex_indices"
+    print "end_header"
+    for (j = 0; j < n; j++) for (i = 0; i < n; i++) {
+      h = sin(i * 12.9898 + j * 78.233) * 43758.5453; h -= int(h); h -= 0.5
+      if (top) printf "%.9g %.9g %.9g\n", i * 0.02 * top, j * 0.02 * top, ((7 * i + 3 * j) % 3 ? top : 0.9 * top)
+      else printf "%.17g %.17g %.17g\n", i * 0.1 * s, j * 0.1 * s, 0.05 * h * s
+    }
+    for (j = 0; j < n - 1; j++) for (i = 0; i < n - 1; i++) {
+      a = j * n + i; print 3, a, a + 1, a + n + 1; print 3, a, a + n + 1, a + n
+    }
+  }' > "$1.txt"
+  expect 0 "$rsmooth" noise "$1.txt" "$1" --sigma 0 -q --force
+}
+grid_ply grid.ply double 1 0
+header=$(header_end grid.ply)
+# (a) a PLY with no comment: the in-memory writer adds "comment written by rsmooth"
+{ head -c "$header" grid.ply | grep -av '^comment'; tail -c +"$((header + 1))" grid.ply; } > bare.ply
+grep -aq '^comment' bare.ply && fail "bare.ply kept a comment"
+agree no_comment bare.ply
+# (b) a byte-order mark, which the in-memory writer keeps
+{ printf '\357\273\277'; cat bare.ply; } > bom.ply
+agree byte_order_mark bom.ply
+# (c) a header over 1 MB, with 'end_header' inside a comment before its end
+head -c 1200000 /dev/zero | tr '\0' x | sed 's/^/comment /' > long_comment.txt
+echo >> long_comment.txt
+{ head -c "$header" grid.ply | head -n 2; echo "comment the end_header line comes later"
+  cat long_comment.txt; head -c "$header" grid.ply | tail -n +3
+  tail -c +"$((header + 1))" grid.ply; } > long_header.ply
+agree long_header long_header.ply
+# (d) double coordinates at 1e-300: the mean area (1e-602) has no double in the mesh's units
+grid_ply tiny.ply double 1e-300 1
+agree tiny_double tiny.ply
+agree tiny_double_reference tiny.ply --device reference
+# (e) a negative list count in an element before the vertices: the in-memory reader's refusal
+awk 'NR == 3 { print "element extra 1"; print "property list char int data" } { print }
+     /^end_header/ { print "3 1 2 3" }' grid.ply.txt > extra.txt
+expect 0 "$rsmooth" noise extra.txt extra.ply --sigma 0 -q
+printf '\375' | dd of=extra.ply bs=1 seek="$(header_end extra.ply)" conv=notrunc 2>/dev/null
+expect 2 "$rsmooth" extra.ply -o refused.ply -q
+memory=$(cat err.txt)
+expect 2 "$rsmooth" extra.ply -o refused.ply --max-memory 10M -q
+[ "$(cat err.txt)" = "$memory" ] && echo "negative count: $memory" ||
+  fail "negative list count: streamed '$(cat err.txt)', in memory '$memory'"
+if [ -n "$mpi" ]; then # the ranks write the same file
+  for pair in bom.ply:byte_order_mark tiny.ply:tiny_double; do
+    input=${pair%%:*} name=${pair#*:}
+    rm -f "mpi_$input"
+    expect 0 "$mpirun" -n 2 --oversubscribe "$mpi" "$input" -o "mpi_$input" --max-memory 10M -q
+    cmp -s "mpi_$input" "agree_$name.memory.ply" ||
+      fail "rsmooth-mpi -n 2 on $input differs from the in-memory file"
+  done
+fi
+# 4. float32 results beyond FLT_MAX, and a float32 mesh at 1e-44 (subnormal): refused as in
+# memory, exit 1, the same message (the scale the streamed check holds float32 to is the input's
+# largest coordinate, known before any piece: the figure it prints after "largest" may differ)
+grid_ply plateau.ply float 1 1 3.40282347e38
+grid_ply subnormal.ply float 1e-43 1
+for input in plateau.ply subnormal.ply; do
+  rm -f refused.ply
+  expect 1 "$rsmooth" "$input" -o refused.ply -q
+  memory=$(sed 's/(largest [^)]*)//' err.txt)
+  expect 1 "$rsmooth" "$input" -o refused.ply --max-memory 10M -q
+  [ "$(sed 's/(largest [^)]*)//' err.txt)" = "$memory" ] && echo "$input: $memory" ||
+    fail "$input: streamed '$(cat err.txt)', in memory '$memory'"
+  [ ! -e refused.ply ] || fail "$input: a refused streamed run wrote its output"
+done
+
 [ "$failures" -eq 0 ] && echo ok
 exit "$((failures > 0))"

@@ -722,13 +722,22 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_view(rsmooth_context *ctx, const rsmoo
 /* What a piece of a larger mesh is filtered with, besides its own arrays. (Added in 0.7) */
 typedef struct rsmooth_piece_info {
     size_t struct_size;      /* sizeof(rsmooth_piece_info): set by rsmooth_piece_info_init */
-    size_t core_count;       /* the piece's first core_count vertices are solved */
-    double mean_edge_length; /* of the whole mesh, caller's units (as rsmooth_mean_edge_length) */
-    double mean_area;        /* of the whole mesh's triangles of non-zero area, caller's units */
+    size_t core_count;       /* the piece's first core_count vertices are solved; <= its vertex
+                              * count */
+    double mean_edge_length; /* of the whole mesh, caller's units (as rsmooth_mean_edge_length);
+                              * finite and > 0 */
+    double mean_area;        /* of the whole mesh's triangles of non-zero area, caller's units;
+                              * finite and > 0 */
     double scale;            /* the power of two the whole run multiplies coordinates by inside
-                              * (rsmooth_stream_smooth passes its own); 0: the piece chooses,
-                              * which gives the same bits unless a coordinate lies beyond about
-                              * 1e75 typical edges from the origin */
+                              * (one of [2^-500, 2^1000], the scales it chooses); 0: the piece
+                              * chooses, which gives the same bits unless a coordinate lies beyond
+                              * about 1e75 typical edges from the origin. The two figures times it
+                              * (and its square) must be normal doubles: for a mesh whose area
+                              * has none in its own units (coordinates near 1e-300), give
+                              * positions and figures times the scale, and scale 1 (what
+                              * rsmooth_stream_smooth does). A scale that puts the piece's typical
+                              * edge beyond 2^+-250 or so, where its facets' areas over- or
+                              * underflow, is not the whole mesh's and is refused */
 } rsmooth_piece_info;
 
 /* Sets struct_size and zeroes the rest. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if info is NULL. */
@@ -738,7 +747,8 @@ RSMOOTH_API rsmooth_status rsmooth_piece_info_init(rsmooth_piece_info *info);
  * units: the halo a piece must carry around its core vertices. `reach` is the whole mesh's largest
  * distance from a triangle's centroid to its corners. Checks params as the filter does; params
  * that need the whole mesh (passes above 1, the normal update stage, colours, a move mask) are
- * RSMOOTH_ERROR_UNSUPPORTED naming the field. (Added in 0.7) */
+ * RSMOOTH_ERROR_UNSUPPORTED naming the field; figures that give a halo beyond double range
+ * (mean_edge_length 1e308) RSMOOTH_ERROR_INVALID_ARGUMENT. (Added in 0.7) */
 RSMOOTH_API rsmooth_status rsmooth_piece_halo(const rsmooth_params *params,
                                               double mean_edge_length, double reach,
                                               double *out_halo, rsmooth_error *error);
@@ -749,8 +759,9 @@ RSMOOTH_API rsmooth_status rsmooth_piece_halo(const rsmooth_params *params,
  * receives 3 * core_count values. The whole mesh's mean edge length, mean facet area and scale
  * stand in for the piece's own, so results are the whole run's bit for bit, on a device (as tiles
  * are, see rsmooth_context_set_memory_budget) and on the reference path (ctx NULL). Params as
- * rsmooth_piece_halo accepts them. Errors as
- * rsmooth_smooth, nothing written on failure. Thread-safety as rsmooth_smooth. (Added in 0.7) */
+ * rsmooth_piece_halo accepts them. Errors as rsmooth_smooth, and RSMOOTH_ERROR_INVALID_ARGUMENT
+ * naming the field of `info` outside its range (see rsmooth_piece_info); nothing written on
+ * failure. Thread-safety as rsmooth_smooth. (Added in 0.7) */
 RSMOOTH_API rsmooth_status rsmooth_smooth_piece(rsmooth_context *ctx, const double *positions,
                                                 size_t vertex_count, const uint32_t *indices,
                                                 size_t triangle_count,

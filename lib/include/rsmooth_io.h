@@ -209,7 +209,9 @@ typedef struct rsmooth_stream_options {
     int replace;           /* non-zero: an existing output is replaced (atomically) */
     /* Several processes sharing the pieces (the MPI driver): each calls with the same arguments,
      * its own rank in [0, ranks), and `sync`, which every rank calls at the same points and which
-     * returns the worst (largest) status any rank passed (an all-reduce). ranks 0 or 1: alone. */
+     * returns the worst (largest) status any rank passed (an all-reduce). ranks 0 or 1: alone,
+     * rank 0. Ranks without a sync, a rank outside [0, ranks) and negative ranks are
+     * RSMOOTH_ERROR_INVALID_ARGUMENT naming the field. */
     int rank, ranks;
     int (*sync)(void *user, int status);
     void *sync_user;
@@ -247,10 +249,16 @@ RSMOOTH_API void rsmooth_stream_report_init(rsmooth_stream_report *report);
  * sums them, so the sigmas are the same bits) and writes its triangles, cut into spatial pieces
  * with their halos (rsmooth_piece_halo), to temporary files; each piece is filtered
  * (rsmooth_smooth_piece, on `ctx`'s device, or the reference path when ctx is NULL); results go
- * into a copy of the input at their vertices' places, so the output is the input byte for byte
- * (header, comments, other properties and elements, faces) but for x, y and z. The positions are
- * an in-memory run's bit for bit, on a device and on the reference path (see
- * rsmooth_smooth_piece). The output appears whole and at once, or not at all.
+ * into a copy of the input's data at their vertices' places, after the header rsmooth_mesh_write
+ * gives the file read whole, so the output is the in-memory path's byte for byte: the input's
+ * header, comments, other properties and elements and faces (the generic header with its
+ * "comment written by rsmooth" where the reader keeps no extras), little-endian, a byte-order
+ * mark kept, and the positions an in-memory run's bit for bit, on a device and on the reference
+ * path (see rsmooth_smooth_piece). Positions the file's x y z type cannot hold (float32 beyond
+ * FLT_MAX, or below its precision at the mesh's scale) are RSMOOTH_ERROR_NUMERICAL with
+ * rsmooth_mesh_write's message, nothing written; where the reader keeps no extras, a write from
+ * memory would switch to double x y z instead, which a copy cannot. The output appears whole and
+ * at once, or not at all.
  *
  * What streams: binary PLY (either byte order) with float or double x, y, z, faces of any size
  * (fanned into triangles as the reader does), up to 2^32 - 1 vertices and any number of faces.

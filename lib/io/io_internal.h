@@ -5,6 +5,7 @@
 #include "rsmooth_internal.h"
 #include "rsmooth_io.h"
 
+#include <math.h>
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -71,6 +72,11 @@ rsmooth_status rs_io_mesh_check(const rsmooth_mesh *mesh, const char *where, rsm
 rsmooth_status rs_io_mesh_check_values(const rsmooth_mesh *mesh, const char *where,
                                        rsmooth_error *error);
 
+/* rs_io_mesh_check_values' check of positions on `count` of them: the i-th at xyz + 3 i, named
+ * vertex ids[i] (i when ids is NULL; the streamed writer checks a piece's at a time). */
+rsmooth_status rs_io_check_position_values(const double *xyz, size_t count, const uint32_t *ids,
+                                           const char *where, rsmooth_error *error);
+
 /* A coordinate float32 cannot hold at the mesh's own scale: beyond FLT_MAX, or rounded by more
  * than float32's precision relative to the largest coordinate magnitude, |x - (float)x| >
  * 2^-24 * largest. No normal float is that far off, so in practice: a value beyond float range,
@@ -83,6 +89,19 @@ typedef struct rs_io_float32_misfit {
     double rounded; /* as a float32 */
     double largest; /* the mesh's largest coordinate magnitude */
 } rs_io_float32_misfit;
+
+/* How far float32 may round a coordinate of a mesh whose largest magnitude is `largest`. A normal
+ * float rounds within 2^-24 of its own magnitude, so only values beyond FLT_MAX, or subnormal ones
+ * in a mesh whose largest coordinate is itself about as small, exceed it. */
+static inline double rs_io_float32_tolerance(double largest) {
+    return ldexp(largest, -24);
+}
+
+/* Whether coordinate x is a misfit at that tolerance: the one test every float32 writer makes. */
+static inline bool rs_io_float32_misfits(double x, double tolerance) {
+    float f = (float)x;
+    return !isfinite(f) || fabs(x - (double)f) > tolerance;
+}
 
 /* Finds the first misfit among the vertices `indices` names (index_count entries; every one of
  * vertex_count when indices is NULL), in the components whose bit is set in `axes` (1 x, 2 y,

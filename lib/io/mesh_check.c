@@ -37,19 +37,30 @@ rsmooth_status rs_io_mesh_check(const rsmooth_mesh *mesh, const char *where, rsm
     return RSMOOTH_OK;
 }
 
-rsmooth_status rs_io_mesh_check_values(const rsmooth_mesh *mesh, const char *where,
-                                       rsmooth_error *error) {
-    for (size_t i = 0; i < 3 * mesh->vertex_count; i++) {
-        double x = mesh->positions[i];
+rsmooth_status rs_io_check_position_values(const double *xyz, size_t count, const uint32_t *ids,
+                                           const char *where, rsmooth_error *error) {
+    for (size_t i = 0; i < 3 * count; i++) {
+        double x = xyz[i];
+        size_t vertex = ids ? ids[i / 3] : i / 3;
         if (!isfinite(x))
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                           "vertex %zu has a non-finite coordinate (%g): not written", i / 3, x);
+                           "vertex %zu has a non-finite coordinate (%g): not written", vertex, x);
         if (!rs_io_coordinate_ok(x))
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                            "vertex %zu has coordinate %s beyond the supported magnitude %s: not "
                            "written (rsmooth could not read it back)",
-                           i / 3, rs_io_shortest(x).text, rs_io_shortest(RS_MAX_COORDINATE).text);
+                           vertex, rs_io_shortest(x).text,
+                           rs_io_shortest(RS_MAX_COORDINATE).text);
     }
+    return RSMOOTH_OK;
+}
+
+rsmooth_status rs_io_mesh_check_values(const rsmooth_mesh *mesh, const char *where,
+                                       rsmooth_error *error) {
+    rsmooth_status status =
+        rs_io_check_position_values(mesh->positions, mesh->vertex_count, NULL, where, error);
+    if (status != RSMOOTH_OK)
+        return status;
     for (size_t i = 0; mesh->vertex_quality && i < mesh->vertex_count; i++)
         if (!isfinite(mesh->vertex_quality[i]))
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
@@ -66,16 +77,13 @@ bool rs_io_float32_misfit_find(const double *xyz, size_t vertex_count, const uin
         const double *p = xyz + 3 * (size_t)(indices ? indices[i] : i);
         largest = fmax(largest, fmax(fabs(p[0]), fmax(fabs(p[1]), fabs(p[2]))));
     }
-    /* A normal float rounds within 2^-24 of its own magnitude, so only values beyond FLT_MAX, or
-     * subnormal ones in a mesh whose largest coordinate is itself about as small, exceed this. */
-    const double tolerance = ldexp(largest, -24);
+    const double tolerance = rs_io_float32_tolerance(largest);
     for (size_t i = 0; i < n; i++) {
         size_t v = indices ? indices[i] : i;
         for (int c = 0; c < 3; c++) {
             double x = xyz[3 * v + (size_t)c];
-            float f = (float)x;
-            if (((axes >> c) & 1) && (!isfinite(f) || fabs(x - (double)f) > tolerance)) {
-                *misfit = (rs_io_float32_misfit){v, c, x, f, largest};
+            if (((axes >> c) & 1) && rs_io_float32_misfits(x, tolerance)) {
+                *misfit = (rs_io_float32_misfit){v, c, x, (float)x, largest};
                 return true;
             }
         }

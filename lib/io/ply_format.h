@@ -170,4 +170,24 @@ struct rs_ply_extras {
     size_t vertex_element, face_element; /* indices into elements; SIZE_MAX when absent */
 };
 
+/* ---- ply_write.c: what the streamed writer (lib/stream) shares with rs_io_ply_write, so that a
+ * file streamed and one written from memory are the same bytes */
+
+/* Writes the header rs_io_ply_write gives a binary PLY read with header `x` (roles assigned),
+ * counts unchanged and no normals: `plain` (rs_ply_is_plain: the reader keeps no extras), the
+ * generic header, "comment written by rsmooth" and x y z as float when `f32`, else double;
+ * otherwise the file's own header (its comments, elements and type words), little-endian. After
+ * a UTF-8 byte-order mark when `bom`. false when the stream fails. */
+bool rs_io_ply_write_binary_header(FILE *stream, const rs_ply_extras *x, bool plain, bool bom,
+                                   bool f32);
+
+/* The checks rs_io_ply_check makes of x y z before writing (the positions' values, each held by
+ * its property's type, float32 ones within float32's precision at `largest`, the mesh's largest
+ * coordinate magnitude), on `count` positions: the i-th at xyz + 3 i, vertex ids[i] (i when ids
+ * is NULL), of vertex element `v`. RSMOOTH_ERROR_INVALID_ARGUMENT naming the first that fails,
+ * in rs_io_ply_check's words. */
+rsmooth_status rs_io_ply_check_positions(const double *xyz, size_t count, const uint32_t *ids,
+                                         const rs_ply_element *v, double largest,
+                                         rsmooth_error *error);
+
 #endif /* RSMOOTH_PLY_FORMAT_H */

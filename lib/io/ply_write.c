@@ -92,26 +92,35 @@ static bool use_float(const rsmooth_mesh *mesh) {
     return rs_io_float32_holds(mesh);
 }
 
-static bool write_header(const rsmooth_mesh *mesh, FILE *stream, bool binary, bool f32,
-                         bool normals, bool wide_count, bool unsigned_index) {
-    const char *scalar = f32 ? "float" : "double";
-    bool ok = rs_io_put_bom(mesh, binary ? RSMOOTH_FORMAT_PLY_BINARY : RSMOOTH_FORMAT_PLY_ASCII,
-                            stream) &&
+/* The UTF-8 byte-order mark the input opened with (rs_io_keeps_bom), when `bom`. */
+static bool put_bom(FILE *stream, bool bom) {
+    return !bom || fwrite(RS_IO_UTF8_BOM, 1, RS_IO_UTF8_BOM_SIZE, stream) == RS_IO_UTF8_BOM_SIZE;
+}
+
+/* What the generic path's header says: the mesh's counts and which of its fields follow x y z. */
+typedef struct generic_header {
+    bool bom, binary, f32, normals, quality, colors, wide_count, unsigned_index;
+    size_t vertex_count, face_count;
+} generic_header;
+
+static bool write_header(FILE *stream, const generic_header *h) {
+    const char *scalar = h->f32 ? "float" : "double";
+    bool ok = put_bom(stream, h->bom) &&
               fprintf(stream,
                       "ply\nformat %s 1.0\ncomment written by rsmooth\nelement vertex %zu\n"
                       "property %s x\nproperty %s y\nproperty %s z\n",
-                      binary ? "binary_little_endian" : "ascii", mesh->vertex_count, scalar, scalar,
-                      scalar) >= 0;
-    if (ok && normals)
+                      h->binary ? "binary_little_endian" : "ascii", h->vertex_count, scalar,
+                      scalar, scalar) >= 0;
+    if (ok && h->normals)
         ok = fprintf(stream, "property %s nx\nproperty %s ny\nproperty %s nz\n", scalar, scalar,
                      scalar) >= 0;
-    if (ok && mesh->vertex_quality)
+    if (ok && h->quality)
         ok = fputs("property float quality\n", stream) >= 0;
-    if (ok && mesh->vertex_colors)
+    if (ok && h->colors)
         ok = fputs("property uchar red\nproperty uchar green\nproperty uchar blue\n", stream) >= 0;
     ok = ok && fprintf(stream, "element face %zu\nproperty list %s %s vertex_indices\nend_header\n",
-                       mesh->face_count, wide_count ? "uint" : "uchar",
-                       unsigned_index ? "uint" : "int") >= 0;
+                       h->face_count, h->wide_count ? "uint" : "uchar",
+                       h->unsigned_index ? "uint" : "int") >= 0;
     return ok;
 }
 
@@ -230,8 +239,12 @@ static rsmooth_status write_generic(const rsmooth_mesh *mesh, FILE *stream, bool
             return status;
     }
     const bool f32 = use_float(mesh);
+    const generic_header h = {
+        rs_io_keeps_bom(mesh, binary ? RSMOOTH_FORMAT_PLY_BINARY : RSMOOTH_FORMAT_PLY_ASCII),
+        binary, f32, normals != NULL, mesh->vertex_quality != NULL, mesh->vertex_colors != NULL,
+        wide_count, unsigned_index, mesh->vertex_count, mesh->face_count};
     errno = 0;
-    bool ok = write_header(mesh, stream, binary, f32, normals != NULL, wide_count, unsigned_index);
+    bool ok = write_header(stream, &h);
     if (ok)
         ok = binary ? write_binary(mesh, normals, stream, f32, wide_count)
                     : write_ascii(mesh, normals, stream, f32);
@@ -346,60 +359,109 @@ static face_types choose_face_types(const rsmooth_mesh *mesh, const rs_ply_prope
     return ft;
 }
 
+/* Whether property p's type holds `value` as written: float32 a finite one (a double any, an
+ * integer type the value rounded). */
+static bool holds_written(const rs_ply_property *p, double value) {
+    return p->type == RS_PLY_FLOAT32       ? isfinite((float)value)
+           : rs_ply_type_is_float(p->type) ? true
+                                           : type_holds(p->type, round(value));
+}
+
+/* Component c of `count` triples (the i-th at values + 3 i, vertex ids[i], or i when ids is NULL)
+ * against property p's type, naming the first that does not fit. */
+static rsmooth_status check_component(const rs_ply_property *p, const double *values, int c,
+                                      size_t count, const uint32_t *ids, rsmooth_error *error) {
+    for (size_t i = 0; i < count; i++) {
+        double value = values[3 * i + (size_t)c];
+        if (!holds_written(p, value))
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                           "vertex %zu: %s = %.17g does not fit the file's '%s' type",
+                           ids ? (size_t)ids[i] : i, p->name, value,
+                           rs_ply_spelling(p->spelling));
+    }
+    return RSMOOTH_OK;
+}
+
+/* The float32 x y z (`axis[c]` of type float for the bits of `float_axes`: 1 x, 2 y, 4 z) must
+ * hold the positions (addressed as check_component's) at the scale of `largest`, the mesh's
+ * largest coordinate magnitude (rs_io_float32_misfit), vertex by vertex. */
+static rsmooth_status check_float32_scale(const double *xyz, size_t count, const uint32_t *ids,
+                                          unsigned float_axes,
+                                          const rs_ply_property *const axis[3], double largest,
+                                          rsmooth_error *error) {
+    const double tolerance = rs_io_float32_tolerance(largest);
+    for (size_t i = 0; float_axes && i < count; i++)
+        for (int c = 0; c < 3; c++) {
+            double x = xyz[3 * i + (size_t)c];
+            if (!((float_axes >> c) & 1) || !rs_io_float32_misfits(x, tolerance))
+                continue;
+            const rs_ply_property *p = axis[c];
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, /* 256 bytes: briefly */
+                           "vertex %zu: %s = %s is %s in the file's '%s' type, beyond float32's "
+                           "precision at the mesh's scale (largest %s); a PLY with double x y z "
+                           "(extras NULL), OBJ or ascii STL holds it",
+                           ids ? (size_t)ids[i] : i, p->name, rs_io_shortest(x).text,
+                           rs_io_shortest((float)x).text, rs_ply_spelling(p->spelling),
+                           rs_io_shortest(largest).text);
+        }
+    return RSMOOTH_OK;
+}
+
 /* The file's types must hold the filtered positions (rounded, for integer types) and a point
  * cloud's own normals (`normals`, NULL for recomputed ones: unit vectors every float type holds),
- * and its float x y z must hold the positions at the mesh's scale (rs_io_float32_misfit_find):
- * checked before anything is written. */
+ * and its float x y z must hold the positions at the mesh's scale (check_float32_scale): checked
+ * before anything is written, property by property in the element's order. */
 static rsmooth_status check_vertex_values(const rsmooth_mesh *mesh, const rs_ply_element *v,
                                           const double *normals, rsmooth_error *error) {
     unsigned float_axes = 0;
     const rs_ply_property *axis[3] = {NULL, NULL, NULL};
     for (size_t k = 0; k < v->property_count; k++) {
         const rs_ply_property *p = &v->properties[k];
-        const double *values;
-        int c;
+        rsmooth_status status = RSMOOTH_OK;
         if (p->role >= RS_PLY_X && p->role <= RS_PLY_Z) {
-            values = mesh->positions;
-            c = p->role - RS_PLY_X;
+            int c = p->role - RS_PLY_X;
             axis[c] = p;
             if (p->type == RS_PLY_FLOAT32)
                 float_axes |= 1u << c;
+            status = check_component(p, mesh->positions, c, mesh->vertex_count, NULL, error);
         } else if (p->role >= RS_PLY_NX && p->role <= RS_PLY_NZ && normals) {
-            values = normals;
-            c = p->role - RS_PLY_NX;
-        } else {
-            continue;
+            status = check_component(p, normals, p->role - RS_PLY_NX, mesh->vertex_count, NULL,
+                                     error);
         }
-        for (size_t i = 0; i < mesh->vertex_count; i++) {
-            double value = values[3 * i + (size_t)c];
-            bool fits = p->type == RS_PLY_FLOAT32       ? isfinite((float)value)
-                        : rs_ply_type_is_float(p->type) ? true
-                                                        : type_holds(p->type, round(value));
-            if (!fits)
-                return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                               "vertex %zu: %s = %.17g does not fit the file's '%s' type", i,
-                               p->name, value, rs_ply_spelling(p->spelling));
-        }
+        if (status != RSMOOTH_OK)
+            return status;
     }
-    rs_io_float32_misfit misfit;
-    if (float_axes == 0 || !rs_io_float32_misfit_find(mesh->positions, mesh->vertex_count, NULL, 0,
-                                                      float_axes, &misfit))
-        return RSMOOTH_OK;
-    const rs_ply_property *p = axis[misfit.axis];
-    return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, /* 256 bytes: say it briefly */
-                   "vertex %zu: %s = %s is %s in the file's '%s' type, beyond float32's precision "
-                   "at the mesh's scale (largest %s); a PLY with double x y z (extras NULL), OBJ "
-                   "or ascii STL holds it",
-                   misfit.vertex, p->name, rs_io_shortest(misfit.value).text,
-                   rs_io_shortest(misfit.rounded).text, rs_ply_spelling(p->spelling),
-                   rs_io_shortest(misfit.largest).text);
+    double largest = 0;
+    for (size_t i = 0; float_axes && i < 3 * mesh->vertex_count; i++)
+        largest = fmax(largest, fabs(mesh->positions[i]));
+    return check_float32_scale(mesh->positions, mesh->vertex_count, NULL, float_axes, axis,
+                               largest, error);
 }
 
-static bool write_faithful_header(const rsmooth_mesh *mesh, const rs_ply_extras *x, FILE *stream,
-                                  bool binary, const face_types *ft) {
-    bool ok = rs_io_put_bom(mesh, binary ? RSMOOTH_FORMAT_PLY_BINARY : RSMOOTH_FORMAT_PLY_ASCII,
-                            stream) &&
-              fputs("ply\n", stream) >= 0;
+rsmooth_status rs_io_ply_check_positions(const double *xyz, size_t count, const uint32_t *ids,
+                                         const rs_ply_element *v, double largest,
+                                         rsmooth_error *error) {
+    rsmooth_status status = rs_io_check_position_values(xyz, count, ids, where, error);
+    unsigned float_axes = 0;
+    const rs_ply_property *axis[3] = {NULL, NULL, NULL};
+    for (size_t k = 0; status == RSMOOTH_OK && k < v->property_count; k++) {
+        const rs_ply_property *p = &v->properties[k];
+        if (p->role < RS_PLY_X || p->role > RS_PLY_Z)
+            continue;
+        int c = p->role - RS_PLY_X;
+        axis[c] = p;
+        if (p->type == RS_PLY_FLOAT32)
+            float_axes |= 1u << c;
+        status = check_component(p, xyz, c, count, ids, error);
+    }
+    return status != RSMOOTH_OK ? status
+                                : check_float32_scale(xyz, count, ids, float_axes, axis, largest,
+                                                      error);
+}
+
+static bool write_faithful_header(const rs_ply_extras *x, FILE *stream, bool bom, bool binary,
+                                  const face_types *ft) {
+    bool ok = put_bom(stream, bom) && fputs("ply\n", stream) >= 0;
     for (size_t c = 0; ok && c < x->comment_count; c++)
         if (x->comments[c].before_format)
             ok = fprintf(stream, "%s\n", x->comments[c].text) >= 0;
@@ -430,6 +492,26 @@ static bool write_faithful_header(const rsmooth_mesh *mesh, const rs_ply_extras 
         }
     }
     return ok && fputs("end_header\n", stream) >= 0;
+}
+
+bool rs_io_ply_write_binary_header(FILE *stream, const rs_ply_extras *x, bool plain, bool bom,
+                                   bool f32) {
+    const rs_ply_element *v = &x->elements[x->vertex_element];
+    bool faces = x->face_element < x->element_count;
+    if (plain) { /* as write_generic: no normals, quality or colours; counts of uchar */
+        const generic_header h = {bom,   true,  f32,   false,
+                                  false, false, false, v->count > (uint64_t)INT32_MAX,
+                                  (size_t)v->count, faces ? (size_t)x->elements[1].count : 0};
+        return write_header(stream, &h);
+    }
+    /* the list's own types: the values read from them fit them (choose_face_types keeps them) */
+    face_types ft = {RS_PLY_NONE, RS_PLY_NONE, 0, 0};
+    const rs_ply_element *f = faces ? &x->elements[x->face_element] : NULL;
+    for (size_t k = 0; f && k < f->property_count; k++)
+        if (f->properties[k].role == RS_PLY_FACE_LIST)
+            ft = (face_types){f->properties[k].count_type, f->properties[k].type,
+                              f->properties[k].count_spelling, f->properties[k].spelling};
+    return write_faithful_header(x, stream, bom, true, &ft);
 }
 
 static rsmooth_status inconsistent(const rs_ply_element *e, rsmooth_error *error) {
@@ -512,7 +594,10 @@ static rsmooth_status write_faithful(const rsmooth_mesh *mesh, const rs_ply_extr
     }
     errno = 0;
     out_buffer *out = NULL;
-    bool ok = write_faithful_header(mesh, x, stream, binary, &ft);
+    bool ok = write_faithful_header(
+        x, stream,
+        rs_io_keeps_bom(mesh, binary ? RSMOOTH_FORMAT_PLY_BINARY : RSMOOTH_FORMAT_PLY_ASCII),
+        binary, &ft);
     if (ok)
         ok = (out = out_open(stream)) != NULL;
     for (size_t ei = 0; ok && status == RSMOOTH_OK && ei < x->element_count; ei++)

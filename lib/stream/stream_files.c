@@ -113,9 +113,9 @@ bool rs_stream_pread(int fd, void *data, size_t n, uint64_t offset) {
     return true;
 }
 
-bool rs_stream_copy(int from, int to, uint64_t size) {
+bool rs_stream_copy(int from, uint64_t from_offset, int to, uint64_t to_offset, uint64_t size) {
     uint64_t done = 0;
-    loff_t in = 0, out = 0;
+    loff_t in = (loff_t)from_offset, out = (loff_t)to_offset;
     while (done < size) { /* in the kernel, without passing through this process's memory */
         size_t want = size - done > (1u << 30) ? (1u << 30) : (size_t)(size - done);
         ssize_t n = copy_file_range(from, &in, to, &out, want, 0);
@@ -134,7 +134,8 @@ bool rs_stream_copy(int from, int to, uint64_t size) {
     bool ok = true;
     while (ok && done < size) {
         size_t n = size - done > CHUNK ? CHUNK : (size_t)(size - done);
-        ok = rs_stream_pread(from, buf, n, done) && rs_stream_pwrite(to, buf, n, done);
+        ok = rs_stream_pread(from, buf, n, from_offset + done) &&
+             rs_stream_pwrite(to, buf, n, to_offset + done);
         done += n;
     }
     rs_free(buf);

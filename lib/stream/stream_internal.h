@@ -57,8 +57,9 @@ int rs_stream_temporary(const char *dir);
 bool rs_stream_pwrite(int fd, const void *data, size_t n, uint64_t offset);
 bool rs_stream_pread(int fd, void *data, size_t n, uint64_t offset);
 
-/* Copies `size` bytes of `from` to `to` from offset 0 (copy_file_range where it works). */
-bool rs_stream_copy(int from, int to, uint64_t size);
+/* Copies `size` bytes of `from` at `from_offset` to `to` at `to_offset` (copy_file_range where
+ * it works). */
+bool rs_stream_copy(int from, uint64_t from_offset, int to, uint64_t to_offset, uint64_t size);
 
 /* Appends records to many regions of one file (the pieces' lists): each region has its own
  * small buffer, flushed with a positioned write at the region's running offset. */
@@ -80,24 +81,39 @@ void rs_region_writer_free(rs_region_writer *w);
 
 /* ---- stream_ply.c -------------------------------------------------------------------------- */
 
+/* The input, and the output as rs_io_ply_write writes it from memory: the header that writer
+ * gives (the generic one, with its comment, for a file it keeps no extras of), then the input's
+ * data little-endian, x y z rewritten. Offsets are bytes from the start of the file. */
 typedef struct rs_stream_ply {
     int fd;
     const char *path;
-    uint64_t size;       /* of the file */
-    rs_ply_reader header; /* the parsed header (data: a copy of the header bytes) */
-    bool swap;           /* data in the other byte order than the host's */
+    uint64_t size;        /* of the file */
+    bool bom;             /* it opens with a UTF-8 byte-order mark (kept in the output) */
+    rs_ply_reader header; /* the parsed header (data: a copy of the header bytes after the mark) */
+    bool plain;           /* rs_ply_is_plain: written from memory with the generic header */
+    bool swap;            /* data in the other byte order than the host's */
+    bool out_swap;        /* the output (little-endian) in the other byte order than the host's */
     uint64_t vertex_count, face_count;
-    uint64_t vertex_start; /* byte offset of the vertex block */
+    uint64_t data_start, data_end; /* the elements' data (data_end: once the faces are read) */
+    uint64_t vertex_start; /* the vertex block */
     size_t vertex_stride;  /* bytes per vertex row */
     size_t xyz_offset[3];
     rs_ply_type xyz_type;  /* FLOAT32 or FLOAT64, the same for x, y and z */
-    uint64_t face_start;   /* byte offset of the face block */
+    uint64_t face_start;   /* the face block */
+    double magnitude;      /* the largest |coordinate| read: the mesh's scale for float32 */
+    char *out_header;      /* the output's header bytes, its mark included */
+    size_t out_header_size;
 } rs_stream_ply;
 
-/* Opens `path` and reads its header and layout; refuses (UNSUPPORTED, naming the file and why)
- * what streaming cannot do. */
-rsmooth_status rs_stream_ply_open(rs_stream_ply *ply, const char *path, rsmooth_error *error);
+/* Opens `path` and reads its header (holding at most `header_memory` bytes of it) and layout;
+ * refuses (UNSUPPORTED, naming the file and why) what streaming cannot do. */
+rsmooth_status rs_stream_ply_open(rs_stream_ply *ply, const char *path, uint64_t header_memory,
+                                  rsmooth_error *error);
 void rs_stream_ply_close(rs_stream_ply *ply);
+
+/* Writes the output's header and the input's data into `out_fd` (from offset 0): the copy the
+ * results are written into. Needs data_end (rs_stream_ply_write_triangles). */
+bool rs_stream_ply_write_copy(const rs_stream_ply *ply, int out_fd);
 
 /* The vertices' extent: their bounding box and largest |coordinate|. */
 typedef struct rs_stream_extent {
@@ -115,8 +131,15 @@ rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz,
 rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_fd,
                                              uint64_t *triangle_count, rsmooth_error *error);
 
+/* Refuses positions (3 doubles each, of the vertices `ids[0, n)`) the output cannot hold, as
+ * rs_io_ply_check refuses them in memory (its message, after "OUTPUT: cannot write: "):
+ * RSMOOTH_ERROR_NUMERICAL, before any of them is written. */
+rsmooth_status rs_stream_ply_check_positions(const rs_stream_ply *ply, const uint32_t *ids,
+                                             size_t n, const double *xyz, const char *output,
+                                             rsmooth_error *error);
+
 /* Writes vertex positions (3 doubles each) of the vertices `ids[0, n)` (ascending) into the
- * output file `out_fd`, a copy of the input, in the file's type and byte order. */
+ * output file `out_fd` (rs_stream_ply_write_copy's), in the file's type. */
 bool rs_stream_ply_write_positions(const rs_stream_ply *ply, int out_fd, const uint32_t *ids,
                                    size_t n, const double *xyz);
 
@@ -154,6 +177,9 @@ typedef struct rs_stream_stats {
     double scale;            /* power of two the sums run at (exact; see stream_stats.c) */
     double mean_edge_length; /* caller's units */
     double mean_area;
+    /* the two at `scale` (internal units), as the in-memory path holds them: in the caller's
+     * units a mesh at 1e-300 has no representable area */
+    double scaled_mean_edge_length, scaled_mean_area;
     double reach;            /* largest centroid-to-corner distance of a facet */
     uint64_t facet_count;
     double lo[3], hi[3];     /* the vertices' bounding box */

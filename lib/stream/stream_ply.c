@@ -6,13 +6,15 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #define READ_BUFFER (1u << 20)
-/* A header longer than this is refused (comments of megabytes are not a mesh). */
-#define MAX_HEADER (64u << 20)
+/* The header is read in steps of this many bytes at first (growing fourfold). */
+#define HEADER_STEP (64u << 10)
 
 static rsmooth_status io_fail(const char *path, const char *what, rsmooth_error *error) {
     return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "%s: %s: %s", path, what,
@@ -37,32 +39,65 @@ static double value_at(const unsigned char *p, rs_ply_type t, bool swap) {
     return rs_ply_host_value(b, t);
 }
 
-/* Reads the header bytes (up to and past 'end_header') into a buffer the parser reads. */
-static rsmooth_status read_header(rs_stream_ply *ply, rsmooth_error *error) {
-    size_t want = 1u << 20;
+/* Whether the line [line, end) is the parser's last: its first word is 'end_header' (a word
+ * later on a line, a comment's, does not end the header). */
+static bool ends_header(const char *line, const char *end) {
+    while (line < end && rs_ply_is_space(*line))
+        line++;
+    static const char word[] = "end_header";
+    size_t n = sizeof word - 1;
+    return (size_t)(end - line) >= n && memcmp(line, word, n) == 0 &&
+           (line + n == end || rs_ply_is_space(line[n]));
+}
+
+/* Reads the header after the byte-order mark, up to and with its 'end_header' line (or the whole
+ * file, whose missing line the parser then reports), through a buffer that grows as the lines
+ * need, to at most `limit` bytes. */
+static rsmooth_status read_header(rs_stream_ply *ply, uint64_t limit, rsmooth_error *error) {
+    const uint64_t start = ply->bom ? RS_IO_UTF8_BOM_SIZE : 0, available = ply->size - start;
+    size_t cap = 0, len = 0, line = 0; /* buf[line, len): not yet seen whole */
+    char *buf = NULL;
     for (;;) {
-        if ((uint64_t)want > ply->size)
-            want = (size_t)ply->size;
-        char *buf = rs_alloc_array(want + 1, 1);
-        if (!buf)
-            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "PLY header");
-        if (!rs_stream_pread(ply->fd, buf, want, 0)) {
+        const char *eol = NULL;
+        while (len > line && (eol = memchr(buf + line, '\n', len - line)) != NULL) {
+            if (ends_header(buf + line, eol)) {
+                len = (size_t)(eol + 1 - buf);
+                break;
+            }
+            line = (size_t)(eol + 1 - buf);
+        }
+        if (eol || len == available) {
+            ply->header.data = buf;
+            ply->header.size = len;
+            return RSMOOTH_OK;
+        }
+        if (len == cap) {
+            if (cap >= limit) {
+                rs_free(buf);
+                return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
+                               "%s: the header runs past %.1f MB without its 'end_header' line: "
+                               "more than the memory cap allows it",
+                               ply->path, (double)cap / (1 << 20));
+            }
+            uint64_t grown = cap ? 4 * (uint64_t)cap : HEADER_STEP;
+            grown = grown > limit ? limit : grown;
+            grown = grown > available ? available : grown;
+            char *bigger = rs_realloc_array(buf, (size_t)grown + 1, 1);
+            if (!bigger) {
+                rs_free(buf);
+                return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
+                               "%s: no memory for a header of %.1f MB", ply->path,
+                               (double)grown / (1 << 20));
+            }
+            buf = bigger;
+            cap = (size_t)grown;
+        }
+        if (!rs_stream_pread(ply->fd, buf + len, cap - len, start + len)) {
             rs_free(buf);
             return io_fail(ply->path, "cannot read", error);
         }
-        buf[want] = 0;
-        bool found = false;
-        for (const char *p = buf; !found && (p = memmem(p, (size_t)(buf + want - p),
-                                                         "end_header", 10)) != NULL;
-             p++)
-            found = memchr(p, '\n', (size_t)(buf + want - p)) != NULL;
-        if (found || (uint64_t)want == ply->size || want >= MAX_HEADER) {
-            ply->header.data = buf;
-            ply->header.size = want;
-            return RSMOOTH_OK;
-        }
-        rs_free(buf);
-        want *= 4;
+        len = cap;
+        buf[len] = 0;
     }
 }
 
@@ -104,10 +139,21 @@ static uint64_t step_over(rs_stream_ply *ply, const rs_ply_element *e, uint64_t 
             const rs_ply_property *p = &e->properties[k];
             size_t n = 1;
             if (p->count_type != RS_PLY_NONE) {
+                uint64_t at = rs_stream_reader_offset(&r);
                 const unsigned char *c = rs_stream_read(&r, rs_ply_type_size(p->count_type));
                 if (!c)
                     goto short_file;
-                n = (size_t)value_at(c, p->count_type, ply->swap);
+                double count = value_at(c, p->count_type, ply->swap);
+                if (count < 0) { /* the in-memory reader's refusal, where it makes it */
+                    rs_stream_reader_close(&r);
+                    *st = rs_fail_parse(error, -1, (int64_t)at, RS_STREAM_WHERE,
+                                        "%s: byte %llu: negative list count in element '%.40s' "
+                                        "item %llu",
+                                        ply->path, (unsigned long long)at, e->name,
+                                        (unsigned long long)i);
+                    return 0;
+                }
+                n = (size_t)count;
             }
             for (size_t j = 0; j < n; j++)
                 if (!rs_stream_read(&r, rs_ply_type_size(p->type)))
@@ -157,7 +203,7 @@ static rsmooth_status find_layout(rs_stream_ply *ply, rsmooth_error *error) {
     }
     /* Elements before the later of the two blocks are stepped over (those with lists item by
      * item: the faces too, in a file that puts them before the vertices). */
-    uint64_t at = h->pos;
+    uint64_t at = ply->data_start;
     rsmooth_status st = RSMOOTH_OK;
     bool vertex_seen = false, face_seen = h->face_element == NULL;
     for (size_t ei = 0; ei < h->x->element_count && !(vertex_seen && face_seen); ei++) {
@@ -179,7 +225,20 @@ static rsmooth_status find_layout(rs_stream_ply *ply, rsmooth_error *error) {
     return RSMOOTH_OK;
 }
 
-rsmooth_status rs_stream_ply_open(rs_stream_ply *ply, const char *path, rsmooth_error *error) {
+/* The output's header: rs_io_ply_write's for what the reader makes of this one. */
+static rsmooth_status output_header(rs_stream_ply *ply, rsmooth_error *error) {
+    FILE *f = open_memstream(&ply->out_header, &ply->out_header_size);
+    bool ok = f && rs_io_ply_write_binary_header(f, ply->header.x, ply->plain, ply->bom,
+                                                 ply->xyz_type == RS_PLY_FLOAT32);
+    if (f && fclose(f) != 0)
+        ok = false;
+    return ok ? RSMOOTH_OK
+              : rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
+                        "%s: no memory for the output's header", ply->path);
+}
+
+rsmooth_status rs_stream_ply_open(rs_stream_ply *ply, const char *path, uint64_t header_memory,
+                                  rsmooth_error *error) {
     memset(ply, 0, sizeof *ply);
     ply->path = path;
     ply->fd = open(path, O_RDONLY | O_CLOEXEC);
@@ -192,11 +251,16 @@ rsmooth_status rs_stream_ply_open(rs_stream_ply *ply, const char *path, rsmooth_
         return unsupported(path, "needs a regular file (it reads the file more than once)",
                            error);
     ply->size = (uint64_t)sb.st_size;
-    char magic[4] = {0};
-    if (ply->size < 4 || !rs_stream_pread(ply->fd, magic, 4, 0) ||
-        memcmp(magic, "ply", 3) != 0 || (magic[3] != '\n' && magic[3] != '\r'))
+    char magic[7] = {0}; /* a byte-order mark, as the in-memory reader takes it, then "ply" */
+    size_t got = ply->size < sizeof magic ? (size_t)ply->size : sizeof magic;
+    if (!rs_stream_pread(ply->fd, magic, got, 0))
+        return io_fail(path, "cannot read", error);
+    ply->bom = got >= RS_IO_UTF8_BOM_SIZE && !memcmp(magic, RS_IO_UTF8_BOM, RS_IO_UTF8_BOM_SIZE);
+    const char *m = magic + (ply->bom ? RS_IO_UTF8_BOM_SIZE : 0);
+    if (got < (size_t)(m - magic) + 4 || memcmp(m, "ply", 3) != 0 ||
+        (m[3] != '\n' && m[3] != '\r'))
         return unsupported(path, "reads binary PLY only, and this is not a PLY file", error);
-    rsmooth_status st = read_header(ply, error);
+    rsmooth_status st = read_header(ply, header_memory, error);
     if (st != RSMOOTH_OK)
         return st;
     ply->header.precision = RSMOOTH_FLOAT32;
@@ -211,11 +275,18 @@ rsmooth_status rs_stream_ply_open(rs_stream_ply *ply, const char *path, rsmooth_
     if (st == RSMOOTH_OK)
         st = rs_ply_assign_roles(&ply->header, &detail);
     if (st != RSMOOTH_OK) { /* the reader's message, with the file named */
-        rs_fail_parse(error, detail.line, detail.byte_offset, RS_STREAM_WHERE, "%s: %s", path,
+        int64_t offset = detail.byte_offset;
+        if (offset >= 0 && ply->bom) /* offsets count from the file's first byte */
+            offset += RS_IO_UTF8_BOM_SIZE;
+        rs_fail_parse(error, detail.line, offset, RS_STREAM_WHERE, "%s: %s", path,
                       detail.message);
         return st;
     }
-    return find_layout(ply, error);
+    ply->data_start = (ply->bom ? RS_IO_UTF8_BOM_SIZE : 0) + (uint64_t)ply->header.pos;
+    ply->plain = rs_ply_is_plain(&ply->header);
+    ply->out_swap = !rs_ply_host_is_le(); /* rs_io_ply_write writes little-endian */
+    st = find_layout(ply, error);
+    return st == RSMOOTH_OK ? output_header(ply, error) : st;
 }
 
 void rs_stream_ply_close(rs_stream_ply *ply) {
@@ -223,6 +294,7 @@ void rs_stream_ply_close(rs_stream_ply *ply) {
         close(ply->fd);
     rs_free((char *)ply->header.data);
     rs_io_ply_extras_free(ply->header.x);
+    free(ply->out_header); /* open_memstream's */
     memset(ply, 0, sizeof *ply);
 }
 
@@ -268,6 +340,7 @@ rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz,
         }
     }
     rs_stream_reader_close(&r);
+    ply->magnitude = extent->magnitude;
     return RSMOOTH_OK;
 }
 
@@ -282,6 +355,7 @@ static rsmooth_status check_end(rs_stream_ply *ply, size_t next, uint64_t at,
         if (st != RSMOOTH_OK)
             return st;
     }
+    ply->data_end = at;
     rs_stream_reader r;
     if (!rs_stream_reader_open(&r, ply->fd, ply->path, at, ply->size, READ_BUFFER))
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
@@ -428,6 +502,93 @@ static void put_value(unsigned char *p, double x, rs_ply_type t, bool swap) {
         p[i] = swap ? b[n - 1 - i] : b[i];
 }
 
+/* Where input byte `at` of the data goes in the output: after the output's own header. */
+static uint64_t output_offset(const rs_stream_ply *ply, uint64_t at) {
+    return ply->out_header_size + (at - ply->data_start);
+}
+
+/* The output's data written front to back through a buffer, each value's bytes reversed. */
+typedef struct swapped_writer {
+    int fd;
+    uint64_t at; /* where buf goes */
+    unsigned char *buf;
+    size_t used;
+    bool ok;
+} swapped_writer;
+
+/* Copies the next value, of type t, from the input to the output in the other byte order; its
+ * value (a list's count: checked when its element was read), or -1 when the input ends. */
+static double copy_value(rs_stream_reader *r, swapped_writer *w, rs_ply_type t, bool swap) {
+    size_t size = rs_ply_type_size(t);
+    const unsigned char *v = rs_stream_read(r, size);
+    if (!v)
+        return w->ok = false, -1;
+    if (w->used + size > READ_BUFFER) {
+        w->ok = w->ok && rs_stream_pwrite(w->fd, w->buf, w->used, w->at);
+        w->at += w->used;
+        w->used = 0;
+    }
+    for (size_t b = 0; b < size; b++)
+        w->buf[w->used + b] = v[size - 1 - b];
+    w->used += size;
+    return value_at(v, t, swap);
+}
+
+/* The data into the output little-endian from a big-endian input: value by value, lists walked. */
+static bool copy_swapped(const rs_stream_ply *ply, int out_fd) {
+    swapped_writer w = {out_fd, output_offset(ply, ply->data_start),
+                        rs_alloc_array(READ_BUFFER, 1), 0, true};
+    rs_stream_reader r;
+    if (!w.buf || !rs_stream_reader_open(&r, ply->fd, ply->path, ply->data_start,
+                                         ply->data_end, READ_BUFFER)) {
+        rs_free(w.buf);
+        return false;
+    }
+    const rs_ply_extras *x = ply->header.x;
+    for (size_t ei = 0; w.ok && ei < x->element_count; ei++) {
+        const rs_ply_element *e = &x->elements[ei];
+        for (uint64_t i = 0; w.ok && i < e->count && e->property_count > 0; i++)
+            for (size_t k = 0; w.ok && k < e->property_count; k++) {
+                const rs_ply_property *p = &e->properties[k];
+                double n = p->count_type == RS_PLY_NONE ? 1
+                                                        : copy_value(&r, &w, p->count_type,
+                                                                     ply->swap);
+                for (double j = 0; w.ok && j < n; j++)
+                    copy_value(&r, &w, p->type, ply->swap);
+            }
+    }
+    bool ok = w.ok && rs_stream_pwrite(out_fd, w.buf, w.used, w.at);
+    rs_stream_reader_close(&r);
+    rs_free(w.buf);
+    return ok;
+}
+
+bool rs_stream_ply_write_copy(const rs_stream_ply *ply, int out_fd) {
+    if (!rs_stream_pwrite(out_fd, ply->out_header, ply->out_header_size, 0))
+        return false;
+    if (ply->swap != ply->out_swap) /* big-endian in: rs_io_ply_write writes little-endian */
+        return copy_swapped(ply, out_fd);
+    return rs_stream_copy(ply->fd, ply->data_start, out_fd, output_offset(ply, ply->data_start),
+                          ply->data_end - ply->data_start);
+}
+
+rsmooth_status rs_stream_ply_check_positions(const rs_stream_ply *ply, const uint32_t *ids,
+                                             size_t n, const double *xyz, const char *output,
+                                             rsmooth_error *error) {
+    rsmooth_error detail;
+    rsmooth_error_init(&detail);
+    if (rs_io_ply_check_positions(xyz, n, ids, ply->header.vertex_element, ply->magnitude,
+                                  &detail) == RSMOOTH_OK)
+        return RSMOOTH_OK;
+    if (ply->plain && ply->xyz_type == RS_PLY_FLOAT32) /* from memory: written as double */
+        return rs_fail(error, RSMOOTH_ERROR_NUMERICAL, RS_STREAM_WHERE,
+                       "%s: cannot write: streaming keeps the input's float x y z (without "
+                       "--max-memory they are written as double): %s",
+                       output, detail.message);
+    return rs_fail(error, RSMOOTH_ERROR_NUMERICAL, RS_STREAM_WHERE, "%s: cannot write: %s",
+                   output, detail.message);
+}
+
 bool rs_stream_ply_write_positions(const rs_stream_ply *ply, int out_fd, const uint32_t *ids,
                                    size_t n, const double *xyz) {
     enum { RUN_ROWS = 4096 };
@@ -442,12 +603,12 @@ bool rs_stream_ply_write_positions(const rs_stream_ply *ply, int out_fd, const u
         size_t run = 1; /* consecutive ids: one read and one write */
         while (i + run < n && run < RUN_ROWS && ids[i + run] == ids[i] + run)
             run++;
-        uint64_t at = ply->vertex_start + (uint64_t)ids[i] * stride;
+        uint64_t at = output_offset(ply, ply->vertex_start + (uint64_t)ids[i] * stride);
         ok = whole_rows || rs_stream_pread(out_fd, rows, run * stride, at);
         for (size_t j = 0; ok && j < run; j++)
             for (int k = 0; k < 3; k++)
                 put_value(rows + j * stride + ply->xyz_offset[k], xyz[3 * (i + j) + (size_t)k],
-                          ply->xyz_type, ply->swap);
+                          ply->xyz_type, ply->out_swap);
         ok = ok && rs_stream_pwrite(out_fd, rows, run * stride, at);
         i += run;
     }

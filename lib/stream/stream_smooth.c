@@ -114,9 +114,23 @@ static rsmooth_status check_arguments(stream_call *c, const rsmooth_params *para
                            options->struct_size);
         c->opt = *options;
     }
-    if (c->opt.ranks < 0 || (c->opt.ranks > 1 && (c->opt.rank < 0 || c->opt.rank >= c->opt.ranks)))
+    if (c->opt.ranks < 0)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, RS_STREAM_WHERE,
-                       "rank %d of %d ranks", c->opt.rank, c->opt.ranks);
+                       "options->ranks %d: give 0 or 1 alone, else the number of ranks",
+                       c->opt.ranks);
+    if (c->opt.ranks > 1 && (c->opt.rank < 0 || c->opt.rank >= c->opt.ranks))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, RS_STREAM_WHERE,
+                       "options->rank %d of %d ranks: give a rank in [0, ranks)", c->opt.rank,
+                       c->opt.ranks);
+    if (c->opt.ranks <= 1 && c->opt.rank != 0)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, RS_STREAM_WHERE,
+                       "options->rank %d with options->ranks %d: alone, the rank is 0",
+                       c->opt.rank, c->opt.ranks);
+    if (c->opt.ranks > 1 && !c->opt.sync) /* each rank would write its own pieces only */
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, RS_STREAM_WHERE,
+                       "options->ranks %d without options->sync: the ranks cannot agree, and "
+                       "each would write only its own pieces",
+                       c->opt.ranks);
     if (c->opt.ranks <= 1) {
         c->opt.ranks = 1;
         c->opt.rank = 0;
@@ -148,7 +162,8 @@ static rsmooth_status check_arguments(stream_call *c, const rsmooth_params *para
 /* Steps 1-3: everything before the output is touched. */
 static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
     double t0 = now_ms();
-    rsmooth_status st = rs_stream_ply_open(&c->ply, c->input, error);
+    /* the header, its parse and the output's: about three times its size */
+    rsmooth_status st = rs_stream_ply_open(&c->ply, c->input, c->opt.max_memory / 4, error);
     if (st != RSMOOTH_OK)
         return st;
     c->rep.vertex_count = c->ply.vertex_count;
@@ -247,7 +262,7 @@ static rsmooth_status make_copy(stream_call *c, rsmooth_error *error) {
                            "cannot create the output in the folder of %s: %s", c->output,
                            strerror(errno));
     }
-    if (!rs_stream_copy(c->ply.fd, c->out_fd, c->ply.size))
+    if (!rs_stream_ply_write_copy(&c->ply, c->out_fd))
         return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",
                        c->output, strerror(errno));
     return RSMOOTH_OK;
@@ -283,6 +298,46 @@ static size_t id_slot(const id_table *t, uint32_t id) {
     while (t->key[i] != id && t->key[i] != UINT32_MAX)
         i = (i + 1) & t->mask;
     return i;
+}
+
+/* The filter on an assembled piece (k vertices at xyz, its n core vertices first; m triangles):
+ * the core's results into `out`. It is handed over in internal units, its positions times the
+ * whole mesh's scale (exact: a power of two) and the figures as the in-memory path holds them, at
+ * scale 1: in the caller's units a mesh at 1e-300 has no double for its mean area. The results
+ * come back divided by the scale, as the in-memory path divides them. */
+static rsmooth_status filter_piece(stream_call *c, double *xyz, size_t k, const uint32_t *tri,
+                                   size_t m, size_t n, double *out, rsmooth_error *error) {
+    if (c->stats.facet_count == 0) { /* nothing moves, as in memory (and no mean area) */
+        memcpy(out, xyz, n * 3 * sizeof *out);
+        return RSMOOTH_OK;
+    }
+    const double scale = c->stats.scale;
+    for (size_t i = 0; i < 3 * k; i++)
+        xyz[i] *= scale;
+    rsmooth_params params = c->params; /* absolute widths: in internal units too */
+    if (params.absolute) {
+        params.sigma_f *= scale;
+        params.sigma_g *= scale; /* +INFINITY stays */
+        params.normal_sigma_s *= scale;
+    }
+    rsmooth_piece_info info;
+    rsmooth_piece_info_init(&info);
+    info.core_count = n;
+    info.mean_edge_length = c->stats.scaled_mean_edge_length;
+    info.mean_area = c->stats.scaled_mean_area;
+    info.scale = 1;
+    rsmooth_report rep;
+    rsmooth_report_init(&rep);
+    rsmooth_status st = rsmooth_smooth_piece(c->ctx, xyz, k, tri, m, &info, &params, out, &rep,
+                                             error);
+    if (st != RSMOOTH_OK)
+        return st;
+    if (!c->rep.device[0])
+        snprintf(c->rep.device, sizeof c->rep.device, "%s", rep.device);
+    const double unscale = 1 / scale;
+    for (size_t i = 0; i < 3 * n; i++)
+        out[i] *= unscale;
+    return RSMOOTH_OK;
 }
 
 /* Step 5 for one piece: its lists read, its vertices numbered core first (then the others as the
@@ -345,21 +400,12 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
     }
     id_table_free(&table);
     table.key = table.value = NULL;
-    rsmooth_piece_info info;
-    rsmooth_piece_info_init(&info);
-    info.core_count = n;
-    info.mean_edge_length = c->stats.mean_edge_length;
-    info.mean_area = c->stats.mean_area;
-    info.scale = c->stats.scale;
-    rsmooth_report rep;
-    rsmooth_report_init(&rep);
-    double t_library = now_ms();
-    c->rep.ms_assemble += t_library - t_piece;
-    st = rsmooth_smooth_piece(c->ctx, xyz, k, tri, m, &info, &c->params, out, &rep, error);
+    c->rep.ms_assemble += now_ms() - t_piece;
+    st = filter_piece(c, xyz, k, tri, m, n, out, error);
+    if (st == RSMOOTH_OK) /* what the in-memory writer refuses, before any of it is written */
+        st = rs_stream_ply_check_positions(&c->ply, core, n, out, c->output, error);
     if (st != RSMOOTH_OK)
         goto done;
-    if (!c->rep.device[0])
-        snprintf(c->rep.device, sizeof c->rep.device, "%s", rep.device);
     double t = now_ms();
     if (!rs_stream_ply_write_positions(&c->ply, c->out_fd, core, n, out))
         st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",

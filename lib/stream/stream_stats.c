@@ -187,7 +187,8 @@ static rsmooth_status facet_figures(const rs_stream_positions *pos, int fd, uint
     }
     rs_stream_reader_close(&r);
     stats->facet_count = facets;
-    stats->mean_area = facets ? area_sum / (double)facets / scale / scale : 0;
+    stats->scaled_mean_area = facets ? area_sum / (double)facets : 0;
+    stats->mean_area = stats->scaled_mean_area / scale / scale;
     stats->reach = reach / scale;
     return RSMOOTH_OK;
 }
@@ -225,9 +226,9 @@ rsmooth_status rs_stream_statistics(const rs_stream_positions *positions, int tr
     if (st != RSMOOTH_OK)
         return st;
     st = mean_edge_length(positions, triangles_fd, triangle_count, stats->scale, memory,
-                          &stats->mean_edge_length, error);
+                          &stats->scaled_mean_edge_length, error);
     if (st != RSMOOTH_OK)
         return st;
-    stats->mean_edge_length /= stats->scale;
+    stats->mean_edge_length = stats->scaled_mean_edge_length / stats->scale;
     return facet_figures(positions, triangles_fd, triangle_count, stats->scale, stats, error);
 }
