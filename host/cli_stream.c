@@ -63,6 +63,16 @@ int cli_stream_exit_code(rsmooth_status st) {
     }
 }
 
+void cli_stream_print_error(const char *program, const char *message) {
+    static const char library_hint[] = "set options->replace";
+    const char *hint = strstr(message, library_hint);
+    if (hint)
+        fprintf(stderr, "%s: %.*suse --force%s\n", program, (int)(hint - message), message,
+                hint + sizeof library_hint - 1);
+    else
+        fprintf(stderr, "%s: %s\n", program, message);
+}
+
 void cli_stream_print_json(const rsmooth_stream_report *r, const options *opt, int ranks) {
     printf("{\"input\":");
     cli_print_json_string(opt->input);
@@ -118,9 +128,11 @@ int cli_stream_file(const options *opt, const char *path) {
     cli_progress_clear(&bar);
     rsmooth_context_destroy(ctx);
     if (st != RSMOOTH_OK) {
-        fprintf(stderr, "rsmooth: %s\n", err.message);
+        cli_stream_print_error("rsmooth", err.message);
         return cli_stream_exit_code(st);
     }
+    if (rep.notes[0] && !opt->quiet)
+        fprintf(stderr, "rsmooth: %s: warning: %s\n", opt->output, rep.notes);
     if (opt->json)
         cli_stream_print_json(&rep, opt, 1);
     if (!opt->quiet)

@@ -16,6 +16,10 @@ int cli_stream_file(const options *opt, const char *path);
 /* The exit status for a streaming failure. */
 int cli_stream_exit_code(rsmooth_status st);
 
+/* Prints a streaming failure as "PROGRAM: message", in the command's words: the library's
+ * "set options->replace" is the command's "use --force". */
+void cli_stream_print_error(const char *program, const char *message);
+
 /* --json for a streaming run: one object on stdout. */
 void cli_stream_print_json(const rsmooth_stream_report *r, const options *opt, int ranks);
 

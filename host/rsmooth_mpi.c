@@ -7,33 +7,27 @@
  * pieces the plan gives it (by facet count, the largest first to the least loaded rank); rank 0
  * makes the output's copy and names it when every rank is done. The result is the single-process
  * streaming result, bit for bit: the same pieces, filtered by the same code. "%l" in --device is
- * replaced by the rank's index on its node (e.g. --device 0:%l, one GPU per local rank). */
+ * replaced by the rank's index on its node (e.g. --device 0:%l, one GPU per local rank).
+ *
+ * Before any work the ranks compare digests of what they were given (mpi_agree.c): a rank with
+ * another input, other parameters, another cap or another output would write garbage into the
+ * shared file, so the run is refused, naming the rank. */
 #define _POSIX_C_SOURCE 200809L
 #include "cli_args.h"
 #include "cli_device.h"
 #include "cli_files.h"
 #include "cli_options.h"
 #include "cli_stream.h"
+#include "mpi_agree.h"
 #include "rsmooth_io.h"
 
 #include <mpi.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
 #define DEFAULT_MAX_MEMORY (1ull << 30)
-
-/* The partial output, removed if a signal ends the run while it exists. */
-static char partial[4200];
-
-static void remove_partial_and_exit(int signal_number) {
-    if (partial[0])
-        unlink(partial);
-    signal(signal_number, SIG_DFL);
-    raise(signal_number);
-}
 
 /* rsmooth_stream_options.sync: every rank's worst status. */
 static int all_reduce(void *user, int status) {
@@ -85,10 +79,10 @@ static int parse(int argc, char **argv, int rank, options *opt) {
             break;
         }
     int code = cli_options_parse(argc, argv, opt);
-    if (code < 0 && (opt->input_count != 1 || !opt->output_option || opt->output_dir ||
-                     opt->suffix || opt->list_devices)) {
+    if (code < 0 && (opt->input_count != 1 || !(opt->output_option || opt->in_place) ||
+                     opt->output_dir || opt->suffix || opt->list_devices)) {
         code = cli_usage_error(NULL, "rsmooth-mpi smooths one input into one output: "
-                                     "rsmooth-mpi IN.ply -o OUT.ply [options]");
+                                     "rsmooth-mpi IN.ply -o OUT.ply (or --in-place) [options]");
         cli_options_free(opt);
     }
     if (code < 0 && !opt->max_memory) {
@@ -133,6 +127,8 @@ int main(int argc, char **argv) {
         code = cli_check_output(opt.output, opt.input, opt.force, opt.in_place,
                                 opt.format != RSMOOTH_FORMAT_AUTO);
     MPI_Bcast(&code, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    if (code < 0)
+        code = mpi_agree(&opt, rank, ranks);
     if (code >= 0) {
         cli_options_free(&opt);
         MPI_Finalize();
@@ -155,11 +151,6 @@ int main(int argc, char **argv) {
         MPI_Finalize();
         return code;
     }
-    snprintf(partial, sizeof partial, "%s.rsmooth-partial", opt.output);
-    signal(SIGINT, remove_partial_and_exit);
-    signal(SIGTERM, remove_partial_and_exit);
-    signal(SIGHUP, remove_partial_and_exit);
-
     rsmooth_stream_options so;
     rsmooth_stream_options_init(&so);
     so.max_memory = opt.max_memory;
@@ -173,11 +164,12 @@ int main(int argc, char **argv) {
     rsmooth_error err;
     rsmooth_status st =
         rsmooth_stream_smooth(ctx, opt.input, opt.output, &opt.params, &so, &rep, &err);
-    partial[0] = 0;
     /* a rank that failed says why; the others only that they stopped with it */
     bool own = st != RSMOOTH_OK && strstr(err.message, "another rank failed") == NULL;
+    char program[48];
+    snprintf(program, sizeof program, "rsmooth-mpi: rank %d", rank);
     if (own)
-        fprintf(stderr, "rsmooth-mpi: rank %d: %s\n", rank, err.message);
+        cli_stream_print_error(program, err.message);
     code = st == RSMOOTH_OK ? EXIT_OK : cli_stream_exit_code(st);
     if (st == RSMOOTH_OK && !quiet)
         fprintf(stderr, "rsmooth-mpi: rank %d of %d on %s: %zu pieces, %llu facets with halos, "
@@ -188,6 +180,8 @@ int main(int argc, char **argv) {
                 rep.ms_write / 1000);
     MPI_Barrier(MPI_COMM_WORLD); /* the ranks' lines before the summary */
     if (st == RSMOOTH_OK && rank == 0) {
+        if (rep.notes[0] && !quiet)
+            fprintf(stderr, "rsmooth-mpi: %s: warning: %s\n", opt.output, rep.notes);
         if (opt.json)
             cli_stream_print_json(&rep, &opt, ranks);
         if (!quiet)

@@ -205,8 +205,11 @@ typedef struct rsmooth_stream_options {
     uint64_t max_memory;   /* bytes the call may hold at its peak, besides the OpenCL runtime's
                             * own (docs: README "Large meshes"); 0: 1 GiB */
     const char *tmpdir;    /* folder of the temporary files (all unnamed: nothing is left behind,
-                            * however the process ends); NULL: the output's folder */
-    int replace;           /* non-zero: an existing output is replaced (atomically) */
+                            * however the process ends); an existing folder, or NULL: the
+                            * output's folder. "" is refused */
+    int replace;           /* non-zero: an existing output (a regular file, or a symbolic link to
+                            * one: written through) is replaced atomically, keeping its mode,
+                            * owner and group; nothing else is ever replaced */
     /* Several processes sharing the pieces (the MPI driver): each calls with the same arguments,
      * its own rank in [0, ranks), and `sync`, which every rank calls at the same points and which
      * returns the worst (largest) status any rank passed (an all-reduce). ranks 0 or 1: alone,
@@ -238,6 +241,10 @@ typedef struct rsmooth_stream_report {
      * the copy */
     double ms_read, ms_statistics, ms_buckets, ms_copy, ms_assemble, ms_filter, ms_write, ms_total;
     char device[128];
+    /* What the caller should tell its user about the output it replaced: other hard links that
+     * keep the old content, an owner or group that could not be kept (only root can give a file
+     * away). "" when nothing. (Added in 0.9) */
+    char notes[400];
 } rsmooth_stream_report;
 
 /* Zeroes `report` and sets its struct_size. Accepts NULL. */
@@ -257,8 +264,14 @@ RSMOOTH_API void rsmooth_stream_report_init(rsmooth_stream_report *report);
  * path (see rsmooth_smooth_piece). Positions the file's x y z type cannot hold (float32 beyond
  * FLT_MAX, or below its precision at the mesh's scale) are RSMOOTH_ERROR_NUMERICAL with
  * rsmooth_mesh_write's message, nothing written; where the reader keeps no extras, a write from
- * memory would switch to double x y z instead, which a copy cannot. The output appears whole and
- * at once, or not at all.
+ * memory would switch to double x y z instead, which a copy cannot. The output appears whole and at
+ * once, or not at all: written beside its final name and put in place only when complete, as the
+ * rsmooth command writes its files. Without options->replace an existing output, or one another
+ * program creates while the call works, is never replaced (RSMOOTH_ERROR_IO, "already exists");
+ * folders, devices, FIFOs and links to nothing never are. Several ranks share a partial file
+ * ".rsmooth-partial-<hash>" beside the output, made by rank 0 and named as the output when every
+ * rank is done. While a named temporary exists, a SIGINT, SIGTERM or SIGHUP (unless ignored)
+ * removes it first, then takes its previous action (the default, or the program's own handler).
  *
  * What streams: binary PLY (either byte order) with float or double x, y, z, faces of any size
  * (fanned into triangles as the reader does), up to 2^32 - 1 vertices and any number of faces.

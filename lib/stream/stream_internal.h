@@ -17,6 +17,8 @@
 #include <string.h>
 
 #define RS_STREAM_WHERE "rsmooth_stream_smooth"
+/* How a caller of rsmooth_stream_smooth asks for an existing output to be replaced. */
+#define RS_STREAM_REPLACE_HINT "set options->replace"
 
 /* ---- stream_files.c ------------------------------------------------------------------------ */
 

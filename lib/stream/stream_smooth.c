@@ -12,6 +12,7 @@
  * rows: disjoint bytes of one file. */
 #define _GNU_SOURCE /* O_TMPFILE, linkat, renameat2 */
 #include "stream/stream_internal.h"
+#include "io/output_file.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -62,13 +63,13 @@ typedef struct stream_call {
     rs_stream_ply ply;
     void *xyz;
     rs_stream_positions positions;
-    int triangles_fd, out_fd;
+    int triangles_fd;
+    rs_output out;         /* the output: its target, and the copy the results go into */
     uint64_t triangle_count;
     rs_stream_stats stats;
     double halo;
     uint64_t piece_vertices;
     rs_stream_pieces pieces;
-    char partial[4200];    /* the named partial output of several ranks */
 } stream_call;
 
 static double now_ms(void) {
@@ -98,6 +99,28 @@ static void output_dir(const char *output, char *dir, size_t size) {
         dir[1] = 0;
     else
         *slash = 0;
+}
+
+/* The temporaries' folder: options->tmpdir (an existing folder, its name whole), else the output's. */
+static rsmooth_status check_tmpdir(stream_call *c, rsmooth_error *error) {
+    if (!c->opt.tmpdir) {
+        output_dir(c->output, c->dir, sizeof c->dir);
+        return RSMOOTH_OK;
+    }
+    if (!c->opt.tmpdir[0])
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, RS_STREAM_WHERE,
+                       "options->tmpdir is empty: name a folder, or NULL for the output's");
+    if (strlen(c->opt.tmpdir) >= sizeof c->dir)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, RS_STREAM_WHERE,
+                       "options->tmpdir is %zu bytes long: at most %zu", strlen(c->opt.tmpdir),
+                       sizeof c->dir - 1);
+    struct stat sb;
+    if (stat(c->opt.tmpdir, &sb) != 0 || !S_ISDIR(sb.st_mode))
+        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                       "options->tmpdir %s: %s", c->opt.tmpdir,
+                       stat(c->opt.tmpdir, &sb) != 0 ? strerror(errno) : "not a folder");
+    snprintf(c->dir, sizeof c->dir, "%s", c->opt.tmpdir);
+    return RSMOOTH_OK;
 }
 
 static rsmooth_status check_arguments(stream_call *c, const rsmooth_params *params,
@@ -148,15 +171,13 @@ static rsmooth_status check_arguments(stream_call *c, const rsmooth_params *para
         rsmooth_params_init(&c->params);
     c->params.progress = NULL;
     c->params.progress_cancel = NULL;
-    struct stat sb;
-    if (!c->opt.replace && lstat(c->output, &sb) == 0)
-        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                       "%s exists (replace it with options->replace)", c->output);
-    if (c->opt.tmpdir)
-        snprintf(c->dir, sizeof c->dir, "%s", c->opt.tmpdir);
-    else
-        output_dir(c->output, c->dir, sizeof c->dir);
-    return RSMOOTH_OK;
+    st = check_tmpdir(c, error);
+    if (st != RSMOOTH_OK)
+        return st;
+    /* what the command checks for its in-memory outputs: only files, links to them written
+     * through, nothing replaced unasked */
+    return rs_output_resolve(&c->out, c->output, c->opt.replace != 0, RS_STREAM_REPLACE_HINT,
+                             RS_STREAM_WHERE, error);
 }
 
 /* Steps 1-3: everything before the output is touched. */
@@ -241,28 +262,16 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
                : rs_fail(error, RSMOOTH_ERROR_CANCELLED, RS_STREAM_WHERE, "cancelled");
 }
 
-/* Step 4: the copy of the input the results go into. Alone: unnamed (O_TMPFILE) until step 6.
- * Ranks: named <output>.rsmooth-partial, made by rank 0, so the others can open it. */
+/* Step 4: the copy of the input the results go into, beside the output's target. Alone: unnamed
+ * where the system allows, until step 6. Ranks: a named partial file (output_file.h), made by rank
+ * 0 and opened by the others once it exists. */
 static rsmooth_status make_copy(stream_call *c, rsmooth_error *error) {
-    if (c->opt.ranks > 1) {
-        c->out_fd = open(c->partial, O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (c->out_fd < 0)
-            return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                           "cannot create %s: %s%s", c->partial, strerror(errno),
-                           errno == EEXIST ? " (left by a run that was killed: remove it)" : "");
-    } else {
-        c->out_fd = -1;
-#ifdef O_TMPFILE
-        char dir[4096];
-        output_dir(c->output, dir, sizeof dir);
-        c->out_fd = open(dir, O_TMPFILE | O_RDWR | O_CLOEXEC, 0666);
-#endif
-        if (c->out_fd < 0)
-            return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                           "cannot create the output in the folder of %s: %s", c->output,
-                           strerror(errno));
-    }
-    if (!rs_stream_ply_write_copy(&c->ply, c->out_fd))
+    rsmooth_status st = c->opt.ranks > 1
+                            ? rs_output_create_partial(&c->out, true, RS_STREAM_WHERE, error)
+                            : rs_output_create(&c->out, RS_STREAM_WHERE, error);
+    if (st != RSMOOTH_OK)
+        return st;
+    if (!rs_stream_ply_write_copy(&c->ply, c->out.fd))
         return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",
                        c->output, strerror(errno));
     return RSMOOTH_OK;
@@ -407,7 +416,7 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
     if (st != RSMOOTH_OK)
         goto done;
     double t = now_ms();
-    if (!rs_stream_ply_write_positions(&c->ply, c->out_fd, core, n, out))
+    if (!rs_stream_ply_write_positions(&c->ply, c->out.fd, core, n, out))
         st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",
                      c->output, strerror(errno));
     c->rep.ms_write += now_ms() - t;
@@ -445,45 +454,6 @@ static rsmooth_status run_pieces(stream_call *c, rsmooth_error *error) {
     return RSMOOTH_OK;
 }
 
-/* Step 6, alone: the unnamed copy linked under a temporary name beside the output, then renamed
- * over it (or linked as the output directly, which fails if one appeared meanwhile). */
-static rsmooth_status publish(stream_call *c, rsmooth_error *error) {
-    if (fsync(c->out_fd) != 0)
-        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",
-                       c->output, strerror(errno));
-    if (c->opt.ranks > 1) {
-        if (rename(c->partial, c->output) != 0)
-            return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot rename %s to %s: %s",
-                           c->partial, c->output, strerror(errno));
-        c->partial[0] = 0;
-        return RSMOOTH_OK;
-    }
-    char proc[64], temporary[4200];
-    snprintf(proc, sizeof proc, "/proc/self/fd/%d", c->out_fd);
-    if (!c->opt.replace) {
-        if (linkat(AT_FDCWD, proc, AT_FDCWD, c->output, AT_SYMLINK_FOLLOW) == 0)
-            return RSMOOTH_OK;
-        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",
-                       c->output, strerror(errno));
-    }
-    for (int attempt = 0; attempt < 100; attempt++) {
-        snprintf(temporary, sizeof temporary, "%s.rsmooth-%d-%d", c->output, (int)getpid(),
-                 attempt);
-        if (linkat(AT_FDCWD, proc, AT_FDCWD, temporary, AT_SYMLINK_FOLLOW) == 0) {
-            if (rename(temporary, c->output) == 0)
-                return RSMOOTH_OK;
-            int saved = errno;
-            unlink(temporary);
-            errno = saved;
-            break;
-        }
-        if (errno != EEXIST)
-            break;
-    }
-    return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s", c->output,
-                   strerror(errno));
-}
-
 /* A status that another rank failed with, said so here. */
 static rsmooth_status others_failed(int worst, rsmooth_status mine, rsmooth_error *error) {
     if (mine != RSMOOTH_OK || worst == RSMOOTH_OK)
@@ -505,13 +475,13 @@ rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input, co
     c->ctx = ctx;
     c->input = input;
     c->output = output;
-    c->triangles_fd = c->out_fd = -1;
+    c->triangles_fd = -1;
+    c->out.fd = -1;
+    c->out.guard = -1;
     c->ply.fd = -1;
     c->pieces.vertex_fd = c->pieces.facet_fd = -1;
     rsmooth_stream_report_init(&c->rep);
     rsmooth_status st = check_arguments(c, params, options, error);
-    if (st == RSMOOTH_OK && c->opt.ranks > 1)
-        snprintf(c->partial, sizeof c->partial, "%s.rsmooth-partial", output);
     if (st == RSMOOTH_OK)
         st = plan(c, error);
     st = others_failed(sync_ranks(c, st), st, error);
@@ -521,24 +491,20 @@ rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input, co
         c->rep.ms_copy = now_ms() - t;
     }
     st = others_failed(sync_ranks(c, st), st, error);
-    if (st == RSMOOTH_OK && c->opt.rank != 0) {
-        c->out_fd = open(c->partial, O_RDWR | O_CLOEXEC);
-        if (c->out_fd < 0)
-            st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot open %s: %s",
-                         c->partial, strerror(errno));
-    }
+    if (st == RSMOOTH_OK && c->opt.rank != 0)
+        st = rs_output_create_partial(&c->out, false, RS_STREAM_WHERE, error);
     if (st == RSMOOTH_OK)
         st = run_pieces(c, error);
-    if (st == RSMOOTH_OK && c->opt.ranks > 1 && fsync(c->out_fd) != 0)
+    /* every rank's rows on disk before rank 0 names the file */
+    if (st == RSMOOTH_OK && c->opt.ranks > 1 && fsync(c->out.fd) != 0)
         st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",
-                     c->partial, strerror(errno));
+                     c->out.temporary, strerror(errno));
     st = others_failed(sync_ranks(c, st), st, error);
-    if (c->opt.rank == 0 && c->out_fd >= 0) {
-        if (st == RSMOOTH_OK)
-            st = publish(c, error);
-        if (st != RSMOOTH_OK && c->partial[0])
-            unlink(c->partial); /* nothing half-written is left */
-    }
+    if (c->opt.rank == 0 && c->out.fd >= 0 && st == RSMOOTH_OK)
+        st = rs_output_publish(&c->out, c->opt.replace != 0, RS_STREAM_WHERE, error);
+    if (st == RSMOOTH_OK && c->out.notes[0])
+        snprintf(c->rep.notes, sizeof c->rep.notes, "%s", c->out.notes);
+    rs_output_discard(&c->out); /* nothing half-written is left */
     st = others_failed(sync_ranks(c, st), st, error);
     if (st == RSMOOTH_OK)
         report_progress(c, 1.0);
@@ -549,8 +515,6 @@ rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input, co
         memcpy(report, &c->rep, size);
         report->struct_size = size;
     }
-    if (c->out_fd >= 0)
-        close(c->out_fd);
     if (c->triangles_fd >= 0)
         close(c->triangles_fd);
     rs_stream_pieces_free(&c->pieces);
