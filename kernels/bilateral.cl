@@ -26,8 +26,8 @@ inline void store_group_normals(lanef ax, lanef ay, lanef az, lanef nx, lanef ny
     store_lanes(select(nx, ax / len, some), 0, mx);
     store_lanes(select(ny, ay / len, some), 0, my);
     store_lanes(select(nz, az / len, some), 0, mz);
-    for (uint l = 0; l < count; l++)
-        normal_out[first + l] = (float4)(mx[l], my[l], mz[l], 0.0f);
+    for (uint l = 0; l < count; l++) /* vstore4: see DECLARE_STAGE (common.cl) */
+        vstore4((float4)(mx[l], my[l], mz[l], 0.0f), first + l, (__global float *)normal_out);
 }
 
 __kernel void bilateral_cell_normals(uint cell_count, float reach2, float inv_2s2, float inv_2t2,

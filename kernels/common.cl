@@ -68,8 +68,21 @@ inline float lane_max(lanef v) { return max4(v); }
 inline float lane_min(lanef v) { return min4(fmin(v.lo, v.hi)); }
 inline float lane_max(lanef v) { return max4(fmax(v.lo, v.hi)); }
 #elif RS_LANES == 16
-inline float lane_min(lanef v) { float8 m = fmin(v.lo, v.hi); return min4(fmin(m.lo, m.hi)); }
-inline float lane_max(lanef v) { float8 m = fmax(v.lo, v.hi); return max4(fmax(m.lo, m.hi)); }
+/* The halves through a private array, not v.lo and v.hi: Oclgrind takes a lane picked from
+ * element 11 of a vector for undefined (its error 7 in tests/test_oclgrind.c); compilers keep the
+ * array in registers all the same. Once per block, out of the facet loops. */
+inline float lane_min(lanef v) {
+    float h[16];
+    vstore16(v, 0, h);
+    float8 m = fmin(vload8(0, h), vload8(1, h));
+    return min4(fmin(m.lo, m.hi));
+}
+inline float lane_max(lanef v) {
+    float h[16];
+    vstore16(v, 0, h);
+    float8 m = fmax(vload8(0, h), vload8(1, h));
+    return max4(fmax(m.lo, m.hi));
+}
 #else
 #error "RS_LANES must be 1, 4, 8 or 16"
 #endif
@@ -224,7 +237,11 @@ inline int4 slot_cell(__global const int4 *block_cell, __global const uchar *blo
 
 #if RS_LANES == 1
 
-/* The local memory of the group variant, declared at kernel scope (OpenCL C requires it there). */
+/* The local memory of the group variant, declared at kernel scope (OpenCL C requires it there).
+ * Vectors made of scalars go in with vstore4: stored whole, LLVM writes them with the scalar lanes
+ * undefined and then each lane, which Oclgrind's uninitialised-value check reports. Boxes are
+ * float4, not float3, whose fourth lane LLVM leaves undefined: that check crashes on it.
+ * (Oclgrind's errors 2 and 3 in tests/test_oclgrind.c; both forms cost nothing.) */
 #define DECLARE_STAGE                                                                              \
     __local float4 stage_c[RS_GROUP], stage_n[RS_GROUP];                                           \
     __local int4 stage_d[RS_GROUP];                                                                \
@@ -244,21 +261,21 @@ inline int4 slot_cell(__global const int4 *block_cell, __global const uchar *blo
           pz = (block_pos)[3 * own_ + 2];                                                          \
     int4 cell_ = (block_cell)[own_];                                                               \
     stage_d[lid_] = cell_;                                                                         \
-    stage_c[lid_] = (float4)(px, py, pz, 0.0f);                                                    \
+    vstore4((float4)(px, py, pz, 0.0f), lid_, (__local float *)stage_c);                           \
     barrier(CLK_LOCAL_MEM_FENCE);                                                                  \
     if (lid_ == 0) {                                                                               \
         int4 a_ = stage_d[0];                                                                      \
         for (uint i_ = 1; i_ < RS_GROUP; i_++)                                                     \
             a_ = min(a_, stage_d[i_]);                                                             \
-        float3 l_ = MAXFLOAT, h_ = -MAXFLOAT;                                                      \
+        float4 l_ = MAXFLOAT, h_ = -MAXFLOAT; /* w: 0, unread */                                   \
         for (uint i_ = 0; i_ < RS_GROUP; i_++) {                                                   \
-            float3 p_ = convert_float3((stage_d[i_] - a_).xyz) + stage_c[i_].xyz;                  \
+            float4 p_ = convert_float4(stage_d[i_] - a_) + stage_c[i_];                            \
             l_ = fmin(l_, p_);                                                                     \
             h_ = fmax(h_, p_);                                                                     \
         }                                                                                          \
         stage_anchor = a_;                                                                         \
-        stage_box[0] = (float4)(l_, 0.0f);                                                         \
-        stage_box[1] = (float4)(h_, 0.0f);                                                         \
+        stage_box[0] = l_;                                                                         \
+        stage_box[1] = h_;                                                                         \
     }                                                                                              \
     barrier(CLK_LOCAL_MEM_FENCE);                                                                  \
     int4 anchor = stage_anchor;                                                                    \
@@ -302,7 +319,7 @@ inline int4 slot_cell(__global const int4 *block_cell, __global const uchar *blo
                     stage_q[filled_ + slot_] = gap2_ <= cull2_ ? q_ : UINT_MAX;                    \
                     stage_c[filled_ + slot_] = c_;                                                 \
                     stage_n[filled_ + slot_] = (NORMALS)[q_];                                      \
-                    stage_d[filled_ + slot_] = (int4)(dx, dy, dz, 0);                              \
+                    vstore4((int4)(dx, dy, dz, 0), filled_ + slot_, (__local int *)stage_d);       \
                 }                                                                                  \
                 filled_ += take_;                                                                  \
                 next_ += take_;                                                                    \

@@ -122,20 +122,25 @@ lanef smallest_exponent(lanef px, lanef py, lanef pz, lanei ox, lanei oy, lanei 
                         __global const uint *column_first, __global const int *column_table,
                         uint column_mask) {
     lanef e_min = MAXFLOAT;
+    /* Tukey's test applies to every lane or none: picked by select() rather than an `if`, which
+     * the compiler turns into a choice between boolean vectors, one of them all true, and
+     * Oclgrind computes that one as all false (its error 4 in tests/test_oclgrind.c) */
+    lanei tukey_lanes = (lanei)(tukey ? -1 : 0);
     uint pairs = 0; /* not counted: the rescue's second pass counts its facets */
     FOR_EACH_FACET_OWN(reach2, normal, pairs, {
         lanef ex = c.x - qx, ey = c.y - qy, ez = c.z - qz;
         lanef d2 = ex * ex + ey * ey + ez * ez;
         lanef t = n.x * ex + n.y * ey + n.z * ez;
         lanef e = (predict_centroid ? d2 : t * t) * inv_2sg2;
-        lanei counts = d2 <= reach2;
+        lanei near = d2 <= reach2;
         if (use_color) {
             float4 fc = facet_color[q];
             lanef dr = fc.x - cr, dg = fc.y - cg, db = fc.z - cb;
             e += (dr * dr + dg * dg + db * db) * inv_2sc2;
         }
-        if (tukey) /* only the facets Tukey's weight does not reject */
-            counts = counts && (predict_centroid ? d2 : t * t) * inv_sg2 < 5.0f;
+        /* with Tukey's weight, only the facets it does not reject */
+        lanei counts =
+            select(near, near && (predict_centroid ? d2 : t * t) * inv_sg2 < 5.0f, tukey_lanes);
         e_min = select(e_min, fmin(e_min, e), counts);
     })
     return e_min;

@@ -15,6 +15,7 @@
  * RSMOOTH_BILATERAL_LISTS=0 forces that, for tests and measurements. */
 typedef struct bilateral_lists {
     cl_uint4 *info; /* per group: first facet, lanes, cell, 0 */
+    cl_uint *start; /* the host's copy of list_start */
     cl_uint *facet; /* the lists, in host memory on a device that shares it */
     cl_float *weight;
     cl_kernel count, fill, round;
@@ -31,6 +32,7 @@ static void bilateral_lists_free(bilateral_lists *l) {
         if (kernels[i])
             clReleaseKernel(kernels[i]);
     rs_free(l->info); /* after the buffers that used them */
+    rs_free(l->start);
     rs_free(l->facet);
     rs_free(l->weight);
 }
@@ -98,7 +100,7 @@ static cl_int run_bilateral_lists(rsmooth_context *ctx, const rs_problem *pb, co
     if (err == CL_SUCCESS)
         l.round = clCreateKernel(ctx->program, "bilateral_list_normals", &err);
     if (err == CL_SUCCESS)
-        l.group_info = clCreateBuffer(ctx->context, CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR,
+        l.group_info = clCreateBuffer(ctx->context, CL_MEM_READ_ONLY | rs_cl_input_flags(ctx),
                                       groups * sizeof(cl_uint4), l.info, &err);
     if (err == CL_SUCCESS)
         l.list_start = clCreateBuffer(ctx->context, CL_MEM_READ_WRITE, start_bytes, NULL, &err);
@@ -116,22 +118,24 @@ static cl_int run_bilateral_lists(rsmooth_context *ctx, const rs_problem *pb, co
         (err = rs_cl_run_1d(ctx, pb, l.count, groups, 0, share)) != CL_SUCCESS)
         goto done;
 
-    /* counts to offsets, each group with its spare row */
-    cl_uint *start =
-        clEnqueueMapBuffer(ctx->queue, l.list_start, CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0,
-                           start_bytes, 0, NULL, NULL, &err);
-    if (err != CL_SUCCESS)
+    /* counts to offsets, each group with its spare row: read, then written back whole (a map
+     * for reading and writing would do on any device, but Oclgrind's uninitialised-value check
+     * does not see the host's writes through one: error 5 in tests/test_oclgrind.c) */
+    if (!(l.start = rs_alloc_array(groups + 1, sizeof *l.start)))
+        goto done; /* no host memory for them (err CL_SUCCESS): search in each round */
+    if ((err = clEnqueueReadBuffer(ctx->queue, l.list_start, CL_TRUE, 0, groups * sizeof(cl_uint),
+                                   l.start, 0, NULL, NULL)) != CL_SUCCESS)
         goto done;
     uint64_t rows = 0, near_rows = 0;
     for (size_t g = 0; g < groups; g++) {
-        uint64_t n = start[g];
-        start[g] = (cl_uint)rows;
+        uint64_t n = l.start[g];
+        l.start[g] = (cl_uint)rows;
         near_rows += n;
         rows += n + 1;
     }
-    start[groups] = (cl_uint)rows;
-    if ((err = clEnqueueUnmapMemObject(ctx->queue, l.list_start, start, 0, NULL, NULL)) !=
-        CL_SUCCESS)
+    l.start[groups] = (cl_uint)rows;
+    if ((err = clEnqueueWriteBuffer(ctx->queue, l.list_start, CL_TRUE, 0, start_bytes, l.start, 0,
+                                    NULL, NULL)) != CL_SUCCESS)
         goto done;
     uint64_t weight_bytes = rows * lanes_per_group * sizeof(cl_float);
     if (rows > UINT32_MAX / lanes_per_group ||
@@ -140,12 +144,8 @@ static cl_int run_bilateral_lists(rsmooth_context *ctx, const rs_problem *pb, co
         goto done; /* no room (err CL_SUCCESS): the rounds search instead */
     /* A device that shares the host's memory gets it from rs_alloc_array, which asks for huge
      * pages: faulting in tens of megabytes 4 KiB at a time costs more than filling them. */
-    cl_bool unified = CL_FALSE;
-    if (clGetDeviceInfo(ctx->device, CL_DEVICE_HOST_UNIFIED_MEMORY, sizeof unified, &unified,
-                        NULL) != CL_SUCCESS)
-        unified = CL_FALSE;
     cl_mem_flags flags = CL_MEM_READ_WRITE;
-    if (unified) {
+    if (ctx->host_unified) {
         l.facet = rs_alloc_array((size_t)rows, sizeof(cl_uint));
         l.weight = rs_alloc_array((size_t)rows, lanes_per_group * sizeof(cl_float));
         if (!l.facet || !l.weight)

@@ -276,6 +276,11 @@ static rsmooth_status read_memory_limits(rsmooth_context *ctx, rsmooth_error *er
     cl_ulong max_alloc = device_ulong(ctx->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, 0);
     ctx->global_memory = global ? global : (uint64_t)1 << 30;
     ctx->max_allocation = max_alloc ? max_alloc : ctx->global_memory / 4;
+    cl_bool unified = CL_FALSE;
+    if (clGetDeviceInfo(ctx->device, CL_DEVICE_HOST_UNIFIED_MEMORY, sizeof unified, &unified,
+                        NULL) != CL_SUCCESS)
+        unified = CL_FALSE;
+    ctx->host_unified = unified == CL_TRUE;
     const char *budget = getenv("RSMOOTH_MEMORY_BUDGET");
     if (budget && *budget && !rs_parse_bytes(budget, &ctx->memory_budget))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_context_create",
@@ -292,6 +297,13 @@ uint64_t rs_cl_usable_memory(const rsmooth_context *ctx) {
     /* most of the device: the driver and other programs keep some */
     uint64_t device = ctx->global_memory / 4 * 3;
     return ctx->memory_budget && ctx->memory_budget < device ? ctx->memory_budget : device;
+}
+
+cl_mem_flags rs_cl_input_flags(const rsmooth_context *ctx) {
+    /* Copying also keeps the buffer's contents defined for the OpenCL implementation itself: a
+     * checker such as Oclgrind's uninitialised-value check sees CL_MEM_USE_HOST_PTR buffers as
+     * never written (error 1 in tests/test_oclgrind.c). */
+    return ctx->host_unified ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR;
 }
 
 void rsmooth_context_set_memory_budget(rsmooth_context *ctx, uint64_t bytes) {

@@ -44,8 +44,14 @@
     X(cl_int, EnqueueNDRangeKernel,                                                                \
       (cl_command_queue, cl_kernel, cl_uint, const size_t *, const size_t *, const size_t *,       \
        cl_uint, const cl_event *, cl_event *))                                                     \
+    X(cl_int, EnqueueReadBuffer,                                                                   \
+      (cl_command_queue, cl_mem, cl_bool, size_t, size_t, void *, cl_uint, const cl_event *,      \
+       cl_event *))                                                                                \
     X(cl_int, EnqueueUnmapMemObject,                                                               \
       (cl_command_queue, cl_mem, void *, cl_uint, const cl_event *, cl_event *))                   \
+    X(cl_int, EnqueueWriteBuffer,                                                                  \
+      (cl_command_queue, cl_mem, cl_bool, size_t, size_t, const void *, cl_uint, const cl_event *, \
+       cl_event *))                                                                                \
     X(cl_int, Finish, (cl_command_queue))                                                          \
     X(cl_int, Flush, (cl_command_queue))                                                           \
     X(cl_int, GetCommandQueueInfo,                                                                 \
@@ -97,7 +103,9 @@ rsmooth_status rs_cl_load(const char *where, rsmooth_error *error);
 #define clCreateProgramWithSource rs_cl_api.CreateProgramWithSource
 #define clEnqueueMapBuffer rs_cl_api.EnqueueMapBuffer
 #define clEnqueueNDRangeKernel rs_cl_api.EnqueueNDRangeKernel
+#define clEnqueueReadBuffer rs_cl_api.EnqueueReadBuffer
 #define clEnqueueUnmapMemObject rs_cl_api.EnqueueUnmapMemObject
+#define clEnqueueWriteBuffer rs_cl_api.EnqueueWriteBuffer
 #define clFinish rs_cl_api.Finish
 #define clFlush rs_cl_api.Flush
 #define clGetCommandQueueInfo rs_cl_api.GetCommandQueueInfo

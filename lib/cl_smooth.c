@@ -492,14 +492,15 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
                      (unsigned long long)ctx->max_allocation);
         goto cleanup;
     }
-    /* Inputs are handed over in place (CL_MEM_USE_HOST_PTR): a CPU device reads the staging
-     * arrays themselves (no copy, no second allocation; they are aligned for it, see alloc.c), a
-     * GPU copies them when first used. They stay alive until the buffers are released. */
+    /* Inputs are handed over in place where the device shares the host's memory (a CPU device
+     * reads the staging arrays themselves: no copy, no second allocation; they are aligned for
+     * it, see alloc.c), else copied at creation (rs_cl_input_flags). They stay alive until the
+     * buffers are released. */
     for (int b = 0; b < BUF_COUNT; b++) {
         if (spec[b].size == 0) /* a buffer this run's mode does not use */
             continue;
         cl_int err = CL_SUCCESS;
-        cl_mem_flags flags = spec[b].flags | (spec[b].host ? CL_MEM_USE_HOST_PTR : 0);
+        cl_mem_flags flags = spec[b].flags | (spec[b].host ? rs_cl_input_flags(ctx) : 0);
         buf[b] = clCreateBuffer(ctx->context, flags, spec[b].size, spec[b].host, &err);
         if (err != CL_SUCCESS) {
             st = rs_cl_fail(error, err, "clCreateBuffer", ctx->device_name);
