@@ -309,26 +309,35 @@ cl_mem_flags rs_cl_input_flags(const rsmooth_context *ctx) {
 void rsmooth_context_set_memory_budget(rsmooth_context *ctx, uint64_t bytes) {
     if (!ctx)
         return;
-    rs_context_lock(ctx);
+    bool mine = rs_context_held_here(ctx); /* from a callback of a call on ctx */
+    if (!mine)
+        rs_context_lock(ctx);
     ctx->memory_budget = bytes;
-    rs_context_unlock(ctx);
+    if (!mine)
+        rs_context_unlock(ctx);
 }
 
 void rsmooth_context_set_host_threads(rsmooth_context *ctx, unsigned threads) {
     if (!ctx)
         return;
-    rs_context_lock(ctx);
+    bool mine = rs_context_held_here(ctx); /* from a callback of a call on ctx */
+    if (!mine)
+        rs_context_lock(ctx);
     ctx->host_threads = threads;
-    rs_context_unlock(ctx);
+    if (!mine)
+        rs_context_unlock(ctx);
 }
 
 unsigned rsmooth_context_host_threads(const rsmooth_context *ctx) {
     if (!ctx)
         return 0;
     rsmooth_context *shared = (rsmooth_context *)ctx; /* the lock is the one mutable part */
-    rs_context_lock(shared);
+    bool mine = rs_context_held_here(ctx); /* from a callback of a call on ctx */
+    if (!mine)
+        rs_context_lock(shared);
     unsigned threads = ctx->host_threads;
-    rs_context_unlock(shared);
+    if (!mine)
+        rs_context_unlock(shared);
     return threads;
 }
 
@@ -336,18 +345,39 @@ uint64_t rsmooth_context_memory_budget(const rsmooth_context *ctx) {
     if (!ctx)
         return 0;
     rsmooth_context *shared = (rsmooth_context *)ctx; /* the lock is the one mutable part */
-    rs_context_lock(shared);
+    bool mine = rs_context_held_here(ctx); /* from a callback of a call on ctx */
+    if (!mine)
+        rs_context_lock(shared);
     uint64_t bytes = rs_cl_usable_memory(ctx);
-    rs_context_unlock(shared);
+    if (!mine)
+        rs_context_unlock(shared);
     return bytes;
 }
 
 void rs_context_lock(rsmooth_context *ctx) {
     pthread_mutex_lock(&ctx->lock);
+    ctx->owner = pthread_self();
+    atomic_store(&ctx->busy, 1);
 }
 
 void rs_context_unlock(rsmooth_context *ctx) {
+    atomic_store(&ctx->busy, 0);
     pthread_mutex_unlock(&ctx->lock);
+}
+
+bool rs_context_held_here(const rsmooth_context *ctx) {
+    /* only the holder sets `owner` to itself, so another thread's holding never reads as ours */
+    return atomic_load(&ctx->busy) && pthread_equal(ctx->owner, pthread_self());
+}
+
+rsmooth_status rs_context_enter(rsmooth_context *ctx, const char *where, rsmooth_error *error) {
+    if (rs_context_held_here(ctx))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "called on a context from a callback of a call still running on it (the "
+                       "context serves one call at a time): use another context, or the "
+                       "reference path");
+    rs_context_lock(ctx);
+    return RSMOOTH_OK;
 }
 
 static rsmooth_context *new_context(void) {
@@ -463,7 +493,8 @@ rsmooth_status rsmooth_context_create_from_queue(cl_command_queue queue, rsmooth
 }
 
 void rsmooth_context_destroy(rsmooth_context *ctx) {
-    if (!ctx)
+    /* from a callback of a call still running on it: the call would go on with freed objects */
+    if (!ctx || rs_context_held_here(ctx))
         return;
     for (int k = 0; k < RS_KERNEL_COUNT; k++)
         if (ctx->kernels[k])

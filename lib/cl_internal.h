@@ -13,6 +13,7 @@
 #include <CL/cl.h>
 #include "cl_loader.h" /* the cl* calls below go to the loader opened at run time */
 #include <pthread.h>
+#include <stdatomic.h>
 
 
 enum {
@@ -25,6 +26,8 @@ enum {
 
 struct rsmooth_context {
     pthread_mutex_t lock;     /* serialises the calls of threads sharing the context */
+    pthread_t owner;          /* the thread holding `lock`, while `busy` */
+    _Atomic int busy;
     cl_context context;
     cl_device_id device;
     cl_command_queue queue;
@@ -51,6 +54,12 @@ rsmooth_status rs_cl_choose_variant(rsmooth_context *ctx, rsmooth_error *error);
 /* A context's calls hold its lock while they use it: threads sharing one run one at a time. */
 void rs_context_lock(rsmooth_context *ctx);
 void rs_context_unlock(rsmooth_context *ctx);
+/* Whether the calling thread holds ctx's lock: it is inside a call on ctx, in one of the call's
+ * callbacks (progress, progress_cancel). */
+bool rs_context_held_here(const rsmooth_context *ctx);
+/* Takes the lock for a filter call, or refuses (RSMOOTH_ERROR_INVALID_ARGUMENT) a call made from
+ * a callback of a call on the same context, which would wait for itself for ever. */
+rsmooth_status rs_context_enter(rsmooth_context *ctx, const char *where, rsmooth_error *error);
 
 /* Bytes one run may hold on the device: the caller's budget, else most of the device's memory. */
 uint64_t rs_cl_usable_memory(const rsmooth_context *ctx);

@@ -723,7 +723,9 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     if (!ctx)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_smooth", "ctx is NULL");
     /* the kernels' arguments and the queue are the context's: one call at a time */
-    rs_context_lock(ctx);
+    rsmooth_status entered = rs_context_enter(ctx, "rsmooth_smooth", error);
+    if (entered != RSMOOTH_OK)
+        return entered;
     size_t threads_before = rs_set_call_threads(ctx->host_threads);
     rsmooth_status st = rs_filter_passes(cl_pass, ctx, scalar, positions, vertex_count, indices,
                                          triangle_count, params, out_positions, out_weight,

@@ -194,7 +194,9 @@ rsmooth_status rsmooth_smooth_piece(rsmooth_context *ctx, const double *position
     if (st != RSMOOTH_OK)
         return st;
     if (ctx) {
-        rs_context_lock(ctx);
+        st = rs_context_enter(ctx, where, error);
+        if (st != RSMOOTH_OK)
+            return st;
         size_t threads_before = rs_set_call_threads(ctx->host_threads);
         st = prepare_piece(&pb, positions, vertex_count, indices, triangle_count, info, params,
                            out_positions, false, error);

@@ -1,5 +1,6 @@
 /* The OpenCL context: device choice by spec, a caller's own queue (retained, never owned), bit-identical
- * repeated runs, threads sharing one context, and argument errors that leave the output untouched. */
+ * repeated runs, threads sharing one context, calls from a call's own progress callback refused at
+ * once instead of deadlocking, and argument errors that leave the output untouched. */
 #define _POSIX_C_SOURCE 200809L
 #include "mesh_shapes.h"
 #include "rsmooth_cl.h"
@@ -128,6 +129,86 @@ static void check_shared_context(rsmooth_context *ctx) {
     CHECK_EQ_INT(wrong, 0);
 }
 
+/* A progress callback that calls back into the context its call runs on (issue 23): every entry
+ * point must answer at once instead of waiting for the lock its own call holds. */
+typedef struct reentry {
+    rsmooth_context *ctx, *other;
+    const shape_mesh *m;
+    double *scratch;
+    int calls;
+    rsmooth_status nested, piece, nested_other;
+    char message[256];
+    uint64_t budget;
+    unsigned threads;
+} reentry;
+
+static void call_back_in(void *user, double fraction) {
+    (void)fraction;
+    reentry *r = user;
+    if (r->calls++)
+        return;
+    rsmooth_error err;
+    r->nested = rsmooth_smooth(r->ctx, RSMOOTH_FLOAT64, r->m->xyz, r->m->vertex_count,
+                               r->m->indices, r->m->triangle_count, NULL, r->scratch, NULL, NULL,
+                               NULL, &err);
+    snprintf(r->message, sizeof r->message, "%s", err.message);
+    rsmooth_piece_info info;
+    rsmooth_piece_info_init(&info);
+    info.core_count = r->m->vertex_count;
+    r->piece = rsmooth_smooth_piece(r->ctx, r->m->xyz, r->m->vertex_count, r->m->indices,
+                                    r->m->triangle_count, &info, NULL, r->scratch, NULL, &err);
+    /* another context is free: its call runs */
+    r->nested_other = rsmooth_smooth(r->other, RSMOOTH_FLOAT64, r->m->xyz, r->m->vertex_count,
+                                     r->m->indices, r->m->triangle_count, NULL, r->scratch, NULL,
+                                     NULL, NULL, &err);
+    /* the getters and setters answer from inside the call, and destroy leaves it alone */
+    r->budget = rsmooth_context_memory_budget(r->ctx);
+    rsmooth_context_set_host_threads(r->ctx, rsmooth_context_host_threads(r->ctx));
+    r->threads = rsmooth_context_host_threads(r->ctx);
+    rsmooth_context_destroy(r->ctx);
+}
+
+static void check_reentry(rsmooth_context *ctx, const shape_mesh *m, const double *expected) {
+    size_t n = 3 * m->vertex_count;
+    double *out = malloc(n * sizeof *out), *scratch = malloc(n * sizeof *scratch);
+    CHECK(out && scratch);
+    reentry r;
+    memset(&r, 0, sizeof r);
+    r.ctx = ctx;
+    r.m = m;
+    r.scratch = scratch;
+    rsmooth_error err;
+    CHECK_STATUS(rsmooth_context_create(NULL, &r.other, &err), RSMOOTH_OK);
+    rsmooth_params p;
+    rsmooth_params_init(&p);
+    p.progress = call_back_in;
+    p.progress_user = &r;
+    alarm(120); /* a deadlock fails the test instead of hanging it */
+    CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                m->triangle_count, &p, out, NULL, NULL, NULL, &err),
+                 RSMOOTH_OK);
+    alarm(0);
+    printf("a call from its own progress callback: %s (%s); a piece: %s; another context: %s\n",
+           rsmooth_status_str(r.nested), r.message, rsmooth_status_str(r.piece),
+           rsmooth_status_str(r.nested_other));
+    CHECK(r.calls > 0);
+    CHECK_STATUS(r.nested, RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(r.message, "callback") != NULL);
+    CHECK_STATUS(r.piece, RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK_STATUS(r.nested_other, RSMOOTH_OK);
+    CHECK(memcmp(scratch, expected, n * sizeof *out) == 0);
+    CHECK(r.budget > 0);
+    CHECK(memcmp(out, expected, n * sizeof *out) == 0); /* the outer call as if alone */
+    /* the context still works afterwards */
+    CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                m->triangle_count, NULL, out, NULL, NULL, NULL, &err),
+                 RSMOOTH_OK);
+    CHECK(memcmp(out, expected, n * sizeof *out) == 0);
+    rsmooth_context_destroy(r.other);
+    free(out);
+    free(scratch);
+}
+
 int main(void) {
     rsmooth_context *ctx = open_test_context();
     shape_mesh cube;
@@ -143,6 +224,16 @@ int main(void) {
     CHECK(memcmp(a, b, n * sizeof *a) == 0);
     printf("two runs: bit-identical\n");
     check_shared_context(ctx);
+    {
+        double *plain = malloc(n * sizeof *plain);
+        CHECK(plain);
+        CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count,
+                                    cube.indices, cube.triangle_count, NULL, plain, NULL, NULL,
+                                    NULL, NULL),
+                     RSMOOTH_OK);
+        check_reentry(ctx, &cube, plain);
+        free(plain);
+    }
 
     /* One host thread or several: the same bits (static chunks, fixed-size partial sums). */
     {

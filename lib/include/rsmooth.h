@@ -577,7 +577,9 @@ typedef struct rsmooth_context rsmooth_context;
  * Returns RSMOOTH_ERROR_NO_DEVICE, RSMOOTH_ERROR_KERNEL_BUILD, RSMOOTH_ERROR_OPENCL, ... with *ctx
  * set to NULL on failure. Thread-safe. A context may be shared by threads: its calls are
  * serialised (each holds the context while it runs), so threads sharing one wait for each other;
- * give each thread its own context to filter concurrently. RSMOOTH_MEMORY_BUDGET set but not a
+ * give each thread its own context to filter concurrently. A call on a context from a progress
+ * callback of a call still running on it would wait for itself: it returns
+ * RSMOOTH_ERROR_INVALID_ARGUMENT at once instead. RSMOOTH_MEMORY_BUDGET set but not a
  * positive byte count is RSMOOTH_ERROR_INVALID_ARGUMENT naming it. */
 RSMOOTH_API rsmooth_status rsmooth_context_create(const char *device, rsmooth_context **ctx,
                                                   rsmooth_error *error);
@@ -603,7 +605,8 @@ RSMOOTH_API void rsmooth_device_info_init(rsmooth_device_info *info);
  * (0 when no OpenCL platform exists). Thread-safe. */
 RSMOOTH_API size_t rsmooth_list_devices(rsmooth_device_info *devices, size_t capacity);
 
-/* Releases everything the context holds. Accepts NULL. */
+/* Releases everything the context holds. Accepts NULL. Called from a progress callback of a call
+ * still running on ctx, does nothing (the call would go on with freed objects). */
 RSMOOTH_API void rsmooth_context_destroy(rsmooth_context *ctx);
 
 /* "Platform name / device name" of the context's device; valid while ctx lives. */
