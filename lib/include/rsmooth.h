@@ -47,7 +47,7 @@
 #include <stdint.h>
 
 #define RSMOOTH_VERSION_MAJOR 0
-#define RSMOOTH_VERSION_MINOR 8
+#define RSMOOTH_VERSION_MINOR 9
 #define RSMOOTH_VERSION_PATCH 0
 
 #if defined(_WIN32)
