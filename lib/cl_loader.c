@@ -80,22 +80,6 @@ typedef Elf32_Phdr elf_segment;
 #define ELF_CLASS ELFCLASS32
 #endif
 
-/* Reads `n` bytes at `offset`; false when the file ends first. */
-static bool read_at(int fd, void *out, size_t n, uint64_t offset) {
-    unsigned char *p = out;
-    while (n > 0) {
-        ssize_t r = pread(fd, p, n, (off_t)offset);
-        if (r < 0 && errno == EINTR)
-            continue;
-        if (r <= 0)
-            return false;
-        p += r;
-        n -= (size_t)r;
-        offset += (uint64_t)r;
-    }
-    return true;
-}
-
 /* Whether the file a path names can be handed to dlopen: a regular file (a FIFO or device would
  * block it or feed it endless bytes), a shared object of this process's class and byte order,
  * whose program headers and every loaded segment lie within the file (dlopen maps segments
@@ -118,7 +102,7 @@ static const char *check_library_file(const char *path, char *why, size_t size) 
         bad = strerror(errno);
     else if (!S_ISREG(st.st_mode))
         bad = S_ISDIR(st.st_mode) ? "a folder, not a library file" : "not a regular file";
-    else if (!read_at(fd, &h, sizeof h, 0) || memcmp(h.e_ident, ELFMAG, SELFMAG) != 0)
+    else if (!rs_pread_all(fd, &h, sizeof h, 0) || memcmp(h.e_ident, ELFMAG, SELFMAG) != 0)
         bad = "not an ELF file";
     else if (h.e_ident[EI_CLASS] != ELF_CLASS || h.e_ident[EI_DATA] != order)
         bad = "an ELF file of another word size or byte order than this program";
@@ -130,7 +114,7 @@ static const char *check_library_file(const char *path, char *why, size_t size) 
         bad = "truncated or damaged (its program headers lie outside the file)";
     for (unsigned i = 0; !bad && i < h.e_phnum; i++) {
         elf_segment seg;
-        if (!read_at(fd, &seg, sizeof seg, (uint64_t)h.e_phoff + (uint64_t)i * sizeof seg))
+        if (!rs_pread_all(fd, &seg, sizeof seg, (uint64_t)h.e_phoff + (uint64_t)i * sizeof seg))
             bad = "truncated (a program header cannot be read)";
         else if (seg.p_type == PT_LOAD &&
                  (uint64_t)seg.p_offset + (uint64_t)seg.p_filesz > (uint64_t)st.st_size) {

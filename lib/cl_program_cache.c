@@ -299,20 +299,6 @@ static void digest_of(const unsigned char *header, const unsigned char *binary, 
     rs_blake2b_final(&s, digest);
 }
 
-/* Reads exactly `n` bytes; false on a short read or an error. */
-static bool read_all(int fd, unsigned char *data, size_t n) {
-    while (n > 0) {
-        ssize_t r = read(fd, data, n);
-        if (r < 0 && errno == EINTR)
-            continue;
-        if (r <= 0)
-            return false;
-        data += r;
-        n -= (size_t)r;
-    }
-    return true;
-}
-
 /* The binary of a valid file for the key (to rs_free), or NULL; *refused when the file (or its
  * folder) was refused as untrusted rather than missing or invalid. */
 static unsigned char *read_binary(const rs_program_cache *cache, size_t *size, bool *refused) {
@@ -340,14 +326,14 @@ static unsigned char *read_binary(const rs_program_cache *cache, size_t *size, b
         goto fail;
     }
     if (st.st_size < HEADER_BYTES || (uint64_t)st.st_size > HEADER_BYTES + MAX_BINARY_BYTES ||
-        !read_all(fd, header, sizeof header))
+        !rs_pread_all(fd, header, sizeof header, 0))
         goto fail;
     uint64_t binary_size = (uint64_t)st.st_size - HEADER_BYTES;
     header_words(cache, binary_size, expected);
     if (binary_size == 0 || memcmp(header, expected, sizeof expected) != 0)
         goto fail;
     data = rs_alloc_array((size_t)binary_size, 1);
-    if (!data || !read_all(fd, data, (size_t)binary_size))
+    if (!data || !rs_pread_all(fd, data, (size_t)binary_size, HEADER_BYTES))
         goto fail;
     digest_of(header, data, (size_t)binary_size, digest);
     if (memcmp(digest, header + HEADER_WORDS * 8, DIGEST_BYTES) != 0)
@@ -384,20 +370,6 @@ cl_program rs_program_cache_load(rs_program_cache *cache, const rsmooth_context 
 }
 
 /* ---- writing ------------------------------------------------------------------------------- */
-
-/* Writes all of `n` bytes; false on any failure. */
-static bool write_all(int fd, const unsigned char *data, size_t n) {
-    while (n > 0) {
-        ssize_t w = write(fd, data, n);
-        if (w < 0 && errno == EINTR)
-            continue;
-        if (w <= 0)
-            return false;
-        data += w;
-        n -= (size_t)w;
-    }
-    return true;
-}
 
 /* The binary of `program` for ctx's device (to rs_free), or NULL. */
 static unsigned char *program_binary(const rsmooth_context *ctx, cl_program program,
@@ -467,7 +439,8 @@ void rs_program_cache_store(const rs_program_cache *cache, const rsmooth_context
         char temporary[sizeof cache->name + 16];
         int fd = create_temporary(dir_fd, cache->name, temporary, sizeof temporary);
         if (fd >= 0) {
-            bool ok = write_all(fd, header, sizeof header) && write_all(fd, binary, size);
+            bool ok = rs_pwrite_all(fd, header, sizeof header, 0) &&
+                      rs_pwrite_all(fd, binary, size, sizeof header);
             ok = close(fd) == 0 && ok;
             /* rename replaces the final name at once: readers see the old file or the new one */
             if (!ok || renameat(dir_fd, temporary, dir_fd, cache->name) != 0)

@@ -51,6 +51,13 @@ static inline bool rs_mul_overflows(size_t a, size_t b) {
 /* Monotonic clock in milliseconds. */
 double rs_now_ms(void);
 
+/* ---- file_io.c: whole positioned reads and writes ---------------------------------------------- */
+
+/* Writes or reads all n bytes at `offset` (EINTR and short counts retried); false with errno on
+ * failure (EIO: the file ended first). */
+bool rs_pwrite_all(int fd, const void *data, size_t n, uint64_t offset);
+bool rs_pread_all(int fd, void *data, size_t n, uint64_t offset);
+
 /* ---- parallel.c: host loops on every core ------------------------------------------------------ */
 
 /* Elements [begin, end) of a loop, as chunk number `chunk` (chunks are contiguous and in order). */

@@ -80,39 +80,6 @@ int rs_stream_temporary(const char *dir) {
     return fd;
 }
 
-bool rs_stream_pwrite(int fd, const void *data, size_t n, uint64_t offset) {
-    const char *p = data;
-    while (n > 0) {
-        ssize_t put = pwrite(fd, p, n, (off_t)offset);
-        if (put < 0 && errno == EINTR)
-            continue;
-        if (put <= 0)
-            return false;
-        p += put;
-        n -= (size_t)put;
-        offset += (uint64_t)put;
-    }
-    return true;
-}
-
-bool rs_stream_pread(int fd, void *data, size_t n, uint64_t offset) {
-    char *p = data;
-    while (n > 0) {
-        ssize_t got = pread(fd, p, n, (off_t)offset);
-        if (got < 0 && errno == EINTR)
-            continue;
-        if (got <= 0) {
-            if (got == 0)
-                errno = EIO; /* the file is shorter than it was */
-            return false;
-        }
-        p += got;
-        n -= (size_t)got;
-        offset += (uint64_t)got;
-    }
-    return true;
-}
-
 bool rs_stream_copy(int from, uint64_t from_offset, int to, uint64_t to_offset, uint64_t size) {
     uint64_t done = 0;
     loff_t in = (loff_t)from_offset, out = (loff_t)to_offset;
@@ -134,8 +101,8 @@ bool rs_stream_copy(int from, uint64_t from_offset, int to, uint64_t to_offset, 
     bool ok = true;
     while (ok && done < size) {
         size_t n = size - done > CHUNK ? CHUNK : (size_t)(size - done);
-        ok = rs_stream_pread(from, buf, n, from_offset + done) &&
-             rs_stream_pwrite(to, buf, n, to_offset + done);
+        ok = rs_pread_all(from, buf, n, from_offset + done) &&
+             rs_pwrite_all(to, buf, n, to_offset + done);
         done += n;
     }
     rs_free(buf);
@@ -166,7 +133,7 @@ static bool flush_region(rs_region_writer *w, size_t i) {
     size_t bytes = (size_t)w->filled[i] * w->record;
     if (bytes == 0)
         return true;
-    if (!rs_stream_pwrite(w->fd, w->buffers + i * w->per_buffer * w->record, bytes, w->next[i]))
+    if (!rs_pwrite_all(w->fd, w->buffers + i * w->per_buffer * w->record, bytes, w->next[i]))
         return false;
     w->next[i] += bytes;
     w->filled[i] = 0;

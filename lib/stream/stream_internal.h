@@ -55,10 +55,6 @@ static inline bool rs_stream_next_triangle(rs_stream_reader *r, uint32_t tri[3])
  * nothing is left behind however the process ends. -1 with errno on failure. */
 int rs_stream_temporary(const char *dir);
 
-/* Positioned write and read of all n bytes; false with errno on failure. */
-bool rs_stream_pwrite(int fd, const void *data, size_t n, uint64_t offset);
-bool rs_stream_pread(int fd, void *data, size_t n, uint64_t offset);
-
 /* Copies `size` bytes of `from` at `from_offset` to `to` at `to_offset` (copy_file_range where
  * it works). */
 bool rs_stream_copy(int from, uint64_t from_offset, int to, uint64_t to_offset, uint64_t size);

@@ -92,7 +92,7 @@ static rsmooth_status read_header(rs_stream_ply *ply, uint64_t limit, rsmooth_er
             buf = bigger;
             cap = (size_t)grown;
         }
-        if (!rs_stream_pread(ply->fd, buf + len, cap - len, start + len)) {
+        if (!rs_pread_all(ply->fd, buf + len, cap - len, start + len)) {
             rs_free(buf);
             return io_fail(ply->path, "cannot read", error);
         }
@@ -253,7 +253,7 @@ rsmooth_status rs_stream_ply_open(rs_stream_ply *ply, const char *path, uint64_t
     ply->size = (uint64_t)sb.st_size;
     char magic[7] = {0}; /* a byte-order mark, as the in-memory reader takes it, then "ply" */
     size_t got = ply->size < sizeof magic ? (size_t)ply->size : sizeof magic;
-    if (!rs_stream_pread(ply->fd, magic, got, 0))
+    if (!rs_pread_all(ply->fd, magic, got, 0))
         return io_fail(path, "cannot read", error);
     ply->bom = got >= RS_IO_UTF8_BOM_SIZE && !memcmp(magic, RS_IO_UTF8_BOM, RS_IO_UTF8_BOM_SIZE);
     const char *m = magic + (ply->bom ? RS_IO_UTF8_BOM_SIZE : 0);
@@ -463,7 +463,7 @@ rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_f
                     t[1] = previous;
                     t[2] = index;
                     if (buffered == OUT_TRIANGLES) {
-                        if (!rs_stream_pwrite(triangles_fd, out, buffered * 3 * sizeof *out,
+                        if (!rs_pwrite_all(triangles_fd, out, buffered * 3 * sizeof *out,
                                               written * 3 * sizeof *out))
                             st = io_fail("temporary file", "cannot write", error);
                         written += buffered;
@@ -475,7 +475,7 @@ rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_f
         }
     }
     if (st == RSMOOTH_OK && buffered > 0 &&
-        !rs_stream_pwrite(triangles_fd, out, buffered * 3 * sizeof *out,
+        !rs_pwrite_all(triangles_fd, out, buffered * 3 * sizeof *out,
                           written * 3 * sizeof *out))
         st = io_fail("temporary file", "cannot write", error);
     written += buffered;
@@ -524,7 +524,7 @@ static double copy_value(rs_stream_reader *r, swapped_writer *w, rs_ply_type t, 
     if (!v)
         return w->ok = false, -1;
     if (w->used + size > READ_BUFFER) {
-        w->ok = w->ok && rs_stream_pwrite(w->fd, w->buf, w->used, w->at);
+        w->ok = w->ok && rs_pwrite_all(w->fd, w->buf, w->used, w->at);
         w->at += w->used;
         w->used = 0;
     }
@@ -557,14 +557,14 @@ static bool copy_swapped(const rs_stream_ply *ply, int out_fd) {
                     copy_value(&r, &w, p->type, ply->swap);
             }
     }
-    bool ok = w.ok && rs_stream_pwrite(out_fd, w.buf, w.used, w.at);
+    bool ok = w.ok && rs_pwrite_all(out_fd, w.buf, w.used, w.at);
     rs_stream_reader_close(&r);
     rs_free(w.buf);
     return ok;
 }
 
 bool rs_stream_ply_write_copy(const rs_stream_ply *ply, int out_fd) {
-    if (!rs_stream_pwrite(out_fd, ply->out_header, ply->out_header_size, 0))
+    if (!rs_pwrite_all(out_fd, ply->out_header, ply->out_header_size, 0))
         return false;
     if (ply->swap != ply->out_swap) /* big-endian in: rs_io_ply_write writes little-endian */
         return copy_swapped(ply, out_fd);
@@ -604,12 +604,12 @@ bool rs_stream_ply_write_positions(const rs_stream_ply *ply, int out_fd, const u
         while (i + run < n && run < RUN_ROWS && ids[i + run] == ids[i] + run)
             run++;
         uint64_t at = output_offset(ply, ply->vertex_start + (uint64_t)ids[i] * stride);
-        ok = whole_rows || rs_stream_pread(out_fd, rows, run * stride, at);
+        ok = whole_rows || rs_pread_all(out_fd, rows, run * stride, at);
         for (size_t j = 0; ok && j < run; j++)
             for (int k = 0; k < 3; k++)
                 put_value(rows + j * stride + ply->xyz_offset[k], xyz[3 * (i + j) + (size_t)k],
                           ply->xyz_type, ply->out_swap);
-        ok = ok && rs_stream_pwrite(out_fd, rows, run * stride, at);
+        ok = ok && rs_pwrite_all(out_fd, rows, run * stride, at);
         i += run;
     }
     rs_free(rows);

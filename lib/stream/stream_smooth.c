@@ -367,8 +367,8 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
                      "no memory for a piece of %zu facets", m);
         goto done;
     }
-    if (!rs_stream_pread(c->pieces.vertex_fd, core, n * 4, p->vertex_start * 4) ||
-        !rs_stream_pread(c->pieces.facet_fd, tri, m * 12, p->facet_start * 12)) {
+    if (!rs_pread_all(c->pieces.vertex_fd, core, n * 4, p->vertex_start * 4) ||
+        !rs_pread_all(c->pieces.facet_fd, tri, m * 12, p->facet_start * 12)) {
         st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
                      "cannot read a temporary file: %s", strerror(errno));
         goto done;

@@ -204,7 +204,7 @@ static rsmooth_status whole_scale(const rs_stream_positions *pos, int fd, uint64
     if (!sampled)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "scale samples");
     for (size_t i = 0; i < count; i++)
-        if (!rs_stream_pread(fd, sampled + 3 * i, 12, (uint64_t)i * stride * 12)) {
+        if (!rs_pread_all(fd, sampled + 3 * i, 12, (uint64_t)i * stride * 12)) {
             rs_free(sampled);
             return read_fail(error);
         }
