@@ -2,6 +2,7 @@
 #define _POSIX_C_SOURCE 200809L
 #define RS_CL_LOADER_KEEP_NAMES
 #include "cl_loader.h"
+#include "cl_loader_elf.h"
 
 #include <pthread.h>
 #include <stdint.h>
@@ -13,14 +14,6 @@
 #include <windows.h>
 #else
 #include <dlfcn.h>
-#endif
-#if defined(__linux__) || defined(__FreeBSD__) /* ELF systems whose <elf.h> we know */
-#define RS_CHECK_ELF 1
-#include <elf.h>
-#include <errno.h>
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 #endif
 
 /* The table's types are the headers' prototypes (a mismatch fails the build here). */
@@ -69,68 +62,6 @@ static void *open_library(const char *path, char *why, size_t size) {
 #endif
 }
 
-#ifdef RS_CHECK_ELF
-#if UINTPTR_MAX > 0xffffffffu
-typedef Elf64_Ehdr elf_header;
-typedef Elf64_Phdr elf_segment;
-#define ELF_CLASS ELFCLASS64
-#else
-typedef Elf32_Ehdr elf_header;
-typedef Elf32_Phdr elf_segment;
-#define ELF_CLASS ELFCLASS32
-#endif
-
-/* Whether the file a path names can be handed to dlopen: a regular file (a FIFO or device would
- * block it or feed it endless bytes), a shared object of this process's class and byte order,
- * whose program headers and every loaded segment lie within the file (dlopen maps segments
- * without looking at the file's size, and touching a page past its end raises SIGBUS). NULL, or
- * why not. Bare names are the dynamic linker's to search, and not checked. */
-static const char *check_library_file(const char *path, char *why, size_t size) {
-    if (!strchr(path, '/'))
-        return NULL;
-    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-    if (fd < 0) {
-        snprintf(why, size, "%s", strerror(errno));
-        return why;
-    }
-    struct stat st;
-    elf_header h;
-    const char *bad = NULL;
-    uint16_t native = 1;
-    int order = *(unsigned char *)&native ? ELFDATA2LSB : ELFDATA2MSB;
-    if (fstat(fd, &st) != 0)
-        bad = strerror(errno);
-    else if (!S_ISREG(st.st_mode))
-        bad = S_ISDIR(st.st_mode) ? "a folder, not a library file" : "not a regular file";
-    else if (!rs_pread_all(fd, &h, sizeof h, 0) || memcmp(h.e_ident, ELFMAG, SELFMAG) != 0)
-        bad = "not an ELF file";
-    else if (h.e_ident[EI_CLASS] != ELF_CLASS || h.e_ident[EI_DATA] != order)
-        bad = "an ELF file of another word size or byte order than this program";
-    else if (h.e_type != ET_DYN)
-        bad = "not a shared library";
-    else if (h.e_phentsize != sizeof(elf_segment) || h.e_phnum == 0 ||
-             (uint64_t)h.e_phoff + (uint64_t)h.e_phnum * sizeof(elf_segment) >
-                 (uint64_t)st.st_size)
-        bad = "truncated or damaged (its program headers lie outside the file)";
-    for (unsigned i = 0; !bad && i < h.e_phnum; i++) {
-        elf_segment seg;
-        if (!rs_pread_all(fd, &seg, sizeof seg, (uint64_t)h.e_phoff + (uint64_t)i * sizeof seg))
-            bad = "truncated (a program header cannot be read)";
-        else if (seg.p_type == PT_LOAD &&
-                 (uint64_t)seg.p_offset + (uint64_t)seg.p_filesz > (uint64_t)st.st_size) {
-            snprintf(why, size, "truncated: a segment ends at byte %llu of a %llu-byte file",
-                     (unsigned long long)((uint64_t)seg.p_offset + (uint64_t)seg.p_filesz),
-                     (unsigned long long)st.st_size);
-            bad = why;
-        }
-    }
-    close(fd);
-    if (bad && bad != why)
-        snprintf(why, size, "%s", bad);
-    return bad ? why : NULL;
-}
-#endif
-
 static void close_library(void *library) {
 #ifdef _WIN32
     FreeLibrary((HMODULE)library);
@@ -161,7 +92,7 @@ static void load(void) {
     char why[200];
     void *library = NULL;
 #ifdef RS_CHECK_ELF
-    if (!check_library_file(path, why, sizeof why))
+    if (!rs_check_shared_library(path, why, sizeof why))
 #endif
         library = open_library(path, why, sizeof why);
     if (!library && !named && FALLBACK_LOADER) {

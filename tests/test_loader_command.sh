@@ -74,16 +74,31 @@ if [ -n "$loader" ]; then
 fi
 
 # Named files that must never reach dlopen (issue 23, item 13): a truncated copy of the loader
-# (dlopen maps segments past the file's end: SIGBUS), a FIFO (blocks forever), a device, a folder,
-# a text file. Each refused before dlopen, naming the file and why, within seconds.
+# (dlopen maps segments past the file's end: SIGBUS), copies ending in zeros or with zeroed code
+# (SIGSEGV inside dlopen or the constructors), a FIFO (blocks forever), a device, a folder, a text
+# file. Each refused before dlopen, naming the file and why, within seconds.
 if [ -n "$loader" ]; then
   real=$(readlink -f "$loader")
   head -c 30000 "$real" >truncated.so
   head -c 200 "$real" >headers-only.so
   mkfifo fifo.so
   echo "not a library" >text.so
+  # copies whose end, or a block of whose code, is zeros (an incomplete copy, a sparse file):
+  # dlopen crashed in their relocations, versions or constructors
+  size=$(stat -Lc %s "$real")
+  head -c 8192 "$real" >zero-padded.so
+  truncate -s "$size" zero-padded.so
+  cp "$real" zero-tail.so
+  dd if=/dev/zero of=zero-tail.so bs=1 seek=$((size - 4096)) count=4096 conv=notrunc 2>/dev/null
+  head -c 8192 "$real" >sparse.so
+  truncate -s 1G sparse.so
+  text=$((0x$(readelf -SW "$real" | awk '$2 == ".text" { print $5 }')))
+  cp "$real" zero-code.so
+  dd if=/dev/zero of=zero-code.so bs=1 seek=$((text + 64)) count=400 conv=notrunc 2>/dev/null
   for case in "truncated.so:truncated" "headers-only.so:truncated" "fifo.so:not a regular file" \
-              "/dev/zero:not a regular file" "empty:a folder" "text.so:not an ELF file"; do
+              "/dev/zero:not a regular file" "empty:a folder" "text.so:not an ELF file" \
+              "zero-padded.so:damaged" "zero-tail.so:damaged" "sparse.so:damaged" \
+              "zero-code.so:damaged (its code holds a block of zeros"; do
     file=${case%%:*} why=${case#*:}
     [ "${file#/}" = "$file" ] && file=$PWD/$file
     RSMOOTH_OPENCL_LIBRARY=$file expect_within 20 2 "$rsmooth" noisy.ply -o x.ply --device cpu
