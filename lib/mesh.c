@@ -401,7 +401,12 @@ rsmooth_status rs_problem_prepare_within(rs_problem *problem, rsmooth_scalar sca
         rs_problem_free(problem);
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for edges");
     }
-    rs_problem_apply_params(problem, &p, p.absolute ? scale : problem->mean_edge_length);
+    rsmooth_status applied = rs_problem_apply_params(
+        problem, &p, p.absolute ? scale : problem->mean_edge_length, error, where);
+    if (applied != RSMOOTH_OK) {
+        rs_problem_free(problem);
+        return applied;
+    }
     if (keep_facet_data && problem->colors && problem->facet_count > 0) {
         problem->facet_color = rs_alloc_array(problem->facet_count, 3 * sizeof(double));
         if (!problem->facet_color) {
@@ -415,7 +420,8 @@ rsmooth_status rs_problem_prepare_within(rs_problem *problem, rsmooth_scalar sca
     return RSMOOTH_OK;
 }
 
-void rs_problem_apply_params(rs_problem *problem, const rsmooth_params *p, double unit) {
+rsmooth_status rs_problem_apply_params(rs_problem *problem, const rsmooth_params *p,
+                                       double unit, rsmooth_error *error, const char *where) {
     problem->sigma_f = p->sigma_f * unit;
     problem->sigma_g = isinf(p->sigma_g) ? INFINITY : p->sigma_g * unit;
     problem->sigma_m = problem->sigma_f / 2;
@@ -435,6 +441,15 @@ void rs_problem_apply_params(rs_problem *problem, const rsmooth_params *p, doubl
     problem->progress = p->progress;
     problem->progress_cancel = p->progress_cancel;
     problem->progress_user = p->progress_user;
-    if (!(problem->sigma_f > 0) || !isfinite(problem->radius) || !isfinite(problem->normal_radius))
+    if (unit > 0 && (!isfinite(problem->radius) || !isfinite(problem->mollify_radius) ||
+                     !isfinite(problem->normal_radius) ||
+                     (isfinite(p->sigma_g) && !isfinite(problem->sigma_g))))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "sigma_f %g, sigma_g %g or normal_sigma_s %g (%s) with cutoff %g: the "
+                       "reach exceeds the range of numbers on this mesh",
+                       p->sigma_f, p->sigma_g, p->normal_sigma_s,
+                       p->absolute ? "absolute" : "mean edge lengths", p->cutoff);
+    if (!(problem->sigma_f > 0))
         problem->facet_count = 0; /* no edge of non-zero length: nothing can move */
+    return RSMOOTH_OK;
 }

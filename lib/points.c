@@ -277,7 +277,9 @@ static rsmooth_status smooth_points(rsmooth_scalar scalar, const void *positions
         pb.area = a.area;
         pb.mean_edge_length = input_spacing; /* what the report gives as the unit */
         pb.mean_area = area_sum / (double)n;
-        rs_problem_apply_params(&pb, &p, unit);
+        st = rs_problem_apply_params(&pb, &p, unit, error, where);
+        if (st != RSMOOTH_OK)
+            goto done;
         pb.facet_color = pb.colors ? a.color : NULL;
         pb.progress = NULL;
         pb.progress_cancel = reports ? rs_report_pass_progress : NULL;

@@ -179,8 +179,11 @@ rsmooth_status rs_problem_prepare_within(rs_problem *problem, rsmooth_scalar sca
 /* The params-to-problem part of rs_problem_prepare: the absolute widths and radii (relative
  * sigmas times `unit`, the mean edge length or, for point clouds, the point spacing; 1 when
  * params->absolute) and the flags, from resolved params. Sets facet_count to 0 when nothing can
- * move (unit 0). Point clouds (points.c) call it on a problem whose facets are the points. */
-void rs_problem_apply_params(rs_problem *problem, const rsmooth_params *params, double unit);
+ * move (unit 0). Point clouds (points.c) call it on a problem whose facets are the points.
+ * RSMOOTH_ERROR_INVALID_ARGUMENT when a width times the unit overflows (a reach of +inf would
+ * leave every vertex where it is, as if nothing could move). */
+rsmooth_status rs_problem_apply_params(rs_problem *problem, const rsmooth_params *params,
+                                       double unit, rsmooth_error *error, const char *where);
 
 /* Checks rsmooth_params.colors, 3 finite values per vertex of magnitude <= RS_MAX_COLOR, naming
  * the first vertex that fails. NULL passes. */

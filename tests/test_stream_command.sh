@@ -186,5 +186,15 @@ for input in plateau.ply subnormal.ply; do
   [ ! -e refused.ply ] || fail "$input: a refused streamed run wrote its output"
 done
 
+# A width whose reach overflows (--sigma-f 1e308): refused alike in memory (it left every vertex
+# where it was, exit 0) and streamed (a halo of inf), on both paths.
+for device in reference cpu; do
+  expect 2 "$rsmooth" noisy.ply -o refused.ply --sigma-f 1e308 --cutoff 5 --device "$device"
+  grep -q "range of numbers" err.txt || fail "--sigma-f 1e308 on $device: $(cat err.txt)"
+  expect 2 "$rsmooth" noisy.ply -o refused.ply --sigma-f 1e308 --cutoff 5 --device "$device" \
+    --max-memory 64M
+  [ ! -e refused.ply ] || fail "--sigma-f 1e308 on $device wrote its output"
+done
+
 [ "$failures" -eq 0 ] && echo ok
 exit "$((failures > 0))"
