@@ -104,10 +104,6 @@ static rsmooth_status check_info(const rsmooth_piece_info *info, size_t vertex_c
     return RSMOOTH_OK;
 }
 
-/* How far (a power of two) the whole mesh's mean edge length may lie from a piece's typical edge,
- * and its mean area (twice that) from the typical edge squared. */
-#define PIECE_FIGURE_LOG2 20
-
 /* In internal units (the figures times the scale) a power of two converts them exactly only
  * while they stay normal doubles. */
 static bool exact_in_internal_units(double figure) {
@@ -129,20 +125,9 @@ static rsmooth_status check_scale_fits(const rs_problem *pb, const double *posit
                        "the scale, the figures likewise, and scale 1",
                        info->mean_edge_length, info->mean_area, pb->scale, pb->mean_edge_length,
                        pb->mean_area);
-    double typical = rs_typical_edge(RSMOOTH_FLOAT64, positions, indices, triangle_count);
-    /* The whole mesh's mean figures against this piece's own edges: a piece is part of that
-     * mesh, so they agree within far less than these bounds; figures off by more weigh every
-     * facet by areas no float holds (2^120 gave results 0.05 edges off with exit 0). */
-    if (typical > 0 && (!(fabs(log2(info->mean_edge_length / typical)) <= PIECE_FIGURE_LOG2) ||
-                        !(fabs(log2(info->mean_area / (typical * typical))) <=
-                          2 * PIECE_FIGURE_LOG2)))
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "info->mean_edge_length %g and info->mean_area %g are not this mesh's: "
-                       "the piece's typical edge is %g (they must agree within 2^%d and 2^%d)",
-                       info->mean_edge_length, info->mean_area, typical, PIECE_FIGURE_LOG2,
-                       2 * PIECE_FIGURE_LOG2);
     if (info->scale == 0 || pb->scale != info->scale)
         return RSMOOTH_OK; /* the piece's own choice */
+    double typical = rs_typical_edge(RSMOOTH_FLOAT64, positions, indices, triangle_count);
     int e = 0; /* typical * scale in [2^(e-1), 2^e) */
     if (typical > 0)
         frexp(typical * info->scale, &e);
