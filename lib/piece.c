@@ -96,6 +96,15 @@ static rsmooth_status check_info(const rsmooth_piece_info *info, size_t vertex_c
     if (!(info->mean_area > 0) || !isfinite(info->mean_area))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "info->mean_area %g must be finite and > 0", info->mean_area);
+    /* No mesh has a mean area beyond this many squared mean edge lengths: a triangle holds at
+     * most sqrt(3)/36 of its perimeter squared, a perimeter is at most the sum of the mesh's
+     * edges (3T of them, each shared by at most T triangles), so the mean area is under
+     * T^4 * mean edge^2 with T < 2^64 triangles. Beyond it the figures are not a mesh's. */
+    if (info->mean_area > ldexp(info->mean_edge_length * info->mean_edge_length, 260))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "info->mean_area %g is more than any mesh of mean edge length %g can have "
+                       "(2^260 times its square)",
+                       info->mean_area, info->mean_edge_length);
     if (info->scale != 0 && !rs_scale_possible(info->scale))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "info->scale %g: neither 0 nor a power of two in [2^-500, 2^1000], the "

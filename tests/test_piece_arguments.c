@@ -138,6 +138,9 @@ static void check_info_fields(rsmooth_context *ctx, piece_case *c) {
         bad.mean_edge_length = far[i].mean_edge_length;
         check_refused(ctx, c, &bad, far[i].why);
     }
+    bad = good; /* more than any mesh of this mean edge can have: results 0.08 edges off */
+    bad.mean_area = 1.5e300;
+    check_refused(ctx, c, &bad, "more than any mesh");
     bad = good; /* figures whose internal units fall out of the normal doubles */
     bad.mean_area = 1e-300;
     bad.scale = ldexp(1, -40);
