@@ -68,16 +68,34 @@ def test_progress_raising_stops_the_call(big):
 def test_ctrl_c_interrupts(big):
     v, f = big
     v0 = v.copy()
-    start = time.perf_counter()
-    full = None
-    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
-    timer.start()
-    try:
-        with pytest.raises(KeyboardInterrupt):
-            rsmooth.smooth(v, f, device="reference", best=True, passes=6)
-        stopped = time.perf_counter() - start
-    finally:
-        timer.cancel()
+
+    # The SIGINT is sent from another thread once the call is under way (its first progress
+    # report), so a loaded machine cannot make the call end before the signal is sent; a
+    # progress callable that does nothing leaves the signal check to the library's reports.
+    def attempt():
+        timer = threading.Timer(0.2, lambda: os.kill(os.getpid(), signal.SIGINT))
+        started = []
+
+        def progress(fraction):
+            if not started:
+                started.append(time.perf_counter())
+                timer.start()
+
+        start = time.perf_counter()
+        try:
+            rsmooth.smooth(v, f, device="reference", best=True, passes=6, progress=progress)
+        except KeyboardInterrupt:
+            return time.perf_counter() - start
+        finally:
+            timer.cancel()
+        return None
+
+    stopped = None
+    for _ in range(3):  # a call that ends within 0.2 s of its first report is tried again
+        stopped = attempt()
+        if stopped is not None:
+            break
+    assert stopped is not None, "Ctrl-C did not interrupt the call in 3 tries"
     assert np.array_equal(v, v0)
     t0 = time.perf_counter()
     full = rsmooth.smooth(v, f, device="reference", best=True, passes=6)
