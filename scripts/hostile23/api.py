@@ -55,34 +55,17 @@ class ApiCases:
                 [device] if device else [])
             r = c.run(argv, self.s, env=c.sanitizer_env(self.b), cwd=self.dir,
                       timeout=max(60, count // 2 if not self.b.sanitizer else count * 2))
-            begun, done = None, set()
-            for line in r.out.decode("utf-8", "replace").splitlines():
-                if line.startswith("begin "):
-                    begun = int(line.split()[1])
-                    continue
-                d = json.loads(line)
-                done.add(d["case"])
-                case = c.Case(surface, "%s %d: %s" % (mode, d["case"], d["what"]))
-                case.commands.append(" ".join(argv[:2] + [str(self.s.seed), str(d["case"]),
-                                                          str(d["case"] + 1)] + argv[5:]))
-                if d["verdict"] != "ok":
-                    case.add(d["verdict"], "%s: %s (status %s: %s)" % (d["verdict"], d["detail"],
-                                                                       d["status"], d["message"]))
-                elif d["detail"]:
-                    case.notes.append(d["detail"])
-                tally.record(case)
+            begun, done = c.record_batch(
+                r, surface, mode, lambda d: " ".join(argv[:2] + [str(self.s.seed), str(d["case"]),
+                                                                 str(d["case"] + 1)] + argv[5:]),
+                tally)
             if r.rc == 0 and not r.hung:
                 return None
             if r.rc == 5 and begun is None:
                 return "no device %s: %s" % (device, c.said(r.err, 200))
             # the process ended inside case `begun`
             at = begun if begun is not None and begun not in done else first
-            case = c.Case(surface, "%s %d" % (mode, at))
-            r.argv = argv[:3] + [str(at), str(at + 1)] + argv[5:]
-            case.judge(r)
-            if not case.failed():
-                case.add("crashes", "exit %d: %s" % (r.rc, c.tail(r.err)))
-            tally.record(case)
+            c.record_ended(r, argv, at, surface, "%s %d" % (mode, at), tally)
             first = at + 1
 
     # rsmooth_stream_smooth ----------------------------------------------------------------------
@@ -115,26 +98,8 @@ class ApiCases:
             else:
                 final = out
                 os.rename(os.path.join(d, "target.ply"), out)
-        elif output_kind == "fifo":
-            os.mkfifo(out)
-        elif output_kind == "device":
-            os.mknod(out, 0o666 | stat.S_IFCHR, os.makedev(1, 3))
-        elif output_kind == "folder":
-            os.makedirs(out)
-        elif output_kind == "socket":
-            s = socket.socket(socket.AF_UNIX)
-            s.bind(out)
-            s.close()
-        elif output_kind == "dangling-link":
-            os.symlink("missing.ply", out)
-        elif output_kind == "link-to-device":
-            os.mknod(os.path.join(d, "null"), 0o666 | stat.S_IFCHR, os.makedev(1, 3))
-            os.symlink("null", out)
-        elif output_kind == "link-to-folder":
-            os.symlink("folder", out)
-        elif output_kind == "link-to-fifo":
-            os.mkfifo(os.path.join(d, "fifo"))
-            os.symlink("fifo", out)
+        elif output_kind != "new":
+            c.make_special(out, output_kind)
         if input_kind == "zero":
             inp = "/dev/zero"
         elif input_kind == "folder":

@@ -560,3 +560,76 @@ def writer_env(build, writer, extra=None):
     e = sanitizer_env(build, leaks=writer != "mpi")
     e.update(extra or {})
     return e
+
+
+def make_special(path, kind):
+    """Makes a file that is not a regular one at `path`, links beside it named as the README of
+    the campaign says: fifo, device (/dev/null's numbers), folder, socket, dangling-link,
+    link-into-missing-folder, link-to-folder (./folder), link-to-fifo, link-to-device, link-loop."""
+    import socket
+    d = os.path.dirname(path)
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "device":
+        os.mknod(path, 0o666 | stat.S_IFCHR, os.makedev(1, 3))
+    elif kind == "folder":
+        os.makedirs(path)
+    elif kind == "socket":
+        s = socket.socket(socket.AF_UNIX)
+        s.bind(path)
+        s.close()
+    elif kind == "dangling-link":
+        os.symlink("missing.ply", path)
+    elif kind == "link-into-missing-folder":
+        os.symlink("nowhere/out.ply", path)
+    elif kind == "link-to-folder":
+        os.symlink("folder", path)
+    elif kind == "link-to-fifo":
+        os.mkfifo(os.path.join(d, "fifo"))
+        os.symlink("fifo", path)
+    elif kind == "link-to-device":
+        os.mknod(os.path.join(d, "null"), 0o666 | stat.S_IFCHR, os.makedev(1, 3))
+        os.symlink("null", path)
+    elif kind == "link-loop":
+        os.symlink("loop2.ply", path)
+        os.symlink(os.path.basename(path), os.path.join(d, "loop2.ply"))
+    else:
+        raise ValueError("no special file kind " + kind)
+
+
+def record_batch(r, surface, label, command, tally):
+    """Records each case a batch child printed (a line "begin N" before case N, then one JSON
+    line with its verdict); returns the case begun last and the set of cases finished."""
+    import json
+    begun, done = None, set()
+    for line in r.out.decode("utf-8", "replace").splitlines():
+        if line.startswith("begin "):
+            begun = int(line.split()[1])
+            continue
+        try:
+            d = json.loads(line)
+        except ValueError:
+            continue
+        done.add(d["case"])
+        case = Case(surface, "%s %d: %s" % (label, d["case"], d["what"]))
+        case.commands.append(command(d))
+        if d["verdict"] != "ok":
+            detail = d["detail"]
+            if "status" in d:
+                detail = "%s: %s (status %s: %s)" % (d["verdict"], detail, d["status"], d["message"])
+            case.add(d["verdict"], detail)
+        elif d["detail"]:
+            case.notes.append(d["detail"])
+        tally.record(case)
+    return begun, done
+
+
+def record_ended(r, argv, at, surface, label, tally):
+    """Records the batch child that ended (crash, hang, sanitizer report) inside case `at`, with
+    the command that runs that case alone (argv[3:5] are the first and end case)."""
+    case = Case(surface, label)
+    r.argv = argv[:3] + [str(at), str(at + 1)] + argv[5:]
+    case.judge(r)
+    if not case.failed():
+        case.add("crashes", "exit %d: %s" % (r.rc, tail(r.err)))
+    tally.record(case)

@@ -214,31 +214,7 @@ class OutputCases:
         os.makedirs(os.path.join(d, "folder"))
         self.put_input(d)
         out = os.path.join(d, "out.ply")
-        if kind == "fifo":
-            os.mkfifo(out)
-        elif kind == "device":
-            os.mknod(out, 0o666 | stat.S_IFCHR, os.makedev(1, 3))
-        elif kind == "folder":
-            os.makedirs(out)
-        elif kind == "socket":
-            s = socket.socket(socket.AF_UNIX)
-            s.bind(out)
-            s.close()
-        elif kind == "dangling-link":
-            os.symlink("missing.ply", out)
-        elif kind == "link-into-missing-folder":
-            os.symlink("nowhere/out.ply", out)
-        elif kind == "link-to-folder":
-            os.symlink("folder", out)
-        elif kind == "link-to-fifo":
-            os.mkfifo(os.path.join(d, "fifo"))
-            os.symlink("fifo", out)
-        elif kind == "link-to-device":
-            os.mknod(os.path.join(d, "null"), 0o666 | stat.S_IFCHR, os.makedev(1, 3))
-            os.symlink("null", out)
-        elif kind == "link-loop":
-            os.symlink("loop2.ply", out)
-            os.symlink("out.ply", os.path.join(d, "loop2.ply"))
+        c.make_special(out, kind)
         before = c.listing(d)
         r, ok = self.run(case, d, ["in.ply", "-o", "out.ply", "-q"] + (["--force"] if force else []),
                          timeout=60)

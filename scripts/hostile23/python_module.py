@@ -305,30 +305,11 @@ class PythonCases:
                     "1" if self.have_cl else "0"]
             r = c.run(argv, self.s, env=self.env, cwd=self.dir,
                       timeout=self.s.timeout + count * (2 if self.b.sanitizer else 0.5))
-            begun, done = None, set()
-            for line in r.out.decode("utf-8", "replace").splitlines():
-                if line.startswith("begin "):
-                    begun = int(line.split()[1])
-                    continue
-                try:
-                    d = json.loads(line)
-                except ValueError:
-                    continue
-                done.add(d["case"])
-                case = c.Case(self.surface, "python %d: %s" % (d["case"], d["what"]))
-                case.commands.append("%s  # case %d" % (r.text(), d["case"]))
-                if d["verdict"] != "ok":
-                    case.add(d["verdict"], d["detail"])
-                elif d["detail"]:
-                    case.notes.append(d["detail"])
-                tally.record(case)
+            begun, done = c.record_batch(r, self.surface, "python",
+                                         lambda d: "%s  # case %d" % (r.text(), d["case"]), tally)
             if r.rc == 0 and not r.hung and not c.SANITIZER_RE.search(r.err):
                 return
             at = begun if begun is not None and begun not in done else first
-            case = c.Case(self.surface, "python %d (ended the interpreter)" % at)
-            r.argv = argv[:3] + [str(at), str(at + 1)] + argv[5:]
-            case.judge(r)
-            if not case.failed():
-                case.add("crashes", "exit %d: %s" % (r.rc, c.tail(r.err)))
-            tally.record(case)
+            c.record_ended(r, argv, at, self.surface, "python %d (ended the interpreter)" % at,
+                           tally)
             first = at + 1
