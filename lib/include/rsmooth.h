@@ -1,4 +1,4 @@
-/*
+/** @file
  * rsmooth: feature-preserving, non-iterative smoothing of triangle meshes on OpenCL devices.
  *
  * Implements Jones, Durand and Desbrun, "Non-Iterative, Feature-Preserving Mesh Smoothing",
@@ -7,11 +7,12 @@
  *
  *     p' = sum_q Pi_q(p) a_q f(|c_q - p|) g(|Pi_q(p) - p|) / k(p),   k(p) = sum_q a_q f g
  *
- * with c_q the centroid, a_q the area, Pi_q(p) the projection of p onto the plane of q (whose normal
- * comes from a "mollified" copy of the mesh, smoothed by a plain Gaussian of width sigma_f / 2),
- * f a spatial Gaussian of width sigma_f and g an influence Gaussian of width sigma_g. Gaussians are
- * exp(-x^2 / (2 sigma^2)). Facets whose centroid lies farther than cutoff * sigma_f are ignored.
- * One pass, no iteration and no connectivity: triangle soups, non-manifold and cracked meshes work.
+ * with c_q the centroid, a_q the area, Pi_q(p) the projection of p onto the plane of q (whose
+ * normal comes from a "mollified" copy of the mesh, smoothed by a plain Gaussian of width sigma_f /
+ * 2), f a spatial Gaussian of width sigma_f and g an influence Gaussian of width sigma_g. Gaussians
+ * are exp(-x^2 / (2 sigma^2)). Facets whose centroid lies farther than cutoff * sigma_f are
+ * ignored. One pass, no iteration and no connectivity: triangle soups, non-manifold and cracked
+ * meshes work.
  *
  * Beyond the paper, each optional (the defaults are the paper's filter, unchanged): bilateral
  * filtering of the facet normals instead of mollification, repeated and confidence-driven passes,
@@ -46,10 +47,22 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/** @def RSMOOTH_VERSION_MAJOR
+ * The major version of this header (CMake reads the version from these three lines); compare with
+ * rsmooth_version(), the library's. */
+/** @def RSMOOTH_VERSION_MINOR
+ * The minor version of this header: while the major version is 0, each minor version has its own
+ * ABI (soname librsmooth.so.0.MINOR). */
+/** @def RSMOOTH_VERSION_PATCH
+ * The patch version of this header: fixes within one ABI. */
 #define RSMOOTH_VERSION_MAJOR 0
 #define RSMOOTH_VERSION_MINOR 9
 #define RSMOOTH_VERSION_PATCH 0
 
+/** @def RSMOOTH_API
+ * Marks the library's exported functions: default visibility (the library is built with hidden
+ * visibility), and on Windows dllexport / dllimport for a shared build (RSMOOTH_SHARED, which the
+ * CMake target and rsmooth.pc define for a shared library). */
 #if defined(_WIN32)
 #if defined(RSMOOTH_BUILDING_LIBRARY) && defined(RSMOOTH_SHARED)
 #define RSMOOTH_API __declspec(dllexport)
@@ -70,37 +83,39 @@ extern "C" {
 /* Status and error detail                                                                          */
 /* ---------------------------------------------------------------------------------------------- */
 
-/* Every call that can fail returns one of these; RSMOOTH_OK (0) is success. They name classes of
+/** Every call that can fail returns one of these; RSMOOTH_OK (0) is success. They name classes of
  * failure; the optional rsmooth_error carries the detail. */
 typedef enum rsmooth_status {
-    RSMOOTH_OK = 0,
-    RSMOOTH_ERROR_INVALID_ARGUMENT = 1, /* NULL array, index out of range, bad sigma, non-finite... */
-    RSMOOTH_ERROR_OUT_OF_MEMORY = 2,    /* host allocation failed, or a size overflows size_t */
-    RSMOOTH_ERROR_IO = 3,               /* a file could not be opened, read or written */
-    RSMOOTH_ERROR_PARSE = 4,            /* a mesh file is malformed */
-    RSMOOTH_ERROR_NO_DEVICE = 5,        /* no OpenCL loader or platform, or no device matches the
+    RSMOOTH_OK = 0,                     /**< success */
+    RSMOOTH_ERROR_INVALID_ARGUMENT = 1, /**< NULL array, index out of range, bad sigma,
+                                         * non-finite... */
+    RSMOOTH_ERROR_OUT_OF_MEMORY = 2,    /**< host allocation failed, or a size overflows size_t */
+    RSMOOTH_ERROR_IO = 3,               /**< a file could not be opened, read or written */
+    RSMOOTH_ERROR_PARSE = 4,            /**< a mesh file is malformed */
+    RSMOOTH_ERROR_NO_DEVICE = 5,        /**< no OpenCL loader or platform, or no device matches the
                                          * choice */
-    RSMOOTH_ERROR_KERNEL_BUILD = 6,     /* the OpenCL program failed to build (see build_log) */
-    RSMOOTH_ERROR_OPENCL = 7,           /* an OpenCL call failed (see cl_error and where) */
-    RSMOOTH_ERROR_UNSUPPORTED = 8,      /* valid request this build or device cannot do */
-    RSMOOTH_ERROR_NUMERICAL = 9,        /* a result would not be finite in the output's type (a
+    RSMOOTH_ERROR_KERNEL_BUILD = 6,     /**< the OpenCL program failed to build (see build_log) */
+    RSMOOTH_ERROR_OPENCL = 7,           /**< an OpenCL call failed (see cl_error and where) */
+    RSMOOTH_ERROR_UNSUPPORTED = 8,      /**< valid request this build or device cannot do */
+    RSMOOTH_ERROR_NUMERICAL = 9,        /**< a result would not be finite in the output's type (a
                                          * float32 position beyond FLT_MAX, k(p) beyond float's
                                          * range): nothing non-finite is ever returned as OK.
                                          * (Added in 0.4.1) */
-    RSMOOTH_ERROR_CANCELLED = 10        /* the caller's progress_cancel callback asked to stop
+    RSMOOTH_ERROR_CANCELLED = 10        /**< the caller's progress_cancel callback asked to stop
                                          * (Added in 0.5) */
 } rsmooth_status;
 
-/* Static, human-readable text for a status. Never NULL; thread-safe. */
+/** Static, human-readable text for a status. Never NULL; thread-safe. */
 RSMOOTH_API const char *rsmooth_status_str(rsmooth_status status);
 
-/* The version of the library actually loaded, "MAJOR.MINOR.PATCH" (compare with the
+/** The version of the library actually loaded, "MAJOR.MINOR.PATCH" (compare with the
  * RSMOOTH_VERSION_* macros of the header a program was built with: while the major version is 0,
  * a different MINOR means a different ABI). Writes the three numbers to those pointers that are
  * not NULL. Thread-safe. (Added in 0.5) */
 RSMOOTH_API const char *rsmooth_version(int *major, int *minor, int *patch);
 
-/* Structs the caller allocates and the library fills (rsmooth_error, rsmooth_report,
+/** @page struct_size Struct sizes and library versions
+ * Structs the caller allocates and the library fills (rsmooth_error, rsmooth_report,
  * rsmooth_device_info) start with struct_size, as rsmooth_params does: set it with the struct's
  * _init function (or to sizeof the struct), and a later version of the library writes only the
  * fields a struct of that size has, so a program built against this header keeps working with a
@@ -108,111 +123,123 @@ RSMOOTH_API const char *rsmooth_version(int *major, int *minor, int *patch);
  * size any version had (a struct never initialised) is taken as this version's layout, 0.5's, the
  * first with struct_size. (Added in 0.5) */
 
-/* Optional detail of a failure, filled by any call given a non-NULL pointer to one. On success it is
- * reset (status RSMOOTH_OK, empty strings). The library never prints: callers show these fields. */
+/** Optional detail of a failure, filled by any call given a non-NULL pointer to one. On success it
+ * is reset (status RSMOOTH_OK, empty strings). The library never prints: callers show these
+ * fields. */
 typedef struct rsmooth_error {
-    size_t struct_size;    /* sizeof(rsmooth_error): rsmooth_error_init */
-    rsmooth_status status;
-    int cl_error;          /* raw cl_int of the failing OpenCL call, 0 if none */
-    char where[64];        /* failing function, OpenCL call or kernel, e.g. "clEnqueueNDRangeKernel" */
-    char message[256];     /* one sentence on what went wrong, e.g. "index 7 >= vertex count 5" */
-    int64_t line;          /* parse errors: 1-based line (text formats), else -1 */
-    int64_t byte_offset;   /* parse errors: byte offset of the offending token, else -1 */
-    char build_log[2048];  /* kernel build failures: the head of the OpenCL build log */
+    size_t struct_size;    /**< sizeof(rsmooth_error): rsmooth_error_init */
+    rsmooth_status status; /**< the status the call returned (RSMOOTH_OK after a success) */
+    int cl_error;          /**< raw cl_int of the failing OpenCL call, 0 if none */
+    char where[64];        /**< failing function, OpenCL call or kernel, e.g.
+                            * "clEnqueueNDRangeKernel" */
+    char message[256];     /**< one sentence on what went wrong, e.g. "index 7 >= vertex count 5" */
+    int64_t line;          /**< parse errors: 1-based line (text formats), else -1 */
+    int64_t byte_offset;   /**< parse errors: byte offset of the offending token, else -1 */
+    char build_log[2048];  /**< kernel build failures: the head of the OpenCL build log */
 } rsmooth_error;
 
-/* Zeroes `error` and sets its struct_size. Accepts NULL. (Added in 0.5) */
+/** Zeroes `error` and sets its struct_size. Accepts NULL. (Added in 0.5) */
 RSMOOTH_API void rsmooth_error_init(rsmooth_error *error);
 
 /* ---------------------------------------------------------------------------------------------- */
 /* Parameters                                                                                       */
 /* ---------------------------------------------------------------------------------------------- */
 
+/** The type of the coordinates in the caller's position arrays (inputs and outputs alike). */
 typedef enum rsmooth_scalar {
-    RSMOOTH_FLOAT32 = 0, /* positions are float[3] per vertex */
-    RSMOOTH_FLOAT64 = 1  /* positions are double[3] per vertex (georeferenced scans, CAD in mm...) */
+    RSMOOTH_FLOAT32 = 0, /**< positions are float[3] per vertex */
+    RSMOOTH_FLOAT64 = 1  /**< positions are double[3] per vertex (georeferenced scans, CAD in
+                          * mm...) */
 } rsmooth_scalar;
 
-/* Progress of a long filter call: `fraction` of the work done, in [0, 1], non-decreasing. Called on
- * the calling thread between pieces of work (the OpenCL path then launches its kernels in slices,
- * which does not change the result). */
+/** Progress of a long filter call: `fraction` of the work done, in [0, 1], non-decreasing. Called
+ * on the calling thread between pieces of work (the OpenCL path then launches its kernels in
+ * slices, which does not change the result). */
 typedef void (*rsmooth_progress_fn)(void *user, double fraction);
 
-/* The same report, answered: return 0 to go on, non-zero to stop the call, which then returns
+/** The same report, answered: return 0 to go on, non-zero to stop the call, which then returns
  * RSMOOTH_ERROR_CANCELLED at once (the OpenCL path after the kernel slice under way; reports come
  * every 1/32 of a kernel launch, every 4096 vertices on the reference path). The outputs are
  * then undefined: they may be partly written. This is how a host application offers a Cancel
  * button, or a Python binding lets Ctrl-C through. Called on the calling thread. */
 typedef int (*rsmooth_progress_cancel_fn)(void *user, double fraction);
 
-/* What each nearby triangle q predicts for a vertex p. */
+/** What each nearby triangle q predicts for a vertex p. */
 typedef enum rsmooth_predictor {
-    RSMOOTH_PREDICT_PROJECTION = 0, /* Pi_q(p), p projected onto q's (mollified) plane: the paper */
-    RSMOOTH_PREDICT_CENTROID = 1    /* c_q, q's centroid: with sigma_g = +INFINITY this is plain
+    RSMOOTH_PREDICT_PROJECTION = 0, /**< Pi_q(p), p projected onto q's (mollified) plane: the
+                                     * paper */
+    RSMOOTH_PREDICT_CENTROID = 1    /**< c_q, q's centroid: with sigma_g = +INFINITY this is plain
                                      * isotropic Gaussian smoothing (the paper's Fig. 4 baseline);
                                      * the influence, if on, weighs |c_q - p| */
 } rsmooth_predictor;
 
-/* How the normals of the predictors' planes are made. */
+/** How the normals of the predictors' planes are made. */
 typedef enum rsmooth_normal_filter {
-    RSMOOTH_NORMALS_MOLLIFY = 0,  /* the paper (Sec. 3.2): the normals of a copy of the mesh whose
+    RSMOOTH_NORMALS_MOLLIFY = 0,  /**< the paper (Sec. 3.2): the normals of a copy of the mesh whose
                                    * vertices moved to the Gaussian average (width sigma_f / 2) of
                                    * nearby centroids */
-    RSMOOTH_NORMALS_BILATERAL = 1 /* bilateral filter on the facet normals themselves, repeated
+    RSMOOTH_NORMALS_BILATERAL = 1 /**< bilateral filter on the facet normals themselves, repeated
                                    * normal_iterations times: n_r <- normalise(sum_q a_q
-                                   * exp(-|c_q - c_r|^2 / 2 s^2) exp(-|n_q - n_r|^2 / 2 t^2) n_q), s =
-                                   * normal_sigma_s, t = normal_sigma_n, facets within cutoff * s
+                                   * exp(-|c_q - c_r|^2 / 2 s^2) exp(-|n_q - n_r|^2 / 2 t^2) n_q), s
+                                   * = normal_sigma_s, t = normal_sigma_n, facets within cutoff * s
                                    * (Zheng et al. 2011). Keeps creases the Gaussian rounds */
 } rsmooth_normal_filter;
 
-/* The robust weight g of a prediction at distance x from the vertex (Black et al. 1998), all
+/** The robust weight g of a prediction at distance x from the vertex (Black et al. 1998), all
  * scaled by sigma_g so that outliers start being rejected near it. */
 typedef enum rsmooth_influence {
-    RSMOOTH_INFLUENCE_GAUSSIAN = 0,   /* exp(-x^2 / 2 sigma_g^2): the paper */
-    RSMOOTH_INFLUENCE_TUKEY = 1,      /* Tukey's biweight (1 - x^2 / c^2)^2 for x < c = sqrt(5)
+    RSMOOTH_INFLUENCE_GAUSSIAN = 0,   /**< exp(-x^2 / 2 sigma_g^2): the paper */
+    RSMOOTH_INFLUENCE_TUKEY = 1,      /**< Tukey's biweight (1 - x^2 / c^2)^2 for x < c = sqrt(5)
                                        * sigma_g, else 0: far outliers get no weight at all */
-    RSMOOTH_INFLUENCE_LORENTZIAN = 2, /* 1 / (1 + x^2 / sigma_g^2): heavy tails, never zero */
-    RSMOOTH_INFLUENCE_HUBER = 3       /* min(1, sigma_g / x): least squares near, L1 far */
+    RSMOOTH_INFLUENCE_LORENTZIAN = 2, /**< 1 / (1 + x^2 / sigma_g^2): heavy tails, never zero */
+    RSMOOTH_INFLUENCE_HUBER = 3       /**< min(1, sigma_g / x): least squares near, L1 far */
 } rsmooth_influence;
 
-/* Filter parameters. Fill with rsmooth_params_init() first, then change fields: struct_size lets
+/** Filter parameters. Fill with rsmooth_params_init() first, then change fields: struct_size lets
  * later versions add fields without breaking callers compiled against this one. */
 typedef struct rsmooth_params {
-    size_t struct_size;    /* sizeof(rsmooth_params), set by rsmooth_params_init */
-    double sigma_f;        /* spatial width: how far a triangle's influence reaches. In mean edge
+    size_t struct_size;    /**< sizeof(rsmooth_params), set by rsmooth_params_init */
+    double sigma_f;        /**< spatial width: how far a triangle's influence reaches. In mean edge
                             * lengths unless `absolute`. > 0 and finite. Default 2. */
-    double sigma_g;        /* influence width: how far a predicted position may be from the vertex
-                            * before it counts as an outlier (a feature on the other side). Same units
-                            * as sigma_f. > 0; +INFINITY turns the influence weight off. Default 0.5. */
-    int absolute;          /* 0: sigmas in mean edge lengths (default); 1: in the mesh's units */
-    double cutoff;         /* facets farther than cutoff * sigma_f are ignored. (0, 5]. Default 2 */
-    double mollify_cutoff; /* mollification radius in units of sigma_f, (0, cutoff]; 0 (default)
+    double sigma_g;        /**< influence width: how far a predicted position may be from the vertex
+                            * before it counts as an outlier (a feature on the other side). Same
+                            * units as sigma_f. > 0; +INFINITY turns the influence weight off.
+                            * Default 0.5. */
+    int absolute;          /**< 0: sigmas in mean edge lengths (default); 1: in the mesh's units */
+    double cutoff;         /**< facets farther than cutoff * sigma_f are ignored. (0, 5]. Default
+                            * 2 */
+    double mollify_cutoff; /**< mollification radius in units of sigma_f, (0, cutoff]; 0 (default)
                             * means the same radius as `cutoff` (the published setting) */
-    int mollify;           /* 1 (default): predict with mollified normals; 0: with the input's own
+    int mollify;           /**< 1 (default): predict with mollified normals; 0: with the input's own
                             * (the paper's Fig. 4 ablation) */
-    rsmooth_progress_fn progress; /* optional (NULL, default): progress reports */
-    void *progress_user;          /* passed to `progress` unchanged */
-    int predictor;                /* an rsmooth_predictor; default RSMOOTH_PREDICT_PROJECTION. (Added
-                                   * in 0.2: callers with an older struct_size get the default.) */
-    /* Beyond the paper (added in 0.4; callers with an older struct_size get the defaults, which
-     * are the paper's filter exactly). */
-    int normal_filter;            /* an rsmooth_normal_filter: how the predictors' normals are
-                                   * smoothed when `mollify` is 1. Default RSMOOTH_NORMALS_MOLLIFY */
-    double normal_sigma_s;        /* bilateral: spatial width, units of sigma_f. Default 1 */
-    double normal_sigma_n;        /* bilateral: width on |n_q - n_r| between unit normals, (0, 2].
+    rsmooth_progress_fn progress; /**< optional (NULL, default): progress reports */
+    void *progress_user;          /**< passed to `progress` unchanged */
+    int predictor;                /**< an rsmooth_predictor; default RSMOOTH_PREDICT_PROJECTION.
+                                   * (Added in 0.2: callers with an older struct_size get the
+                                   * default.) */
+    /** @name Beyond the paper
+     * Beyond the paper (added in 0.4; callers with an older struct_size get the defaults, which
+     * are the paper's filter exactly). @{ */
+    int normal_filter;            /**< an rsmooth_normal_filter: how the predictors' normals are
+                                   * smoothed when `mollify` is 1. Default
+                                   * RSMOOTH_NORMALS_MOLLIFY */
+    double normal_sigma_s;        /**< bilateral: spatial width, units of sigma_f. Default 1 */
+    double normal_sigma_n;        /**< bilateral: width on |n_q - n_r| between unit normals, (0, 2].
                                    * Default 0.35 */
-    int normal_iterations;        /* bilateral: rounds, [1, 100]. Default 5 */
-    int influence;                /* an rsmooth_influence: the robust weight g. Default
+    int normal_iterations;        /**< bilateral: rounds, [1, 100]. Default 5 */
+    int influence;                /**< an rsmooth_influence: the robust weight g. Default
                                    * RSMOOTH_INFLUENCE_GAUSSIAN (the paper's) */
-    int passes;                   /* the whole filter this many times, [1, 100], each pass from the
-                                   * previous pass's positions (sigmas stay those of the input).
+    int passes;                   /**< the whole filter this many times, [1, 100], each pass from
+                                   * the previous pass's positions (sigmas stay those of the input).
                                    * Default 1. 0 only with vertex_updates > 0: the normal update
                                    * stage alone (then weights are 0 and confidences 1) */
-    double pass_confidence;       /* 0 (default): every pass moves every vertex. In (0, 1]: passes
+    double pass_confidence;       /**< 0 (default): every pass moves every vertex. In (0, 1]: passes
                                    * after the first move only the vertices whose confidence in the
                                    * previous pass was below this (low confidence: features and
                                    * outliers, the paper's Sec. 5 suggestion) */
-    /* Colour in the influence weight (the paper's future work; added in 0.4). With a colour C_p
+    /** @} */
+    /** @name Colour in the influence weight
+     * Colour in the influence weight (the paper's future work; added in 0.4). With a colour C_p
      * per vertex, the robust weight of facet q for vertex p gains the factor
      *     exp(-|C_q - C_p|^2 / (2 sigma_c^2)),   C_q = the mean colour of q's three vertices,
      * so a vertex is pulled mostly by triangles of its own colour: a colour edge (a painted line,
@@ -220,43 +247,45 @@ typedef struct rsmooth_params {
      * applies to the robust estimate (Eq. 3) only; the predictors' normals (mollification or the
      * bilateral filter) ignore colour. The confidence k / sum a f counts the factor in k only,
      * so it drops where neighbouring triangles differ in colour. For point clouds
-     * (rsmooth_smooth_points_reference) a point's own colour is its facet's C_q. */
-    const float *colors;          /* NULL (default): off. Else 3 * vertex_count floats, a colour
+     * (rsmooth_smooth_points_reference) a point's own colour is its facet's C_q. @{ */
+    const float *colors;          /**< NULL (default): off. Else 3 * vertex_count floats, a colour
                                    * per vertex (e.g. RGB in [0, 1]; any finite values of
                                    * magnitude <= 1e15), in the positions' vertex order. Borrowed:
                                    * read during the call only. A bad one is an
                                    * RSMOOTH_ERROR_INVALID_ARGUMENT naming its vertex */
-    double sigma_c;               /* colour width, in the colours' units, > 0; +INFINITY turns the
+    double sigma_c;               /**< colour width, in the colours' units, > 0; +INFINITY turns the
                                    * colour factor off (the result is then exactly that of colors
                                    * = NULL). Default 0.1 */
-    rsmooth_progress_cancel_fn progress_cancel; /* optional (NULL, default): progress reports that
+    /** @} */
+    rsmooth_progress_cancel_fn progress_cancel; /**< optional (NULL, default): progress reports that
                                    * may stop the call (see the type); called with progress_user,
                                    * after `progress` when both are set. (Added in 0.5) */
-    const uint8_t *move_mask;     /* NULL (default): every vertex moves. Else vertex_count bytes
+    const uint8_t *move_mask;     /**< NULL (default): every vertex moves. Else vertex_count bytes
                                    * (points: point_count): a vertex whose byte is 0 keeps its
                                    * input position bit for bit in every pass, while its triangles
                                    * still support the others (smoothing a selection). Its weight
                                    * and confidence are still computed. Borrowed. (Added in 0.5) */
-    /* The normal update stage (added in 0.6; off by default, so older callers and the paper's
+    /** @name The normal update stage
+     * The normal update stage (added in 0.6; off by default, so older callers and the paper's
      * filter are unchanged). With vertex_updates > 0, before the passes: the facet normals are
      * filtered by guided normal filtering (Zhang et al. 2015: a joint bilateral filter whose range
      * weight compares the mean normals of each facet's most consistent nearby patch, so creases
      * survive heavy noise), guided_rounds times, and then the vertices are moved to agree with
      * those normals by Sun et al. 2007's iterative update, vertex_updates times. The passes then
-     * start from the updated positions. Runs on the host's cores, in double precision. */
-    int vertex_updates;           /* 0 (default): no stage. [1, 1000]: update iterations */
-    double guided_sigma_s;        /* spatial width of the guided filter's Gaussian, in the units
+     * start from the updated positions. Runs on the host's cores, in double precision. @{ */
+    int vertex_updates;           /**< 0 (default): no stage. [1, 1000]: update iterations */
+    double guided_sigma_s;        /**< spatial width of the guided filter's Gaussian, in the units
                                    * of sigma_f, > 0; its reach is fixed at twice the mean
                                    * distance between the centroids of facets sharing an edge (the
                                    * paper's), so 2 (default) weighs that reach nearly evenly */
-    double guided_sigma_n;        /* width on the difference of guidance normals, (0, 2].
+    double guided_sigma_n;        /**< width on the difference of guidance normals, (0, 2].
                                    * Default 0.2 */
-    int guided_rounds;            /* guided filter rounds, [1, 100]. Default 20 */
-    int stage_repeats;            /* the stage (guided rounds, then vertex updates) this many
+    int guided_rounds;            /**< guided filter rounds, [1, 100]. Default 20 */
+    int stage_repeats;            /**< the stage (guided rounds, then vertex updates) this many
                                    * times, [1, 100], each from the facets of the positions the
                                    * one before left: a vertex thrown far (impulsive noise) comes
                                    * back over several repeats. Default 1 */
-    double discrepancy_level;     /* 0 (default): off. > 0: the noise level, in mean edge lengths
+    double discrepancy_level;     /**< 0 (default): off. > 0: the noise level, in mean edge lengths
                                    * of the input (rsmooth_params_auto sets it to the estimate in
                                    * the best mode). When the result is curved at the scale of its
                                    * triangles (fewer than 52% of the facet pairs sharing an edge
@@ -266,21 +295,23 @@ typedef struct rsmooth_params {
                                    * vertices moved (RMS) this far (the discrepancy principle), at
                                    * most 40 iterations.
                                    * Needs connected triangles (a soup keeps the filter's result) */
+    /** @} */
 } rsmooth_params;
 
-/* Fills `params` with the defaults above. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if params is NULL. */
+/** Fills `params` with the defaults above. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if params is
+ * NULL. */
 RSMOOTH_API rsmooth_status rsmooth_params_init(rsmooth_params *params);
 
-/* Fills `params` with rsmooth's most accurate mode, beyond the paper: the normal update stage
+/** Fills `params` with rsmooth's most accurate mode, beyond the paper: the normal update stage
  * (4 guided normal filtering rounds of width 0.2, then 10 vertex updates, 5 times), then one
  * robust pass with
  * bilateral normals at sigma_f 0.8, sigma_g 0.3 (chosen on noisy meshes with a ground truth,
  * docs/experiments.md section 7). rsmooth_params_auto fits its strength to a mesh's noise. */
 RSMOOTH_API rsmooth_status rsmooth_params_init_best(rsmooth_params *params);
 
-/* Mean length of the mesh's unique undirected edges (an edge shared by two triangles counts once),
- * in the mesh's units: the unit of relative sigmas. Writes 0 when there is no edge of non-zero length.
- * Fails like rsmooth_smooth_reference on bad arrays. Thread-safe. */
+/** Mean length of the mesh's unique undirected edges (an edge shared by two triangles counts once),
+ * in the mesh's units: the unit of relative sigmas. Writes 0 when there is no edge of non-zero
+ * length. Fails like rsmooth_smooth_reference on bad arrays. Thread-safe. */
 RSMOOTH_API rsmooth_status rsmooth_mean_edge_length(rsmooth_scalar scalar, const void *positions,
                                                     size_t vertex_count, const uint32_t *indices,
                                                     size_t triangle_count, double *out_length,
@@ -290,7 +321,7 @@ RSMOOTH_API rsmooth_status rsmooth_mean_edge_length(rsmooth_scalar scalar, const
 /* Noise estimate                                                                                   */
 /* ---------------------------------------------------------------------------------------------- */
 
-/* Estimates the mesh's noise: the standard deviation of its vertices' displacement along the
+/** Estimates the mesh's noise: the standard deviation of its vertices' displacement along the
  * surface normal, in mean edge lengths of the mesh as given (the unit of relative sigmas, as
  * rsmooth_mean_edge_length computes it), from the geometry alone. Each vertex (at most 50000, at a
  * fixed stride) is predicted by a quadric fitted to the other vertices within 2.5 mean edge
@@ -308,7 +339,7 @@ RSMOOTH_API rsmooth_status rsmooth_estimate_noise(rsmooth_scalar scalar, const v
                                                   size_t triangle_count, double *out_noise,
                                                   rsmooth_error *error);
 
-/* Automatic parameters: estimates the mesh's noise (rsmooth_estimate_noise) and sets the fields
+/** Automatic parameters: estimates the mesh's noise (rsmooth_estimate_noise) and sets the fields
  * of `params` the rules chosen in docs/experiments.md (section 7; cross-validated, whole meshes
  * left out) give for it. `params` must be initialised first; it picks the rule:
  *   the paper's filter (rsmooth_params_init: normal_filter RSMOOTH_NORMALS_MOLLIFY and no
@@ -324,32 +355,34 @@ RSMOOTH_API rsmooth_status rsmooth_params_auto(rsmooth_scalar scalar, const void
                                                size_t triangle_count, rsmooth_params *params,
                                                double *out_noise, rsmooth_error *error);
 
-/* What rsmooth_params_auto_report read from a mesh and chose (added in 0.6). */
+/** The kind of noise rsmooth_params_auto_report found in a mesh (added in 0.6). */
 typedef enum rsmooth_noise_kind {
-    RSMOOTH_NOISE_NONE = 0,      /* nothing measurable (too few vertices, no edge) */
-    RSMOOTH_NOISE_GAUSSIAN = 1,  /* every vertex displaced */
-    RSMOOTH_NOISE_IMPULSIVE = 2  /* a share of the vertices thrown, the others (nearly) exact */
+    RSMOOTH_NOISE_NONE = 0,      /**< nothing measurable (too few vertices, no edge) */
+    RSMOOTH_NOISE_GAUSSIAN = 1,  /**< every vertex displaced */
+    RSMOOTH_NOISE_IMPULSIVE = 2  /**< a share of the vertices thrown, the others (nearly) exact */
 } rsmooth_noise_kind;
 
+/** What rsmooth_params_auto_report read from a mesh and chose (added in 0.6): initialise it with
+ * rsmooth_noise_report_init. */
 typedef struct rsmooth_noise_report {
-    size_t struct_size;        /* sizeof(rsmooth_noise_report): rsmooth_noise_report_init */
-    double level;              /* rsmooth_estimate_noise's figure: the standard deviation of the
+    size_t struct_size;        /**< sizeof(rsmooth_noise_report): rsmooth_noise_report_init */
+    double level;              /**< rsmooth_estimate_noise's figure: the standard deviation of the
                                 * displacement along the surface normal, in mean edge lengths of
                                 * the clean mesh (impulsive: of the displaced vertices) */
-    int kind;                  /* an rsmooth_noise_kind */
-    double impulsive_fraction; /* the share of vertices displaced: 1 unless impulsive */
-    double tangential_level;   /* the displacement's standard deviation along one tangent
+    int kind;                  /**< an rsmooth_noise_kind */
+    double impulsive_fraction; /**< the share of vertices displaced: 1 unless impulsive */
+    double tangential_level;   /**< the displacement's standard deviation along one tangent
                                 * direction, same unit (about `level` for noise in random
                                 * directions, near 0 along the normals); NAN when not measured */
-    double mean_edge_length;   /* the clean mesh's, as estimated, in the mesh's units */
-    char preset[32];           /* the setting the rule chose, e.g. "best: strong" */
-    char reason[192];          /* why, in words, for printing */
+    double mean_edge_length;   /**< the clean mesh's, as estimated, in the mesh's units */
+    char preset[32];           /**< the setting the rule chose, e.g. "best: strong" */
+    char reason[192];          /**< why, in words, for printing */
 } rsmooth_noise_report;
 
-/* Sets struct_size and clears the rest. */
+/** Sets struct_size and clears the rest. */
 RSMOOTH_API void rsmooth_noise_report_init(rsmooth_noise_report *report);
 
-/* rsmooth_params_auto, also saying what it read and chose in *report (when not NULL; initialise
+/** rsmooth_params_auto, also saying what it read and chose in *report (when not NULL; initialise
  * it with rsmooth_noise_report_init). (Added in 0.6.) */
 RSMOOTH_API rsmooth_status rsmooth_params_auto_report(rsmooth_scalar scalar,
                                                       const void *positions, size_t vertex_count,
@@ -359,77 +392,79 @@ RSMOOTH_API rsmooth_status rsmooth_params_auto_report(rsmooth_scalar scalar,
                                                       rsmooth_noise_report *report,
                                                       rsmooth_error *error);
 
-/* Figures of one filter run, filled when a non-NULL pointer is passed. Times in milliseconds;
+/** Figures of one filter run, filled when a non-NULL pointer is passed. Times in milliseconds;
  * stages a path does not have are 0. */
 typedef struct rsmooth_report {
-    size_t struct_size;           /* sizeof(rsmooth_report): rsmooth_report_init (added in 0.5) */
-    size_t vertex_count;
-    size_t triangle_count;        /* triangles given */
-    size_t facet_count;           /* triangles with non-zero area: the ones that carry weight */
-    double mean_edge_length;      /* in mesh units */
-    double sigma_f;               /* absolute, mesh units */
-    double sigma_g;               /* absolute, mesh units (+INFINITY when the influence is off) */
-    double radius;                /* cutoff * sigma_f: the reach of a vertex, mesh units */
-    size_t grid_cell_count;       /* occupied grid cells */
-    char device[128];             /* "reference (double, 1 thread)" or the OpenCL device name */
-    double ms_setup;              /* program build / context work done for this call */
-    double ms_facets;             /* facet data and mean edge length */
-    double ms_grid;               /* grid build and vertex ordering */
-    double ms_upload;
-    double ms_mollify;            /* vertex mollification */
-    double ms_normals;            /* normals of the mollified copy */
-    double ms_robust;             /* robust estimation */
-    double ms_download;
-    double ms_total;              /* the whole filter call */
-    /* Work counts (0 where a path does not count them; the reference path does not). */
-    double mollify_radius;        /* reach of the mollification pass (of one round of the
+    size_t struct_size;           /**< sizeof(rsmooth_report): rsmooth_report_init (added in 0.5) */
+    size_t vertex_count;          /**< vertices given */
+    size_t triangle_count;        /**< triangles given */
+    size_t facet_count;           /**< triangles with non-zero area: the ones that carry weight */
+    double mean_edge_length;      /**< in mesh units */
+    double sigma_f;               /**< absolute, mesh units */
+    double sigma_g;               /**< absolute, mesh units (+INFINITY when the influence is off) */
+    double radius;                /**< cutoff * sigma_f: the reach of a vertex, mesh units */
+    size_t grid_cell_count;       /**< occupied grid cells */
+    char device[128];             /**< "reference (double, 1 thread)" or the OpenCL device name */
+    double ms_setup;              /**< program build / context work done for this call */
+    double ms_facets;             /**< facet data and mean edge length */
+    double ms_grid;               /**< grid build and vertex ordering */
+    double ms_upload;             /**< copying the inputs to the device */
+    double ms_mollify;            /**< vertex mollification */
+    double ms_normals;            /**< normals of the mollified copy */
+    double ms_robust;             /**< robust estimation */
+    double ms_download;           /**< copying the results back */
+    double ms_total;              /**< the whole filter call */
+    /** @name Work counts
+     * 0 where a path does not count them; the reference path does not. @{ */
+    double mollify_radius;        /**< reach of the mollification pass (of one round of the
                                    * bilateral normal filter when it replaces it), mesh units */
-    uint64_t pairs_mollify;       /* vertex-facet pairs the mollification pass evaluated */
-    uint64_t pairs_robust;        /* vertex-facet pairs the robust pass evaluated (each of them,
+    uint64_t pairs_mollify;       /**< vertex-facet pairs the mollification pass evaluated */
+    uint64_t pairs_robust;        /**< vertex-facet pairs the robust pass evaluated (each of them,
                                      within reach or not: the grid's waste is counted) */
-    size_t tiles;                 /* spatial tiles the mesh was cut into to fit the device (1 when
+    size_t tiles;                 /**< spatial tiles the mesh was cut into to fit the device (1 when
                                      it fitted whole) */
-    int discrepancy_iterations;   /* params.discrepancy_level's guard: the Taubin iterations that
+    /** @} */
+    int discrepancy_iterations;   /**< params.discrepancy_level's guard: the Taubin iterations that
                                    * replaced the filter's result, 0 when it was kept (added in
                                    * 0.6) */
 } rsmooth_report;
 
-/* Zeroes `report` and sets its struct_size. Accepts NULL. (Added in 0.5) */
+/** Zeroes `report` and sets its struct_size. Accepts NULL. (Added in 0.5) */
 RSMOOTH_API void rsmooth_report_init(rsmooth_report *report);
 
 /* ---------------------------------------------------------------------------------------------- */
 /* Error metrics                                                                                    */
 /* ---------------------------------------------------------------------------------------------- */
 
-/* How far a result (a denoised mesh) is from its ground truth, both made of the same triangles
+/** How far a result (a denoised mesh) is from its ground truth, both made of the same triangles
  * over the same vertices: what `rsmooth compare` prints. Lower is better; 0 for identical meshes.
  * The figures follow ../shared/tools/meshmetrics.py (the independent oracle), except that
  * distances to a surface here are exact (the closest point over all triangles), where the script
  * tries only the 24 triangles with the nearest centroids, so its ev can be slightly larger.
  * (Added in 0.5) */
 typedef struct rsmooth_metrics {
-    size_t vertex_count;
-    size_t triangle_count;
-    double theta;       /* mean angle between corresponding face normals, degrees, over the
+    size_t vertex_count;   /**< vertices compared */
+    size_t triangle_count; /**< triangles of the meshes */
+    double theta;       /**< mean angle between corresponding face normals, degrees, over the
                          * triangles with non-zero area in both meshes (NAN when there is none) */
-    size_t theta_count; /* how many triangles theta averages */
-    double ev;          /* Sun et al. 2007 E_v: sqrt(sum_v A_v d_v^2 / sum_v A_v), A_v the area of
+    size_t theta_count; /**< how many triangles theta averages */
+    double ev;          /**< Sun et al. 2007 E_v: sqrt(sum_v A_v d_v^2 / sum_v A_v), A_v the area of
                          * the result's triangles around v, d_v the distance from result vertex v
                          * to the ground-truth surface (exact), over vertices with A_v > 0; in
                          * thousandths of bbox_diag (NAN when no vertex has A_v > 0) */
-    double rms_v;       /* RMS distance between corresponding vertices (all of them), in
+    double rms_v;       /**< RMS distance between corresponding vertices (all of them), in
                          * mean_edge (mean edge lengths of the truth) */
-    double hausdorff;   /* symmetric Hausdorff distance sampled at the vertices: the larger of the
+    double hausdorff;   /**< symmetric Hausdorff distance sampled at the vertices: the larger of the
                          * farthest result vertex from the ground-truth surface and the farthest
                          * ground-truth vertex from the result surface (vertices used by some
                          * triangle); in thousandths of bbox_diag */
-    double mean_edge;   /* mean length of the truth's unique undirected edges (an edge shared by
+    double mean_edge;   /**< mean length of the truth's unique undirected edges (an edge shared by
                          * two triangles counts once; a repeated index is no edge), mesh units */
-    double bbox_diag;   /* diagonal of the truth's axis-aligned bounding box (all vertices), mesh
+    double bbox_diag;   /**< diagonal of the truth's axis-aligned bounding box (all vertices), mesh
                          * units */
 } rsmooth_metrics;
 
-/* Compares `result_positions` with `truth_positions` (3 * vertex_count floats or doubles each, as
+/** Compares `result_positions` with `truth_positions` (3 * vertex_count floats or doubles each, as
  * `scalar` says, finite, magnitude <= 1e150), both meshes made of the same `indices`
  * (triangle_count triples, each < vertex_count), and writes the figures to `out`. The arrays are
  * only read. float32 positions give exactly the figures of float64 positions of the same values.
@@ -454,7 +489,7 @@ RSMOOTH_API rsmooth_status rsmooth_compare(rsmooth_scalar scalar, const void *re
 /* Layer 1: arrays in, arrays out                                                                   */
 /* ---------------------------------------------------------------------------------------------- */
 
-/* The filter in double precision on one CPU thread: the oracle of the OpenCL path and the fallback
+/** The filter in double precision on one CPU thread: the oracle of the OpenCL path and the fallback
  * when no OpenCL device exists.
  *
  * scalar         type of `positions` and `out_positions`.
@@ -491,7 +526,7 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_reference(rsmooth_scalar scalar, const
                                                     float *out_confidence, rsmooth_report *report,
                                                     rsmooth_error *error);
 
-/* The isotropic baselines people already use, for comparison only: `iterations` rounds of
+/** The isotropic baselines people already use, for comparison only: `iterations` rounds of
  * p += lambda * U(p), each followed, when mu != 0, by p += mu * U(p) (Taubin's lambda|mu smoothing,
  * SIGGRAPH 1995; typical lambda 0.5, mu -0.53). mu = 0 gives plain Laplacian smoothing, which
  * shrinks the mesh. U(p) is the uniform umbrella operator: the mean of p's edge neighbours minus p.
@@ -505,7 +540,7 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const vo
                                                  unsigned iterations, void *out_positions,
                                                  rsmooth_error *error);
 
-/* Point clouds with normals (beyond the paper; added in 0.4). A point set has no triangles, so
+/** Point clouds with normals (beyond the paper; added in 0.4). A point set has no triangles, so
  * each point p_i is its own facet: its centroid is p_i, its plane the tangent plane through p_i
  * with normal n_i, and its area a_i = (sqrt(3) / 2) s_i^2, where s_i is p_i's mean distance to its
  * 6 nearest other points (the area per point of a regular triangular lattice of spacing s_i), so
@@ -547,7 +582,7 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_points_reference(
     const rsmooth_params *params, void *out_positions, void *out_normals, float *out_confidence,
     rsmooth_report *report, rsmooth_error *error);
 
-/* The point spacing of a point set, as above: the mean over the points of each one's mean distance
+/** The point spacing of a point set, as above: the mean over the points of each one's mean distance
  * to its 6 nearest others (fewer when there are fewer points; 0 for one point). Fails like
  * rsmooth_smooth_points_reference on bad positions. Thread-safe. */
 RSMOOTH_API rsmooth_status rsmooth_point_spacing(rsmooth_scalar scalar, const void *positions,
@@ -558,10 +593,10 @@ RSMOOTH_API rsmooth_status rsmooth_point_spacing(rsmooth_scalar scalar, const vo
 /* Layer 2: an OpenCL context object                                                                */
 /* ---------------------------------------------------------------------------------------------- */
 
-/* Owns (or shares) an OpenCL context, device, queue and the built program. */
+/** Owns (or shares) an OpenCL context, device, queue and the built program. */
 typedef struct rsmooth_context rsmooth_context;
 
-/* Creates a context on the device named by `device`:
+/** Creates a context on the device named by `device`:
  *   NULL        use the RSMOOTH_DEVICE environment variable if set, else "auto";
  *   "auto"      first GPU of any platform, else first CPU device, else the first device;
  *   "gpu"/"cpu" first device of that type;
@@ -584,38 +619,38 @@ typedef struct rsmooth_context rsmooth_context;
 RSMOOTH_API rsmooth_status rsmooth_context_create(const char *device, rsmooth_context **ctx,
                                                   rsmooth_error *error);
 
-/* One OpenCL device as rsmooth_list_devices reports it. */
+/** One OpenCL device as rsmooth_list_devices reports it. */
 typedef struct rsmooth_device_info {
-    size_t struct_size;      /* sizeof(rsmooth_device_info), rsmooth_device_info_init: the first
+    size_t struct_size;      /**< sizeof(rsmooth_device_info), rsmooth_device_info_init: the first
                               * entry's says how large every entry of the array is (added in 0.5) */
-    int platform_index;      /* the P of a "P:D" device choice */
-    int device_index;        /* the D */
-    char name[256];          /* "platform name / device name", what a name choice matches */
-    char type[8];            /* "gpu", "cpu", "accel" or "other" */
-    char version[64];        /* CL_DEVICE_VERSION, e.g. "OpenCL 3.0 PoCL ..." */
-    unsigned compute_units;
-    uint64_t global_memory;  /* bytes */
+    int platform_index;      /**< the P of a "P:D" device choice */
+    int device_index;        /**< the D */
+    char name[256];          /**< "platform name / device name", what a name choice matches */
+    char type[8];            /**< "gpu", "cpu", "accel" or "other" */
+    char version[64];        /**< CL_DEVICE_VERSION, e.g. "OpenCL 3.0 PoCL ..." */
+    unsigned compute_units;  /**< CL_DEVICE_MAX_COMPUTE_UNITS */
+    uint64_t global_memory;  /**< bytes */
 } rsmooth_device_info;
 
-/* Zeroes `info` and sets its struct_size. Accepts NULL. (Added in 0.5) */
+/** Zeroes `info` and sets its struct_size. Accepts NULL. (Added in 0.5) */
 RSMOOTH_API void rsmooth_device_info_init(rsmooth_device_info *info);
 
-/* Fills up to `capacity` entries of `devices` (may be NULL when capacity is 0) with every OpenCL
+/** Fills up to `capacity` entries of `devices` (may be NULL when capacity is 0) with every OpenCL
  * device of every platform, in the order "P:D" choices count them, and returns how many there are
  * (0 when no OpenCL platform exists). Thread-safe. */
 RSMOOTH_API size_t rsmooth_list_devices(rsmooth_device_info *devices, size_t capacity);
 
-/* Releases everything the context holds. Accepts NULL. Called from a progress callback of a call
+/** Releases everything the context holds. Accepts NULL. Called from a progress callback of a call
  * still running on ctx, does nothing (the call would go on with freed objects). */
 RSMOOTH_API void rsmooth_context_destroy(rsmooth_context *ctx);
 
-/* "Platform name / device name" of the context's device; valid while ctx lives. */
+/** "Platform name / device name" of the context's device; valid while ctx lives. */
 RSMOOTH_API const char *rsmooth_context_device_name(const rsmooth_context *ctx);
 
-/* Milliseconds the context's creation spent building the OpenCL program. */
+/** Milliseconds the context's creation spent building the OpenCL program. */
 RSMOOTH_API double rsmooth_context_build_ms(const rsmooth_context *ctx);
 
-/* Where the context's program came from: "hit" (built from the binary in rsmooth's program cache),
+/** Where the context's program came from: "hit" (built from the binary in rsmooth's program cache),
  * "miss" (built from source, its binary then stored), "refused" (built from source: the cache
  * folder or file could have been written by another user, see below) or "off" (no cache:
  * RSMOOTH_CACHE_DIR is empty or "off", or neither XDG_CACHE_HOME nor HOME is set). The cache is the
@@ -630,7 +665,7 @@ RSMOOTH_API double rsmooth_context_build_ms(const rsmooth_context *ctx);
  * in 0.9) */
 RSMOOTH_API const char *rsmooth_context_program_cache(const rsmooth_context *ctx);
 
-/* How the context's kernels spread the work on its device: *lanes vertices per work-item (the
+/** How the context's kernels spread the work on its device: *lanes vertices per work-item (the
  * block variant, CPU devices: the device's preferred float vector width, 4, 8 or 16) or 1 (the
  * group variant, GPUs: one vertex per work-item, the work-group's candidate facets staged through
  * local memory), and *group work-items per work-group. RSMOOTH_KERNEL_VARIANT=cpu|gpu and
@@ -639,7 +674,7 @@ RSMOOTH_API const char *rsmooth_context_program_cache(const rsmooth_context *ctx
 RSMOOTH_API void rsmooth_context_kernel_shape(const rsmooth_context *ctx, unsigned *lanes,
                                               size_t *group);
 
-/* Limits the device memory one filter call holds to `bytes` (0: most of the device's memory, the
+/** Limits the device memory one filter call holds to `bytes` (0: most of the device's memory, the
  * default; the environment variable RSMOOTH_MEMORY_BUDGET, e.g. "256M", sets it at creation).
  * Thread-safe: waits for a running call on the context.
  * A mesh that needs more, or a buffer larger than the device's largest allocation, is cut into
@@ -650,17 +685,19 @@ RSMOOTH_API void rsmooth_context_kernel_shape(const rsmooth_context *ctx, unsign
  * says how many ran. */
 RSMOOTH_API void rsmooth_context_set_memory_budget(rsmooth_context *ctx, uint64_t bytes);
 
-/* The bytes one filter call may hold on the device now: the budget, else the device's share. */
+/** The bytes one filter call may hold on the device now: the budget, else the device's share. */
 RSMOOTH_API uint64_t rsmooth_context_memory_budget(const rsmooth_context *ctx);
 
-/* Threads the host stages of the context's calls use (facet data, grid, packing, results): 0 (the
+/** Threads the host stages of the context's calls use (facet data, grid, packing, results): 0 (the
  * default) means every online core, or RSMOOTH_HOST_THREADS when set; at most 64 run. A host
  * application with its own thread pool sets 1, or its share. The result does not depend on it (bit
  * for bit). Thread-safe: waits for a running call on the context. (Added in 0.5) */
 RSMOOTH_API void rsmooth_context_set_host_threads(rsmooth_context *ctx, unsigned threads);
+/** The threads set by rsmooth_context_set_host_threads (0: every online core, or
+ * RSMOOTH_HOST_THREADS). (Added in 0.5) */
 RSMOOTH_API unsigned rsmooth_context_host_threads(const rsmooth_context *ctx);
 
-/* The filter on the context's device, float32 arithmetic in cell-local coordinates (so meshes far
+/** The filter on the context's device, float32 arithmetic in cell-local coordinates (so meshes far
  * from the origin lose nothing). Same arguments, outputs and argument errors as
  * rsmooth_smooth_reference; the result agrees with it to about 1e-4 mean edge lengths, and two
  * runs on the same device are bit-identical. Also returns RSMOOTH_ERROR_OPENCL (outputs undefined)
@@ -676,41 +713,41 @@ RSMOOTH_API rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar s
 /* Meshes as host applications hold them: strided vertices, any index type                          */
 /* ---------------------------------------------------------------------------------------------- */
 
-/* The type of a mesh view's indices. */
+/** The type of a mesh view's indices. */
 typedef enum rsmooth_index_type {
-    RSMOOTH_INDEX_UINT32 = 0, /* rsmooth's own, OpenGL's, meshoptimizer's */
-    RSMOOTH_INDEX_INT32 = 1,  /* Open3D's triangles */
-    RSMOOTH_INDEX_INT64 = 2   /* numpy's default integers (trimesh's faces) */
+    RSMOOTH_INDEX_UINT32 = 0, /**< rsmooth's own, OpenGL's, meshoptimizer's */
+    RSMOOTH_INDEX_INT32 = 1,  /**< Open3D's triangles */
+    RSMOOTH_INDEX_INT64 = 2   /**< numpy's default integers (trimesh's faces) */
 } rsmooth_index_type;
 
-/* A mesh where the host keeps it: vertex v's x, y, z are the three `scalar`s at byte
+/** A mesh where the host keeps it: vertex v's x, y, z are the three `scalar`s at byte
  * v * position_stride of `positions` (an interleaved vertex buffer: position, normal, uv...), and
  * triangle t's three indices of `index_type` at byte t * index_stride of `indices`. Strides of 0
  * mean packed. Nothing need be aligned. (Added in 0.5) */
 typedef struct rsmooth_mesh_view {
-    size_t struct_size;            /* sizeof(rsmooth_mesh_view): set by rsmooth_mesh_view_init */
-    rsmooth_scalar scalar;
-    const void *positions;
-    size_t position_stride;        /* bytes; 0, or >= 3 * sizeof(scalar) */
-    size_t vertex_count;
-    const void *indices;           /* may be NULL only when triangle_count is 0 */
-    int index_type;                /* an rsmooth_index_type */
-    size_t index_stride;           /* bytes; 0, or >= 3 * sizeof(index) */
-    size_t triangle_count;
+    size_t struct_size;            /**< sizeof(rsmooth_mesh_view): set by rsmooth_mesh_view_init */
+    rsmooth_scalar scalar;         /**< float32 or float64 coordinates */
+    const void *positions;         /**< vertex 0's x; borrowed, read during the call only */
+    size_t position_stride;        /**< bytes; 0, or >= 3 * sizeof(scalar) */
+    size_t vertex_count;           /**< >= 1 and < 2^32 */
+    const void *indices;           /**< may be NULL only when triangle_count is 0 */
+    int index_type;                /**< an rsmooth_index_type */
+    size_t index_stride;           /**< bytes; 0, or >= 3 * sizeof(index) */
+    size_t triangle_count;         /**< triangles (index triples) */
 } rsmooth_mesh_view;
 
-/* Sets struct_size and packed float32 with uint32 indices, everything else 0 / NULL. Returns
+/** Sets struct_size and packed float32 with uint32 indices, everything else 0 / NULL. Returns
  * RSMOOTH_ERROR_INVALID_ARGUMENT if view is NULL. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_view_init(rsmooth_mesh_view *view);
 
-/* The filter on a mesh view: on `ctx`'s device, or the reference path when ctx is NULL. The view is
- * read whole (into packed arrays; the packed calls above avoid that copy) before any output is
- * written, so out_positions may be the view's own vertex buffer: vertex v's result goes to the three
- * scalars at byte v * out_stride of out_positions (0: packed), the bytes between them untouched.
- * out_weight and out_confidence are packed floats, as for rsmooth_smooth. Indices are checked
- * first: a negative one, or one >= vertex_count, is RSMOOTH_ERROR_INVALID_ARGUMENT naming the
- * triangle and corner, with nothing written; so are outputs that overlap each other. Otherwise the
- * same arguments, results (bit for bit those of the packed call on the same values), errors and
+/** The filter on a mesh view: on `ctx`'s device, or the reference path when ctx is NULL. The view
+ * is read whole (into packed arrays; the packed calls above avoid that copy) before any output is
+ * written, so out_positions may be the view's own vertex buffer: vertex v's result goes to the
+ * three scalars at byte v * out_stride of out_positions (0: packed), the bytes between them
+ * untouched. out_weight and out_confidence are packed floats, as for rsmooth_smooth. Indices are
+ * checked first: a negative one, or one >= vertex_count, is RSMOOTH_ERROR_INVALID_ARGUMENT naming
+ * the triangle and corner, with nothing written; so are outputs that overlap each other. Otherwise
+ * the same arguments, results (bit for bit those of the packed call on the same values), errors and
  * thread-safety as rsmooth_smooth and rsmooth_smooth_reference. (Added in 0.5) */
 RSMOOTH_API rsmooth_status rsmooth_smooth_view(rsmooth_context *ctx, const rsmooth_mesh_view *mesh,
                                                const rsmooth_params *params, void *out_positions,
@@ -722,16 +759,16 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_view(rsmooth_context *ctx, const rsmoo
 /* Pieces of a larger mesh (out-of-core and distributed filtering)                                 */
 /* ---------------------------------------------------------------------------------------------- */
 
-/* What a piece of a larger mesh is filtered with, besides its own arrays. (Added in 0.7) */
+/** What a piece of a larger mesh is filtered with, besides its own arrays. (Added in 0.7) */
 typedef struct rsmooth_piece_info {
-    size_t struct_size;      /* sizeof(rsmooth_piece_info): set by rsmooth_piece_info_init */
-    size_t core_count;       /* the piece's first core_count vertices are solved; <= its vertex
+    size_t struct_size;      /**< sizeof(rsmooth_piece_info): set by rsmooth_piece_info_init */
+    size_t core_count;       /**< the piece's first core_count vertices are solved; <= its vertex
                               * count */
-    double mean_edge_length; /* of the whole mesh, caller's units (as rsmooth_mean_edge_length);
+    double mean_edge_length; /**< of the whole mesh, caller's units (as rsmooth_mean_edge_length);
                               * finite and > 0 */
-    double mean_area;        /* of the whole mesh's triangles of non-zero area, caller's units;
+    double mean_area;        /**< of the whole mesh's triangles of non-zero area, caller's units;
                               * finite and > 0 */
-    double scale;            /* the power of two the whole run multiplies coordinates by inside
+    double scale;            /**< the power of two the whole run multiplies coordinates by inside
                               * (one of [2^-500, 2^1000], the scales it chooses); 0: the piece
                               * chooses, which gives the same bits unless a coordinate lies beyond
                               * about 1e75 typical edges from the origin. The two figures times it
@@ -743,10 +780,10 @@ typedef struct rsmooth_piece_info {
                               * underflow, is not the whole mesh's and is refused */
 } rsmooth_piece_info;
 
-/* Sets struct_size and zeroes the rest. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if info is NULL. */
+/** Sets struct_size and zeroes the rest. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if info is NULL. */
 RSMOOTH_API rsmooth_status rsmooth_piece_info_init(rsmooth_piece_info *info);
 
-/* How far from a vertex the centroids of the triangles that move it may lie, in the caller's
+/** How far from a vertex the centroids of the triangles that move it may lie, in the caller's
  * units: the halo a piece must carry around its core vertices. `reach` is the whole mesh's largest
  * distance from a triangle's centroid to its corners. Checks params as the filter does; params
  * that need the whole mesh (passes above 1, the normal update stage, colours, a move mask) are
@@ -756,7 +793,7 @@ RSMOOTH_API rsmooth_status rsmooth_piece_halo(const rsmooth_params *params,
                                               double mean_edge_length, double reach,
                                               double *out_halo, rsmooth_error *error);
 
-/* The filter on a piece of a larger mesh: its first info->core_count vertices move as they would
+/** The filter on a piece of a larger mesh: its first info->core_count vertices move as they would
  * in a run on the whole mesh, provided the piece holds every triangle whose centroid lies within
  * rsmooth_piece_halo of them (more do no harm). Positions are double, packed; out_positions
  * receives 3 * core_count values. The whole mesh's mean edge length, mean facet area and scale

@@ -1,4 +1,4 @@
-/*
+/** @file
  * rsmooth_io: reading and writing the mesh files scanners and tools produce (library target
  * rsmooth::io, separate from rsmooth::rsmooth so hosts that pass arrays do not pull it in).
  *
@@ -41,45 +41,50 @@
 extern "C" {
 #endif
 
+/** A mesh file format: what rsmooth_mesh_read_memory expects, rsmooth_mesh_write_file writes. */
 typedef enum rsmooth_format {
-    RSMOOTH_FORMAT_AUTO = 0,       /* reading: from the content; writing: from the path's extension */
-    RSMOOTH_FORMAT_OBJ = 1,
-    RSMOOTH_FORMAT_PLY_ASCII = 2,
-    RSMOOTH_FORMAT_PLY_BINARY = 3, /* little-endian on output; either endianness on input */
-    RSMOOTH_FORMAT_PLY_BINARY_BE = 4, /* input only */
-    RSMOOTH_FORMAT_OFF = 5,        /* OFF and its COFF / NOFF / CNOFF variants */
-    RSMOOTH_FORMAT_STL_ASCII = 6,
-    RSMOOTH_FORMAT_STL_BINARY = 7
+    RSMOOTH_FORMAT_AUTO = 0,       /**< reading: from the content; writing: from the path's
+                                    * extension */
+    RSMOOTH_FORMAT_OBJ = 1,        /**< Wavefront OBJ (text) */
+    RSMOOTH_FORMAT_PLY_ASCII = 2,  /**< Stanford PLY, ascii */
+    RSMOOTH_FORMAT_PLY_BINARY = 3, /**< little-endian on output; either endianness on input */
+    RSMOOTH_FORMAT_PLY_BINARY_BE = 4, /**< input only */
+    RSMOOTH_FORMAT_OFF = 5,        /**< OFF and its COFF / NOFF / CNOFF variants */
+    RSMOOTH_FORMAT_STL_ASCII = 6,  /**< STL, ascii (an unindexed triangle soup) */
+    RSMOOTH_FORMAT_STL_BINARY = 7  /**< STL, binary (an unindexed triangle soup) */
 } rsmooth_format;
 
-/* A mesh read from a file. All arrays are owned by the mesh and freed by rsmooth_mesh_destroy. */
+/** A mesh read from a file. All arrays are owned by the mesh and freed by rsmooth_mesh_destroy. */
 typedef struct rsmooth_mesh {
-    size_t vertex_count;
-    double *positions;          /* 3 * vertex_count: x, y, z per vertex, file order */
-    rsmooth_scalar precision;   /* precision the file stored positions in: FLOAT32 for PLY float,
+    size_t vertex_count;        /**< vertices in the file (unreferenced ones included) */
+    double *positions;          /**< 3 * vertex_count: x, y, z per vertex, file order */
+    rsmooth_scalar precision;   /**< precision the file stored positions in: FLOAT32 for PLY float,
                                  * FLOAT64 for PLY double and for text (OBJ) coordinates */
-    size_t face_count;          /* polygons as in the file */
-    uint32_t *face_offsets;     /* face_count + 1 entries: face i is
+    size_t face_count;          /**< polygons as in the file */
+    uint32_t *face_offsets;     /**< face_count + 1 entries: face i is
                                  * face_indices[face_offsets[i] .. face_offsets[i + 1]) */
-    uint32_t *face_indices;     /* 0-based vertex indices */
-    size_t triangle_count;      /* the faces fanned into triangles (v0, vi, vi+1) */
-    uint32_t *triangles;        /* 3 * triangle_count */
-    rsmooth_format source_format; /* format it was read from */
-    int has_vertex_normals;     /* the file carried vertex normals: writers that can hold them write
-                                 * normals recomputed from `positions` (area-weighted face normals) */
+    uint32_t *face_indices;     /**< 0-based vertex indices */
+    size_t triangle_count;      /**< the faces fanned into triangles (v0, vi, vi+1) */
+    uint32_t *triangles;        /**< 3 * triangle_count */
+    rsmooth_format source_format; /**< format it was read from */
+    int has_vertex_normals;     /**< the file carried vertex normals: writers that can hold them
+                                 * write normals recomputed from `positions` (area-weighted face
+                                 * normals) */
 
-    /* Per-vertex attributes writers of every format that can hold them write when non-NULL.
+    /** @name Per-vertex attributes
+     * Per-vertex attributes writers of every format that can hold them write when non-NULL.
      * Readers fill vertex_colors when the file has vertex colours (PLY red/green/blue, OBJ
-     * "v x y z r g b", COFF); vertex_quality is for callers (the confidence output). */
-    float *vertex_quality;      /* vertex_count values: PLY "quality" property */
-    uint8_t *vertex_colors;     /* 3 * vertex_count RGB bytes */
+     * "v x y z r g b", COFF); vertex_quality is for callers (the confidence output). @{ */
+    float *vertex_quality;      /**< vertex_count values: PLY "quality" property */
+    uint8_t *vertex_colors;     /**< 3 * vertex_count RGB bytes */
+    /** @} */
 
-    /* What the file held beyond the fields above, kept by the reader so writing back to the same
+    /** What the file held beyond the fields above, kept by the reader so writing back to the same
      * format loses nothing (opaque; NULL when there is nothing). Writers to the same format use it
      * in place of vertex_colors / vertex_quality; set it to NULL to write only the fields above. */
     struct rsmooth_mesh_extras *extras;
 
-    /* The vertex normals the file held (added in 0.4): 3 * vertex_count values as read (PLY nx,
+    /** The vertex normals the file held (added in 0.4): 3 * vertex_count values as read (PLY nx,
      * ny, nz; OFF NOFF; OBJ vn when there are no faces and as many vn as v), NULL when it held
      * none. Point clouds live on them. Writers emit them in place of recomputed normals when the
      * mesh has no triangles (nothing to recompute from); a caller may set or replace them (the
@@ -87,7 +92,7 @@ typedef struct rsmooth_mesh {
     double *vertex_normals;
 } rsmooth_mesh;
 
-/* Parses a whole file held in memory. Any PLY value reads every PLY encoding (the header decides),
+/** Parses a whole file held in memory. Any PLY value reads every PLY encoding (the header decides),
  * either STL value both STL encodings (the size decides). With `format` AUTO, the content decides:
  *   - a binary STL by its exact size (84 + 50 x the count at byte 80), whatever its header says;
  *   - after an optional UTF-8 byte-order mark: PLY when the file starts with "ply";
@@ -117,18 +122,18 @@ RSMOOTH_API rsmooth_status rsmooth_mesh_read_memory(const void *data, size_t siz
                                                     rsmooth_format format, rsmooth_mesh **mesh,
                                                     rsmooth_error *error);
 
-/* Reads a file, its format told by the content (rsmooth_mesh_read_memory with AUTO).
+/** Reads a file, its format told by the content (rsmooth_mesh_read_memory with AUTO).
  * RSMOOTH_ERROR_IO when the path cannot be opened or read (a directory, missing, unreadable), else
  * as rsmooth_mesh_read_memory. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_read_file(const char *path, rsmooth_mesh **mesh,
                                                   rsmooth_error *error);
 
-/* Reads a whole stream (to its end), then parses it as rsmooth_mesh_read_memory with AUTO.
+/** Reads a whole stream (to its end), then parses it as rsmooth_mesh_read_memory with AUTO.
  * RSMOOTH_ERROR_IO when the stream fails. `name` (may be NULL) is used in messages. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_read_stream(FILE *stream, const char *name,
                                                     rsmooth_mesh **mesh, rsmooth_error *error);
 
-/* Writes `mesh` (its faces as polygons, not the fanned triangles; STL: the triangles) to an open
+/** Writes `mesh` (its faces as polygons, not the fanned triangles; STL: the triangles) to an open
  * stream. `format` must not be AUTO; big-endian PLY output is RSMOOTH_ERROR_UNSUPPORTED. Returns
  * RSMOOTH_ERROR_INVALID_ARGUMENT, naming the vertex and having written nothing, for what no reader
  * would read back as it is (rsmooth_mesh_check_writable lists it); RSMOOTH_ERROR_IO when the
@@ -146,7 +151,7 @@ RSMOOTH_API rsmooth_status rsmooth_mesh_read_stream(FILE *stream, const char *na
 RSMOOTH_API rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, FILE *stream,
                                                      rsmooth_format format, rsmooth_error *error);
 
-/* Runs exactly the refusals of rsmooth_mesh_write_stream for `format` without writing anything
+/** Runs exactly the refusals of rsmooth_mesh_write_stream for `format` without writing anything
  * (for a caller that wants to know before it filters whether the output format can hold the mesh):
  * RSMOOTH_OK when the writer would write it; else the status and message the writer would give:
  * RSMOOTH_ERROR_INVALID_ARGUMENT, naming the vertex (or face, triangle), for a mesh that is not
@@ -161,56 +166,58 @@ RSMOOTH_API rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, F
 RSMOOTH_API rsmooth_status rsmooth_mesh_check_writable(const rsmooth_mesh *mesh,
                                                        rsmooth_format format, rsmooth_error *error);
 
-/* Writes `mesh` to `path` (created or truncated). AUTO picks the format from the extension: .obj,
+/** Writes `mesh` to `path` (created or truncated). AUTO picks the format from the extension: .obj,
  * .ply (binary little-endian), .off, .stl (binary). A mesh refused as by rsmooth_mesh_write_stream
  * creates no file. Callers that must never leave a partial file write to a temporary path and
  * rename it (the rsmooth command does). */
 RSMOOTH_API rsmooth_status rsmooth_mesh_write_file(const rsmooth_mesh *mesh, const char *path,
                                                    rsmooth_format format, rsmooth_error *error);
 
-/* The format a path's extension names (case-insensitive .obj, .ply (binary), .off, .stl (binary)),
+/** The format a path's extension names (case-insensitive .obj, .ply (binary), .off, .stl (binary)),
  * or AUTO if none. */
 RSMOOTH_API rsmooth_format rsmooth_format_from_path(const char *path);
 
-/* Allocates an empty mesh with room for the given counts (arrays zeroed; face_offsets[0] = 0).
+/** Allocates an empty mesh with room for the given counts (arrays zeroed; face_offsets[0] = 0).
  * Used by generators and tests. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_create(size_t vertex_count, size_t face_count,
                                                size_t face_index_count, rsmooth_mesh **mesh,
                                                rsmooth_error *error);
 
-/* Recomputes `triangles` by fanning the faces. */
+/** Recomputes `triangles` by fanning the faces. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_triangulate(rsmooth_mesh *mesh, rsmooth_error *error);
 
-/* Describes what writing `mesh` in `format` would drop (e.g. "texture coordinates, groups"), as
+/** Describes what writing `mesh` in `format` would drop (e.g. "texture coordinates, groups"), as
  * one comma-separated line in `buffer` (always NUL-terminated when size > 0). Returns the number of
  * kinds of data dropped (0: nothing is lost). */
 RSMOOTH_API size_t rsmooth_mesh_conversion_losses(const rsmooth_mesh *mesh, rsmooth_format format,
                                                   char *buffer, size_t size);
 
-/* Area-weighted vertex normals of the mesh's triangles (unit length; 0 for vertices no triangle
+/** Area-weighted vertex normals of the mesh's triangles (unit length; 0 for vertices no triangle
  * uses), 3 * vertex_count doubles. What writers emit for files that carried normals. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_vertex_normals(const rsmooth_mesh *mesh, double *normals,
                                                        rsmooth_error *error);
 
-/* Frees the mesh and everything it owns (extras included). Accepts NULL. */
+/** Frees the mesh and everything it owns (extras included). Accepts NULL. */
 RSMOOTH_API void rsmooth_mesh_destroy(rsmooth_mesh *mesh);
 
 /* ---------------------------------------------------------------------------------------------- */
 /* Streaming: meshes larger than memory (added in 0.7)                                             */
 /* ---------------------------------------------------------------------------------------------- */
 
-/* How rsmooth_stream_smooth may use memory, disk and other processes. */
+/** How rsmooth_stream_smooth may use memory, disk and other processes. */
 typedef struct rsmooth_stream_options {
-    size_t struct_size;    /* sizeof(rsmooth_stream_options): set by rsmooth_stream_options_init */
-    uint64_t max_memory;   /* bytes the call may hold at its peak, besides the OpenCL runtime's
+    size_t struct_size;    /**< sizeof(rsmooth_stream_options): set by
+                            * rsmooth_stream_options_init */
+    uint64_t max_memory;   /**< bytes the call may hold at its peak, besides the OpenCL runtime's
                             * own (docs: README "Large meshes"); 0: 1 GiB */
-    const char *tmpdir;    /* folder of the temporary files (all unnamed: nothing is left behind,
+    const char *tmpdir;    /**< folder of the temporary files (all unnamed: nothing is left behind,
                             * however the process ends); an existing folder, or NULL: the
                             * output's folder. "" is refused */
-    int replace;           /* non-zero: an existing output (a regular file, or a symbolic link to
+    int replace;           /**< non-zero: an existing output (a regular file, or a symbolic link to
                             * one: written through) is replaced atomically, keeping its mode,
                             * owner and group; nothing else is ever replaced */
-    /* Several processes sharing the pieces (the MPI driver): each calls with the same arguments,
+    /** @{ */
+    /** Several processes sharing the pieces (the MPI driver): each calls with the same arguments,
      * its own rank in [0, ranks), and `sync`, which every rank calls at the same points and which
      * returns the worst (largest) status any rank passed (an all-reduce). ranks 0 or 1: alone,
      * rank 0. Ranks without a sync, a rank outside [0, ranks) and negative ranks are
@@ -218,39 +225,46 @@ typedef struct rsmooth_stream_options {
     int rank, ranks;
     int (*sync)(void *user, int status);
     void *sync_user;
+    /** @} */
 } rsmooth_stream_options;
 
-/* Sets struct_size and the defaults (zeroes). Returns RSMOOTH_ERROR_INVALID_ARGUMENT on NULL. */
+/** Sets struct_size and the defaults (zeroes). Returns RSMOOTH_ERROR_INVALID_ARGUMENT on NULL. */
 RSMOOTH_API rsmooth_status rsmooth_stream_options_init(rsmooth_stream_options *options);
 
-/* What a streaming call did. */
+/** What a streaming call did. */
 typedef struct rsmooth_stream_report {
-    size_t struct_size;        /* sizeof(rsmooth_stream_report): rsmooth_stream_report_init */
+    size_t struct_size;        /**< sizeof(rsmooth_stream_report): rsmooth_stream_report_init */
+    /** @{ */
+    /** The input's vertices, faces, triangles (faces fanned) and triangles of non-zero area */
     uint64_t vertex_count, face_count, triangle_count, facet_count;
-    double mean_edge_length;   /* of the input, its units: the unit of the relative sigmas */
-    double halo;               /* how far around a piece its facets reach, mesh units */
-    size_t pieces;             /* pieces the mesh was cut into (all ranks) */
-    size_t pieces_here;        /* of them, those this rank filtered */
-    uint64_t piece_facets_max; /* facets of the largest piece, its halo's included */
-    uint64_t facets_filtered;  /* facets this rank's pieces held, halos included */
-    uint64_t memory_planned;   /* the peak this call planned for, bytes (<= max_memory) */
-    uint64_t temporary_bytes;  /* disk the temporary files took at their largest */
-    /* read: the vertex block and the faces; statistics: mean edge length, area, reach; buckets:
-     * the pieces cut and their lists written; copy: the output's copy of the input; assemble:
-     * the pieces' arrays from their lists; filter: rsmooth_smooth_piece; write: results into
-     * the copy */
+    /** @} */
+    double mean_edge_length;   /**< of the input, its units: the unit of the relative sigmas */
+    double halo;               /**< how far around a piece its facets reach, mesh units */
+    size_t pieces;             /**< pieces the mesh was cut into (all ranks) */
+    size_t pieces_here;        /**< of them, those this rank filtered */
+    uint64_t piece_facets_max; /**< facets of the largest piece, its halo's included */
+    uint64_t facets_filtered;  /**< facets this rank's pieces held, halos included */
+    uint64_t memory_planned;   /**< the peak this call planned for, bytes (<= max_memory) */
+    uint64_t temporary_bytes;  /**< disk the temporary files took at their largest */
+    /** @{ */
+    /** Milliseconds of each step. read: the vertex block and the faces; statistics: mean edge
+     * length, area, reach; buckets: the pieces cut and their lists written; copy: the output's
+     * copy of the input; assemble: the pieces' arrays from their lists; filter:
+     * rsmooth_smooth_piece; write: results into the copy; total: the whole call */
     double ms_read, ms_statistics, ms_buckets, ms_copy, ms_assemble, ms_filter, ms_write, ms_total;
-    char device[128];
-    /* What the caller should tell its user about the output it replaced: other hard links that
+    /** @} */
+    char device[128];          /**< "reference ..." or the OpenCL device's name, as
+                                * rsmooth_report */
+    /** What the caller should tell its user about the output it replaced: other hard links that
      * keep the old content, an owner or group that could not be kept (only root can give a file
      * away). "" when nothing. (Added in 0.9) */
     char notes[400];
 } rsmooth_stream_report;
 
-/* Zeroes `report` and sets its struct_size. Accepts NULL. */
+/** Zeroes `report` and sets its struct_size. Accepts NULL. */
 RSMOOTH_API void rsmooth_stream_report_init(rsmooth_stream_report *report);
 
-/* The filter of rsmooth_smooth on the mesh in file `input`, written to `output`, holding at most
+/** The filter of rsmooth_smooth on the mesh in file `input`, written to `output`, holding at most
  * options->max_memory bytes at a time (the OpenCL runtime's own memory aside): one pass over the
  * input gathers the mesh's figures (mean edge length and area in the order the in-memory path
  * sums them, so the sigmas are the same bits) and writes its triangles, cut into spatial pieces
