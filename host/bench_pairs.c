@@ -1,5 +1,5 @@
 /* Vertex-facet pairs within reach on a uniform grid of facet centroids (see bench_pairs.h). Written
- * apart from lib/grid.c on purpose: a second, plain implementation whose counts check the
+ * apart from lib/core/grid.c on purpose: a second, plain implementation whose counts check the
  * library's. */
 #include "bench_pairs.h"
 

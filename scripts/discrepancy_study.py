@@ -3,7 +3,7 @@
 each with its E_v, theta and its RMS displacement from the noisy input (in the input's mean edge
 lengths) and the share of its edge-adjacent face pairs within 2 degrees (flat_share), beside the
 noise estimate. The best mode's results on organic meshes coarse for their curvature, where tuned
-Taubin wins, have a low flat share: the guard of lib/passes.c keys on it, and runs Taubin until
+Taubin wins, have a low flat share: the guard of lib/passes/passes.c keys on it, and runs Taubin until
 the vertices moved as far as the noise did (the discrepancy principle). The figures in
 docs/results/discrepancy.json were measured before the guard existed (--best --auto then ran the
 stage alone's rule), with the flat share computed by the same formula.
@@ -24,7 +24,7 @@ TAUBIN = [1, 2, 3, 5, 7, 10, 14, 20, 30, 40, 60]
 
 def flat_share(v, faces, degrees=2.0):
     """Share of edge-adjacent face pairs whose normals are within `degrees` (the guard's test in
-    lib/passes.c), and the median dihedral angle."""
+    lib/passes/passes.c), and the median dihedral angle."""
     import math
 
     def normal(t):

@@ -20,7 +20,7 @@ ANCHORS = {
                         "Twelve0.5Impulsive": (1.76, 3.4)},
 }
 
-# The preset `--best` (lib/params.c rsmooth_params_init_best), two other starting points (gentler
+# The preset `--best` (lib/core/params.c rsmooth_params_init_best), two other starting points (gentler
 # normals for smooth shapes, stronger for CAD shapes and impulsive noise) and the lattice the
 # per-model descent moves on, one option at a time from the best of the three.
 PRESET = {"--sigma-f": 0.8, "--sigma-g": 0.3, "--normal-sigma-n": 0.45, "--normal-sigma-s": 1,

@@ -1,7 +1,7 @@
 /* noise_accuracy driver: for each line "NOISY CLEAN" on stdin, the true noise of NOISY against CLEAN
  * and rs_estimate_noise_details on NOISY, as one JSON line. */
 #define _POSIX_C_SOURCE 200809L
-#include "noise_estimate.h"
+#include "auto/noise_estimate.h"
 #include "mesh_shapes.h"
 #include "rsmooth_io.h"
 #include <math.h>

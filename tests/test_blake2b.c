@@ -1,7 +1,7 @@
-/* The program cache's digest (lib/blake2b.c) against independent values: RFC 7693 Appendix A's
+/* The program cache's digest (lib/core/blake2b.c) against independent values: RFC 7693 Appendix A's
  * BLAKE2b-512 of "abc", and BLAKE2b-256 of bytes (7i + 3) mod 256 as coreutils' `b2sum -l 256`
  * prints them, at lengths around the 128-byte block; fed whole and in uneven pieces. */
-#include "blake2b.h"
+#include "core/blake2b.h"
 #include "test_util.h"
 
 #include <stdio.h>

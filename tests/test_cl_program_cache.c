@@ -1,4 +1,4 @@
-/* rsmooth's program cache (lib/cl_program_cache.c): a miss writes one file, the next context hits
+/* rsmooth's program cache (lib/opencl/cl_program_cache.c): a miss writes one file, the next context hits
  * it and smooths bit for bit as the source build; damaged files (truncated, flipped bytes, wrong
  * magic, empty, a folder in the file's place) are misses that get rewritten; folders that cannot be
  * made or written, and "off", build from source and leave nothing; the default folders; and
@@ -9,7 +9,7 @@
  * a link or a file of another user at the key's name is never opened as a cache file. Everything
  * happens in a fresh folder in the working directory. */
 #define _POSIX_C_SOURCE 200809L
-#include "blake2b.h"
+#include "core/blake2b.h"
 #include "mesh_shapes.h"
 #include "test_cl_util.h"
 
@@ -26,7 +26,7 @@
 
 #define PROCESSES 6
 #define THREADS 4
-/* The file format (lib/cl_program_cache.c): 64 bytes of words, BLAKE2b-256 of them and the
+/* The file format (lib/opencl/cl_program_cache.c): 64 bytes of words, BLAKE2b-256 of them and the
  * binary, the binary; the binary's size is the word at byte 48. */
 #define HEADER_WORDS_BYTES 64
 #define HEADER_BYTES 96

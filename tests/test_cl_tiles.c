@@ -1,4 +1,4 @@
-/* Spatial tiles (lib/tiles.c): with a memory budget far below what a mesh needs, the OpenCL path
+/* Spatial tiles (lib/opencl/tiles.c): with a memory budget far below what a mesh needs, the OpenCL path
  * cuts it into tiles and must give the untiled run's positions bit for bit (grid cells count from
  * a lattice fixed in space and the kernels' differences do not depend on which vertices share a
  * block) and agree with the double-precision reference path (max deviation <= 1e-3 mean edge

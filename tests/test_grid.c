@@ -1,6 +1,6 @@
 /* The facet grid: neighbour queries through the 27 cells around a point equal a brute-force scan.
  */
-#include "spatial.h"
+#include "core/spatial.h"
 #include "test_util.h"
 
 #include <stdint.h>

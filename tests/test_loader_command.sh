@@ -13,7 +13,7 @@ missing=/nonexistent/libOpenCL.so.1
 unset RSMOOTH_DEVICE # the default device is auto here, whatever the caller chose
 
 # Linked: no libOpenCL among the NEEDED libraries, no undefined OpenCL function (each goes
-# through lib/cl_loader.c's table).
+# through lib/opencl/cl_loader.c's table).
 for file in "$rsmooth" "$shape" "$@"; do
   needed=$(readelf -d "$file" 2>/dev/null | grep NEEDED)
   grep -q libOpenCL <<<"$needed" && fail "$file needs libOpenCL: $needed"

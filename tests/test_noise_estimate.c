@@ -46,7 +46,7 @@ static void check_auto(const char *name, const double *xyz, size_t nv, const uin
     CHECK_STATUS(rsmooth_params_auto(RSMOOTH_FLOAT64, xyz, nv, tri, nt, &paper, &got, NULL),
                  RSMOOTH_OK);
     CHECK(got == noise);
-    CHECK_NEAR(paper.sigma_f, 0.6 + 1.6 * noise, 1e-12); /* lib/params_auto.c's paper rule */
+    CHECK_NEAR(paper.sigma_f, 0.6 + 1.6 * noise, 1e-12); /* lib/auto/params_auto.c's paper rule */
     CHECK_NEAR(paper.sigma_g, 4.0 * noise, 1e-12);
     rsmooth_noise_report r;
     rsmooth_noise_report_init(&r);
@@ -68,7 +68,7 @@ static double mean_edge(const double *xyz, size_t nv, const uint32_t *tri, size_
 
 /* The true noise of `noisy` against `clean` (same vertices and triangles): the standard deviation
  * of the displacement along the clean mesh's vertex normals, in mean edge lengths of the clean
- * mesh (the unit the estimate is in: lib/noise_estimate.h). */
+ * mesh (the unit the estimate is in: lib/auto/noise_estimate.h). */
 static double true_noise(const shape_mesh *clean, const double *noisy) {
     size_t nv = clean->vertex_count;
     double *normal = malloc(3 * nv * sizeof *normal);

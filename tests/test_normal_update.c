@@ -5,7 +5,7 @@
  * kept, repeats equal to chained calls, the discrepancy guard against Taubin's own smoothing, the
  * automatic choice's report, and the stage's parameters checked. */
 #include "mesh_shapes.h"
-#include "normal_update.h"
+#include "stages/normal_update.h"
 #include "test_util.h"
 
 #include <string.h>

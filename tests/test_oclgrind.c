@@ -2,7 +2,7 @@
  * barrier semantics, as a GPU does (PoCL's CPU device checks none of it), with its checks on:
  * memory accesses out of bounds, API misuse (OCLGRIND_CHECK_API), data races
  * (OCLGRIND_DATA_RACES) and uses of uninitialised values (OCLGRIND_UNINITIALIZED). Each kernel
- * variant (lib/cl_variant.c: vertex blocks 4 and 16 wide, and the GPU's work-groups) runs in a
+ * variant (lib/opencl/cl_variant.c: vertex blocks 4 and 16 wide, and the GPU's work-groups) runs in a
  * child process of its own, on a small noisy cylinder: the paper's filter, the bilateral normal filter from lists
  * and searching, every influence function, both predictors, the underflow rescue with and
  * without colour. Each case must agree with the double-precision reference path, Oclgrind must

@@ -2,7 +2,7 @@
 #ifndef RSMOOTH_IO_INTERNAL_H
 #define RSMOOTH_IO_INTERNAL_H
 
-#include "rsmooth_internal.h"
+#include "core/rsmooth_internal.h"
 #include "rsmooth_io.h"
 
 #include <math.h>

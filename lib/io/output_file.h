@@ -10,7 +10,7 @@
 #ifndef RSMOOTH_OUTPUT_FILE_H
 #define RSMOOTH_OUTPUT_FILE_H
 
-#include "rsmooth_internal.h"
+#include "core/rsmooth_internal.h"
 
 #include <stdbool.h>
 #include <sys/stat.h>

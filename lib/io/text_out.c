@@ -3,7 +3,7 @@
 #include "io/text_out.h"
 
 #include "io/io_internal.h"
-#include "rsmooth_internal.h"
+#include "core/rsmooth_internal.h"
 
 #include <errno.h>
 #include <stdarg.h>

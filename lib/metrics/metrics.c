@@ -12,7 +12,7 @@
  * overflow nor underflow at any scale the library accepts. mean_edge and bbox_diag are divided by
  * it again. */
 #include "metrics/surface_index.h"
-#include "rsmooth_internal.h"
+#include "core/rsmooth_internal.h"
 
 #include <math.h>
 #include <stdbool.h>

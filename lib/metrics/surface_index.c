@@ -2,7 +2,7 @@
  * triangle, and a uniform grid of cubic cells over the triangles searched in shells of cells
  * around the query point until no unvisited cell can hold a nearer point. */
 #include "metrics/surface_index.h"
-#include "rsmooth_internal.h"
+#include "core/rsmooth_internal.h"
 
 #include <math.h>
 #include <stdbool.h>

@@ -1,5 +1,5 @@
 /* The whole mesh's figures, from its triangles on disk, summed in the order the in-memory path
- * sums them (lib/mesh.c), so that the sigmas and the area scale are the same bits:
+ * sums them (lib/core/mesh.c), so that the sigmas and the area scale are the same bits:
  *
  *   - the mean edge length over unique edges: each edge belongs to its lower vertex, vertices in
  *     ascending order, a vertex's edges in the order the triangles first name them (mesh.c's

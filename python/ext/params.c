@@ -19,7 +19,7 @@ typedef struct field {
 #define INT_FIELD(f, min, max) {#f, offsetof(rsmooth_params, f), FIELD_INT, min, max}
 
 /* The ranges of the int fields are the command's (host/cli_options.c) and the library's
- * (RS_MAX_ROUNDS 100 and RS_MAX_UPDATES 1000, lib/params.c): checked here too, so that a
+ * (RS_MAX_ROUNDS 100 and RS_MAX_UPDATES 1000, lib/core/params.c): checked here too, so that a
  * Python int beyond a C int is refused by name and range instead of wrapping. The doubles'
  * ranges (NaN and infinities included) are the library's to check. */
 static const field fields[] = {

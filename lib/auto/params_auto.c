@@ -1,0 +1,174 @@
+/* Automatic parameters: the widths (and, for the best mode, its whole setting) picked from the
+ * input's estimated noise, by rules chosen on noisy meshes with a ground truth with
+ * cross-validation that leaves whole meshes out (scripts/calibrate.py; the figures of meshes the
+ * rules never saw are in docs/experiments.md, section 7). */
+#include "auto/noise_estimate.h"
+#include "core/rsmooth_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+/* The paper's filter: sigma_f = A + B n, sigma_g = C n for noise n (scripts/calibrate.py fit,
+ * the lattice rule with the lowest mean ratio to each case's best sigmas). */
+#define PAPER_SIGMA_F_AT_0 0.6
+#define PAPER_SIGMA_F_PER_NOISE 1.6
+#define PAPER_SIGMA_G_PER_NOISE 4.0
+
+/* The best mode: the normal update stage (guided normals, then the vertex update, repeated) and
+ * one robust pass with bilateral normals, its strength by noise class; then the discrepancy guard
+ * (rsmooth_params.discrepancy_level) at the estimated noise. */
+typedef struct best_preset {
+    const char *name;
+    double below;         /* for Gaussian levels below this (the last: any) */
+    double guided_sigma_n;
+    int guided_rounds;
+    int vertex_updates;
+    int stage_repeats;
+} best_preset;
+
+static const best_preset GAUSSIAN_PRESETS[] = {
+    {"best: gentle", 0.25, 0.15, 5, 25, 1},
+    {"best: strong", INFINITY, 0.2, 4, 10, 5},
+};
+static const best_preset IMPULSIVE_PRESET = {"best: impulsive", INFINITY, 0.2, 4, 10, 5};
+#define TANGENTIAL_SHARE 0.5 /* tangential / normal level above which noise reads as random
+                              * in direction (for the report only) */
+
+void rsmooth_noise_report_init(rsmooth_noise_report *report) {
+    if (!report)
+        return;
+    memset(report, 0, sizeof *report);
+    report->struct_size = sizeof *report;
+    report->tangential_level = NAN;
+}
+
+/* "noise estimate 0.31 mean edge lengths, Gaussian along the normals (tangential 0.05)". */
+static void describe(const rs_noise_details *d, char *out, size_t size) {
+    double n = d->level > 0 ? d->level : 0;
+    if (!(n > 0)) {
+        snprintf(out, size, "noise estimate 0 (nothing measurable)");
+        return;
+    }
+    if (d->impulsive) {
+        snprintf(out, size, "noise estimate %.3g mean edge lengths, impulsive (%.0f%% of the "
+                 "vertices thrown)", n, 100 * d->impulsive_fraction);
+        return;
+    }
+    if (!isfinite(d->tangential_level)) {
+        snprintf(out, size, "noise estimate %.3g mean edge lengths, Gaussian", n);
+        return;
+    }
+    snprintf(out, size, "noise estimate %.3g mean edge lengths, Gaussian %s (tangential %.2g)", n,
+             d->tangential_level > TANGENTIAL_SHARE * n ? "in random directions"
+                                                         : "along the normals",
+             d->tangential_level);
+}
+
+/* Sets the fields of `params` the rule chooses for what `d` read, and says which and why. */
+static void choose(rsmooth_params *params, const rs_noise_details *d, char *preset,
+                   size_t preset_size, char *reason, size_t reason_size) {
+    double n = d->level > 0 ? d->level : 0;
+    char what[128];
+    describe(d, what, sizeof what);
+    params->absolute = 0;
+    if (params->normal_filter == RSMOOTH_NORMALS_MOLLIFY && params->vertex_updates == 0) {
+        params->sigma_f = PAPER_SIGMA_F_AT_0 + PAPER_SIGMA_F_PER_NOISE * n;
+        if (n > 0)
+            params->sigma_g = PAPER_SIGMA_G_PER_NOISE * n;
+        snprintf(preset, preset_size, "paper");
+        snprintf(reason, reason_size, "%s: sigma_f = %.2g + %.2g x noise, sigma_g = %.2g x noise",
+                 what, PAPER_SIGMA_F_AT_0, PAPER_SIGMA_F_PER_NOISE, PAPER_SIGMA_G_PER_NOISE);
+        return;
+    }
+    const best_preset *b = &IMPULSIVE_PRESET;
+    if (!d->impulsive)
+        for (b = GAUSSIAN_PRESETS; !(n < b->below); b++)
+            ;
+    rsmooth_params best;
+    rsmooth_params_init_best(&best);
+    params->sigma_f = best.sigma_f;
+    params->sigma_g = best.sigma_g;
+    params->normal_filter = best.normal_filter;
+    params->normal_sigma_s = best.normal_sigma_s;
+    params->normal_sigma_n = best.normal_sigma_n;
+    params->normal_iterations = best.normal_iterations;
+    params->influence = best.influence;
+    params->guided_sigma_s = best.guided_sigma_s;
+    params->guided_sigma_n = b->guided_sigma_n;
+    params->guided_rounds = b->guided_rounds;
+    params->vertex_updates = b->vertex_updates;
+    params->stage_repeats = b->stage_repeats;
+    params->passes = best.passes;
+    params->discrepancy_level = d->impulsive ? d->overall_level : n; /* all vertices' rms */
+    snprintf(preset, preset_size, "%s", b->name);
+    char stage[96];
+    snprintf(stage, sizeof stage, "%s%d guided rounds of width %.2g, %d vertex updates",
+             b->stage_repeats > 1 ? "repeated " : "", b->guided_rounds, b->guided_sigma_n,
+             b->vertex_updates);
+    if (b->stage_repeats > 1)
+        snprintf(stage + strlen(stage), sizeof stage - strlen(stage), ", %d times",
+                 b->stage_repeats);
+    if (d->impulsive)
+        snprintf(reason, reason_size, "%s: %s", what, stage);
+    else
+        snprintf(reason, reason_size, "%s, %s %.2g: %s", what,
+                 isfinite(b->below) ? "below" : "at least",
+                 isfinite(b->below) ? b->below : (b - 1)->below, stage);
+}
+
+rsmooth_status rsmooth_params_auto_report(rsmooth_scalar scalar, const void *positions,
+                                          size_t vertex_count, const uint32_t *indices,
+                                          size_t triangle_count, rsmooth_params *params,
+                                          rsmooth_noise_report *report, rsmooth_error *error) {
+    static const char where[] = "rsmooth_params_auto";
+    rs_error_clear(error);
+    if (!params)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "params is NULL: initialise it with rsmooth_params_init or "
+                       "rsmooth_params_init_best first");
+    if (report && report->struct_size < sizeof *report)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "report.struct_size %zu is not sizeof(rsmooth_noise_report): call "
+                       "rsmooth_noise_report_init first", report->struct_size);
+    rsmooth_params checked;
+    rsmooth_status st = rs_params_resolve(params, &checked, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
+    rs_noise_details d;
+    st = rs_estimate_noise_details(scalar, positions, vertex_count, indices, triangle_count, &d,
+                                   error, where);
+    if (st != RSMOOTH_OK)
+        return st;
+    rsmooth_noise_report r;
+    rsmooth_noise_report_init(&r);
+    choose(&checked, &d, r.preset, sizeof r.preset, r.reason, sizeof r.reason);
+    /* only the fields the caller's struct has are written */
+    size_t size = params->struct_size;
+    memcpy(params, &checked, size < sizeof checked ? size : sizeof checked);
+    params->struct_size = size;
+    if (report) {
+        r.level = d.level;
+        r.kind = !(d.level > 0) ? RSMOOTH_NOISE_NONE
+                 : d.impulsive  ? RSMOOTH_NOISE_IMPULSIVE
+                                : RSMOOTH_NOISE_GAUSSIAN;
+        r.impulsive_fraction = d.impulsive_fraction;
+        r.tangential_level = d.tangential_level;
+        r.mean_edge_length = d.mean_edge_clean;
+        *report = r;
+    }
+    return RSMOOTH_OK;
+}
+
+rsmooth_status rsmooth_params_auto(rsmooth_scalar scalar, const void *positions,
+                                   size_t vertex_count, const uint32_t *indices,
+                                   size_t triangle_count, rsmooth_params *params,
+                                   double *out_noise, rsmooth_error *error) {
+    rsmooth_noise_report r;
+    rsmooth_noise_report_init(&r);
+    rsmooth_status st = rsmooth_params_auto_report(scalar, positions, vertex_count, indices,
+                                                   triangle_count, params, &r, error);
+    if (st == RSMOOTH_OK && out_noise)
+        *out_noise = r.level;
+    return st;
+}

@@ -1,0 +1,104 @@
+/* What a filter call writes: positions back in the caller's type and units, and the last check
+ * before RSMOOTH_OK that none of it is NaN, infinite or out of range. A call never returns success
+ * with a non-finite output, whatever went wrong inside. */
+#include "core/rsmooth_internal.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+void rs_store_position(rsmooth_scalar scalar, void *out_positions, size_t v, const double p[3],
+                       double unscale) {
+    for (int c = 0; c < 3; c++) {
+        double x = p[c] * unscale; /* exact: a power of two */
+        if (scalar == RSMOOTH_FLOAT32)
+            ((float *)out_positions)[3 * v + c] = (float)x;
+        else
+            ((double *)out_positions)[3 * v + c] = x;
+    }
+}
+
+void rs_store_unmoved(const rs_problem *problem, rsmooth_scalar scalar, void *out_positions,
+                      float *out_weight, float *out_confidence) {
+    for (size_t v = 0; v < problem->vertex_count; v++) {
+        rs_store_position(scalar, out_positions, v, problem->xyz + 3 * v, 1 / problem->scale);
+        if (out_weight)
+            out_weight[v] = 0;
+        if (out_confidence)
+            out_confidence[v] = 0;
+    }
+}
+
+float rs_weight_value(double k, double unscale) {
+    double w = k * unscale * unscale; /* areas: the scale squared */
+    if (!(w <= FLT_MAX))
+        return NAN; /* rs_check_results reports it (a tiny k rounds to 0, as floats do) */
+    return (float)w;
+}
+
+rsmooth_status rs_check_results(rsmooth_scalar scalar, const void *out_positions,
+                                const float *out_weight, const float *out_confidence,
+                                size_t count, const char *noun, rsmooth_error *error,
+                                const char *where) {
+    for (size_t i = 0; i < 3 * count; i++) {
+        double x = rs_coordinate(scalar, out_positions, i);
+        if (!isfinite(x))
+            return rs_fail(error, RSMOOTH_ERROR_NUMERICAL, where,
+                           "the result for %s %zu is not finite%s", noun, i / 3,
+                           scalar == RSMOOTH_FLOAT32 && !isnan(x)
+                               ? " in float32 (beyond FLT_MAX): pass float64 positions"
+                               : "");
+        if (fabs(x) > RS_MAX_COORDINATE)
+            return rs_fail(error, RSMOOTH_ERROR_NUMERICAL, where,
+                           "the result for %s %zu has coordinate %.17g beyond the supported "
+                           "magnitude %g",
+                           noun, i / 3, x, RS_MAX_COORDINATE);
+    }
+    for (size_t v = 0; out_weight && v < count; v++)
+        if (!isfinite(out_weight[v]) || out_weight[v] < 0)
+            return rs_fail(error, RSMOOTH_ERROR_NUMERICAL, where,
+                           "the weight k(p) of %s %zu does not fit a float: this mesh's areas "
+                           "are beyond float32's range; pass out_weight = NULL (the confidence "
+                           "is scale-free)",
+                           noun, v);
+    for (size_t v = 0; out_confidence && v < count; v++)
+        if (!(out_confidence[v] >= 0 && out_confidence[v] <= 1))
+            return rs_fail(error, RSMOOTH_ERROR_NUMERICAL, where,
+                           "the confidence of %s %zu (%g) is not in [0, 1]", noun, v,
+                           (double)out_confidence[v]);
+    return RSMOOTH_OK;
+}
+
+void rsmooth_report_init(rsmooth_report *report) {
+    if (!report)
+        return;
+    memset(report, 0, sizeof *report);
+    report->struct_size = sizeof *report;
+}
+
+void rs_report_problem(rsmooth_report *report, const rs_problem *problem, size_t cell_count,
+                       const char *device) {
+    memset(report, 0, sizeof *report);
+    report->vertex_count = problem->vertex_count;
+    report->triangle_count = problem->triangle_count;
+    report->facet_count = problem->facet_count;
+    report->mean_edge_length = problem->mean_edge_length;
+    report->sigma_f = problem->sigma_f;
+    report->sigma_g = problem->sigma_g;
+    report->radius = problem->radius;
+    report->mollify_radius = problem->bilateral ? problem->normal_radius
+                             : problem->mollify ? problem->mollify_radius
+                                                : 0;
+    rs_report_unscale(report, 1 / problem->scale);
+    report->grid_cell_count = cell_count;
+    snprintf(report->device, sizeof report->device, "%s", device);
+}
+
+void rs_report_unscale(rsmooth_report *report, double unscale) {
+    report->mean_edge_length *= unscale; /* exact: a power of two */
+    report->sigma_f *= unscale;
+    report->sigma_g *= unscale;
+    report->radius *= unscale;
+    report->mollify_radius *= unscale;
+}

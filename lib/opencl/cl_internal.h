@@ -1,0 +1,181 @@
+/* The OpenCL path's shared declarations: the context object, and the run and tiles that filter a
+ * prepared problem on its device. Internal, not installed. */
+#ifndef RSMOOTH_CL_INTERNAL_H
+#define RSMOOTH_CL_INTERNAL_H
+
+#include "core/rsmooth_internal.h"
+
+/* ---- cl_device.c / cl_program.c: the OpenCL context object ------------------------------------ */
+
+#ifndef CL_TARGET_OPENCL_VERSION
+#define CL_TARGET_OPENCL_VERSION 120
+#endif
+#include <CL/cl.h>
+#include "opencl/cl_loader.h" /* the cl* calls below go to the loader opened at run time */
+#include <pthread.h>
+#include <stdatomic.h>
+
+
+enum {
+    RS_KERNEL_MOLLIFY,
+    RS_KERNEL_NORMALS,
+    RS_KERNEL_BILATERAL,
+    RS_KERNEL_ROBUST,
+    RS_KERNEL_COUNT
+};
+
+struct rsmooth_context {
+    pthread_mutex_t lock;     /* serialises the calls of threads sharing the context */
+    pthread_t owner;          /* the thread holding `lock`, while `busy` */
+    _Atomic int busy;
+    cl_context context;
+    cl_device_id device;
+    cl_command_queue queue;
+    cl_program program;
+    cl_kernel kernels[RS_KERNEL_COUNT];
+    char device_name[256];
+    double build_ms;
+    int program_cache;        /* RS_PROGRAM_CACHE_: whether the program came from rsmooth's cache */
+    size_t local_size;        /* work-group size used for every kernel */
+    unsigned lanes;           /* vertices per block: the kernels' vector width (RS_LANES, see
+                               * cl_variant.c); 1 is the GPU variant, one vertex per work-item */
+    uint64_t global_memory;   /* CL_DEVICE_GLOBAL_MEM_SIZE */
+    uint64_t max_allocation;  /* CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest one buffer may be */
+    bool host_unified;        /* CL_DEVICE_HOST_UNIFIED_MEMORY: the device reads host arrays in
+                               * place (rs_cl_input_flags) */
+    uint64_t memory_budget;   /* caller's or RSMOOTH_MEMORY_BUDGET's limit; 0: the device's */
+    unsigned host_threads;    /* threads of the host stages of its calls; 0: every core */
+};
+
+/* Picks the kernel variant and vector width for ctx->device (cl_variant.c): sets ctx->lanes and
+ * ctx->local_size. RSMOOTH_KERNEL_VARIANT (cpu, gpu) and RSMOOTH_LANES (4, 8, 16) override it. */
+rsmooth_status rs_cl_choose_variant(rsmooth_context *ctx, rsmooth_error *error);
+
+/* A context's calls hold its lock while they use it: threads sharing one run one at a time. */
+void rs_context_lock(rsmooth_context *ctx);
+void rs_context_unlock(rsmooth_context *ctx);
+/* Whether the calling thread holds ctx's lock: it is inside a call on ctx, in one of the call's
+ * callbacks (progress, progress_cancel). */
+bool rs_context_held_here(const rsmooth_context *ctx);
+/* Takes the lock for a filter call, or refuses (RSMOOTH_ERROR_INVALID_ARGUMENT) a call made from
+ * a callback of a call on the same context, which would wait for itself for ever. */
+rsmooth_status rs_context_enter(rsmooth_context *ctx, const char *where, rsmooth_error *error);
+
+/* Bytes one run may hold on the device: the caller's budget, else most of the device's memory. */
+uint64_t rs_cl_usable_memory(const rsmooth_context *ctx);
+
+/* How a buffer whose contents the host filled before creating it gets them: handed over in place
+ * (CL_MEM_USE_HOST_PTR) on a device that shares the host's memory, copied at creation
+ * (CL_MEM_COPY_HOST_PTR) on one that does not, which would copy them at its first use anyway. */
+cl_mem_flags rs_cl_input_flags(const rsmooth_context *ctx);
+
+/* Reads a byte count such as "256M", "1.5G", "4096" (suffixes K, M, G, T: powers of 1024).
+ * false when `text` is not one. */
+bool rs_parse_bytes(const char *text, uint64_t *bytes);
+
+/* ---- cl_smooth.c / tiles.c: the OpenCL path ------------------------------------------------- */
+
+/* Where a run's results go: vertex v < core_count of the problem it solved is written to entry
+ * target[v] (v itself when target is NULL) of the caller's arrays; the others are a tile's halo. */
+typedef struct rs_result_sink {
+    rsmooth_scalar scalar;
+    void *positions;
+    float *weight, *confidence; /* optional */
+    const uint32_t *target;
+    size_t core_count;
+} rs_result_sink;
+
+/* Stage times and work, summed over the runs (tiles) of one call. */
+typedef struct rs_run_stats {
+    double ms_grid, ms_upload, ms_mollify, ms_normals, ms_robust, ms_download;
+    uint64_t pairs_mollify, pairs_robust; /* vertex-facet pairs each pass evaluated */
+    size_t cells;      /* occupied grid cells */
+    size_t tiles;
+} rs_run_stats;
+
+/* Device bytes a run needs at most, estimated before its grid exists (tiles.c plans with it). */
+#define RS_DEVICE_BYTES_PER_FACET 64
+/* What the bilateral normal filter adds per facet: a second copy of the normals to alternate with,
+ * and a per-cell pair count (at most one cell per facet). */
+#define RS_DEVICE_BYTES_PER_BILATERAL_FACET 24
+/* And what its rounds' lists add where they fit (cl_smooth.c, run_bilateral_lists), per facet of
+ * problem `pb`: 20 bytes of group data and 36 a row, with about (1.5 r + 1.5)^2 rows per facet for
+ * a reach of r mean edge lengths (measured on the benchmark meshes: 11 to 14 at r = 2, 76 to 96
+ * at r = 6), and a spare row. Past 128 rows the estimate stops growing (a run whose lists do not
+ * fit searches in every round instead). Uses fmin and pow (math.h). */
+#define RS_DEVICE_BYTES_PER_BILATERAL_LIST_FACET(pb)                                              \
+    ((uint64_t)(20 + 36 * (1 + fmin(128.0, pow(1.5 * (pb)->normal_radius /                        \
+                                                    (pb)->mean_edge_length + 1.5, 2)))))
+#define RS_DEVICE_BYTES_PER_VERTEX 72
+/* What the colour factor adds: a float4 mean colour per facet, three floats per vertex slot
+ * (about 1.5 slots per vertex). */
+#define RS_DEVICE_BYTES_PER_COLOR_FACET 16
+#define RS_DEVICE_BYTES_PER_COLOR_VERTEX 20
+
+/* One run of the whole pipeline on `problem` (facet_count > 0). When its buffers would exceed
+ * rs_cl_usable_memory or the device's largest allocation, returns RSMOOTH_ERROR_OUT_OF_MEMORY
+ * with `*needed` set to the bytes it wanted, having run nothing. */
+rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *problem, const rs_result_sink *sink,
+                         rs_run_stats *stats, uint64_t *needed, rsmooth_error *error);
+
+/* The filter on `problem`: one run when it fits the device, else spatial tiles, each with the
+ * facets within reach of its vertices' results (tiles.c). */
+rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *problem,
+                            const rs_result_sink *sink, rs_run_stats *stats, rsmooth_error *error);
+
+/* How far beyond a set of vertices the centroids of the facets their results depend on may lie
+ * (tiles.c's top explains it): the robust reach, plus the normals' (the bilateral rounds', or the
+ * mollification of facets whose corners lie up to `reach`, the largest centroid-to-corner
+ * distance, from their centroids). Tiles and pieces of a larger mesh (piece.c) both use it. */
+double rs_halo_radius(const rs_problem *pb, double reach);
+
+/* Fills a report from a run's problem and stats (t_start: the call's start; t_facets: when its
+ * facet data was ready). */
+void rs_cl_report(rsmooth_report *report, const rs_problem *pb, const rs_run_stats *stats,
+                  const char *device, double t_start, double t_facets);
+
+/* Builds the program from the embedded kernels (or RSMOOTH_KERNEL_DIR) and creates the kernels. */
+rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error);
+
+/* ---- cl_program_cache.c: rsmooth's cache of program binaries ---------------------------------- */
+
+enum { RS_PROGRAM_CACHE_OFF, RS_PROGRAM_CACHE_MISS, RS_PROGRAM_CACHE_HIT, RS_PROGRAM_CACHE_REFUSED };
+
+/* One program's entry: where its folder is (`top`, then the folders `below` it that must be the
+ * user's own), the file's name, and the key the file must hold. */
+typedef struct rs_program_cache {
+    char top[4096], below[1024], name[48];
+    uint64_t key[2], key_bytes, key_fields;
+    bool enabled; /* a folder and key are known */
+    bool refused; /* the folder or file was refused as another user's (said on stderr) */
+} rs_program_cache;
+
+/* Keys the program of the `count` sources (OpenCL's strings and lengths, as passed to
+ * clCreateProgramWithSource) and build `options` for ctx's device, its driver and platform.
+ * false (the cache off) when RSMOOTH_CACHE_DIR is empty or "off", or no directory is known. */
+bool rs_program_cache_open(rs_program_cache *cache, const rsmooth_context *ctx, cl_uint count,
+                           const char *const *sources, const size_t *sizes, const char *options);
+
+/* The program built from the entry's binary with `options`, or NULL (no file, a file that is not
+ * whole and this key's, a file or folder another user could have written: cache->refused, or a
+ * build that fails): then build from source. */
+cl_program rs_program_cache_load(rs_program_cache *cache, const rsmooth_context *ctx,
+                                 const char *options);
+
+/* Stores the binary of `program`, built from source, for the entry, unless the entry was refused;
+ * failures are silent (the next context builds from source again). Safe against concurrent
+ * writers and readers. */
+void rs_program_cache_store(const rs_program_cache *cache, const rsmooth_context *ctx,
+                            cl_program program);
+
+/* What rs_cl_run_1d returns when the caller's progress_cancel asked to stop: positive, so never
+ * an OpenCL code; rs_cl_fail turns it into RSMOOTH_ERROR_CANCELLED. */
+#define RS_CL_CANCELLED 1
+
+/* Records an OpenCL failure: status RSMOOTH_ERROR_OPENCL with the raw code and failing call. */
+rsmooth_status rs_cl_fail(rsmooth_error *error, cl_int code, const char *call, const char *what);
+
+/* Symbolic name of an OpenCL error code, e.g. "CL_OUT_OF_RESOURCES". */
+const char *rs_cl_error_name(cl_int code);
+
+#endif /* RSMOOTH_CL_INTERNAL_H */

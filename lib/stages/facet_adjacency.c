@@ -1,0 +1,121 @@
+/* Which facets meet at each vertex, with vertices at exactly the same position taken as one (a
+ * triangle soup's or an STL file's corners): the connectivity the normal update stage reads, so a
+ * soup is filtered as the mesh it was cut from. */
+#include "stages/normal_update.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct weld_key {
+    double xyz[3];
+    uint32_t vertex;
+} weld_key;
+
+static int compare_weld(const void *pa, const void *pb) {
+    const weld_key *a = pa, *b = pb;
+    for (int k = 0; k < 3; k++)
+        if (a->xyz[k] != b->xyz[k])
+            return a->xyz[k] < b->xyz[k] ? -1 : 1;
+    return a->vertex < b->vertex ? -1 : a->vertex > b->vertex;
+}
+
+/* rep[v]: the lowest-numbered vertex at v's position. */
+static bool weld(const double *xyz, size_t vertex_count, uint32_t *rep) {
+    weld_key *keys = rs_alloc_array(vertex_count ? vertex_count : 1, sizeof *keys);
+    if (!keys)
+        return false;
+    for (size_t v = 0; v < vertex_count; v++) {
+        memcpy(keys[v].xyz, xyz + 3 * v, sizeof keys[v].xyz);
+        keys[v].vertex = (uint32_t)v;
+    }
+    qsort(keys, vertex_count, sizeof *keys, compare_weld);
+    for (size_t i = 0; i < vertex_count; i++) {
+        bool same = i > 0 && !memcmp(keys[i].xyz, keys[i - 1].xyz, sizeof keys[i].xyz);
+        rep[keys[i].vertex] = same ? rep[keys[i - 1].vertex] : keys[i].vertex;
+    }
+    rs_free(keys);
+    return true;
+}
+
+/* Visits corner c of facet f unless an earlier corner welded to the same vertex. */
+static bool first_corner(const uint32_t *rep, const uint32_t *t, int c) {
+    uint32_t r = rep[t[c]];
+    return !((c > 0 && rep[t[0]] == r) || (c > 1 && rep[t[1]] == r));
+}
+
+bool rs_adjacency_build(rs_adjacency *adj, const double *xyz, size_t vertex_count,
+                        const uint32_t *indices, const rs_facets *facets) {
+    memset(adj, 0, sizeof *adj);
+    adj->rep = rs_alloc_array(vertex_count ? vertex_count : 1, sizeof *adj->rep);
+    adj->start = rs_calloc_array(vertex_count + 1, sizeof *adj->start);
+    adj->facet = rs_alloc_array(facets->count ? 3 * facets->count : 1, sizeof *adj->facet);
+    size_t *fill = rs_alloc_array(vertex_count ? vertex_count : 1, sizeof *fill);
+    if (!adj->rep || !adj->start || !adj->facet || !fill || !weld(xyz, vertex_count, adj->rep)) {
+        rs_free(fill);
+        rs_adjacency_free(adj);
+        return false;
+    }
+    for (size_t f = 0; f < facets->count; f++) {
+        const uint32_t *t = indices + 3 * (size_t)facets->triangle[f];
+        for (int c = 0; c < 3; c++)
+            if (first_corner(adj->rep, t, c))
+                adj->start[adj->rep[t[c]] + 1]++;
+    }
+    for (size_t v = 0; v < vertex_count; v++)
+        adj->start[v + 1] += adj->start[v];
+    memcpy(fill, adj->start, vertex_count * sizeof *fill);
+    for (size_t f = 0; f < facets->count; f++) { /* in facet order: deterministic lists */
+        const uint32_t *t = indices + 3 * (size_t)facets->triangle[f];
+        for (int c = 0; c < 3; c++)
+            if (first_corner(adj->rep, t, c))
+                adj->facet[fill[adj->rep[t[c]]]++] = (uint32_t)f;
+    }
+    rs_free(fill);
+    return true;
+}
+
+void rs_adjacency_free(rs_adjacency *adj) {
+    rs_free(adj->rep);
+    rs_free(adj->start);
+    rs_free(adj->facet);
+    memset(adj, 0, sizeof *adj);
+}
+
+double rs_flat_share(const double *xyz, size_t vertex_count, const uint32_t *indices,
+                     size_t triangle_count, double max_angle) {
+    rs_facets facets;
+    rs_adjacency adj;
+    if (!rs_facets_build(&facets, xyz, indices, triangle_count))
+        return -1;
+    if (!rs_adjacency_build(&adj, xyz, vertex_count, indices, &facets)) {
+        rs_facets_free(&facets);
+        return -1;
+    }
+    double cos_max = cos(max_angle);
+    size_t pairs = 0, flat = 0;
+    /* each pair of facets sharing an edge is met at both of its welded vertices; it is counted
+     * at the lower one */
+    for (size_t r = 0; r < vertex_count; r++)
+        for (size_t i = adj.start[r]; i < adj.start[r + 1]; i++)
+            for (size_t j = i + 1; j < adj.start[r + 1]; j++) {
+                uint32_t f = adj.facet[i], g = adj.facet[j];
+                const uint32_t *tf = indices + 3 * (size_t)facets.triangle[f];
+                const uint32_t *tg = indices + 3 * (size_t)facets.triangle[g];
+                uint32_t other = UINT32_MAX; /* the second welded vertex they share */
+                for (int a = 0; a < 3; a++)
+                    for (int b = 0; b < 3; b++) {
+                        uint32_t ra = adj.rep[tf[a]];
+                        if (ra == adj.rep[tg[b]] && ra != r)
+                            other = ra;
+                    }
+                if (other == UINT32_MAX || other < r)
+                    continue;
+                pairs++;
+                flat += rs_dot3(facets.normal + 3 * (size_t)f, facets.normal + 3 * (size_t)g) >=
+                        cos_max;
+            }
+    rs_adjacency_free(&adj);
+    rs_facets_free(&facets);
+    return pairs ? (double)flat / (double)pairs : 1;
+}
