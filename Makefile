@@ -8,7 +8,7 @@ FUZZ_SECONDS ?= 60
 FUZZ_BUILD ?= $(BUILD)-fuzz
 FUZZERS = obj ply off stl auto
 
-.PHONY: all deps configure build demo experiments check python-check sanitize fuzz install clean
+.PHONY: all deps configure build demo experiments check python-check sanitize fuzz docs install clean
 
 all: build
 
@@ -77,6 +77,22 @@ fuzz:
 	done; \
 	if [ -n "$$failed" ]; then echo "fuzzing failed:$$failed (inputs in $(FUZZ_BUILD)/artifacts)"; \
 	  exit 1; fi
+
+# The API reference in $(BUILD)/docs: the C headers through Doxygen (docs/api/Doxyfile: every public
+# name documented, any warning an error) into html/, and the Python module's docstrings through pdoc
+# into python/, from the package `make python-check` installed in $(BUILD)-python/venv (pdoc is
+# added there from PyPI; without that venv only the C part is built, and this says so).
+docs:
+	@.ci/install-deps.sh
+	rm -rf $(BUILD)/docs && mkdir -p $(BUILD)/docs
+	RSMOOTH_DOCS_OUT=$(abspath $(BUILD))/docs doxygen docs/api/Doxyfile
+	@echo "C API reference: $(BUILD)/docs/html/index.html"
+	@if $(BUILD)-python/venv/bin/python -c "import rsmooth" 2>/dev/null; then \
+	  $(BUILD)-python/venv/bin/python -c "import pdoc" 2>/dev/null \
+	    || $(BUILD)-python/venv/bin/pip install -q pdoc || exit 1; \
+	  $(BUILD)-python/venv/bin/python -m pdoc rsmooth -o $(BUILD)/docs/python || exit 1; \
+	  echo "Python reference: $(BUILD)/docs/python/index.html"; \
+	else echo "no $(BUILD)-python/venv with rsmooth (make python-check): Python reference not built"; fi
 
 # `make install PREFIX=/opt/rsmooth` installs the command (bin/rsmooth), the libraries, headers,
 # CMake package and pkg-config files under PREFIX (without PREFIX: CMAKE_INSTALL_PREFIX, by

@@ -2,13 +2,14 @@
 # Installs what rsmooth builds and tests with, from Debian's packages, when any of it is missing:
 # compiler, CMake, the OpenCL ICD loader and headers, PoCL (an OpenCL implementation on the CPU) and
 # libpng (the pictures of `rsmooth render`), Open MPI (rsmooth-mpi, and its tests under mpirun) and
-# Oclgrind (an OpenCL simulator that checks every kernel: tests/test_oclgrind.c).
+# Oclgrind (an OpenCL simulator that checks every kernel: tests/test_oclgrind.c) and Doxygen (the
+# C API reference: `make docs`).
 # `install-deps.sh fuzz` (or FUZZ=1) also installs clang and its libFuzzer runtime, for `make fuzz`;
 # `install-deps.sh experiments` Python's numpy, scipy and matplotlib, for `make experiments`;
 # `install-deps.sh python` Python's headers and venv, for `make python-check` (the rest from PyPI).
 set -euo pipefail
 packages=(build-essential cmake pkg-config ocl-icd-opencl-dev opencl-c-headers pocl-opencl-icd clinfo libpng-dev
-          libopenmpi-dev openmpi-bin oclgrind)
+          libopenmpi-dev openmpi-bin oclgrind doxygen)
 fuzz_packages=(clang libclang-rt-14-dev) # Debian 12: libFuzzer for its clang 14
 if [ "${1:-}" = fuzz ] || [ "${FUZZ:-0}" = 1 ]; then
   packages+=("${fuzz_packages[@]}")
