@@ -22,6 +22,41 @@ int cli_usage_error(const char *command, const char *format, ...) {
     return EXIT_USAGE;
 }
 
+size_t cli_edit_distance(const char *a, size_t a_length, const char *b) {
+    enum { LONGEST = 64 }; /* option and command names are shorter; longer words match nothing */
+    size_t b_length = strlen(b);
+    if (a_length >= LONGEST || b_length >= LONGEST)
+        return (size_t)-1;
+    /* rows i-2, i-1 and i of the table of distances between prefixes (optimal string alignment) */
+    size_t rows[3][LONGEST + 1];
+    for (size_t j = 0; j <= b_length; j++)
+        rows[0][j] = j;
+    size_t *before = NULL, *last = rows[0];
+    for (size_t i = 1; i <= a_length; i++) {
+        size_t *row = rows[i % 3];
+        row[0] = i;
+        for (size_t j = 1; j <= b_length; j++) {
+            size_t cost = a[i - 1] != b[j - 1];
+            size_t best = last[j - 1] + cost;
+            if (last[j] + 1 < best)
+                best = last[j] + 1;
+            if (row[j - 1] + 1 < best)
+                best = row[j - 1] + 1;
+            if (before && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] &&
+                before[j - 2] + 1 < best)
+                best = before[j - 2] + 1;
+            row[j] = best;
+        }
+        before = last;
+        last = row;
+    }
+    return last[b_length];
+}
+
+bool cli_close_enough(size_t distance, size_t length) {
+    return distance <= 2 && 2 * distance < length;
+}
+
 bool cli_parse_number(const char *text, double *out) {
     char *end = NULL;
     errno = 0;

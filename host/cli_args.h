@@ -3,6 +3,7 @@
 #define RSMOOTH_CLI_ARGS_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 /* Prints "rsmooth[ COMMAND]: message" and the --help hint to stderr; returns the usage exit status
@@ -11,6 +12,15 @@
 __attribute__((format(printf, 2, 3)))
 #endif
 int cli_usage_error(const char *command, const char *format, ...);
+
+/* The edit distance (insertions, deletions, substitutions and swaps of neighbours, each 1) between
+ * the first `a_length` characters of `a` and the string `b`: how "did you mean" finds the name a
+ * typo was meant to be. */
+size_t cli_edit_distance(const char *a, size_t a_length, const char *b);
+
+/* Whether a word at edit distance `distance` from a name is close enough to suggest the name: at
+ * most 2 edits, and fewer than half the word's `length`. */
+bool cli_close_enough(size_t distance, size_t length);
 
 /* Parses the whole of `text` as a number; false for junk, NaN or out of range. Accepts "inf". */
 bool cli_parse_number(const char *text, double *out);

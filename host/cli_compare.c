@@ -20,7 +20,7 @@ static const char compare_usage[] =
     "mesh the noisy input was made from). Files: OBJ, PLY, OFF, STL; polygons count as the\n"
     "triangles of their fans.\n"
     "\n"
-    "Metrics (lower is better; 0 for identical meshes):\n"
+    "Metrics (lower is better; 0 for identical meshes), one a line with its unit:\n"
     "  theta      mean angle between corresponding face normals, in degrees (faces with zero\n"
     "             area in either mesh are left out). Measures how well features and flat parts\n"
     "             are restored.\n"
@@ -144,7 +144,12 @@ int cli_compare_main(int argc, char **argv) {
         print_json_number("bbox_diag", m.bbox_diag, false);
         printf("\"vertices\": %zu, \"faces\": %zu}\n", m.vertex_count, m.triangle_count);
     } else {
-        printf("theta=%.6g ev=%.6g rms_v=%.6g hausdorff=%.6g mean_edge=%.6g bbox_diag=%.6g\n",
+        printf("theta      %.6g degrees\n"
+               "ev         %.6g thousandths of the bounding-box diagonal\n"
+               "rms_v      %.6g mean edge lengths\n"
+               "hausdorff  %.6g thousandths of the bounding-box diagonal\n"
+               "mean_edge  %.6g (the truth's units)\n"
+               "bbox_diag  %.6g (the truth's units)\n",
                m.theta, m.ev, m.rms_v, m.hausdorff, m.mean_edge, m.bbox_diag);
     }
     if (fflush(stdout) != 0 || ferror(stdout)) {

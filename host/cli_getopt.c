@@ -31,6 +31,19 @@ static int take_value(cli_getopt_state *s, const cli_option *o, const char *atta
     return o->id;
 }
 
+/* The table's long name nearest the `length` characters at `name` (a typo of it: "sigma_f" for
+ * "sigma-f"), or NULL when none is close. */
+static const char *nearest_name(const cli_option *table, const char *name, size_t length) {
+    const char *near = NULL;
+    size_t best = (size_t)-1;
+    for (const cli_option *o = table; o->name; o++) {
+        size_t d = cli_edit_distance(name, length, o->name);
+        if (d < best && cli_close_enough(d, length))
+            best = d, near = o->name;
+    }
+    return near;
+}
+
 static int short_option(cli_getopt_state *s, const char **value) {
     char letter = *s->cluster++;
     const cli_option *o = s->table;
@@ -78,7 +91,9 @@ int cli_getopt(cli_getopt_state *s, const char **value) {
         o++;
     snprintf(s->spelled, sizeof s->spelled, "--%.*s", (int)(length < 60 ? length : 60), name);
     if (!o->name) {
-        cli_usage_error(s->command, "unknown option '%.*s'", (int)(length + 2), a);
+        const char *near = nearest_name(s->table, name, length);
+        cli_usage_error(s->command, "unknown option '%.*s'%s%s%s", (int)(length + 2), a,
+                        near ? " (did you mean --" : "", near ? near : "", near ? "?)" : "");
         return CLI_GETOPT_ERROR;
     }
     if (!o->takes_value) {

@@ -24,7 +24,7 @@ enum {
     OPT_PASS_CONFIDENCE, OPT_SIGMA_C, OPT_NORMAL_ITERATIONS, OPT_PASSES, OPT_AUTO, OPT_BEST,
     OPT_ABSOLUTE, OPT_NO_MOLLIFY, OPT_ASCII, OPT_JSON, OPT_STATS, OPT_LIST_DEVICES, OPT_FORCE,
     OPT_QUIET, OPT_MASK, OPT_VERTEX_UPDATES, OPT_GUIDED_SIGMA_S, OPT_GUIDED_SIGMA_N,
-    OPT_GUIDED_ROUNDS, OPT_STAGE_REPEATS, OPT_MAX_MEMORY, OPT_TMPDIR
+    OPT_GUIDED_ROUNDS, OPT_STAGE_REPEATS, OPT_MAX_MEMORY, OPT_TMPDIR, OPT_PROGRESS
 };
 
 static const cli_option table[] = {
@@ -70,6 +70,7 @@ static const cli_option table[] = {
     {"list-devices", 0, false, OPT_LIST_DEVICES},
     {"force", 'f', false, OPT_FORCE},
     {"quiet", 'q', false, OPT_QUIET},
+    {"progress", 0, false, OPT_PROGRESS},
     {NULL, 0, false, 0}
 };
 
@@ -233,6 +234,7 @@ static int apply(options *opt, int id, const char *name, const char *value) {
     case OPT_LIST_DEVICES: opt->list_devices = true; break;
     case OPT_FORCE: opt->force = true; break;
     case OPT_QUIET: opt->quiet = true; break;
+    case OPT_PROGRESS: opt->progress = true; break;
     default: break;
     }
     return -1;

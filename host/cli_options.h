@@ -62,6 +62,7 @@ typedef struct options {
     bool colors;            /* --sigma-c: the input's vertex colours in the weight */
     bool sigma_g_given, umbrella_given; /* for consistency checks against --method */
     bool ascii, json, force, quiet, in_place, stats, list_devices, best;
+    bool progress;          /* --progress: the bar even where stderr is no terminal */
     bool auto_params;       /* --auto */
     unsigned given;         /* GIVEN_* bits: parameters set on the command line */
     double noise;           /* --auto's estimate */

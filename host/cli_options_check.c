@@ -86,9 +86,8 @@ static int check_files(options *opt) {
     opt->output_dir = out && strcmp(out, "-") != 0 &&
                       (out[strlen(out) - 1] == '/' ||
                        (opt->input_count > 1 && stat(out, &st) == 0 && S_ISDIR(st.st_mode)));
-    if (opt->output_dir && !(stat(out, &st) == 0 && S_ISDIR(st.st_mode)))
-        return cli_usage_error(NULL, "-o %s: no such folder (results go into an existing one)",
-                               out);
+    if (opt->output_dir && stat(out, &st) == 0 && !S_ISDIR(st.st_mode))
+        return cli_usage_error(NULL, "-o %s: is not a folder", out); /* a missing one is made */
     bool named_after_input = opt->output_dir || opt->suffix;
     if (out && opt->suffix && !opt->output_dir)
         return cli_usage_error(NULL, "--suffix names each result after its input: with -o give "

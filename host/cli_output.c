@@ -23,6 +23,51 @@ int cli_check_output_path(const char *path, bool replace) {
     return EXIT_USAGE;
 }
 
+int cli_make_folders(const char *path, bool whole, bool quiet) {
+    char folder[4096];
+    const char *slash = strrchr(path, '/');
+    size_t length = whole ? strlen(path) : slash ? (size_t)(slash - path) : 0;
+    if (length == 0 || length >= sizeof folder)
+        return -1; /* the current folder, or a name too long for the writer to refuse */
+    memcpy(folder, path, length);
+    folder[length] = '\0';
+    struct stat st;
+    if (stat(folder, &st) == 0 && S_ISDIR(st.st_mode))
+        return -1;
+    /* each prefix ending before a '/' (and the whole), from the top: made where missing */
+    bool created = false;
+    for (size_t end = 1; end <= length; end++) {
+        if (end < length && folder[end] != '/')
+            continue;
+        char c = folder[end];
+        folder[end] = '\0';
+        bool made = false;
+        int failure = 0;
+        if (stat(folder, &st) != 0) {
+            if (errno != ENOENT)
+                failure = errno;
+            else if (mkdir(folder, 0777) == 0)
+                made = true;
+            else if (errno != EEXIST || stat(folder, &st) != 0) /* EEXIST: another run's */
+                failure = errno;
+        }
+        if (!failure && !made && !S_ISDIR(st.st_mode)) {
+            fprintf(stderr, "rsmooth: %s: '%s' is not a folder\n", path, folder);
+            return EXIT_USAGE;
+        }
+        if (failure) {
+            fprintf(stderr, "rsmooth: %s: cannot make the folder '%s': %s\n", path, folder,
+                    strerror(failure));
+            return EXIT_USAGE;
+        }
+        created = created || made;
+        folder[end] = c;
+    }
+    if (created && !quiet)
+        fprintf(stderr, "rsmooth: created the folder %s\n", folder);
+    return -1;
+}
+
 bool cli_same_file(const char *a, const char *b) {
     struct stat sa, sb;
     return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev &&

@@ -30,6 +30,12 @@ typedef int (*cli_writer)(FILE *stream, void *user, char *message, size_t size);
  * RSMOOTH_NAMED_TEMPORARY=1 in the environment skips O_TMPFILE (tests of the fallback). */
 int cli_write_atomically(const char *path, bool replace, bool quiet, cli_writer write, void *user);
 
+/* Creates the folders of `path` that are missing (mode 0777 less the umask), as mkdir -p does:
+ * those above its last '/', or with `whole` all of it (-o DIR/). Says which it created on stderr
+ * unless `quiet`. -1 when the folders are there, else prints why ("rsmooth: PATH: 'a/b' is not a
+ * folder", or the system's reason) and returns the usage exit status (2). */
+int cli_make_folders(const char *path, bool whole, bool quiet);
+
 /* True when both paths name the same existing file (links followed). */
 bool cli_same_file(const char *a, const char *b);
 

@@ -8,6 +8,7 @@
 
 #define SHOW_AFTER_MS 1000.0 /* quick runs never show a bar */
 #define REDRAW_MS 100.0
+#define LINE_MS 1000.0       /* into a file: a line a second */
 #define WIDTH 30
 
 double cli_now_ms(void) {
@@ -16,8 +17,12 @@ double cli_now_ms(void) {
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
 }
 
-void cli_progress_init(cli_progress *bar, bool quiet) {
-    bar->enabled = !quiet && isatty(STDERR_FILENO);
+void cli_progress_init(cli_progress *bar, bool quiet, bool force) {
+    bool terminal = isatty(STDERR_FILENO);
+    bar->enabled = !quiet && (terminal || force);
+    bar->lines = !terminal;
+    bar->show_after_ms = force ? 0 : SHOW_AFTER_MS;
+    bar->redraw_ms = terminal ? REDRAW_MS : LINE_MS;
     bar->drawn = false;
     bar->start_ms = cli_now_ms();
     bar->last_draw_ms = 0;
@@ -37,7 +42,7 @@ void cli_progress_update(cli_progress *bar, double fraction) {
     if (!bar->enabled)
         return;
     double now = cli_now_ms();
-    if (now - bar->start_ms < SHOW_AFTER_MS || now - bar->last_draw_ms < REDRAW_MS)
+    if (now - bar->start_ms < bar->show_after_ms || now - bar->last_draw_ms < bar->redraw_ms)
         return;
     bar->last_draw_ms = now;
     double whole = bar->stage_from + (bar->stage_to - bar->stage_from) * fraction;
@@ -46,10 +51,11 @@ void cli_progress_update(cli_progress *bar, double fraction) {
     for (int i = 0; i < WIDTH; i++)
         cells[i] = i < filled ? '#' : '.';
     cells[WIDTH] = '\0';
-    fprintf(stderr, "\r[%s] %3d%% %-9s %5.1f s", cells, (int)(whole * 100 + 0.5), bar->stage,
-            (now - bar->start_ms) / 1e3);
+    fprintf(stderr, "%s[%s] %3d%% %-9s %5.1f s%s", bar->lines ? "" : "\r", cells,
+            (int)(whole * 100 + 0.5), bar->stage, (now - bar->start_ms) / 1e3,
+            bar->lines ? "\n" : "");
     fflush(stderr);
-    bar->drawn = true;
+    bar->drawn = !bar->lines; /* a whole line needs no clearing */
 }
 
 void cli_progress_callback(void *user, double fraction) {

@@ -1,12 +1,15 @@
 /* A progress bar on stderr for the rsmooth command: shown only when stderr is a terminal and the
- * work has taken more than a second, so scripts and quick runs see nothing. */
+ * work has taken more than a second, so scripts and quick runs see nothing; --progress forces it
+ * (from the start, and into a file or pipe as one line a second). */
 #ifndef RSMOOTH_CLI_PROGRESS_H
 #define RSMOOTH_CLI_PROGRESS_H
 
 #include <stdbool.h>
 
 typedef struct cli_progress {
-    bool enabled;    /* stderr is a terminal and the user did not ask for quiet */
+    bool enabled;    /* stderr is a terminal (or --progress) and the user did not ask for quiet */
+    bool lines;      /* forced where stderr is no terminal: whole lines, no carriage returns */
+    double show_after_ms, redraw_ms;
     bool drawn;      /* something is on the line, to be cleared */
     double start_ms; /* when the work began */
     double last_draw_ms;
@@ -14,7 +17,8 @@ typedef struct cli_progress {
     const char *stage;           /* "reading", "smoothing", "writing" */
 } cli_progress;
 
-void cli_progress_init(cli_progress *bar, bool quiet);
+/* `force` (--progress): drawn from the start, even where stderr is not a terminal. `quiet` wins. */
+void cli_progress_init(cli_progress *bar, bool quiet, bool force);
 
 /* Enters a stage that covers [from, to] of the bar. */
 void cli_progress_stage(cli_progress *bar, const char *stage, double from, double to);

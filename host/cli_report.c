@@ -26,11 +26,17 @@ int cli_list_devices(void) {
         rsmooth_context_destroy(ctx);
         return EXIT_OK;
     }
-    printf("%-5s %-5s %-60s %6s %9s  %s\n", "P:D", "type", "name", "units", "memory", "version");
+    /* the name column as wide as the longest name, the version last and whole */
+    int width = 4;
+    for (size_t i = 0; i < n && i < 64; i++)
+        if ((int)strlen(devices[i].name) > width)
+            width = (int)strlen(devices[i].name);
+    printf("%-5s %-5s %-*s %6s %9s  %s\n", "P:D", "type", width, "name", "units", "memory",
+           "version");
     for (size_t i = 0; i < n && i < 64; i++) {
         char pd[16];
         snprintf(pd, sizeof pd, "%d:%d", devices[i].platform_index, devices[i].device_index);
-        printf("%-5s %-5s %-60s %6u %6.1f GiB  %s\n", pd, devices[i].type, devices[i].name,
+        printf("%-5s %-5s %-*s %6u %6.1f GiB  %s\n", pd, devices[i].type, width, devices[i].name,
                devices[i].compute_units, (double)devices[i].global_memory / (1u << 30),
                devices[i].version);
     }
@@ -56,7 +62,11 @@ void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read,
     cli_print_json_string(opt->input);
     printf(",\"output\":");
     cli_print_json_string(opt->output);
-    printf(",\"method\":\"%s\"", cli_method_names[opt->method]);
+    if (r->discrepancy_iterations > 0) /* --auto's guard: Taubin's result replaced the filter's */
+        printf(",\"method\":\"taubin\",\"lambda\":0.5,\"mu\":-0.53,\"iterations\":%d,"
+               "\"instead_of\":\"%s\"", r->discrepancy_iterations, cli_method_names[opt->method]);
+    else
+        printf(",\"method\":\"%s\"", cli_method_names[opt->method]);
     if (cli_method_uses_edges(opt->method))
         printf(",\"lambda\":%.9g,\"mu\":%.9g,\"iterations\":%u", opt->lambda, opt->mu,
                opt->iterations);

@@ -104,7 +104,7 @@ int cli_stream_file(const options *opt, const char *path) {
         return EXIT_USAGE;
     }
     cli_progress bar;
-    cli_progress_init(&bar, opt->quiet);
+    cli_progress_init(&bar, opt->quiet, opt->progress);
     cli_progress_stage(&bar, "streaming", 0, 1);
     rsmooth_context *ctx = NULL;
     double ms_setup = 0;

@@ -286,8 +286,9 @@ static int smooth_file(const options *job, const char *path) {
     options opt = *job; /* --auto changes the parameters for this file only */
     int code;
     bool to_stdout = !strcmp(opt.output, "-");
-    if (!to_stdout && (code = cli_check_output(opt.output, path, opt.force, opt.in_place,
-                                               opt.format != RSMOOTH_FORMAT_AUTO)) >= 0)
+    if (!to_stdout && ((code = cli_make_folders(opt.output, false, opt.quiet)) >= 0 ||
+                       (code = cli_check_output(opt.output, path, opt.force, opt.in_place,
+                                                opt.format != RSMOOTH_FORMAT_AUTO)) >= 0))
         return code;
     if (opt.confidence) {
         if (!strcmp(opt.confidence, opt.output) || cli_same_file(opt.confidence, opt.output)) {
@@ -295,14 +296,15 @@ static int smooth_file(const options *job, const char *path) {
                     opt.confidence);
             return EXIT_USAGE;
         }
-        if ((code = cli_check_output(opt.confidence, path, opt.force, false, false)) >= 0)
+        if ((code = cli_make_folders(opt.confidence, false, opt.quiet)) >= 0 ||
+            (code = cli_check_output(opt.confidence, path, opt.force, false, false)) >= 0)
             return code;
     }
 
     if (opt.max_memory)
         return cli_stream_file(&opt, path);
     cli_progress bar;
-    cli_progress_init(&bar, opt.quiet);
+    cli_progress_init(&bar, opt.quiet, opt.progress);
     cli_progress_stage(&bar, "reading", 0, 0.1);
     rsmooth_mesh *mesh = NULL;
     double t0 = cli_now_ms();
@@ -391,6 +393,14 @@ static int smooth_file(const options *job, const char *path) {
         fprintf(stderr, "rsmooth: %s: %zu vertices, %zu triangles; %s: %.1f ms; wrote %s\n",
                 opt.input, report.vertex_count, report.triangle_count, report.device,
                 report.ms_total, wrote);
+    else if (!opt.quiet && report.discrepancy_iterations > 0)
+        fprintf(stderr,
+                "rsmooth: %s: %zu vertices, %zu triangles, mean edge %.6g; Taubin smoothing, %d "
+                "iterations (--auto's choice, in place of the filter's result on %s): %.1f ms; "
+                "wrote %s%s%s\n",
+                opt.input, report.vertex_count, report.triangle_count, report.mean_edge_length,
+                report.discrepancy_iterations, report.device, report.ms_total, wrote,
+                opt.confidence ? " and " : "", opt.confidence ? opt.confidence : "");
     else if (!opt.quiet && points)
         fprintf(stderr,
                 "rsmooth: %s: %zu points with normals, spacing %.6g; sigma_f %.6g, sigma_g "
@@ -447,6 +457,21 @@ static int smooth_files(options *opt) {
     return failed ? EXIT_USAGE : EXIT_OK;
 }
 
+/* A first word that is no file but nearly a subcommand ("compre"): the subcommand was meant, and
+ * saying so beats "no output file". -1, or the usage exit status (printed). */
+static int check_subcommand_typo(int argc, char **argv) {
+    static const char *const commands[] = {"compare", "noise", "render"};
+    struct stat st;
+    if (argc < 2 || argv[1][0] == '-' || stat(argv[1], &st) == 0)
+        return -1;
+    size_t length = strlen(argv[1]);
+    for (size_t k = 0; k < sizeof commands / sizeof *commands; k++)
+        if (cli_close_enough(cli_edit_distance(argv[1], length, commands[k]), length))
+            return cli_usage_error(NULL, "%s: no such file or command: did you mean \"%s\"?",
+                                   argv[1], commands[k]);
+    return -1;
+}
+
 int main(int argc, char **argv) {
     if (argc >= 2 && !strcmp(argv[1], "compare"))
         return cli_compare_main(argc - 1, argv + 1);
@@ -454,8 +479,11 @@ int main(int argc, char **argv) {
         return cli_noise_main(argc - 1, argv + 1);
     if (argc >= 2 && !strcmp(argv[1], "render"))
         return cli_render_main(argc - 1, argv + 1);
+    int code;
+    if ((code = check_subcommand_typo(argc, argv)) >= 0)
+        return code;
     options opt;
-    int code = cli_options_parse(argc, argv, &opt);
+    code = cli_options_parse(argc, argv, &opt);
     if (code >= 0)
         return code;
     if ((code = cli_check_environment()) >= 0) {

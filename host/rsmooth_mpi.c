@@ -141,7 +141,7 @@ int main(int argc, char **argv) {
     if (rank != 0)
         opt.quiet = true; /* one warning about a missing device, not one per rank */
     cli_progress bar;
-    cli_progress_init(&bar, true);
+    cli_progress_init(&bar, true, false);
     rsmooth_context *ctx = NULL;
     double ms_setup = 0;
     code = worst_code(cli_open_device(&opt, &bar, &ctx, &ms_setup));

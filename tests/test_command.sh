@@ -171,13 +171,19 @@ for f in unit_truth unit_result; do
     $f.obj > tiny_${f#unit_}.obj
 done
 expect 0 "$rsmooth" compare unit_result.obj unit_truth.obj
-unit=$(cut -d' ' -f1-4 out.txt)
+unit=$(head -n 4 out.txt)
 expect 0 "$rsmooth" compare tiny_result.obj tiny_truth.obj
-tiny=$(cut -d' ' -f1-4 out.txt)
+tiny=$(head -n 4 out.txt)
 [ -n "$unit" ] && [ "$unit" = "$tiny" ] ||
   fail "compare at 1e-200 ($tiny) differs from compare at 1 ($unit)"
-grep -q "mean_edge=1.16569e-200 bbox_diag=1.73205e-200" out.txt ||
+grep -q "^mean_edge  1.16569e-200 (the truth's units)" out.txt &&
+  grep -q "^bbox_diag  1.73205e-200 (the truth's units)" out.txt ||
   fail "compare at 1e-200: lengths not in the mesh's units: $(cat out.txt)"
+# its plain figures say their units
+for line in "theta .* degrees" "ev .* thousandths of the bounding-box diagonal" \
+            "rms_v .* mean edge lengths" "hausdorff .* thousandths of the bounding-box diagonal"; do
+  grep -q "^$line\$" out.txt || fail "compare prints no line '$line': $(cat out.txt)"
+done
 
 # Pictures: the input, the result and its confidence side by side, as PNG, never clobbered.
 expect 0 "$rsmooth" render noisy.ply smooth.ply conf.ply -o pair.png --size 480x160
@@ -439,10 +445,21 @@ grep -q "hard.ply: warning: the file has 2 hard links" err.txt ||
 cmp -s hard.ply small_b.ply && cmp -s hard_other.ply small.ply ||
   fail "--in-place on a hard link: the name or its other link does not hold what it should"
 # An output folder that is missing, or that the user may not write in, is found before the work.
-expect 2 "$rsmooth" small.ply -o nofolder/x.ply --device reference
-grep -q "nofolder/x.ply: cannot write there: 'nofolder'" err.txt ||
-  fail "a missing output folder is not explained before the work: $(cat err.txt)"
-grep -q "vertices" err.txt && fail "the work was done before finding the output folder missing"
+# A missing folder is made (mode 0777 less the umask, said on stderr); a part of the path that
+# is a file is named before the work.
+(umask 027; "$rsmooth" small.ply -o nofolder/sub/x.ply --device reference) >out.txt 2>err.txt ||
+  fail "-o into missing folders failed: $(cat err.txt)"
+[ -s nofolder/sub/x.ply ] || fail "-o nofolder/sub/x.ply wrote nothing"
+grep -q "created the folder nofolder/sub" err.txt || fail "made folders not said: $(cat err.txt)"
+[ "$(stat -c %a nofolder) $(stat -c %a nofolder/sub)" = "750 750" ] ||
+  fail "made folders' modes ignore the umask: $(stat -c %a nofolder nofolder/sub)"
+expect 0 "$rsmooth" small.ply -o nofolder/q/x.ply --device reference -q --confidence c2/c.ply
+[ -s nofolder/q/x.ply ] && [ -s c2/c.ply ] && [ ! -s err.txt ] ||
+  fail "-q with missing folders: $(cat err.txt)"
+expect 2 "$rsmooth" small.ply -o small.ply/sub/x.ply --device reference
+grep -q "small.ply/sub/x.ply: 'small.ply' is not a folder" err.txt ||
+  fail "a file in the output's path is not named before the work: $(cat err.txt)"
+grep -q "vertices" err.txt && fail "the work was done before finding the output folder wrong"
 mkfifo fifo.ply
 expect 2 "$rsmooth" small.ply -o fifo.ply --force --device reference
 grep -q "fifo.ply: is not a regular file" err.txt || fail "a FIFO output is not refused: $(cat err.txt)"
@@ -519,6 +536,48 @@ printf 'v 0 0 0\nv 1e-300 0 0\nv 0 1e-300 0\nv 0 0 1e-300\nf 1 3 2\nf 1 2 4\nf 1
   > tiny.obj
 expect 0 "$rsmooth" noise tiny.obj tiny_noisy.obj --sigma 0.1
 cmp -s tiny.obj tiny_noisy.obj && fail "rsmooth noise did not move a mesh at 1e-300"
+
+# Typos: "did you mean" for an option and for a subcommand (unless the word is a file)
+expect 2 "$rsmooth" --sigma_f 1 noisy.ply -o typo.ply
+grep -q "unknown option '--sigma_f' (did you mean --sigma-f?)" err.txt ||
+  fail "no suggestion for --sigma_f: $(cat err.txt)"
+expect 2 "$rsmooth" noisy.ply -o typo.ply --jsn
+grep -q "(did you mean --json?)" err.txt || fail "no suggestion for --jsn: $(cat err.txt)"
+expect 2 "$rsmooth" noisy.ply -o typo.ply --zzzzzz
+grep -q "did you mean" err.txt && fail "a suggestion for a word near nothing: $(cat err.txt)"
+expect 2 "$rsmooth" compre a.ply b.ply
+grep -q 'did you mean "compare"?' err.txt || fail "no suggestion for compre: $(cat err.txt)"
+grep -q "no output file" err.txt && fail "compre taken for an input: $(cat err.txt)"
+expect 2 "$rsmooth" rendr noisy.ply -o x.png
+grep -q 'did you mean "render"?' err.txt || fail "no suggestion for rendr: $(cat err.txt)"
+cp noisy.ply nois
+expect 0 "$rsmooth" nois -o nois_out.ply -q --format ply
+[ -s nois_out.ply ] || fail "an input file named like a subcommand (nois) was not smoothed"
+
+# --progress: the bar into a file (whole lines, no carriage returns); -q still wins
+expect 0 "$rsmooth" noisy.ply -o progress.ply --progress --device reference
+grep -q '^\[[#.]*\] *[0-9]*% reading' err.txt || fail "--progress drew no bar: $(cat err.txt)"
+grep -q "$(printf '\r')" err.txt && fail "--progress wrote carriage returns into a file"
+expect 0 "$rsmooth" noisy.ply -o progress_q.ply --progress -q --device reference
+[ -s err.txt ] && fail "--progress -q printed: $(cat err.txt)"
+
+# --auto's guard hands a coarse curved mesh to Taubin smoothing: the status line and --json say so
+awk 'BEGIN { pi = atan2(0, -1); R = 12; C = 24; print "v 0 0 1"
+  for (i = 1; i < R; i++) for (j = 0; j < C; j++) {
+    t = pi * i / R; p = 2 * pi * j / C; printf "v %.9f %.9f %.9f\n", sin(t) * cos(p), sin(t) * sin(p), cos(t) }
+  print "v 0 0 -1"; n = 2 + (R - 1) * C
+  for (j = 0; j < C; j++) printf "f 1 %d %d\n", 2 + j, 2 + (j + 1) % C
+  for (i = 0; i < R - 2; i++) for (j = 0; j < C; j++) {
+    a = 2 + i * C + j; b = 2 + i * C + (j + 1) % C; printf "f %d %d %d\nf %d %d %d\n", a, a + C, b + C, a, b + C, b }
+  for (j = 0; j < C; j++) printf "f %d %d %d\n", 2 + (R - 2) * C + j, n, 2 + (R - 2) * C + (j + 1) % C }' > uv.obj
+expect 0 "$rsmooth" noise uv.obj uv_noisy.obj --sigma 0.3 --seed 1
+expect 0 "$rsmooth" uv_noisy.obj -o uv_out.obj --best --auto --json --device reference
+grep -q '"method":"taubin","lambda":0.5,"mu":-0.53,"iterations":[1-9][0-9]*,"instead_of":"robust"' out.txt ||
+  fail "--json after --auto's Taubin does not say taubin: $(cat out.txt)"
+status=$(grep "wrote uv_out.obj" err.txt)
+echo "$status" | grep -q "; Taubin smoothing, [1-9][0-9]* iterations" ||
+  fail "the status line after --auto's Taubin: $status"
+echo "$status" | grep -q "sigma_f" && fail "the status line names the filter's sigmas: $status"
 
 expect 0 "$rsmooth" --help
 grep -q "sigma-g" out.txt || fail "--help does not explain sigma-g"

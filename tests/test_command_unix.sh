@@ -93,8 +93,11 @@ expect 2 "$rsmooth" a.obj c.ply -o one.ply
 grep -q "2 inputs: -o must be a folder" err.txt || fail "two inputs to one file: $(cat err.txt)"
 expect 2 "$rsmooth" a.obj out/../a.obj -o out/
 grep -q "would both be written to out/a.obj" err.txt || fail "same output twice: $(cat err.txt)"
-expect 2 "$rsmooth" a.obj -o missing/
-grep -q "missing/: no such folder" err.txt || fail "missing folder: $(cat err.txt)"
+expect 0 "$rsmooth" a.obj -o missing/ $ref
+[ -s missing/a.obj ] || fail "-o missing/ did not make the folder: $(cat err.txt)"
+grep -q "created the folder missing" err.txt || fail "-o missing/ made it silently"
+expect 2 "$rsmooth" a.obj -o a.obj/ $ref
+grep -q "a.obj/: is not a folder\|'a.obj' is not a folder" err.txt || fail "-o FILE/: $(cat err.txt)"
 
 # --suffix: beside each input; with --format the format's extension
 mkdir sub
