@@ -30,9 +30,9 @@ int main(void) {
     float *xyz = malloc(3 * vertex_count * sizeof *xyz);
     float *out = malloc(3 * vertex_count * sizeof *out);
     uint32_t *indices = malloc(3 * triangle_count * sizeof *indices);
+    unsigned long long state = 1;
     if (!xyz || !out || !indices)
         return EXIT_FAILURE;
-    unsigned long long state = 1;
     for (size_t v = 0; v < vertex_count; v++) { /* edges of length 1 on the plane z = 0 */
         xyz[3 * v] = (float)(v % N);
         xyz[3 * v + 1] = (float)(v / N);
@@ -44,7 +44,6 @@ int main(void) {
             uint32_t a = y * N + x, b = a + 1, c = a + N, d = c + 1;
             *t++ = a, *t++ = b, *t++ = d, *t++ = a, *t++ = d, *t++ = c;
         }
-
     rsmooth_params params;
     rsmooth_params_init(&params); /* the paper's filter: sigma_f 2, sigma_g 0.5 edge lengths */
     rsmooth_error err;
@@ -73,9 +72,8 @@ int main(void) {
         moved += d * d;
         farthest = d > farthest ? d : farthest;
     }
-    printf("%zu vertices, %zu triangles\n", vertex_count, triangle_count);
-    printf("vertices moved: RMS %.3f, at most %.3f edge lengths\n",
-           sqrt(moved / (double)vertex_count), farthest);
+    printf("%zu vertices, %zu triangles; vertices moved: RMS %.3f, at most %.3f edge lengths\n",
+           vertex_count, triangle_count, sqrt(moved / (double)vertex_count), farthest);
     printf("distance to the plane (RMS): %.3f -> %.3f edge lengths\n", rms_height(xyz, vertex_count),
            rms_height(out, vertex_count));
     free(xyz), free(out), free(indices);
