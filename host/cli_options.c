@@ -9,14 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-const char *const cli_method_names[4] = {"robust", "gaussian", "laplacian", "taubin"};
-const char *const cli_normal_filter_names[2] = {"mollify", "bilateral"};
-const char *const cli_influence_names[4] = {"gaussian", "tukey", "lorentzian", "huber"};
-
-bool cli_method_uses_edges(method m) {
-    return m == METHOD_LAPLACIAN || m == METHOD_TAUBIN;
-}
-
 enum {
     OPT_HELP = 1, OPT_VERSION, OPT_OUTPUT, OPT_IN_PLACE, OPT_SUFFIX, OPT_FORMAT, OPT_CONFIDENCE,
     OPT_DEVICE, OPT_MEMORY_BUDGET, OPT_METHOD, OPT_LAMBDA, OPT_MU, OPT_ITERATIONS, OPT_SIGMA_F,

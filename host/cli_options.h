@@ -1,6 +1,7 @@
 /* The rsmooth command's options: what the command line asked for (cli_options.c reads it through
- * the option table, cli_options_check.c refuses what cannot work together and names each input's
- * output), and the help text (cli_help.c). */
+ * the option table, cli_options_check.c refuses what cannot work together), each input's output
+ * name and format (cli_output_name.c), the method names (cli_method.c) and the help text
+ * (cli_help.c). Calls flow one way: options -> checks -> stream check -> names. */
 #ifndef RSMOOTH_CLI_OPTIONS_H
 #define RSMOOTH_CLI_OPTIONS_H
 
