@@ -33,7 +33,8 @@ def objects(build):
         rel = o.split(".dir" + os.sep, 1)[1][:-2]  # lib/x.c
         if not (rel.startswith("lib/") or rel.startswith("host/")):
             continue
-        found.setdefault(rel, o)
+        if os.path.exists(os.path.join(ROOT, rel)):  # not a stale object of a moved file
+            found.setdefault(rel, o)
     return found
 
 

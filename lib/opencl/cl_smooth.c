@@ -340,46 +340,6 @@ static rsmooth_status build_grid(const rs_problem *pb, rs_grid *grid, double **c
     return st;
 }
 
-/* Slices a kernel launch takes when the caller wants progress reports. Every work-item computes
- * its own vertex alone, so slicing never changes the result. */
-#define PROGRESS_SLICES 32
-
-cl_int rs_cl_run_1d(rsmooth_context *ctx, const rs_problem *pb, cl_kernel kernel, size_t count,
-                    double from, double to) {
-    size_t local = ctx->local_size;
-    bool reports = pb->progress || pb->progress_cancel;
-    size_t slices = reports && count > PROGRESS_SLICES * local ? PROGRESS_SLICES : 1;
-    size_t slice = (count + slices - 1) / slices;
-    slice = (slice + local - 1) / local * local;
-    cl_event done[PROGRESS_SLICES];
-    size_t ends[PROGRESS_SLICES];
-    size_t enqueued = 0;
-    cl_int err = CL_SUCCESS;
-    for (size_t start = 0; start < count && err == CL_SUCCESS; start += slice) {
-        size_t n = count - start < slice ? count - start : slice;
-        size_t global = (n + local - 1) / local * local;
-        err = clEnqueueNDRangeKernel(ctx->queue, kernel, 1, &start, &global, &local, 0, NULL,
-                                     &done[enqueued]);
-        if (err == CL_SUCCESS)
-            ends[enqueued++] = start + n;
-    }
-    if (err == CL_SUCCESS)
-        err = clFlush(ctx->queue);
-    for (size_t i = 0; i < enqueued; i++) {
-        if (err == CL_SUCCESS)
-            err = clWaitForEvents(1, &done[i]);
-        /* the last slice reports `to` itself, so the next launch's first report never lies
-         * below it by a rounding */
-        double at = ends[i] == count ? to : from + (to - from) * ((double)ends[i] / (double)count);
-        if (err == CL_SUCCESS && !rs_progress(pb, at))
-            err = RS_CL_CANCELLED;
-        clReleaseEvent(done[i]);
-    }
-    /* the slices still queued after a cancel finish before their buffers are released */
-    cl_int finished = clFinish(ctx->queue);
-    return err == CL_SUCCESS ? finished : err;
-}
-
 typedef struct result_job {
     const rs_problem *pb;
     const rs_result_sink *sink;
@@ -678,59 +638,4 @@ void rs_cl_report(rsmooth_report *report, const rs_problem *pb, const rs_run_sta
     report->pairs_mollify = stats->pairs_mollify;
     report->pairs_robust = stats->pairs_robust;
     report->tiles = stats->tiles > 0 ? stats->tiles : 1; /* no facet: one trivial run */
-}
-
-/* One pass of the filter on the device (rs_filter_passes repeats it). */
-static rsmooth_status cl_pass(void *context, rsmooth_scalar scalar, const void *positions,
-                              size_t vertex_count, const uint32_t *indices, size_t triangle_count,
-                              const rsmooth_params *params, void *out_positions, float *out_weight,
-                              float *out_confidence, rsmooth_report *report, rsmooth_error *error) {
-    static const char where[] = "rsmooth_smooth";
-    rsmooth_context *ctx = context;
-    double t_start = rs_now_ms();
-    rs_error_clear(error);
-    rs_problem pb;
-    rsmooth_status st = rs_problem_prepare(&pb, scalar, positions, vertex_count, indices,
-                                           triangle_count, params, out_positions, false, error,
-                                           where);
-    if (st != RSMOOTH_OK)
-        return st;
-    double t_facets = rs_now_ms();
-    rs_run_stats stats;
-    memset(&stats, 0, sizeof stats);
-    if (pb.facet_count == 0) {
-        rs_store_unmoved(&pb, scalar, out_positions, out_weight, out_confidence);
-    } else {
-        rs_result_sink sink = {scalar, out_positions, out_weight, out_confidence, NULL,
-                               vertex_count};
-        st = rs_cl_filter(ctx, &pb, &sink, &stats, error);
-    }
-    if (st == RSMOOTH_OK) {
-        rs_progress(&pb, 1.0);
-        if (report)
-            rs_cl_report(report, &pb, &stats, ctx->device_name, t_start, t_facets);
-    }
-    rs_problem_free(&pb);
-    rs_release_free_memory();
-    return st;
-}
-
-rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const void *positions,
-                              size_t vertex_count, const uint32_t *indices, size_t triangle_count,
-                              const rsmooth_params *params, void *out_positions, float *out_weight,
-                              float *out_confidence, rsmooth_report *report, rsmooth_error *error) {
-    rs_error_clear(error);
-    if (!ctx)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_smooth", "ctx is NULL");
-    /* the kernels' arguments and the queue are the context's: one call at a time */
-    rsmooth_status entered = rs_context_enter(ctx, "rsmooth_smooth", error);
-    if (entered != RSMOOTH_OK)
-        return entered;
-    size_t threads_before = rs_set_call_threads(ctx->host_threads);
-    rsmooth_status st = rs_filter_passes(cl_pass, ctx, scalar, positions, vertex_count, indices,
-                                         triangle_count, params, out_positions, out_weight,
-                                         out_confidence, report, error, "rsmooth_smooth");
-    rs_set_call_threads(threads_before);
-    rs_context_unlock(ctx);
-    return st;
 }

@@ -1,0 +1,62 @@
+/* rsmooth_smooth, the public entry point of the OpenCL path: one call on a context at a time,
+ * the caller's host threads, and the passes (passes/passes.c) each run as one device pass:
+ * facet data, then the tiles (opencl/tiles.c) that each run the kernels (opencl/cl_smooth.c).
+ * The reference path's entry point is rsmooth_smooth_reference (reference/reference.c). */
+#include "opencl/cl_run.h"
+
+#include <string.h>
+
+/* One pass of the filter on the device (rs_filter_passes repeats it). */
+static rsmooth_status cl_pass(void *context, rsmooth_scalar scalar, const void *positions,
+                              size_t vertex_count, const uint32_t *indices, size_t triangle_count,
+                              const rsmooth_params *params, void *out_positions, float *out_weight,
+                              float *out_confidence, rsmooth_report *report, rsmooth_error *error) {
+    static const char where[] = "rsmooth_smooth";
+    rsmooth_context *ctx = context;
+    double t_start = rs_now_ms();
+    rs_error_clear(error);
+    rs_problem pb;
+    rsmooth_status st = rs_problem_prepare(&pb, scalar, positions, vertex_count, indices,
+                                           triangle_count, params, out_positions, false, error,
+                                           where);
+    if (st != RSMOOTH_OK)
+        return st;
+    double t_facets = rs_now_ms();
+    rs_run_stats stats;
+    memset(&stats, 0, sizeof stats);
+    if (pb.facet_count == 0) {
+        rs_store_unmoved(&pb, scalar, out_positions, out_weight, out_confidence);
+    } else {
+        rs_result_sink sink = {scalar, out_positions, out_weight, out_confidence, NULL,
+                               vertex_count};
+        st = rs_cl_filter(ctx, &pb, &sink, &stats, error);
+    }
+    if (st == RSMOOTH_OK) {
+        rs_progress(&pb, 1.0);
+        if (report)
+            rs_cl_report(report, &pb, &stats, ctx->device_name, t_start, t_facets);
+    }
+    rs_problem_free(&pb);
+    rs_release_free_memory();
+    return st;
+}
+
+rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const void *positions,
+                              size_t vertex_count, const uint32_t *indices, size_t triangle_count,
+                              const rsmooth_params *params, void *out_positions, float *out_weight,
+                              float *out_confidence, rsmooth_report *report, rsmooth_error *error) {
+    rs_error_clear(error);
+    if (!ctx)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_smooth", "ctx is NULL");
+    /* the kernels' arguments and the queue are the context's: one call at a time */
+    rsmooth_status entered = rs_context_enter(ctx, "rsmooth_smooth", error);
+    if (entered != RSMOOTH_OK)
+        return entered;
+    size_t threads_before = rs_set_call_threads(ctx->host_threads);
+    rsmooth_status st = rs_filter_passes(cl_pass, ctx, scalar, positions, vertex_count, indices,
+                                         triangle_count, params, out_positions, out_weight,
+                                         out_confidence, report, error, "rsmooth_smooth");
+    rs_set_call_threads(threads_before);
+    rs_context_unlock(ctx);
+    return st;
+}
