@@ -1,4 +1,15 @@
-/* Helpers shared by the mesh file readers and writers (not installed). Prefix rs_io_. */
+/* Helpers shared by the mesh file readers and writers (not installed). Prefix rs_io_.
+ *
+ * Calls run one way, down this list (a file calls only files below it):
+ *   mesh_file.c     the public reads and writes; the per-format dispatch of writers and their checks
+ *   mesh_detect.c   reading from memory: which format, then its reader
+ *   *_read.c        the readers (ply_read.c over ply_header.c, ply_ascii.c / ply_binary.c, then
+ *                   ply_element.c)
+ *   *_write.c       the writers and their own checks, over text_out.c, float_print.c, mesh_normals.c
+ *   mesh_data.c     the mesh record (create, destroy, adopt) and the conversion-loss report
+ *   mesh_check.c    the well-formedness and value checks every writer makes
+ *   *_extras.c      each format's extras record: its release and what a conversion drops
+ *   coordinates.c, float32_check.c, bom.c, losses.c: small helpers that call nothing in io/ */
 #ifndef RSMOOTH_IO_INTERNAL_H
 #define RSMOOTH_IO_INTERNAL_H
 
@@ -172,8 +183,8 @@ rsmooth_status rs_io_vertex_normals(const rsmooth_mesh *mesh, double **normals, 
 
 /* ---- extras: what a format keeps beyond positions and faces ---------------------------------- */
 
-/* Each format defines its own record in its own files (ply_extras.c, obj_extras.c, off_*.c,
- * stl_*.c); a mesh holds at most one of them, the one its reader made. */
+/* Each format defines its own record (its *_format.h), released and reported in its own *_extras.c;
+ * a mesh holds at most one of them, the one its reader made. */
 typedef struct rs_ply_extras rs_ply_extras;
 typedef struct rs_obj_extras rs_obj_extras;
 typedef struct rs_off_extras rs_off_extras;

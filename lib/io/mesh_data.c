@@ -109,26 +109,6 @@ struct rsmooth_mesh_extras *rs_io_mesh_extras(rsmooth_mesh *mesh) {
     return mesh->extras;
 }
 
-size_t rs_io_loss_add(char *list, size_t size, const char *what) {
-    size_t used = strnlen(list, size);
-    if (used + 1 < size)
-        snprintf(list + used, size - used, "%s%s", used ? ", " : "", what);
-    return 1;
-}
-
-bool rs_io_keeps_bom(const rsmooth_mesh *mesh, rsmooth_format format) {
-    if (!mesh->extras || !mesh->extras->utf8_bom || format == RSMOOTH_FORMAT_STL_BINARY)
-        return false;
-    rsmooth_format source = mesh->source_format;
-    return source == format || (rs_io_is_ply(source) && rs_io_is_ply(format)) ||
-           (rs_io_is_stl(source) && rs_io_is_stl(format));
-}
-
-bool rs_io_put_bom(const rsmooth_mesh *mesh, rsmooth_format format, FILE *stream) {
-    return !rs_io_keeps_bom(mesh, format) ||
-           fwrite(RS_IO_UTF8_BOM, 1, RS_IO_UTF8_BOM_SIZE, stream) == RS_IO_UTF8_BOM_SIZE;
-}
-
 size_t rsmooth_mesh_conversion_losses(const rsmooth_mesh *mesh, rsmooth_format format,
                                       char *buffer, size_t size) {
     char scratch[1];
@@ -183,31 +163,6 @@ rsmooth_format rsmooth_format_from_path(const char *path) {
     if (ends_with_ci(path, len, ".stl"))
         return RSMOOTH_FORMAT_STL_BINARY;
     return RSMOOTH_FORMAT_AUTO;
-}
-
-rs_io_digits rs_io_shortest(double v) {
-    rs_io_digits d;
-    for (int digits = 1; digits <= 17; digits++) {
-        snprintf(d.text, sizeof d.text, "%.*g", digits, v);
-        if (!isfinite(v) || strtod(d.text, NULL) == v)
-            break;
-    }
-    return d;
-}
-
-rsmooth_status rs_io_check_vertex(const double xyz[3], size_t number, int64_t line,
-                                  int64_t byte_offset, const char *where, rsmooth_error *error) {
-    for (int k = 0; k < 3; k++) {
-        if (!isfinite(xyz[k]))
-            return rs_fail_parse(error, line, byte_offset, where,
-                                 "vertex %zu has a non-finite coordinate", number);
-        if (!rs_io_coordinate_ok(xyz[k]))
-            return rs_fail_parse(error, line, byte_offset, where,
-                                 "vertex %zu has coordinate %s beyond the supported magnitude %s",
-                                 number, rs_io_shortest(xyz[k]).text,
-                                 rs_io_shortest(RS_MAX_COORDINATE).text);
-    }
-    return RSMOOTH_OK;
 }
 
 rsmooth_status rs_io_mesh_adopt(double *positions, size_t vertex_count, rsmooth_scalar precision,

@@ -106,6 +106,41 @@ rsmooth_status rsmooth_mesh_read_stream(FILE *stream, const char *name, rsmooth_
     return status;
 }
 
+rsmooth_status rs_io_check_writable(const rsmooth_mesh *mesh, rsmooth_format format,
+                                    const char *where, rsmooth_error *error) {
+    rsmooth_status status = rs_io_mesh_check(mesh, where, error);
+    if (status == RSMOOTH_OK)
+        status = rs_io_mesh_check_values(mesh, where, error);
+    if (status != RSMOOTH_OK)
+        return status;
+    switch (format) {
+    case RSMOOTH_FORMAT_OBJ:
+        return rs_io_obj_check(mesh, error);
+    case RSMOOTH_FORMAT_PLY_ASCII:
+    case RSMOOTH_FORMAT_PLY_BINARY:
+        return rs_io_ply_check(mesh, error);
+    case RSMOOTH_FORMAT_PLY_BINARY_BE:
+        return rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, where,
+                       "big-endian PLY output is not supported");
+    case RSMOOTH_FORMAT_OFF:
+        return rs_io_off_check(mesh, error);
+    case RSMOOTH_FORMAT_STL_ASCII:
+        return rs_io_stl_check(mesh, false, error);
+    case RSMOOTH_FORMAT_STL_BINARY:
+        return rs_io_stl_check(mesh, true, error);
+    case RSMOOTH_FORMAT_AUTO:
+        break;
+    }
+    return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                   "format %d: give OBJ, PLY, OFF or STL", (int)format);
+}
+
+rsmooth_status rsmooth_mesh_check_writable(const rsmooth_mesh *mesh, rsmooth_format format,
+                                           rsmooth_error *error) {
+    rs_error_clear(error);
+    return rs_io_check_writable(mesh, format, "rsmooth_mesh_check_writable", error);
+}
+
 /* Writes a mesh that passed rs_io_check_writable for `format`. */
 static rsmooth_status write_checked(const rsmooth_mesh *mesh, FILE *stream, rsmooth_format format,
                                     rsmooth_error *error) {

@@ -1,6 +1,6 @@
 /* The PLY reader's state, shared by its parts (not installed): ply_header.c reads the header and
- * gives each property its role, ply_binary.c and ply_ascii.c read the data, ply_read.c drives them
- * and builds the mesh. */
+ * gives each property its role, ply_binary.c and ply_ascii.c read the data (with ply_element.c's
+ * helpers), ply_read.c drives them and builds the mesh. */
 #ifndef RSMOOTH_PLY_READER_H
 #define RSMOOTH_PLY_READER_H
 
@@ -54,7 +54,7 @@ rsmooth_status rs_ply_assign_roles(rs_ply_reader *r, rsmooth_error *error);
 /* The header is the generic writer's layout: nothing for the extras to keep. */
 bool rs_ply_is_plain(const rs_ply_reader *r);
 
-/* ---- ply_read.c: what both data readers share */
+/* ---- ply_element.c: what both data readers share */
 
 /* Starts face `item` of `n` vertices (n >= 3, room reserved), or a located error. */
 rsmooth_status rs_ply_face_begin(rs_ply_reader *r, uint64_t n, uint64_t item, int64_t line,

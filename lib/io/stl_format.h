@@ -27,4 +27,12 @@ struct rs_stl_extras {
     uint16_t *attributes;  /* triangle_count values; NULL when every one is 0 */
 };
 
+/* A binary header of spaces and NULs only: nothing worth keeping. */
+static inline bool rs_stl_header_is_blank(const unsigned char *header) {
+    for (size_t i = 0; i < RS_STL_HEADER_SIZE; i++)
+        if (header[i] != ' ' && header[i] != '\0')
+            return false;
+    return true;
+}
+
 #endif /* RSMOOTH_STL_FORMAT_H */

@@ -86,13 +86,6 @@ static float get_f32(const unsigned char *p) {
     return f;
 }
 
-static bool header_is_blank(const unsigned char *header) {
-    for (size_t i = 0; i < RS_STL_HEADER_SIZE; i++)
-        if (header[i] != ' ' && header[i] != '\0')
-            return false;
-    return true;
-}
-
 static rsmooth_status read_binary(const unsigned char *data, size_t size, rsmooth_mesh **mesh,
                                   rsmooth_error *error) {
     if (size < RS_STL_HEADER_SIZE + 4)
@@ -138,7 +131,7 @@ static rsmooth_status read_binary(const unsigned char *data, size_t size, rsmoot
     }
     soup.triangle_count = t;
     const unsigned char *header = data;
-    if (any_attribute || !header_is_blank(header)) {
+    if (any_attribute || !rs_stl_header_is_blank(header)) {
         soup.extras = rs_calloc_array(1, sizeof *soup.extras);
         if (!soup.extras) {
             soup_free(&soup);
@@ -448,32 +441,4 @@ rsmooth_status rs_io_stl_read(const char *data, size_t size, rsmooth_mesh **mesh
         !(size >= RS_STL_HEADER_SIZE + 4 && memchr(data, '\0', size)))
         return read_ascii(data, size, mesh, error);
     return read_binary(bytes, size, mesh, error);
-}
-
-void rs_io_stl_extras_free(rs_stl_extras *extras) {
-    if (!extras)
-        return;
-    for (size_t i = 0; i < extras->solid_count; i++)
-        rs_free(extras->solids[i].name);
-    rs_free(extras->solids);
-    rs_free(extras->attributes);
-    rs_free(extras);
-}
-
-size_t rs_io_stl_losses(const rs_stl_extras *extras, rsmooth_format target, char *list,
-                        size_t size) {
-    if (!extras)
-        return 0;
-    size_t lost = 0;
-    if (!rs_io_is_stl(target)) {
-        bool named = extras->binary && !header_is_blank(extras->header);
-        for (size_t i = 0; !named && i < extras->solid_count; i++)
-            named = extras->solids[i].name_len > 0;
-        if (named)
-            lost += rs_io_loss_add(list, size, "STL header");
-    }
-    /* Only binary STL holds attributes. */
-    if (extras->attributes && target != RSMOOTH_FORMAT_STL_BINARY)
-        lost += rs_io_loss_add(list, size, "STL facet attributes");
-    return lost;
 }
