@@ -1,0 +1,129 @@
+/* The rsmooth command's filtering of one mesh in memory: the filter on the chosen device, the
+ * Laplacian and Taubin baselines, and point clouds on the reference path (see cli_smooth.h). */
+#define _POSIX_C_SOURCE 200809L
+#include "cli_smooth.h"
+#include "cli_files.h"
+#include "cli_device.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+/* Laplacian or Taubin smoothing (always on the CPU); fills the report's counts and time. */
+static int smooth_umbrella(const options *opt, const rsmooth_mesh *mesh, double *out,
+                           rsmooth_report *report) {
+    rsmooth_error err;
+    double t = cli_now_ms();
+    rsmooth_status st = rsmooth_smooth_taubin(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
+                                              mesh->triangles, mesh->triangle_count, opt->lambda,
+                                              opt->mu, opt->iterations, out, &err);
+    if (st == RSMOOTH_OK)
+        st = rsmooth_mean_edge_length(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
+                                      mesh->triangles, mesh->triangle_count,
+                                      &report->mean_edge_length, &err);
+    if (st != RSMOOTH_OK) {
+        fprintf(stderr, "rsmooth: %s: %s\n", opt->input, err.message);
+        return st == RSMOOTH_ERROR_INVALID_ARGUMENT ? EXIT_USAGE : EXIT_OTHER;
+    }
+    report->ms_total = cli_now_ms() - t;
+    report->vertex_count = mesh->vertex_count;
+    report->triangle_count = mesh->triangle_count;
+    snprintf(report->device, sizeof report->device, "%s, %u iterations (double, 1 thread)",
+             cli_method_names[opt->method], opt->iterations);
+    return EXIT_OK;
+}
+
+int cli_smooth_mesh(const options *opt, const rsmooth_mesh *mesh, double *out, float *confidence,
+                    rsmooth_report *report, cli_progress *bar) {
+    if (cli_method_uses_edges(opt->method))
+        return smooth_umbrella(opt, mesh, out, report);
+    rsmooth_context *ctx = NULL;
+    rsmooth_error err;
+    rsmooth_status st;
+    double ms_setup = 0;
+    int code = cli_open_device(opt, bar, &ctx, &ms_setup);
+    if (code >= 0)
+        return code;
+    bool reference = ctx == NULL;
+    rsmooth_params params = opt->params;
+    if (bar->enabled) { /* progress slices the kernel launches: only when a bar can show */
+        params.progress = cli_progress_callback;
+        params.progress_user = bar;
+    }
+    if (reference)
+        st = rsmooth_smooth_reference(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
+                                      mesh->triangles, mesh->triangle_count, &params, out, NULL,
+                                      confidence, report, &err);
+    else
+        st = rsmooth_smooth(ctx, RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
+                            mesh->triangles, mesh->triangle_count, &params, out, NULL, confidence,
+                            report, &err);
+    code = EXIT_OK;
+    if (st != RSMOOTH_OK) {
+        cli_progress_clear(bar);
+        if (st == RSMOOTH_ERROR_OPENCL)
+            fprintf(stderr, "rsmooth: %s: device '%s': %s\n", opt->input,
+                    rsmooth_context_device_name(ctx), err.message);
+        else
+            fprintf(stderr, "rsmooth: %s: %s\n", opt->input, err.message);
+        code = st == RSMOOTH_ERROR_OPENCL             ? EXIT_DEVICE
+               : st == RSMOOTH_ERROR_INVALID_ARGUMENT ? EXIT_USAGE
+                                                      : EXIT_OTHER;
+    }
+    report->ms_setup = ms_setup;
+    rsmooth_context_destroy(ctx);
+    return code;
+}
+
+int cli_check_point_cloud(const options *opt, const rsmooth_mesh *mesh) {
+    if (!mesh->vertex_normals) {
+        /* what is missing would come after everything the file holds: name its end */
+        struct stat st;
+        char end[64] = ""; /* (standard input has no size to name) */
+        if (stat(opt->input, &st) == 0)
+            snprintf(end, sizeof end, " byte %lld (the end):", (long long)st.st_size);
+        fprintf(stderr,
+                "rsmooth: %s:%s %zu vertices but no faces and no vertex normals: a mesh needs "
+                "faces, a point cloud normals (nx, ny, nz)\n",
+                opt->input, end, mesh->vertex_count);
+        return EXIT_USAGE;
+    }
+    if (cli_method_uses_edges(opt->method)) {
+        fprintf(stderr, "rsmooth: %s is a point cloud (no faces): --method %s needs edges\n",
+                opt->input, cli_method_names[opt->method]);
+        return EXIT_USAGE;
+    }
+    return EXIT_OK;
+}
+
+int cli_smooth_points(const options *opt, const rsmooth_mesh *mesh, double *out,
+                      double *out_normals, float *confidence, rsmooth_report *report,
+                      cli_progress *bar) {
+    const char *device = opt->device ? opt->device : getenv("RSMOOTH_DEVICE");
+    if (!opt->quiet) {
+        cli_progress_clear(bar);
+        if (device && strcmp(device, "reference") != 0 && strcmp(device, "auto") != 0)
+            fprintf(stderr, "rsmooth: note: %s is a point cloud, which the OpenCL path does not "
+                            "take yet: filtering on the reference path, not on device '%s'\n",
+                    opt->input, device);
+        else if (!device || strcmp(device, "reference") != 0)
+            fprintf(stderr, "rsmooth: note: %s is a point cloud (no faces): filtering its points "
+                            "and normals on the reference path (CPU)\n", opt->input);
+    }
+    rsmooth_params params = opt->params;
+    if (bar->enabled) {
+        params.progress = cli_progress_callback;
+        params.progress_user = bar;
+    }
+    rsmooth_error err;
+    rsmooth_status st = rsmooth_smooth_points_reference(
+        RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_normals, mesh->vertex_count, &params, out,
+        out_normals, confidence, report, &err);
+    if (st != RSMOOTH_OK) {
+        cli_progress_clear(bar);
+        fprintf(stderr, "rsmooth: %s: %s\n", opt->input, err.message);
+        return st == RSMOOTH_ERROR_INVALID_ARGUMENT ? EXIT_USAGE : EXIT_OTHER;
+    }
+    return EXIT_OK;
+}
