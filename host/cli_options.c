@@ -74,29 +74,12 @@ static int find_name(const char *value, const char *const *names, int count) {
     return -1;
 }
 
-/* Sets what option `id` (spelled `name`, e.g. "--sigma-f") with `value` asks for. -1, or the exit
- * status (--help, --version, or a bad value). */
-static int apply(options *opt, int id, const char *name, const char *value) {
-    double x = 0;
-    bool number = value && cli_parse_number(value, &x);
+/* What apply_choice and apply_number return for an option that is not theirs. */
+#define NOT_HANDLED (-3)
+
+/* The options that name one of a few choices: --format, --method, --normals, --influence. */
+static int apply_choice(options *opt, int id, const char *value) {
     switch (id) {
-    case OPT_HELP:
-        fputs(cli_usage_text, stdout);
-        return EXIT_OK;
-    case OPT_VERSION:
-        printf("rsmooth %d.%d.%d\n", RSMOOTH_VERSION_MAJOR, RSMOOTH_VERSION_MINOR,
-               RSMOOTH_VERSION_PATCH);
-        return EXIT_OK;
-    case OPT_OUTPUT: opt->output_option = value; break;
-    case OPT_CONFIDENCE: opt->confidence = value; break;
-    case OPT_MASK: opt->mask = value; break;
-    case OPT_DEVICE: opt->device = value; break;
-    case OPT_SUFFIX:
-        if (!*value || strchr(value, '/'))
-            return cli_usage_error(NULL, "--suffix: '%s' is not a file name's end (e.g. _smooth)",
-                                   value);
-        opt->suffix = value;
-        break;
     case OPT_FORMAT: {
         static const char *const names[] = {"obj", "ply", "off", "stl"};
         static const rsmooth_format formats[] = {RSMOOTH_FORMAT_OBJ, RSMOOTH_FORMAT_PLY_BINARY,
@@ -107,22 +90,6 @@ static int apply(options *opt, int id, const char *name, const char *value) {
         opt->format = formats[k];
         break;
     }
-    case OPT_MEMORY_BUDGET:
-        if (!cli_parse_bytes(value, &opt->memory_budget) || opt->memory_budget == 0)
-            return cli_usage_error(NULL, "--memory-budget: '%s' is not a byte count above 0 "
-                                         "(examples: 256M, 1.5G; leave it out for most of "
-                                         "the device's memory)", value);
-        break;
-    case OPT_MAX_MEMORY:
-        if (!cli_parse_bytes(value, &opt->max_memory) || opt->max_memory == 0)
-            return cli_usage_error(NULL, "--max-memory: '%s' is not a byte count above 0 "
-                                         "(examples: 512M, 2G)", value);
-        break;
-    case OPT_TMPDIR:
-        if (!*value)
-            return cli_usage_error(NULL, "--tmpdir: an empty folder name");
-        opt->tmpdir = value;
-        break;
     case OPT_METHOD: {
         int m = find_name(value, cli_method_names, 4);
         if (m < 0)
@@ -147,6 +114,16 @@ static int apply(options *opt, int id, const char *name, const char *value) {
         opt->given |= GIVEN_INFLUENCE;
         break;
     }
+    default: return NOT_HANDLED;
+    }
+    return -1;
+}
+
+/* The options that take a number, each checked against its range. */
+static int apply_number(options *opt, int id, const char *name, const char *value) {
+    double x = 0;
+    bool number = value && cli_parse_number(value, &x);
+    switch (id) {
     case OPT_LAMBDA: case OPT_MU: case OPT_ITERATIONS: case OPT_SIGMA_F: case OPT_SIGMA_G:
     case OPT_CUTOFF: case OPT_NORMAL_SIGMA_S: case OPT_NORMAL_SIGMA_N: case OPT_PASS_CONFIDENCE:
         if (!number)
@@ -214,6 +191,53 @@ static int apply(options *opt, int id, const char *name, const char *value) {
             opt->params.guided_sigma_s = x, opt->given |= GIVEN_GUIDED_SIGMA_S;
         else
             opt->params.guided_sigma_n = x, opt->given |= GIVEN_GUIDED_SIGMA_N;
+        break;
+    default: return NOT_HANDLED;
+    }
+    return -1;
+}
+
+/* Sets what option `id` (spelled `name`, e.g. "--sigma-f") with `value` asks for. -1, or the exit
+ * status (--help, --version, or a bad value). */
+static int apply(options *opt, int id, const char *name, const char *value) {
+    int code = apply_choice(opt, id, value);
+    if (code != NOT_HANDLED)
+        return code;
+    if ((code = apply_number(opt, id, name, value)) != NOT_HANDLED)
+        return code;
+    switch (id) {
+    case OPT_HELP:
+        fputs(cli_usage_text, stdout);
+        return EXIT_OK;
+    case OPT_VERSION:
+        printf("rsmooth %d.%d.%d\n", RSMOOTH_VERSION_MAJOR, RSMOOTH_VERSION_MINOR,
+               RSMOOTH_VERSION_PATCH);
+        return EXIT_OK;
+    case OPT_OUTPUT: opt->output_option = value; break;
+    case OPT_CONFIDENCE: opt->confidence = value; break;
+    case OPT_MASK: opt->mask = value; break;
+    case OPT_DEVICE: opt->device = value; break;
+    case OPT_SUFFIX:
+        if (!*value || strchr(value, '/'))
+            return cli_usage_error(NULL, "--suffix: '%s' is not a file name's end (e.g. _smooth)",
+                                   value);
+        opt->suffix = value;
+        break;
+    case OPT_MEMORY_BUDGET:
+        if (!cli_parse_bytes(value, &opt->memory_budget) || opt->memory_budget == 0)
+            return cli_usage_error(NULL, "--memory-budget: '%s' is not a byte count above 0 "
+                                         "(examples: 256M, 1.5G; leave it out for most of "
+                                         "the device's memory)", value);
+        break;
+    case OPT_MAX_MEMORY:
+        if (!cli_parse_bytes(value, &opt->max_memory) || opt->max_memory == 0)
+            return cli_usage_error(NULL, "--max-memory: '%s' is not a byte count above 0 "
+                                         "(examples: 512M, 2G)", value);
+        break;
+    case OPT_TMPDIR:
+        if (!*value)
+            return cli_usage_error(NULL, "--tmpdir: an empty folder name");
+        opt->tmpdir = value;
         break;
     case OPT_AUTO: opt->auto_params = true; break;
     case OPT_BEST: break; /* applied before the others, so the options after it can change it */
