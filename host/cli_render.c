@@ -74,18 +74,25 @@ static int write_picture(FILE *stream, void *user, char *message, size_t size) {
     return png_write_rgb(stream, p->rgb, p->width, p->height, message, size);
 }
 
-int cli_render_main(int argc, char **argv) {
-    const char *output = NULL;
-    bool force = false;
-    int width = 0, height = 0;
+/* What the command line asked for. */
+typedef struct render_job {
+    const char *output;
+    bool force;
+    int width, height; /* --size (0: not given), then the whole picture's */
     render_options options;
-    render_options_default(&options);
-    const char **inputs = calloc((size_t)(argc > 0 ? argc : 1), sizeof *inputs);
-    if (!inputs) {
+    const char **inputs;
+    size_t input_count;
+} render_job;
+
+/* Reads the command line into `job` (its inputs allocated): -1 to go on, else the exit status
+ * (0 after --help). */
+static int parse_render_args(int argc, char **argv, render_job *job) {
+    job->inputs = calloc((size_t)(argc > 0 ? argc : 1), sizeof *job->inputs);
+    if (!job->inputs) {
         fprintf(stderr, "rsmooth render: out of memory\n");
         return 1;
     }
-    size_t input_count = 0;
+    render_options *options = &job->options;
     int status = 0;
     enum { R_HELP = 1, R_OUTPUT, R_SIZE, R_AZIMUTH, R_ELEVATION, R_ORTHOGRAPHIC, R_FORCE };
     static const cli_option table[] = {
@@ -102,74 +109,74 @@ int cli_render_main(int argc, char **argv) {
             status = 2;
         } else if (id == R_HELP) {
             fputs(render_usage, stdout);
-            free(inputs);
             return 0;
         } else if (id == R_OUTPUT) {
-            output = value;
+            job->output = value;
         } else if (id == R_SIZE) {
-            if (!parse_size(value, &width, &height))
+            if (!parse_size(value, &job->width, &job->height))
                 status = cli_usage_error("render", "--size wants WxH, each 1 to 16384: %s", value);
         } else if (id == R_AZIMUTH) {
-            if (!cli_parse_number(value, &options.azimuth_deg) || !isfinite(options.azimuth_deg))
+            if (!cli_parse_number(value, &options->azimuth_deg) || !isfinite(options->azimuth_deg))
                 status = cli_usage_error("render", "--azimuth wants degrees: %s", value);
         } else if (id == R_ELEVATION) {
-            if (!cli_parse_number(value, &options.elevation_deg) ||
-                !(options.elevation_deg > -90 && options.elevation_deg < 90))
+            if (!cli_parse_number(value, &options->elevation_deg) ||
+                !(options->elevation_deg > -90 && options->elevation_deg < 90))
                 status = cli_usage_error("render", "--elevation wants degrees in (-90, 90): %s",
                                          value);
         } else if (id == R_ORTHOGRAPHIC) {
-            options.orthographic = true;
+            options->orthographic = true;
         } else if (id == R_FORCE) {
-            force = true;
+            job->force = true;
         } else {
-            inputs[input_count++] = value;
+            job->inputs[job->input_count++] = value;
         }
     }
-    if (status == 0 && input_count == 0)
+    if (status == 0 && job->input_count == 0)
         status = cli_usage_error("render", "needs at least one mesh file");
-    if (status == 0 && !output)
+    if (status == 0 && !job->output)
         status = cli_usage_error("render", "needs -o OUT.png");
-    if (status != 0) {
-        free(inputs);
-        return status;
-    }
-    /* --size is each panel's (the default 800 x 800): the picture is the panels side by side */
-    int panel_width = width ? width : DEFAULT_PANEL, panel_height = width ? height : DEFAULT_PANEL;
-    size_t total = input_count * (size_t)panel_width + (input_count - 1) * (size_t)options.gap;
-    if (total > MAX_SIDE && !width && input_count * 8 + (input_count - 1) * (size_t)options.gap <=
-                                          MAX_SIDE) {
+    return status != 0 ? status : -1;
+}
+
+/* The picture's size (--size is each panel's, the default 800 x 800: the picture is the panels
+ * side by side), and the output checked: -1 to go on, else the exit status. */
+static int check_picture(render_job *job) {
+    size_t n = job->input_count, gap = (size_t)job->options.gap;
+    int panel_width = job->width ? job->width : DEFAULT_PANEL;
+    int panel_height = job->width ? job->height : DEFAULT_PANEL;
+    size_t total = n * (size_t)panel_width + (n - 1) * gap;
+    if (total > MAX_SIDE && !job->width && n * 8 + (n - 1) * gap <= MAX_SIDE) {
         total = MAX_SIDE; /* many meshes: narrower panels by default */
     } else if (total > MAX_SIDE) {
-        free(inputs);
         return cli_usage_error("render", "%zu panels of %d pixels make a picture wider than %d: "
-                                         "give a smaller --size", input_count, panel_width,
-                               MAX_SIDE);
+                                         "give a smaller --size", n, panel_width, MAX_SIDE);
     }
-    width = (int)total;
-    height = panel_height;
-    for (size_t i = 0; i < input_count; i++) {
-        if (cli_same_file(output, inputs[i])) {
-            fprintf(stderr, "rsmooth render: %s: refusing to overwrite an input file\n", output);
-            free(inputs);
+    job->width = (int)total;
+    job->height = panel_height;
+    for (size_t i = 0; i < n; i++) {
+        if (cli_same_file(job->output, job->inputs[i])) {
+            fprintf(stderr, "rsmooth render: %s: refusing to overwrite an input file\n",
+                    job->output);
             return 2;
         }
     }
-    if ((status = cli_check_output_path(output, force)) >= 0) {
-        free(inputs);
-        return status;
-    }
-    status = 0;
+    return cli_check_output_path(job->output, job->force);
+}
 
-    rsmooth_mesh **meshes = calloc(input_count, sizeof *meshes);
-    render_mesh *views = calloc(input_count, sizeof *views);
+/* Reads the meshes, draws them and writes the picture: the exit status. */
+static int draw(const render_job *job) {
+    size_t n = job->input_count;
+    int status = 0, width = job->width, height = job->height;
+    rsmooth_mesh **meshes = calloc(n, sizeof *meshes);
+    render_mesh *views = calloc(n, sizeof *views);
     uint8_t *rgb = NULL;
     if (!meshes || !views) {
         fprintf(stderr, "rsmooth render: out of memory\n");
         status = 1;
         goto done;
     }
-    for (size_t i = 0; i < input_count && status == 0; i++) {
-        status = cli_read_mesh(inputs[i], NULL, &meshes[i]);
+    for (size_t i = 0; i < n && status == 0; i++) {
+        status = cli_read_mesh(job->inputs[i], NULL, &meshes[i]);
         if (status == 0) {
             views[i].xyz = meshes[i]->positions;
             views[i].vertex_count = meshes[i]->vertex_count;
@@ -181,21 +188,33 @@ int cli_render_main(int argc, char **argv) {
     if (status != 0)
         goto done;
     rgb = malloc(3 * (size_t)width * (size_t)height);
-    if (!rgb || mesh_render(views, input_count, &options, rgb, width, height) != 0) {
+    if (!rgb || mesh_render(views, n, &job->options, rgb, width, height) != 0) {
         /* The arguments were checked above; what is left is memory. */
         fprintf(stderr, "rsmooth render: out of memory for a %d x %d picture\n", width, height);
         status = 1;
         goto done;
     }
     picture pic = {rgb, width, height};
-    status = cli_write_atomically(output, force, false, write_picture, &pic);
+    status = cli_write_atomically(job->output, job->force, false, write_picture, &pic);
 done:
     if (meshes)
-        for (size_t i = 0; i < input_count; i++)
+        for (size_t i = 0; i < n; i++)
             rsmooth_mesh_destroy(meshes[i]);
     free(meshes);
     free(views);
     free(rgb);
-    free(inputs);
+    return status;
+}
+
+int cli_render_main(int argc, char **argv) {
+    render_job job;
+    memset(&job, 0, sizeof job);
+    render_options_default(&job.options);
+    int status = parse_render_args(argc, argv, &job);
+    if (status < 0)
+        status = check_picture(&job);
+    if (status < 0)
+        status = draw(&job);
+    free(job.inputs);
     return status;
 }
