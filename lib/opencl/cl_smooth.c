@@ -374,56 +374,70 @@ static void store_results(void *ctx, size_t begin, size_t end, size_t chunk) {
     }
 }
 
-rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_result_sink *sink,
-                         rs_run_stats *stats, uint64_t *needed, rsmooth_error *error) {
-    static const char where[] = "rsmooth_smooth";
-    double t_start = rs_now_ms();
-    double t_upload = t_start, t_mollify = t_start, t_normals = t_start, t_robust = t_start;
-    *needed = 0;
-
+/* One run on the device, its steps below in order: the host-side grid and packing, the buffers,
+ * the predictors' normals, the robust pass, the results. */
+typedef struct cl_run {
+    rsmooth_context *ctx;
+    const rs_problem *pb;
+    const rs_result_sink *sink;
+    rsmooth_error *error;
     rs_grid grid;
-    memset(&grid, 0, sizeof grid);
     packed pk;
-    memset(&pk, 0, sizeof pk);
-    cl_mem buf[BUF_COUNT] = {0};
-    /* mapped results, per block, as block_result, block_extra and block_pairs */
-    cl_float *result = NULL, *extra = NULL;
-    cl_uint *pairs = NULL;
+    cl_mem buf[BUF_COUNT];
+    cl_mem normals;           /* the predictors' normals, once filtered */
+    uint64_t bilateral_pairs;
+    cl_float *result, *extra; /* mapped results, per block, as block_result and block_extra */
+    cl_uint *pairs;           /* and block_pairs */
+    double t_start, t_grid, t_upload, t_mollify, t_normals, t_robust;
+} cl_run;
 
+static const char where[] = "rsmooth_smooth";
+
+/* The grid and the packed facets and vertex blocks, on the host. */
+static rsmooth_status prepare_host(cl_run *r) {
     double *centroid = NULL; /* build_grid's, for pack */
-    rsmooth_status st = build_grid(pb, &grid, &centroid, error);
+    rsmooth_status st = build_grid(r->pb, &r->grid, &centroid, r->error);
     if (st == RSMOOTH_OK)
-        st = pack(pb, &grid, &centroid, ctx->lanes, &pk, error);
+        st = pack(r->pb, &r->grid, &centroid, r->ctx->lanes, &r->pk, r->error);
     rs_free(centroid);
     if (st != RSMOOTH_OK)
-        goto cleanup;
-    rs_free(grid.facet_order); /* packing was its last use: 4 bytes per facet less at the peak */
-    grid.facet_order = NULL;
-    double t_grid = rs_now_ms();
+        return st;
+    rs_free(r->grid.facet_order); /* packing was its last use: 4 bytes per facet less at the peak */
+    r->grid.facet_order = NULL;
+    r->t_grid = rs_now_ms();
+    return RSMOOTH_OK;
+}
 
-    size_t nv = pb->vertex_count, nf = pb->facet_count, nc = grid.cell_count;
-    size_t nb = pk.block_count, ns = nb * ctx->lanes; /* blocks and slots */
+/* Every buffer of the run, refused whole (with the bytes it needs in *needed, for the tiles)
+ * where they do not fit the device. */
+static rsmooth_status create_buffers(cl_run *r, uint64_t *needed) {
+    rsmooth_context *ctx = r->ctx;
+    const rs_problem *pb = r->pb;
+    const packed *pk = &r->pk;
+    const rs_grid *grid = &r->grid;
+    size_t nf = pb->facet_count, nc = grid->cell_count;
+    size_t nb = pk->block_count, ns = nb * ctx->lanes; /* blocks and slots */
     bool paper_mollify = pb->mollify && !pb->bilateral;
     const struct {
         size_t size;
         void *host;
         cl_mem_flags flags;
     } spec[BUF_COUNT] = {
-        [BUF_FACET_CENTROID] = {nf * sizeof(cl_float4), pk.facet_centroid, CL_MEM_READ_ONLY},
+        [BUF_FACET_CENTROID] = {nf * sizeof(cl_float4), pk->facet_centroid, CL_MEM_READ_ONLY},
         /* the input normals, replaced in place by the mollified ones (bilateral: by the rounds
          * that write here) */
-        [BUF_FACET_NORMAL] = {nf * sizeof(cl_float4), pk.facet_normal, CL_MEM_READ_WRITE},
-        [BUF_FACET_VERTICES] = {nf * 3 * sizeof(cl_uint), pk.facet_vertices, CL_MEM_READ_ONLY},
-        [BUF_FACET_PLACE] = {nf * sizeof(cl_uint), pk.facet_place, CL_MEM_READ_ONLY},
-        [BUF_CELL_COORD] = {nc * 4 * sizeof(cl_int), grid.cell_coord, CL_MEM_READ_ONLY},
-        [BUF_CELL_START] = {(nc + 1) * sizeof(cl_uint), grid.cell_start, CL_MEM_READ_ONLY},
-        [BUF_COLUMN_FIRST] = {(grid.column_count + 1) * sizeof(cl_uint), grid.column_first,
+        [BUF_FACET_NORMAL] = {nf * sizeof(cl_float4), pk->facet_normal, CL_MEM_READ_WRITE},
+        [BUF_FACET_VERTICES] = {nf * 3 * sizeof(cl_uint), pk->facet_vertices, CL_MEM_READ_ONLY},
+        [BUF_FACET_PLACE] = {nf * sizeof(cl_uint), pk->facet_place, CL_MEM_READ_ONLY},
+        [BUF_CELL_COORD] = {nc * 4 * sizeof(cl_int), grid->cell_coord, CL_MEM_READ_ONLY},
+        [BUF_CELL_START] = {(nc + 1) * sizeof(cl_uint), grid->cell_start, CL_MEM_READ_ONLY},
+        [BUF_COLUMN_FIRST] = {(grid->column_count + 1) * sizeof(cl_uint), grid->column_first,
                               CL_MEM_READ_ONLY},
-        [BUF_COLUMN_TABLE] = {((size_t)grid.column_mask + 1) * sizeof(cl_int), grid.column_table,
-                              CL_MEM_READ_ONLY},
-        [BUF_BLOCK_POS] = {ns * 3 * sizeof(cl_float), pk.block_pos, CL_MEM_READ_ONLY},
-        [BUF_BLOCK_CELL] = {nb * sizeof(cl_int4), pk.block_cell, CL_MEM_READ_ONLY},
-        [BUF_BLOCK_OFFSET] = {ns * 3 * sizeof(cl_uchar), pk.block_offset, CL_MEM_READ_ONLY},
+        [BUF_COLUMN_TABLE] = {((size_t)grid->column_mask + 1) * sizeof(cl_int),
+                              grid->column_table, CL_MEM_READ_ONLY},
+        [BUF_BLOCK_POS] = {ns * 3 * sizeof(cl_float), pk->block_pos, CL_MEM_READ_ONLY},
+        [BUF_BLOCK_CELL] = {nb * sizeof(cl_int4), pk->block_cell, CL_MEM_READ_ONLY},
+        [BUF_BLOCK_OFFSET] = {ns * 3 * sizeof(cl_uchar), pk->block_offset, CL_MEM_READ_ONLY},
         [BUF_BLOCK_SHIFT] = {paper_mollify ? ns * 3 * sizeof(cl_float) : 0, NULL,
                              CL_MEM_READ_WRITE},
         [BUF_BLOCK_RESULT] = {ns * 4 * sizeof(cl_float), NULL, CL_MEM_WRITE_ONLY},
@@ -432,9 +446,9 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
         [BUF_FACET_SCRATCH] = {pb->bilateral ? nf * sizeof(cl_float4) : 0, NULL,
                                CL_MEM_READ_WRITE},
         [BUF_CELL_PAIRS] = {pb->bilateral ? nc * sizeof(cl_ulong) : 0, NULL, CL_MEM_WRITE_ONLY},
-        [BUF_FACET_COLOR] = {pb->colors ? nf * sizeof(cl_float4) : 0, pk.facet_color,
+        [BUF_FACET_COLOR] = {pb->colors ? nf * sizeof(cl_float4) : 0, pk->facet_color,
                              CL_MEM_READ_ONLY},
-        [BUF_BLOCK_COLOR] = {pb->colors ? ns * 3 * sizeof(cl_float) : 0, pk.block_color,
+        [BUF_BLOCK_COLOR] = {pb->colors ? ns * 3 * sizeof(cl_float) : 0, pk->block_color,
                              CL_MEM_READ_ONLY},
     };
     uint64_t total = 0, largest = 0;
@@ -444,13 +458,12 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     }
     if (total > rs_cl_usable_memory(ctx) || largest > ctx->max_allocation) {
         *needed = total;
-        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where,
-                     "%zu facets need %llu bytes on %s (usable %llu, largest buffer %llu of at "
-                     "most %llu)",
-                     nf, (unsigned long long)total, ctx->device_name,
-                     (unsigned long long)rs_cl_usable_memory(ctx), (unsigned long long)largest,
-                     (unsigned long long)ctx->max_allocation);
-        goto cleanup;
+        return rs_fail(r->error, RSMOOTH_ERROR_OUT_OF_MEMORY, where,
+                       "%zu facets need %llu bytes on %s (usable %llu, largest buffer %llu of at "
+                       "most %llu)",
+                       nf, (unsigned long long)total, ctx->device_name,
+                       (unsigned long long)rs_cl_usable_memory(ctx), (unsigned long long)largest,
+                       (unsigned long long)ctx->max_allocation);
     }
     /* Inputs are handed over in place where the device shares the host's memory (a CPU device
      * reads the staging arrays themselves: no copy, no second allocation; they are aligned for
@@ -461,89 +474,108 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
             continue;
         cl_int err = CL_SUCCESS;
         cl_mem_flags flags = spec[b].flags | (spec[b].host ? rs_cl_input_flags(ctx) : 0);
-        buf[b] = clCreateBuffer(ctx->context, flags, spec[b].size, spec[b].host, &err);
-        if (err != CL_SUCCESS) {
-            st = rs_cl_fail(error, err, "clCreateBuffer", ctx->device_name);
-            goto cleanup;
-        }
+        r->buf[b] = clCreateBuffer(ctx->context, flags, spec[b].size, spec[b].host, &err);
+        if (err != CL_SUCCESS)
+            return rs_cl_fail(r->error, err, "clCreateBuffer", ctx->device_name);
     }
     cl_int err = clFinish(ctx->queue);
-    if (err != CL_SUCCESS) {
-        st = rs_cl_fail(error, err, "clFinish (upload)", ctx->device_name);
-        goto cleanup;
-    }
-    t_upload = rs_now_ms();
+    if (err != CL_SUCCESS)
+        return rs_cl_fail(r->error, err, "clFinish (upload)", ctx->device_name);
+    r->t_upload = rs_now_ms();
+    return RSMOOTH_OK;
+}
 
+/* The paper's mollification (Sec. 3.2): the vertices' shifts, then each facet's normal from its
+ * shifted corners, in place of the input normal. */
+static rsmooth_status run_mollify(cl_run *r) {
+    rsmooth_context *ctx = r->ctx;
+    const rs_problem *pb = r->pb;
+    cl_mem *buf = r->buf;
     /* Lengths in cell units (h), so every float the kernels see is of order one. */
-    const double h = grid.cell_size;
-    cl_uint bcount = (cl_uint)nb, fcount = (cl_uint)nf, mask = grid.column_mask;
-    cl_float reach2 = (cl_float)((pb->radius / h) * (pb->radius / h));
+    const double h = r->grid.cell_size;
+    cl_uint bcount = (cl_uint)r->pk.block_count, fcount = (cl_uint)pb->facet_count;
+    cl_uint mask = r->grid.column_mask;
     cl_float mollify_reach2 = (cl_float)((pb->mollify_radius / h) * (pb->mollify_radius / h));
     /* Exponents in base 2 (the kernels' fast_exp2): 1 / 2 sigma^2 scaled by log2 e. */
     cl_float inv_2sm2 = (cl_float)(LOG2_E * h * h / (2 * pb->sigma_m * pb->sigma_m));
+    arg_setter s = {ctx->kernels[RS_KERNEL_MOLLIFY], 0, CL_SUCCESS};
+    arg(&s, sizeof bcount, &bcount);
+    arg(&s, sizeof mollify_reach2, &mollify_reach2);
+    arg(&s, sizeof inv_2sm2, &inv_2sm2);
+    arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_POS]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_CELL]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_OFFSET]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
+    arg_grid(&s, buf, &mask);
+    arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_SHIFT]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_PAIRS]);
+    cl_int err = s.err != CL_SUCCESS ? s.err
+                                     : rs_cl_run_1d(ctx, pb, s.kernel, r->pk.block_count, 0,
+                                                    MOLLIFY_SHARE);
+    if (err != CL_SUCCESS)
+        return rs_cl_fail(r->error, err, "mollify_block", ctx->device_name);
+    r->t_mollify = rs_now_ms();
+
+    s = (arg_setter){ctx->kernels[RS_KERNEL_NORMALS], 0, CL_SUCCESS};
+    arg(&s, sizeof fcount, &fcount);
+    arg(&s, sizeof(cl_mem), &buf[BUF_FACET_VERTICES]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_FACET_PLACE]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_POS]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_CELL]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_OFFSET]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_FACET_NORMAL]);
+    arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_SHIFT]);
+    err = s.err != CL_SUCCESS
+              ? s.err
+              : rs_cl_run_1d(ctx, pb, s.kernel, pb->facet_count, MOLLIFY_SHARE, MOLLIFY_SHARE);
+    if (err != CL_SUCCESS)
+        return rs_cl_fail(r->error, err, "mollified_facet_normal", ctx->device_name);
+    return RSMOOTH_OK;
+}
+
+/* The predictors' normals: the bilateral filter's rounds, the paper's mollification, or the
+ * input normals as they are. */
+static rsmooth_status run_normals(cl_run *r) {
+    r->normals = r->buf[BUF_FACET_NORMAL];
+    r->t_mollify = r->t_normals = r->t_upload;
+    if (r->pb->bilateral) {
+        cl_int err = rs_cl_run_bilateral(r->ctx, r->pb, &r->grid, r->buf, &r->normals,
+                                         &r->bilateral_pairs);
+        if (err != CL_SUCCESS)
+            return rs_cl_fail(r->error, err, "bilateral_cell_normals", r->ctx->device_name);
+        r->t_mollify = rs_now_ms();
+    } else if (r->pb->mollify) {
+        rsmooth_status st = run_mollify(r);
+        if (st != RSMOOTH_OK)
+            return st;
+    } else {
+        r->t_mollify = rs_now_ms();
+    }
+    r->t_normals = rs_now_ms();
+    return RSMOOTH_OK;
+}
+
+/* The robust estimate (Eq. 3) of every vertex, with its weight and confidence. */
+static rsmooth_status run_robust(cl_run *r) {
+    rsmooth_context *ctx = r->ctx;
+    const rs_problem *pb = r->pb;
+    cl_mem *buf = r->buf;
+    const double h = r->grid.cell_size;
+    cl_uint bcount = (cl_uint)r->pk.block_count, mask = r->grid.column_mask;
+    cl_float reach2 = (cl_float)((pb->radius / h) * (pb->radius / h));
     cl_float inv_2sf2 = (cl_float)(LOG2_E * h * h / (2 * pb->sigma_f * pb->sigma_f));
     cl_float inv_2sg2 =
         isinf(pb->sigma_g) ? 0.0f : (cl_float)(LOG2_E * h * h / (2 * pb->sigma_g * pb->sigma_g));
     /* the other influence functions take x^2 / sigma_g^2 itself */
     cl_float inv_sg2 = isinf(pb->sigma_g) ? 0.0f : (cl_float)(h * h / (pb->sigma_g * pb->sigma_g));
     cl_int influence = pb->influence;
-    cl_int want_confidence = sink->confidence != NULL;
+    cl_int want_confidence = r->sink->confidence != NULL;
     cl_int predict_centroid = pb->predict_centroid;
     /* the colour factor's exponent, in base 2; colours have no length scale (finite however
      * small sigma_c is, so equal colours still give 0) */
     cl_int use_color = pb->colors != NULL;
     cl_float inv_2sc2 =
         use_color ? (cl_float)fmin(LOG2_E / (2 * pb->sigma_c * pb->sigma_c), FLT_MAX) : 0.0f;
-    cl_mem normals = buf[BUF_FACET_NORMAL]; /* the predictors' normals, once filtered */
-    uint64_t bilateral_pairs = 0;
-
-    if (pb->bilateral) {
-        err = rs_cl_run_bilateral(ctx, pb, &grid, buf, &normals, &bilateral_pairs);
-        if (err != CL_SUCCESS) {
-            st = rs_cl_fail(error, err, "bilateral_cell_normals", ctx->device_name);
-            goto cleanup;
-        }
-        t_mollify = rs_now_ms();
-    } else if (pb->mollify) {
-        arg_setter s = {ctx->kernels[RS_KERNEL_MOLLIFY], 0, CL_SUCCESS};
-        arg(&s, sizeof bcount, &bcount);
-        arg(&s, sizeof mollify_reach2, &mollify_reach2);
-        arg(&s, sizeof inv_2sm2, &inv_2sm2);
-        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_POS]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_CELL]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_OFFSET]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
-        arg_grid(&s, buf, &mask);
-        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_SHIFT]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_PAIRS]);
-        err = s.err != CL_SUCCESS ? s.err : rs_cl_run_1d(ctx, pb, s.kernel, nb, 0, MOLLIFY_SHARE);
-        if (err != CL_SUCCESS) {
-            st = rs_cl_fail(error, err, "mollify_block", ctx->device_name);
-            goto cleanup;
-        }
-        t_mollify = rs_now_ms();
-
-        s = (arg_setter){ctx->kernels[RS_KERNEL_NORMALS], 0, CL_SUCCESS};
-        arg(&s, sizeof fcount, &fcount);
-        arg(&s, sizeof(cl_mem), &buf[BUF_FACET_VERTICES]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_FACET_PLACE]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_POS]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_CELL]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_OFFSET]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_FACET_NORMAL]);
-        arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_SHIFT]);
-        err = s.err != CL_SUCCESS
-                  ? s.err
-                  : rs_cl_run_1d(ctx, pb, s.kernel, nf, MOLLIFY_SHARE, MOLLIFY_SHARE);
-        if (err != CL_SUCCESS) {
-            st = rs_cl_fail(error, err, "mollified_facet_normal", ctx->device_name);
-            goto cleanup;
-        }
-    } else {
-        t_mollify = rs_now_ms();
-    }
-    t_normals = rs_now_ms();
-
     arg_setter s = {ctx->kernels[RS_KERNEL_ROBUST], 0, CL_SUCCESS};
     arg(&s, sizeof bcount, &bcount);
     arg(&s, sizeof reach2, &reach2);
@@ -560,66 +592,96 @@ rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_re
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_OFFSET]);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_COLOR]); /* NULL without colour: never read */
     arg(&s, sizeof(cl_mem), &buf[BUF_FACET_CENTROID]);
-    arg(&s, sizeof(cl_mem), &normals);
+    arg(&s, sizeof(cl_mem), &r->normals);
     arg(&s, sizeof(cl_mem), &buf[BUF_FACET_COLOR]);
     arg_grid(&s, buf, &mask);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_RESULT]);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_EXTRA]);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_PAIRS]);
-    err = s.err != CL_SUCCESS
-              ? s.err
-              : rs_cl_run_1d(ctx, pb, s.kernel, nb, pb->mollify ? MOLLIFY_SHARE : 0, 1);
-    if (err != CL_SUCCESS) {
-        st = rs_cl_fail(error, err, "robust_block", ctx->device_name);
-        goto cleanup;
-    }
-    t_robust = rs_now_ms();
+    cl_int err = s.err != CL_SUCCESS ? s.err
+                                     : rs_cl_run_1d(ctx, pb, s.kernel, r->pk.block_count,
+                                                    pb->mollify ? MOLLIFY_SHARE : 0, 1);
+    if (err != CL_SUCCESS)
+        return rs_cl_fail(r->error, err, "robust_block", ctx->device_name);
+    r->t_robust = rs_now_ms();
+    return RSMOOTH_OK;
+}
 
-    /* Results are mapped, not copied: a CPU device hands over its own memory. */
-    result = clEnqueueMapBuffer(ctx->queue, buf[BUF_BLOCK_RESULT], CL_TRUE, CL_MAP_READ, 0,
-                                ns * 4 * sizeof(cl_float), 0, NULL, NULL, &err);
+/* The results mapped (not copied: a CPU device hands over its own memory), scattered to the
+ * caller's vertices in the caller's type, and the run's figures added to *stats. */
+static rsmooth_status collect_results(cl_run *r, rs_run_stats *stats) {
+    rsmooth_context *ctx = r->ctx;
+    const rs_problem *pb = r->pb;
+    size_t nv = pb->vertex_count, nb = r->pk.block_count, ns = nb * ctx->lanes;
+    cl_int err = CL_SUCCESS;
+    r->result = clEnqueueMapBuffer(ctx->queue, r->buf[BUF_BLOCK_RESULT], CL_TRUE, CL_MAP_READ, 0,
+                                   ns * 4 * sizeof(cl_float), 0, NULL, NULL, &err);
     if (err == CL_SUCCESS)
-        extra = clEnqueueMapBuffer(ctx->queue, buf[BUF_BLOCK_EXTRA], CL_TRUE, CL_MAP_READ, 0,
-                                   ns * 2 * sizeof(cl_float), 0, NULL, NULL, &err);
+        r->extra = clEnqueueMapBuffer(ctx->queue, r->buf[BUF_BLOCK_EXTRA], CL_TRUE, CL_MAP_READ,
+                                      0, ns * 2 * sizeof(cl_float), 0, NULL, NULL, &err);
     if (err == CL_SUCCESS)
-        pairs = clEnqueueMapBuffer(ctx->queue, buf[BUF_BLOCK_PAIRS], CL_TRUE, CL_MAP_READ, 0,
-                                   nb * 2 * sizeof(cl_uint), 0, NULL, NULL, &err);
-    if (err != CL_SUCCESS) {
-        st = rs_cl_fail(error, err, "clEnqueueMapBuffer", ctx->device_name);
-        goto cleanup;
-    }
-    result_job rj = {pb, sink, &pk, result, extra, h};
-    rs_parallel_for(sink->core_count < nv ? sink->core_count : nv, PARALLEL_GRAIN, store_results,
-                    &rj);
+        r->pairs = clEnqueueMapBuffer(ctx->queue, r->buf[BUF_BLOCK_PAIRS], CL_TRUE, CL_MAP_READ,
+                                      0, nb * 2 * sizeof(cl_uint), 0, NULL, NULL, &err);
+    if (err != CL_SUCCESS)
+        return rs_cl_fail(r->error, err, "clEnqueueMapBuffer", ctx->device_name);
+    result_job rj = {pb, r->sink, &r->pk, r->result, r->extra, r->grid.cell_size};
+    rs_parallel_for(r->sink->core_count < nv ? r->sink->core_count : nv, PARALLEL_GRAIN,
+                    store_results, &rj);
     double t_end = rs_now_ms();
-    stats->ms_grid += t_grid - t_start;
-    stats->ms_upload += t_upload - t_grid;
-    stats->ms_mollify += t_mollify - t_upload;
-    stats->ms_normals += t_normals - t_mollify;
-    stats->ms_robust += t_robust - t_normals;
-    stats->ms_download += t_end - t_robust;
+    stats->ms_grid += r->t_grid - r->t_start;
+    stats->ms_upload += r->t_upload - r->t_grid;
+    stats->ms_mollify += r->t_mollify - r->t_upload;
+    stats->ms_normals += r->t_normals - r->t_mollify;
+    stats->ms_robust += r->t_robust - r->t_normals;
+    stats->ms_download += t_end - r->t_robust;
+    bool paper_mollify = pb->mollify && !pb->bilateral;
     for (size_t b = 0; b < nb; b++) {
-        stats->pairs_mollify += paper_mollify ? (uint64_t)pairs[2 * b] * ctx->lanes : 0;
-        stats->pairs_robust += (uint64_t)pairs[2 * b + 1] * ctx->lanes;
+        stats->pairs_mollify += paper_mollify ? (uint64_t)r->pairs[2 * b] * ctx->lanes : 0;
+        stats->pairs_robust += (uint64_t)r->pairs[2 * b + 1] * ctx->lanes;
     }
-    stats->pairs_mollify += bilateral_pairs;
-    stats->cells += grid.cell_count;
+    stats->pairs_mollify += r->bilateral_pairs;
+    stats->cells += r->grid.cell_count;
     stats->tiles++;
+    return RSMOOTH_OK;
+}
 
-cleanup:
-    if (result)
-        clEnqueueUnmapMemObject(ctx->queue, buf[BUF_BLOCK_RESULT], result, 0, NULL, NULL);
-    if (extra)
-        clEnqueueUnmapMemObject(ctx->queue, buf[BUF_BLOCK_EXTRA], extra, 0, NULL, NULL);
-    if (pairs)
-        clEnqueueUnmapMemObject(ctx->queue, buf[BUF_BLOCK_PAIRS], pairs, 0, NULL, NULL);
-    if (result || extra || pairs)
+static void release_run(cl_run *r) {
+    rsmooth_context *ctx = r->ctx;
+    if (r->result)
+        clEnqueueUnmapMemObject(ctx->queue, r->buf[BUF_BLOCK_RESULT], r->result, 0, NULL, NULL);
+    if (r->extra)
+        clEnqueueUnmapMemObject(ctx->queue, r->buf[BUF_BLOCK_EXTRA], r->extra, 0, NULL, NULL);
+    if (r->pairs)
+        clEnqueueUnmapMemObject(ctx->queue, r->buf[BUF_BLOCK_PAIRS], r->pairs, 0, NULL, NULL);
+    if (r->result || r->extra || r->pairs)
         clFinish(ctx->queue);
     for (int b = 0; b < BUF_COUNT; b++)
-        if (buf[b])
-            clReleaseMemObject(buf[b]);
-    packed_free(&pk);
-    rs_grid_free(&grid);
+        if (r->buf[b])
+            clReleaseMemObject(r->buf[b]);
+    packed_free(&r->pk);
+    rs_grid_free(&r->grid);
+}
+
+rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_result_sink *sink,
+                         rs_run_stats *stats, uint64_t *needed, rsmooth_error *error) {
+    cl_run r;
+    memset(&r, 0, sizeof r);
+    r.ctx = ctx;
+    r.pb = pb;
+    r.sink = sink;
+    r.error = error;
+    r.t_start = r.t_grid = r.t_upload = rs_now_ms();
+    *needed = 0;
+    rsmooth_status st = prepare_host(&r);
+    if (st == RSMOOTH_OK)
+        st = create_buffers(&r, needed);
+    if (st == RSMOOTH_OK)
+        st = run_normals(&r);
+    if (st == RSMOOTH_OK)
+        st = run_robust(&r);
+    if (st == RSMOOTH_OK)
+        st = collect_results(&r, stats);
+    release_run(&r);
     return st;
 }
 
