@@ -43,8 +43,7 @@ rsmooth_status rs_io_check_position_values(const double *xyz, size_t count, cons
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                            "vertex %zu has coordinate %s beyond the supported magnitude %s: not "
                            "written (rsmooth could not read it back)",
-                           vertex, rs_io_shortest(x).text,
-                           rs_io_shortest(RS_MAX_COORDINATE).text);
+                           vertex, rs_io_shortest(x).text, rs_io_shortest(RS_MAX_COORDINATE).text);
     }
     return RSMOOTH_OK;
 }

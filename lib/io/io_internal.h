@@ -1,11 +1,12 @@
 /* Helpers shared by the mesh file readers and writers (not installed). Prefix rs_io_.
  *
  * Calls run one way, down this list (a file calls only files below it):
- *   mesh_file.c     the public reads and writes; the per-format dispatch of writers and their checks
+ *   mesh_file.c     the public reads and writes: the dispatch to each format's check and writer
  *   mesh_detect.c   reading from memory: which format, then its reader
  *   *_read.c        the readers (ply_read.c over ply_header.c, ply_ascii.c / ply_binary.c, then
  *                   ply_element.c)
- *   *_write.c       the writers and their own checks, over text_out.c, float_print.c, mesh_normals.c
+ *   *_write.c       the writers and their own checks (over text_out.c, float_print.c and
+ *                   mesh_normals.c)
  *   mesh_data.c     the mesh record (create, destroy, adopt) and the conversion-loss report
  *   mesh_check.c    the well-formedness and value checks every writer makes
  *   *_extras.c      each format's extras record: its release and what a conversion drops

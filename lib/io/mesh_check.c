@@ -49,4 +49,3 @@ rsmooth_status rs_io_mesh_check_values(const rsmooth_mesh *mesh, const char *whe
                            (double)mesh->vertex_quality[i]);
     return RSMOOTH_OK;
 }
-

@@ -173,59 +173,118 @@ static rsmooth_status copy_rows(rs_ply_reader *r, rs_ply_element *e, size_t item
     return RSMOOTH_OK;
 }
 
-rsmooth_status rs_ply_read_binary_element(rs_ply_reader *r, rs_ply_element *e,
-                                          rsmooth_error *error) {
+/* The x y z (and nx ny nz when read) of an all-scalar vertex element's items of `item_size` bytes,
+ * each vertex checked as read (its row already copied). */
+static rsmooth_status read_scalar_vertices(rs_ply_reader *r, const rs_ply_element *e,
+                                           size_t item_size, rsmooth_error *error) {
     const bool be = r->encoding == RS_PLY_BINARY_BE;
-    const bool is_vertex = e == r->vertex_element, is_face = e == r->face_element;
     const unsigned char *data = (const unsigned char *)r->data;
-    bool all_scalar = true;
-    size_t item_size = 0;
+    /* x, y, z, then nx, ny, nz (when read) */
+    size_t offsets[6] = {0, 0, 0, 0, 0, 0};
+    rs_ply_type types[6] = {RS_PLY_NONE, RS_PLY_NONE, RS_PLY_NONE,
+                            RS_PLY_NONE, RS_PLY_NONE, RS_PLY_NONE};
+    size_t at = 0;
     for (size_t k = 0; k < e->property_count; k++) {
         const rs_ply_property *p = &e->properties[k];
-        all_scalar = all_scalar && p->count_type == RS_PLY_NONE;
-        item_size += rs_ply_type_size(p->count_type != RS_PLY_NONE ? p->count_type : p->type);
+        if (p->role >= RS_PLY_X && p->role <= RS_PLY_NZ) {
+            offsets[p->role - RS_PLY_X] = at;
+            types[p->role - RS_PLY_X] = p->type;
+        }
+        at += rs_ply_type_size(p->type);
     }
-    /* item_size is the minimum size of an item, checked for every element in read_data. */
-    if (all_scalar) {
-        if (e->row_size > 0) { /* first: the vertex checks read the colours from the rows */
-            rsmooth_status status = copy_rows(r, e, item_size, error);
+    for (size_t i = 0; i < e->count; i++) {
+        const unsigned char *item = data + r->pos + i * item_size;
+        double *xyz = r->positions + 3 * i;
+        for (int c = 0; c < 3; c++)
+            xyz[c] = load_value(item + offsets[c], types[c], be);
+        for (int c = 0; r->normal_values && c < 3; c++)
+            r->normal_values[3 * i + (size_t)c] =
+                load_value(item + offsets[3 + c], types[3 + c], be);
+        rsmooth_status status = rs_ply_check_vertex(r, i, -1, (int64_t)(item - data), error);
+        if (status != RSMOOTH_OK)
+            return status;
+    }
+    return RSMOOTH_OK;
+}
+
+/* An element without lists: items of `item_size` bytes, copied to the rows a run at a time. */
+static rsmooth_status read_scalar_element(rs_ply_reader *r, rs_ply_element *e, size_t item_size,
+                                          rsmooth_error *error) {
+    if (e->row_size > 0) { /* first: the vertex checks read the colours from the rows */
+        rsmooth_status status = copy_rows(r, e, item_size, error);
+        if (status != RSMOOTH_OK)
+            return status;
+    }
+    if (e == r->vertex_element) {
+        rsmooth_status status = read_scalar_vertices(r, e, item_size, error);
+        if (status != RSMOOTH_OK)
+            return status;
+    }
+    r->pos += (size_t)e->count * item_size;
+    return RSMOOTH_OK;
+}
+
+/* Scalar property p of item i (bounds-checked): kept in the row, or a coordinate or normal. */
+static void read_scalar(rs_ply_reader *r, const rs_ply_property *p, uint64_t i,
+                        unsigned char *row) {
+    const bool be = r->encoding == RS_PLY_BINARY_BE;
+    const unsigned char *src = (const unsigned char *)r->data + r->pos;
+    size_t size = rs_ply_type_size(p->type);
+    if (p->role == RS_PLY_STORED)
+        copy_values(row + p->row_offset, src, 1, size, r->swap);
+    else if (p->role >= RS_PLY_X && p->role <= RS_PLY_Z)
+        r->positions[3 * i + (uint64_t)(p->role - RS_PLY_X)] = load_value(src, p->type, be);
+    else if (p->role >= RS_PLY_NX && p->role <= RS_PLY_NZ)
+        r->normal_values[3 * i + (uint64_t)(p->role - RS_PLY_NX)] = load_value(src, p->type, be);
+    r->pos += size;
+}
+
+/* List property p of item i of element e: a face's vertex indices, or its count kept in the row
+ * and its values appended to the element's list items. */
+static rsmooth_status read_list(rs_ply_reader *r, rs_ply_element *e, const rs_ply_property *p,
+                                uint64_t i, unsigned char *row, rsmooth_error *error) {
+    const bool be = r->encoding == RS_PLY_BINARY_BE;
+    const unsigned char *data = (const unsigned char *)r->data;
+    size_t count_size = rs_ply_type_size(p->count_type);
+    if (r->size - r->pos < count_size)
+        return truncated(r, e, i, error);
+    size_t count_offset = r->pos;
+    uint64_t n = load_uint(data + r->pos, count_size, be);
+    if (is_signed_int(p->count_type) && n >> (8 * count_size - 1))
+        return rs_fail_parse(error, -1, (int64_t)count_offset, where,
+                             "negative list count in element '%.40s' item %llu", e->name,
+                             (unsigned long long)i);
+    r->pos += count_size;
+    size_t size = rs_ply_type_size(p->type);
+    if (n > (r->size - r->pos) / size)
+        return truncated(r, e, i, error);
+    if (p->role == RS_PLY_FACE_LIST) {
+        rsmooth_status status = rs_ply_face_begin(r, n, i, -1, (int64_t)count_offset, error);
+        if (status != RSMOOTH_OK)
+            return status;
+        for (uint64_t j = 0; j < n; j++, r->pos += size) {
+            status = rs_ply_face_index(r, load_value(data + r->pos, p->type, be), -1,
+                                       (int64_t)r->pos, error);
             if (status != RSMOOTH_OK)
                 return status;
         }
-        if (is_vertex) {
-            /* x, y, z, then nx, ny, nz (when read) */
-            size_t offsets[6] = {0, 0, 0, 0, 0, 0};
-            rs_ply_type types[6] = {RS_PLY_NONE, RS_PLY_NONE, RS_PLY_NONE,
-                                    RS_PLY_NONE, RS_PLY_NONE, RS_PLY_NONE};
-            size_t at = 0;
-            for (size_t k = 0; k < e->property_count; k++) {
-                const rs_ply_property *p = &e->properties[k];
-                if (p->role >= RS_PLY_X && p->role <= RS_PLY_NZ) {
-                    offsets[p->role - RS_PLY_X] = at;
-                    types[p->role - RS_PLY_X] = p->type;
-                }
-                at += rs_ply_type_size(p->type);
-            }
-            for (size_t i = 0; i < e->count; i++) {
-                const unsigned char *item = data + r->pos + i * item_size;
-                double *xyz = r->positions + 3 * i;
-                for (int c = 0; c < 3; c++)
-                    xyz[c] = load_value(item + offsets[c], types[c], be);
-                for (int c = 0; r->normal_values && c < 3; c++)
-                    r->normal_values[3 * i + (size_t)c] =
-                        load_value(item + offsets[3 + c], types[3 + c], be);
-                rsmooth_status status =
-                    rs_ply_check_vertex(r, i, -1, (int64_t)(item - data), error);
-                if (status != RSMOOTH_OK)
-                    return status;
-            }
-        }
-        r->pos += (size_t)e->count * item_size;
         return RSMOOTH_OK;
     }
-    if (is_face && e->property_count == 1 &&
-        (e->properties[0].type == RS_PLY_INT32 || e->properties[0].type == RS_PLY_UINT32))
-        return read_binary_faces(r, e, error);
+    copy_values(row + p->row_offset, data + count_offset, 1, count_size, r->swap);
+    size_t bytes = (size_t)n * size; /* n * size <= the bytes left */
+    if (bytes == 0)
+        return RSMOOTH_OK; /* list_items may still be NULL */
+    if (!rs_ply_list_reserve(e, bytes))
+        return rs_ply_list_oom(e, error);
+    copy_values(e->list_items + e->list_bytes, data + r->pos, (size_t)n, size, r->swap);
+    e->list_bytes += bytes;
+    r->pos += bytes;
+    return RSMOOTH_OK;
+}
+
+/* An element with lists, item by item and property by property. */
+static rsmooth_status read_items(rs_ply_reader *r, rs_ply_element *e, rsmooth_error *error) {
+    const bool is_vertex = e == r->vertex_element, is_face = e == r->face_element;
     for (uint64_t i = 0; i < e->count; i++) {
         const size_t item_start = r->pos;
         unsigned char *row = e->rows ? e->rows + (size_t)i * e->row_size : NULL;
@@ -234,56 +293,14 @@ rsmooth_status rs_ply_read_binary_element(rs_ply_reader *r, rs_ply_element *e,
         for (size_t k = 0; k < e->property_count; k++) {
             const rs_ply_property *p = &e->properties[k];
             if (p->count_type == RS_PLY_NONE) {
-                size_t size = rs_ply_type_size(p->type);
-                if (r->size - r->pos < size)
+                if (r->size - r->pos < rs_ply_type_size(p->type))
                     return truncated(r, e, i, error);
-                const unsigned char *src = data + r->pos;
-                if (p->role == RS_PLY_STORED)
-                    copy_values(row + p->row_offset, src, 1, size, r->swap);
-                else if (p->role >= RS_PLY_X && p->role <= RS_PLY_Z)
-                    r->positions[3 * i + (uint64_t)(p->role - RS_PLY_X)] =
-                        load_value(src, p->type, be);
-                else if (p->role >= RS_PLY_NX && p->role <= RS_PLY_NZ)
-                    r->normal_values[3 * i + (uint64_t)(p->role - RS_PLY_NX)] =
-                        load_value(src, p->type, be);
-                r->pos += size;
+                read_scalar(r, p, i, row);
                 continue;
             }
-            size_t count_size = rs_ply_type_size(p->count_type);
-            if (r->size - r->pos < count_size)
-                return truncated(r, e, i, error);
-            size_t count_offset = r->pos;
-            uint64_t n = load_uint(data + r->pos, count_size, be);
-            if (is_signed_int(p->count_type) && n >> (8 * count_size - 1))
-                return rs_fail_parse(error, -1, (int64_t)count_offset, where,
-                                     "negative list count in element '%.40s' item %llu", e->name,
-                                     (unsigned long long)i);
-            r->pos += count_size;
-            size_t size = rs_ply_type_size(p->type);
-            if (n > (r->size - r->pos) / size)
-                return truncated(r, e, i, error);
-            if (p->role == RS_PLY_FACE_LIST) {
-                rsmooth_status status =
-                    rs_ply_face_begin(r, n, i, -1, (int64_t)count_offset, error);
-                if (status != RSMOOTH_OK)
-                    return status;
-                for (uint64_t j = 0; j < n; j++, r->pos += size) {
-                    status = rs_ply_face_index(r, load_value(data + r->pos, p->type, be), -1,
-                                               (int64_t)r->pos, error);
-                    if (status != RSMOOTH_OK)
-                        return status;
-                }
-                continue;
-            }
-            copy_values(row + p->row_offset, data + count_offset, 1, count_size, r->swap);
-            size_t bytes = (size_t)n * size; /* n * size <= the bytes left */
-            if (bytes == 0)
-                continue; /* list_items may still be NULL */
-            if (!rs_ply_list_reserve(e, bytes))
-                return rs_ply_list_oom(e, error);
-            copy_values(e->list_items + e->list_bytes, data + r->pos, (size_t)n, size, r->swap);
-            e->list_bytes += bytes;
-            r->pos += bytes;
+            rsmooth_status status = read_list(r, e, p, i, row, error);
+            if (status != RSMOOTH_OK)
+                return status;
         }
         if (is_vertex) {
             rsmooth_status status =
@@ -293,4 +310,22 @@ rsmooth_status rs_ply_read_binary_element(rs_ply_reader *r, rs_ply_element *e,
         }
     }
     return RSMOOTH_OK;
+}
+
+rsmooth_status rs_ply_read_binary_element(rs_ply_reader *r, rs_ply_element *e,
+                                          rsmooth_error *error) {
+    bool all_scalar = true;
+    size_t item_size = 0;
+    for (size_t k = 0; k < e->property_count; k++) {
+        const rs_ply_property *p = &e->properties[k];
+        all_scalar = all_scalar && p->count_type == RS_PLY_NONE;
+        item_size += rs_ply_type_size(p->count_type != RS_PLY_NONE ? p->count_type : p->type);
+    }
+    /* item_size is the minimum size of an item, checked for every element in read_data. */
+    if (all_scalar)
+        return read_scalar_element(r, e, item_size, error);
+    if (e == r->face_element && e->property_count == 1 &&
+        (e->properties[0].type == RS_PLY_INT32 || e->properties[0].type == RS_PLY_UINT32))
+        return read_binary_faces(r, e, error);
+    return read_items(r, e, error);
 }
