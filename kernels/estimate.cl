@@ -146,6 +146,68 @@ lanef smallest_exponent(lanef px, lanef py, lanef pz, lanei ox, lanei oy, lanei 
     return e_min;
 }
 
+/* A lane whose Gaussian weights (nearly) all underflowed: redo its sums with the exponents
+ * shifted by their smallest value, as the reference path does. Shifting never changes the
+ * weighted average, only how well float32 holds it. The other influence functions keep
+ * their sums: a weight of zero there is a verdict, not an underflow; but with colour, their
+ * colour factors can underflow, and the colour exponent alone is shifted. Returns each lane's
+ * shift (0 where its sums stand) and replaces *a's sums where it redid them. */
+lanef rescued_sums(robust_acc *a, lanef px, lanef py, lanef pz, lanei ox, lanei oy, lanei oz,
+                   float3 lo, float3 hi, int4 anchor, float reach2, float inv_2sf2,
+                   float inv_2sg2, int influence, float inv_sg2, int predict_centroid,
+                   int use_color, lanef cr, lanef cg, lanef cb, float inv_2sc2,
+                   __global const float4 *facet_color, __global const float4 *facet_centroid,
+                   __global const float4 *normal, __global const int4 *cell_coord,
+                   __global const uint *cell_start, __global const uint *column_first,
+                   __global const int *column_table, uint column_mask, uint *rescue_pairs) {
+#define NO_COLOR 0, (lanef)0.0f, (lanef)0.0f, (lanef)0.0f, inv_2sc2, facet_color
+#define COLOR 1, cr, cg, cb, inv_2sc2, facet_color
+    bool gaussian = influence == RS_INFLUENCE_GAUSSIAN;
+    lanei rescue = gaussian || use_color ? a->k < RS_RESCUE_WEIGHT : (lanei)0;
+    lanef shift = 0.0f;
+#if RS_LANES == 1
+    /* the group variant's rescue: each work-item searches around its own vertex alone */
+    float3 own = (float3)(px + (float)ox, py + (float)oy, pz + (float)oz);
+#define RESCUE_BOX own, own
+#define RESCUE_SUMS robust_sums_own
+#else
+#define RESCUE_BOX lo, hi
+#define RESCUE_SUMS robust_sums
+#endif
+    if (lane_any(rescue)) {
+        lanef e_min = smallest_exponent(px, py, pz, ox, oy, oz, RESCUE_BOX, anchor, reach2,
+                                        gaussian ? inv_2sg2 : 0.0f, predict_centroid,
+                                        influence == RS_INFLUENCE_TUKEY, inv_sg2, use_color,
+                                        cr, cg, cb, inv_2sc2,
+                                        facet_color, facet_centroid, normal, cell_coord,
+                                        cell_start, column_first, column_table, column_mask);
+        shift = select((lanef)0.0f, e_min, rescue && e_min < MAXFLOAT);
+    }
+    if (lane_any(shift != 0.0f)) {
+        robust_acc r;
+        if (use_color)
+            r = RESCUE_SUMS(px, py, pz, ox, oy, oz, RESCUE_BOX, anchor, reach2, inv_2sf2,
+                            inv_2sg2, shift, 0, predict_centroid, influence, inv_sg2, COLOR,
+                            facet_centroid, normal, cell_coord, cell_start, column_first,
+                            column_table, column_mask, rescue_pairs);
+        else
+            r = RESCUE_SUMS(px, py, pz, ox, oy, oz, RESCUE_BOX, anchor, reach2, inv_2sf2,
+                            inv_2sg2, shift, 0, predict_centroid, RS_INFLUENCE_GAUSSIAN, inv_sg2,
+                            NO_COLOR, facet_centroid, normal, cell_coord, cell_start,
+                            column_first, column_table, column_mask, rescue_pairs);
+        lanei redo = shift != 0.0f;
+        a->x = select(a->x, r.x, redo);
+        a->y = select(a->y, r.y, redo);
+        a->z = select(a->z, r.z, redo);
+        a->k = select(a->k, r.k, redo);
+    }
+#undef NO_COLOR
+#undef COLOR
+#undef RESCUE_BOX
+#undef RESCUE_SUMS
+    return shift;
+}
+
 __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float inv_2sg2,
                            int influence, float inv_sg2, int want_confidence, int predict_centroid,
                            int use_color, float inv_2sc2,
@@ -160,7 +222,7 @@ __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float
                            __global uint *block_pairs) {
     uint b = get_global_id(0);
     BEGIN_BLOCK(b, block_count, block_pos, block_cell, block_offset);
-    uint pairs = 0, rescue_pairs = 0;
+    uint pairs = 0;
     lanef cr = 0.0f, cg = 0.0f, cb = 0.0f; /* the lanes' colours, when use_color */
     if (use_color) {
         size_t own = min(b, block_count - 1); /* the group variant's spare work-items */
@@ -230,54 +292,14 @@ __kernel void robust_block(uint block_count, float reach2, float inv_2sf2, float
                         &pairs STAGE_ARGS);
 #endif
     lanef kf = a.kf;
-    /* A lane whose Gaussian weights (nearly) all underflowed: redo its sums with the exponents
-     * shifted by their smallest value, as the reference path does. Shifting never changes the
-     * weighted average, only how well float32 holds it. The other influence functions keep
-     * their sums: a weight of zero there is a verdict, not an underflow; but with colour, their
-     * colour factors can underflow, and the colour exponent alone is shifted. */
-    bool gaussian = influence == RS_INFLUENCE_GAUSSIAN;
-    lanei rescue = gaussian || use_color ? a.k < RS_RESCUE_WEIGHT : (lanei)0;
-    lanef shift = 0.0f;
-#if RS_LANES == 1
-    /* the group variant's rescue: each work-item searches around its own vertex alone */
-    float3 own = (float3)(px + (float)ox, py + (float)oy, pz + (float)oz);
-#define RESCUE_BOX own, own
-#define RESCUE_SUMS robust_sums_own
-#else
-#define RESCUE_BOX lo, hi
-#define RESCUE_SUMS robust_sums
-#endif
-    if (lane_any(rescue)) {
-        lanef e_min = smallest_exponent(px, py, pz, ox, oy, oz, RESCUE_BOX, anchor, reach2,
-                                        gaussian ? inv_2sg2 : 0.0f, predict_centroid,
-                                        influence == RS_INFLUENCE_TUKEY, inv_sg2, use_color,
-                                        cr, cg, cb, inv_2sc2,
-                                        facet_color, facet_centroid, normal, cell_coord,
-                                        cell_start, column_first, column_table, column_mask);
-        shift = select((lanef)0.0f, e_min, rescue && e_min < MAXFLOAT);
-    }
-    if (lane_any(shift != 0.0f)) {
-        robust_acc r;
-        if (use_color)
-            r = RESCUE_SUMS(px, py, pz, ox, oy, oz, RESCUE_BOX, anchor, reach2, inv_2sf2,
-                            inv_2sg2, shift, 0, predict_centroid, influence, inv_sg2, COLOR,
-                            facet_centroid, normal, cell_coord, cell_start, column_first,
-                            column_table, column_mask, &rescue_pairs);
-        else
-            r = RESCUE_SUMS(px, py, pz, ox, oy, oz, RESCUE_BOX, anchor, reach2, inv_2sf2,
-                            inv_2sg2, shift, 0, predict_centroid, RS_INFLUENCE_GAUSSIAN, inv_sg2,
-                            NO_COLOR, facet_centroid, normal, cell_coord, cell_start,
-                            column_first, column_table, column_mask, &rescue_pairs);
-        lanei redo = shift != 0.0f;
-        a.x = select(a.x, r.x, redo);
-        a.y = select(a.y, r.y, redo);
-        a.z = select(a.z, r.z, redo);
-        a.k = select(a.k, r.k, redo);
-    }
+    uint rescue_pairs = 0;
+    lanef shift = rescued_sums(&a, px, py, pz, ox, oy, oz, lo, hi, anchor, reach2, inv_2sf2,
+                               inv_2sg2, influence, inv_sg2, predict_centroid, use_color, cr, cg,
+                               cb, inv_2sc2, facet_color, facet_centroid, normal, cell_coord,
+                               cell_start, column_first, column_table, column_mask,
+                               &rescue_pairs);
 #undef NO_COLOR
 #undef COLOR
-#undef RESCUE_BOX
-#undef RESCUE_SUMS
     if (b >= block_count) /* the group variant's spare work-items */
         return;
     lanei some = a.k > 0.0f;
