@@ -165,29 +165,49 @@ rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void
     return st;
 }
 
-static rsmooth_status smooth_points(rsmooth_scalar scalar, const void *positions,
-                                    const void *normals, size_t point_count,
-                                    const rsmooth_params *params, void *out_positions,
-                                    void *out_normals, float *out_confidence,
-                                    rsmooth_report *report, rsmooth_error *error) {
-    double t_start = rs_now_ms();
-    rs_error_clear(error);
-    rsmooth_params p;
-    rsmooth_status st = rs_params_resolve(params, &p, error, where);
+/* One call of smooth_points: the caller's inputs, the resolved parameters and the state its
+ * steps share across the passes. */
+typedef struct points_run {
+    rsmooth_scalar scalar;
+    const void *positions, *normals; /* the caller's */
+    size_t n;                        /* points */
+    rsmooth_params p;                /* resolved */
+    double scale;                    /* internal units per caller unit (scale.c) */
+    point_arrays a;
+    rs_kdtree tree; /* of the pass's positions, while the pass measures spacings */
+    /* The unit of relative sigmas: the input's spacing, kept through the passes (as meshes keep
+     * their input's mean edge length), so later passes do not shrink their reach. */
+    double unit, input_spacing;
+    rs_pass_progress pp;
+    bool reports;            /* the caller asked for progress or cancellation */
+    size_t weighted_points;  /* points of positive area in the first pass: the report's facets */
+    rsmooth_report sum, one; /* the passes' so far, and this pass's */
+    rsmooth_report *report;  /* the caller's, or NULL */
+    rsmooth_error *error;
+} points_run;
+
+static rsmooth_status no_memory(points_run *r) {
+    return rs_fail(r->error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for %zu points", r->n);
+}
+
+/* Resolves the parameters and checks the caller's arrays, before anything is allocated. */
+static rsmooth_status check_call(points_run *r, const rsmooth_params *params, void *out_positions,
+                                 void *out_normals, float *out_confidence) {
+    rsmooth_error *error = r->error;
+    rsmooth_status st = rs_params_resolve(params, &r->p, error, where);
     if (st != RSMOOTH_OK)
         return st;
-    double scale = 1;
-    if ((st = check_positions(scalar, positions, point_count, &scale, error, where)) !=
+    if ((st = check_positions(r->scalar, r->positions, r->n, &r->scale, error, where)) !=
         RSMOOTH_OK)
         return st;
-    if ((st = rs_check_colors(p.colors, point_count, error, where)) != RSMOOTH_OK)
+    if ((st = rs_check_colors(r->p.colors, r->n, error, where)) != RSMOOTH_OK)
         return st;
-    if (!normals)
+    if (!r->normals)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "normals is NULL: a point cloud needs a normal per point");
-    for (size_t i = 0; i < point_count; i++) {
+    for (size_t i = 0; i < r->n; i++) {
         double n[3];
-        const char *wrong = unit_normal(scalar, normals, i, n);
+        const char *wrong = unit_normal(r->scalar, r->normals, i, n);
         if (wrong)
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                            "point %zu has a %s normal", i, wrong);
@@ -196,156 +216,206 @@ static rsmooth_status smooth_points(rsmooth_scalar scalar, const void *positions
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_positions is NULL");
     /* Every input is read before any output is written, so outputs may be the inputs; but two
      * outputs in one place would mix. */
-    size_t vec_bytes =
-        point_count * rs_vertex_bytes(scalar);
-    size_t conf_bytes = point_count * sizeof(float);
+    size_t vec_bytes = r->n * rs_vertex_bytes(r->scalar);
+    size_t conf_bytes = r->n * sizeof(float);
     if (rs_ranges_overlap(out_positions, vec_bytes, out_normals, vec_bytes) ||
         rs_ranges_overlap(out_positions, vec_bytes, out_confidence, conf_bytes) ||
         rs_ranges_overlap(out_normals, vec_bytes, out_confidence, conf_bytes))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "out_positions, out_normals and out_confidence overlap");
+    return RSMOOTH_OK;
+}
 
-    size_t n = point_count;
-    point_arrays a = {0};
-    a.xyz = rs_alloc_array(n, 3 * sizeof(double));
-    a.next = rs_alloc_array(n, 3 * sizeof(double));
-    a.input_normal = rs_alloc_array(n, 3 * sizeof(double));
-    a.normal = rs_alloc_array(n, 3 * sizeof(double));
-    a.filtered = rs_alloc_array(n, 3 * sizeof(double));
-    a.spacing = rs_alloc_array(n, sizeof(double));
-    a.area = rs_alloc_array(n, sizeof(double));
-    a.confidence = rs_alloc_array(n, sizeof(float));
-    a.prev_confidence = rs_alloc_array(n, sizeof(float));
-    if (p.colors && !isinf(p.sigma_c)) {
+/* The arrays of point_arrays, filled with the scaled positions, the unit input normals and the
+ * colours; false when memory ran out. */
+static bool load_points(points_run *r) {
+    size_t n = r->n;
+    point_arrays *a = &r->a;
+    a->xyz = rs_alloc_array(n, 3 * sizeof(double));
+    a->next = rs_alloc_array(n, 3 * sizeof(double));
+    a->input_normal = rs_alloc_array(n, 3 * sizeof(double));
+    a->normal = rs_alloc_array(n, 3 * sizeof(double));
+    a->filtered = rs_alloc_array(n, 3 * sizeof(double));
+    a->spacing = rs_alloc_array(n, sizeof(double));
+    a->area = rs_alloc_array(n, sizeof(double));
+    a->confidence = rs_alloc_array(n, sizeof(float));
+    a->prev_confidence = rs_alloc_array(n, sizeof(float));
+    if (r->p.colors && !isinf(r->p.sigma_c)) {
         /* a point is its own facet: its colour is the facet's */
-        a.color = rs_alloc_array(n, 3 * sizeof(double));
-        if (!a.color)
-            goto fail_memory;
+        a->color = rs_alloc_array(n, 3 * sizeof(double));
+        if (!a->color)
+            return false;
         for (size_t i = 0; i < 3 * n; i++)
-            a.color[i] = p.colors[i];
+            a->color[i] = r->p.colors[i];
     }
-    rs_kdtree tree = {0};
-    if (!a.xyz || !a.next || !a.input_normal || !a.normal || !a.filtered ||
-        !a.spacing || !a.area || !a.confidence || !a.prev_confidence)
-        goto fail_memory;
-    rs_scale_positions(scalar, positions, n, scale, a.xyz);
+    if (!a->xyz || !a->next || !a->input_normal || !a->normal || !a->filtered || !a->spacing ||
+        !a->area || !a->confidence || !a->prev_confidence)
+        return false;
+    rs_scale_positions(r->scalar, r->positions, n, r->scale, a->xyz);
     for (size_t i = 0; i < n; i++)
-        unit_normal(scalar, normals, i, a.input_normal + 3 * i);
+        unit_normal(r->scalar, r->normals, i, a->input_normal + 3 * i);
+    return true;
+}
 
-    /* The unit of relative sigmas: the input's spacing, kept through the passes (as meshes keep
-     * their input's mean edge length), so later passes do not shrink their reach. */
-    double unit = 0, input_spacing = 0;
-    if (p.mollify) /* the one normal filter points have */
-        p.normal_filter = RSMOOTH_NORMALS_BILATERAL;
-    rs_pass_progress pp = {p.progress, p.progress_cancel, p.progress_user, 0, p.passes};
-    bool reports = p.progress || p.progress_cancel;
-    rsmooth_report sum, one;
-    memset(&sum, 0, sizeof sum);
-    size_t weighted_points = 0;
-    for (int pass = 0; pass < p.passes; pass++) {
-        double t_pass = rs_now_ms();
-        pp.pass = pass;
-        if (reports && rs_report_pass_progress(&pp, 0) != 0) {
-            st = rs_cancelled(error, where);
-            goto done;
-        }
-        if (!rs_kdtree_build(&tree, a.xyz, n))
-            goto fail_memory;
-        double spacing = point_spacings(&tree, a.spacing);
-        if (pass == 0) {
-            input_spacing = spacing;
-            unit = p.absolute ? scale : spacing;
-        }
-        double area_sum = 0;
-        size_t positive = 0;
-        for (size_t i = 0; i < n; i++) {
-            a.area[i] = LATTICE_AREA * a.spacing[i] * a.spacing[i];
-            area_sum += a.area[i];
-            positive += a.area[i] > 0;
-        }
-        if (pass == 0)
-            weighted_points = positive;
-
-        rs_problem pb;
-        memset(&pb, 0, sizeof pb);
-        pb.vertex_count = n;
-        pb.scale = 1; /* the solve writes next positions in internal units, as a.xyz holds */
-        pb.xyz = a.xyz;
-        pb.facet_count = n; /* points of zero area (duplicates) just carry no weight */
-        pb.centroid = a.xyz;
-        pb.normal = a.input_normal;
-        pb.area = a.area;
-        pb.mean_edge_length = input_spacing; /* what the report gives as the unit */
-        pb.mean_area = area_sum / (double)n;
-        st = rs_problem_apply_params(&pb, &p, unit, error, where);
-        if (st != RSMOOTH_OK)
-            goto done;
-        pb.facet_color = pb.colors ? a.color : NULL;
-        pb.progress = NULL;
-        pb.progress_cancel = reports ? rs_report_pass_progress : NULL;
-        pb.progress_user = &pp;
-        rs_kdtree_free(&tree);
-
-        /* Every pass filters the input's normals (pb.normal), at the pass's positions. A mesh's
-         * passes recompute facet normals from the smoother positions; points have no normals but
-         * the input's, and filtering the previous pass's output again stacks the rounds, which
-         * flattens curved parts into facets (on point clouds of the benchmark models, 2 or 3
-         * passes so gave 2-6% lower E_v but 10-30% larger normal errors). The reference solve
-         * writes the normals it predicted with; with no facet to weigh, they stay the input's. */
-        memcpy(a.filtered, a.input_normal, n * 3 * sizeof(double));
-        st = rs_reference_solve(&pb, RSMOOTH_FLOAT64, a.next, NULL, a.confidence, a.filtered,
-                                report ? &one : NULL, t_pass, error, where);
-        if (st != RSMOOTH_OK)
-            goto done;
-        if (report) {
-            one.facet_count = weighted_points;
-            rs_add_pass_report(&sum, &one);
-        }
-        if (pass > 0 && p.pass_confidence > 0) {
-            /* confident points keep what the pass before gave them */
-            for (size_t v = 0; v < n; v++)
-                if (a.prev_confidence[v] >= p.pass_confidence) {
-                    memcpy(a.next + 3 * v, a.xyz + 3 * v, 3 * sizeof(double));
-                    memcpy(a.filtered + 3 * v, a.normal + 3 * v, 3 * sizeof(double));
-                    a.confidence[v] = a.prev_confidence[v];
-                }
-        }
-        for (size_t v = 0; p.move_mask && v < n; v++)
-            if (!p.move_mask[v]) /* held still (scaled by a power of two: exact both ways) */
-                for (int k = 0; k < 3; k++)
-                    a.next[3 * v + (size_t)k] =
-                        rs_coordinate(scalar, positions, 3 * v + (size_t)k) * scale;
-        /* the next pass starts from these positions; its output replaces these normals */
-        double *t = a.xyz;
-        a.xyz = a.next;
-        a.next = t;
-        t = a.normal;
-        a.normal = a.filtered;
-        a.filtered = t;
-        float *c = a.prev_confidence;
-        a.prev_confidence = a.confidence;
-        a.confidence = c;
+/* The pass's problem: every point a facet at its position, with the input's normal and an area
+ * from its spacing at the pass's positions. */
+static rsmooth_status pass_problem(points_run *r, int pass, rs_problem *pb) {
+    size_t n = r->n;
+    point_arrays *a = &r->a;
+    if (!rs_kdtree_build(&r->tree, a->xyz, n))
+        return no_memory(r);
+    double spacing = point_spacings(&r->tree, a->spacing);
+    if (pass == 0) {
+        r->input_spacing = spacing;
+        r->unit = r->p.absolute ? r->scale : spacing;
     }
-    for (size_t v = 0; v < n; v++) {
-        rs_store_position(scalar, out_positions, v, a.xyz + 3 * v, 1 / scale);
+    double area_sum = 0;
+    size_t positive = 0;
+    for (size_t i = 0; i < n; i++) {
+        a->area[i] = LATTICE_AREA * a->spacing[i] * a->spacing[i];
+        area_sum += a->area[i];
+        positive += a->area[i] > 0;
+    }
+    if (pass == 0)
+        r->weighted_points = positive;
+
+    memset(pb, 0, sizeof *pb);
+    pb->vertex_count = n;
+    pb->scale = 1; /* the solve writes next positions in internal units, as a.xyz holds */
+    pb->xyz = a->xyz;
+    pb->facet_count = n; /* points of zero area (duplicates) just carry no weight */
+    pb->centroid = a->xyz;
+    pb->normal = a->input_normal;
+    pb->area = a->area;
+    pb->mean_edge_length = r->input_spacing; /* what the report gives as the unit */
+    pb->mean_area = area_sum / (double)n;
+    rsmooth_status st = rs_problem_apply_params(pb, &r->p, r->unit, r->error, where);
+    if (st != RSMOOTH_OK)
+        return st;
+    pb->facet_color = pb->colors ? a->color : NULL;
+    pb->progress = NULL;
+    pb->progress_cancel = r->reports ? rs_report_pass_progress : NULL;
+    pb->progress_user = &r->pp;
+    rs_kdtree_free(&r->tree);
+    return RSMOOTH_OK;
+}
+
+/* After a pass's solve: confident points keep the pass before's result, held points their input
+ * position; then this pass's arrays become the next pass's input. */
+static void finish_pass(points_run *r, int pass) {
+    size_t n = r->n;
+    point_arrays *a = &r->a;
+    const rsmooth_params *p = &r->p;
+    if (pass > 0 && p->pass_confidence > 0) {
+        /* confident points keep what the pass before gave them */
+        for (size_t v = 0; v < n; v++)
+            if (a->prev_confidence[v] >= p->pass_confidence) {
+                memcpy(a->next + 3 * v, a->xyz + 3 * v, 3 * sizeof(double));
+                memcpy(a->filtered + 3 * v, a->normal + 3 * v, 3 * sizeof(double));
+                a->confidence[v] = a->prev_confidence[v];
+            }
+    }
+    for (size_t v = 0; p->move_mask && v < n; v++)
+        if (!p->move_mask[v]) /* held still (scaled by a power of two: exact both ways) */
+            for (int k = 0; k < 3; k++)
+                a->next[3 * v + (size_t)k] =
+                    rs_coordinate(r->scalar, r->positions, 3 * v + (size_t)k) * r->scale;
+    /* the next pass starts from these positions; its output replaces these normals */
+    double *t = a->xyz;
+    a->xyz = a->next;
+    a->next = t;
+    t = a->normal;
+    a->normal = a->filtered;
+    a->filtered = t;
+    float *c = a->prev_confidence;
+    a->prev_confidence = a->confidence;
+    a->confidence = c;
+}
+
+/* One pass: the bilateral filter's solve on the points at the previous pass's positions. */
+static rsmooth_status run_pass(points_run *r, int pass) {
+    double t_pass = rs_now_ms();
+    r->pp.pass = pass;
+    if (r->reports && rs_report_pass_progress(&r->pp, 0) != 0)
+        return rs_cancelled(r->error, where);
+    rs_problem pb;
+    rsmooth_status st = pass_problem(r, pass, &pb);
+    if (st != RSMOOTH_OK)
+        return st;
+    /* Every pass filters the input's normals (pb.normal), at the pass's positions. A mesh's
+     * passes recompute facet normals from the smoother positions; points have no normals but
+     * the input's, and filtering the previous pass's output again stacks the rounds, which
+     * flattens curved parts into facets (on point clouds of the benchmark models, 2 or 3
+     * passes so gave 2-6% lower E_v but 10-30% larger normal errors). The reference solve
+     * writes the normals it predicted with; with no facet to weigh, they stay the input's. */
+    point_arrays *a = &r->a;
+    memcpy(a->filtered, a->input_normal, r->n * 3 * sizeof(double));
+    st = rs_reference_solve(&pb, RSMOOTH_FLOAT64, a->next, NULL, a->confidence, a->filtered,
+                            r->report ? &r->one : NULL, t_pass, r->error, where);
+    if (st != RSMOOTH_OK)
+        return st;
+    if (r->report) {
+        r->one.facet_count = r->weighted_points;
+        rs_add_pass_report(&r->sum, &r->one);
+    }
+    finish_pass(r, pass);
+    return RSMOOTH_OK;
+}
+
+/* The last pass's positions, normals and confidence into the caller's arrays, and the report. */
+static rsmooth_status write_points(points_run *r, void *out_positions, void *out_normals,
+                                   float *out_confidence, double t_start) {
+    const point_arrays *a = &r->a;
+    for (size_t v = 0; v < r->n; v++) {
+        rs_store_position(r->scalar, out_positions, v, a->xyz + 3 * v, 1 / r->scale);
         if (out_normals)
-            rs_store_position(scalar, out_normals, v, a.normal + 3 * v, 1); /* unit vectors */
+            rs_store_position(r->scalar, out_normals, v, a->normal + 3 * v, 1); /* unit vectors */
         if (out_confidence)
-            out_confidence[v] = a.prev_confidence[v];
+            out_confidence[v] = a->prev_confidence[v];
     }
-    if (report) {
-        *report = sum;
-        rs_report_unscale(report, 1 / scale);
-        report->ms_total = rs_now_ms() - t_start;
+    if (r->report) {
+        *r->report = r->sum;
+        rs_report_unscale(r->report, 1 / r->scale);
+        r->report->ms_total = rs_now_ms() - t_start;
     }
-    st = rs_check_results(scalar, out_positions, NULL, out_confidence, n, "point", error, where);
-    goto done;
+    return rs_check_results(r->scalar, out_positions, NULL, out_confidence, r->n, "point", r->error,
+                            where);
+}
 
-fail_memory:
-    st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for %zu points", n);
+static rsmooth_status smooth_points(rsmooth_scalar scalar, const void *positions,
+                                    const void *normals, size_t point_count,
+                                    const rsmooth_params *params, void *out_positions,
+                                    void *out_normals, float *out_confidence,
+                                    rsmooth_report *report, rsmooth_error *error) {
+    double t_start = rs_now_ms();
+    rs_error_clear(error);
+    points_run r;
+    memset(&r, 0, sizeof r);
+    r.scalar = scalar;
+    r.positions = positions;
+    r.normals = normals;
+    r.n = point_count;
+    r.scale = 1;
+    r.report = report;
+    r.error = error;
+    rsmooth_status st = check_call(&r, params, out_positions, out_normals, out_confidence);
+    if (st != RSMOOTH_OK)
+        return st;
+    if (!load_points(&r)) {
+        st = no_memory(&r);
+        goto done;
+    }
+    if (r.p.mollify) /* the one normal filter points have */
+        r.p.normal_filter = RSMOOTH_NORMALS_BILATERAL;
+    r.pp = (rs_pass_progress){r.p.progress, r.p.progress_cancel, r.p.progress_user, 0, r.p.passes};
+    r.reports = r.p.progress || r.p.progress_cancel;
+    for (int pass = 0; pass < r.p.passes && st == RSMOOTH_OK; pass++)
+        st = run_pass(&r, pass);
+    if (st == RSMOOTH_OK)
+        st = write_points(&r, out_positions, out_normals, out_confidence, t_start);
 done:
-    rs_kdtree_free(&tree);
-    free_arrays(&a);
+    rs_kdtree_free(&r.tree);
+    free_arrays(&r.a);
     rs_release_free_memory();
     return st;
 }
