@@ -228,8 +228,9 @@ def tables(rows, models, fmt):
             m, r["ms_paper"], r["ms_preset"], r["ms_best"], r["ms_best"] / r["ms_paper"]))
     preset = [rows[m]["ms_preset"] / rows[m]["ms_paper"] for m in models]
     tuned = [rows[m]["ms_best"] / rows[m]["ms_paper"] for m in models]
-    time_summary = ("The accuracy is not free: `--best` takes %.1f to %.1f times the paper "
-                    "filter's time at its defaults here, and the tuned settings %.1f to %.1f "
+    time_summary = ("The accuracy is not free: version 0.5's `--best` took %.1f to %.1f times "
+                    "the paper filter's time at its defaults here (the present `--best` costs "
+                    "far more: [best-mode.md](best-mode.md)), and the tuned settings %.1f to %.1f "
                     "times (their bilateral rounds and passes; every pass also redoes the host "
                     "work, which dominates on meshes this small)." % (
                         min(preset), max(preset), min(tuned), max(tuned)))

@@ -1,18 +1,24 @@
 #!/usr/bin/env python3
-"""Speed figures for the README's "Performance" section (issue 5), regenerated, never typed.
+"""Speed figures for docs/performance.md, regenerated, never typed.
 
 Runs build/rsmooth-bench and build/rsmooth on this machine and writes
   docs/results/performance/*.json   each benchmark's JSON, as printed
-  README.md                          the table between the "performance" markers
+  docs/performance.md                the text and tables between its "performance" markers
+                                     (never README.md)
 
     python3 scripts/performance.py [--build build] [--before OLD_BUILD [--before-label T]] [--quick]
+    python3 scripts/performance.py --render [--before-label T] [--machine TEXT]
 
 --quick skips the 4M and 16M runs (minutes, several GiB of memory). --before runs the headline
 cases (Bunny, 200k, the command's setup, Fandisk end to end, --best against the paper filter)
-on an older build too, alternating with this one, for a before/after table. Needs only the standard
-library. Run it on a quiet machine: every figure is a median, but the ratios that matter
-(useful pairs/s against the native roofline, per-triangle time across sizes, tiled against
-untiled) are each measured within one run or back to back.
+on an older build too, alternating with this one, and quotes its figures as "before"; T names it
+in the text (e.g. "commit 445f166"; default: its path). --render runs nothing: it rewrites the
+section from the JSON already in docs/results/performance/ (the machine and the before label come
+from after-headline.json, or from --machine and --before-label where an older run did not record
+them; "before" figures are quoted only with a label). Needs only the standard library. Run it on a
+quiet machine: every figure is a median, but the ratios that matter (useful pairs/s against the
+native roofline, per-triangle time across sizes, tiled against untiled) are each measured within
+one run or back to back.
 """
 import argparse
 import json
@@ -27,7 +33,12 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SHARED = os.path.join(os.path.dirname(ROOT), "shared", "data", "benchmark")
 OUT = os.path.join(ROOT, "docs", "results", "performance")
+PAGE = os.path.join(ROOT, "docs", "performance.md")
 BEGIN, END = "<!-- BEGIN performance", "<!-- END performance -->"
+# The JSON files of one run (docs/results/performance/NAME.json), by the key the text uses.
+RUN_FILES = {"cold": "program-build-cold", "s1M": "scaling-1M", "s4M": "scaling-4M",
+             "s16M": "scaling-16M", "tiled": "scaling-16M-256M"}
+HEADLINE_FILES = {"bunny": "bunny0.2-2-0.5", "g200k": "generated-200k-4-1"}
 
 
 def bench(build, name, args, env=None):
@@ -68,13 +79,14 @@ def command_json_ms(build, mesh, extra, runs=7):
 
 
 def headline(build, tag):
-    """The issue-17 targets' figures for one build (each a median, on this machine)."""
+    """The headline figures for one build (each a median, on this machine)."""
     out = {}
     bunny = os.path.join(SHARED, "Bunny0.2", "Noisy.obj")
     fandisk = os.path.join(SHARED, "Fandisk0.3", "Noisy.obj")
     if os.path.exists(bunny):
-        out["bunny"] = bench(build, f"{tag}-bunny0.2-2-0.5", [bunny, "--repeat", "9"])
-    out["g200k"] = bench(build, f"{tag}-generated-200k-4-1",
+        out["bunny"] = bench(build, f"{tag}-{HEADLINE_FILES['bunny']}",
+                             [bunny, "--repeat", "9"])
+    out["g200k"] = bench(build, f"{tag}-{HEADLINE_FILES['g200k']}",
                          ["--triangles", "200000", "--sigma-f", "4", "--sigma-g", "1",
                           "--repeat", "9"])
     if os.path.exists(fandisk):
@@ -88,34 +100,50 @@ def headline(build, tag):
     return out
 
 
-def headline_rows(before, after):
-    """Rows of the before/after table: figure, before, after, target, met."""
-    rows = []
+def standing(before, after, label):
+    """The paragraph on where the headline figures stand, each with its "before" figure when an
+    older build was measured too."""
+    b = before or {}
 
-    def add(name, key_fn, target, limit, unit="ms", fmt="{:.0f}"):
-        b = key_fn(before) if before else None
-        a = key_fn(after)
-        if a is None:
-            return
-        cell = lambda v: "–" if v is None else fmt.format(v) + (f" {unit}" if unit else "")
-        met = "yes" if (a <= limit if unit else a >= limit) else "**no**"
-        rows.append(f"| {name} | {cell(b)} | **{cell(a)}** | {target} | {met} |")
+    def was(key, fmt, text):
+        """text.format(the before figure), or "" where there is none."""
+        v = b.get(key)
+        return text.format(fmt.format(v)) if v is not None else ""
 
-    get = lambda case, f: (lambda r: f(r[case]) if case in r else None)
-    add("200k at σ 4/1, filter total", get("g200k", lambda r: ms(r, "total")), "≤ 70 ms", 70)
-    add("200k, useful-pair ratio (robust)", get("g200k", lambda r: r["robust"]["ratio"]),
-        "≥ 0.5", 0.5, unit="", fmt="{:.2f}")
-    add("200k, useful-pair ratio (mollify)", get("g200k", lambda r: r["mollify"]["ratio"]),
-        "≥ 0.5", 0.5, unit="", fmt="{:.2f}")
-    add("Bunny0.2 at σ 2/0.5, filter total", get("bunny", lambda r: ms(r, "total")), "≤ 18 ms",
-        18)
-    add("command setup (`--json` setup, warm caches), Fandisk0.3",
-        lambda r: r.get("setup"), "≤ 35 ms", 35)
-    add("Fandisk0.3 end to end", lambda r: r.get("fandisk_ms"), "≤ 100 ms", 100)
-    ratio = lambda r: (r["best_filter"] / r["paper_filter"]) if "best_filter" in r else None
-    add("`--best` / paper filter, Bunny0.2 (filter times)", ratio, "≤ 3×", 3, unit="×",
-        fmt="{:.1f}")
-    return rows
+    g = after["g200k"]
+    text = "What these figures stand at"
+    if before:
+        text += f", measured one after the other against {label}\n(\"before\")"
+    clauses = []
+    clauses.append(f" the 200k-triangle case at σ 4/1 filters in **{ms(g, 'total'):.0f} ms**" +
+                   (f" ({ms(b['g200k'], 'total'):.0f} ms\nbefore)" if "g200k" in b else ""))
+    robust, mollify = g["robust"].get("ratio"), g["mollify"].get("ratio")
+    if robust is not None and mollify is not None:
+        c = (f" its useful-pair ratio is **{robust:.2f}** for the robust pass and "
+             f"**{mollify:.2f}** for mollification")
+        if "g200k" in b and b["g200k"]["robust"].get("ratio") is not None:
+            c += (f"\n({b['g200k']['robust']['ratio']:.2f} and "
+                  f"{b['g200k']['mollify']['ratio']:.2f} before)")
+        if g.get("kernel_variant", "block") == "block" and max(robust, mollify) < 0.5:
+            c += (f", which whole cells and {g.get('lanes', 8)}-wide blocks bound below 0.5 on a "
+                  "CPU (below)")
+        clauses.append(c)
+    if "bunny" in after:
+        clauses.append(f"\nBunny0.2 at σ 2/0.5 filters in **{ms(after['bunny'], 'total'):.0f} ms**"
+                       + (f" ({ms(b['bunny'], 'total'):.0f} ms before)" if "bunny" in b else ""))
+    if "setup" in after and "fandisk_ms" in after:
+        clauses.append(f" the command's setup on Fandisk0.3 with\nwarm caches takes "
+                       f"**{after['setup']:.0f} ms**" + was("setup", "{:.0f}", " ({} ms before)") +
+                       f" and the whole run **{after['fandisk_ms']:.0f} ms**" +
+                       was("fandisk_ms", "{:.0f}", " ({} ms before)"))
+    text += ":" + ";".join(clauses) + "."
+    ratio = lambda r: (r["best_filter"] / r["paper_filter"]
+                       if "best_filter" in r and "paper_filter" in r else None)
+    if ratio(after) is not None:
+        text += (f" `--best`\ntakes **{ratio(after):.0f}×** the paper filter's filter time on "
+                 "Bunny0.2" + (f" ({ratio(b):.0f}× before)" if ratio(b) is not None else "") +
+                 ", because its normal update\nstage runs on the host ([best-mode.md](best-mode.md)).")
+    return text
 
 
 def machine():
@@ -144,64 +172,33 @@ def fmt_pass(result, name):
             f"(**{p['ratio']:.2f}**), waste {p['waste']:.0%}")
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--build", default=os.path.join(ROOT, "build"))
-    ap.add_argument("--before", help="an older build to compare the headline figures with")
-    ap.add_argument("--before-label", default=None,
-                    help="what the older build is, for the table (default: its path)")
-    ap.add_argument("--quick", action="store_true")
-    a = ap.parse_args()
-    os.makedirs(OUT, exist_ok=True)
-
-    before = headline(a.before, "before") if a.before else None
-    after = headline(a.build, "after")
-    runs = {}
-    # empty PoCL and rsmooth program caches: the cold build
-    with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as programs:
-        runs["cold"] = bench(a.build, "program-build-cold",
-                             ["--triangles", "2000", "--repeat", "1", "--no-pairs"],
-                             env={"POCL_CACHE_DIR": cache, "RSMOOTH_CACHE_DIR": programs})
-    if "bunny" in after:
-        runs["bunny"] = after["bunny"]
-    runs["g200k"] = after["g200k"]
-    sizes = [("1M", 1000000, 5)] + ([] if a.quick else [("4M", 4000000, 3), ("16M", 16000000, 3)])
-    for label, n, rep in sizes:
-        runs["s" + label] = bench(a.build, f"scaling-{label}",
-                                  ["--triangles", str(n), "--repeat", str(rep), "--no-pairs"])
-    if not a.quick:
-        runs["tiled"] = bench(a.build, "scaling-16M-256M",
-                              ["--triangles", "16000000", "--repeat", "3", "--no-pairs",
-                               "--memory-budget", "256M"])
-    fandisk_ms = (after["fandisk_ms"],) if "fandisk_ms" in after else None
-
+def section(before, after, runs, label, machine_text):
+    """The text between the markers, from the runs' JSON."""
     device = runs["g200k"]["device"]
+    pocl_cpu = (" (PoCL's CPU device)" if device.startswith("Portable Computing Language") and
+                runs["g200k"].get("kernel_variant", "block") == "block" else "")
     lines = [f"{BEGIN} (generated by scripts/performance.py; do not edit) -->", "",
-             f"Measured on {machine()}, through {device} (PoCL's CPU device), with "
+             f"Measured on {machine_text}, through {device}{pocl_cpu}, with "
              "`python3 scripts/performance.py` (JSON in `docs/results/performance/`). Filter "
              "time excludes file I/O and the program build; every time is the median of the "
              "runs after a first one.", ""]
     g = runs["g200k"]
     lines += [f"Kernels: the {g.get('kernel_variant', 'block')} variant, "
               f"{g.get('lanes', 8)} vertices per work-item, work-groups of "
-              f"{g.get('work_group', 64)} (chosen per device; see How it works).", ""]
-    label = a.before_label or (a.before and os.path.relpath(a.before, ROOT))
-    lines += ["Issue 17's targets" + (f", before ({label}) and after, run one after the other:"
-                                      if before else ":"), "",
-              "| figure | before | after | target | met |", "| --- | --- | --- | --- | --- |"]
-    lines += headline_rows(before, after) + [""]
+              f"{g.get('work_group', 64)} (chosen per device; see [method.md](method.md)).", ""]
+    lines += [standing(before, after, label), ""]
     lines += ["| case | filter total | facets + grid | mollify | robust | useful pairs/s, "
-              "robust (of the native roofline: **ratio**) | mollify | target |",
-              "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+              "robust (of the native roofline: **ratio**) | mollify |",
+              "| --- | --- | --- | --- | --- | --- | --- |"]
     cases = []
     if "bunny" in runs:
-        cases.append(("Bunny0.2, σ 2 / 0.5", runs["bunny"], "≤ 18 ms"))
-    cases.append(("generated 200k triangles, σ 4 / 1", runs["g200k"], "≤ 70 ms, ratio ≥ 0.5"))
-    for name, r, target in cases:
+        cases.append(("Bunny0.2, σ 2 / 0.5", runs["bunny"]))
+    cases.append(("generated 200k triangles, σ 4 / 1", runs["g200k"]))
+    for name, r in cases:
         lines.append(f"| {name} | **{ms(r, 'total'):.0f} ms** | "
                      f"{ms(r, 'facets') + ms(r, 'grid'):.0f} ms | {ms(r, 'mollify'):.0f} ms | "
                      f"{ms(r, 'robust'):.0f} ms | {fmt_pass(r, 'robust')} | "
-                     f"{fmt_pass(r, 'mollify')} | {target} |")
+                     f"{fmt_pass(r, 'mollify')} |")
     lines += ["", "Scaling (generated closed cylinders, σ 2 / 0.5; memory is the peak resident "
               "size the filter added to the process, per triangle):", "",
               "| triangles | filter total | per triangle | vs 1M | filter memory | tiles |",
@@ -212,8 +209,8 @@ def main():
             continue
         r = runs[key]
         per = ms(r, "total") / r["triangles"]
-        label = f"{r['triangles'] / 1e6:.0f}M" + (" (256 MB budget)" if key == "tiled" else "")
-        lines.append(f"| {label} | {ms(r, 'total') / 1e3:.2f} s | {per * 1e6:.0f} ns | "
+        size = f"{r['triangles'] / 1e6:.0f}M" + (" (256 MB budget)" if key == "tiled" else "")
+        lines.append(f"| {size} | {ms(r, 'total') / 1e3:.2f} s | {per * 1e6:.0f} ns | "
                      f"{per / base:.2f}× | {r['filter_bytes_per_triangle']:.0f} B | "
                      f"{r['tiles']} |")
     if "tiled" in runs and "s16M" in runs:
@@ -228,22 +225,110 @@ def main():
               "program cache; the first launch "
               f"of the kernels adds PoCL's code generation ({cold['kernel_codegen_ms']:.0f} ms, "
               "cold cache)."]
-    if fandisk_ms:
+    if "fandisk_ms" in after:
         lines.append(f"`rsmooth Fandisk0.3/Noisy.obj -o out.obj` end to end (process start to "
-                     f"file written, warm cache): **{fandisk_ms[0]:.0f} ms** median of 7 "
-                     "(target ≤ 100 ms).")
+                     f"file written, warm cache): **{after['fandisk_ms']:.0f} ms** median of 7.")
     lines += ["", END]
-    section = "\n".join(lines)
+    return "\n".join(lines)
 
-    readme = os.path.join(ROOT, "README.md")
-    text = open(readme).read()
-    if BEGIN in text:
-        head, rest = text.split(BEGIN, 1)
-        text = head + section + rest.split(END, 1)[1]
-    else:
-        text = text.rstrip("\n") + "\n\n" + section + "\n"
-    open(readme, "w").write(text)
-    print(section)
+
+def write_section(text):
+    """Replaces what lies between docs/performance.md's markers."""
+    page = open(PAGE).read()
+    if BEGIN not in page or END not in page:
+        sys.exit("performance.py: %s has no performance markers (%s ... %s)" % (PAGE, BEGIN, END))
+    head, rest = page.split(BEGIN, 1)
+    page = head + text + rest.split(END, 1)[1]
+    with open(PAGE + ".tmp", "w") as f:
+        f.write(page)
+    os.replace(PAGE + ".tmp", PAGE)
+
+
+def load(name):
+    with open(os.path.join(OUT, name + ".json")) as f:
+        return json.load(f)
+
+
+def saved_headline(tag):
+    """One build's headline figures as a run left them in docs/results/performance/."""
+    if not os.path.exists(os.path.join(OUT, f"{tag}-headline.json")):
+        return None
+    out = dict(load(f"{tag}-headline"))
+    for key, name in HEADLINE_FILES.items():
+        if os.path.exists(os.path.join(OUT, f"{tag}-{name}.json")):
+            out[key] = load(f"{tag}-{name}")
+    return out
+
+
+def render_saved(a):
+    """--render: the section from the JSON of the last run; nothing is run."""
+    after = saved_headline("after")
+    if after is None:
+        sys.exit("performance.py: no after-headline.json in %s; run the benchmarks first" % OUT)
+    label = a.before_label or after.get("before_label")
+    before = saved_headline("before") if label else None
+    machine_text = a.machine or after.get("machine")
+    if not machine_text:
+        sys.exit("performance.py: after-headline.json does not say which machine ran it; "
+                 "pass --machine")
+    names = after.get("runs", list(RUN_FILES.values()))
+    runs = {k: load(RUN_FILES[k]) for k in RUN_FILES
+            if RUN_FILES[k] in names and os.path.exists(os.path.join(OUT, RUN_FILES[k] + ".json"))}
+    for key in HEADLINE_FILES:
+        if key in after:
+            runs[key] = after[key]
+    return section(before, after, runs, label, machine_text)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--build", default=os.path.join(ROOT, "build"))
+    ap.add_argument("--before", help="an older build to compare the headline figures with")
+    ap.add_argument("--before-label", default=None,
+                    help="what the older build is, for the text (default: its path)")
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--render", action="store_true",
+                    help="rewrite the section from the saved JSON; run nothing")
+    ap.add_argument("--machine", help="with --render: the machine the JSON was measured on, "
+                    "where after-headline.json does not record it")
+    a = ap.parse_args()
+    if a.render:
+        text = render_saved(a)
+        write_section(text)
+        print(text)
+        return
+    os.makedirs(OUT, exist_ok=True)
+
+    before = headline(a.before, "before") if a.before else None
+    after = headline(a.build, "after")
+    runs = {}
+    # empty PoCL and rsmooth program caches: the cold build
+    with tempfile.TemporaryDirectory() as cache, tempfile.TemporaryDirectory() as programs:
+        runs["cold"] = bench(a.build, RUN_FILES["cold"],
+                             ["--triangles", "2000", "--repeat", "1", "--no-pairs"],
+                             env={"POCL_CACHE_DIR": cache, "RSMOOTH_CACHE_DIR": programs})
+    if "bunny" in after:
+        runs["bunny"] = after["bunny"]
+    runs["g200k"] = after["g200k"]
+    sizes = [("1M", 1000000, 5)] + ([] if a.quick else [("4M", 4000000, 3), ("16M", 16000000, 3)])
+    for size, n, rep in sizes:
+        runs["s" + size] = bench(a.build, RUN_FILES["s" + size],
+                                 ["--triangles", str(n), "--repeat", str(rep), "--no-pairs"])
+    if not a.quick:
+        runs["tiled"] = bench(a.build, RUN_FILES["tiled"],
+                              ["--triangles", "16000000", "--repeat", "3", "--no-pairs",
+                               "--memory-budget", "256M"])
+    label = (a.before_label or os.path.relpath(a.before, ROOT)) if a.before else None
+    machine_text = machine()
+    # what --render needs to write the same text again
+    record = {k: v for k, v in after.items() if not isinstance(v, dict)}
+    record.update(machine=machine_text, before_label=label,
+                  runs=[RUN_FILES[k] for k in RUN_FILES if k in runs])
+    with open(os.path.join(OUT, "after-headline.json"), "w") as f:
+        json.dump(record, f, indent=1)
+    text = section(before, after, runs, label, machine_text)
+    write_section(text)
+    print(text)
 
 
 if __name__ == "__main__":
