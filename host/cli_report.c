@@ -36,9 +36,12 @@ int cli_list_devices(void) {
     for (size_t i = 0; i < n && i < 64; i++) {
         char pd[16];
         snprintf(pd, sizeof pd, "%d:%d", devices[i].platform_index, devices[i].device_index);
+        char version[1024]; /* the field holds 63 bytes; this the whole version */
+        if (rsmooth_device_version(devices[i].platform_index, devices[i].device_index, version,
+                                   sizeof version) == 0)
+            snprintf(version, sizeof version, "%s", devices[i].version);
         printf("%-5s %-5s %-*s %6u %6.1f GiB  %s\n", pd, devices[i].type, width, devices[i].name,
-               devices[i].compute_units, (double)devices[i].global_memory / (1u << 30),
-               devices[i].version);
+               devices[i].compute_units, (double)devices[i].global_memory / (1u << 30), version);
     }
     printf("--device auto picks the first GPU, else the first CPU device; --device reference runs "
            "the double-precision C path.\n");

@@ -293,6 +293,25 @@ int main(void) {
               strlen(devices[i].version) < sizeof devices[i].version);
     printf("devices: %zu, first %s (%s, %u compute units, %s)\n", device_count, devices[0].name,
            devices[0].type, devices[0].compute_units, devices[0].version);
+    /* rsmooth_device_version: the whole CL_DEVICE_VERSION as the driver gives it (asked here
+     * straight from OpenCL), snprintf's contract on short buffers, "" and 0 for no device */
+    {
+        cl_device_id device = NULL;
+        clGetCommandQueueInfo(rsmooth_context_queue(other), CL_QUEUE_DEVICE, sizeof device,
+                              &device, NULL);
+        char truth[1024] = "", whole[1024], cut[8] = "xxxxxxx";
+        CHECK(clGetDeviceInfo(device, CL_DEVICE_VERSION, sizeof truth, truth, NULL) ==
+              CL_SUCCESS);
+        size_t length = rsmooth_device_version(0, 0, whole, sizeof whole);
+        CHECK(length == strlen(truth) && strcmp(whole, truth) == 0);
+        CHECK(strncmp(whole, devices[0].version, sizeof devices[0].version - 1) == 0);
+        CHECK(rsmooth_device_version(0, 0, NULL, 0) == length);
+        CHECK(rsmooth_device_version(0, 0, cut, sizeof cut) == length);
+        CHECK(strlen(cut) == sizeof cut - 1 && strncmp(cut, truth, sizeof cut - 1) == 0);
+        CHECK(rsmooth_device_version(99, 0, cut, sizeof cut) == 0 && cut[0] == '\0');
+        CHECK(rsmooth_device_version(0, -1, whole, sizeof whole) == 0 && whole[0] == '\0');
+        printf("device 0:0 version, whole: %s (%zu bytes)\n", truth, length);
+    }
     smooth_cube(other, &cube, c);
     rsmooth_context_destroy(other);
     other = NULL;

@@ -76,6 +76,9 @@ static int missing_loader(void) {
     rsmooth_device_info devices[4];
     CHECK_EQ_INT(rsmooth_list_devices(devices, 4), 0);
     CHECK_EQ_INT(rsmooth_list_devices(NULL, 0), 0);
+    char version[16] = "x";
+    CHECK_EQ_INT(rsmooth_device_version(0, 0, version, sizeof version), 0);
+    CHECK(version[0] == '\0');
     check_reference();
     printf("missing loader: OpenCL refused with the reason, reference path works\n");
     return 0;

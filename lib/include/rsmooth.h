@@ -640,6 +640,15 @@ RSMOOTH_API void rsmooth_device_info_init(rsmooth_device_info *info);
  * (0 when no OpenCL platform exists). Thread-safe. */
 RSMOOTH_API size_t rsmooth_list_devices(rsmooth_device_info *devices, size_t capacity);
 
+/** The whole CL_DEVICE_VERSION of device `device_index` of platform `platform_index` (the
+ * numbers of an rsmooth_device_info), which its `version` field holds only the first 63 bytes of.
+ * Writes as much as fits `size` bytes, always terminated when `size` > 0 (`out` may be NULL when
+ * `size` is 0), and returns the whole version's length without the terminator, as snprintf
+ * does; returns 0 and writes "" when there is no such device or no OpenCL platform. Thread-safe.
+ * (Added in 0.10) */
+RSMOOTH_API size_t rsmooth_device_version(int platform_index, int device_index, char *out,
+                                          size_t size);
+
 /** Releases everything the context holds. Accepts NULL. Called from a progress callback of a call
  * still running on ctx, does nothing (the call would go on with freed objects). */
 RSMOOTH_API void rsmooth_context_destroy(rsmooth_context *ctx);

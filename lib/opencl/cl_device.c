@@ -102,6 +102,36 @@ void rsmooth_device_info_init(rsmooth_device_info *info) {
     info->struct_size = sizeof *info;
 }
 
+size_t rsmooth_device_version(int platform_index, int device_index, char *out, size_t size) {
+    if (out && size > 0)
+        out[0] = '\0';
+    if (rs_cl_load("rsmooth_device_version", NULL) != RSMOOTH_OK)
+        return 0;
+    candidate all[MAX_DEVICES];
+    int n = list_devices(all, MAX_DEVICES);
+    for (int i = 0; i < n; i++) {
+        if (all[i].platform_index != platform_index || all[i].device_index != device_index)
+            continue;
+        size_t need = 0;
+        if (clGetDeviceInfo(all[i].device, CL_DEVICE_VERSION, 0, NULL, &need) != CL_SUCCESS ||
+            need == 0)
+            return 0;
+        char *text = malloc(need + 1);
+        if (!text)
+            return 0;
+        size_t length = 0;
+        if (clGetDeviceInfo(all[i].device, CL_DEVICE_VERSION, need, text, NULL) == CL_SUCCESS) {
+            text[need] = '\0';
+            length = strlen(text);
+            if (out && size > 0)
+                copy_cut(text, out, size);
+        }
+        free(text);
+        return length;
+    }
+    return 0;
+}
+
 size_t rsmooth_list_devices(rsmooth_device_info *devices, size_t capacity) {
     if (rs_cl_load("rsmooth_list_devices", NULL) != RSMOOTH_OK)
         return 0; /* no loader: no platform either */

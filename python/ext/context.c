@@ -85,7 +85,12 @@ PyObject *ext_devices(PyObject *self, PyObject *args) {
             "global_memory", (unsigned long long)d->global_memory);
         PyObject *id = item ? PyUnicode_FromFormat("%d:%d", d->platform_index, d->device_index)
                             : NULL;
-        PyObject *version = item ? PyUnicode_FromString(d->version) : NULL;
+        char whole[1024]; /* d->version holds 63 bytes of it */
+        const char *v = rsmooth_device_version(d->platform_index, d->device_index, whole,
+                                               sizeof whole) > 0
+                            ? whole
+                            : d->version;
+        PyObject *version = item ? PyUnicode_FromString(v) : NULL;
         if (!id || !version || PyDict_SetItemString(item, "id", id) != 0 ||
             PyDict_SetItemString(item, "version", version) != 0 || PyList_Append(list, item) != 0) {
             Py_CLEAR(list);
