@@ -31,8 +31,8 @@ demo: build
 	@echo "error before:" && $(BUILD)/rsmooth-demo-shape compare $(DEMO)/noisy.ply $(DEMO)/truth.ply
 	@echo "error after: " && $(BUILD)/rsmooth-demo-shape compare $(DEMO)/smoothed.ply $(DEMO)/truth.ply
 
-# Regenerates docs/experiments.md, docs/img/ and the README's "How well does it work" from
-# ../shared/data (about 20 minutes on 2 cores; reruns reuse out/experiments/cache.json).
+# Regenerates docs/experiments.md and docs/img/ from the benchmark meshes beside the checkout
+# (../shared/data; about 20 minutes on 2 cores; reruns reuse out/experiments/cache.json).
 experiments: build
 	@.ci/install-deps.sh experiments
 	POCL_CACHE_DIR=$(abspath $(BUILD))/pocl-cache python3 scripts/experiments.py
