@@ -3,7 +3,8 @@
 # path the command has, the stream and MPI writers, compare, noise), so that two builds (before
 # and after a change that must not change results) can be compared with diff:
 #   scripts/same_bytes.sh build-old > old.txt; scripts/same_bytes.sh build > new.txt; diff old.txt new.txt
-# Timings and versions are left out of what is hashed.
+# Timings and versions are left out of what is hashed; the last line is rsmooth-bench filter's
+# figures but its timings.
 set -euo pipefail
 build=$(cd "${1:-build}" && pwd)
 work=$(mktemp -d)
@@ -42,3 +43,11 @@ printf '%-28s %s\n' compare "$("$build/rsmooth" compare default-reference.ply t.
 printf '%-28s %s\n' noise "$("$build/rsmooth" noise n.ply 2>&1 | sha256sum | cut -c1-16)"
 printf '%-28s %s\n' json "$("$build/rsmooth" n.ply -o j.ply --force --device reference --json 2>/dev/null |
   sed 's/"ms":{[^}]*}//' | sha256sum | cut -c1-16)"
+# rsmooth-bench filter on a generated mesh: every field but timings, memory and cache states
+printf '%-28s %s\n' bench "$("$build/rsmooth-bench" filter --triangles 20000 --repeat 2 --no-roofline 2>/dev/null |
+  python3 -c '
+import json, sys
+skip = ("ms", "time", "per_s", "peak", "rss", "build", "cache", "bytes_per", "memory_budget")
+def strip(x):
+    return {k: strip(v) for k, v in x.items() if not any(t in k for t in skip)} if isinstance(x, dict) else x
+print(json.dumps(strip(json.load(sys.stdin)), sort_keys=True))' | sha256sum | cut -c1-16)"
