@@ -964,125 +964,175 @@ rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positi
     return st;
 }
 
+/* One estimate's state, shared by its steps. */
+typedef struct estimate_run {
+    const uint32_t *indices;
+    size_t vertex_count, triangle_count;
+    double scale;       /* internal units per caller unit (scale.c) */
+    double unit;        /* the noisy mesh's mean edge length, internal units */
+    uint32_t *point_of; /* per vertex: its point (UINT32_MAX: none), until the rings are built */
+    point_set pts;
+    rs_grid grid;
+    bool grid_built;
+    uint32_t *ring_start, *ring; /* the mesh's edges, per point */
+    sample_job job;
+    double *scratch; /* per sample */
+    rsmooth_error *error;
+    const char *caller;
+} estimate_run;
+
+static void free_estimate(estimate_run *e) {
+    rs_free(e->point_of);
+    rs_free(e->job.residual);
+    rs_free(e->job.variance);
+    rs_free(e->job.robust);
+    rs_free(e->job.rscale);
+    rs_free(e->job.rshare);
+    rs_free(e->job.edges);
+    rs_free(e->ring_start);
+    rs_free(e->ring);
+    rs_free(e->scratch);
+    if (e->grid_built)
+        rs_grid_free(&e->grid);
+    free_points(&e->pts);
+}
+
+/* The mean edge length (e->unit; not above 0 when the mesh has no edge, and then nothing else)
+ * and the points, from the positions in internal units. */
+static rsmooth_status read_points(estimate_run *e, rsmooth_scalar scalar, const void *positions) {
+    size_t vertex_count = e->vertex_count;
+    double *xyz = rs_alloc_array(vertex_count, 3 * sizeof *xyz);
+    if (!xyz)
+        return rs_fail(e->error, RSMOOTH_ERROR_OUT_OF_MEMORY, e->caller, "no memory for positions");
+    rs_scale_positions(scalar, positions, vertex_count, e->scale, xyz);
+    if (!rs_mean_edge_length(xyz, vertex_count, e->indices, e->triangle_count, &e->unit)) {
+        rs_free(xyz);
+        return rs_fail(e->error, RSMOOTH_ERROR_OUT_OF_MEMORY, e->caller, "no memory for edges");
+    }
+    if (!(e->unit > 0)) { /* no edge: no unit, nothing to measure */
+        rs_free(xyz);
+        return RSMOOTH_OK;
+    }
+    e->point_of = rs_alloc_array(vertex_count, sizeof *e->point_of);
+    bool ok = e->point_of &&
+              build_points(xyz, vertex_count, e->indices, e->triangle_count, &e->pts, e->point_of);
+    rs_free(xyz);
+    if (!ok)
+        return rs_fail(e->error, RSMOOTH_ERROR_OUT_OF_MEMORY, e->caller,
+                       "no memory for %zu vertex normals", vertex_count);
+    return RSMOOTH_OK;
+}
+
+/* The points' grid, the points sorted into its order, and each point's ring of edges. */
+static rsmooth_status order_points(estimate_run *e) {
+    point_set *pts = &e->pts;
+    rsmooth_status st = rs_grid_build(&e->grid, pts->xyz, pts->count,
+                                      (hypot(RADIUS, SLAB) + MARGIN) * e->unit, e->error);
+    if (st != RSMOOTH_OK)
+        return st;
+    e->grid_built = true;
+    uint32_t *sorted_of = rs_alloc_array(pts->count, sizeof *sorted_of);
+    bool ok = sorted_of && sort_points(pts, e->grid.facet_order);
+    if (ok) { /* the vertices' points in the sorted order, then the rings */
+        for (size_t i = 0; i < pts->count; i++)
+            sorted_of[e->grid.facet_order[i]] = (uint32_t)i;
+        for (size_t v = 0; v < e->vertex_count; v++)
+            if (e->point_of[v] != UINT32_MAX)
+                e->point_of[v] = sorted_of[e->point_of[v]];
+        ok = build_rings(e->indices, e->triangle_count, e->point_of, pts->count, &e->ring_start,
+                         &e->ring);
+    }
+    rs_free(sorted_of);
+    rs_free(e->point_of);
+    e->point_of = NULL;
+    if (!ok)
+        return rs_fail(e->error, RSMOOTH_ERROR_OUT_OF_MEMORY, e->caller, "no memory for %zu points",
+                       pts->count);
+    return RSMOOTH_OK;
+}
+
+/* Each sample's fit (sample_range), on all threads. */
+static rsmooth_status take_samples(estimate_run *e) {
+    sample_job *job = &e->job;
+    memset(job, 0, sizeof *job);
+    job->points = &e->pts;
+    job->grid = &e->grid;
+    job->ring_start = e->ring_start;
+    job->ring = e->ring;
+    job->unit = e->unit;
+    job->sample_count = e->pts.count < MAX_SAMPLES ? e->pts.count : MAX_SAMPLES;
+    job->residual = rs_alloc_array(job->sample_count, sizeof *job->residual);
+    job->variance = rs_alloc_array(job->sample_count, sizeof *job->variance);
+    job->robust = rs_alloc_array(job->sample_count, sizeof *job->robust);
+    job->rscale = rs_alloc_array(job->sample_count, sizeof *job->rscale);
+    job->rshare = rs_alloc_array(job->sample_count, sizeof *job->rshare);
+    job->edges = rs_alloc_array(job->sample_count, sizeof *job->edges);
+    e->scratch = rs_alloc_array(job->sample_count, sizeof *e->scratch);
+    if (!job->residual || !job->variance || !job->robust || !job->rscale || !job->rshare ||
+        !job->edges || !e->scratch)
+        return rs_fail(e->error, RSMOOTH_ERROR_OUT_OF_MEMORY, e->caller,
+                       "no memory for %zu samples", job->sample_count);
+    rs_parallel_for(job->sample_count, SAMPLE_GRAIN, sample_range, job);
+    rsmooth_status st = RSMOOTH_OK;
+    for (size_t c = 0; c < sizeof job->failed / sizeof *job->failed; c++)
+        if (job->failed[c])
+            st = rs_fail(e->error, RSMOOTH_ERROR_OUT_OF_MEMORY, e->caller,
+                         "no memory for a vertex's neighbours");
+    return st;
+}
+
+/* The samples with a fit moved to the front, in sample order; their count. */
+static size_t keep_fitted(sample_job *job) {
+    size_t valid = 0;
+    for (size_t s = 0; s < job->sample_count; s++)
+        if (!isnan(job->residual[s])) {
+            job->residual[valid] = job->residual[s];
+            job->variance[valid] = job->variance[s];
+            job->robust[valid] = job->robust[s];
+            job->rscale[valid] = job->rscale[s];
+            job->rshare[valid] = job->rshare[s];
+            job->edges[valid++] = job->edges[s];
+        }
+    return valid;
+}
+
 rsmooth_status rs_estimate_noise_details(rsmooth_scalar scalar, const void *positions,
                                          size_t vertex_count, const uint32_t *indices,
                                          size_t triangle_count, rs_noise_details *out,
                                          rsmooth_error *error, const char *caller) {
-    double magnitude = 0, scale = 1;
+    double magnitude = 0;
+    estimate_run e;
+    memset(&e, 0, sizeof e);
+    e.indices = indices;
+    e.vertex_count = vertex_count;
+    e.triangle_count = triangle_count;
+    e.scale = 1;
+    e.error = error;
+    e.caller = caller;
     rsmooth_status st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices,
                                              triangle_count, &magnitude, error, caller);
     if (st == RSMOOTH_OK) /* internal units (scale.c): the estimate is a ratio, unchanged */
-        st = rs_mesh_scale(scalar, positions, indices, triangle_count, magnitude, &scale, error,
+        st = rs_mesh_scale(scalar, positions, indices, triangle_count, magnitude, &e.scale, error,
                            caller);
     if (st != RSMOOTH_OK)
         return st;
     memset(out, 0, sizeof *out);
     out->impulsive_fraction = 1;
     out->tangential_level = NAN;
-    double *xyz = rs_alloc_array(vertex_count, 3 * sizeof *xyz);
-    if (!xyz)
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, caller, "no memory for positions");
-    rs_scale_positions(scalar, positions, vertex_count, scale, xyz);
-    double unit = 0;
-    if (!rs_mean_edge_length(xyz, vertex_count, indices, triangle_count, &unit)) {
-        rs_free(xyz);
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, caller, "no memory for edges");
+    st = read_points(&e, scalar, positions);
+    if (st == RSMOOTH_OK && e.unit > 0 && e.pts.count <= MIN_POINTS) {
+        /* too few vertices for any fit: nothing measurable */
+        out->mean_edge_noisy = out->mean_edge_clean = e.unit / e.scale;
+    } else if (st == RSMOOTH_OK && e.unit > 0) {
+        if ((st = order_points(&e)) == RSMOOTH_OK)
+            st = take_samples(&e);
+        if (st == RSMOOTH_OK) {
+            size_t valid = keep_fitted(&e.job);
+            out->mean_edge_noisy = out->mean_edge_clean = e.unit / e.scale;
+            if (valid > 0)
+                summarise(&e.job, valid, e.unit, e.scale, e.scratch, out);
+        }
     }
-    if (!(unit > 0)) { /* no edge: no unit, nothing to measure */
-        rs_free(xyz);
-        return RSMOOTH_OK;
-    }
-    point_set pts;
-    uint32_t *point_of = rs_alloc_array(vertex_count, sizeof *point_of);
-    bool ok = point_of && build_points(xyz, vertex_count, indices, triangle_count, &pts, point_of);
-    rs_free(xyz);
-    if (!ok) {
-        rs_free(point_of);
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, caller,
-                       "no memory for %zu vertex normals", vertex_count);
-    }
-    if (pts.count <= MIN_POINTS) { /* too few vertices for any fit: nothing measurable */
-        rs_free(point_of);
-        free_points(&pts);
-        out->mean_edge_noisy = out->mean_edge_clean = unit / scale;
-        return RSMOOTH_OK;
-    }
-    rs_grid grid;
-    st = rs_grid_build(&grid, pts.xyz, pts.count, (hypot(RADIUS, SLAB) + MARGIN) * unit, error);
-    if (st != RSMOOTH_OK) {
-        rs_free(point_of);
-        free_points(&pts);
-        return st;
-    }
-    uint32_t *ring_start = NULL, *ring = NULL, *sorted_of = rs_alloc_array(pts.count, sizeof *sorted_of);
-    ok = sorted_of && sort_points(&pts, grid.facet_order);
-    if (ok) { /* the vertices' points in the sorted order, then the rings */
-        for (size_t i = 0; i < pts.count; i++)
-            sorted_of[grid.facet_order[i]] = (uint32_t)i;
-        for (size_t v = 0; v < vertex_count; v++)
-            if (point_of[v] != UINT32_MAX)
-                point_of[v] = sorted_of[point_of[v]];
-        ok = build_rings(indices, triangle_count, point_of, pts.count, &ring_start, &ring);
-    }
-    rs_free(sorted_of);
-    rs_free(point_of);
-    if (!ok) {
-        rs_grid_free(&grid);
-        free_points(&pts);
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, caller, "no memory for %zu points",
-                       pts.count);
-    }
-    sample_job job;
-    memset(&job, 0, sizeof job);
-    job.points = &pts;
-    job.grid = &grid;
-    job.ring_start = ring_start;
-    job.ring = ring;
-    job.unit = unit;
-    job.sample_count = pts.count < MAX_SAMPLES ? pts.count : MAX_SAMPLES;
-    job.residual = rs_alloc_array(job.sample_count, sizeof *job.residual);
-    job.variance = rs_alloc_array(job.sample_count, sizeof *job.variance);
-    job.robust = rs_alloc_array(job.sample_count, sizeof *job.robust);
-    job.rscale = rs_alloc_array(job.sample_count, sizeof *job.rscale);
-    job.rshare = rs_alloc_array(job.sample_count, sizeof *job.rshare);
-    job.edges = rs_alloc_array(job.sample_count, sizeof *job.edges);
-    double *scratch = rs_alloc_array(job.sample_count, sizeof *scratch);
-    if (!job.residual || !job.variance || !job.robust || !job.rscale || !job.rshare ||
-        !job.edges || !scratch) {
-        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, caller, "no memory for %zu samples",
-                     job.sample_count);
-    } else {
-        rs_parallel_for(job.sample_count, SAMPLE_GRAIN, sample_range, &job);
-        for (size_t c = 0; c < sizeof job.failed / sizeof *job.failed; c++)
-            if (job.failed[c])
-                st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, caller,
-                             "no memory for a vertex's neighbours");
-    }
-    if (st == RSMOOTH_OK) {
-        size_t valid = 0; /* the samples with a fit, in sample order */
-        for (size_t s = 0; s < job.sample_count; s++)
-            if (!isnan(job.residual[s])) {
-                job.residual[valid] = job.residual[s];
-                job.variance[valid] = job.variance[s];
-                job.robust[valid] = job.robust[s];
-                job.rscale[valid] = job.rscale[s];
-                job.rshare[valid] = job.rshare[s];
-                job.edges[valid++] = job.edges[s];
-            }
-        out->mean_edge_noisy = out->mean_edge_clean = unit / scale;
-        if (valid > 0)
-            summarise(&job, valid, unit, scale, scratch, out);
-    }
-    rs_free(job.residual);
-    rs_free(job.variance);
-    rs_free(job.robust);
-    rs_free(job.rscale);
-    rs_free(job.rshare);
-    rs_free(job.edges);
-    rs_free(ring_start);
-    rs_free(ring);
-    rs_free(scratch);
-    rs_grid_free(&grid);
-    free_points(&pts);
+    free_estimate(&e);
     return st;
 }
