@@ -20,6 +20,20 @@
 /* The benchmark meshes (sharp features, uneven sampling, scanned): within this. */
 #define BENCHMARK_TOLERANCE 0.15
 
+/* The generated shapes, about 10000 vertices each (about 2500 under the sanitizers: test_small):
+ * a plane, a sphere, a cube and a capped cylinder. */
+static void make_shape(shape_mesh *m, const char *name) {
+    bool small = test_small();
+    if (strcmp(name, "plane") == 0)
+        CHECK_EQ_INT(shape_plane(m, small ? 50 : 100, small ? 50 : 100, 0.01), 0); /* 10201 */
+    else if (strcmp(name, "sphere") == 0)
+        CHECK_EQ_INT(shape_sphere(m, small ? 4 : 5, 1.0), 0); /* 10242 */
+    else if (strcmp(name, "cube") == 0)
+        CHECK_EQ_INT(shape_cube(m, small ? 20 : 40, 1.0), 0); /* 9602 */
+    else
+        CHECK_EQ_INT(shape_capped_cylinder(m, 1.0, 2.0, small ? 5000 : 20000), 0);
+}
+
 static double now_ms(void) {
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
@@ -121,10 +135,8 @@ static double check_level(const char *name, const shape_mesh *clean, double sigm
 static void generated_shapes(void) {
     shape_mesh shapes[4];
     const char *names[4] = {"plane", "sphere", "cube", "cylinder"};
-    CHECK_EQ_INT(shape_plane(&shapes[0], 100, 100, 0.01), 0);   /* 10201 vertices */
-    CHECK_EQ_INT(shape_sphere(&shapes[1], 5, 1.0), 0);          /* 10242 */
-    CHECK_EQ_INT(shape_cube(&shapes[2], 40, 1.0), 0);           /* 9602 */
-    CHECK_EQ_INT(shape_capped_cylinder(&shapes[3], 1.0, 2.0, 20000), 0);
+    for (int s = 0; s < 4; s++)
+        make_shape(&shapes[s], names[s]);
     const double levels[] = {0.1, 0.2, 0.3, 0.5};
     double worst = 0;
     for (int s = 0; s < 4; s++) {
@@ -178,9 +190,8 @@ static void generated_shapes(void) {
 static void random_directions(void) {
     shape_mesh shapes[3];
     const char *names[3] = {"sphere", "cube", "cylinder"};
-    CHECK_EQ_INT(shape_sphere(&shapes[0], 5, 1.0), 0);
-    CHECK_EQ_INT(shape_cube(&shapes[1], 40, 1.0), 0);
-    CHECK_EQ_INT(shape_capped_cylinder(&shapes[2], 1.0, 2.0, 20000), 0);
+    for (int s = 0; s < 3; s++)
+        make_shape(&shapes[s], names[s]);
     const double levels[] = {0.2, 0.5, 0.7};
     double worst = 0;
     for (int s = 0; s < 3; s++) {
@@ -225,9 +236,8 @@ static bool reads_impulsive(const shape_mesh *m, const double *xyz) {
 static void check_kind(void) {
     shape_mesh shapes[3];
     const char *names[3] = {"sphere", "cube", "cylinder"};
-    CHECK_EQ_INT(shape_sphere(&shapes[0], 5, 1.0), 0);
-    CHECK_EQ_INT(shape_cube(&shapes[1], 40, 1.0), 0);
-    CHECK_EQ_INT(shape_capped_cylinder(&shapes[2], 1.0, 2.0, 20000), 0);
+    for (int s = 0; s < 3; s++)
+        make_shape(&shapes[s], names[s]);
     const double gaussian[] = {0.05, 0.2, 0.5, 1.0}, impulsive[] = {0.3, 0.5, 1.0};
     const double fractions[] = {0.05, 0.1};
     for (int s = 0; s < 3; s++) {
@@ -295,16 +305,18 @@ static void check_invariance(void) {
     shape_free(&soup);
 }
 
-/* More vertices than the estimate samples (50000): the stride's subset reads the same noise. */
+/* More vertices than the estimate samples (lib/auto/noise_estimate.c's MAX_SAMPLES, 6000): the
+ * stride's subset reads the same noise. */
 static void check_sampled(void) {
     shape_mesh clean, noisy;
-    CHECK_EQ_INT(shape_plane(&clean, 250, 250, 0.01), 0); /* 63001 vertices */
+    int side = test_small() ? 120 : 250; /* 14641 or 63001 vertices */
+    CHECK_EQ_INT(shape_plane(&clean, side, side, 0.01), 0);
     CHECK_EQ_INT(shape_copy(&clean, &noisy), 0);
     CHECK_EQ_INT(shape_add_normal_noise(&noisy, 0.3, 11), 0);
     double t0 = now_ms();
     double est = estimate(noisy.xyz, noisy.vertex_count, noisy.indices, noisy.triangle_count);
     double truth = true_noise(&clean, noisy.xyz);
-    printf("plane %zu vertices (50000 sampled), noise 0.3: truth %.4f estimate %.4f ratio %.3f "
+    printf("plane %zu vertices (at most 6000 sampled), noise 0.3: truth %.4f estimate %.4f ratio %.3f "
            "(%.0f ms)\n",
            clean.vertex_count, truth, est, est / truth, now_ms() - t0);
     CHECK_NEAR(est / truth, 1, SHAPE_TOLERANCE);

@@ -9,6 +9,15 @@
 
 #define TEST_SKIP 77
 
+/* Smaller cases of the same checks: tests/CMakeLists.txt sets RSMOOTH_TEST_SMALL=1 for every test
+ * of a sanitizer build (RSMOOTH_SANITIZE), where host code runs 5-15 times slower. A test then
+ * makes its meshes and repeats smaller, never its assertions fewer or weaker; the plain build runs
+ * the full sizes. Setting it by hand runs a plain build's tests small too. */
+static inline int test_small(void) {
+    const char *small = getenv("RSMOOTH_TEST_SMALL");
+    return small && small[0] == '1' && small[1] == '\0';
+}
+
 #define CHECK(cond)                                                                                \
     do {                                                                                           \
         if (!(cond)) {                                                                             \
