@@ -443,8 +443,8 @@ static void print_pass(const char *name, uint64_t examined, uint64_t useful, boo
         printf("\"useful\":null,");
     print_json_number("useful_pairs_per_s", per_s);
     putchar(',');
-    print_json_number("waste", examined > 0 && counted ? 1 - (double)useful / (double)examined
-                                                       : NAN);
+    print_json_number("waste",
+                      examined > 0 && counted ? 1 - (double)useful / (double)examined : NAN);
     if (roofline) {
         putchar(',');
         print_json_number("roofline_pairs_per_s",
@@ -476,193 +476,243 @@ static void stage_times(const rsmooth_report *r, double ms[STAGE_COUNT]) {
     memcpy(ms, v, sizeof v);
 }
 
-static int bench_filter(int argc, char **argv) {
+/* One filter benchmark: its options and input, the context and buffers it runs with, and the
+ * figures it prints, filled in by its steps in the order they run. */
+typedef struct filter_bench {
     filter_options opt;
-    int code = parse_filter_args(argc, argv, &opt);
-    if (code >= 0)
-        return code;
     bench_input in;
-    if ((code = load_input(&opt, &in)) != EXIT_OK)
-        return code;
-    const size_t nv = in.vertex_count, nt = in.triangle_count;
-    rsmooth_context *ctx = NULL;
-    float *first = NULL, *out = NULL;
-    bench_grid grid;
-    memset(&grid, 0, sizeof grid);
+    rsmooth_context *ctx;
+    float *first, *out; /* the first run's output, and each timed run's */
+    bench_grid grid;    /* the pair-counting grid */
+    /* the program build, from source (unless cached) and again from the cache */
+    double ms_create_first, ms_create_cached, ms_build_first, ms_build_cached;
+    const char *cache_first, *cache_cached;
+    double codegen_ms; /* the warm-up run on two triangles */
+    bool peak_reset;
+    double baseline, first_run_ms, first_run_peak, peak; /* bytes resident; ms */
+    rsmooth_report report;                               /* the last run's */
+    bool identical;                                      /* every timed run as the first */
+    double median_ms[STAGE_COUNT], min_ms[STAGE_COUNT], max_ms[STAGE_COUNT];
+    uint64_t useful_mollify, useful_robust;
+    bench_roofline roof;
+    bool have_roofline;
+} filter_bench;
 
+/* The context twice, to time the program build from source and from the cache; the second stays.
+ * An exit status. */
+static int build_programs(filter_bench *b) {
     /* the option wins over the environment, as in the rsmooth command */
-    if (opt.memory_budget)
+    if (b->opt.memory_budget)
         unsetenv("RSMOOTH_MEMORY_BUDGET");
     /* The program build twice: from source (unless rsmooth's program cache has it), then from
      * the binary the first stored (or, with that cache off, from source with PoCL's). */
-    double ms_create_first, ms_create_cached, ms_build_first, ms_build_cached;
-    const char *cache_first, *cache_cached;
-    if ((code = create_context(opt.device, &ctx, &ms_create_first)) != EXIT_OK)
-        goto done;
-    ms_build_first = rsmooth_context_build_ms(ctx);
-    cache_first = rsmooth_context_program_cache(ctx);
-    rsmooth_context_destroy(ctx);
-    ctx = NULL;
-    if ((code = create_context(opt.device, &ctx, &ms_create_cached)) != EXIT_OK)
-        goto done;
-    ms_build_cached = rsmooth_context_build_ms(ctx);
-    cache_cached = rsmooth_context_program_cache(ctx);
-    if (opt.memory_budget)
-        rsmooth_context_set_memory_budget(ctx, opt.memory_budget);
+    int code = create_context(b->opt.device, &b->ctx, &b->ms_create_first);
+    if (code != EXIT_OK)
+        return code;
+    b->ms_build_first = rsmooth_context_build_ms(b->ctx);
+    b->cache_first = rsmooth_context_program_cache(b->ctx);
+    rsmooth_context_destroy(b->ctx);
+    b->ctx = NULL;
+    if ((code = create_context(b->opt.device, &b->ctx, &b->ms_create_cached)) != EXIT_OK)
+        return code;
+    b->ms_build_cached = rsmooth_context_build_ms(b->ctx);
+    b->cache_cached = rsmooth_context_program_cache(b->ctx);
+    if (b->opt.memory_budget)
+        rsmooth_context_set_memory_budget(b->ctx, b->opt.memory_budget);
+    return EXIT_OK;
+}
 
-    code = EXIT_OTHER;
-    first = malloc(nv * 3 * sizeof *first);
-    out = malloc(nv * 3 * sizeof *out);
-    if (!first || !out) {
+/* The output buffers, touched, and the kernels' code generated on a tiny mesh: what the memory
+ * baseline should count. An exit status. */
+static int prepare_runs(filter_bench *b) {
+    const size_t nv = b->in.vertex_count;
+    b->first = malloc(nv * 3 * sizeof *b->first);
+    b->out = malloc(nv * 3 * sizeof *b->out);
+    if (!b->first || !b->out) {
         fprintf(stderr, "rsmooth-bench: out of memory for the output\n");
-        goto done;
+        return EXIT_OTHER;
     }
-    memset(first, 0, nv * 3 * sizeof *first); /* touched, so the baseline counts them */
-    memset(out, 0, nv * 3 * sizeof *out);
+    memset(b->first, 0, nv * 3 * sizeof *b->first); /* touched, so the baseline counts them */
+    memset(b->out, 0, nv * 3 * sizeof *b->out);
     /* PoCL generates each kernel's code at its first launch (about a second, and tens of MiB
      * that stay): a two-triangle mesh pays for that before the baseline is taken, so the memory
      * figures are the filter's own. */
-    double codegen_ms = 0;
-    {
-        static const float tiny_xyz[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0.1f};
-        static const uint32_t tiny_idx[] = {0, 1, 2, 2, 1, 3};
-        float tiny_out[12];
-        rsmooth_report tiny;
-        rsmooth_error tiny_err;
-        if (rsmooth_smooth(ctx, RSMOOTH_FLOAT32, tiny_xyz, 4, tiny_idx, 2, &opt.params, tiny_out,
-                           NULL, NULL, &tiny, &tiny_err) == RSMOOTH_OK)
-            codegen_ms = tiny.ms_total;
-    }
-    const bool peak_reset = reset_peak_rss();
-    const double baseline = rss_bytes();
+    b->codegen_ms = 0;
+    static const float tiny_xyz[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0.1f};
+    static const uint32_t tiny_idx[] = {0, 1, 2, 2, 1, 3};
+    float tiny_out[12];
+    rsmooth_report tiny;
+    rsmooth_error tiny_err;
+    if (rsmooth_smooth(b->ctx, RSMOOTH_FLOAT32, tiny_xyz, 4, tiny_idx, 2, &b->opt.params, tiny_out,
+                       NULL, NULL, &tiny, &tiny_err) == RSMOOTH_OK)
+        b->codegen_ms = tiny.ms_total;
+    return EXIT_OK;
+}
+
+/* The first run, then the timed ones, with the memory they reach; each stage's median, min and
+ * max. An exit status (the failure printed). */
+static int time_runs(filter_bench *b) {
+    const size_t nv = b->in.vertex_count, nt = b->in.triangle_count;
+    const filter_options *opt = &b->opt;
+    b->peak_reset = reset_peak_rss();
+    b->baseline = rss_bytes();
 
     /* The first run includes PoCL's one-time code generation for each kernel. */
-    rsmooth_report report;
-    memset(&report, 0, sizeof report);
+    memset(&b->report, 0, sizeof b->report);
     rsmooth_error err;
-    rsmooth_status st = rsmooth_smooth(ctx, RSMOOTH_FLOAT32, in.positions, nv, in.indices, nt,
-                                       &opt.params, first, NULL, NULL, &report, &err);
-    const double first_run_ms = report.ms_total;
-    const double first_run_peak = (double)peak_rss_kib() * 1024;
+    rsmooth_status st = rsmooth_smooth(b->ctx, RSMOOTH_FLOAT32, b->in.positions, nv, b->in.indices,
+                                       nt, &opt->params, b->first, NULL, NULL, &b->report, &err);
+    b->first_run_ms = b->report.ms_total;
+    b->first_run_peak = (double)peak_rss_kib() * 1024;
     double ms[STAGE_COUNT][99];
-    bool identical = true;
-    for (int i = 0; i < opt.repeat && st == RSMOOTH_OK; i++) {
-        st = rsmooth_smooth(ctx, RSMOOTH_FLOAT32, in.positions, nv, in.indices, nt, &opt.params,
-                            out, NULL, NULL, &report, &err);
+    b->identical = true;
+    for (int i = 0; i < opt->repeat && st == RSMOOTH_OK; i++) {
+        st = rsmooth_smooth(b->ctx, RSMOOTH_FLOAT32, b->in.positions, nv, b->in.indices, nt,
+                            &opt->params, b->out, NULL, NULL, &b->report, &err);
         double stage[STAGE_COUNT];
-        stage_times(&report, stage);
+        stage_times(&b->report, stage);
         for (int s = 0; s < STAGE_COUNT; s++)
             ms[s][i] = stage[s];
-        identical = identical && memcmp(first, out, nv * 3 * sizeof *out) == 0;
+        b->identical = b->identical && memcmp(b->first, b->out, nv * 3 * sizeof *b->out) == 0;
     }
-    const double peak = (double)peak_rss_kib() * 1024;
+    b->peak = (double)peak_rss_kib() * 1024;
     if (st != RSMOOTH_OK) {
-        const char *name = opt.mesh_path ? opt.mesh_path : "generated mesh";
+        const char *name = opt->mesh_path ? opt->mesh_path : "generated mesh";
         if (st == RSMOOTH_ERROR_OPENCL)
             fprintf(stderr, "rsmooth-bench: %s: device '%s': %s\n", name,
-                    rsmooth_context_device_name(ctx), err.message);
+                    rsmooth_context_device_name(b->ctx), err.message);
         else
             fprintf(stderr, "rsmooth-bench: %s: %s\n", name, err.message);
-        code = st == RSMOOTH_ERROR_OPENCL             ? EXIT_DEVICE
+        return st == RSMOOTH_ERROR_OPENCL             ? EXIT_DEVICE
                : st == RSMOOTH_ERROR_INVALID_ARGUMENT ? EXIT_USAGE
                                                       : EXIT_OTHER;
-        goto done;
     }
-    double median_ms[STAGE_COUNT], min_ms[STAGE_COUNT], max_ms[STAGE_COUNT];
     for (int s = 0; s < STAGE_COUNT; s++) {
-        median_ms[s] = median(ms[s], opt.repeat); /* sorts: min and max at the ends */
-        min_ms[s] = ms[s][0];
-        max_ms[s] = ms[s][opt.repeat - 1];
+        b->median_ms[s] = median(ms[s], opt->repeat); /* sorts: min and max at the ends */
+        b->min_ms[s] = ms[s][0];
+        b->max_ms[s] = ms[s][opt->repeat - 1];
     }
+    return EXIT_OK;
+}
 
-    /* Counted after the peak was read: the grid and the roofline use memory of their own. */
-    uint64_t useful_mollify = 0, useful_robust = 0;
-    const double cell = fmax(report.radius, report.mollify_radius);
-    if (report.facet_count > 0 && opt.pairs) {
-        if (bench_grid_build(&grid, in.positions, in.indices, nt, cell) != 0) {
+/* The useful pairs of each pass and the native roofline, counted after the peak was read: the
+ * grid and the roofline use memory of their own. An exit status. */
+static int count_pairs(filter_bench *b) {
+    const rsmooth_report *report = &b->report;
+    const size_t nv = b->in.vertex_count, nt = b->in.triangle_count;
+    const double cell = fmax(report->radius, report->mollify_radius);
+    if (report->facet_count > 0 && b->opt.pairs) {
+        if (bench_grid_build(&b->grid, b->in.positions, b->in.indices, nt, cell) != 0) {
             fprintf(stderr, "rsmooth-bench: cannot build the pair-counting grid (out of memory, "
                             "or the mesh spans over 2^30 cells)\n");
-            goto done;
+            return EXIT_OTHER;
         }
-        useful_robust = bench_pairs_within(&grid, in.positions, nv, report.radius);
-        if (report.mollify_radius > 0)
-            useful_mollify = bench_pairs_within(&grid, in.positions, nv, report.mollify_radius);
+        b->useful_robust = bench_pairs_within(&b->grid, b->in.positions, nv, report->radius);
+        if (report->mollify_radius > 0)
+            b->useful_mollify =
+                bench_pairs_within(&b->grid, b->in.positions, nv, report->mollify_radius);
     }
-    bench_roofline roof;
-    memset(&roof, 0, sizeof roof);
-    bool have_roofline = false;
-    if (opt.roofline && grid.facet_count > 0) {
+    memset(&b->roof, 0, sizeof b->roof);
+    b->have_roofline = false;
+    if (b->opt.roofline && b->grid.facet_count > 0) {
         const bench_roofline_setup setup = {
-            .sigma_f = report.sigma_f,
-            .sigma_g = report.sigma_g,
-            .sigma_m = report.sigma_f / 2, /* the library mollifies with sigma_f / 2 */
-            .radius = report.radius,
-            .mollify_radius = report.mollify_radius,
+            .sigma_f = report->sigma_f,
+            .sigma_g = report->sigma_g,
+            .sigma_m = report->sigma_f / 2, /* the library mollifies with sigma_f / 2 */
+            .radius = report->radius,
+            .mollify_radius = report->mollify_radius,
         };
-        have_roofline = bench_roofline_run(&grid, in.positions, nv, &setup, &roof) == 0;
-        if (!have_roofline)
+        b->have_roofline = bench_roofline_run(&b->grid, b->in.positions, nv, &setup, &b->roof) == 0;
+        if (!b->have_roofline)
             fprintf(stderr, "rsmooth-bench: roofline skipped: out of memory\n");
     }
+    return EXIT_OK;
+}
 
+/* The JSON object's first part: the mesh, the widths, the run's layout and the device. */
+static void print_setup(const filter_bench *b) {
+    const filter_options *opt = &b->opt;
+    const rsmooth_report *report = &b->report;
     printf("{\"mode\":\"filter\",\"mesh\":");
-    cli_print_json_string(opt.mesh_path ? opt.mesh_path : "generated");
-    if (!opt.mesh_path)
-        printf(",\"noise\":%.6g", opt.noise);
-    printf(",\"vertices\":%zu,\"triangles\":%zu,\"facets\":%zu,\"mean_edge_length\":%.6g,", nv, nt,
-           report.facet_count, report.mean_edge_length);
-    print_json_number("sigma_f", opt.params.sigma_f);
+    cli_print_json_string(opt->mesh_path ? opt->mesh_path : "generated");
+    if (!opt->mesh_path)
+        printf(",\"noise\":%.6g", opt->noise);
+    printf(",\"vertices\":%zu,\"triangles\":%zu,\"facets\":%zu,\"mean_edge_length\":%.6g,",
+           b->in.vertex_count, b->in.triangle_count, report->facet_count, report->mean_edge_length);
+    print_json_number("sigma_f", opt->params.sigma_f);
     putchar(',');
-    print_json_number("sigma_g", opt.params.sigma_g); /* null: inf, the influence off */
+    print_json_number("sigma_g", opt->params.sigma_g); /* null: inf, the influence off */
     putchar(',');
-    print_json_number("sigma_f_abs", report.sigma_f);
+    print_json_number("sigma_f_abs", report->sigma_f);
     putchar(',');
-    print_json_number("sigma_g_abs", report.sigma_g);
+    print_json_number("sigma_g_abs", report->sigma_g);
     printf(",\"radius\":%.6g,\"mollify_radius\":%.6g,\"grid_cell_count\":%zu,\"tiles\":%zu,"
            "\"memory_budget\":%llu,\"device\":",
-           report.radius, report.mollify_radius, report.grid_cell_count, report.tiles,
-           (unsigned long long)rsmooth_context_memory_budget(ctx));
-    cli_print_json_string(report.device);
+           report->radius, report->mollify_radius, report->grid_cell_count, report->tiles,
+           (unsigned long long)rsmooth_context_memory_budget(b->ctx));
+    cli_print_json_string(report->device);
     unsigned lanes = 0;
     size_t group = 0;
-    rsmooth_context_kernel_shape(ctx, &lanes, &group);
+    rsmooth_context_kernel_shape(b->ctx, &lanes, &group);
     printf(",\"kernel_variant\":\"%s\",\"lanes\":%u,\"work_group\":%zu",
            lanes > 1 ? "block" : "group", lanes, group);
+}
+
+/* The JSON object's rest: the times, the pairs, the roofline and the memory. */
+static void print_figures(const filter_bench *b) {
+    const filter_options *opt = &b->opt;
+    const rsmooth_report *report = &b->report;
     printf(",\"repeat\":%d,\"context_create_first_ms\":%.1f,\"program_build_first_ms\":%.1f,"
            "\"context_create_cached_ms\":%.1f,\"program_build_cached_ms\":%.1f,"
            "\"program_cache_first\":\"%s\",\"program_cache_cached\":\"%s\","
            "\"kernel_codegen_ms\":%.2f,\"first_run_ms\":%.2f,\"ms\":{",
-           opt.repeat, ms_create_first, ms_build_first, ms_create_cached, ms_build_cached,
-           cache_first, cache_cached, codegen_ms, first_run_ms);
+           opt->repeat, b->ms_create_first, b->ms_build_first, b->ms_create_cached,
+           b->ms_build_cached, b->cache_first, b->cache_cached, b->codegen_ms, b->first_run_ms);
     for (int s = 0; s < STAGE_COUNT; s++)
         printf("%s\"%s\":{\"median\":%.3f,\"min\":%.3f,\"max\":%.3f}", s ? "," : "", stage_names[s],
-               median_ms[s], min_ms[s], max_ms[s]);
-    printf("},\"bit_identical\":%s", identical ? "true" : "false");
-    print_pass("mollify", report.pairs_mollify, useful_mollify, opt.pairs, median_ms[STAGE_MOLLIFY],
-               roof.mollify_pairs_per_s, have_roofline);
-    print_pass("robust", report.pairs_robust, useful_robust, opt.pairs, median_ms[STAGE_ROBUST],
-               roof.robust_pairs_per_s, have_roofline);
-    if (have_roofline)
+               b->median_ms[s], b->min_ms[s], b->max_ms[s]);
+    printf("},\"bit_identical\":%s", b->identical ? "true" : "false");
+    print_pass("mollify", report->pairs_mollify, b->useful_mollify, opt->pairs,
+               b->median_ms[STAGE_MOLLIFY], b->roof.mollify_pairs_per_s, b->have_roofline);
+    print_pass("robust", report->pairs_robust, b->useful_robust, opt->pairs,
+               b->median_ms[STAGE_ROBUST], b->roof.robust_pairs_per_s, b->have_roofline);
+    const bench_roofline *roof = &b->roof;
+    if (b->have_roofline)
         printf(",\"roofline\":{\"threads\":%d,\"openmp\":%s,\"lanes\":%d,\"window\":%zu,"
                "\"seconds\":%.2f}",
-               roof.threads, roof.openmp ? "true" : "false", roof.lanes, roof.window, roof.seconds);
+               roof->threads, roof->openmp ? "true" : "false", roof->lanes, roof->window,
+               roof->seconds);
     else
         printf(",\"roofline\":null");
-    const double input_bytes = (double)nv * 3 * sizeof(float) + (double)nt * 3 * sizeof(uint32_t);
+    const double nv = (double)b->in.vertex_count, nt = (double)b->in.triangle_count;
+    const double input_bytes = nv * 3 * sizeof(float) + nt * 3 * sizeof(uint32_t);
     printf(",\"rss_baseline_MiB\":%.1f,\"peak_rss_MiB\":%.1f,\"first_run_peak_rss_MiB\":%.1f,"
            "\"peak_rss_reset\":%s,\"input_MiB\":%.1f,",
-           baseline / 1048576, peak / 1048576, first_run_peak / 1048576,
-           peak_reset ? "true" : "false", input_bytes / 1048576);
+           b->baseline / 1048576, b->peak / 1048576, b->first_run_peak / 1048576,
+           b->peak_reset ? "true" : "false", input_bytes / 1048576);
     print_json_number("filter_bytes_per_triangle",
-                      baseline >= 0 ? (peak - baseline) / (double)nt : NAN);
+                      b->baseline >= 0 ? (b->peak - b->baseline) / nt : NAN);
     printf("}\n");
-    code = EXIT_OK;
+}
 
-done:
-    bench_grid_free(&grid);
-    rsmooth_context_destroy(ctx);
-    free(first);
-    free(out);
-    bench_input_free(&in);
+static int bench_filter(int argc, char **argv) {
+    filter_bench b;
+    memset(&b, 0, sizeof b);
+    int code = parse_filter_args(argc, argv, &b.opt);
+    if (code >= 0)
+        return code;
+    if ((code = load_input(&b.opt, &b.in)) != EXIT_OK)
+        return code;
+    if ((code = build_programs(&b)) == EXIT_OK && (code = prepare_runs(&b)) == EXIT_OK &&
+        (code = time_runs(&b)) == EXIT_OK && (code = count_pairs(&b)) == EXIT_OK) {
+        print_setup(&b);
+        print_figures(&b);
+    }
+    bench_grid_free(&b.grid);
+    rsmooth_context_destroy(b.ctx);
+    free(b.first);
+    free(b.out);
+    bench_input_free(&b.in);
     return code;
 }
 
