@@ -56,7 +56,7 @@
 /** @def RSMOOTH_VERSION_PATCH
  * The patch version of this header: fixes within one ABI. */
 #define RSMOOTH_VERSION_MAJOR 0
-#define RSMOOTH_VERSION_MINOR 9
+#define RSMOOTH_VERSION_MINOR 10
 #define RSMOOTH_VERSION_PATCH 0
 
 /** @def RSMOOTH_API
