@@ -37,8 +37,9 @@ experiments: build
 	@.ci/install-deps.sh experiments
 	POCL_CACHE_DIR=$(abspath $(BUILD))/pocl-cache python3 scripts/experiments.py
 
+# ctest -j $(JOBS): tests that use both cores themselves ask for them (tests/CMakeLists.txt).
 check: build
-	cd $(BUILD) && ctest --output-on-failure
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
 # The Python package (pyproject.toml, python/): `pip install .` into a fresh virtual environment,
 # the pytest suite tests/python/ against the command just built, and the wheel from `pip wheel`
@@ -47,12 +48,15 @@ python-check: build
 	@.ci/install-deps.sh python
 	.ci/python-check.sh python3 $(BUILD) $(WERROR)
 
-# The whole suite again under AddressSanitizer and UndefinedBehaviorSanitizer (Debug build).
+# The whole suite again under AddressSanitizer and UndefinedBehaviorSanitizer (Debug build), on
+# smaller cases of the same checks (RSMOOTH_TEST_SMALL), with the kernels PoCL compiled for
+# $(BUILD) (its caches: RSMOOTH_TEST_CACHE_DIR in tests/CMakeLists.txt).
 sanitize: deps
+	mkdir -p $(BUILD)
 	cmake -S . -B $(BUILD)-sanitize -DCMAKE_BUILD_TYPE=Debug -DRSMOOTH_SANITIZE=ON \
-	  -DRSMOOTH_INSTALL=OFF -DRSMOOTH_WERROR=$(WERROR)
+	  -DRSMOOTH_INSTALL=OFF -DRSMOOTH_WERROR=$(WERROR) -DRSMOOTH_TEST_CACHE_DIR=$(abspath $(BUILD))
 	cmake --build $(BUILD)-sanitize -j $(JOBS)
-	cd $(BUILD)-sanitize && ctest --output-on-failure
+	cd $(BUILD)-sanitize && ctest --output-on-failure -j $(JOBS)
 
 # Each reader, and automatic detection (fuzz_auto), under libFuzzer with ASan and UBSan for
 # $(FUZZ_SECONDS) s each, from the seed corpus make_seed_corpus writes (each run on a copy); each
