@@ -323,7 +323,7 @@ RSMOOTH_API rsmooth_status rsmooth_mean_edge_length(rsmooth_scalar scalar, const
 
 /** Estimates the mesh's noise: the standard deviation of its vertices' displacement along the
  * surface normal, in mean edge lengths of the mesh as given (the unit of relative sigmas, as
- * rsmooth_mean_edge_length computes it), from the geometry alone. Each vertex (at most 50000, at a
+ * rsmooth_mean_edge_length computes it), from the geometry alone. Each vertex (at most 6000, at a
  * fixed stride) is predicted by a quadric fitted to the other vertices within 2.5 mean edge
  * lengths; vertices whose neighbourhood is no quadric (sharp edges, corners) are screened out by
  * the fit's residual variance, and the noise is a robust scale (1.4826 x median) of the others'
