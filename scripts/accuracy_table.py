@@ -1,9 +1,9 @@
-"""Issue 15's acceptance table: for every case, rsmooth's modes as the left-out rules chose them
+"""The accuracy table (docs/accuracy.md): for every case, rsmooth's modes as the left-out rules chose them
 (docs/results/final.json from scripts/calibrate.py final, run with the command as users run it)
 against the anchors tuned against the truth (docs/results/anchors_classic.json, docs/results/anchors_normal_filtering.json), and
 the issue's targets counted.
 
-    python3 scripts/issue15_table.py [--markdown docs/results/issue15_table.md]
+    python3 scripts/accuracy_table.py [--markdown docs/results/accuracy_table.md]
 
 Figures: E_v (thousandths of the bounding-box diagonal) / theta (degrees) / milliseconds of one
 run (rsmooth: the filter call, `--json` ms.filter; anchors: one run of the tool at its E_v

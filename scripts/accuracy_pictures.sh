@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Before/after pictures of issue 15 (docs/accuracy.md): noisy | `--best --auto` | truth, flat
+# Before/after pictures of docs/accuracy.md: noisy | `--best --auto` | truth, flat
 # shaded, for the scanned models among the cases (the Stanford bunny, the rocker arm, the
 # beetle) and two machined parts. The cases come from scripts/make_cases.py.
-#   scripts/issue15_pictures.sh build/rsmooth /work/cases docs/img
+#   scripts/accuracy_pictures.sh build/rsmooth /work/cases docs/img
 set -euo pipefail
 rsmooth=$1 cases=$2 out=$3
 shared=$(cd "$(dirname "$0")/../../shared/data" && pwd)
@@ -12,7 +12,7 @@ picture() { # name noisy truth [render options]
   local name=$1 noisy=$2 truth=$3
   shift 3
   "$rsmooth" "$noisy" -o "$work/$name.obj" -f --best --auto 2> "$work/$name.txt"
-  "$rsmooth" render "$noisy" "$work/$name.obj" "$truth" -o "$out/issue15-$name.png" -f \
+  "$rsmooth" render "$noisy" "$work/$name.obj" "$truth" -o "$out/accuracy-$name.png" -f \
     --size 360x360 "$@"
   echo "$name: $(head -c 300 "$work/$name.txt" | head -1)"
 }
