@@ -34,26 +34,28 @@ static void copy_cut(const char *text, char *out, size_t size) {
 }
 
 /* A string property of `device` (or of `platform` when device is NULL), its size asked first so
- * a long one (PoCL's 65-character version) is read whole, then cut to `out`; "" when a query
- * fails. */
-static void info_string(cl_platform_id platform, cl_device_id device, cl_uint param, char *out,
-                        size_t size) {
-    size_t need = 0;
+ * a long one (PoCL's 65-character version) is read whole, then cut to `out` (`size` > 0); "" when
+ * a query fails. Returns the whole property's length, 0 when it failed. */
+static size_t info_string(cl_platform_id platform, cl_device_id device, cl_uint param, char *out,
+                          size_t size) {
+    size_t need = 0, length = 0;
     out[0] = '\0';
     cl_int err = device ? clGetDeviceInfo(device, param, 0, NULL, &need)
                         : clGetPlatformInfo(platform, param, 0, NULL, &need);
     if (err != CL_SUCCESS || need == 0)
-        return;
+        return 0;
     char *text = malloc(need + 1);
     if (!text)
-        return;
+        return 0;
     err = device ? clGetDeviceInfo(device, param, need, text, NULL)
                  : clGetPlatformInfo(platform, param, need, text, NULL);
     if (err == CL_SUCCESS) {
         text[need] = '\0';
+        length = strlen(text);
         copy_cut(text, out, size);
     }
     free(text);
+    return length;
 }
 
 /* A fixed-size property, `fallback` when the query fails. */
@@ -103,32 +105,19 @@ void rsmooth_device_info_init(rsmooth_device_info *info) {
 }
 
 size_t rsmooth_device_version(int platform_index, int device_index, char *out, size_t size) {
-    if (out && size > 0)
-        out[0] = '\0';
+    char none[1];
+    if (!out || size == 0) { /* only the length asked */
+        out = none;
+        size = sizeof none;
+    }
+    out[0] = '\0';
     if (rs_cl_load("rsmooth_device_version", NULL) != RSMOOTH_OK)
         return 0;
     candidate all[MAX_DEVICES];
     int n = list_devices(all, MAX_DEVICES);
-    for (int i = 0; i < n; i++) {
-        if (all[i].platform_index != platform_index || all[i].device_index != device_index)
-            continue;
-        size_t need = 0;
-        if (clGetDeviceInfo(all[i].device, CL_DEVICE_VERSION, 0, NULL, &need) != CL_SUCCESS ||
-            need == 0)
-            return 0;
-        char *text = malloc(need + 1);
-        if (!text)
-            return 0;
-        size_t length = 0;
-        if (clGetDeviceInfo(all[i].device, CL_DEVICE_VERSION, need, text, NULL) == CL_SUCCESS) {
-            text[need] = '\0';
-            length = strlen(text);
-            if (out && size > 0)
-                copy_cut(text, out, size);
-        }
-        free(text);
-        return length;
-    }
+    for (int i = 0; i < n; i++)
+        if (all[i].platform_index == platform_index && all[i].device_index == device_index)
+            return info_string(NULL, all[i].device, CL_DEVICE_VERSION, out, size);
     return 0;
 }
 
