@@ -44,6 +44,21 @@ static const char noise_usage_text[] =
     "                   exactly round(F x vertex count) vertices, chosen at random, each get\n"
     "                   the Gaussian displacement; all others stay exactly where they are.\n"
     "                   F in (0, 1]; without this option every vertex moves.\n"
+    "  --correlation L  spatially correlated (band-limited) noise, as real range scans have:\n"
+    "                   each vertex's i.i.d. Gaussian is replaced by the Gaussian-weighted\n"
+    "                   average, weights exp(-d^2 / 2 (L e)^2), of the Gaussians of all\n"
+    "                   vertices within 3 L e of it (Euclidean distance d, e the mean edge\n"
+    "                   length), divided by the root of the sum of the squared weights, so each\n"
+    "                   vertex's displacement still has standard deviation --sigma; two\n"
+    "                   vertices d apart correlate by about exp(-d^2 / 4 (L e)^2). L > 0 mean\n"
+    "                   edge lengths (at most 100).\n"
+    "  --stripes W      scan-line stripes instead of i.i.d. noise: a direction u drawn from\n"
+    "                   the seed cuts space into slabs W mean edge lengths wide (the first\n"
+    "                   boundary at a random phase); slab k gets a Gaussian amplitude a_k and a\n"
+    "                   vertex a fraction f across it is displaced by a_k sin(pi f) (ridges and\n"
+    "                   grooves along u's normal planes, continuous), the whole scaled so the\n"
+    "                   root mean square displacement over the vertices is exactly --sigma.\n"
+    "                   W > 0 (at most 1e6); not with --correlation.\n"
     "  --seed N         seed of the random generator, an integer in [0, 2^64) (default 1).\n"
     "                   The same INPUT, options and seed give the same OUTPUT, byte for\n"
     "                   byte; a vertex moved by --impulsive moves exactly as without it.\n"
@@ -57,6 +72,7 @@ static const char noise_usage_text[] =
     "Examples:\n"
     "  rsmooth noise fandisk.obj fandisk-0.3.obj --sigma 0.3 --seed 7\n"
     "  rsmooth noise part.ply part-impulsive.ply --sigma 0.5 --impulsive 0.1\n"
+    "  rsmooth noise bunny.obj bunny-scan.obj --sigma 0.15 --correlation 2\n"
     "\n"
     "Exit status: 0 success, 2 bad usage, a bad input file or an OUTPUT that may not be\n"
     "written, 1 other.\n";
@@ -89,12 +105,16 @@ static int parse_noise_args(int argc, char **argv, noise_args *a) {
     memset(a, 0, sizeof *a);
     a->noise.direction = MESH_NOISE_NORMAL;
     a->noise.seed = DEFAULT_SEED;
-    enum { N_HELP = 1, N_SIGMA, N_IMPULSIVE, N_DIRECTION, N_SEED, N_ASCII, N_FORCE, N_QUIET };
+    enum {
+        N_HELP = 1, N_SIGMA, N_IMPULSIVE, N_DIRECTION, N_SEED, N_ASCII, N_FORCE, N_QUIET,
+        N_CORRELATION, N_STRIPES
+    };
     static const cli_option table[] = {
         {"help", 'h', false, N_HELP},          {"sigma", 0, true, N_SIGMA},
         {"impulsive", 0, true, N_IMPULSIVE},   {"direction", 0, true, N_DIRECTION},
         {"seed", 0, true, N_SEED},             {"ascii", 0, false, N_ASCII},
         {"force", 'f', false, N_FORCE},        {"quiet", 'q', false, N_QUIET},
+        {"correlation", 0, true, N_CORRELATION}, {"stripes", 0, true, N_STRIPES},
         {NULL, 0, false, 0}};
     cli_getopt_state s;
     cli_getopt_init(&s, argc, argv, "noise", table);
@@ -129,6 +149,17 @@ static int parse_noise_args(int argc, char **argv, noise_args *a) {
                 a->noise.impulsive_fraction = x;
                 a->impulsive = true;
             }
+        } else if (id == N_CORRELATION || id == N_STRIPES) {
+            /* beyond 100 edges the neighbour sums of --correlation cost too much; stripes
+             * cost nothing */
+            double most = id == N_CORRELATION ? 100 : MAX_SIGMA;
+            if (!cli_parse_number(value, &x) || !(x > 0 && x <= most))
+                return cli_usage_error("noise", "%s must be in (0, %g] mean edge lengths (got '%s')",
+                                       s.spelled, most, value);
+            if (id == N_CORRELATION)
+                a->noise.correlation = x;
+            else
+                a->noise.stripes = x;
         } else if (id == N_DIRECTION) {
             if (!strcmp(value, "normal"))
                 a->noise.direction = MESH_NOISE_NORMAL;
@@ -158,6 +189,8 @@ static int parse_noise_args(int argc, char **argv, noise_args *a) {
         return cli_usage_error("noise", "no input file");
     if (!a->output)
         return cli_usage_error("noise", "no output file");
+    if (a->noise.correlation > 0 && a->noise.stripes > 0)
+        return cli_usage_error("noise", "--correlation and --stripes exclude each other");
     if (!a->have_sigma)
         return cli_usage_error("noise",
                                "--sigma is required (in mean edge lengths, e.g. --sigma 0.3)");
@@ -232,9 +265,16 @@ int cli_noise_main(int argc, char **argv) {
     if (!a.quiet) {
         size_t moved =
             a.noise.sigma > 0 ? mesh_noise_moved_count(nv, a.noise.impulsive_fraction) : 0;
-        char impulsive[64] = "";
+        char impulsive[128] = "";
         if (a.impulsive)
             snprintf(impulsive, sizeof impulsive, " (impulsive %g)", a.noise.impulsive_fraction);
+        if (a.noise.correlation > 0)
+            snprintf(impulsive + strlen(impulsive), sizeof impulsive - strlen(impulsive),
+                     "; band-limited, correlation length %g mean edge lengths",
+                     a.noise.correlation);
+        if (a.noise.stripes > 0)
+            snprintf(impulsive + strlen(impulsive), sizeof impulsive - strlen(impulsive),
+                     "; scan-line stripes %g mean edge lengths wide", a.noise.stripes);
         fprintf(stderr,
                 "rsmooth noise: %s: %zu vertices; sigma %.6g mean edge lengths = %.6g mesh units "
                 "%s; moved %zu of %zu vertices%s; seed %" PRIu64 "; wrote %s\n",

@@ -112,7 +112,10 @@ int mesh_add_noise(double *xyz, size_t vertex_count, const uint32_t *triangles,
                    size_t triangle_count, const mesh_noise_options *options) {
     if (!options || !(options->sigma >= 0) || !isfinite(options->sigma) ||
         !(options->impulsive_fraction >= 0 && options->impulsive_fraction <= 1) ||
-        (options->direction != MESH_NOISE_NORMAL && options->direction != MESH_NOISE_RANDOM))
+        (options->direction != MESH_NOISE_NORMAL && options->direction != MESH_NOISE_RANDOM) ||
+        !(options->correlation >= 0) || !isfinite(options->correlation) ||
+        !(options->stripes >= 0) || !isfinite(options->stripes) ||
+        (options->correlation > 0 && options->stripes > 0))
         return -1;
     if ((vertex_count && !xyz) || (triangle_count && !triangles) ||
         vertex_count > SIZE_MAX / (3 * sizeof(double)) ||
@@ -163,6 +166,25 @@ int mesh_add_noise(double *xyz, size_t vertex_count, const uint32_t *triangles,
             return -1;
         }
     }
+    /* correlated noise: a field of unit-variance values replaces the i.i.d. Gaussians */
+    double *field = NULL;
+    if (options->correlation > 0 || options->stripes > 0) {
+        field = malloc(vertex_count * sizeof *field);
+        int bad = !field;
+        if (!bad && options->correlation > 0)
+            bad = mesh_band_limited_field(scaled, vertex_count, options->correlation * edge * unit,
+                                          options->seed, field) != 0;
+        else if (!bad)
+            bad = mesh_stripe_field(scaled, vertex_count, options->stripes * edge * unit,
+                                    options->seed, field) != 0;
+        if (bad) {
+            free(field);
+            free(normals);
+            free(chosen);
+            free(scaled);
+            return -1;
+        }
+    }
     free(scaled);
 
     /* All displacements are computed from the input's normals and added in one pass; a vertex's
@@ -171,6 +193,8 @@ int mesh_add_noise(double *xyz, size_t vertex_count, const uint32_t *triangles,
     uint64_t direction_base = mix64(options->seed ^ DIRECTION_STREAM);
     for (size_t v = 0; v < vertex_count; v++) {
         double g = shape_gaussian(&gauss_state); /* drawn for every vertex: see the top */
+        if (field)
+            g = field[v];
         if (chosen && !chosen[v])
             continue;
         double d[3];
@@ -186,6 +210,7 @@ int mesh_add_noise(double *xyz, size_t vertex_count, const uint32_t *triangles,
         for (int k = 0; k < 3; k++)
             xyz[3 * v + k] += scale * g * d[k];
     }
+    free(field);
     free(normals);
     free(chosen);
     return 0;

@@ -3,6 +3,8 @@
 #ifndef RSMOOTH_MESH_NOISE_H
 #define RSMOOTH_MESH_NOISE_H
 
+#include "mesh_noise_correlated.h"
+
 #include <stddef.h>
 #include <stdint.h>
 
@@ -28,6 +30,14 @@ typedef struct mesh_noise_options {
     /* Same seed, options and mesh: bit-identical output on every platform with a correctly
      * rounded (or identical) libm; splitmix64 streams, no rand(). */
     uint64_t seed;
+    /* > 0: band-limited noise instead of i.i.d. noise: each vertex's Gaussian is replaced by
+     * mesh_band_limited_field's, a Gaussian smoothing of width `correlation` mean edge lengths
+     * (still of standard deviation 1 per vertex, so `sigma` keeps its meaning). 0: off. */
+    double correlation;
+    /* > 0: scan-line stripes of width `stripes` mean edge lengths (mesh_stripe_field, root mean
+     * square over the vertices exactly 1, times sigma) instead of i.i.d. noise; not with
+     * `correlation`. 0: off. */
+    double stripes;
 } mesh_noise_options;
 
 /* Adds noise to `xyz` (3 * vertex_count doubles) in place. `triangles` (3 * triangle_count
@@ -35,7 +45,8 @@ typedef struct mesh_noise_options {
  * fraction and no unreferenced vertex, the result equals shape_add_normal_noise's for the same
  * seed. A mesh without edges has no unit: nothing moves. Returns 0, or -1 on bad options (sigma
  * negative or not finite, fraction outside [0, 1], unknown direction), bad arrays (NULL, an index
- * out of range) or out of memory; xyz is then unchanged. */
+ * out of range, correlation or stripes negative or not finite, both set) or out of memory;
+ * xyz is then unchanged. */
 int mesh_add_noise(double *xyz, size_t vertex_count, const uint32_t *triangles,
                    size_t triangle_count, const mesh_noise_options *options);
 

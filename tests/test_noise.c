@@ -28,7 +28,7 @@ static double *copy_xyz(const shape_mesh *m) {
 static double *noisy(const shape_mesh *m, double sigma, mesh_noise_direction direction,
                      double fraction, uint64_t seed) {
     double *xyz = copy_xyz(m);
-    mesh_noise_options o = {sigma, direction, fraction, seed};
+    mesh_noise_options o = {sigma, direction, fraction, seed, 0, 0};
     CHECK_EQ_INT(mesh_add_noise(xyz, m->vertex_count, m->indices, m->triangle_count, &o), 0);
     return xyz;
 }
@@ -178,7 +178,7 @@ static void check_reproducible(const shape_mesh *m) {
     CHECK(before);
     memcpy(before, z, bytes);
     for (int dir = 0; dir < 2; dir++) {
-        mesh_noise_options o = {0, (mesh_noise_direction)dir, 0, 7};
+        mesh_noise_options o = {0, (mesh_noise_direction)dir, 0, 7, 0, 0};
         CHECK_EQ_INT(mesh_add_noise(z, m->vertex_count, m->indices, m->triangle_count, &o), 0);
         o.impulsive_fraction = 0.5;
         CHECK_EQ_INT(mesh_add_noise(z, m->vertex_count, m->indices, m->triangle_count, &o), 0);
@@ -219,15 +219,17 @@ static void check_bad_options(const shape_mesh *m) {
     size_t bytes = 3 * m->vertex_count * sizeof(double);
     double *xyz = copy_xyz(m);
     const mesh_noise_options bad[] = {
-        {-1, MESH_NOISE_NORMAL, 0, 1},        {NAN, MESH_NOISE_NORMAL, 0, 1},
-        {INFINITY, MESH_NOISE_NORMAL, 0, 1},  {0.3, MESH_NOISE_NORMAL, -0.1, 1},
-        {0.3, MESH_NOISE_NORMAL, 1.1, 1},     {0.3, MESH_NOISE_RANDOM, NAN, 1},
-        {0.3, (mesh_noise_direction)7, 0, 1},
+        {-1, MESH_NOISE_NORMAL, 0, 1, 0, 0},        {NAN, MESH_NOISE_NORMAL, 0, 1, 0, 0},
+        {INFINITY, MESH_NOISE_NORMAL, 0, 1, 0, 0},  {0.3, MESH_NOISE_NORMAL, -0.1, 1, 0, 0},
+        {0.3, MESH_NOISE_NORMAL, 1.1, 1, 0, 0},     {0.3, MESH_NOISE_RANDOM, NAN, 1, 0, 0},
+        {0.3, (mesh_noise_direction)7, 0, 1, 0, 0},   {0.3, MESH_NOISE_NORMAL, 0, 1, -1, 0},
+        {0.3, MESH_NOISE_NORMAL, 0, 1, NAN, 0}, {0.3, MESH_NOISE_NORMAL, 0, 1, 0, -2},
+        {0.3, MESH_NOISE_NORMAL, 0, 1, 2, 3},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)
         CHECK_EQ_INT(mesh_add_noise(xyz, m->vertex_count, m->indices, m->triangle_count, &bad[i]),
                      -1);
-    mesh_noise_options good = {0.3, MESH_NOISE_NORMAL, 0, 1};
+    mesh_noise_options good = {0.3, MESH_NOISE_NORMAL, 0, 1, 0, 0};
     CHECK_EQ_INT(mesh_add_noise(xyz, m->vertex_count, m->indices, m->triangle_count, NULL), -1);
     CHECK_EQ_INT(mesh_add_noise(NULL, m->vertex_count, m->indices, m->triangle_count, &good), -1);
     CHECK_EQ_INT(mesh_add_noise(xyz, m->vertex_count, NULL, m->triangle_count, &good), -1);

@@ -155,7 +155,7 @@ static void generated_shapes(void) {
     double *xyz = malloc(3 * shapes[1].vertex_count * sizeof *xyz);
     CHECK(xyz);
     memcpy(xyz, shapes[1].xyz, 3 * shapes[1].vertex_count * sizeof *xyz);
-    mesh_noise_options o = {0.5, MESH_NOISE_NORMAL, 0.5, 7};
+    mesh_noise_options o = {0.5, MESH_NOISE_NORMAL, 0.5, 7, 0, 0};
     CHECK_EQ_INT(mesh_add_noise(xyz, shapes[1].vertex_count, shapes[1].indices,
                                 shapes[1].triangle_count, &o),
                  0);
@@ -170,7 +170,7 @@ static void generated_shapes(void) {
             double *noisy = malloc(3 * shapes[s].vertex_count * sizeof *noisy);
             CHECK(noisy);
             memcpy(noisy, shapes[s].xyz, 3 * shapes[s].vertex_count * sizeof *noisy);
-            mesh_noise_options g = {levels[l], MESH_NOISE_NORMAL, 0, 200 + l};
+            mesh_noise_options g = {levels[l], MESH_NOISE_NORMAL, 0, 200 + l, 0, 0};
             CHECK_EQ_INT(mesh_add_noise(noisy, shapes[s].vertex_count, shapes[s].indices,
                                         shapes[s].triangle_count, &g),
                          0);
@@ -200,7 +200,7 @@ static void random_directions(void) {
             double *noisy = malloc(3 * nv * sizeof *noisy);
             CHECK(noisy);
             memcpy(noisy, shapes[s].xyz, 3 * nv * sizeof *noisy);
-            mesh_noise_options o = {levels[l], MESH_NOISE_RANDOM, 0, 300 + l};
+            mesh_noise_options o = {levels[l], MESH_NOISE_RANDOM, 0, 300 + l, 0, 0};
             CHECK_EQ_INT(mesh_add_noise(noisy, nv, shapes[s].indices, nt, &o), 0);
             double truth = true_noise(&shapes[s], noisy), est = estimate(noisy, nv, shapes[s].indices, nt);
             printf("%-9s random directions %.1f: truth (normal part) %.4f  estimate %.4f  ratio "
@@ -248,7 +248,7 @@ static void check_kind(void) {
             for (size_t l = 0; l < sizeof gaussian / sizeof *gaussian; l++) {
                 memcpy(noisy, shapes[s].xyz, 3 * nv * sizeof *noisy);
                 mesh_noise_options o = {gaussian[l], d ? MESH_NOISE_RANDOM : MESH_NOISE_NORMAL, 0,
-                                        400 + 10 * (uint64_t)d + l};
+                                        400 + 10 * (uint64_t)d + l, 0, 0};
                 CHECK_EQ_INT(mesh_add_noise(noisy, nv, shapes[s].indices, nt, &o), 0);
                 bool imp = reads_impulsive(&shapes[s], noisy);
                 printf("%-9s Gaussian %s %.2f: %s\n", names[s], d ? "random" : "normal",
@@ -259,7 +259,7 @@ static void check_kind(void) {
             for (size_t l = 0; l < sizeof impulsive / sizeof *impulsive; l++) {
                 memcpy(noisy, shapes[s].xyz, 3 * nv * sizeof *noisy);
                 mesh_noise_options o = {impulsive[l], MESH_NOISE_NORMAL, fractions[f],
-                                        500 + 10 * (uint64_t)f + l};
+                                        500 + 10 * (uint64_t)f + l, 0, 0};
                 CHECK_EQ_INT(mesh_add_noise(noisy, nv, shapes[s].indices, nt, &o), 0);
                 bool imp = reads_impulsive(&shapes[s], noisy);
                 printf("%-9s impulsive F %.2f %.1f: %s\n", names[s], fractions[f], impulsive[l],
