@@ -107,6 +107,11 @@ static int read_input(file_job *job) {
         return code;
     job->ms_read = cli_now_ms() - t0;
     rsmooth_mesh *mesh = job->mesh;
+    size_t cols, rows, samples;
+    if (!opt->quiet && rsmooth_mesh_range_grid(mesh, &cols, &rows, &samples))
+        fprintf(stderr, "rsmooth: note: %s is a range grid (%zu x %zu cells, %zu samples): read as "
+                        "%zu triangles; the output is a triangle mesh, not a range grid\n",
+                opt->input, cols, rows, samples, mesh->triangle_count);
     job->points = mesh->triangle_count == 0;
     if (job->points && (code = cli_check_point_cloud(opt, mesh)) != EXIT_OK)
         return code;

@@ -192,6 +192,21 @@ RSMOOTH_API rsmooth_status rsmooth_mesh_triangulate(rsmooth_mesh *mesh, rsmooth_
 RSMOOTH_API size_t rsmooth_mesh_conversion_losses(const rsmooth_mesh *mesh, rsmooth_format format,
                                                   char *buffer, size_t size);
 
+/** Whether `mesh` was read from a scanner's PLY range grid (an "element range_grid" with
+ * "obj_info num_cols" / "num_rows" lines, each cell listing 0 or 1 vertex index, no faces; added in
+ * 0.11). Such a file is read as a triangle mesh: each 2x2 block of cells gives two triangles when
+ * all four samples exist (split along the shorter diagonal) and one when three do, all wound the
+ * same way, and no triangle whose longest edge exceeds 10 times the scan's median distance between
+ * adjacent samples (a depth jump; docs/file-formats.md). Its faces replace the range_grid element
+ * in the extras, so a PLY written back is a triangle mesh, not a range grid. Returns 1 and sets
+ * *cols, *rows (the grid's size in cells) and *samples (cells holding a sample), each when not
+ * NULL; 0 when the mesh was not (or its extras were set to NULL). Thread-safe. A malformed grid
+ * fails rsmooth_mesh_read_* with RSMOOTH_ERROR_PARSE: a cell listing 2 or more indices, an index
+ * out of range or listed by two cells, num_cols x num_rows other than the element's count, a
+ * missing or malformed num_cols / num_rows, or a face element as well. */
+RSMOOTH_API int rsmooth_mesh_range_grid(const rsmooth_mesh *mesh, size_t *cols, size_t *rows,
+                                        size_t *samples);
+
 /** Area-weighted vertex normals of the mesh's triangles (unit length; 0 for vertices no triangle
  * uses), 3 * vertex_count doubles. What writers emit for files that carried normals. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_vertex_normals(const rsmooth_mesh *mesh, double *normals,

@@ -219,6 +219,17 @@ rsmooth_status rs_ply_read_ascii_element(rs_ply_reader *r, rs_ply_element *e,
                     return status;
                 continue;
             }
+            if (p->role == RS_PLY_GRID_LIST) {
+                status = rs_ply_grid_cell(r, n, i, r->line, (int64_t)offset, error);
+                for (uint64_t j = 0; status == RSMOOTH_OK && j < n; j++) {
+                    status = read_typed_value(r, &item, p, p->type, &v, &offset, error);
+                    if (status == RSMOOTH_OK)
+                        status = rs_ply_grid_index(r, v, i, r->line, (int64_t)offset, error);
+                }
+                if (status != RSMOOTH_OK)
+                    return status;
+                continue;
+            }
             store_value(row + p->row_offset, p->count_type, v);
             const size_t size = rs_ply_type_size(p->type);
             for (uint64_t j = 0; j < n; j++) {

@@ -270,6 +270,13 @@ static rsmooth_status read_list(rs_ply_reader *r, rs_ply_element *e, const rs_pl
         }
         return RSMOOTH_OK;
     }
+    if (p->role == RS_PLY_GRID_LIST) {
+        rsmooth_status status = rs_ply_grid_cell(r, n, i, -1, (int64_t)count_offset, error);
+        for (uint64_t j = 0; status == RSMOOTH_OK && j < n; j++, r->pos += size)
+            status = rs_ply_grid_index(r, load_value(data + r->pos, p->type, be), i, -1,
+                                       (int64_t)r->pos, error);
+        return status;
+    }
     copy_values(row + p->row_offset, data + count_offset, 1, count_size, r->swap);
     size_t bytes = (size_t)n * size; /* n * size <= the bytes left */
     if (bytes == 0)

@@ -125,7 +125,8 @@ typedef enum rs_ply_role {
     RS_PLY_NX,         /* vertex normals (float or double): recomputed by writers, not kept */
     RS_PLY_NY,
     RS_PLY_NZ,
-    RS_PLY_FACE_LIST   /* the face element's vertex indices: mesh->face_*, not kept here */
+    RS_PLY_FACE_LIST,  /* the face element's vertex indices: mesh->face_*, not kept here */
+    RS_PLY_GRID_LIST   /* a range_grid element's vertex indices: triangulated (ply_range_grid.c) */
 } rs_ply_role;
 
 typedef struct rs_ply_property {
@@ -168,6 +169,9 @@ struct rs_ply_extras {
     rs_ply_element *elements; /* header order */
     size_t element_count, element_capacity;
     size_t vertex_element, face_element; /* indices into elements; SIZE_MAX when absent */
+    /* The faces were triangulated from a range grid of grid_cols x grid_rows cells holding
+     * grid_samples samples (ply_range_grid.c); all 0 otherwise. */
+    uint64_t grid_cols, grid_rows, grid_samples;
 };
 
 /* ---- ply_write.c: what the streamed writer (lib/stream) shares with rs_io_ply_write, so that a

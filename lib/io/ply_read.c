@@ -87,6 +87,14 @@ static rsmooth_status read_data(rs_ply_reader *r, rsmooth_error *error) {
                 return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "%zu vertices",
                                r->vertex_count);
         }
+        if (e == r->grid_element) {
+            r->grid_cells = rs_alloc_array((size_t)e->count, sizeof(uint32_t));
+            r->grid_owner = rs_calloc_array(r->vertex_count, sizeof(uint64_t));
+            if (!r->grid_cells || !r->grid_owner)
+                return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where,
+                               "range grid of %llu cells", (unsigned long long)e->count);
+            memset(r->grid_cells, 0xff, (size_t)e->count * sizeof(uint32_t)); /* no sample */
+        }
         if (is_face) {
             r->face_count = (size_t)e->count;
             r->face_offsets = rs_alloc_array(r->face_count + 1, sizeof(uint32_t));
@@ -159,11 +167,17 @@ rsmooth_status rs_io_ply_read(const char *data, size_t size, rsmooth_mesh **mesh
     if (status == RSMOOTH_OK)
         status = rs_ply_find_elements(&r, error);
     if (status == RSMOOTH_OK)
+        status = rs_ply_range_grid_header(&r, error);
+    if (status == RSMOOTH_OK)
         status = rs_ply_assign_roles(&r, error);
     if (status == RSMOOTH_OK)
         status = read_data(&r, error);
     if (status == RSMOOTH_OK)
         status = check_end(&r, error);
+    if (status == RSMOOTH_OK && r.grid_element)
+        status = rs_ply_range_grid_triangulate(&r, error);
+    rs_free(r.grid_cells);
+    rs_free(r.grid_owner);
     uint32_t *indices = r.indices.data;
     if (status == RSMOOTH_OK && !indices) {
         indices = rs_alloc_array(1, sizeof(uint32_t));
@@ -182,7 +196,7 @@ rsmooth_status rs_io_ply_read(const char *data, size_t size, rsmooth_mesh **mesh
     rsmooth_format format = r.encoding == RS_PLY_ASCII       ? RSMOOTH_FORMAT_PLY_ASCII
                             : r.encoding == RS_PLY_BINARY_LE ? RSMOOTH_FORMAT_PLY_BINARY
                                                              : RSMOOTH_FORMAT_PLY_BINARY_BE;
-    bool plain = rs_ply_is_plain(&r);
+    bool plain = rs_ply_is_plain(&r) && !r.grid_element; /* extras say it was a grid */
     rsmooth_mesh *m = NULL;
     status = rs_io_mesh_adopt(r.positions, r.vertex_count, r.precision, r.face_offsets,
                               r.face_count, indices, format, &m, error);

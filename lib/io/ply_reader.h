@@ -32,6 +32,12 @@ typedef struct rs_ply_reader {
     double *normal_values; /* 3 per vertex when `normals`: nx, ny, nz as read */
     size_t color[3]; /* property index of red, green, blue in the vertex element; SIZE_MAX: none */
     uint8_t *colors;
+    /* range grid (ply_range_grid.c): the element, its size, each cell's sample (UINT32_MAX: none)
+     * and each vertex's cell + 1 (0: none), to refuse a sample listed twice */
+    rs_ply_element *grid_element;
+    uint64_t grid_cols, grid_rows;
+    uint32_t *grid_cells;
+    uint64_t *grid_owner;
 } rs_ply_reader;
 
 /* PLY's blanks (header and ascii data), line ends included. */
@@ -71,6 +77,29 @@ rsmooth_status rs_ply_check_vertex(const rs_ply_reader *r, size_t i, int64_t lin
 /* Room for `extra` more bytes of an element's list items; false when out of memory. */
 bool rs_ply_list_reserve(rs_ply_element *e, size_t extra);
 rsmooth_status rs_ply_list_oom(const rs_ply_element *e, rsmooth_error *error);
+
+/* ---- ply_range_grid.c: a scanner's range grid (element range_grid) read as triangles */
+
+/* The header's element named "range_grid", or NULL. */
+rs_ply_element *rs_ply_range_grid_element(const rs_ply_extras *x);
+
+/* Finds a range grid and checks its header (num_cols / num_rows obj_info lines whose product is
+ * its count, an integer vertex_indices list, no face element), marking the list RS_PLY_GRID_LIST;
+ * RSMOOTH_OK with r->grid_element NULL when there is none. Before rs_ply_assign_roles. */
+rsmooth_status rs_ply_range_grid_header(rs_ply_reader *r, rsmooth_error *error);
+
+/* Cell `item` of the grid lists `n` vertex indices (0 or 1), or a located error. */
+rsmooth_status rs_ply_grid_cell(rs_ply_reader *r, uint64_t n, uint64_t item, int64_t line,
+                                int64_t offset, rsmooth_error *error);
+
+/* Cell `item`'s vertex index v (whole, in range, in no other cell), or a located error. */
+rsmooth_status rs_ply_grid_index(rs_ply_reader *r, double v, uint64_t item, int64_t line,
+                                 int64_t offset, rsmooth_error *error);
+
+/* After the data: the grid's triangles into r->face_offsets / r->indices, and the extras made a
+ * mesh's (the range_grid element becomes the face element; the obj_info lines describing the grid
+ * are dropped). */
+rsmooth_status rs_ply_range_grid_triangulate(rs_ply_reader *r, rsmooth_error *error);
 
 /* ---- ply_binary.c, ply_ascii.c: one element's items from r->pos (its count already bounded by
  * the bytes left; rows, positions, normals and face offsets allocated) */

@@ -551,6 +551,8 @@ static rsmooth_status write_element(const rsmooth_mesh *mesh, const rs_ply_extra
                     emit_double(out, binary, ft->index_type, mesh->face_indices[j]);
                 break;
             }
+            case RS_PLY_GRID_LIST: /* the reader made the grid a face element */
+                return inconsistent(e, error);
             case RS_PLY_STORED:
                 if (!row || p->row_offset >= e->row_size)
                     return inconsistent(e, error);

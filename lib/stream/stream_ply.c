@@ -282,6 +282,8 @@ rsmooth_status rs_stream_ply_open(rs_stream_ply *ply, const char *path, uint64_t
                       detail.message);
         return st;
     }
+    if (rs_ply_range_grid_element(ply->header.x)) /* not a point cloud: refused, not misread */
+        return unsupported(path, "does not triangulate range grids (element 'range_grid')", error);
     ply->data_start = (ply->bom ? RS_IO_UTF8_BOM_SIZE : 0) + (uint64_t)ply->header.pos;
     ply->plain = rs_ply_is_plain(&ply->header);
     ply->out_swap = !rs_ply_host_is_le(); /* rs_io_ply_write writes little-endian */
