@@ -19,6 +19,8 @@ const char cli_usage_text[] =
     "\n"
     "Files: OBJ, PLY (ascii, binary), OFF and STL, by content on input and by extension on "
     "output.\n"
+    "A scanner's PLY range grid (element range_grid) is read as triangles: neighbouring samples\n"
+    "joined, none across a depth jump (an edge over 10 times the median sample spacing).\n"
     "'-' as INPUT reads standard input. Several inputs are smoothed one after another (one line\n"
     "each); a file that fails is reported and the others still done, then a summary.\n"
     "Vertex order, faces and everything else the file holds (colours, texture coordinates,\n"
