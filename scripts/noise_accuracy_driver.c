@@ -70,10 +70,14 @@ int main(void) {
                "\"true_tangential\": %.6g, \"true_fraction\": %.6g, \"true_edge\": %.6g, "
                "\"level\": %.6g, \"impulsive\": %s, \"fraction\": %.6g, \"tangential\": %.6g, "
                "\"edge_clean\": %.6g, \"edge_noisy\": %.6g, \"overall\": %.6g, \"tail\": %.6g, "
-               "\"samples\": %zu, \"ms\": %.2f}\n",
+               "\"samples\": %zu, \"ms\": %.2f, \"correlated\": %.6g, \"length\": %.6g, "
+               "\"profile\": [%.6g, %.6g, %.6g], \"profile_floor\": [%.6g, %.6g, %.6g]}\n",
                noisy_path, nv, t_n, t_all, t_tan, frac, edge, d.level,
                d.impulsive ? "true" : "false", d.impulsive_fraction, d.tangential_level,
-               d.mean_edge_clean, d.mean_edge_noisy, d.overall_level, d.tail_share, d.samples, ms);
+               d.mean_edge_clean, d.mean_edge_noisy, d.overall_level, d.tail_share, d.samples, ms,
+               d.correlated_level, d.correlation_length, d.profile.low[0], d.profile.low[1],
+               d.profile.low[2], d.profile.low_floor[0], d.profile.low_floor[1],
+               d.profile.low_floor[2]);
         fflush(stdout);
         rsmooth_mesh_destroy(noisy);
         rsmooth_mesh_destroy(clean);

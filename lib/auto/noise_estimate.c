@@ -198,6 +198,10 @@ static double inverse_diagonal(double l[TERMS][TERMS], const double inv[TERMS], 
     return sum;
 }
 
+void rs_noise_eigen3(double m[3][3], double values[3], double vectors[3][3]) {
+    symmetric_eigen3(m, values, vectors);
+}
+
 /* ---- the points: welded vertices with normals ------------------------------------------------ */
 
 typedef struct point_set {
@@ -1096,6 +1100,24 @@ static size_t keep_fitted(sample_job *job) {
     return valid;
 }
 
+/* The correlated noise (noise_scales.c) into out, in the clean mesh's mean edge lengths. */
+static rsmooth_status correlated_part(estimate_run *e, rs_noise_details *out) {
+    rsmooth_status st = rs_noise_scales(e->pts.xyz, e->pts.normal, e->pts.count, e->unit,
+                                        e->ring_start, e->ring, &out->profile, e->error,
+                                        e->caller);
+    if (st != RSMOOTH_OK)
+        return st;
+    double noisy_per_clean = out->mean_edge_noisy / out->mean_edge_clean; /* level's unit */
+    /* the rms over all vertices: for impulsive noise that of the displaced ones times the root
+     * of their share */
+    double white = out->impulsive ? out->level * sqrt(out->impulsive_fraction) : out->overall_level;
+    double level_noisy = white / noisy_per_clean, length = 0, correlated = 0;
+    rs_noise_correlated(&out->profile, level_noisy, &correlated, &length);
+    out->correlated_level = correlated * noisy_per_clean;
+    out->correlation_length = length * noisy_per_clean;
+    return RSMOOTH_OK;
+}
+
 rsmooth_status rs_estimate_noise_details(rsmooth_scalar scalar, const void *positions,
                                          size_t vertex_count, const uint32_t *indices,
                                          size_t triangle_count, rs_noise_details *out,
@@ -1131,6 +1153,8 @@ rsmooth_status rs_estimate_noise_details(rsmooth_scalar scalar, const void *posi
             out->mean_edge_noisy = out->mean_edge_clean = e.unit / e.scale;
             if (valid > 0)
                 summarise(&e.job, valid, e.unit, e.scale, e.scratch, out);
+            if (valid > 0)
+                st = correlated_part(&e, out);
         }
     }
     free_estimate(&e);

@@ -3,6 +3,7 @@
 #ifndef RSMOOTH_NOISE_ESTIMATE_H
 #define RSMOOTH_NOISE_ESTIMATE_H
 
+#include "auto/noise_scales.h"
 #include "rsmooth.h"
 
 #include <stdbool.h>
@@ -35,6 +36,13 @@ typedef struct rs_noise_details {
     double tail_share;
     /* Vertices whose residual was measured. */
     size_t samples;
+    /* The rms of the noise along the normals including its spatially correlated part (noise_scales.c),
+     * clean mean edge lengths: level when the noise reads uncorrelated. */
+    double correlated_level;
+    /* The correlated part's correlation length (mean edge lengths; 0: uncorrelated). */
+    double correlation_length;
+    /* What the two are read from (radii and figures in the noisy mesh's mean edge lengths). */
+    rs_noise_profile profile;
 } rs_noise_details;
 
 /* rsmooth_estimate_noise with the details; errors name `caller`. Deterministic for any thread
@@ -43,5 +51,9 @@ rsmooth_status rs_estimate_noise_details(rsmooth_scalar scalar, const void *posi
                                          size_t vertex_count, const uint32_t *indices,
                                          size_t triangle_count, rs_noise_details *out,
                                          rsmooth_error *error, const char *caller);
+
+/* The eigenvalues of the symmetric m (ascending) and their unit eigenvectors (vectors[i] for
+ * values[i]): noise_estimate.c's PCA, shared with noise_scales.c. */
+void rs_noise_eigen3(double m[3][3], double values[3], double vectors[3][3]);
 
 #endif
