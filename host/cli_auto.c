@@ -48,6 +48,8 @@ int cli_choose_params(options *opt, const rsmooth_mesh *mesh, bool points) {
         chosen.guided_rounds = given->guided_rounds;
     if (opt->given & GIVEN_STAGE_REPEATS)
         chosen.stage_repeats = given->stage_repeats;
+    if (opt->given & GIVEN_GUIDED_RADIUS)
+        chosen.guided_radius = given->guided_radius;
     if (opt->given & (GIVEN_SIGMA_F | GIVEN_SIGMA_G))
         chosen.absolute = given->absolute;
     opt->params = chosen;

@@ -16,7 +16,8 @@ enum {
     OPT_PASS_CONFIDENCE, OPT_SIGMA_C, OPT_NORMAL_ITERATIONS, OPT_PASSES, OPT_AUTO, OPT_BEST,
     OPT_ABSOLUTE, OPT_NO_MOLLIFY, OPT_ASCII, OPT_JSON, OPT_STATS, OPT_LIST_DEVICES, OPT_FORCE,
     OPT_QUIET, OPT_MASK, OPT_VERTEX_UPDATES, OPT_GUIDED_SIGMA_S, OPT_GUIDED_SIGMA_N,
-    OPT_GUIDED_ROUNDS, OPT_STAGE_REPEATS, OPT_MAX_MEMORY, OPT_TMPDIR, OPT_PROGRESS
+    OPT_GUIDED_ROUNDS, OPT_STAGE_REPEATS, OPT_MAX_MEMORY, OPT_TMPDIR, OPT_PROGRESS,
+    OPT_GUIDED_RADIUS
 };
 
 static const cli_option table[] = {
@@ -52,6 +53,7 @@ static const cli_option table[] = {
     {"guided-sigma-n", 0, true, OPT_GUIDED_SIGMA_N},
     {"guided-rounds", 0, true, OPT_GUIDED_ROUNDS},
     {"stage-repeats", 0, true, OPT_STAGE_REPEATS},
+    {"guided-radius", 0, true, OPT_GUIDED_RADIUS},
     {"auto", 0, false, OPT_AUTO},
     {"best", 0, false, OPT_BEST},
     {"absolute", 0, false, OPT_ABSOLUTE},
@@ -167,10 +169,15 @@ static int apply_number(options *opt, int id, const char *name, const char *valu
             opt->params.normal_iterations = (int)x, opt->given |= GIVEN_NORMAL_ITERATIONS;
         break;
     case OPT_STAGE_REPEATS:
-        if (!number || !(x >= 1 && x <= 100 && x == floor(x)))
-            return cli_usage_error(NULL, "%s must be a whole number in [1, 100] (got '%s')",
+        if (!number || !(x >= 1 && x <= 1000 && x == floor(x)))
+            return cli_usage_error(NULL, "%s must be a whole number in [1, 1000] (got '%s')",
                                    name, value);
         opt->params.stage_repeats = (int)x, opt->given |= GIVEN_STAGE_REPEATS;
+        break;
+    case OPT_GUIDED_RADIUS:
+        if (!number || !(x >= 1 && x <= 8))
+            return cli_usage_error(NULL, "%s must be a number in [1, 8] (got '%s')", name, value);
+        opt->params.guided_radius = x, opt->given |= GIVEN_GUIDED_RADIUS;
         break;
     case OPT_VERTEX_UPDATES: case OPT_GUIDED_ROUNDS:
         if (!number || !(x >= (id == OPT_VERTEX_UPDATES ? 0 : 1) &&

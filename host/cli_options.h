@@ -39,7 +39,8 @@ enum {
     GIVEN_GUIDED_SIGMA_S = 1u << 8,
     GIVEN_GUIDED_SIGMA_N = 1u << 9,
     GIVEN_GUIDED_ROUNDS = 1u << 10,
-    GIVEN_STAGE_REPEATS = 1u << 11
+    GIVEN_STAGE_REPEATS = 1u << 11,
+    GIVEN_GUIDED_RADIUS = 1u << 12
 };
 
 typedef struct options {

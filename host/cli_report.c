@@ -65,11 +65,10 @@ void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read,
     cli_print_json_string(opt->input);
     printf(",\"output\":");
     cli_print_json_string(opt->output);
-    if (r->discrepancy_iterations > 0) /* --auto's guard: Taubin's result replaced the filter's */
-        printf(",\"method\":\"taubin\",\"lambda\":0.5,\"mu\":-0.53,\"iterations\":%d,"
-               "\"instead_of\":\"%s\"", r->discrepancy_iterations, cli_method_names[opt->method]);
-    else
-        printf(",\"method\":\"%s\"", cli_method_names[opt->method]);
+    printf(",\"method\":\"%s\"", cli_method_names[opt->method]);
+    if (r->discrepancy_iterations > 0) /* --auto's choice per region: blended with Taubin's */
+        printf(",\"region_choice\":{\"taubin_iterations\":%d,\"lambda\":0.5,\"mu\":-0.53,"
+               "\"filter_share\":%.4f}", r->discrepancy_iterations, r->region_filter_share);
     if (cli_method_uses_edges(opt->method))
         printf(",\"lambda\":%.9g,\"mu\":%.9g,\"iterations\":%u", opt->lambda, opt->mu,
                opt->iterations);
@@ -93,11 +92,11 @@ void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read,
                cli_influence_names[p->influence], p->passes, p->pass_confidence);
         printf(",\"vertex_updates\":%d", p->vertex_updates);
         if (p->vertex_updates > 0)
-            printf(",\"guided_sigma_s\":%.9g,\"guided_sigma_n\":%.9g,\"guided_rounds\":%d,"
-                   "\"stage_repeats\":%d,\"discrepancy_level\":%.9g,"
+            printf(",\"guided_sigma_s\":%.9g,\"guided_sigma_n\":%.9g,\"guided_radius\":%.9g,"
+                   "\"guided_rounds\":%d,\"stage_repeats\":%d,\"discrepancy_level\":%.9g,"
                    "\"discrepancy_iterations\":%d",
-                   p->guided_sigma_s, p->guided_sigma_n, p->guided_rounds, p->stage_repeats,
-                   p->discrepancy_level, r->discrepancy_iterations);
+                   p->guided_sigma_s, p->guided_sigma_n, p->guided_radius, p->guided_rounds,
+                   p->stage_repeats, p->discrepancy_level, r->discrepancy_iterations);
         if (opt->auto_params)
             printf(",\"noise_estimate\":%.9g", opt->noise);
     }

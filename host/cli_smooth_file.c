@@ -179,11 +179,12 @@ static void report_file(const file_job *job) {
     const char *and = opt->confidence ? " and " : "";
     const char *confidence = opt->confidence ? opt->confidence : "";
     if (!opt->quiet && r->discrepancy_iterations > 0)
-        fprintf(stderr, "rsmooth: %s: --auto: the result is curved at the scale of its "
-                        "triangles (an organic mesh coarse for its curvature, where low-pass "
-                        "smoothing restores the surface better): Taubin smoothing instead, %d "
-                        "iterations, until the vertices moved as far as the noise\n",
-                opt->input, r->discrepancy_iterations);
+        fprintf(stderr, "rsmooth: %s: --auto: a choice per region: the filter's result where it "
+                        "came out flat faces and creases, Taubin smoothing (%d iterations, until "
+                        "the vertices moved as far as the noise) where it came out curved at the "
+                        "scale of its triangles (organic parts coarse for their curvature), "
+                        "blended between: the filter's weight %.0f%% on average\n",
+                opt->input, r->discrepancy_iterations, 100 * r->region_filter_share);
     if (opt->json)
         cli_print_json(r, opt, job->ms_read, job->ms_write);
     if (opt->stats)
@@ -196,11 +197,12 @@ static void report_file(const file_job *job) {
                 job->wrote);
     else if (r->discrepancy_iterations > 0)
         fprintf(stderr,
-                "rsmooth: %s: %zu vertices, %zu triangles, mean edge %.6g; Taubin smoothing, %d "
-                "iterations (--auto's choice, in place of the filter's result on %s): %.1f ms; "
-                "wrote %s%s%s\n",
+                "rsmooth: %s: %zu vertices, %zu triangles, mean edge %.6g; the filter (%.0f%%) "
+                "blended per region with Taubin smoothing, %d iterations (--auto's choice) on "
+                "%s: %.1f ms; wrote %s%s%s\n",
                 opt->input, r->vertex_count, r->triangle_count, r->mean_edge_length,
-                r->discrepancy_iterations, r->device, r->ms_total, job->wrote, and, confidence);
+                100 * r->region_filter_share, r->discrepancy_iterations, r->device, r->ms_total,
+                job->wrote, and, confidence);
     else if (job->points)
         fprintf(stderr,
                 "rsmooth: %s: %zu points with normals, spacing %.6g; sigma_f %.6g, sigma_g "

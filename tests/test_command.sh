@@ -569,7 +569,8 @@ grep -q "$(printf '\r')" err.txt && fail "--progress wrote carriage returns into
 expect 0 "$rsmooth" noisy.ply -o progress_q.ply --progress -q --device reference
 [ -s err.txt ] && fail "--progress -q printed: $(cat err.txt)"
 
-# --auto's guard hands a coarse curved mesh to Taubin smoothing: the status line and --json say so
+# --auto's choice per region hands a coarse curved mesh to Taubin smoothing: the status line and
+# --json say so
 awk 'BEGIN { pi = atan2(0, -1); R = 12; C = 24; print "v 0 0 1"
   for (i = 1; i < R; i++) for (j = 0; j < C; j++) {
     t = pi * i / R; p = 2 * pi * j / C; printf "v %.9f %.9f %.9f\n", sin(t) * cos(p), sin(t) * sin(p), cos(t) }
@@ -580,12 +581,13 @@ awk 'BEGIN { pi = atan2(0, -1); R = 12; C = 24; print "v 0 0 1"
   for (j = 0; j < C; j++) printf "f %d %d %d\n", 2 + (R - 2) * C + j, n, 2 + (R - 2) * C + (j + 1) % C }' > uv.obj
 expect 0 "$rsmooth" noise uv.obj uv_noisy.obj --sigma 0.3 --seed 1
 expect 0 "$rsmooth" uv_noisy.obj -o uv_out.obj --best --auto --json --device reference
-grep -q '"method":"taubin","lambda":0.5,"mu":-0.53,"iterations":[1-9][0-9]*,"instead_of":"robust"' out.txt ||
-  fail "--json after --auto's Taubin does not say taubin: $(cat out.txt)"
+grep -q '"region_choice":{"taubin_iterations":[1-9][0-9]*,"lambda":0.5,"mu":-0.53,"filter_share":0\.0' out.txt ||
+  fail "--json after --auto's choice per region does not say Taubin took the sphere: $(cat out.txt)"
 status=$(grep "wrote uv_out.obj" err.txt)
-echo "$status" | grep -q "; Taubin smoothing, [1-9][0-9]* iterations" ||
-  fail "the status line after --auto's Taubin: $status"
+echo "$status" | grep -q "; the filter ([0-9]*%) blended per region with Taubin smoothing, [1-9][0-9]* iterations" ||
+  fail "the status line after --auto's choice per region: $status"
 echo "$status" | grep -q "sigma_f" && fail "the status line names the filter's sigmas: $status"
+grep -q -- "--auto: a choice per region" err.txt || fail "--auto does not explain its choice: $(cat err.txt)"
 
 expect 0 "$rsmooth" --help
 grep -q "sigma-g" out.txt || fail "--help does not explain sigma-g"

@@ -2,8 +2,9 @@
  * against a brute-force evaluation of its equations over every facet pair (no grid, no threads, no
  * welding shortcuts), a clean mesh as a fixed point, a soup equal to its indexed mesh, the same bytes
  * for any thread count, a noisy cube restored better than by the paper's filter with its edges
- * kept, repeats equal to chained calls, the discrepancy guard against Taubin's own smoothing, the
- * automatic choice's report, and the stage's parameters checked. */
+ * kept, the stage's cycles against brute force, the choice per region against Taubin's own
+ * smoothing and the filter's result, the automatic choice's report, and the stage's parameters
+ * checked. */
 #include "mesh_shapes.h"
 #include "stages/normal_update.h"
 #include "test_util.h"
@@ -32,8 +33,10 @@ static bool share(const uint32_t *idx, const rs_facets *f, size_t k, size_t l, i
     return shared >= n;
 }
 
-static void brute_guided(const rs_facets *f, const uint32_t *idx, double s, double t, int rounds,
-                         double *out) {
+/* Rounds of guided filtering on the geometry of f; the neighbour sets from `input` (the facets as
+ * the stage found them on its input), within radius x their mean adjacent-centroid distance. */
+static void brute_guided_from(const rs_facets *f, const rs_facets *input, double radius,
+                              const uint32_t *idx, double s, double t, int rounds, double *out) {
     size_t n = f->count;
     double *cur = malloc(n * 3 * sizeof(double)), *mean = malloc(n * 3 * sizeof(double));
     double *score = malloc(n * sizeof(double)), *guide = malloc(n * 3 * sizeof(double));
@@ -44,10 +47,10 @@ static void brute_guided(const rs_facets *f, const uint32_t *idx, double s, doub
     for (size_t k = 0; k < n; k++)
         for (size_t l = k + 1; l < n; l++)
             if (share(idx, f, k, l, 2)) {
-                adjacent += sqrt(dist2(f->centroid + 3 * k, f->centroid + 3 * l));
+                adjacent += sqrt(dist2(input->centroid + 3 * k, input->centroid + 3 * l));
                 pairs++;
             }
-    double reach = 2.0 * adjacent / (double)pairs;
+    double reach = radius * adjacent / (double)pairs;
     for (int r = 0; r < rounds; r++) {
         for (size_t j = 0; j < n; j++) { /* patch j: the facets sharing a vertex with j */
             double m[3] = {0, 0, 0}, phi = 0, emax = 0, esum = 0;
@@ -83,9 +86,9 @@ static void brute_guided(const rs_facets *f, const uint32_t *idx, double s, doub
         for (size_t i = 0; i < n; i++) {
             double acc[3] = {0, 0, 0};
             for (size_t k = 0; k < n; k++) {
-                double d2 = dist2(f->centroid + 3 * k, f->centroid + 3 * i);
-                if (d2 > reach * reach)
+                if (dist2(input->centroid + 3 * k, input->centroid + 3 * i) > reach * reach)
                     continue;
+                double d2 = dist2(f->centroid + 3 * k, f->centroid + 3 * i);
                 double g2 = dist2(guide + 3 * k, guide + 3 * i);
                 double w = f->area[k] * exp(-d2 / (2 * s * s)) * exp(-g2 / (2 * t * t));
                 for (int c = 0; c < 3; c++)
@@ -101,6 +104,11 @@ static void brute_guided(const rs_facets *f, const uint32_t *idx, double s, doub
     free(mean);
     free(score);
     free(guide);
+}
+
+static void brute_guided(const rs_facets *f, const uint32_t *idx, double s, double t, int rounds,
+                         double *out) {
+    brute_guided_from(f, f, 2.0, idx, s, t, rounds, out);
 }
 
 /* Sun et al.'s update on an indexed mesh whose vertices are all distinct: for each vertex, the
@@ -307,15 +315,16 @@ static void test_parameters_checked(void) {
     CHECK(out);
     struct {
         int passes, updates, rounds, repeats;
-        double s, n, level;
-    } bad[] = {{0, 0, 5, 1, 1, 0.3, 0},        {1, -1, 5, 1, 1, 0.3, 0},
-               {1, 1001, 5, 1, 1, 0.3, 0},     {1, 5, 0, 1, 1, 0.3, 0},
-               {1, 5, 101, 1, 1, 0.3, 0},      {1, 5, 5, 1, 0, 0.3, 0},
-               {1, 5, 5, 1, NAN, 0.3, 0},      {1, 5, 5, 1, INFINITY, 0.3, 0},
-               {1, 5, 5, 1, 1, 0, 0},          {1, 5, 5, 1, 1, 2.5, 0},
-               {1, 5, 5, 0, 1, 0.3, 0},        {1, 5, 5, 101, 1, 0.3, 0},
-               {1, 5, 5, 1, 1, 0.3, -1},       {1, 5, 5, 1, 1, 0.3, NAN},
-               {1, 5, 5, 1, 1, 0.3, INFINITY}};
+        double s, n, level, radius;
+    } bad[] = {{1, 5, 5, 1, 1, 0.3, 0, 0.99}, {1, 5, 5, 1, 1, 0.3, 0, 8.01},
+               {1, 5, 5, 1, 1, 0.3, 0, NAN}, {0, 0, 5, 1, 1, 0.3, 0, 2},
+               {1, -1, 5, 1, 1, 0.3, 0, 2}, {1, 1001, 5, 1, 1, 0.3, 0, 2},
+               {1, 5, 0, 1, 1, 0.3, 0, 2}, {1, 5, 101, 1, 1, 0.3, 0, 2},
+               {1, 5, 5, 1, 0, 0.3, 0, 2}, {1, 5, 5, 1, NAN, 0.3, 0, 2},
+               {1, 5, 5, 1, INFINITY, 0.3, 0, 2}, {1, 5, 5, 1, 1, 0, 0, 2},
+               {1, 5, 5, 1, 1, 2.5, 0, 2}, {1, 5, 5, 0, 1, 0.3, 0, 2},
+               {1, 5, 5, 1001, 1, 0.3, 0, 2}, {1, 5, 5, 1, 1, 0.3, -1, 2},
+               {1, 5, 5, 1, 1, 0.3, NAN, 2}, {1, 5, 5, 1, 1, 0.3, INFINITY, 2}};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         rsmooth_params p;
         rsmooth_params_init(&p);
@@ -326,6 +335,7 @@ static void test_parameters_checked(void) {
         p.guided_sigma_n = bad[i].n;
         p.stage_repeats = bad[i].repeats;
         p.discrepancy_level = bad[i].level;
+        p.guided_radius = bad[i].radius;
         CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count,
                                               cube.indices, cube.triangle_count, &p, out, NULL,
                                               NULL, NULL, NULL),
@@ -337,36 +347,49 @@ static void test_parameters_checked(void) {
 
 
 /* stage_repeats R is R chained calls of the stage alone (absolute widths: the same in each). */
-static void test_repeats_chain(void) {
+/* The stage's cycles against brute force: each cycle the facets' geometry from the current
+ * positions, guided rounds over neighbour sets found once on the input, then the vertex update. */
+static void test_cycles_against_brute_force(void) {
     shape_mesh cube;
-    CHECK(shape_cube(&cube, 6, 1.0) == 0);
+    CHECK(shape_cube(&cube, 4, 1.0) == 0);
     CHECK(shape_add_normal_noise(&cube, 0.4, 5) == 0);
-    size_t n = 3 * cube.vertex_count;
-    double *once = malloc(n * sizeof(double)), *twice = malloc(n * sizeof(double));
-    double *chained = malloc(n * sizeof(double));
-    CHECK(once && twice && chained);
-    rsmooth_params p;
-    rsmooth_params_init(&p);
-    p.absolute = 1;
-    p.passes = 0;
-    p.vertex_updates = 7;
-    p.guided_rounds = 3;
-    p.guided_sigma_s = 0.3;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count,
-                                          cube.indices, cube.triangle_count, &p, once, NULL, NULL,
-                                          NULL, NULL), RSMOOTH_OK);
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, once, cube.vertex_count, cube.indices,
-                                          cube.triangle_count, &p, chained, NULL, NULL, NULL,
-                                          NULL), RSMOOTH_OK);
-    p.stage_repeats = 2;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count,
-                                          cube.indices, cube.triangle_count, &p, twice, NULL, NULL,
-                                          NULL, NULL), RSMOOTH_OK);
-    CHECK(memcmp(twice, chained, n * sizeof(double)) == 0);
-    CHECK(memcmp(twice, once, n * sizeof(double)) != 0);
-    free(once);
-    free(twice);
-    free(chained);
+    size_t nv = cube.vertex_count, n = 3 * nv;
+    double edge = shape_mean_edge_length(&cube);
+    rs_stage_setting setting = {0.7 * edge, 0.3, 3.0, 2, 3, 4}; /* s, t, radius, rounds, k, cycles */
+    double *lib = malloc(n * sizeof(double)), *brute = malloc(n * sizeof(double));
+    CHECK(lib && brute);
+    memcpy(lib, cube.xyz, n * sizeof(double));
+    memcpy(brute, cube.xyz, n * sizeof(double));
+    CHECK_STATUS(rs_normal_update_stage(lib, nv, cube.indices, cube.triangle_count, &setting, NULL,
+                                        NULL, NULL, NULL, "test"), RSMOOTH_OK);
+    rs_facets input, now;
+    CHECK(rs_facets_build(&input, cube.xyz, cube.indices, cube.triangle_count));
+    double *normals = malloc(input.count * 3 * sizeof(double));
+    CHECK(normals);
+    for (int c = 0; c < setting.cycles; c++) {
+        CHECK(rs_facets_build(&now, brute, cube.indices, cube.triangle_count));
+        CHECK(now.count == input.count);
+        brute_guided_from(&now, &input, setting.radius, cube.indices, setting.sigma_s,
+                          setting.sigma_n, setting.rounds, normals);
+        brute_update(brute, nv, cube.indices, &now, normals, setting.updates);
+        rs_facets_free(&now);
+    }
+    double worst = max_gap(lib, brute, n);
+    printf("stage: %d cycles (radius %.0f) equal brute force within %.2g edge lengths\n",
+           setting.cycles, setting.radius, worst / edge);
+    CHECK_LE(worst, 1e-10 * edge);
+    /* the neighbour sets stay those of the input: not a chain of one-cycle stages */
+    rs_stage_setting one = setting;
+    one.cycles = 1;
+    memcpy(brute, cube.xyz, n * sizeof(double));
+    for (int c = 0; c < setting.cycles; c++)
+        CHECK_STATUS(rs_normal_update_stage(brute, nv, cube.indices, cube.triangle_count, &one,
+                                            NULL, NULL, NULL, NULL, "test"), RSMOOTH_OK);
+    CHECK(max_gap(lib, brute, n) > 0);
+    rs_facets_free(&input);
+    free(normals);
+    free(lib);
+    free(brute);
     shape_free(&cube);
 }
 
@@ -377,71 +400,174 @@ static double rms_move(const double *a, const double *b, size_t nv) {
     return sqrt(sum / (double)nv);
 }
 
-/* The guard: on a sphere (curved at the scale of its triangles) the result is Taubin's smoothing
- * of the input (the public rsmooth_smooth_taubin with the iterations reported, bit for bit), the
+/* The best mode on m, with the choice per region at `level` (0: off); the report's figures. */
+static void best_on(const shape_mesh *m, double level, double *out, rsmooth_report *r) {
+    rsmooth_params p;
+    rsmooth_params_init_best(&p);
+    p.discrepancy_level = level;
+    rsmooth_report_init(r);
+    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                          m->triangle_count, &p, out, NULL, NULL, r, NULL),
+                 RSMOOTH_OK);
+}
+
+/* The vertices whose result is a's, bit for bit. */
+static size_t same_vertices(const double *a, const double *b, size_t nv) {
+    size_t same = 0;
+    for (size_t v = 0; v < nv; v++)
+        same += memcmp(a + 3 * v, b + 3 * v, 3 * sizeof(double)) == 0;
+    return same;
+}
+
+/* The largest distance of a vertex of `out` from the segment between f and t. */
+static double off_segment(const double *out, const double *f, const double *t, size_t nv) {
+    double worst = 0;
+    for (size_t v = 0; v < nv; v++) {
+        double d[3], e[3], len2 = 0, along = 0;
+        for (int k = 0; k < 3; k++) {
+            d[k] = t[3 * v + k] - f[3 * v + k];
+            e[k] = out[3 * v + k] - f[3 * v + k];
+            len2 += d[k] * d[k];
+            along += d[k] * e[k];
+        }
+        double w = len2 > 0 ? fmin(fmax(along / len2, 0), 1) : 0, gap2 = 0;
+        for (int k = 0; k < 3; k++)
+            gap2 += (e[k] - w * d[k]) * (e[k] - w * d[k]);
+        worst = fmax(worst, sqrt(gap2));
+    }
+    return worst;
+}
+
+/* The two shapes as one mesh of two parts (the cube shifted clear of the sphere). */
+static void join(const shape_mesh *a, const shape_mesh *b, shape_mesh *out) {
+    memset(out, 0, sizeof *out);
+    out->vertex_count = a->vertex_count + b->vertex_count;
+    out->triangle_count = a->triangle_count + b->triangle_count;
+    out->xyz = malloc(out->vertex_count * 3 * sizeof(double));
+    out->indices = malloc(out->triangle_count * 3 * sizeof(uint32_t));
+    CHECK(out->xyz && out->indices);
+    memcpy(out->xyz, a->xyz, a->vertex_count * 3 * sizeof(double));
+    for (size_t i = 0; i < 3 * b->vertex_count; i++)
+        out->xyz[3 * a->vertex_count + i] = b->xyz[i] + (i % 3 == 0 ? 4.0 : 0.0);
+    memcpy(out->indices, a->indices, a->triangle_count * 3 * sizeof(uint32_t));
+    for (size_t i = 0; i < 3 * b->triangle_count; i++)
+        out->indices[3 * a->triangle_count + i] = b->indices[i] + (uint32_t)a->vertex_count;
+}
+
+/* The choice per region: on a sphere (curved at the scale of its triangles) Taubin's smoothing of
+ * the input (the public rsmooth_smooth_taubin with the iterations reported, bit for bit), the
  * first iteration count that moves the vertices as far as the level; on a cube (flat faces and
- * creases) the filter's result stays, bit for bit. */
-static void test_discrepancy_guard(void) {
-    shape_mesh sphere, cube;
+ * creases) the filter's result; on both as one mesh, each part its own; every vertex between
+ * the two results. */
+static void test_region_choice(void) {
+    shape_mesh sphere, cube, both;
     CHECK(shape_sphere(&sphere, 3, 1.0) == 0);
     CHECK(shape_add_normal_noise(&sphere, 0.3, 9) == 0);
     CHECK(shape_cube(&cube, 8, 1.0) == 0);
     CHECK(shape_add_normal_noise(&cube, 0.3, 9) == 0);
-    size_t nv = sphere.vertex_count, n = 3 * nv;
-    double *plain = malloc(n * sizeof(double)), *guarded = malloc(n * sizeof(double));
-    double *taubin = malloc(n * sizeof(double)), *fewer = malloc(n * sizeof(double));
-    CHECK(plain && guarded && taubin && fewer);
-    rsmooth_params p;
-    rsmooth_params_init_best(&p);
+    join(&sphere, &cube, &both);
+    size_t ns = sphere.vertex_count, nc = cube.vertex_count, nb = both.vertex_count;
+    double *plain = malloc(3 * nb * sizeof(double)), *chosen = malloc(3 * nb * sizeof(double));
+    double *taubin = malloc(3 * nb * sizeof(double)), *fewer = malloc(3 * nb * sizeof(double));
+    CHECK(plain && chosen && taubin && fewer);
     rsmooth_report r;
-    rsmooth_report_init(&r);
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, sphere.xyz, nv, sphere.indices,
-                                          sphere.triangle_count, &p, plain, NULL, NULL, &r, NULL),
-                 RSMOOTH_OK);
+    double level = 0.15; /* reached within 40 iterations */
+    best_on(&sphere, 0, plain, &r);
     CHECK_EQ_INT(r.discrepancy_iterations, 0);
-    double unit = 0;
-    CHECK_STATUS(rsmooth_mean_edge_length(RSMOOTH_FLOAT64, sphere.xyz, nv, sphere.indices,
-                                          sphere.triangle_count, &unit, NULL), RSMOOTH_OK);
-    double level = 0.15; /* reached within the guard's 40 iterations */
-    p.discrepancy_level = level;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, sphere.xyz, nv, sphere.indices,
-                                          sphere.triangle_count, &p, guarded, NULL, NULL, &r,
-                                          NULL), RSMOOTH_OK);
+    best_on(&sphere, level, chosen, &r);
     int k = r.discrepancy_iterations;
     CHECK(k >= 2 && k < 40);
-    CHECK_STATUS(rsmooth_smooth_taubin(RSMOOTH_FLOAT64, sphere.xyz, nv, sphere.indices,
+    double unit = shape_mean_edge_length(&sphere);
+    CHECK_STATUS(rsmooth_smooth_taubin(RSMOOTH_FLOAT64, sphere.xyz, ns, sphere.indices,
                                        sphere.triangle_count, 0.5, -0.53, (unsigned)k, taubin,
                                        NULL), RSMOOTH_OK);
-    CHECK(memcmp(guarded, taubin, n * sizeof(double)) == 0);
-    CHECK(rms_move(guarded, sphere.xyz, nv) >= level * unit);
-    CHECK_STATUS(rsmooth_smooth_taubin(RSMOOTH_FLOAT64, sphere.xyz, nv, sphere.indices,
+    CHECK_STATUS(rsmooth_smooth_taubin(RSMOOTH_FLOAT64, sphere.xyz, ns, sphere.indices,
                                        sphere.triangle_count, 0.5, -0.53, (unsigned)k - 1, fewer,
                                        NULL), RSMOOTH_OK);
-    CHECK(rms_move(fewer, sphere.xyz, nv) < level * unit);
-    printf("guard: sphere -> Taubin %d iterations (moved %.3f edge lengths, level %.2f)\n", k,
-           rms_move(guarded, sphere.xyz, nv) / unit, level);
-    /* the cube keeps the filter's result */
-    size_t cn = 3 * cube.vertex_count;
-    double *cube_plain = malloc(cn * sizeof(double)), *cube_guarded = malloc(cn * sizeof(double));
-    CHECK(cube_plain && cube_guarded);
-    p.discrepancy_level = 0;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count,
-                                          cube.indices, cube.triangle_count, &p, cube_plain, NULL,
-                                          NULL, &r, NULL), RSMOOTH_OK);
-    p.discrepancy_level = level;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count,
-                                          cube.indices, cube.triangle_count, &p, cube_guarded,
-                                          NULL, NULL, &r, NULL), RSMOOTH_OK);
-    CHECK_EQ_INT(r.discrepancy_iterations, 0);
-    CHECK(memcmp(cube_plain, cube_guarded, cn * sizeof(double)) == 0);
-    free(cube_plain);
-    free(cube_guarded);
+    CHECK(rms_move(taubin, sphere.xyz, ns) >= level * unit);
+    CHECK(rms_move(fewer, sphere.xyz, ns) < level * unit);
+    size_t as_taubin = same_vertices(chosen, taubin, ns);
+    printf("region: sphere -> Taubin %d iterations on %zu of %zu vertices (filter's weight %.3f)\n",
+           k, as_taubin, ns, r.region_filter_share);
+    CHECK(as_taubin >= ns * 9 / 10 && r.region_filter_share < 0.1);
+    CHECK_LE(off_segment(chosen, plain, taubin, ns), 1e-12 * unit);
+    /* the cube: the filter's result */
+    best_on(&cube, 0, plain, &r);
+    best_on(&cube, level, chosen, &r);
+    size_t as_filter = same_vertices(chosen, plain, nc);
+    printf("region: cube -> the filter's result on %zu of %zu vertices (weight %.3f)\n", as_filter,
+           nc, r.region_filter_share);
+    CHECK(as_filter >= nc * 9 / 10 && r.region_filter_share > 0.9);
+    /* both in one mesh (the filter's widths now from both parts' edges): each part its own */
+    best_on(&both, level, chosen, &r);
+    double *alone = malloc(3 * nb * sizeof(double));
+    CHECK(alone);
+    best_on(&both, 0, alone, &r);
+    size_t cube_kept = same_vertices(chosen + 3 * ns, alone + 3 * ns, nc);
+    size_t sphere_moved = ns - same_vertices(chosen, alone, ns);
+    printf("region: sphere + cube -> cube %zu of %zu kept, sphere %zu of %zu replaced\n",
+           cube_kept, nc, sphere_moved, ns);
+    CHECK(cube_kept >= nc * 9 / 10 && sphere_moved >= ns * 9 / 10);
+    free(alone);
     free(plain);
-    free(guarded);
+    free(chosen);
     free(taubin);
     free(fewer);
     shape_free(&sphere);
     shape_free(&cube);
+    shape_free(&both);
+}
+
+/* Boundary vertices move at most the level, in the mean length of their own edges (computed
+ * here from the triangles), from the input: an open grid with noise, at a level its Taubin
+ * smoothing exceeds at the rim. */
+static void test_boundary_limit(void) {
+    shape_mesh plane;
+    CHECK(shape_plane(&plane, 24, 24, 1.0) == 0);
+    CHECK(shape_add_normal_noise(&plane, 0.3, 4) == 0);
+    size_t nv = plane.vertex_count, nt = plane.triangle_count;
+    double *out = malloc(3 * nv * sizeof(double)), *sum = calloc(nv, sizeof(double));
+    size_t *edges = calloc(nv, sizeof(size_t));
+    CHECK(out && sum && edges);
+    rsmooth_report r;
+    double level = 0.1;
+    best_on(&plane, level, out, &r);
+    /* an edge is on the boundary when one triangle has it: count each (a, b) over all triangles */
+    bool *rim = calloc(nv, sizeof(bool));
+    CHECK(rim);
+    for (size_t t = 0; t < nt; t++)
+        for (int c = 0; c < 3; c++) {
+            uint32_t a = plane.indices[3 * t + c], b = plane.indices[3 * t + (c + 1) % 3];
+            int holders = 0;
+            for (size_t u = 0; u < nt; u++)
+                for (int d = 0; d < 3; d++) {
+                    uint32_t x = plane.indices[3 * u + d], y = plane.indices[3 * u + (d + 1) % 3];
+                    holders += (x == a && y == b) || (x == b && y == a);
+                }
+            rim[a] |= holders == 1;
+            rim[b] |= holders == 1;
+            sum[a] += gap(plane.xyz + 3 * a, plane.xyz + 3 * b);
+            sum[b] += gap(plane.xyz + 3 * a, plane.xyz + 3 * b);
+            edges[a]++;
+            edges[b]++;
+        }
+    size_t on_rim = 0, at_limit = 0;
+    for (size_t v = 0; v < nv; v++) {
+        if (!rim[v])
+            continue;
+        double limit = level * sum[v] / (double)edges[v], move = gap(out + 3 * v, plane.xyz + 3 * v);
+        CHECK_LE(move, limit * (1 + 1e-9));
+        on_rim++;
+        at_limit += move > limit * 0.999;
+    }
+    printf("region: %zu boundary vertices within the level of their edges (%zu at the limit)\n",
+           on_rim, at_limit);
+    CHECK(on_rim == 4 * 24 && at_limit > 0);
+    free(rim);
+    free(out);
+    free(sum);
+    free(edges);
+    shape_free(&plane);
 }
 
 /* rsmooth_params_auto_report on Gaussian noise: what it read and chose. */
@@ -483,8 +609,9 @@ int main(void) {
     test_clean_stays();
     test_soup_equals_mesh_and_threads();
     test_restores_cube();
-    test_repeats_chain();
-    test_discrepancy_guard();
+    test_cycles_against_brute_force();
+    test_region_choice();
+    test_boundary_limit();
     test_auto_report();
     test_parameters_checked();
     printf("normal_update: all checks passed\n");

@@ -37,6 +37,7 @@ rsmooth_status rsmooth_params_init(rsmooth_params *params) {
     params->guided_rounds = 20;
     params->discrepancy_level = 0.0;
     params->stage_repeats = 1;
+    params->guided_radius = 2.0;
     return RSMOOTH_OK;
 }
 
@@ -126,10 +127,13 @@ rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *o
     if (!(out->guided_sigma_n > 0) || !(out->guided_sigma_n <= 2))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "guided_sigma_n must be in (0, 2] (got %g)", out->guided_sigma_n);
-    if (out->stage_repeats < 1 || out->stage_repeats > RS_MAX_ROUNDS)
+    if (out->stage_repeats < 1 || out->stage_repeats > RS_MAX_CYCLES)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "stage_repeats must be in [1, %d] (got %d)", RS_MAX_ROUNDS,
+                       "stage_repeats must be in [1, %d] (got %d)", RS_MAX_CYCLES,
                        out->stage_repeats);
+    if (!(out->guided_radius >= 1 && out->guided_radius <= 8)) /* NaN fails too */
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "guided_radius must be in [1, 8] (got %g)", out->guided_radius);
     if (!(out->discrepancy_level >= 0) || !isfinite(out->discrepancy_level))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "discrepancy_level must be 0 (off) or positive and finite (got %g)",

@@ -89,6 +89,7 @@ bool rs_radix_sort_u64(uint64_t *keys, uint32_t *values, size_t count);
 
 /* Most bilateral rounds and filter passes one call may ask for. */
 #define RS_MAX_ROUNDS 100
+#define RS_MAX_CYCLES 1000 /* the normal update stage's cycles */
 /* Most normal-stage vertex updates one call may ask for. */
 #define RS_MAX_UPDATES 1000
 

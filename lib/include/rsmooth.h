@@ -274,27 +274,40 @@ typedef struct rsmooth_params {
      * those normals by Sun et al. 2007's iterative update, vertex_updates times. The passes then
      * start from the updated positions. Runs on the host's cores, in double precision. @{ */
     int vertex_updates;           /**< 0 (default): no stage. [1, 1000]: update iterations */
-    double guided_sigma_s;        /**< spatial width of the guided filter's Gaussian, in the units
-                                   * of sigma_f, > 0; its reach is fixed at twice the mean
-                                   * distance between the centroids of facets sharing an edge (the
-                                   * paper's), so 2 (default) weighs that reach nearly evenly */
+    double guided_sigma_s;        /**< spatial width of the guided filter's Gaussian, in mean edge
+                                   * lengths (absolute = 0) or mesh units (absolute = 1), > 0; its
+                                   * reach is guided_radius times the mean distance between the
+                                   * centroids of facets sharing an edge, so 2 (default) weighs
+                                   * the default reach nearly evenly */
     double guided_sigma_n;        /**< width on the difference of guidance normals, (0, 2].
                                    * Default 0.2 */
     int guided_rounds;            /**< guided filter rounds, [1, 100]. Default 20 */
-    int stage_repeats;            /**< the stage (guided rounds, then vertex updates) this many
-                                   * times, [1, 100], each from the facets of the positions the
-                                   * one before left: a vertex thrown far (impulsive noise) comes
-                                   * back over several repeats. Default 1 */
+    int stage_repeats;            /**< the stage's cycles, [1, 1000]: each cycle reads fresh facet
+                                   * normals, areas and centroids from the current positions, runs
+                                   * guided_rounds rounds and then vertex_updates updates (the
+                                   * guided filter's authors run hundreds of cycles of one round
+                                   * and a few updates). What depends only on connectivity, and
+                                   * each facet's neighbour set, is built once on the input.
+                                   * Default 1 */
     double discrepancy_level;     /**< 0 (default): off. > 0: the noise level, in mean edge lengths
                                    * of the input (rsmooth_params_auto sets it to the estimate in
-                                   * the best mode). When the result is curved at the scale of its
-                                   * triangles (fewer than 52% of the facet pairs sharing an edge
-                                   * within 2 degrees: an organic mesh coarse for its curvature,
-                                   * where low-pass smoothing wins), it is replaced by Taubin's
-                                   * lambda|mu smoothing (0.5, -0.53) of the input, run until the
-                                   * vertices moved (RMS) this far (the discrepancy principle), at
-                                   * most 40 iterations.
-                                   * Needs connected triangles (a soup keeps the filter's result) */
+                                   * the best mode): a choice per region. Taubin's lambda|mu
+                                   * smoothing (0.5, -0.53) of the input is run until the vertices
+                                   * moved (RMS) this far (the discrepancy principle, at most 40
+                                   * iterations), and each vertex's result is a blend of the
+                                   * filter's and Taubin's, the filter's weight rising with the
+                                   * share of its neighbourhood's facet pairs that meet within 2
+                                   * degrees in the filter's result (flat faces and creases: the
+                                   * filter's; curved at the scale of the triangles, as organic
+                                   * meshes coarse for their curvature: Taubin's). Boundary
+                                   * vertices then move at most this level (in their local edge
+                                   * length) from the input. Changed in 0.11: it swapped the
+                                   * whole mesh before. Needs connected triangles (a soup keeps
+                                   * the filter's result) */
+    double guided_radius;         /**< the guided filter's neighbourhood, in mean distances between
+                                   * the centroids of facets sharing an edge, [1, 8]. Default 2
+                                   * (the authors'); 3-4 holds creases better under heavy noise.
+                                   * (Added in 0.11) */
     /** @} */
 } rsmooth_params;
 
@@ -424,9 +437,12 @@ typedef struct rsmooth_report {
     size_t tiles;                 /**< spatial tiles the mesh was cut into to fit the device (1 when
                                      it fitted whole) */
     /** @} */
-    int discrepancy_iterations;   /**< params.discrepancy_level's guard: the Taubin iterations that
-                                   * replaced the filter's result, 0 when it was kept (added in
-                                   * 0.6) */
+    int discrepancy_iterations;   /**< params.discrepancy_level's choice per region: the Taubin
+                                   * iterations blended with the filter's result, 0 when it was off
+                                   * or had nothing to smooth (added in 0.6) */
+    double region_filter_share;   /**< that choice's mean weight of the filter's result over the
+                                   * vertices (1: the filter's result everywhere, 0: Taubin's);
+                                   * 0 when discrepancy_iterations is 0 (added in 0.11) */
 } rsmooth_report;
 
 /** Zeroes `report` and sets its struct_size. Accepts NULL. (Added in 0.5) */

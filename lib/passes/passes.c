@@ -2,6 +2,7 @@
  * output, optionally only where the previous pass had low confidence. Each pass recomputes facet
  * data, normals and the grid from the previous positions; the sigmas stay those the input's mean
  * edge length gave, so later passes do not shrink their reach as the mesh smooths. */
+#include "passes/region_choice.h"
 #include "stages/normal_update.h"
 
 #include <math.h>
@@ -54,6 +55,11 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                                     rsmooth_report *report, rsmooth_error *error,
                                     const char *where, rsmooth_params *resolved);
 
+/* The stage's progress: the cycles done, as a fraction of the stage's half. */
+static int report_cycle(void *user, int done, int cycles) {
+    return rs_report_pass_progress(user, (double)done / cycles);
+}
+
 /* The normal update stage (normal_update.h) on a double copy of the input, then the passes from
  * its result, in the caller's scalar type (params resolved and outputs checked). */
 static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar scalar,
@@ -86,19 +92,17 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                        "no memory for the normal update stage");
     for (size_t i = 0; i < 3 * vertex_count; i++)
         staged[i] = rs_coordinate(scalar, positions, i);
-    /* Progress: the stage is the first half, reported after each repeat (and the caller may stop
+    /* Progress: the stage is the first half, reported after each cycle (and the caller may stop
      * it there); the passes the second half, through the same rescaling as repeated passes. */
     int halves = p.passes > 0 ? 2 : 1;
     rs_pass_progress pp = {p.progress, p.progress_cancel, p.progress_user, 0, halves};
     bool reports = pp.progress || pp.cancel;
-    for (int r = 0; unit > 0 && st == RSMOOTH_OK && r < p.stage_repeats; r++) { /* no edge: none */
-        st = rs_normal_update_stage(staged, vertex_count, indices, triangle_count,
-                                    p.guided_sigma_s, p.guided_sigma_n, p.guided_rounds,
-                                    p.vertex_updates, p.move_mask, error, where);
-        if (st == RSMOOTH_OK && reports &&
-            rs_report_pass_progress(&pp, (double)(r + 1) / p.stage_repeats) != 0)
-            st = rs_cancelled(error, where);
-    }
+    rs_stage_setting setting = {p.guided_sigma_s, p.guided_sigma_n, p.guided_radius,
+                                p.guided_rounds, p.vertex_updates, p.stage_repeats};
+    if (unit > 0) /* no edge: nothing to filter */
+        st = rs_normal_update_stage(staged, vertex_count, indices, triangle_count, &setting,
+                                    p.move_mask, reports ? report_cycle : NULL, &pp, error,
+                                    where);
     double t_stage = rs_now_ms();
     if (st == RSMOOTH_OK && p.passes == 0) { /* the stage alone */
         for (size_t v = 0; v < vertex_count; v++) {
@@ -267,50 +271,6 @@ done:
     return st;
 }
 
-/* params.discrepancy_level's guard. Where the filter's result is curved at the scale of its
- * triangles (fewer than FLAT_SHARE_MIN of the pairs of facets sharing an edge within FLAT_ANGLE of
- * each other: an organic mesh coarse for its curvature, not a part of flat faces and creases),
- * low-pass smoothing restores the surface better than feature-preserving filtering does: tuned
- * Taubin smoothing won on every such calibration mesh but one. The result is then Taubin's
- * smoothing of the input run until the vertices moved (RMS) as far as the noise did: the
- * discrepancy principle, which needs no truth to choose the iterations. FLAT_SHARE_MIN was read
- * off scripts/discrepancy_study.py over all 30 calibration cases (not cross-validated;
- * docs/accuracy.md): the best mode's results have 0.53-0.86 on the parts and the smooth car body
- * it restores best, 0.16-0.51 on the organic meshes where Taubin wins. */
-#define FLAT_SHARE_MIN 0.52
-#define FLAT_ANGLE (2.0 * 3.14159265358979323846 / 180)
-#define DISCREPANCY_MAX_ITERATIONS 40 /* tuned Taubin needed 5-50 on the calibration meshes; at
-                                     * high noise the move saturates below the level and more
-                                     * iterations only shrink detail (the Stanford bunny at 0.5:
-                                     * E_v 0.93 at 40, 1.35 at 200) */
-
-/* Taubin's iterations that replace the result (0: it stays), or -1 when out of memory. */
-static int discrepancy_guard(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
-                             const uint32_t *indices, size_t triangle_count, double level,
-                             void *out_positions) {
-    double *xyz = rs_alloc_array(vertex_count, 3 * sizeof *xyz);
-    if (!xyz)
-        return -1;
-    for (size_t i = 0; i < 3 * vertex_count; i++)
-        xyz[i] = rs_coordinate(scalar, out_positions, i);
-    double flat = rs_flat_share(xyz, vertex_count, indices, triangle_count, FLAT_ANGLE);
-    int iterations = 0;
-    if (flat >= 0 && flat < FLAT_SHARE_MIN) { /* Taubin from the input, in its edge lengths */
-        for (size_t i = 0; i < 3 * vertex_count; i++)
-            xyz[i] = rs_coordinate(scalar, positions, i);
-        double unit = 0;
-        if (!rs_mean_edge_length(xyz, vertex_count, indices, triangle_count, &unit))
-            flat = -1;
-        else if (unit > 0)
-            iterations = rs_taubin_until(xyz, vertex_count, indices, triangle_count, 0.5, -0.53,
-                                         level * unit, DISCREPANCY_MAX_ITERATIONS);
-        for (size_t v = 0; iterations > 0 && v < vertex_count; v++)
-            rs_store_position(scalar, out_positions, v, xyz + 3 * v, 1);
-    }
-    rs_free(xyz);
-    return flat < 0 || iterations < 0 ? -1 : iterations; /* 0: no edge moves anything (a soup) */
-}
-
 /* The passes, then the last check of what they wrote (results.c): never a non-finite OK. */
 rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar scalar,
                                 const void *positions, size_t vertex_count,
@@ -328,13 +288,18 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar
     if (st != RSMOOTH_OK)
         return st;
     if (p.discrepancy_level > 0 && vertex_count > 0) {
-        int iterations = discrepancy_guard(scalar, positions, vertex_count, indices,
-                                           triangle_count, p.discrepancy_level, out_positions);
+        double share = 0;
+        int iterations = rs_region_choice(scalar, positions, vertex_count, indices,
+                                          triangle_count, p.discrepancy_level, out_positions,
+                                          &share);
         if (iterations < 0)
             return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the guard");
         if (report && caller_size >= offsetof(rsmooth_report, discrepancy_iterations) +
                                          sizeof report->discrepancy_iterations)
             report->discrepancy_iterations = iterations;
+        if (report && caller_size >= offsetof(rsmooth_report, region_filter_share) +
+                                         sizeof report->region_filter_share)
+            report->region_filter_share = iterations > 0 ? share : 0;
     }
     /* every pass held them still; their final bytes are the input's own */
     keep_unselected(scalar, positions, vertex_count, p.move_mask, out_positions);

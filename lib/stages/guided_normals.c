@@ -15,27 +15,31 @@
  *  2. Guidance g_i = m_j of the patch with the smallest H_j among the patches holding i (those of
  *     i and the facets sharing a vertex with it; ties to the lowest index).
  *  3. n_i <- normalise(sum_k a_k exp(-|c_i - c_k|^2 / 2 s^2) exp(-|g_i - g_k|^2 / 2 t^2) n_k) over
- *     the facets whose centroid lies within REACH_ADJACENT times the mean distance between the
- *     centroids of edge-adjacent facets (the paper's geometric neighbourhood), found through the
- *     grid: the range of the filter is fixed by the mesh, s only shapes its weights.
+ *     the facets whose centroid lies within `radius` times the mean distance between the
+ *     centroids of edge-adjacent facets (the paper's geometric neighbourhood, 2 in its runs),
+ *     found through the grid: the range of the filter is fixed by the mesh, s only shapes its
+ *     weights.
  *
- * Centroids and areas are those of the input throughout (the paper filters the normals first and
- * moves the vertices afterwards). Each facet's result depends only on the previous round's arrays,
- * so any thread count gives the same bytes. */
+ * The authors' program runs the filter in cycles (fresh facet normals, areas and centroids from
+ * the current vertices; one guided step; a few vertex updates), and builds everything that
+ * depends only on connectivity, and the neighbour sets, once on the input: so does rs_guided
+ * (init once, then one step per cycle, which re-reads the facets' areas and centroids for the
+ * weights). Each facet's result depends only on the previous round's arrays, so any thread count
+ * gives the same bytes. */
 #include "stages/normal_update.h"
 #include "core/spatial.h"
 
 #include <math.h>
 #include <string.h>
 
-#define REACH_ADJACENT 2.0 /* the filter's neighbourhood, in mean adjacent-centroid distances */
 #define PATCH_MAX 128      /* facets of a patch looked at, at most (a vertex of very high valence
                             * keeps its first ones in facet order: the score only needs a sample) */
 #define TV_EPSILON 1e-9    /* the paper's epsilon in R */
 #define GRAIN 512          /* facets per chunk below which a thread does not pay */
 
 /* What does not change between rounds: each facet's patch and the patch's interior edges, and
- * each facet's neighbours within the filter's reach with their fixed weight a_k exp(-d^2 / 2 s^2).
+ * each facet's neighbours within the filter's reach on the input (their spatial exponents follow the
+ * geometry each cycle).
  * CSR lists: the entries of facet f are [start[f], start[f + 1]). */
 typedef struct guided_lists {
     size_t *patch_start;
@@ -44,11 +48,11 @@ typedef struct guided_lists {
     uint32_t *edge;         /* 2 per interior edge: the facets on either side */
     size_t *near_start;
     uint32_t *near;
-    double *near_weight;
+    double *near_exponent;  /* each neighbour's spatial exponent: weight_range */
 } guided_lists;
 
 typedef struct guided_job {
-    const rs_facets *facets;
+    const rs_facets *facets; /* the current geometry: areas and centroids for the weights */
     const rs_adjacency *adj;
     const uint32_t *indices;
     const rs_grid *grid;
@@ -118,7 +122,7 @@ static void lists_free(guided_lists *l) {
     rs_free(l->edge);
     rs_free(l->near_start);
     rs_free(l->near);
-    rs_free(l->near_weight);
+    rs_free(l->near_exponent);
     memset(l, 0, sizeof *l);
 }
 
@@ -169,10 +173,11 @@ static double adjacent_distance(const guided_job *job) {
     return pairs ? sum / (double)pairs : 0;
 }
 
-/* Each facet's neighbours within the filter's reach, with their fixed weights, through the grid. */
+/* Each facet's neighbours within the filter's reach on the input, through the grid (the sets stay
+ * for every cycle, as in the authors' program; their weights follow the geometry: weight_range). */
 static bool near_lists_build(guided_job *job) {
     guided_lists *l = &job->lists;
-    size_t nf = job->facets->count, nn = 0, cn = 0, cw = 0;
+    size_t nf = job->facets->count, nn = 0, cn = 0;
     l->near_start = rs_alloc_array(nf + 1, sizeof(size_t));
     if (!l->near_start)
         return false;
@@ -189,19 +194,32 @@ static bool near_lists_build(guided_job *job) {
                     for (uint32_t s = cell < 0 ? 0 : grid->cell_start[cell];
                          cell >= 0 && s < grid->cell_start[cell + 1]; s++) {
                         uint32_t q = grid->facet_order[s];
-                        double d2 = gap2(job->facets->centroid + 3 * (size_t)q, cf);
-                        if (d2 > job->reach * job->reach)
+                        if (gap2(job->facets->centroid + 3 * (size_t)q, cf) >
+                            job->reach * job->reach)
                             continue;
-                        double w = job->facets->area[q] * exp(-d2 * job->inv_2s2);
-                        if (!push((void **)&l->near, &cn, nn, sizeof *l->near, &q) ||
-                            !push((void **)&l->near_weight, &cw, nn, sizeof *l->near_weight, &w))
+                        if (!push((void **)&l->near, &cn, nn, sizeof *l->near, &q))
                             return false;
                         nn++;
                     }
                 }
     }
     l->near_start[nf] = nn;
-    return true;
+    l->near_exponent = rs_alloc_array(nn ? nn : 1, sizeof *l->near_exponent);
+    return l->near_exponent != NULL;
+}
+
+/* The spatial exponents |c_i - c_k|^2 / 2 s^2 of facets [begin, end) from the current centroids
+ * (the filter adds the guidance's and takes one exp per pair: exp is most of its time). */
+static void weight_range(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const guided_job *job = ctx;
+    const guided_lists *l = &job->lists;
+    (void)chunk;
+    for (size_t i = begin; i < end; i++)
+        for (size_t k = l->near_start[i]; k < l->near_start[i + 1]; k++) {
+            size_t q = l->near[k];
+            double d2 = gap2(job->facets->centroid + 3 * q, job->facets->centroid + 3 * i);
+            l->near_exponent[k] = d2 * job->inv_2s2;
+        }
 }
 
 /* Step 1 for facets [begin, end). */
@@ -217,13 +235,15 @@ static void patch_range(void *ctx, size_t begin, size_t end, size_t chunk) {
             const double *na = job->normal + 3 * (size_t)member[a];
             for (int k = 0; k < 3; k++)
                 mean[k] += job->facets->area[member[a]] * na[k];
-            for (size_t b = a + 1; b < m; b++)
-                phi2 = fmax(phi2, gap2(na, job->normal + 3 * (size_t)member[b]));
+            for (size_t b = a + 1; b < m; b++) { /* (a comparison: fmax is a call here) */
+                double g2 = gap2(na, job->normal + 3 * (size_t)member[b]);
+                phi2 = g2 > phi2 ? g2 : phi2;
+            }
         }
         for (size_t e = l->edge_start[j]; e < l->edge_start[j + 1]; e++) {
             double gap = sqrt(gap2(job->normal + 3 * (size_t)l->edge[2 * e],
                                    job->normal + 3 * (size_t)l->edge[2 * e + 1]));
-            edge_max = fmax(edge_max, gap);
+            edge_max = gap > edge_max ? gap : edge_max;
             edge_sum += gap;
         }
         double len = sqrt(rs_dot3(mean, mean));
@@ -260,7 +280,8 @@ static void filter_range(void *ctx, size_t begin, size_t end, size_t chunk) {
         double acc[3] = {0, 0, 0};
         for (size_t k = l->near_start[i]; k < l->near_start[i + 1]; k++) {
             size_t q = l->near[k];
-            double w = l->near_weight[k] * exp(-gap2(job->guidance + 3 * q, gi) * job->inv_2t2);
+            double w = job->facets->area[q] *
+                       exp(-(l->near_exponent[k] + gap2(job->guidance + 3 * q, gi) * job->inv_2t2));
             const double *nq = job->normal + 3 * q;
             for (int c = 0; c < 3; c++)
                 acc[c] += w * nq[c];
@@ -271,48 +292,84 @@ static void filter_range(void *ctx, size_t begin, size_t end, size_t chunk) {
     }
 }
 
+/* The filter's state across cycles: the lists, the grid they were found with, the work arrays. */
+struct rs_guided {
+    guided_job job;
+    rs_grid grid;
+    bool filter;   /* false when no two facets share an edge: the normals stay the facets' own */
+    double *prev;  /* the round's input normals */
+};
+
+void rs_guided_destroy(rs_guided *g) {
+    if (!g)
+        return;
+    lists_free(&g->job.lists);
+    rs_grid_free(&g->grid);
+    rs_free(g->prev);
+    rs_free(g->job.patch_mean);
+    rs_free(g->job.patch_score);
+    rs_free(g->job.guidance);
+    rs_free(g);
+}
+
+rs_guided *rs_guided_create(const rs_facets *facets, const rs_adjacency *adj,
+                            const uint32_t *indices, double sigma_s, double sigma_n,
+                            double radius) {
+    rs_guided *g = rs_calloc_array(1, sizeof *g);
+    if (!g)
+        return NULL;
+    size_t nf = facets->count ? facets->count : 1;
+    guided_job *job = &g->job;
+    job->facets = facets;
+    job->adj = adj;
+    job->indices = indices;
+    job->inv_2s2 = 1 / (2 * sigma_s * sigma_s);
+    job->inv_2t2 = 1 / (2 * sigma_n * sigma_n);
+    job->grid = &g->grid;
+    g->prev = rs_alloc_array(nf, 3 * sizeof(double));
+    job->patch_mean = rs_alloc_array(nf, 3 * sizeof(double));
+    job->patch_score = rs_alloc_array(nf, sizeof(double));
+    job->guidance = rs_alloc_array(nf, 3 * sizeof(double));
+    bool ok = g->prev && job->patch_mean && job->patch_score && job->guidance &&
+              patch_lists_build(job);
+    job->reach = ok ? radius * adjacent_distance(job) : 0;
+    g->filter = job->reach > 0;
+    if (ok && g->filter)
+        ok = rs_grid_build(&g->grid, facets->centroid, facets->count, job->reach, NULL) ==
+                 RSMOOTH_OK &&
+             near_lists_build(job);
+    if (!ok) {
+        rs_guided_destroy(g);
+        return NULL;
+    }
+    return g;
+}
+
+void rs_guided_step(rs_guided *g, const rs_facets *facets, int rounds, double *normals) {
+    size_t nf = facets->count;
+    guided_job *job = &g->job;
+    memcpy(normals, facets->normal, nf * 3 * sizeof(double));
+    if (nf == 0 || rounds < 1 || !g->filter)
+        return;
+    job->facets = facets;
+    rs_parallel_for(nf, GRAIN, weight_range, job);
+    for (int round = 0; round < rounds; round++) {
+        memcpy(g->prev, normals, nf * 3 * sizeof(double));
+        job->normal = g->prev;
+        job->out = normals;
+        rs_parallel_for(nf, GRAIN, patch_range, job);
+        rs_parallel_for(nf, GRAIN, guidance_range, job);
+        rs_parallel_for(nf, GRAIN, filter_range, job);
+    }
+}
+
 bool rs_guided_normals(const rs_facets *facets, const rs_adjacency *adj, const uint32_t *indices,
                        double sigma_s, double sigma_n, int rounds, double *normals) {
-    size_t nf = facets->count;
-    memcpy(normals, facets->normal, nf * 3 * sizeof(double));
-    if (nf == 0 || rounds < 1)
-        return true;
-    guided_job job;
-    memset(&job, 0, sizeof job);
-    job.facets = facets;
-    job.adj = adj;
-    job.indices = indices;
-    job.inv_2s2 = 1 / (2 * sigma_s * sigma_s);
-    job.inv_2t2 = 1 / (2 * sigma_n * sigma_n);
-    rs_grid grid;
-    memset(&grid, 0, sizeof grid);
-    double *prev = rs_alloc_array(nf, 3 * sizeof(double));
-    double *mean = rs_alloc_array(nf, 3 * sizeof(double));
-    double *score = rs_alloc_array(nf, sizeof(double));
-    double *guide = rs_alloc_array(nf, 3 * sizeof(double));
-    job.grid = &grid;
-    bool ok = prev && mean && score && guide && patch_lists_build(&job);
-    job.reach = ok ? REACH_ADJACENT * adjacent_distance(&job) : 0;
-    bool filter = job.reach > 0; /* else no two facets share an edge: the input's normals stay */
-    if (ok && filter)
-        ok = rs_grid_build(&grid, facets->centroid, nf, job.reach, NULL) == RSMOOTH_OK &&
-             near_lists_build(&job);
-    job.patch_mean = mean;
-    job.patch_score = score;
-    job.guidance = guide;
-    for (int round = 0; ok && filter && round < rounds; round++) {
-        memcpy(prev, normals, nf * 3 * sizeof(double));
-        job.normal = prev;
-        job.out = normals;
-        rs_parallel_for(nf, GRAIN, patch_range, &job);
-        rs_parallel_for(nf, GRAIN, guidance_range, &job);
-        rs_parallel_for(nf, GRAIN, filter_range, &job);
-    }
-    lists_free(&job.lists);
-    rs_grid_free(&grid);
-    rs_free(prev);
-    rs_free(mean);
-    rs_free(score);
-    rs_free(guide);
-    return ok;
+    rs_guided *g = rs_guided_create(facets, adj, indices, sigma_s, sigma_n,
+                                    RS_GUIDED_RADIUS_DEFAULT);
+    if (!g)
+        return false;
+    rs_guided_step(g, facets, rounds, normals);
+    rs_guided_destroy(g);
+    return true;
 }

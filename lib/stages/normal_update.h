@@ -44,8 +44,25 @@ void rs_adjacency_free(rs_adjacency *adj);
 double rs_flat_share(const double *xyz, size_t vertex_count, const uint32_t *indices,
                      size_t triangle_count, double max_angle);
 
-/* Guided normal filtering (Zhang et al. 2015), `rounds` rounds, spatial width sigma_s (absolute)
- * and guidance width sigma_n; writes 3 doubles per facet to `normals`. false when out of memory. */
+/* The guided filter's reach by default, in mean distances between the centroids of facets
+ * sharing an edge (the authors' setting). */
+#define RS_GUIDED_RADIUS_DEFAULT 2.0
+
+/* Guided normal filtering (Zhang et al. 2015) across cycles (guided_normals.c): made once on the
+ * input's facets (patches, their interior edges and each facet's neighbours within `radius` mean
+ * adjacent-centroid distances: connectivity and neighbour sets stay), then one step per cycle.
+ * sigma_s absolute (mesh units), sigma_n the guidance width. NULL when out of memory. */
+typedef struct rs_guided rs_guided;
+rs_guided *rs_guided_create(const rs_facets *facets, const rs_adjacency *adj,
+                            const uint32_t *indices, double sigma_s, double sigma_n,
+                            double radius);
+/* `rounds` rounds from the facets' own normals, the weights from their current areas and
+ * centroids (`facets` is the one the filter was made with, updated in place); writes 3 doubles
+ * per facet to `normals`. */
+void rs_guided_step(rs_guided *g, const rs_facets *facets, int rounds, double *normals);
+void rs_guided_destroy(rs_guided *g);
+
+/* Create, one step, destroy, at the default radius. false when out of memory. */
 bool rs_guided_normals(const rs_facets *facets, const rs_adjacency *adj, const uint32_t *indices,
                        double sigma_s, double sigma_n, int rounds, double *normals);
 
@@ -57,12 +74,21 @@ bool rs_vertex_update(double *xyz, size_t vertex_count, const uint32_t *indices,
                       rs_facets *facets, const rs_adjacency *adj, const double *normals,
                       int iterations, const uint8_t *move_mask);
 
-/* The whole stage on `xyz` (double, in place): normals from the facets of the current positions
- * by guided filtering, then the vertex update. sigma_s absolute (mesh units). */
+/* What the stage runs: `cycles` times (fresh facet geometry from the current positions; `rounds`
+ * guided rounds; `updates` vertex updates), the lists built once. sigma_s absolute (mesh units),
+ * radius in mean adjacent-centroid distances. */
+typedef struct rs_stage_setting {
+    double sigma_s, sigma_n, radius;
+    int rounds, updates, cycles;
+} rs_stage_setting;
+
+/* Called after each cycle with the cycles done; non-zero stops the stage (RSMOOTH_CANCELLED). */
+typedef int (*rs_cycle_fn)(void *user, int done, int cycles);
+
+/* The whole stage on `xyz` (double, in place). Vertices whose move_mask byte is 0 stay. */
 rsmooth_status rs_normal_update_stage(double *xyz, size_t vertex_count, const uint32_t *indices,
-                                      size_t triangle_count, double sigma_s,
-                                      double sigma_n, int rounds, int updates,
-                                      const uint8_t *move_mask, rsmooth_error *error,
-                                      const char *where);
+                                      size_t triangle_count, const rs_stage_setting *setting,
+                                      const uint8_t *move_mask, rs_cycle_fn cycle_done,
+                                      void *user, rsmooth_error *error, const char *where);
 
 #endif /* RSMOOTH_NORMAL_UPDATE_H */

@@ -47,13 +47,14 @@ static int report(void *user, double fraction) {
 
 static PyObject *report_dict(const rsmooth_report *r) {
     return Py_BuildValue(
-        "{s:n,s:n,s:n,s:d,s:d,s:d,s:d,s:s,s:d,s:d,s:d,s:d,s:d,s:d,s:n,s:i}", "vertex_count",
+        "{s:n,s:n,s:n,s:d,s:d,s:d,s:d,s:s,s:d,s:d,s:d,s:d,s:d,s:d,s:n,s:i,s:d}", "vertex_count",
         (Py_ssize_t)r->vertex_count, "triangle_count", (Py_ssize_t)r->triangle_count,
         "facet_count", (Py_ssize_t)r->facet_count, "mean_edge_length", r->mean_edge_length,
         "sigma_f", r->sigma_f, "sigma_g", r->sigma_g, "radius", r->radius, "device", r->device,
         "ms_setup", r->ms_setup, "ms_grid", r->ms_grid, "ms_mollify", r->ms_mollify,
         "ms_robust", r->ms_robust, "ms_download", r->ms_download, "ms_total", r->ms_total,
-        "tiles", (Py_ssize_t)r->tiles, "discrepancy_iterations", r->discrepancy_iterations);
+        "tiles", (Py_ssize_t)r->tiles, "discrepancy_iterations", r->discrepancy_iterations,
+        "region_filter_share", r->region_filter_share);
 }
 
 /* Hands the library `progress` through p's progress_cancel and lets go of the GIL: the filter

@@ -42,8 +42,9 @@ static const field fields[] = {
     DOUBLE_FIELD(guided_sigma_s),
     DOUBLE_FIELD(guided_sigma_n),
     INT_FIELD(guided_rounds, 1, 100),
-    INT_FIELD(stage_repeats, 1, 100),
+    INT_FIELD(stage_repeats, 1, 1000),
     DOUBLE_FIELD(discrepancy_level),
+    DOUBLE_FIELD(guided_radius),
 };
 #define FIELD_COUNT (sizeof fields / sizeof fields[0])
 

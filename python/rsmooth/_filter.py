@@ -43,6 +43,7 @@ def smooth(
     guided_sigma_n: Optional[float] = None,
     guided_rounds: Optional[int] = None,
     stage_repeats: Optional[int] = None,
+    guided_radius: Optional[float] = None,
     discrepancy_level: Optional[float] = None,
     predictor: Optional[str] = None,
     mollify_cutoff: Optional[float] = None,
@@ -96,18 +97,20 @@ def smooth(
         many iterations ([0, 1000]) moving the vertices to agree with the filtered normals.
         Default 0 (off; ``best``: 10, the stage repeated 5 times). Runs on the CPU's cores in
         double precision.
-    guided_sigma_s, guided_sigma_n, guided_rounds : the guided filter's spatial width (units of
-        sigma_f, default 2), width on guidance-normal differences ((0, 2], default 0.2) and
-        rounds ([1, 100], default 20).
-    stage_repeats : the whole stage (guided rounds, then vertex updates) this many times, each
-        from the positions the one before left ([1, 100], default 1): a vertex thrown far
-        (impulsive noise) comes back over several repeats.
+    guided_sigma_s, guided_sigma_n, guided_rounds : the guided filter's spatial width (mean edge
+        lengths, default 2), width on guidance-normal differences ((0, 2], default 0.2) and
+        rounds per cycle ([1, 100], default 20).
+    guided_radius : the guided filter's neighbourhood, in mean distances between the centroids
+        of triangles sharing an edge ([1, 8], default 2).
+    stage_repeats : the stage's cycles ([1, 1000], default 1): each reads fresh facet normals
+        from the current positions, runs the guided rounds, then the vertex updates.
     discrepancy_level : 0 (default): off. A noise level, in mean edge lengths (``auto`` with
-        ``best`` sets the estimate): when the result is curved at the scale of its triangles
-        (fewer than 52% of the facet pairs sharing an edge within 2 degrees: an organic mesh
-        coarse for its curvature), it is instead Taubin smoothing of the input run until the
-        vertices moved (RMS) that far (the report's
-        ``discrepancy_iterations`` says how many; 0 when the filter's result was kept).
+        ``best`` sets the estimate): a choice per region. Each vertex's result blends the
+        filter's with Taubin smoothing of the input run until the vertices moved (RMS) that far,
+        the filter's weight rising with how flat its neighbourhood came out (flat faces and
+        creases: the filter's; curved at the scale of the triangles: Taubin's); boundary
+        vertices move at most that level. The report's ``discrepancy_iterations`` and
+        ``region_filter_share`` say how many Taubin iterations and the filter's mean weight.
     predictor : "projection" (the paper) or "centroid".
     mollify_cutoff : mollification reach in units of sigma_f, (0, cutoff]; default: cutoff.
     colors : (n, 3) per-vertex colours (floats in [0, 1], or uint8 0..255) weighing each
@@ -150,7 +153,7 @@ def smooth(
         normal_iterations=normal_iterations, influence=influence, passes=passes,
         pass_confidence=pass_confidence, vertex_updates=vertex_updates,
         guided_sigma_s=guided_sigma_s, guided_sigma_n=guided_sigma_n,
-        guided_rounds=guided_rounds, stage_repeats=stage_repeats,
+        guided_rounds=guided_rounds, stage_repeats=stage_repeats, guided_radius=guided_radius,
         discrepancy_level=discrepancy_level, predictor=predictor, mollify_cutoff=mollify_cutoff,
         colors=colors, sigma_c=sigma_c, mask=mask, method=method, iterations=iterations,
         lam=lam, mu=mu, progress=progress,

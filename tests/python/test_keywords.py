@@ -28,7 +28,7 @@ COUNTS = [
     ("passes", "--passes", 0, 100, {"vertex_updates": 1}),  # 0: the normal update stage alone
     ("vertex_updates", "--vertex-updates", 0, 1000, {}),
     ("guided_rounds", "--guided-rounds", 1, 100, {"vertex_updates": 1}),
-    ("stage_repeats", "--stage-repeats", 1, 100, {"vertex_updates": 1}),
+    ("stage_repeats", "--stage-repeats", 1, 1000, {"vertex_updates": 1}),
     ("iterations", "--iterations", 0, 1_000_000, {"method": "taubin"}),
 ]
 

@@ -4,13 +4,14 @@ keywords, and auto_params: what ``auto=True`` reads from a mesh and chooses."""
 from __future__ import annotations
 
 import math
+import sys
 
 import numpy as np
 import pytest
 
 import rsmooth
 
-from conftest import box, noisy, require_opencl, roof
+from conftest import ROOT, box, noisy, require_opencl, roof
 
 
 @pytest.fixture(scope="module")
@@ -57,14 +58,15 @@ def test_guided_keywords_reach_the_library(cube):
                                              passes=0), base)
 
 
-def test_stage_repeats_chain_the_stage(cube):
+def test_cycles_and_radius_reach_the_library(cube):
     _, v, f = cube
-    # absolute widths: the same in each repeat, so two repeats are two chained calls
-    width = dict(absolute=True, guided_sigma_s=0.3, guided_rounds=5)
+    width = dict(absolute=True, guided_sigma_s=0.3, guided_rounds=1)
     once = stage(v, f, **width)
-    twice = stage(v, f, stage_repeats=2, **width)
-    assert not np.array_equal(twice, once)
-    assert np.array_equal(twice, stage(once, f, **width))
+    thrice = stage(v, f, stage_repeats=3, **width)
+    assert not np.array_equal(thrice, once)
+    # the neighbour sets are the input's in every cycle: not three chained one-cycle calls
+    assert not np.array_equal(thrice, stage(stage(once, f, **width), f, **width))
+    assert not np.array_equal(stage(v, f, stage_repeats=3, guided_radius=3.0, **width), thrice)
 
 
 def ball(n: int = 10):
@@ -76,28 +78,39 @@ def ball(n: int = 10):
     return c + d / np.linalg.norm(d, axis=1, keepdims=True), f
 
 
-def test_discrepancy_guard():
-    def moved(out, v, f):
-        return np.sqrt(np.mean(np.sum((out - v) ** 2, axis=1))) / rsmooth.mean_edge_length(v, f)
+def discrepancy_iterations(v, f, level):
+    """The discrepancy principle, computed here: the fewest Taubin iterations that move the
+    vertices (RMS) as far as `level` mean edge lengths (at most 40)."""
+    unit = rsmooth.mean_edge_length(v, f)
+    for k in range(1, 41):
+        t = rsmooth.smooth(v, f, method="taubin", iterations=k)
+        if np.sqrt(np.mean(np.sum((t - v) ** 2, axis=1))) >= level * unit:
+            return k, t
+    return 40, t
 
-    # a part of flat faces and creases keeps the filter's result, whatever the level
-    truth, f = box(12)
-    v = noisy(truth, f, 0.3, seed=9)
-    off = rsmooth.smooth(v, f, device="reference", best=True)
-    kept = rsmooth.smooth(v, f, device="reference", best=True, discrepancy_level=0.3)
-    assert np.array_equal(kept, off)
-    # a ball: Taubin smoothing of the input, run until the vertices moved as far as the level
-    truth, f = ball(10)
-    v = noisy(truth, f, 0.3, seed=9)
-    off = rsmooth.smooth(v, f, device="reference", best=True)
-    guarded = rsmooth.smooth(v, f, device="reference", best=True, discrepancy_level=0.15)
-    assert not np.array_equal(guarded, off)
-    assert moved(guarded, v, f) >= 0.15 * 0.999, moved(guarded, v, f)
-    k = 1
-    while not np.array_equal(rsmooth.smooth(v, f, method="taubin", iterations=k), guarded):
-        k += 1
-        assert k < 40
-    assert moved(rsmooth.smooth(v, f, method="taubin", iterations=k - 1), v, f) < 0.15
+
+def test_region_choice_against_numpy():
+    """The library's choice per region equals scripts/region_study.py's independent numpy blend
+    at the library's bounds, on one mesh of a box (flat faces and creases: the filter's result)
+    and a ball (curved at triangle scale: Taubin's), and each part goes its own way."""
+    sys.path.insert(0, str(ROOT / "scripts"))
+    from region_study import LIBRARY, blend
+
+    bv, bf = box(10)
+    gv, gf = ball(8)
+    v = np.concatenate([bv, gv + [4.0, 0, 0]])
+    f = np.concatenate([bf, gf + len(bv)])
+    v = noisy(v, f, 0.3, seed=9)
+    level = 0.15
+    filtered = rsmooth.smooth(v, f, device="reference", best=True)
+    chosen = rsmooth.smooth(v, f, device="reference", best=True, discrepancy_level=level)
+    _, taubin = discrepancy_iterations(v, f, level)
+    expected, share = blend(v, filtered, taubin, f, level, *LIBRARY)
+    unit = rsmooth.mean_edge_length(v, f)
+    assert np.abs(chosen - expected).max() < 1e-9 * unit
+    on_box = np.all(chosen[: len(bv)] == filtered[: len(bv)], axis=1).mean()
+    on_ball = np.all(chosen[len(bv):] == taubin[len(bv):], axis=1).mean()
+    assert on_box > 0.9 and on_ball > 0.9, (on_box, on_ball)
 
 
 def test_discrepancy_iterations_in_the_report():
