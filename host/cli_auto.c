@@ -54,8 +54,18 @@ int cli_choose_params(options *opt, const rsmooth_mesh *mesh, bool points) {
         chosen.absolute = given->absolute;
     opt->params = chosen;
     opt->noise = report.level;
+    opt->noise_correlated = report.correlated_level;
+    opt->noise_correlation_length = report.correlation_length;
+    /* the correlated part, when there is one: what the rules (which read `level`) do not see */
+    char correlated[128] = "";
+    if (report.correlation_length > 0)
+        snprintf(correlated, sizeof correlated,
+                 "; with its spatially correlated part %.3g mean edge lengths rms (correlation "
+                 "length %.2g edges)",
+                 report.correlated_level, report.correlation_length);
     if (!opt->quiet)
-        fprintf(stderr, "rsmooth: %s: --auto: %s -> %s (sigma_f %.3g, sigma_g %.3g)\n",
-                opt->input, report.reason, report.preset, chosen.sigma_f, chosen.sigma_g);
+        fprintf(stderr, "rsmooth: %s: --auto: %s%s -> %s (sigma_f %.3g, sigma_g %.3g)\n",
+                opt->input, report.reason, correlated, report.preset, chosen.sigma_f,
+                chosen.sigma_g);
     return EXIT_OK;
 }

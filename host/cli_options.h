@@ -68,6 +68,8 @@ typedef struct options {
     bool auto_params;       /* --auto */
     unsigned given;         /* GIVEN_* bits: parameters set on the command line */
     double noise;           /* --auto's estimate */
+    double noise_correlated; /* --auto's rms including the correlated part (= noise when none) */
+    double noise_correlation_length; /* its correlation length, edges (0: uncorrelated) */
 } options;
 
 /* Reads the command line into `opt` and checks it (cli_options_check). Returns -1 when the

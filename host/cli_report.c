@@ -99,6 +99,9 @@ void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read,
                    p->stage_repeats, p->discrepancy_level, r->discrepancy_iterations);
         if (opt->auto_params)
             printf(",\"noise_estimate\":%.9g", opt->noise);
+        if (opt->auto_params && opt->noise_correlation_length > 0)
+            printf(",\"noise_correlated\":%.9g,\"noise_correlation_length\":%.9g",
+                   opt->noise_correlated, opt->noise_correlation_length);
     }
     printf(",\"vertices\":%zu,\"triangles\":%zu,\"facets\":%zu,\"mean_edge_length\":%.9g,"
            "\"sigma_f\":%.9g,",

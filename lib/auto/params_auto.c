@@ -155,6 +155,8 @@ rsmooth_status rsmooth_params_auto_report(rsmooth_scalar scalar, const void *pos
         r.impulsive_fraction = d.impulsive_fraction;
         r.tangential_level = d.tangential_level;
         r.mean_edge_length = d.mean_edge_clean;
+        r.correlated_level = d.correlated_level;
+        r.correlation_length = d.correlation_length;
         *report = r;
     }
     return RSMOOTH_OK;

@@ -390,6 +390,18 @@ typedef struct rsmooth_noise_report {
     double mean_edge_length;   /**< the clean mesh's, as estimated, in the mesh's units */
     char preset[32];           /**< the setting the rule chose, e.g. "best: strong" */
     char reason[192];          /**< why, in words, for printing */
+    double correlated_level;   /**< the rms displacement along the normal including the noise's
+                                * spatially correlated part (real range scans: ridges along the
+                                * scan lines, waves of a few edges), which `level` (read over one
+                                * or two rings) mostly misses; mean edge lengths of the clean
+                                * mesh. Equal to `level` (its rms over all vertices for impulsive
+                                * noise) when the noise reads uncorrelated. Read from residuals
+                                * at radii 2 to 6 edges: noise correlated over more than about 1.5
+                                * edges reads as shape, not noise (docs/accuracy.md). (Added in
+                                * 0.11) */
+    double correlation_length; /**< the correlated part's correlation length, mean edge lengths
+                                * (about L for noise smoothed by a Gaussian of width L); 0 when
+                                * the noise reads uncorrelated. (Added in 0.11) */
 } rsmooth_noise_report;
 
 /** Sets struct_size and clears the rest. */
