@@ -220,15 +220,16 @@ PyObject *ext_default_params(PyObject *self, PyObject *args) {
 
 /* The noise report as a dict: level, kind ("none", "gaussian" or "impulsive"),
  * impulsive_fraction, tangential_level (NaN when not measured), mean_edge_length, preset,
- * reason. */
+ * reason, correlated_level, correlation_length. */
 static PyObject *noise_report_to_dict(const rsmooth_noise_report *r) {
     const char *kind = r->kind == RSMOOTH_NOISE_GAUSSIAN    ? "gaussian"
                        : r->kind == RSMOOTH_NOISE_IMPULSIVE ? "impulsive"
                                                             : "none";
-    return Py_BuildValue("{sd,ss,sd,sd,sd,ss,ss}", "level", r->level, "kind", kind,
+    return Py_BuildValue("{sd,ss,sd,sd,sd,ss,ss,sd,sd}", "level", r->level, "kind", kind,
                          "impulsive_fraction", r->impulsive_fraction, "tangential_level",
                          r->tangential_level, "mean_edge_length", r->mean_edge_length, "preset",
-                         r->preset, "reason", r->reason);
+                         r->preset, "reason", r->reason, "correlated_level",
+                         r->correlated_level, "correlation_length", r->correlation_length);
 }
 
 /* _params_auto(vertices, faces, params) -> (params, report): rsmooth_params_auto_report's rule
