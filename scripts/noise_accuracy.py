@@ -10,6 +10,14 @@ The generated meshes go under --work (never into the project). Truth: the displa
 against the clean mesh, its component along the clean mesh's vertex normal, rms over the vertices
 (for impulsive noise over the displaced ones), in the clean mesh's mean edge lengths; the tangential
 truth is the rms along one tangent direction. Seeds are fixed: the same files and figures every run.
+
+Correlated noise (rsmooth noise --correlation L, --stripes W) is generated on the clean meshes
+(sigma 0.1, 0.3, 0.5; L = 1, 2, 4; W = 3, 6, 12), and the two raw range scans of
+../shared/data/scans/stanford-bunny are read as they are; their truth is scripts/scans.py's rms
+distance to the reconstruction (docs/results/scans.json). For every row the correlated estimate
+(rsmooth_noise_report.correlated_level, lib/auto/noise_scales.c) is compared with the rms normal
+displacement over all vertices (true_overall), separately for the meshes its constants were fitted
+on (FIT_MESHES) and those left out.
 """
 import argparse
 import json
@@ -24,6 +32,12 @@ SHARED = os.path.join(ROOT, "..", "shared", "data")
 LEVELS = [0.05, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0]
 IMPULSIVE = [(f, s) for f in (0.05, 0.1, 0.3) for s in (0.3, 0.5, 1.0)]
 TOLERANCE = 0.10
+CORRELATED_LEVELS = [0.1, 0.3, 0.5]
+CORRELATION = [1, 2, 4]
+STRIPES = [3, 6, 12]
+# the meshes noise_scales.c's constants were fitted on (scripts/noise_scales_fit.py); the rest are
+# left out of the fit
+FIT_MESHES = {"beetle-alt", "rocker-arm", "bun000"}
 
 DRIVER = os.path.join(HERE, "noise_accuracy_driver.c")
 
@@ -49,11 +63,22 @@ def cases(shared, work, rsmooth):
         todo += [("random", s, 1.0, ["--sigma", str(s), "--direction", "random"]) for s in LEVELS]
         todo += [("impulsive", s, f, ["--sigma", str(s), "--impulsive", str(f)])
                  for f, s in IMPULSIVE]
+        if os.path.basename(os.path.dirname(clean)) == "clean":
+            todo += [("band%g" % c, s, 1.0, ["--sigma", str(s), "--correlation", str(c)])
+                     for c in CORRELATION for s in CORRELATED_LEVELS]
+            todo += [("stripes%g" % w, s, 1.0, ["--sigma", str(s), "--stripes", str(w)])
+                     for w in STRIPES for s in CORRELATED_LEVELS]
+            todo += [("clean", 0, 1.0, None)]
         for k, (kind, s, f, opts) in enumerate(todo):
-            tag = "%s-%s%g" % (name, kind[0], s) + ("-f%g" % f if kind == "impulsive" else "")
+            if opts is None:  # the clean mesh itself: the false reading
+                out.append({"mesh": name, "kind": kind, "nominal": 0, "nominal_fraction": f,
+                            "noisy": clean, "clean": clean})
+                continue
+            tag = "%s-%s%g" % (name, kind if kind[0] in "bs" else kind[0], s) + (
+                "-f%g" % f if kind == "impulsive" else "")
             noisy = os.path.join(gen, tag + ".obj")
             if not os.path.exists(noisy):
-                seed = 1000 * (m + 1) + k
+                seed = 1000 * (m + 1) + k if kind[0] not in "bs" else 5000 * (m + 1) + k
                 subprocess.run([rsmooth, "noise", clean, noisy, "--seed", str(seed), "-q"] + opts,
                                check=True)
             out.append({"mesh": name, "kind": kind, "nominal": s, "nominal_fraction": f,
@@ -64,6 +89,14 @@ def cases(shared, work, rsmooth):
             out.append({"mesh": name, "kind": "real", "nominal": None, "nominal_fraction": None,
                         "noisy": os.path.join(d, "Noisy.obj"),
                         "clean": os.path.join(d, "Original.obj")})
+    scans = os.path.join(shared, "scans", "stanford-bunny")
+    truth = json.load(open(os.path.join(ROOT, "docs", "results", "scans.json")))["scans"]
+    for name in ("bun000", "bun045"):
+        path = os.path.join(scans, name + ".ply")
+        if os.path.exists(path) and name in truth:
+            out.append({"mesh": name, "kind": "scan", "nominal": None, "nominal_fraction": None,
+                        "noisy": path, "clean": path,
+                        "scan_truth": truth[name]["raw"]["rms_distance_edges"]})
     return out
 
 
@@ -85,6 +118,8 @@ def run(exe, todo):
             for l in res.stdout.splitlines()]
     for c, r in zip(todo, rows):
         r.update(c)
+        if "scan_truth" in r:  # no clean mesh: the distance to the reconstruction
+            r["true_level"] = r["true_overall"] = r.pop("scan_truth")
     return rows
 
 
@@ -107,12 +142,57 @@ def main():
     report(rows, args.json)
 
 
+def correlated_report(rows):
+    """correlated_level against the rms normal displacement over all vertices, per kind and level,
+    meshes in the fit and left out apart; then the false reading on each clean mesh."""
+    groups = {}
+    for r in rows:
+        r["correlated_error"] = (r["correlated"] / r["true_overall"] - 1
+                                 if r["true_overall"] > 0 else None)
+        part = "fit" if r["mesh"] in FIT_MESHES else "left out"
+        groups.setdefault((r["kind"], r["nominal"], part), []).append(r)
+    print("correlated estimate (correlated_level vs rms normal displacement):")
+    print("| kind | sigma | meshes | within 15% | median error | worst error (mesh) | "
+          "median level error | median length |")
+    print("|---|---|---|---|---|---|---|---|")
+    order = lambda k: (k[2] == "left out", k[0], k[1] or 0)
+    for k in sorted(groups, key=order):
+        g = [r for r in groups[k] if r["correlated_error"] is not None]
+        if not g:
+            continue
+        e = sorted(r["correlated_error"] for r in g)
+        worst = max(g, key=lambda r: abs(r["correlated_error"]))
+        lev = sorted(r["overall"] / r["true_overall"] - 1 for r in g)
+        lengths = sorted(r["length"] for r in g)
+        print("| %s | %s | %s: %d | %d of %d | %+.0f%% | %+.0f%% (%s) | %+.0f%% | %.2f |" % (
+            k[0], "%.2f" % k[1] if k[1] is not None else "–", k[2], len(g),
+            sum(abs(x) <= 0.15 for x in e), len(g), 100 * e[len(e) // 2],
+            100 * worst["correlated_error"], worst["mesh"], 100 * lev[len(lev) // 2],
+            lengths[len(lengths) // 2]))
+    print("\nfalse reading on the clean meshes (no noise added): level / correlated_level / length")
+    for r in rows:
+        if r["kind"] == "clean":
+            print("  %-16s %s %.3f / %.3f / %.2f" % (
+                r["mesh"], "(fit)     " if r["mesh"] in FIT_MESHES else "(left out)",
+                r["level"], r["correlated"], r["length"]))
+    for r in rows:
+        if r["kind"] == "scan":
+            print("  scan %-11s %s true %.3f: level %.3f, correlated_level %.3f (%+.0f%%), "
+                  "length %.2f" % (r["mesh"], "(fit)     " if r["mesh"] in FIT_MESHES else
+                                   "(left out)", r["true_overall"], r["level"], r["correlated"],
+                                   100 * r["correlated_error"], r["length"]))
+    print()
+
+
 def report(rows, json_path):
     worst = {}
     confusion = {"gaussian_as_gaussian": 0, "gaussian_as_impulsive": 0,
                  "impulsive_as_impulsive": 0, "impulsive_as_gaussian": 0}
     print("%-22s %-9s %5s %5s %8s %8s %7s  %s" % ("mesh", "kind", "sigma", "F", "true", "est",
                                                   "err", "tangential / fraction / kind"))
+    correlated_report(rows)
+    rows_all = rows
+    rows = [r for r in rows if r["kind"] in ("normal", "random", "impulsive", "real")]
     for r in rows:
         r["error"] = r["level"] / r["true_level"] - 1 if r["true_level"] > 0 else None
         truth_impulsive = r["kind"] == "impulsive" or (r["kind"] == "real" and
@@ -141,7 +221,7 @@ def report(rows, json_path):
     print("confusion:", confusion)
     if json_path:
         with open(json_path, "w") as f:
-            json.dump({"rows": rows, "confusion": confusion,
+            json.dump({"rows": rows_all, "confusion": confusion,
                        "worst": [{"kind": k[0], "sigma": k[1], "fraction": k[2], "error": w[0],
                                   "mesh": w[1], "meshes": w[2]} for k, w in worst.items()]},
                       f, indent=1)
