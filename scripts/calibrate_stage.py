@@ -6,6 +6,9 @@ same way.
     python3 scripts/calibrate_stage.py run   --cases /work/cases/manifest.json
     python3 scripts/calibrate_stage.py fit   --cases /work/cases/manifest.json \
         --out docs/results/calibration_stage.json
+    python3 scripts/region_study.py --cases /work/cases/manifest.json   (the bounds per fold)
+    python3 scripts/calibrate_stage.py final --cases /work/cases/manifest.json \
+        --final docs/results/final_stage.json
 
 A candidate is one cycle schedule (cycles x vertex updates, one guided round per cycle as the
 guided filter's authors run it), a neighbourhood radius and a guidance width sigma_n; the spatial
@@ -35,9 +38,9 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 
 # (cycles, vertex updates per cycle): from a few long cycles to the authors' many short ones
-SCHEDULES = [(5, 10), (10, 10), (20, 10), (40, 5), (100, 2)]
+SCHEDULES = [(2, 10), (3, 10), (5, 10), (10, 10), (20, 10), (40, 5), (100, 2)]
 RADII = [2, 3]
-SIGMA_N = [0.2, 0.35]
+SIGMA_N = [0.2, 0.35, 0.5]
 LONG = [(300, 1, 3, 0.2)]  # the authors' schedule for impulsive noise (cycles, k, radius, sigma_n)
 SIGMA_S = 1.0
 LEVEL_BOUNDS = [0.25, 0.45]
@@ -178,7 +181,9 @@ def cmd_fit(args, cases):
                          "class": level_class(n, kind), "setting": k,
                          "ev": cache[c["name"]][k]["ev"], "theta": cache[c["name"]][k]["theta"],
                          "s": cache[c["name"]][k]["s"], "oracle": oracle,
-                         "oracle_ev": cache[c["name"]][oracle]["ev"]})
+                         "oracle_ev": cache[c["name"]][oracle]["ev"],
+                         "oracle_theta": min(cache[c["name"]][q].get("theta", float("inf"))
+                                             for q in keys)})
     rule_all = choose(cache, cases, est, keys)
     # robustness of each setting any fold chose: every width 5% up and down, on all cases
     nudges = [nudged(k.split(), f) for k in sorted(chosen) for f in (0.95, 1.05)]
@@ -204,20 +209,136 @@ def cmd_fit(args, cases):
         print("  %s: %s" % (k[40:], v))
 
 
+def adjacent_ratio(path):
+    """The mean distance between the centroids of triangles sharing an edge over the mean edge
+    length (each unique edge once): the guided filter's authors give sigma_s in the former."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import numpy as np
+    from obj_mesh import read_obj
+    v, f = read_obj(path)
+    c = v[f].mean(axis=1)
+    e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    owner = np.tile(np.arange(len(f)), 3)
+    order = np.lexsort((e[:, 1], e[:, 0]))
+    e, owner = e[order], owner[order]
+    same = np.all(e[1:] == e[:-1], axis=1)
+    pairs = np.flatnonzero(same)
+    adjacent = np.linalg.norm(c[owner[pairs]] - c[owner[pairs + 1]], axis=1).mean()
+    unique = e[np.r_[True, ~same]]
+    return adjacent / np.linalg.norm(v[unique[:, 0]] - v[unique[:, 1]], axis=1).mean()
+
+
+def gmnf_defaults(case):
+    """The guided filter's authors' program at its defaults (GuidedDenoising, local scheme: 20
+    cycles of one guided step and 10 vertex updates, radius 2 and sigma_s 1 in mean
+    adjacent-centroid distances, sigma_r 0.35), as rsmooth's stage spells it. Their program
+    re-measures sigma_s on the current mesh each cycle; rsmooth keeps the input's."""
+    return stage_opts(20, 10, 2, 0.35, sigma_s=float("%.4g" % adjacent_ratio(case["noisy"])))
+
+
+def run_report(rsmooth, case, opts, out):
+    """E_v, theta, the filter's ms (--json) and the choice per region's figures."""
+    p = subprocess.run([rsmooth, case["noisy"], "-o", out, "-f", "--json"] + opts,
+                       capture_output=True, text=True, check=True)
+    report = json.loads(p.stdout.strip().splitlines()[-1])
+    m = json.loads(subprocess.run([rsmooth, "compare", out, case["truth"], "--json"],
+                                  capture_output=True, text=True, check=True).stdout)
+    region = report.get("region_choice", {})
+    return {"ev": m["ev"], "theta": m["theta"], "ms_filter": report["ms"]["filter"],
+            "taubin_iterations": region.get("taubin_iterations", 0),
+            "filter_share": region.get("filter_share", 1.0)}
+
+
+def geometry_checks(case, out_path, level):
+    """Triangles facing away from the truth's (normals more than 90 degrees apart) in the result
+    and in the input, and the largest move of a boundary vertex over the noise level in its own
+    edge lengths (region_study.py's measure; at most 1 means within the level)."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import numpy as np
+    import region_study
+    from obj_mesh import read_obj
+    x_in, faces = read_obj(case["noisy"])
+    x_out, x_truth = read_obj(out_path)[0], read_obj(case["truth"])[0]
+
+    def normals(x):
+        return np.cross(x[faces[:, 1]] - x[faces[:, 0]], x[faces[:, 2]] - x[faces[:, 0]])
+
+    truth_n = normals(x_truth)
+    flipped = int(np.sum(np.sum(normals(x_out) * truth_n, axis=1) < 0))
+    flipped_in = int(np.sum(np.sum(normals(x_in) * truth_n, axis=1) < 0))
+    rep, tri, _, boundary = region_study.vertex_shares(x_in, faces)
+    edge = region_study.local_edges(x_in, rep, tri)[rep]
+    move = np.linalg.norm(x_out - x_in, axis=1)
+    b = boundary[rep] & (edge > 0)
+    worst = float(np.max(move[b] / (level * edge[b]))) if b.any() and level > 0 else 0.0
+    return {"flipped": flipped, "flipped_input": flipped_in, "boundary_vertices": int(b.sum()),
+            "boundary_move_over_level": worst}
+
+
+def cmd_final(args, cases):
+    """Per case: the best mode as its fold chose it (the fold's stage setting, then the choice
+    per region at the fold's bounds, by region_study.py's blend, which equals the library's),
+    `--best --auto` as users run it (the rule fitted on all groups, compiled in), the guided
+    filter's authors' defaults and the paper's defaults (for the time ratio)."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import region_study
+    from obj_mesh import write_obj
+    stage = {r["case"]: r for r in json.load(open(args.out))["rows"]}
+    region = {r["case"]: r for r in json.load(open(args.region))["rows"]}
+    out = load(args.final)
+    with tempfile.TemporaryDirectory() as tmp:
+        for c in cases:
+            if c["name"] in out:
+                continue
+            setting = stage[c["name"]]["setting"].split()
+            x_in, f_xyz, t_xyz, faces, level, iterations = region_study.case_inputs(
+                args.rsmooth, c, setting, tmp)
+            lo, hi, spread = region[c["name"]]["bounds"].split()
+            mine, share = region_study.blend(x_in, f_xyz, t_xyz, faces, level, float(lo),
+                                             float(hi), int(spread))
+            path = os.path.join(tmp, "fold.obj")
+            write_obj(path, mine, faces)
+            m = region_study.compare(args.rsmooth, path, c["truth"])
+            path = os.path.join(tmp, "run.obj")
+            res = {"fold": {"ev": m["ev"], "theta": m["theta"], "filter_share": share,
+                            "setting": " ".join(setting), "bounds": region[c["name"]]["bounds"]},
+                   "best_auto": run_report(args.rsmooth, c, ["--best", "--auto"], path),
+                   "checks": geometry_checks(c, path, level),
+                   "gmnf_defaults": run_report(args.rsmooth, c, gmnf_defaults(c), path),
+                   "paper_defaults": run_report(args.rsmooth, c, [], path),
+                   "estimate": stage[c["name"]]["estimate"],
+                   "estimated_kind": stage[c["name"]]["estimated_kind"],
+                   "lattice_oracle": {"ev": stage[c["name"]]["oracle_ev"],
+                                      "theta": stage[c["name"]]["oracle_theta"],
+                                      "setting": stage[c["name"]]["oracle"]}}
+            out[c["name"]] = res
+            with open(args.final, "w") as f:
+                json.dump(out, f, indent=1)
+            print("%-22s fold %.3f/%.2f  --best --auto %.3f/%.2f (%.0f ms)  GMNF defaults "
+                  "%.3f/%.2f  paper defaults %.3f (%.0f ms)" % (
+                      c["name"], res["fold"]["ev"], res["fold"]["theta"],
+                      res["best_auto"]["ev"], res["best_auto"]["theta"],
+                      res["best_auto"]["ms_filter"], res["gmnf_defaults"]["ev"],
+                      res["gmnf_defaults"]["theta"], res["paper_defaults"]["ev"],
+                      res["paper_defaults"]["ms_filter"]), flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("command", choices=["run", "fit"])
+    ap.add_argument("command", choices=["run", "fit", "final"])
     ap.add_argument("--cases", required=True)
     ap.add_argument("--rsmooth", default="build/rsmooth")
     ap.add_argument("--cache", default="/tmp/rsmooth-stage-cache.json")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--only", default="", help="comma-separated case names (default: all)")
     ap.add_argument("--out", default="docs/results/calibration_stage.json")
+    ap.add_argument("--region", default="docs/results/region_study.json")
+    ap.add_argument("--final", default="docs/results/final_stage.json")
     args = ap.parse_args()
     cases = json.load(open(args.cases))["cases"]
     if args.only:
         cases = [c for c in cases if c["name"] in args.only.split(",")]
-    {"run": cmd_run, "fit": cmd_fit}[args.command](args, cases)
+    {"run": cmd_run, "fit": cmd_fit, "final": cmd_final}[args.command](args, cases)
 
 
 if __name__ == "__main__":

@@ -117,6 +117,7 @@ PyObject *ext_smooth(PyObject *self, PyObject *args, PyObject *kwargs) {
         goto done;
     call_state call;
     rsmooth_report rep;
+    rsmooth_report_init(&rep); /* its struct_size says which fields this caller has */
     rsmooth_error err;
     rsmooth_status st;
     start_call(&call, progress, &p, ctx != NULL);
@@ -178,6 +179,7 @@ PyObject *ext_smooth_points(PyObject *self, PyObject *args, PyObject *kwargs) {
         goto done;
     call_state call;
     rsmooth_report rep;
+    rsmooth_report_init(&rep); /* its struct_size says which fields this caller has */
     rsmooth_error err;
     start_call(&call, progress, &p, 0);
     rsmooth_status st = rsmooth_smooth_points_reference(v.scalar, v.data, n.data, (size_t)v.rows,
