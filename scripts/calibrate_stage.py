@@ -12,10 +12,11 @@ same way.
 
 A candidate is one cycle schedule (cycles x vertex updates, one guided round per cycle as the
 guided filter's authors run it), a neighbourhood radius and a guidance width sigma_n; the spatial
-width is 1 mean edge length. Whether one robust pass follows is measured for the settings some
+width is 1 mean edge length. Each runs as `--best --auto` with the stage spelled out (options given
+win over --auto's), so what is measured includes the choice per region that follows the stage at
+the estimated noise, with the library's bounds (region_study.py fits those afterwards). Whether one robust pass follows is measured for the settings some
 fold would choose, and then chosen the same way. `run` measures each (case,
-candidate) with the command (the stage's result, no choice per region: `--best` with the stage
-spelled out, no --auto) and caches E_v, theta and the wall time in --cache (JSON; reruns skip what
+candidate) with the command (`--best --auto` with the stage spelled out) and caches E_v, theta and the wall time in --cache (JSON; reruns skip what
 is there). Two commands run at a time (--jobs).
 
 `fit`, for each group of cases (one underlying model): the rule is chosen on the other groups
@@ -53,10 +54,12 @@ def stage_opts(cycles, updates, radius, sigma_n, passes=0, sigma_s=SIGMA_S):
             "--guided-sigma-s", "%g" % sigma_s]
 
 
-def candidates():
+def candidates(blend=True):
+    """Every candidate; with `blend`, run as `--best --auto` runs it (the choice per region at
+    the estimated noise after the stage: the rule is chosen on what users get)."""
     out = [stage_opts(c, k, r, n) for (c, k) in SCHEDULES for r in RADII for n in SIGMA_N]
     out += [stage_opts(c, k, r, n) for (c, k, r, n) in LONG]
-    return out
+    return [o + ["--auto"] for o in out] if blend else out
 
 
 def with_pass(opts):

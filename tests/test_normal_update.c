@@ -491,6 +491,28 @@ static void test_region_choice(void) {
            k, as_taubin, ns, r.region_filter_share);
     CHECK(as_taubin >= ns * 9 / 10 && r.region_filter_share < 0.1);
     CHECK_LE(off_segment(chosen, plain, taubin, ns), 1e-12 * unit);
+    /* discrepancy_gain: Taubin goes on until an iteration adds less than the gain to the move */
+    double gain = 0.01;
+    rsmooth_params p;
+    rsmooth_params_init_best(&p);
+    p.discrepancy_level = level;
+    p.discrepancy_gain = gain;
+    rsmooth_report_init(&r);
+    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, sphere.xyz, ns, sphere.indices,
+                                          sphere.triangle_count, &p, chosen, NULL, NULL, &r,
+                                          NULL), RSMOOTH_OK);
+    int g = r.discrepancy_iterations;
+    double moved[3];
+    for (int i = 0; i < 3; i++) {
+        CHECK_STATUS(rsmooth_smooth_taubin(RSMOOTH_FLOAT64, sphere.xyz, ns, sphere.indices,
+                                           sphere.triangle_count, 0.5, -0.53, (unsigned)(g - i),
+                                           taubin, NULL), RSMOOTH_OK);
+        moved[i] = rms_move(taubin, sphere.xyz, ns) / unit;
+    }
+    printf("region: gain %.2f -> %d Taubin iterations (the last added %.4f, the one before %.4f)\n",
+           gain, g, moved[0] - moved[1], moved[1] - moved[2]);
+    CHECK(g > k && g < 40);
+    CHECK(moved[0] - moved[1] < gain && moved[1] - moved[2] >= gain);
     /* the cube: the filter's result */
     best_on(&cube, 0, plain, &r);
     best_on(&cube, level, chosen, &r);

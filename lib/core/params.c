@@ -38,6 +38,7 @@ rsmooth_status rsmooth_params_init(rsmooth_params *params) {
     params->discrepancy_level = 0.0;
     params->stage_repeats = 1;
     params->guided_radius = 2.0;
+    params->discrepancy_gain = 0.0;
     return RSMOOTH_OK;
 }
 
@@ -131,6 +132,9 @@ rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *o
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "stage_repeats must be in [1, %d] (got %d)", RS_MAX_CYCLES,
                        out->stage_repeats);
+    if (!(out->discrepancy_gain >= 0 && out->discrepancy_gain <= 1)) /* NaN fails too */
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "discrepancy_gain must be in [0, 1] (got %g)", out->discrepancy_gain);
     if (!(out->guided_radius >= 1 && out->guided_radius <= 8)) /* NaN fails too */
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "guided_radius must be in [1, 8] (got %g)", out->guided_radius);

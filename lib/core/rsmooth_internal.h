@@ -386,11 +386,12 @@ rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positi
 /* ---- taubin.c --------------------------------------------------------------------------------- */
 
 /* Taubin's lambda|mu smoothing of xyz (double, in place) until the RMS distance of the vertices
- * from where they started reaches target_move (mesh units), or max_iterations; returns the
- * iterations run, -1 when out of memory (xyz unchanged). */
+ * from where they started reaches target_move (mesh units) and, when min_gain > 0, an iteration
+ * adds less than min_gain to it; or max_iterations. Returns the iterations run, -1 when out of
+ * memory (xyz unchanged). */
 int rs_taubin_until(double *xyz, size_t vertex_count, const uint32_t *indices,
                     size_t triangle_count, double lambda, double mu, double target_move,
-                    int max_iterations);
+                    double min_gain, int max_iterations);
 
 /* ---- reference.c / passes.c: the filter on a prepared problem, and repeated passes ----------- */
 

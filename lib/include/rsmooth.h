@@ -304,6 +304,13 @@ typedef struct rsmooth_params {
                                    * length) from the input. Changed in 0.11: it swapped the
                                    * whole mesh before. Needs connected triangles (a soup keeps
                                    * the filter's result) */
+    double discrepancy_gain;      /**< 0 (default): Taubin's side of discrepancy_level's choice stops
+                                   * when the vertices moved that level. > 0: it goes on until one
+                                   * more iteration adds less than this (mean edge lengths) to
+                                   * their RMS move: for spatially correlated noise (range
+                                   * scans), whose low frequencies the level alone stops short
+                                   * of; rsmooth_params_auto sets it where the noise reads
+                                   * correlated. (Added in 0.11) */
     double guided_radius;         /**< the guided filter's neighbourhood, in mean distances between
                                    * the centroids of facets sharing an edge, [1, 8]. Default 2
                                    * (the authors'); 3-4 holds creases better under heavy noise.

@@ -290,8 +290,8 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar
     if (p.discrepancy_level > 0 && vertex_count > 0) {
         double share = 0;
         int iterations = rs_region_choice(scalar, positions, vertex_count, indices,
-                                          triangle_count, p.discrepancy_level, out_positions,
-                                          &share);
+                                          triangle_count, p.discrepancy_level,
+                                          p.discrepancy_gain, out_positions, &share);
         if (iterations < 0)
             return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the guard");
         if (report && caller_size >= offsetof(rsmooth_report, discrepancy_iterations) +

@@ -9,7 +9,9 @@
  *      line's vertices would otherwise read curved);
  *   2. w[v] = clamp((share[v] - SHARE_LOW) / (SHARE_HIGH - SHARE_LOW), 0, 1);
  *   3. out = w * filter + (1 - w) * Taubin, Taubin's lambda|mu smoothing of the input run until
- *      the vertices moved (RMS) as far as the noise did (the discrepancy principle);
+ *      the vertices moved (RMS) as far as the noise did (the discrepancy principle) and, for
+ *      spatially correlated noise (discrepancy_gain), until an iteration adds little to the move:
+ *      a scan's correlated noise sits at frequencies the principle stops short of;
  *   4. a boundary vertex (on an edge of one facet) moves at most the noise level, in its own edge
  *      lengths, from the input: neither smoother has the other side to lean on there, and a
  *      boundary pulled inwards opens holes between scans.
@@ -120,7 +122,7 @@ double rs_region_weight(double share) {
 
 int rs_region_choice(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
                      const uint32_t *indices, size_t triangle_count, double level,
-                     void *out_positions, double *out_mean_weight) {
+                     double min_gain, void *out_positions, double *out_mean_weight) {
     double *input = rs_alloc_array(vertex_count, 3 * sizeof(double));
     double *filtered = rs_alloc_array(vertex_count, 3 * sizeof(double));
     double *share = rs_alloc_array(vertex_count, sizeof(double));
@@ -146,7 +148,7 @@ int rs_region_choice(rsmooth_scalar scalar, const void *positions, size_t vertex
     if (low) { /* Taubin from the input, in its edge lengths */
         memcpy(low, input, vertex_count * 3 * sizeof(double));
         iterations = rs_taubin_until(low, vertex_count, indices, triangle_count, 0.5, -0.53,
-                                     level * unit, DISCREPANCY_MAX_ITERATIONS);
+                                     level * unit, min_gain * unit, DISCREPANCY_MAX_ITERATIONS);
         ok = iterations >= 0;
     }
     for (size_t v = 0; ok && low && v < vertex_count; v++) {

@@ -127,7 +127,7 @@ rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const void *position
 
 int rs_taubin_until(double *xyz, size_t vertex_count, const uint32_t *indices,
                     size_t triangle_count, double lambda, double mu, double target_move,
-                    int max_iterations) {
+                    double min_gain, int max_iterations) {
     double *origin = rs_alloc_array(vertex_count, 3 * sizeof *origin);
     double *next = rs_alloc_array(vertex_count, 3 * sizeof *next);
     adjacency adj = {NULL, NULL};
@@ -138,15 +138,17 @@ int rs_taubin_until(double *xyz, size_t vertex_count, const uint32_t *indices,
     }
     memcpy(origin, xyz, vertex_count * 3 * sizeof *xyz);
     int it = 0;
-    double move = 0;
-    while (it < max_iterations && move < target_move) {
+    double move = 0, gain = INFINITY;
+    while (it < max_iterations && (move < target_move || (min_gain > 0 && gain >= min_gain))) {
         umbrella_step(&adj, vertex_count, lambda, xyz, next);
         umbrella_step(&adj, vertex_count, mu, next, xyz);
         it++;
         double sum = 0;
         for (size_t i = 0; i < 3 * vertex_count; i++)
             sum += (xyz[i] - origin[i]) * (xyz[i] - origin[i]);
+        double before = move;
         move = vertex_count ? sqrt(sum / (double)vertex_count) : 0;
+        gain = move - before;
     }
     rs_free(origin);
     rs_free(next);

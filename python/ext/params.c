@@ -45,6 +45,7 @@ static const field fields[] = {
     INT_FIELD(stage_repeats, 1, 1000),
     DOUBLE_FIELD(discrepancy_level),
     DOUBLE_FIELD(guided_radius),
+    DOUBLE_FIELD(discrepancy_gain),
 };
 #define FIELD_COUNT (sizeof fields / sizeof fields[0])
 

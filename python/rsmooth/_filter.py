@@ -45,6 +45,7 @@ def smooth(
     stage_repeats: Optional[int] = None,
     guided_radius: Optional[float] = None,
     discrepancy_level: Optional[float] = None,
+    discrepancy_gain: Optional[float] = None,
     predictor: Optional[str] = None,
     mollify_cutoff: Optional[float] = None,
     colors: Any = None,
@@ -111,6 +112,9 @@ def smooth(
         creases: the filter's; curved at the scale of the triangles: Taubin's); boundary
         vertices move at most that level. The report's ``discrepancy_iterations`` and
         ``region_filter_share`` say how many Taubin iterations and the filter's mean weight.
+    discrepancy_gain : 0 (default). > 0: Taubin's side goes on until an iteration adds less than
+        this (mean edge lengths) to the move (``auto`` sets 0.003 where the noise reads
+        spatially correlated, as in range scans).
     predictor : "projection" (the paper) or "centroid".
     mollify_cutoff : mollification reach in units of sigma_f, (0, cutoff]; default: cutoff.
     colors : (n, 3) per-vertex colours (floats in [0, 1], or uint8 0..255) weighing each
@@ -154,9 +158,9 @@ def smooth(
         pass_confidence=pass_confidence, vertex_updates=vertex_updates,
         guided_sigma_s=guided_sigma_s, guided_sigma_n=guided_sigma_n,
         guided_rounds=guided_rounds, stage_repeats=stage_repeats, guided_radius=guided_radius,
-        discrepancy_level=discrepancy_level, predictor=predictor, mollify_cutoff=mollify_cutoff,
-        colors=colors, sigma_c=sigma_c, mask=mask, method=method, iterations=iterations,
-        lam=lam, mu=mu, progress=progress,
+        discrepancy_level=discrepancy_level, discrepancy_gain=discrepancy_gain,
+        predictor=predictor, mollify_cutoff=mollify_cutoff, colors=colors, sigma_c=sigma_c,
+        mask=mask, method=method, iterations=iterations, lam=lam, mu=mu, progress=progress,
     )
     _check_device(device)
     if device == "reference" or method in ("laplacian", "taubin"):

@@ -166,6 +166,8 @@ def test_none_means_the_modes_default(cube):
         (dict(vertex_updates=5, guided_radius=0.5), "guided_radius"),
         (dict(vertex_updates=5, guided_radius=9.0), "guided_radius"),
         (dict(discrepancy_level=-1.0), "discrepancy_level"),
+        (dict(discrepancy_level=0.1, discrepancy_gain=-0.01), "discrepancy_gain"),
+        (dict(discrepancy_level=0.1, discrepancy_gain=math.nan), "discrepancy_gain"),
         (dict(discrepancy_level=math.inf), "discrepancy_level"),
     ],
 )
