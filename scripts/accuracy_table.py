@@ -64,13 +64,87 @@ def noise_table():
     return "\n".join(out)
 
 
+def stage_table():
+    """Issue 25's table (docs/results/final_stage.json from scripts/calibrate_stage.py final):
+    each case's best mode as its fold chose it against the guided filter's authors' defaults and
+    against the best anchor tuned against the truth (the anchors above, the C++ figures reported
+    for the benchmark models, and rsmooth's cycled guided stage alone tuned on the calibration
+    lattice)."""
+    final = load("final_stage.json")
+    files = {f: load(f).get("cases", {}) for _, _, f in ANCHORS}
+    lines = ["| case | est. noise | `--best --auto`, left out: E_v / θ | as shipped | GMNF defaults |"
+             " best tuned anchor | E_v ratio to GMNF / anchor | θ ratio to GMNF / anchor |"
+             " flipped (input) | boundary move / level |", "|" + "---|" * 10]
+    gm_ev, gm_th, an_ev, an_th, ms = [], [], [], [], []
+    flips_ok = boundary_ok = 0
+    for case, r in final.items():
+        best_ev, best_th, name = float("inf"), float("inf"), ""
+        for key, label, f in ANCHORS:
+            a = files[f].get(case, {}).get(key)
+            if a and "ev_opt" in a:
+                if a["ev_opt"]["ev"] < best_ev:
+                    best_ev, name = a["ev_opt"]["ev"], label
+                best_th = min(best_th, a["theta_opt"]["theta"])
+        if case in ISSUE_GUIDED and ISSUE_GUIDED[case][0] < best_ev:
+            best_ev, name = ISSUE_GUIDED[case][0], "guided (C++, reported)"
+        if case in ISSUE_GUIDED:
+            best_th = min(best_th, ISSUE_GUIDED[case][1])
+        lat = r["lattice_oracle"]
+        if lat["ev"] < best_ev:
+            best_ev, name = lat["ev"], "guided cycles (rsmooth's stage, lattice)"
+        best_th = min(best_th, lat["theta"])
+        fo, gm, ch = r["fold"], r["gmnf_defaults"], r["checks"]
+        gm_ev.append(fo["ev"] / gm["ev"])
+        gm_th.append(fo["theta"] / gm["theta"])
+        an_ev.append(fo["ev"] / best_ev)
+        an_th.append(fo["theta"] / best_th)
+        ms.append(r["best_auto"]["ms_filter"] / r["paper_defaults"]["ms_filter"])
+        flips_ok += ch["flipped"] <= ch["flipped_input"]
+        boundary_ok += ch["boundary_move_over_level"] <= 1 + 1e-9
+        lines.append("| %s | %.3f %s | %.3f / %.2f | %.3f / %.2f | %.3f / %.2f | %.3f / %.2f (%s) |"
+                     " %.2f / %.2f | %.2f / %.2f | %d (%d) | %s |" % (
+                         case, r["estimate"], r["estimated_kind"][0], fo["ev"], fo["theta"],
+                         r["best_auto"]["ev"], r["best_auto"]["theta"], gm["ev"], gm["theta"],
+                         best_ev, best_th, name, gm_ev[-1], an_ev[-1], gm_th[-1], an_th[-1],
+                         ch["flipped"], ch["flipped_input"],
+                         "%.2f" % ch["boundary_move_over_level"] if ch["boundary_vertices"]
+                         else "–"))
+    n = len(an_ev)
+
+    def count(xs, bound=1.0):
+        return sum(x <= bound + 1e-12 for x in xs)
+
+    lines += ["", "%d cases, each with the rule and bounds of a fold that left its model out." % n,
+              "At or below GMNF's defaults: E_v %d of %d (worst %.2fx), θ %d of %d (worst %.2fx)."
+              % (count(gm_ev), n, max(gm_ev, default=0), count(gm_th), n, max(gm_th, default=0)),
+              "At or below the best truth-tuned anchor: E_v %d of %d (%.0f%%), within 1.1x %d, "
+              "median %.2fx, worst %.2fx; θ %d of %d." % (
+                  count(an_ev), n, 100 * count(an_ev) / max(n, 1), count(an_ev, 1.1),
+                  statistics.median(an_ev) if n else 0, max(an_ev, default=0), count(an_th), n),
+              "No more flipped triangles than the input: %d of %d; boundary within the level: "
+              "%d of %d." % (flips_ok, n, boundary_ok, n),
+              "`--best --auto`'s filter time / the paper defaults' (`--json` ms.filter, same "
+              "device): median %.1fx, worst %.1fx." % (statistics.median(ms) if n else 0,
+                                                        max(ms, default=0))]
+    return "\n".join(lines)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--markdown", default=None)
     ap.add_argument("--noise", action="store_true", help="the noise estimate's table instead")
+    ap.add_argument("--stage", action="store_true",
+                    help="issue 25's table (final_stage.json) instead")
     args = ap.parse_args()
     if args.noise:
         print(noise_table())
+        return
+    if args.stage:
+        text = stage_table()
+        print(text)
+        if args.markdown:
+            with open(args.markdown, "w") as f:
+                f.write(text + "\n")
         return
     final = load("final.json")
     files = {f: load(f).get("cases", {}) for _, _, f in ANCHORS}

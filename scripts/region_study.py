@@ -147,6 +147,7 @@ def compare(rsmooth, path, truth):
 def case_inputs(rsmooth, case, stage, tmp):
     """F, T, the level and the input, each as a vertex array, and the faces."""
     f_path, t_path = os.path.join(tmp, "f.obj"), os.path.join(tmp, "t.obj")
+    stage = [o for o in stage if o != "--auto"]  # F: the stage and its pass, no choice
     run(rsmooth, [case["noisy"], "-o", f_path, "-f", "-q"] + stage)
     p = run(rsmooth, [case["noisy"], "-o", os.path.join(tmp, "a.obj"), "-f", "--json", "--auto"]
             + stage)

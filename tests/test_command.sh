@@ -202,7 +202,8 @@ ls -A | grep -qE 'tmp-|^\.rsmooth-' && fail "render left a temporary file: $(ls 
 expect 0 "$rsmooth" noisy.ply -o best.ply --best -q --device reference --json
 grep -q '"normals":"bilateral"' out.txt || fail "--best did not select bilateral normals"
 grep -q '"passes":1' out.txt || fail "--best did not run 1 pass after the stage"
-grep -q '"vertex_updates":10,.*"stage_repeats":5' out.txt || fail "--best did not run the normal update stage"
+grep -q '"vertex_updates":10,.*"guided_radius":3,"guided_rounds":1,"stage_repeats":10' out.txt ||
+  fail "--best did not run the normal update stage's 10 cycles"
 expect 0 "$rsmooth" noisy.ply -o best_tukey.ply --best --influence tukey --passes 2 \
   --pass-confidence 0.8 -q --device reference --json
 grep -q '"influence":"tukey","passes":2' out.txt || fail "options after --best were not applied"

@@ -15,23 +15,29 @@
 #define PAPER_SIGMA_F_PER_NOISE 1.6
 #define PAPER_SIGMA_G_PER_NOISE 4.0
 
-/* The best mode: the normal update stage (guided normals, then the vertex update, repeated) and
- * one robust pass with bilateral normals, its strength by noise class; then the discrepancy guard
- * (rsmooth_params.discrepancy_level) at the estimated noise. */
+/* The best mode: the normal update stage as the guided filter's authors run it (cycles of fresh
+ * facet normals, one guided round and some vertex updates; spatial width 1 mean edge length),
+ * then robust passes with bilateral normals, by noise class; then the choice per region
+ * (rsmooth_params.discrepancy_level) at the estimated noise. The classes' bounds were fixed in
+ * advance; each class's setting is the one scripts/calibrate_stage.py chose on all 30
+ * calibration cases (the figures of cases left out of the fit: docs/accuracy.md). */
 typedef struct best_preset {
     const char *name;
     double below;         /* for Gaussian levels below this (the last: any) */
-    double guided_sigma_n;
-    int guided_rounds;
-    int vertex_updates;
-    int stage_repeats;
+    int cycles;           /* stage_repeats */
+    int updates;          /* vertex_updates per cycle */
+    double radius;        /* guided_radius */
+    double sigma_n;       /* guided_sigma_n */
+    int passes;           /* robust passes after the stage */
 } best_preset;
 
+#define STAGE_SIGMA_S 1.0 /* guided_sigma_s, mean edge lengths */
 static const best_preset GAUSSIAN_PRESETS[] = {
-    {"best: gentle", 0.25, 0.15, 5, 25, 1},
-    {"best: strong", INFINITY, 0.2, 4, 10, 5},
+    {"best: low", 0.25, 5, 10, 3, 0.2, 1},
+    {"best: mid", 0.45, 10, 10, 3, 0.2, 1},
+    {"best: high", INFINITY, 40, 5, 2, 0.2, 1},
 };
-static const best_preset IMPULSIVE_PRESET = {"best: impulsive", INFINITY, 0.2, 4, 10, 5};
+static const best_preset IMPULSIVE_PRESET = {"best: impulsive", INFINITY, 10, 10, 3, 0.2, 0};
 /* Spatially correlated noise (range scans): where the multi-scale estimate reads a correlated part
  * this many times the small-scale level, Taubin's side of the choice per region runs until an
  * iteration adds less than CORRELATED_GAIN mean edge lengths to the move (rsmooth_params
@@ -107,28 +113,25 @@ static void choose(rsmooth_params *params, const rs_noise_details *d, char *pres
     params->normal_sigma_n = best.normal_sigma_n;
     params->normal_iterations = best.normal_iterations;
     params->influence = best.influence;
-    params->guided_sigma_s = best.guided_sigma_s;
-    params->guided_sigma_n = b->guided_sigma_n;
-    params->guided_rounds = b->guided_rounds;
-    params->vertex_updates = b->vertex_updates;
-    params->stage_repeats = b->stage_repeats;
-    params->passes = best.passes;
+    params->guided_sigma_s = STAGE_SIGMA_S;
+    params->guided_sigma_n = b->sigma_n;
+    params->guided_rounds = 1;
+    params->guided_radius = b->radius;
+    params->vertex_updates = b->updates;
+    params->stage_repeats = b->cycles;
+    params->passes = b->passes;
     /* the level Taubin's side of the choice per region runs to: all vertices' rms for impulsive
      * noise, the correlated part too where the noise reads correlated (scans) */
     params->discrepancy_level = d->impulsive ? d->overall_level : fmax(n, d->correlated_level);
     params->discrepancy_gain = reads_correlated(d) ? CORRELATED_GAIN : 0;
     snprintf(preset, preset_size, "%s", b->name);
     char stage[96];
-    snprintf(stage, sizeof stage, "%s%d guided rounds of width %.2g, %d vertex updates",
-             b->stage_repeats > 1 ? "repeated " : "", b->guided_rounds, b->guided_sigma_n,
-             b->vertex_updates);
-    if (b->stage_repeats > 1)
-        snprintf(stage + strlen(stage), sizeof stage - strlen(stage), ", %d times",
-                 b->stage_repeats);
-    if (d->impulsive)
-        snprintf(reason, reason_size, "%s: %s", what, stage);
+    snprintf(stage, sizeof stage, "%d cycles (guided radius %.3g, width %.2g; %d updates)%s",
+             b->cycles, b->radius, b->sigma_n, b->updates, b->passes ? ", robust pass" : "");
+    if (d->impulsive) /* (the precisions keep the whole within the report's 192 bytes) */
+        snprintf(reason, reason_size, "%.110s: %.75s", what, stage);
     else
-        snprintf(reason, reason_size, "%s, %s %.2g: %s", what,
+        snprintf(reason, reason_size, "%.100s, %s %.2g: %.70s", what,
                  isfinite(b->below) ? "below" : "at least",
                  isfinite(b->below) ? b->below : (b - 1)->below, stage);
 }

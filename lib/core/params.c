@@ -52,10 +52,14 @@ rsmooth_status rsmooth_params_init_best(rsmooth_params *params) {
     params->normal_sigma_n = 0.45;
     params->normal_iterations = 5;
     params->passes = 1;
-    /* the normal update stage first (issue 15): 4 guided rounds and 10 vertex updates, 5 times */
+    /* the normal update stage first, as the guided filter's authors run it: 10 cycles of one
+     * guided round (radius 3, width 0.2, spatial width 1 mean edge length) and 10 vertex updates
+     * (params_auto.c's class "mid", the one --best --auto picks at 0.25-0.45 edge lengths) */
     params->vertex_updates = 10;
-    params->guided_rounds = 4;
-    params->stage_repeats = 5;
+    params->guided_rounds = 1;
+    params->stage_repeats = 10;
+    params->guided_radius = 3.0;
+    params->guided_sigma_s = 1.0;
     return RSMOOTH_OK;
 }
 

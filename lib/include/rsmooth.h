@@ -323,10 +323,10 @@ typedef struct rsmooth_params {
 RSMOOTH_API rsmooth_status rsmooth_params_init(rsmooth_params *params);
 
 /** Fills `params` with rsmooth's most accurate mode, beyond the paper: the normal update stage
- * (4 guided normal filtering rounds of width 0.2, then 10 vertex updates, 5 times), then one
- * robust pass with
- * bilateral normals at sigma_f 0.8, sigma_g 0.3 (chosen on noisy meshes with a ground truth,
- * docs/experiments.md section 7). rsmooth_params_auto fits its strength to a mesh's noise. */
+ * (10 cycles of one guided normal filtering round, radius 3, width 0.2, spatial width 1 mean
+ * edge length, then 10 vertex updates), then one robust pass with bilateral normals at sigma_f
+ * 0.8, sigma_g 0.3 (chosen on noisy meshes with a ground truth, docs/accuracy.md).
+ * rsmooth_params_auto fits the stage to a mesh's noise and adds the choice per region. */
 RSMOOTH_API rsmooth_status rsmooth_params_init_best(rsmooth_params *params);
 
 /** Mean length of the mesh's unique undirected edges (an edge shared by two triangles counts once),
@@ -395,7 +395,7 @@ typedef struct rsmooth_noise_report {
                                 * direction, same unit (about `level` for noise in random
                                 * directions, near 0 along the normals); NAN when not measured */
     double mean_edge_length;   /**< the clean mesh's, as estimated, in the mesh's units */
-    char preset[32];           /**< the setting the rule chose, e.g. "best: strong" */
+    char preset[32];           /**< the setting the rule chose, e.g. "best: mid" */
     char reason[192];          /**< why, in words, for printing */
     double correlated_level;   /**< the rms displacement along the normal including the noise's
                                 * spatially correlated part (real range scans: ridges along the

@@ -30,7 +30,7 @@ def auto_params(vertices: Any, faces: Any, *, best: bool = False) -> Dict[str, A
     displaced: 1 unless impulsive), ``tangential_level`` (the displacement along one tangent
     direction, same unit; NaN when not measured), ``mean_edge_length`` (the clean mesh's, as
     estimated, in the mesh's units), ``preset`` (the setting chosen, e.g. "paper" or
-    "best: strong"), ``reason`` (why, in words), ``correlated_level`` (the rms along the normal
+    "best: mid"), ``reason`` (why, in words), ``correlated_level`` (the rms along the normal
     including the noise's spatially correlated part, as real range scans have: ``level`` when the
     noise reads uncorrelated), ``correlation_length`` (mean edge lengths; 0: uncorrelated), and
     ``params``: the chosen setting as

@@ -131,11 +131,13 @@ def test_none_means_the_modes_default(cube):
         stage(v, f, guided_sigma_s=None, guided_sigma_n=None, guided_rounds=None),
         stage(v, f, guided_sigma_s=2.0, guided_sigma_n=0.2, guided_rounds=20),
     )
-    # best: the stage (10 updates after 4 guided rounds, 5 times), then one pass; None keeps them
+    # best: the stage (10 cycles of 1 guided round, radius 3, spatial width 1, and 10 updates),
+    # then one pass; None keeps them
     best = rsmooth.smooth(v, f, device="reference", best=True, vertex_updates=None)
     assert np.array_equal(
         best, rsmooth.smooth(v, f, device="reference", best=True, vertex_updates=10,
-                             guided_rounds=4, stage_repeats=5, passes=1)
+                             guided_rounds=1, stage_repeats=10, guided_radius=3.0,
+                             guided_sigma_s=1.0, passes=1)
     )
     assert not np.array_equal(
         best, rsmooth.smooth(v, f, device="reference", best=True, vertex_updates=0)
