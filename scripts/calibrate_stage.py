@@ -189,12 +189,12 @@ def cmd_fit(args, cases):
                                              for q in keys)})
     rule_all = choose(cache, cases, est, keys)
     robust = {}
-    if args.robustness:  # every width 5% up and down, on the cases each setting was chosen for
-        nudges = [nudged(k.split(), f) for k in sorted(chosen) for f in (0.95, 1.05)]
+    if args.robustness:  # the shipped settings' widths 5% up and down, on their classes' cases
+        shipped = sorted(set(rule_all.values()))
+        nudges = [nudged(k.split(), f) for k in shipped for f in (0.95, 1.05)]
         cache = measure(args, cases, nudges)
-        for k in sorted(chosen):
-            members = [c for c in cases if any(r["setting"] == k and r["case"] == c["name"]
-                                               for r in rows)]
+        for k in shipped:
+            members = [c for c in cases if rule_all[level_class(*est[c["name"]])] == k]
             ratios = {("%.2f" % f): [cache[c["name"]][key(nudged(k.split(), f))]["ev"] /
                                      cache[c["name"]][k]["ev"] for c in members]
                       for f in (0.95, 1.05)}

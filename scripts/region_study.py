@@ -32,10 +32,10 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from obj_mesh import read_obj, write_obj  # noqa: E402
 
-LOWS = [0.15, 0.25, 0.35, 0.45, 0.55]
-WIDTHS = [0.1, 0.3, 0.5]
-SPREADS = [1, 3, 6]
-LIBRARY = (0.35, 0.65, 3)  # region_choice.c's SHARE_LOW, SHARE_HIGH, SHARE_SPREAD
+LOWS = [0.1, 0.2, 0.3, 0.4]
+WIDTHS = [0.3, 0.4, 0.6]
+SPREADS = [3, 6]
+LIBRARY = (0.2, 0.8, 6)  # region_choice.c's SHARE_LOW, SHARE_HIGH, SHARE_SPREAD
 FLAT_ANGLE = np.radians(2.0)
 
 

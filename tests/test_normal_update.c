@@ -489,7 +489,7 @@ static void test_region_choice(void) {
     size_t as_taubin = same_vertices(chosen, taubin, ns);
     printf("region: sphere -> Taubin %d iterations on %zu of %zu vertices (filter's weight %.3f)\n",
            k, as_taubin, ns, r.region_filter_share);
-    CHECK(as_taubin >= ns * 9 / 10 && r.region_filter_share < 0.1);
+    CHECK(as_taubin >= ns * 8 / 10 && r.region_filter_share < 0.1);
     CHECK_LE(off_segment(chosen, plain, taubin, ns), 1e-12 * unit);
     /* discrepancy_gain: Taubin goes on until an iteration adds less than the gain to the move */
     double gain = 0.01;
@@ -519,7 +519,7 @@ static void test_region_choice(void) {
     size_t as_filter = same_vertices(chosen, plain, nc);
     printf("region: cube -> the filter's result on %zu of %zu vertices (weight %.3f)\n", as_filter,
            nc, r.region_filter_share);
-    CHECK(as_filter >= nc * 9 / 10 && r.region_filter_share > 0.9);
+    CHECK(as_filter >= nc * 8 / 10 && r.region_filter_share > 0.9);
     /* both in one mesh (the filter's widths now from both parts' edges): each part its own */
     best_on(&both, level, chosen, &r);
     double *alone = malloc(3 * nb * sizeof(double));
@@ -529,7 +529,7 @@ static void test_region_choice(void) {
     size_t sphere_moved = ns - same_vertices(chosen, alone, ns);
     printf("region: sphere + cube -> cube %zu of %zu kept, sphere %zu of %zu replaced\n",
            cube_kept, nc, sphere_moved, ns);
-    CHECK(cube_kept >= nc * 9 / 10 && sphere_moved >= ns * 9 / 10);
+    CHECK(cube_kept >= nc * 8 / 10 && sphere_moved >= ns * 9 / 10);
     free(alone);
     free(plain);
     free(chosen);

@@ -25,9 +25,9 @@
 #include <string.h>
 
 #define FLAT_ANGLE (2.0 * 3.14159265358979323846 / 180)
-#define SHARE_LOW 0.35
-#define SHARE_HIGH 0.65
-#define SHARE_SPREAD 3
+#define SHARE_LOW 0.2
+#define SHARE_HIGH 0.8
+#define SHARE_SPREAD 6
 #define DISCREPANCY_MAX_ITERATIONS 40 /* tuned Taubin needed 5-50 on the calibration meshes; at
                                      * high noise the move saturates below the level and more
                                      * iterations only shrink detail (the Stanford bunny at 0.5:

@@ -108,9 +108,12 @@ def test_region_choice_against_numpy():
     expected, share = blend(v, filtered, taubin, f, level, *LIBRARY)
     unit = rsmooth.mean_edge_length(v, f)
     assert np.abs(chosen - expected).max() < 1e-9 * unit
-    on_box = np.all(chosen[: len(bv)] == filtered[: len(bv)], axis=1).mean()
+    # the box's vertices lean to the filter's result, the ball's are Taubin's
+    to_f = np.linalg.norm(chosen - filtered, axis=1)
+    to_t = np.linalg.norm(chosen - taubin, axis=1)
+    on_box = np.mean(to_f[: len(bv)] < to_t[: len(bv)])
     on_ball = np.all(chosen[len(bv):] == taubin[len(bv):], axis=1).mean()
-    assert on_box > 0.5 and on_ball > 0.9, (on_box, on_ball)  # (the box is coarse: 10 x 10)
+    assert on_box > 0.7 and on_ball > 0.9, (on_box, on_ball)  # (a coarse box: 10 x 10)
 
 
 def test_discrepancy_iterations_in_the_report():
