@@ -30,13 +30,15 @@ The classes' bounds are fixed in advance, not fitted."""
 import argparse
 import json
 import os
-import re
 import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from concurrent.futures import ThreadPoolExecutor
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import calibrate  # noqa: E402  (its run, estimate and load)
+from calibrate import load  # noqa: E402
 
 # (cycles, vertex updates per cycle): from a few long cycles to the authors' many short ones
 SCHEDULES = [(2, 10), (3, 10), (5, 10), (10, 10), (20, 10), (40, 5), (100, 2)]
@@ -73,33 +75,15 @@ def key(opts):
 
 
 def run_one(rsmooth, case, opts):
+    """calibrate.py's run, in a folder of its own (two run at a time)."""
     with tempfile.TemporaryDirectory() as tmp:
-        out = os.path.join(tmp, "out.obj")
-        t0 = time.perf_counter()
-        p = subprocess.run([rsmooth, case["noisy"], "-o", out, "-f", "-q"] + opts,
-                           capture_output=True, text=True)
-        wall = time.perf_counter() - t0
-        if p.returncode != 0:
-            return {"error": p.stderr.strip()[-300:]}
-        c = subprocess.run([rsmooth, "compare", out, case["truth"], "--json"],
-                           capture_output=True, text=True, check=True)
-        m = json.loads(c.stdout)
-        return {"ev": m["ev"], "theta": m["theta"], "s": round(wall, 3)}
+        return calibrate.run_one(rsmooth, case, opts, tmp)
 
 
 def estimate(rsmooth, case):
     """rsmooth's noise estimate of a case and its kind, as --auto prints them."""
     with tempfile.TemporaryDirectory() as tmp:
-        p = subprocess.run([rsmooth, case["noisy"], "-o", os.path.join(tmp, "e.obj"), "-f",
-                            "--auto"], capture_output=True, text=True)
-    m = re.search(r"noise estimate ([0-9.eE+-]+)", p.stderr)
-    if not m:
-        sys.exit("calibrate_stage.py: no estimate for %s: %s" % (case["name"], p.stderr))
-    return float(m.group(1)), "impulsive" if "impulsive" in p.stderr else "gaussian"
-
-
-def load(path):
-    return json.load(open(path)) if os.path.exists(path) else {}
+        return calibrate.estimate(rsmooth, case, tmp)
 
 
 def measure(args, cases, settings):

@@ -113,7 +113,8 @@ static double local_edge(const rs_adjacency *adj, const rs_facets *facets,
     return n ? sum / (double)n : 0;
 }
 
-double rs_region_weight(double share) {
+/* The filter's weight for a vertex whose neighbourhood has this flat share (NaN: no pairs). */
+static double region_weight(double share) {
     if (isnan(share))
         return 1; /* no two facets share an edge here: nothing says curved */
     double w = (share - SHARE_LOW) / (SHARE_HIGH - SHARE_LOW);
@@ -153,7 +154,7 @@ int rs_region_choice(rsmooth_scalar scalar, const void *positions, size_t vertex
     }
     for (size_t v = 0; ok && low && v < vertex_count; v++) {
         uint32_t r = adj.rep[v];
-        double w = rs_region_weight(share[r]), x[3];
+        double w = region_weight(share[r]), x[3];
         weight_sum += w;
         for (int k = 0; k < 3; k++)
             x[k] = w * filtered[3 * v + k] + (1 - w) * low[3 * v + k];

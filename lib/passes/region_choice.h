@@ -4,9 +4,6 @@
 
 #include "core/rsmooth_internal.h"
 
-/* The filter's weight for a vertex whose neighbourhood has this flat share (NaN: no pairs). */
-double rs_region_weight(double share);
-
 /* Blends the filter's result in out_positions with Taubin's smoothing of `positions` run to
  * `level` mean edge lengths (and, min_gain > 0, until an iteration adds less than min_gain mean edge
  * lengths to the move), per vertex, and limits boundary vertices' moves to that level.

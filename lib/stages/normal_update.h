@@ -37,13 +37,6 @@ bool rs_adjacency_build(rs_adjacency *adj, const double *xyz, size_t vertex_coun
                         const uint32_t *indices, const rs_facets *facets);
 void rs_adjacency_free(rs_adjacency *adj);
 
-/* The share of the pairs of facets sharing an edge (welded) whose normals are within max_angle
- * (radians) of each other: near 1 on a mesh of flat parts and creases (a machined part), low on
- * one curved at the scale of its triangles. 1 when no facets share an edge; -1 when out of
- * memory. */
-double rs_flat_share(const double *xyz, size_t vertex_count, const uint32_t *indices,
-                     size_t triangle_count, double max_angle);
-
 /* The guided filter's reach by default, in mean distances between the centroids of facets
  * sharing an edge (the authors' setting). */
 #define RS_GUIDED_RADIUS_DEFAULT 2.0
