@@ -113,6 +113,15 @@ void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read,
     printf("\"radius\":%.9g,\"grid_cells\":%zu,\"pairs_robust\":%llu,\"tiles\":%zu,\"device\":", r->radius,
            r->grid_cell_count, (unsigned long long)r->pairs_robust, r->tiles);
     cli_print_json_string(r->device);
+    if (r->stage_cycles > 0) /* the normal-update stage: where it ran, its parts, its traffic */
+        printf(",\"stage\":{\"on_device\":%s,\"float_bits\":%d,\"cycles\":%d,"
+               "\"bytes_to_device\":%llu,"
+               "\"bytes_from_device\":%llu,\"ms\":{\"lists\":%.3f,\"upload\":%.3f,"
+               "\"cycles\":%.3f,\"download\":%.3f,\"total\":%.3f}}",
+               r->stage_on_device ? "true" : "false", r->stage_float_bits, r->stage_cycles,
+               (unsigned long long)r->stage_bytes_to_device,
+               (unsigned long long)r->stage_bytes_from_device, r->ms_stage_lists,
+               r->ms_stage_upload, r->ms_stage_cycles, r->ms_stage_download, r->ms_stage);
     printf(",\"ms\":{\"read\":%.3f,\"setup\":%.3f,\"facets\":%.3f,\"grid\":%.3f,\"upload\":%.3f,"
            "\"mollify\":%.3f,\"normals\":%.3f,\"robust\":%.3f,\"download\":%.3f,\"filter\":%.3f,"
            "\"write\":%.3f}}\n",

@@ -361,7 +361,7 @@ static void test_cycles_against_brute_force(void) {
     memcpy(lib, cube.xyz, n * sizeof(double));
     memcpy(brute, cube.xyz, n * sizeof(double));
     CHECK_STATUS(rs_normal_update_stage(lib, nv, cube.indices, cube.triangle_count, &setting, NULL,
-                                        NULL, NULL, NULL, "test"), RSMOOTH_OK);
+                                        NULL, NULL, NULL, NULL, NULL, "test"), RSMOOTH_OK);
     rs_facets input, now;
     CHECK(rs_facets_build(&input, cube.xyz, cube.indices, cube.triangle_count));
     double *normals = malloc(input.count * 3 * sizeof(double));
@@ -384,7 +384,8 @@ static void test_cycles_against_brute_force(void) {
     memcpy(brute, cube.xyz, n * sizeof(double));
     for (int c = 0; c < setting.cycles; c++)
         CHECK_STATUS(rs_normal_update_stage(brute, nv, cube.indices, cube.triangle_count, &one,
-                                            NULL, NULL, NULL, NULL, "test"), RSMOOTH_OK);
+                                            NULL, NULL, NULL, NULL, NULL, NULL, "test"),
+                     RSMOOTH_OK);
     CHECK(max_gap(lib, brute, n) > 0);
     rs_facets_free(&input);
     free(normals);

@@ -4,6 +4,7 @@
  * The reference path's entry point is rsmooth_smooth_reference (reference/reference.c). */
 #include "opencl/cl_run.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 /* One pass of the filter on the device (rs_filter_passes repeats it). */
@@ -52,8 +53,20 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     rsmooth_status entered = rs_context_enter(ctx, "rsmooth_smooth", error);
     if (entered != RSMOOTH_OK)
         return entered;
+    /* the normal-update stage's cycles on the device too, unless RSMOOTH_STAGE=host asks for
+     * the host's (double precision: the comparison the benchmarks and tests make) */
+    const char *stage_env = getenv("RSMOOTH_STAGE");
+    if (stage_env && *stage_env && strcmp(stage_env, "host") != 0 &&
+        strcmp(stage_env, "device") != 0) {
+        rs_context_unlock(ctx);
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_smooth",
+                       "RSMOOTH_STAGE is \"%s\": use device (the default: the normal-update "
+                       "stage on the OpenCL device) or host (on the host's cores, in double)",
+                       stage_env);
+    }
+    rs_stage_runner stage = stage_env && strcmp(stage_env, "host") == 0 ? NULL : rs_cl_stage_run;
     size_t threads_before = rs_set_call_threads(ctx->host_threads);
-    rsmooth_status st = rs_filter_passes(cl_pass, ctx, scalar, positions, vertex_count, indices,
+    rsmooth_status st = rs_filter_passes(cl_pass, stage, ctx, scalar, positions, vertex_count, indices,
                                          triangle_count, params, out_positions, out_weight,
                                          out_confidence, report, error, "rsmooth_smooth");
     rs_set_call_threads(threads_before);

@@ -426,10 +426,24 @@ typedef rsmooth_status (*rs_filter_fn)(void *ctx, rsmooth_scalar scalar, const v
                                        float *out_confidence, rsmooth_report *report,
                                        rsmooth_error *error);
 
+/* The normal-update stage's plan and figures (stage_plan.h). */
+typedef struct rs_stage_plan rs_stage_plan;
+typedef struct rs_stage_stats rs_stage_stats;
+/* Called after each cycle with the cycles done; non-zero stops the stage (RSMOOTH_CANCELLED). */
+typedef int (*rs_cycle_fn)(void *user, int done, int cycles);
+/* Runs every cycle of `plan` elsewhere (the device: opencl/cl_stage.c), writing the final
+ * positions (the stage's units) to xyz. A runner that cannot take the plan (too large for its
+ * device) returns RSMOOTH_ERROR_OUT_OF_MEMORY having changed nothing: the host runs it then. */
+typedef rsmooth_status (*rs_stage_runner)(void *ctx, const rs_stage_plan *plan, double *xyz,
+                                          rs_cycle_fn cycle_done, void *user,
+                                          rs_stage_stats *stats, rsmooth_error *error);
+
 /* Runs `one_pass` params->passes times (once, unchanged, when passes is 1), each pass from the
- * previous pass's positions with the sigmas of the input, honouring pass_confidence. The caller's
- * outputs are written only when every pass succeeded. */
-rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar scalar,
+ * previous pass's positions with the sigmas of the input, honouring pass_confidence; the
+ * normal-update stage before them, if params ask for it, through `stage` (NULL: on the host),
+ * both with `ctx`. The caller's outputs are written only when every pass succeeded. */
+rsmooth_status rs_filter_passes(rs_filter_fn one_pass, rs_stage_runner stage, void *ctx,
+                                rsmooth_scalar scalar,
                                 const void *positions, size_t vertex_count,
                                 const uint32_t *indices, size_t triangle_count,
                                 const rsmooth_params *params, void *out_positions,

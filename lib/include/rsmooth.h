@@ -462,6 +462,21 @@ typedef struct rsmooth_report {
     double region_filter_share;   /**< that choice's mean weight of the filter's result over the
                                    * vertices (1: the filter's result everywhere, 0: Taubin's);
                                    * 0 when discrepancy_iterations is 0 (added in 0.11) */
+    /** @name The normal-update stage (the best mode's; added in 0.12)
+     * Its whole time is also in ms_normals. 0 when the call ran no stage. @{ */
+    double ms_stage;              /**< the whole stage */
+    double ms_stage_lists;        /**< facets, adjacency and the guided filter's lists (host) */
+    double ms_stage_upload;       /**< the lists and the input to the device */
+    double ms_stage_cycles;       /**< every cycle (on the device, or on the host) */
+    double ms_stage_download;     /**< the positions back */
+    int stage_cycles;             /**< cycles run */
+    int stage_on_device;          /**< 1: the cycles ran on the call's OpenCL device; 0: host */
+    int stage_float_bits;         /**< their precision: 64 (the host; a device with fp64, by
+                                   * default), 32 (RSMOOTH_STAGE_PRECISION=float, or a device
+                                   * without fp64) */
+    uint64_t stage_bytes_to_device;   /**< bytes the stage copied to the device */
+    uint64_t stage_bytes_from_device; /**< and back */
+    /** @} */
 } rsmooth_report;
 
 /** Zeroes `report` and sets its struct_size. Accepts NULL. (Added in 0.5) */

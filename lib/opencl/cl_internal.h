@@ -16,12 +16,19 @@
 #include <stdatomic.h>
 
 
+/* The normal-update stage's kernels (stage.cl, cl_stage.c), in this order in each precision. */
+enum { RS_STAGE_FACETS, RS_STAGE_PATCH, RS_STAGE_GUIDANCE, RS_STAGE_FILTER, RS_STAGE_VERTEX,
+       RS_STAGE_KERNELS };
+
 enum {
     RS_KERNEL_MOLLIFY,
     RS_KERNEL_NORMALS,
     RS_KERNEL_BILATERAL,
     RS_KERNEL_ROBUST,
-    RS_KERNEL_COUNT
+    RS_KERNEL_STAGE_FLOAT,  /* RS_STAGE_KERNELS of them, float */
+    RS_KERNEL_STAGE_DOUBLE = RS_KERNEL_STAGE_FLOAT + RS_STAGE_KERNELS, /* double: NULL where the
+                                                                       * device has no fp64 */
+    RS_KERNEL_COUNT = RS_KERNEL_STAGE_DOUBLE + RS_STAGE_KERNELS
 };
 
 struct rsmooth_context {
@@ -133,6 +140,11 @@ double rs_halo_radius(const rs_problem *pb, double reach);
  * facet data was ready). */
 void rs_cl_report(rsmooth_report *report, const rs_problem *pb, const rs_run_stats *stats,
                   const char *device, double t_start, double t_facets);
+
+/* The normal-update stage's cycles on ctx's device (cl_stage.c): an rs_stage_runner. */
+rsmooth_status rs_cl_stage_run(void *ctx, const rs_stage_plan *plan, double *xyz,
+                               rs_cycle_fn cycle_done, void *user, rs_stage_stats *stats,
+                               rsmooth_error *error);
 
 /* Builds the program from the embedded kernels (or RSMOOTH_KERNEL_DIR) and creates the kernels. */
 rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error);

@@ -44,6 +44,9 @@
     X(cl_int, EnqueueNDRangeKernel,                                                                \
       (cl_command_queue, cl_kernel, cl_uint, const size_t *, const size_t *, const size_t *,       \
        cl_uint, const cl_event *, cl_event *))                                                     \
+    X(cl_int, EnqueueCopyBuffer,                                                                   \
+      (cl_command_queue, cl_mem, cl_mem, size_t, size_t, size_t, cl_uint, const cl_event *,       \
+       cl_event *))                                                                                \
     X(cl_int, EnqueueReadBuffer,                                                                   \
       (cl_command_queue, cl_mem, cl_bool, size_t, size_t, void *, cl_uint, const cl_event *,      \
        cl_event *))                                                                                \
@@ -103,6 +106,7 @@ rsmooth_status rs_cl_load(const char *where, rsmooth_error *error);
 #define clCreateProgramWithSource rs_cl_api.CreateProgramWithSource
 #define clEnqueueMapBuffer rs_cl_api.EnqueueMapBuffer
 #define clEnqueueNDRangeKernel rs_cl_api.EnqueueNDRangeKernel
+#define clEnqueueCopyBuffer rs_cl_api.EnqueueCopyBuffer
 #define clEnqueueReadBuffer rs_cl_api.EnqueueReadBuffer
 #define clEnqueueUnmapMemObject rs_cl_api.EnqueueUnmapMemObject
 #define clEnqueueWriteBuffer rs_cl_api.EnqueueWriteBuffer

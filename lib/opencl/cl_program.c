@@ -9,12 +9,26 @@
 #include <string.h>
 
 extern const unsigned char rs_kernel_common[], rs_kernel_mollify[], rs_kernel_bilateral[],
-    rs_kernel_estimate[];
+    rs_kernel_estimate[], rs_kernel_stage[];
 extern const size_t rs_kernel_common_size, rs_kernel_mollify_size, rs_kernel_bilateral_size,
-    rs_kernel_estimate_size;
+    rs_kernel_estimate_size, rs_kernel_stage_size;
 
 /* The kernel files in the order they are compiled, after the prelude and the device's shape. */
-#define KERNEL_FILES 4
+#define KERNEL_FILES 5
+/* The strings compiled: the prelude, the device's shape, the files, and stage.cl's second copy
+ * with the definitions before each copy and the end of the double one's #if. */
+#define SOURCES (KERNEL_FILES + 6)
+
+/* stage.cl's types and kernel names, per copy (kernels/stage.cl) */
+static const char stage_float[] =
+    "#define REAL float\n#define REAL3 float3\n#define REAL4 float4\n"
+    "#define STAGE_NAME(name) name##_f\n";
+static const char stage_double[] =
+    "#undef REAL\n#undef REAL3\n#undef REAL4\n#undef STAGE_NAME\n#ifdef cl_khr_fp64\n"
+    "#pragma OPENCL EXTENSION cl_khr_fp64 : enable\n"
+    "#define REAL double\n#define REAL3 double3\n#define REAL4 double4\n"
+    "#define STAGE_NAME(name) name##_d\n";
+static const char stage_end[] = "\n#endif\n";
 
 /* Constants the host and kernels must agree on. Runtime values (sigmas, counts) are kernel
  * arguments, so changing them never rebuilds the program. */
@@ -61,17 +75,18 @@ static char *read_text_file(const char *dir, const char *name, size_t *size) {
 
 static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *error) {
     static const char *const names[KERNEL_FILES] = {"common.cl", "mollify.cl", "bilateral.cl",
-                                                    "estimate.cl"};
+                                                    "estimate.cl", "stage.cl"};
     /* the variant this device runs (cl_variant.c): its vector width and work-group size */
     char shape[96];
     snprintf(shape, sizeof shape, "#define RS_LANES %u\n#define RS_GROUP %zu\n", ctx->lanes,
              ctx->local_size);
-    const char *sources[KERNEL_FILES + 2] = {
+    const char *sources[SOURCES] = {
         prelude, shape, (const char *)rs_kernel_common, (const char *)rs_kernel_mollify,
-        (const char *)rs_kernel_bilateral, (const char *)rs_kernel_estimate};
-    size_t sizes[KERNEL_FILES + 2] = {sizeof prelude - 1, strlen(shape), rs_kernel_common_size,
-                                      rs_kernel_mollify_size, rs_kernel_bilateral_size,
-                                      rs_kernel_estimate_size};
+        (const char *)rs_kernel_bilateral, (const char *)rs_kernel_estimate,
+        (const char *)rs_kernel_stage};
+    size_t sizes[SOURCES] = {sizeof prelude - 1, strlen(shape), rs_kernel_common_size,
+                             rs_kernel_mollify_size, rs_kernel_bilateral_size,
+                             rs_kernel_estimate_size, rs_kernel_stage_size};
     char *loaded[KERNEL_FILES] = {NULL};
     rsmooth_status st = RSMOOTH_OK;
     const char *dir = getenv("RSMOOTH_KERNEL_DIR");
@@ -86,6 +101,16 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
             sources[i + 2] = loaded[i];
         }
     }
+    /* stage.cl, the last file, twice: in float, and in double where the device has it */
+    const char *stage = sources[KERNEL_FILES + 1];
+    size_t stage_size = sizes[KERNEL_FILES + 1];
+    const char *const tail[5] = {stage_float, stage, stage_double, stage, stage_end};
+    const size_t tail_sizes[5] = {sizeof stage_float - 1, stage_size, sizeof stage_double - 1,
+                                  stage_size, sizeof stage_end - 1};
+    for (int i = 0; i < 5; i++) {
+        sources[KERNEL_FILES + 1 + i] = tail[i];
+        sizes[KERNEL_FILES + 1 + i] = tail_sizes[i];
+    }
 
     double t0 = rs_now_ms();
     cl_int err = CL_SUCCESS;
@@ -95,7 +120,7 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
     /* rsmooth's binary cache (cl_program_cache.c), keyed by exactly the sources and options the
      * build from source below takes */
     rs_program_cache cache;
-    ctx->program_cache = rs_program_cache_open(&cache, ctx, KERNEL_FILES + 2, sources, sizes,
+    ctx->program_cache = rs_program_cache_open(&cache, ctx, SOURCES, sources, sizes,
                                                options)
                              ? RS_PROGRAM_CACHE_MISS
                              : RS_PROGRAM_CACHE_OFF;
@@ -105,7 +130,7 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
     }
     if (cache.refused)
         ctx->program_cache = RS_PROGRAM_CACHE_REFUSED;
-    ctx->program = clCreateProgramWithSource(ctx->context, KERNEL_FILES + 2, sources, sizes, &err);
+    ctx->program = clCreateProgramWithSource(ctx->context, SOURCES, sources, sizes, &err);
     if (err != CL_SUCCESS) {
         st = rs_cl_fail(error, err, "clCreateProgramWithSource", ctx->device_name);
         goto done;
@@ -137,9 +162,23 @@ kernels:;
         [RS_KERNEL_MOLLIFY] = "mollify_block",
         [RS_KERNEL_NORMALS] = "mollified_facet_normal",
         [RS_KERNEL_BILATERAL] = "bilateral_cell_normals",
-        [RS_KERNEL_ROBUST] = "robust_block"};
+        [RS_KERNEL_ROBUST] = "robust_block",
+        [RS_KERNEL_STAGE_FLOAT + RS_STAGE_FACETS] = "stage_facets_f",
+        [RS_KERNEL_STAGE_FLOAT + RS_STAGE_PATCH] = "stage_patch_f",
+        [RS_KERNEL_STAGE_FLOAT + RS_STAGE_GUIDANCE] = "stage_guidance_f",
+        [RS_KERNEL_STAGE_FLOAT + RS_STAGE_FILTER] = "stage_filter_f",
+        [RS_KERNEL_STAGE_FLOAT + RS_STAGE_VERTEX] = "stage_vertex_f",
+        [RS_KERNEL_STAGE_DOUBLE + RS_STAGE_FACETS] = "stage_facets_d",
+        [RS_KERNEL_STAGE_DOUBLE + RS_STAGE_PATCH] = "stage_patch_d",
+        [RS_KERNEL_STAGE_DOUBLE + RS_STAGE_GUIDANCE] = "stage_guidance_d",
+        [RS_KERNEL_STAGE_DOUBLE + RS_STAGE_FILTER] = "stage_filter_d",
+        [RS_KERNEL_STAGE_DOUBLE + RS_STAGE_VERTEX] = "stage_vertex_d"};
     for (int k = 0; k < RS_KERNEL_COUNT; k++) {
         ctx->kernels[k] = clCreateKernel(ctx->program, kernel_names[k], &err);
+        if (err != CL_SUCCESS && k >= RS_KERNEL_STAGE_DOUBLE) { /* a device without fp64 */
+            ctx->kernels[k] = NULL;
+            continue;
+        }
         if (err != CL_SUCCESS) {
             st = rs_cl_fail(error, err, "clCreateKernel", kernel_names[k]);
             goto done;
@@ -158,6 +197,8 @@ static size_t kernels_group_limit(const rsmooth_context *ctx) {
     size_t limit = SIZE_MAX;
     for (int k = 0; k < RS_KERNEL_COUNT; k++) {
         size_t size = 0;
+        if (!ctx->kernels[k]) /* a precision the device does not have */
+            continue;
         if (clGetKernelWorkGroupInfo(ctx->kernels[k], ctx->device, CL_KERNEL_WORK_GROUP_SIZE,
                                      sizeof size, &size, NULL) != CL_SUCCESS)
             return 0;
@@ -174,7 +215,8 @@ rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error) {
     size_t limit = st == RSMOOTH_OK && ctx->lanes == 1 ? kernels_group_limit(ctx) : 0;
     if (limit > 0 && limit < ctx->local_size) {
         for (int k = 0; k < RS_KERNEL_COUNT; k++) {
-            clReleaseKernel(ctx->kernels[k]);
+            if (ctx->kernels[k])
+                clReleaseKernel(ctx->kernels[k]);
             ctx->kernels[k] = NULL;
         }
         clReleaseProgram(ctx->program);

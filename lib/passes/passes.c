@@ -4,6 +4,7 @@
  * edge length gave, so later passes do not shrink their reach as the mesh smooths. */
 #include "passes/region_choice.h"
 #include "stages/normal_update.h"
+#include "core/stage_plan.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -53,7 +54,8 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                                     const rsmooth_params *params, void *out_positions,
                                     float *out_weight, float *out_confidence,
                                     rsmooth_report *report, rsmooth_error *error,
-                                    const char *where, rsmooth_params *resolved);
+                                    const char *where, rsmooth_params *resolved,
+                                    const rs_stage_place *stage, rs_stage_stats *stage_stats);
 
 /* The stage's progress: the cycles done, as a fraction of the stage's half. */
 static int report_cycle(void *user, int done, int cycles) {
@@ -68,7 +70,8 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                                     const rsmooth_params *resolved, void *out_positions,
                                     float *out_weight, float *out_confidence,
                                     rsmooth_report *report, rsmooth_error *error,
-                                    const char *where) {
+                                    const char *where, const rs_stage_place *stage,
+                                    rs_stage_stats *stage_stats) {
     double t_start = rs_now_ms();
     rsmooth_status st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices,
                                              triangle_count, NULL, error, where);
@@ -101,8 +104,8 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                                 p.guided_rounds, p.vertex_updates, p.stage_repeats};
     if (unit > 0) /* no edge: nothing to filter */
         st = rs_normal_update_stage(staged, vertex_count, indices, triangle_count, &setting,
-                                    p.move_mask, reports ? report_cycle : NULL, &pp, error,
-                                    where);
+                                    p.move_mask, stage, reports ? report_cycle : NULL, &pp,
+                                    stage_stats, error, where);
     double t_stage = rs_now_ms();
     if (st == RSMOOTH_OK && p.passes == 0) { /* the stage alone */
         for (size_t v = 0; v < vertex_count; v++) {
@@ -117,8 +120,11 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
             report->vertex_count = vertex_count;
             report->triangle_count = triangle_count;
             report->mean_edge_length = unit;
-            snprintf(report->device, sizeof report->device, "host (double, %zu threads)",
-                     rs_host_threads());
+            if (stage_stats && stage_stats->device[0])
+                snprintf(report->device, sizeof report->device, "%.127s", stage_stats->device);
+            else
+                snprintf(report->device, sizeof report->device, "host (double, %zu threads)",
+                         rs_host_threads());
         }
     } else if (st == RSMOOTH_OK) {
         /* the passes read the stage's result in the caller's type (a float32 caller's outputs
@@ -140,7 +146,7 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
         rsmooth_params unused;
         st = filter_passes(one_pass, ctx, scalar, from, vertex_count, indices, triangle_count, &p,
                            out_positions, out_weight, out_confidence, report, error, where,
-                           &unused);
+                           &unused, NULL, NULL);
     }
     if (st == RSMOOTH_OK && report) {
         report->ms_normals += t_stage - t_start; /* the stage counts as normal filtering */
@@ -157,7 +163,8 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                                     const rsmooth_params *params, void *out_positions,
                                     float *out_weight, float *out_confidence,
                                     rsmooth_report *report, rsmooth_error *error,
-                                    const char *where, rsmooth_params *resolved) {
+                                    const char *where, rsmooth_params *resolved,
+                                    const rs_stage_place *stage, rs_stage_stats *stage_stats) {
     double t_start = rs_now_ms();
     rs_error_clear(error);
     rsmooth_params p;
@@ -171,7 +178,7 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
     if (p.vertex_updates > 0)
         return staged_passes(one_pass, ctx, scalar, positions, vertex_count, indices,
                              triangle_count, &p, out_positions, out_weight, out_confidence,
-                             report, error, where);
+                             report, error, where, stage, stage_stats);
     if (p.passes == 1) /* the paper's single pass, exactly as it was */
         return one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, params,
                         out_positions, out_weight, out_confidence, report, error);
@@ -271,22 +278,43 @@ done:
     return st;
 }
 
+/* The stage's figures into the report (a caller's report new enough to have them). */
+static void report_stage(rsmooth_report *report, const rs_stage_stats *stats) {
+    report->ms_stage_lists = stats->ms_lists;
+    report->ms_stage_upload = stats->ms_upload;
+    report->ms_stage_cycles = stats->ms_cycles;
+    report->ms_stage_download = stats->ms_download;
+    report->ms_stage = stats->ms_lists + stats->ms_upload + stats->ms_cycles + stats->ms_download;
+    report->stage_cycles = stats->cycles;
+    report->stage_on_device = stats->on_device;
+    report->stage_float_bits = stats->float_bits;
+    report->stage_bytes_to_device = stats->bytes_to_device;
+    report->stage_bytes_from_device = stats->bytes_from_device;
+}
+
 /* The passes, then the last check of what they wrote (results.c): never a non-finite OK. */
-rsmooth_status rs_filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar scalar,
-                                const void *positions, size_t vertex_count,
+rsmooth_status rs_filter_passes(rs_filter_fn one_pass, rs_stage_runner stage, void *ctx,
+                                rsmooth_scalar scalar, const void *positions, size_t vertex_count,
                                 const uint32_t *indices, size_t triangle_count,
                                 const rsmooth_params *params, void *out_positions,
                                 float *out_weight, float *out_confidence, rsmooth_report *report,
                                 rsmooth_error *error, const char *where) {
     size_t caller_size = report ? report->struct_size : 0; /* the report's fillers reset it */
     rsmooth_params p;
+    rs_stage_place place = {stage, ctx};
+    rs_stage_stats stage_stats;
+    memset(&stage_stats, 0, sizeof stage_stats);
     rsmooth_status st = filter_passes(one_pass, ctx, scalar, positions, vertex_count, indices,
                                       triangle_count, params, out_positions, out_weight,
-                                      out_confidence, report, error, where, &p);
+                                      out_confidence, report, error, where, &p, &place,
+                                      &stage_stats);
     if (report)
         report->struct_size = caller_size;
     if (st != RSMOOTH_OK)
         return st;
+    if (report && caller_size >= offsetof(rsmooth_report, stage_bytes_from_device) +
+                                     sizeof report->stage_bytes_from_device)
+        report_stage(report, &stage_stats);
     if (p.discrepancy_level > 0 && vertex_count > 0) {
         double share = 0;
         int iterations = rs_region_choice(scalar, positions, vertex_count, indices,

@@ -417,7 +417,7 @@ rsmooth_status rsmooth_smooth_reference(rsmooth_scalar scalar, const void *posit
                                         void *out_positions, float *out_weight,
                                         float *out_confidence, rsmooth_report *report,
                                         rsmooth_error *error) {
-    return rs_filter_passes(reference_pass, NULL, scalar, positions, vertex_count, indices,
+    return rs_filter_passes(reference_pass, NULL, NULL, scalar, positions, vertex_count, indices,
                             triangle_count, params, out_positions, out_weight, out_confidence,
                             report, error, "rsmooth_smooth_reference");
 }

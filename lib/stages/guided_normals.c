@@ -373,3 +373,16 @@ bool rs_guided_normals(const rs_facets *facets, const rs_adjacency *adj, const u
     rs_guided_destroy(g);
     return true;
 }
+
+void rs_guided_describe(const rs_guided *g, rs_stage_plan *plan) {
+    const guided_lists *l = &g->job.lists;
+    plan->patch_start = l->patch_start;
+    plan->patch = l->patch;
+    plan->edge_start = l->edge_start;
+    plan->edge = l->edge;
+    plan->near_start = l->near_start;
+    plan->near = l->near;
+    plan->filter = g->filter;
+    plan->inv_2s2 = g->job.inv_2s2;
+    plan->inv_2t2 = g->job.inv_2t2;
+}

@@ -4,14 +4,70 @@
 #include "stages/normal_update.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
+
+/* The plan of the stage (stage_plan.h) from what the host built, for a runner elsewhere;
+ * facet_vertex (3 per facet) is the caller's to free. false when out of memory. */
+static bool describe(rs_stage_plan *plan, const double *xyz, size_t vertex_count,
+                     const uint32_t *indices, const rs_facets *facets, const rs_adjacency *adj,
+                     const rs_guided *guided, const rs_stage_setting *setting,
+                     const uint8_t *move_mask, uint32_t **facet_vertex) {
+    memset(plan, 0, sizeof *plan);
+    *facet_vertex = rs_alloc_array(facets->count ? facets->count : 1, 3 * sizeof(uint32_t));
+    if (!*facet_vertex)
+        return false;
+    for (size_t f = 0; f < facets->count; f++)
+        memcpy(*facet_vertex + 3 * f, indices + 3 * (size_t)facets->triangle[f],
+               3 * sizeof(uint32_t));
+    plan->vertex_count = vertex_count;
+    plan->facet_count = facets->count;
+    plan->xyz = xyz;
+    plan->facet_vertex = *facet_vertex;
+    plan->facet_normal = facets->normal;
+    plan->facet_area = facets->area;
+    plan->facet_centroid = facets->centroid;
+    plan->rep = adj->rep;
+    plan->rep_start = adj->start;
+    plan->rep_facet = adj->facet;
+    rs_guided_describe(guided, plan);
+    plan->rounds = setting->rounds;
+    plan->updates = setting->updates;
+    plan->cycles = setting->cycles;
+    plan->move_mask = move_mask;
+    return true;
+}
+
+/* The cycles on the runner's device; RSMOOTH_ERROR_OUT_OF_MEMORY from it (a plan too large for
+ * the device) leaves xyz unchanged and the host runs them. */
+static rsmooth_status run_elsewhere(const rs_stage_place *place, double *xyz, size_t vertex_count,
+                                    const uint32_t *indices, const rs_facets *facets,
+                                    const rs_adjacency *adj, const rs_guided *guided,
+                                    const rs_stage_setting *setting, const uint8_t *move_mask,
+                                    rs_cycle_fn cycle_done, void *user, rs_stage_stats *stats,
+                                    rsmooth_error *error) {
+    rs_stage_plan plan;
+    uint32_t *facet_vertex = NULL;
+    if (!describe(&plan, xyz, vertex_count, indices, facets, adj, guided, setting, move_mask,
+                  &facet_vertex))
+        return RSMOOTH_ERROR_OUT_OF_MEMORY;
+    rsmooth_status st = place->runner(place->ctx, &plan, xyz, cycle_done, user, stats, error);
+    rs_free(facet_vertex);
+    return st;
+}
 
 rsmooth_status rs_normal_update_stage(double *xyz, size_t vertex_count, const uint32_t *indices,
                                       size_t triangle_count, const rs_stage_setting *setting,
-                                      const uint8_t *move_mask, rs_cycle_fn cycle_done,
-                                      void *user, rsmooth_error *error, const char *where) {
+                                      const uint8_t *move_mask, const rs_stage_place *place,
+                                      rs_cycle_fn cycle_done, void *user, rs_stage_stats *stats,
+                                      rsmooth_error *error, const char *where) {
+    rs_stage_stats unused;
+    if (!stats)
+        stats = &unused;
+    memset(stats, 0, sizeof *stats);
     if (setting->updates < 1 || setting->cycles < 1 || vertex_count == 0)
         return RSMOOTH_OK;
+    double t_start = rs_now_ms();
     double largest = 0;
     for (size_t i = 0; i < 3 * vertex_count; i++)
         largest = fmax(largest, fabs(xyz[i]));
@@ -33,13 +89,34 @@ rsmooth_status rs_normal_update_stage(double *xyz, size_t vertex_count, const ui
                                   setting->sigma_n, setting->radius);
         ok = normals && guided;
     }
-    for (int c = 0; ok && !cancelled && c < setting->cycles; c++) {
+    stats->ms_lists = rs_now_ms() - t_start;
+    rsmooth_status st = RSMOOTH_OK;
+    bool done = false;
+    if (ok && place && place->runner && facets.count > 0) {
+        st = run_elsewhere(place, xyz, vertex_count, indices, &facets, &adj, guided, setting,
+                           move_mask, cycle_done, user, stats, error);
+        done = st != RSMOOTH_ERROR_OUT_OF_MEMORY;
+        cancelled = st == RSMOOTH_ERROR_CANCELLED;
+        if (!done) /* the host runs it: the runner's refusal is no error */
+            rs_error_clear(error);
+        if (!done || cancelled)
+            st = RSMOOTH_OK;
+    }
+    double t_cycles = rs_now_ms();
+    for (int c = 0; ok && !done && !cancelled && c < setting->cycles; c++) {
         if (c > 0) /* the cycle reads the geometry the one before left */
             rs_facets_update(&facets, xyz, indices);
         rs_guided_step(guided, &facets, setting->rounds, normals);
         ok = rs_vertex_update(xyz, vertex_count, indices, &facets, &adj, normals,
                               setting->updates, move_mask);
+        stats->cycles = c + 1;
         cancelled = ok && cycle_done && cycle_done(user, c + 1, setting->cycles) != 0;
+    }
+    if (!done) {
+        stats->ms_cycles = rs_now_ms() - t_cycles;
+        stats->float_bits = 64;
+        snprintf(stats->device, sizeof stats->device, "host (double, %zu threads)",
+                 rs_host_threads());
     }
     rs_guided_destroy(guided);
     rs_free(normals);
@@ -50,6 +127,8 @@ rsmooth_status rs_normal_update_stage(double *xyz, size_t vertex_count, const ui
         xyz[i] *= unscale;
     if (cancelled)
         return rs_cancelled(error, where);
+    if (st != RSMOOTH_OK)
+        return st;
     return ok ? RSMOOTH_OK
               : rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where,
                         "out of memory in the normal update stage");

@@ -5,7 +5,7 @@
 #ifndef RSMOOTH_NORMAL_UPDATE_H
 #define RSMOOTH_NORMAL_UPDATE_H
 
-#include "core/rsmooth_internal.h"
+#include "core/stage_plan.h"
 
 /* The triangles of non-zero area of a mesh, with their geometry. */
 typedef struct rs_facets {
@@ -54,6 +54,8 @@ rs_guided *rs_guided_create(const rs_facets *facets, const rs_adjacency *adj,
  * per facet to `normals`. */
 void rs_guided_step(rs_guided *g, const rs_facets *facets, int rounds, double *normals);
 void rs_guided_destroy(rs_guided *g);
+/* Fills the plan's guided fields (lists, widths, whether it filters) from g. */
+void rs_guided_describe(const rs_guided *g, rs_stage_plan *plan);
 
 /* Create, one step, destroy, at the default radius. false when out of memory. */
 bool rs_guided_normals(const rs_facets *facets, const rs_adjacency *adj, const uint32_t *indices,
@@ -75,13 +77,19 @@ typedef struct rs_stage_setting {
     int rounds, updates, cycles;
 } rs_stage_setting;
 
-/* Called after each cycle with the cycles done; non-zero stops the stage (RSMOOTH_CANCELLED). */
-typedef int (*rs_cycle_fn)(void *user, int done, int cycles);
+/* Where the stage's cycles run: `runner` with `ctx` (the device), or the host when runner is
+ * NULL or cannot take the plan. */
+typedef struct rs_stage_place {
+    rs_stage_runner runner;
+    void *ctx;
+} rs_stage_place;
 
-/* The whole stage on `xyz` (double, in place). Vertices whose move_mask byte is 0 stay. */
+/* The whole stage on `xyz` (double, in place). Vertices whose move_mask byte is 0 stay. `place`
+ * may be NULL (the host); `stats` (may be NULL) gets what it measured. */
 rsmooth_status rs_normal_update_stage(double *xyz, size_t vertex_count, const uint32_t *indices,
                                       size_t triangle_count, const rs_stage_setting *setting,
-                                      const uint8_t *move_mask, rs_cycle_fn cycle_done,
-                                      void *user, rsmooth_error *error, const char *where);
+                                      const uint8_t *move_mask, const rs_stage_place *place,
+                                      rs_cycle_fn cycle_done, void *user, rs_stage_stats *stats,
+                                      rsmooth_error *error, const char *where);
 
 #endif /* RSMOOTH_NORMAL_UPDATE_H */
