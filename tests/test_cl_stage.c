@@ -3,8 +3,8 @@
  * class's shipped schedule and at more rounds, on a sharp cube, a sphere, an open plane (its rim),
  * a triangle soup (welded corners), with a move mask, and on ../shared's benchmark meshes when
  * present. Every case within 1e-3 mean edge lengths per vertex, for both kernel variants (CPU
- * blocks, GPU groups), bit-identical when rerun; float32 over many cycles measured against the
- * cycle count (the drift); a stage too large for the device's budget runs on the host and equals
+ * blocks, GPU groups), bit-identical when rerun, in double (the default where the device has
+ * fp64) and in float32; both measured against the cycle count up to 1000 (the drift); a stage too large for the device's budget runs on the host and equals
  * the reference bit for bit; a cancel after a cycle stops it. */
 #define _POSIX_C_SOURCE 200809L
 #include "mesh_shapes.h"
@@ -94,6 +94,7 @@ static void compare(rsmooth_context *const variants[2], const char *mesh, const 
         cl[i] = run(variants[i], m, p, &r[i]);
         dev[i] = max_deviation(cl[i], ref, nv, edge);
         CHECK(r[i].stage_on_device == 1 && r[i].stage_cycles == p->stage_repeats);
+        CHECK(r[i].stage_bytes_to_device > 0 && r[i].stage_bytes_from_device > 0);
     }
     double *again = run(variants[0], m, p, &again_report);
     bool same = memcmp(again, cl[0], 3 * nv * sizeof *again) == 0;
@@ -127,21 +128,30 @@ static mesh_ref ref_of(const shape_mesh *s) {
     return (mesh_ref){s->xyz, s->vertex_count, s->indices, s->triangle_count};
 }
 
-/* Deviation against the number of cycles (one update each, radius 3): float32 must not drift. */
+/* Deviation against the number of cycles (one update each, radius 3), in float32 and in double:
+ * neither may drift. */
 static void drift(rsmooth_context *ctx, const char *mesh, const mesh_ref *m, int most) {
     rsmooth_params p;
     schedule s = {"drift", 1, 1, 1, 3, 0.2};
-    printf("%s: deviation against cycles (1 update per cycle):", mesh);
+    printf("%s: deviation against cycles (1 update per cycle), float32 / double:", mesh);
     for (int cycles = 1; cycles <= most; cycles *= 10) {
         s.cycles = cycles;
         stage_params(&p, &s);
-        rsmooth_report rr, cr;
-        double *ref = run(NULL, m, &p, &rr), *cl = run(ctx, m, &p, &cr);
-        double dev = max_deviation(cl, ref, m->vertex_count, rr.mean_edge_length);
-        printf("  %d: %.2e", cycles, dev);
-        CHECK_LE(dev, MAX_DEVIATION);
+        rsmooth_report rr, fr, dr;
+        double *ref = run(NULL, m, &p, &rr), *dbl = run(ctx, m, &p, &dr);
+        setenv("RSMOOTH_STAGE_PRECISION", "float", 1);
+        double *flt = run(ctx, m, &p, &fr);
+        unsetenv("RSMOOTH_STAGE_PRECISION");
+        double edge = rr.mean_edge_length;
+        double dev_f = max_deviation(flt, ref, m->vertex_count, edge);
+        double dev_d = max_deviation(dbl, ref, m->vertex_count, edge);
+        printf("  %d: %.2e / %.2e", cycles, dev_f, dev_d);
+        CHECK(fr.stage_float_bits == 32 && dr.stage_float_bits == 64);
+        CHECK_LE(dev_f, MAX_DEVIATION);
+        CHECK_LE(dev_d, MAX_DEVIATION);
         free(ref);
-        free(cl);
+        free(dbl);
+        free(flt);
     }
     printf("\n");
 }
@@ -238,7 +248,8 @@ static void benchmark_meshes(rsmooth_context *const variants[2]) {
 
 int main(void) {
     unsetenv("RSMOOTH_MEMORY_BUDGET");
-    unsetenv("RSMOOTH_STAGE");
+    setenv("RSMOOTH_STAGE", "device", 1); /* a CPU device's default is the host's stage */
+    unsetenv("RSMOOTH_STAGE_PRECISION");
     rsmooth_context *variants[2] = {open_variant("cpu"), open_variant("gpu")};
     bool small = test_small();
     shape_mesh cube, sphere, plane, soup;
@@ -253,6 +264,11 @@ int main(void) {
 
     compare_schedules(variants, "noisy cube", &c, false);
     compare_schedules(variants, "noisy sphere", &s, small);
+    /* float32, what a device without fp64 runs */
+    setenv("RSMOOTH_STAGE_PRECISION", "float", 1);
+    compare_schedules(variants, "cube, float32", &c, false);
+    compare_schedules(variants, "sphere, float32", &s, true);
+    unsetenv("RSMOOTH_STAGE_PRECISION");
     compare_schedules(variants, "open plane", &pl, true);
     compare_schedules(variants, "cube soup", &so, true);
     masked(variants, &c);

@@ -274,6 +274,18 @@ static void run_cases(const char *variant, const test_mesh *m) {
     p.colors = m->colors;
     p.sigma_c = 0.02; /* colours 1 apart: the colour factor underflows float32 */
     CHECK(run_case(variant, "colour factor: the rescue with colour", m, &p, true) > pairs);
+    /* the best mode's normal-update stage on the device (stage.cl), both precisions, and the
+     * robust pass after it */
+    rsmooth_params_init_best(&p);
+    p.stage_repeats = 2;
+    p.vertex_updates = 2;
+    p.guided_rounds = 2;
+    setenv("RSMOOTH_STAGE", "device", 1);
+    run_case(variant, "normal-update stage, double", m, &p, true);
+    setenv("RSMOOTH_STAGE_PRECISION", "float", 1);
+    run_case(variant, "normal-update stage, float", m, &p, true);
+    unsetenv("RSMOOTH_STAGE_PRECISION");
+    unsetenv("RSMOOTH_STAGE");
 }
 
 /* The child's work for one variant: its output goes to the parent's file. Fails when a case
@@ -365,9 +377,19 @@ static size_t source_kernels(char names[][64]) {
             exit(1);
         }
         count = collect_names(text, "__kernel void ", '(', names, count);
+        /* stage.cl's kernels are named through STAGE_NAME, once per precision */
+        char staged[MAX_KERNELS][64];
+        size_t stage_count = collect_names(text, "__kernel void STAGE_NAME(", ')', staged, 0);
+        for (size_t k = 0; k < stage_count; k++)
+            for (int precision = 0; precision < 2 && count < MAX_KERNELS; precision++)
+                snprintf(names[count++], 64, "%s_%c", staged[k], precision ? 'd' : 'f');
         free(text);
     }
-    return count;
+    size_t kept = 0; /* without the macro's own name */
+    for (size_t k = 0; k < count; k++)
+        if (strcmp(names[k], "STAGE_NAME") != 0)
+            memmove(names[kept++], names[k], 64);
+    return kept;
 }
 
 /* Runs `variant` in a child; prints its cases, checks that it passed (so that Oclgrind reported

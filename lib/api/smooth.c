@@ -42,6 +42,18 @@ static rsmooth_status cl_pass(void *context, rsmooth_scalar scalar, const void *
     return st;
 }
 
+/* Where the normal-update stage's cycles run: on a GPU or other accelerator, the device; on a CPU
+ * device, the host's cores (the same cores, in double, and measured faster there: the kernels'
+ * gathers do not vectorize, docs/best-mode.md). RSMOOTH_STAGE=device or host chooses. */
+static bool stage_on_device(const rsmooth_context *ctx, const char *asked) {
+    if (asked && *asked)
+        return strcmp(asked, "device") == 0;
+    cl_device_type type = CL_DEVICE_TYPE_CPU;
+    if (clGetDeviceInfo(ctx->device, CL_DEVICE_TYPE, sizeof type, &type, NULL) != CL_SUCCESS)
+        return false;
+    return (type & CL_DEVICE_TYPE_CPU) == 0;
+}
+
 rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const void *positions,
                               size_t vertex_count, const uint32_t *indices, size_t triangle_count,
                               const rsmooth_params *params, void *out_positions, float *out_weight,
@@ -53,18 +65,17 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     rsmooth_status entered = rs_context_enter(ctx, "rsmooth_smooth", error);
     if (entered != RSMOOTH_OK)
         return entered;
-    /* the normal-update stage's cycles on the device too, unless RSMOOTH_STAGE=host asks for
-     * the host's (double precision: the comparison the benchmarks and tests make) */
     const char *stage_env = getenv("RSMOOTH_STAGE");
     if (stage_env && *stage_env && strcmp(stage_env, "host") != 0 &&
         strcmp(stage_env, "device") != 0) {
         rs_context_unlock(ctx);
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_smooth",
-                       "RSMOOTH_STAGE is \"%s\": use device (the default: the normal-update "
-                       "stage on the OpenCL device) or host (on the host's cores, in double)",
+                       "RSMOOTH_STAGE is \"%s\": use device (the normal-update stage on the "
+                       "OpenCL device: the default on GPUs) or host (on the host's cores, in "
+                       "double: the default on CPU devices)",
                        stage_env);
     }
-    rs_stage_runner stage = stage_env && strcmp(stage_env, "host") == 0 ? NULL : rs_cl_stage_run;
+    rs_stage_runner stage = stage_on_device(ctx, stage_env) ? rs_cl_stage_run : NULL;
     size_t threads_before = rs_set_call_threads(ctx->host_threads);
     rsmooth_status st = rs_filter_passes(cl_pass, stage, ctx, scalar, positions, vertex_count, indices,
                                          triangle_count, params, out_positions, out_weight,
