@@ -13,8 +13,13 @@
  *     pairs each pass examined against the useful ones (within reach, counted apart in
  *     bench_pairs.c), and useful pairs per second against a native roofline of the same
  *     arithmetic on all cores (bench_roofline.c); peak memory over the input's. One JSON object.
+ *
+ *   rsmooth-bench best [MESH] [--triangles N] [--device D] [--repeat R] [--auto] [--drift]
+ *     The best mode against the paper filter, its normal-update stage on the host and on the
+ *     device (bench_best.c). One JSON object.
  */
 #define _POSIX_C_SOURCE 200809L
+#include "bench_best.h"
 #include "bench_pairs.h"
 #include "bench_roofline.h"
 #include "cli_args.h"
@@ -721,11 +726,16 @@ int main(int argc, char **argv) {
         return bench_io(argc, argv);
     if (argc >= 2 && !strcmp(argv[1], "filter"))
         return bench_filter(argc, argv);
+    if (argc >= 2 && !strcmp(argv[1], "best"))
+        return bench_best(argc, argv);
     bool help = argc >= 2 && (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help"));
     fprintf(help ? stdout : stderr,
             "%s%s"
+            "  rsmooth-bench best [MESH] ...: the best mode against the paper filter, stage by "
+            "stage\n"
             "Each prints one JSON object of figures on stdout, never a pass or fail; "
-            "'rsmooth-bench io --help' and\n'rsmooth-bench filter --help' print one mode's help.\n",
+            "'rsmooth-bench io --help',\n'rsmooth-bench filter --help' and 'rsmooth-bench best "
+            "--help' print one mode's help.\n",
             io_usage, filter_usage);
     return help ? EXIT_OK : EXIT_USAGE;
 }

@@ -27,15 +27,33 @@ bool rs_facets_build(rs_facets *out, const double *xyz, const uint32_t *indices,
     return true;
 }
 
-void rs_facets_update(rs_facets *facets, const double *xyz, const uint32_t *indices) {
-    for (size_t q = 0; q < facets->count; q++) {
+#define GRAIN 4096 /* facets per chunk below which a thread does not pay */
+
+typedef struct update_job {
+    rs_facets *facets;
+    const double *xyz;
+    const uint32_t *indices;
+} update_job;
+
+static void update_range(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const update_job *job = ctx;
+    rs_facets *facets = job->facets;
+    (void)chunk;
+    for (size_t q = begin; q < end; q++) {
         double c[3], n[3], a;
-        if (rs_triangle_geometry(xyz, indices + 3 * (size_t)facets->triangle[q], c, n, &a)) {
+        if (rs_triangle_geometry(job->xyz, job->indices + 3 * (size_t)facets->triangle[q], c, n,
+                                 &a)) {
             memcpy(facets->centroid + 3 * q, c, sizeof c);
             memcpy(facets->normal + 3 * q, n, sizeof n);
             facets->area[q] = a;
         }
     }
+}
+
+/* Each facet on its own: any thread count gives the same bytes. */
+void rs_facets_update(rs_facets *facets, const double *xyz, const uint32_t *indices) {
+    update_job job = {facets, xyz, indices};
+    rs_parallel_for(facets->count, GRAIN, update_range, &job);
 }
 
 void rs_facets_free(rs_facets *facets) {
