@@ -90,29 +90,65 @@ static size_t patch_of(const guided_job *job, size_t f, uint32_t member[PATCH_MA
     return m;
 }
 
-/* Whether facets a and b share two welded vertices (an edge). */
-static bool share_edge(const guided_job *job, uint32_t a, uint32_t b) {
-    const uint32_t *ta = job->indices + 3 * (size_t)job->facets->triangle[a];
-    const uint32_t *tb = job->indices + 3 * (size_t)job->facets->triangle[b];
+/* The welded vertices of facet f's corners. */
+static void corners_of(const guided_job *job, uint32_t f, uint32_t out[3]) {
+    const uint32_t *t = job->indices + 3 * (size_t)job->facets->triangle[f];
+    for (int c = 0; c < 3; c++)
+        out[c] = job->adj->rep[t[c]];
+}
+
+/* Whether two facets' welded corners hold two in common (an edge). */
+static bool share_edge(const uint32_t a[3], const uint32_t b[3]) {
     int shared = 0;
     for (int i = 0; i < 3; i++)
-        for (int k = 0; k < 3; k++)
-            shared += job->adj->rep[ta[i]] == job->adj->rep[tb[k]];
+        shared += (a[i] == b[0]) + (a[i] == b[1]) + (a[i] == b[2]);
     return shared >= 2;
 }
 
-/* Appends to a growing array; false when out of memory. */
-static bool push(void **array, size_t *capacity, size_t count, size_t size, const void *item) {
-    if (count == *capacity) {
-        size_t cap = *capacity ? 2 * *capacity : 1024;
-        void *grown = rs_realloc_array(*array, cap, size);
-        if (!grown)
-            return false;
-        *array = grown;
-        *capacity = cap;
+/* A growing list of one chunk of facets (the lists are built a chunk per thread, then joined in
+ * chunk order: the same lists for any thread count). */
+typedef struct chunk_list {
+    uint32_t *item;
+    size_t count, capacity;
+    size_t first;   /* the chunk's first facet */
+    bool failed;    /* out of memory */
+} chunk_list;
+
+static void chunk_push(chunk_list *c, uint32_t item) {
+    if (c->failed)
+        return;
+    if (c->count == c->capacity) {
+        size_t cap = c->capacity ? 2 * c->capacity : 1024;
+        uint32_t *grown = rs_realloc_array(c->item, cap, sizeof *grown);
+        if (!grown) {
+            c->failed = true;
+            return;
+        }
+        c->item = grown;
+        c->capacity = cap;
     }
-    memcpy((char *)*array + count * size, item, size);
-    return true;
+    c->item[c->count++] = item;
+}
+
+/* Per-chunk lists and per-facet counts, joined into one CSR list (start: count + 1 entries;
+ * `per` items per counted entry), the chunks' arrays freed. false when out of memory. */
+static bool join_chunks(chunk_list *chunks, size_t chunk_count, const size_t *counts,
+                        size_t count, size_t per, size_t *start, uint32_t **list) {
+    bool ok = true;
+    start[0] = 0;
+    for (size_t f = 0; f < count; f++)
+        start[f + 1] = start[f] + counts[f];
+    for (size_t c = 0; c < chunk_count; c++)
+        ok = ok && !chunks[c].failed;
+    size_t total = per * start[count];
+    *list = ok ? rs_alloc_array(total ? total : 1, sizeof **list) : NULL;
+    for (size_t c = 0; *list && c < chunk_count; c++)
+        if (chunks[c].count)
+            memcpy(*list + per * start[chunks[c].first], chunks[c].item,
+                   chunks[c].count * sizeof **list);
+    for (size_t c = 0; c < chunk_count; c++)
+        rs_free(chunks[c].item);
+    return *list != NULL;
 }
 
 static void lists_free(guided_lists *l) {
@@ -126,35 +162,60 @@ static void lists_free(guided_lists *l) {
     memset(l, 0, sizeof *l);
 }
 
-/* Each facet's patch and the patch's interior edges, one facet after another (their order fixes
- * the sums' order: deterministic). */
-static bool patch_lists_build(guided_job *job) {
-    guided_lists *l = &job->lists;
-    size_t nf = job->facets->count, np = 0, ne = 0, cp = 0, ce = 0;
-    l->patch_start = rs_alloc_array(nf + 1, sizeof(size_t));
-    l->edge_start = rs_alloc_array(nf + 1, sizeof(size_t));
-    if (!l->patch_start || !l->edge_start)
-        return false;
-    uint32_t member[PATCH_MAX];
-    for (size_t f = 0; f < nf; f++) {
-        l->patch_start[f] = np;
-        l->edge_start[f] = ne;
-        size_t m = patch_of(job, f, member);
+/* Each facet's patch and the patch's interior edges, a chunk of facets per thread (each facet's
+ * entries in the order one facet after another gives them: deterministic). */
+typedef struct patch_job {
+    guided_job *job;
+    chunk_list *patch, *edge;         /* per chunk */
+    size_t *patch_count, *edge_count; /* per facet */
+} patch_job;
+
+static void patch_lists_range(void *ctx, size_t begin, size_t end, size_t chunk) {
+    patch_job *pj = ctx;
+    chunk_list *patch = &pj->patch[chunk], *edge = &pj->edge[chunk];
+    patch->first = edge->first = begin;
+    uint32_t member[PATCH_MAX], corners[PATCH_MAX][3];
+    for (size_t f = begin; f < end; f++) {
+        size_t m = patch_of(pj->job, f, member), edges = 0;
+        for (size_t a = 0; a < m; a++)
+            corners_of(pj->job, member[a], corners[a]);
         for (size_t a = 0; a < m; a++) {
-            if (!push((void **)&l->patch, &cp, np++, sizeof *l->patch, &member[a]))
-                return false;
+            chunk_push(patch, member[a]);
             for (size_t b = a + 1; b < m; b++)
-                if (share_edge(job, member[a], member[b])) {
-                    if (!push((void **)&l->edge, &ce, 2 * ne, sizeof *l->edge, &member[a]) ||
-                        !push((void **)&l->edge, &ce, 2 * ne + 1, sizeof *l->edge, &member[b]))
-                        return false;
-                    ne++;
+                if (share_edge(corners[a], corners[b])) {
+                    chunk_push(edge, member[a]);
+                    chunk_push(edge, member[b]);
+                    edges++;
                 }
         }
+        pj->patch_count[f] = m;
+        pj->edge_count[f] = edges;
     }
-    l->patch_start[nf] = np;
-    l->edge_start[nf] = ne;
-    return true;
+}
+
+static bool patch_lists_build(guided_job *job) {
+    guided_lists *l = &job->lists;
+    size_t nf = job->facets->count, chunks = rs_parallel_chunks(nf, GRAIN);
+    l->patch_start = rs_alloc_array(nf + 1, sizeof(size_t));
+    l->edge_start = rs_alloc_array(nf + 1, sizeof(size_t));
+    patch_job pj = {job, rs_calloc_array(chunks ? chunks : 1, sizeof(chunk_list)),
+                    rs_calloc_array(chunks ? chunks : 1, sizeof(chunk_list)),
+                    rs_alloc_array(nf ? nf : 1, sizeof(size_t)),
+                    rs_alloc_array(nf ? nf : 1, sizeof(size_t))};
+    bool ok = l->patch_start && l->edge_start && pj.patch && pj.edge && pj.patch_count &&
+              pj.edge_count;
+    if (ok) { /* both joined, so both chunks' arrays are freed */
+        rs_parallel_for(nf, GRAIN, patch_lists_range, &pj);
+        bool patches = join_chunks(pj.patch, chunks, pj.patch_count, nf, 1, l->patch_start,
+                                   &l->patch);
+        ok = join_chunks(pj.edge, chunks, pj.edge_count, nf, 2, l->edge_start, &l->edge) &&
+             patches;
+    }
+    rs_free(pj.patch);
+    rs_free(pj.edge);
+    rs_free(pj.patch_count);
+    rs_free(pj.edge_count);
+    return ok;
 }
 
 /* Mean distance between the centroids of edge-adjacent facets, each pair once: the edges of
@@ -173,17 +234,23 @@ static double adjacent_distance(const guided_job *job) {
     return pairs ? sum / (double)pairs : 0;
 }
 
-/* Each facet's neighbours within the filter's reach on the input, through the grid (the sets stay
- * for every cycle, as in the authors' program; their weights follow the geometry: weight_range). */
-static bool near_lists_build(guided_job *job) {
-    guided_lists *l = &job->lists;
-    size_t nf = job->facets->count, nn = 0, cn = 0;
-    l->near_start = rs_alloc_array(nf + 1, sizeof(size_t));
-    if (!l->near_start)
-        return false;
+/* Each facet's neighbours within the filter's reach on the input, through the grid, a chunk of
+ * facets per thread (the sets stay for every cycle, as in the authors' program; their weights
+ * follow the geometry: weight_range). */
+typedef struct near_job {
+    guided_job *job;
+    chunk_list *near; /* per chunk */
+    size_t *count;    /* per facet */
+} near_job;
+
+static void near_lists_range(void *ctx, size_t begin, size_t end, size_t chunk) {
+    near_job *nj = ctx;
+    const guided_job *job = nj->job;
     const rs_grid *grid = job->grid;
-    for (size_t f = 0; f < nf; f++) {
-        l->near_start[f] = nn;
+    chunk_list *near = &nj->near[chunk];
+    near->first = begin;
+    for (size_t f = begin; f < end; f++) {
+        size_t before = near->count;
         const double *cf = job->facets->centroid + 3 * f;
         int32_t cc[3];
         rs_grid_cell_of(grid, cf, cc);
@@ -194,16 +261,31 @@ static bool near_lists_build(guided_job *job) {
                     for (uint32_t s = cell < 0 ? 0 : grid->cell_start[cell];
                          cell >= 0 && s < grid->cell_start[cell + 1]; s++) {
                         uint32_t q = grid->facet_order[s];
-                        if (gap2(job->facets->centroid + 3 * (size_t)q, cf) >
+                        if (gap2(job->facets->centroid + 3 * (size_t)q, cf) <=
                             job->reach * job->reach)
-                            continue;
-                        if (!push((void **)&l->near, &cn, nn, sizeof *l->near, &q))
-                            return false;
-                        nn++;
+                            chunk_push(near, q);
                     }
                 }
+        nj->count[f] = near->count - before;
     }
-    l->near_start[nf] = nn;
+}
+
+static bool near_lists_build(guided_job *job) {
+    guided_lists *l = &job->lists;
+    size_t nf = job->facets->count, chunks = rs_parallel_chunks(nf, GRAIN);
+    l->near_start = rs_alloc_array(nf + 1, sizeof(size_t));
+    near_job nj = {job, rs_calloc_array(chunks ? chunks : 1, sizeof(chunk_list)),
+                   rs_alloc_array(nf ? nf : 1, sizeof(size_t))};
+    bool ok = l->near_start && nj.near && nj.count;
+    if (ok) {
+        rs_parallel_for(nf, GRAIN, near_lists_range, &nj);
+        ok = join_chunks(nj.near, chunks, nj.count, nf, 1, l->near_start, &l->near);
+    }
+    rs_free(nj.near);
+    rs_free(nj.count);
+    if (!ok)
+        return false;
+    size_t nn = l->near_start[nf];
     l->near_exponent = rs_alloc_array(nn ? nn : 1, sizeof *l->near_exponent);
     return l->near_exponent != NULL;
 }
