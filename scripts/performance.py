@@ -38,7 +38,18 @@ BEGIN, END = "<!-- BEGIN performance", "<!-- END performance -->"
 # The JSON files of one run (docs/results/performance/NAME.json), by the key the text uses.
 RUN_FILES = {"cold": "program-build-cold", "s1M": "scaling-1M", "s4M": "scaling-4M",
              "s16M": "scaling-16M", "tiled": "scaling-16M-256M"}
-HEADLINE_FILES = {"bunny": "bunny0.2-2-0.5", "g200k": "generated-200k-4-1"}
+HEADLINE_FILES = {"bunny": "bunny0.2-2-0.5", "g200k": "generated-200k-4-1",
+                  "best_bunny": "best-bunny0.2", "best_auto_bunny": "best-auto-bunny0.2",
+                  "best_200k": "best-200k"}
+# Issue 26's targets on this machine class (PoCL's CPU device): (key, what, target, at most?)
+TARGETS = [("g200k", "paper filter, 200k triangles at σ 4/1", 70, True),
+           ("bunny", "paper filter, Bunny0.2 at σ 2/0.5", 18, True),
+           ("setup", "command setup, warm caches (Fandisk0.3)", 35, True),
+           ("ratio", "useful-pair ratio, robust pass (200k)", 0.5, False),
+           ("best", "`--best` on Bunny0.2, × the paper filter", 3, True),
+           ("best_auto", "`--best --auto` on Bunny0.2, × the paper filter", 3, True),
+           ("best_device", "`--best` on Bunny0.2, stage on the device, × paper", 3, True),
+           ("best_200k", "`--best` on 200k triangles, × the paper filter", 3, True)]
 
 
 def bench(build, name, args, env=None):
@@ -78,6 +89,26 @@ def command_json_ms(build, mesh, extra, runs=7):
     return {k: statistics.median(v) for k, v in stages.items()}
 
 
+def has_mode(build, mode):
+    """Whether this build's rsmooth-bench has `mode` (older builds lack "best")."""
+    r = subprocess.run([os.path.join(build, "rsmooth-bench"), mode, "--help"],
+                       capture_output=True, text=True)
+    return r.returncode == 0
+
+
+def best_bench(build, name, args):
+    """rsmooth-bench best: the best mode against the paper filter, its stage on the host and on
+    the device, in one run."""
+    cmd = [os.path.join(build, "rsmooth-bench"), "best"] + args
+    print("running:", " ".join(cmd), file=sys.stderr)
+    out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
+    result = json.loads(out)
+    result["command"] = "rsmooth-bench best " + " ".join(args)
+    with open(os.path.join(OUT, name + ".json"), "w") as f:
+        json.dump(result, f, indent=1)
+    return result
+
+
 def headline(build, tag):
     """The headline figures for one build (each a median, on this machine)."""
     out = {}
@@ -95,6 +126,17 @@ def headline(build, tag):
     if os.path.exists(bunny):
         out["paper_filter"] = command_json_ms(build, bunny, [], runs=5)["filter"]
         out["best_filter"] = command_json_ms(build, bunny, ["--best"], runs=3)["filter"]
+        out["best_auto_filter"] = command_json_ms(build, bunny, ["--best", "--auto"],
+                                                  runs=3)["filter"]
+    if has_mode(build, "best"):
+        if os.path.exists(bunny):
+            out["best_bunny"] = best_bench(build, f"{tag}-{HEADLINE_FILES['best_bunny']}",
+                                           [bunny, "--repeat", "3"])
+            out["best_auto_bunny"] = best_bench(
+                build, f"{tag}-{HEADLINE_FILES['best_auto_bunny']}",
+                [bunny, "--repeat", "3", "--auto"])
+        out["best_200k"] = best_bench(build, f"{tag}-{HEADLINE_FILES['best_200k']}",
+                                      ["--triangles", "200000", "--repeat", "1"])
     with open(os.path.join(OUT, f"{tag}-headline.json"), "w") as f:
         json.dump({k: v for k, v in out.items() if not isinstance(v, dict)}, f, indent=1)
     return out
@@ -142,8 +184,48 @@ def standing(before, after, label):
     if ratio(after) is not None:
         text += (f" `--best`\ntakes **{ratio(after):.0f}×** the paper filter's filter time on "
                  "Bunny0.2" + (f" ({ratio(b):.0f}× before)" if ratio(b) is not None else "") +
-                 ", because its normal update\nstage runs on the host ([best-mode.md](best-mode.md)).")
+                 ": its normal-update stage does many times the\npaper filter's work, on the "
+                 "host's cores on a CPU device ([best-mode.md](best-mode.md)).")
     return text
+
+
+def target_figures(r):
+    """Each target's figure from one build's headline results (None where not measured)."""
+    if not r:
+        return {}
+    f = {}
+    if "g200k" in r:
+        f["g200k"] = ms(r["g200k"], "total")
+        f["ratio"] = r["g200k"]["robust"].get("ratio")
+    if "bunny" in r:
+        f["bunny"] = ms(r["bunny"], "total")
+    f["setup"] = r.get("setup")
+    if "best_filter" in r and "paper_filter" in r:
+        f["best"] = r["best_filter"] / r["paper_filter"]
+    if "best_auto_filter" in r and "paper_filter" in r:
+        f["best_auto"] = r["best_auto_filter"] / r["paper_filter"]
+    if "best_bunny" in r:
+        f["best_device"] = r["best_bunny"]["best_stage_device"]["ratio_to_paper"]
+    if "best_200k" in r:
+        f["best_200k"] = min(r["best_200k"][m]["ratio_to_paper"]
+                             for m in ("best_stage_host", "best_stage_device"))
+    return f
+
+
+def targets_table(before, after):
+    """Each figure beside its target, before and after."""
+    b, a = target_figures(before), target_figures(after)
+    fmt = lambda key, v: "–" if v is None else (f"{v:.2f}" if key == "ratio" else
+                                                f"{v:.1f}×" if key.startswith("best") else
+                                                f"{v:.0f} ms")
+    lines = ["| figure | target | before | after | met |", "| --- | --- | --- | --- | --- |"]
+    for key, what, target, at_most in TARGETS:
+        v = a.get(key)
+        met = "–" if v is None else ("yes" if (v <= target if at_most else v >= target) else
+                                     "**no**")
+        goal = ("≤ " if at_most else "≥ ") + fmt(key, target)
+        lines.append(f"| {what} | {goal} | {fmt(key, b.get(key))} | **{fmt(key, v)}** | {met} |")
+    return lines
 
 
 def machine():
@@ -187,6 +269,30 @@ def section(before, after, runs, label, machine_text):
               f"{g.get('lanes', 8)} vertices per work-item, work-groups of "
               f"{g.get('work_group', 64)} (chosen per device; see [method.md](method.md)).", ""]
     lines += [standing(before, after, label), ""]
+    lines += ["Against issue 26's targets (PoCL's CPU device; `--best` ratios are filter times, "
+              "the device-stage and 200k ones `rsmooth-bench best`'s whole calls):", ""]
+    lines += targets_table(before, after) + [""]
+    if "best_bunny" in after:
+        bb = after["best_bunny"]
+        lines += ["The best mode's normal-update stage on Bunny0.2, by part (`rsmooth-bench "
+                  "best`, medians; the host's stage is what a CPU device runs by default):", "",
+                  "| stage on | precision | lists | upload | cycles | download | stage total "
+                  "| whole call | × paper | bytes to / from the device |",
+                  "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+        for mode, where in (("best_stage_host", "host"), ("best_stage_device", "device"),
+                            ("best_stage_device_float32", "device")):
+            m = bb[mode]
+            st = m["stage"]
+            lines.append(f"| {where} | {st['float_bits']}-bit | {st['ms']['lists']:.0f} ms | "
+                         f"{st['ms']['upload']:.0f} ms | {st['ms']['cycles']:.0f} ms | "
+                         f"{st['ms']['download']:.0f} ms | {st['ms']['total']:.0f} ms | "
+                         f"{m['ms_total']:.0f} ms | {m['ratio_to_paper']:.1f}× | "
+                         f"{st['bytes_to_device'] / 2**20:.1f} / "
+                         f"{st['bytes_from_device'] / 2**20:.1f} MiB |")
+        gap = bb["device_from_host_max"]
+        lines += ["", f"The device's result is within {gap['double']:.1g} (double) and "
+                  f"{gap['float32']:.1g} (float32) mean edge lengths of the host's on every "
+                  "vertex.", ""]
     lines += ["| case | filter total | facets + grid | mollify | robust | useful pairs/s, "
               "robust (of the native roofline: **ratio**) | mollify |",
               "| --- | --- | --- | --- | --- | --- | --- |"]
