@@ -45,16 +45,30 @@ static int report(void *user, double fraction) {
     return stop;
 }
 
+/* The normal-update stage's figures: where its cycles ran, in what precision, its parts. */
+static PyObject *stage_dict(const rsmooth_report *r) {
+    return Py_BuildValue("{s:O,s:i,s:i,s:K,s:K,s:d,s:d,s:d,s:d,s:d}", "on_device",
+                         r->stage_on_device ? Py_True : Py_False, "float_bits",
+                         r->stage_float_bits, "cycles", r->stage_cycles, "bytes_to_device",
+                         (unsigned long long)r->stage_bytes_to_device, "bytes_from_device",
+                         (unsigned long long)r->stage_bytes_from_device, "ms", r->ms_stage,
+                         "ms_lists", r->ms_stage_lists, "ms_upload", r->ms_stage_upload,
+                         "ms_cycles", r->ms_stage_cycles, "ms_download", r->ms_stage_download);
+}
+
 static PyObject *report_dict(const rsmooth_report *r) {
+    PyObject *stage = stage_dict(r);
+    if (!stage)
+        return NULL;
     return Py_BuildValue(
-        "{s:n,s:n,s:n,s:d,s:d,s:d,s:d,s:s,s:d,s:d,s:d,s:d,s:d,s:d,s:n,s:i,s:d}", "vertex_count",
+        "{s:n,s:n,s:n,s:d,s:d,s:d,s:d,s:s,s:d,s:d,s:d,s:d,s:d,s:d,s:n,s:i,s:d,s:N}", "vertex_count",
         (Py_ssize_t)r->vertex_count, "triangle_count", (Py_ssize_t)r->triangle_count,
         "facet_count", (Py_ssize_t)r->facet_count, "mean_edge_length", r->mean_edge_length,
         "sigma_f", r->sigma_f, "sigma_g", r->sigma_g, "radius", r->radius, "device", r->device,
         "ms_setup", r->ms_setup, "ms_grid", r->ms_grid, "ms_mollify", r->ms_mollify,
         "ms_robust", r->ms_robust, "ms_download", r->ms_download, "ms_total", r->ms_total,
         "tiles", (Py_ssize_t)r->tiles, "discrepancy_iterations", r->discrepancy_iterations,
-        "region_filter_share", r->region_filter_share);
+        "region_filter_share", r->region_filter_share, "stage", stage);
 }
 
 /* Hands the library `progress` through p's progress_cancel and lets go of the GIL: the filter

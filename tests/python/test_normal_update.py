@@ -125,6 +125,9 @@ def test_discrepancy_iterations_in_the_report():
         assert ctx.last_report["discrepancy_iterations"] >= 1
         ctx.smooth(v, f, best=True)
         assert ctx.last_report["discrepancy_iterations"] == 0
+        stage = ctx.last_report["stage"]  # where the normal-update stage ran, and its cycles
+        assert stage["cycles"] == 10 and stage["float_bits"] in (32, 64), stage
+        assert stage["on_device"] == (stage["bytes_to_device"] > 0), stage
 
 
 def test_none_means_the_modes_default(cube):
