@@ -182,6 +182,14 @@ static void compare_float32(rsmooth_context *ctx, const char *name, const double
     free(x32), free(n32), free(ref), free(dev);
 }
 
+/* A progress_cancel that stops at its `*user`-th report (the first is the pass's start, the
+ * others come from the device's launches). */
+static int stop_at(void *user, double fraction) {
+    (void)fraction;
+    int *left = user;
+    return --*left <= 0;
+}
+
 /* A noisy cloud: the vertices of `mesh` moved along its normals by `noise` mean edge lengths,
  * with the normals of the noisy surface (as a scanner gives them). */
 static double *noisy_cloud(shape_mesh *mesh, double noise, uint64_t seed) {
@@ -317,6 +325,22 @@ int main(void) {
                                        NULL, &err),
                  RSMOOTH_OK);
     CHECK(out[0] == 0 && out[1] == 0 && out[2] == 0);
+
+    /* cancelled inside the device run: its status, and the context usable after it */
+    for (int at = 1; at <= 3; at++) {
+        int left = at;
+        p.progress_cancel = stop_at;
+        p.progress_user = &left;
+        double *sink = malloc(3 * cube.vertex_count * sizeof *sink);
+        CHECK(sink);
+        CHECK_STATUS(rsmooth_smooth_points(ctx, RSMOOTH_FLOAT64, cube.xyz, cube_n,
+                                           cube.vertex_count, &p, sink, NULL, NULL, NULL, &err),
+                     RSMOOTH_ERROR_CANCELLED);
+        free(sink);
+    }
+    rsmooth_params_init(&p);
+    compare(ctx, "noisy cube, 8 points in one place, again", cube.xyz, cube_n, cube.vertex_count,
+            &p);
 
     benchmark_clouds(ctx);
     free(sphere_n);
