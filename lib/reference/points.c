@@ -1,8 +1,9 @@
 /* Point clouds with normals (beyond the paper): the reference filter with the points as its facets.
  * A point is a facet whose centroid is the point, whose plane is its tangent plane and whose area
  * is estimated from how far its nearest neighbours are; rs_reference_solve then runs the bilateral
- * normal filter and Eq. 3 on them unchanged. Points always take the bilateral filter when they
- * take one at all: the paper's mollification moves triangle corners, and points have none. */
+ * normal filter and Eq. 3 on them unchanged (the device's pass, api/points.c, runs the same
+ * problem through the mesh path's kernels instead). Points always take the bilateral filter when
+ * they take one at all: the paper's mollification moves triangle corners, and points have none. */
 #include "reference/points.h"
 #include "core/spatial.h"
 
