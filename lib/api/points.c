@@ -26,9 +26,9 @@ static rsmooth_status cl_points_pass(void *context, const rs_problem *pb, double
         st = rs_cl_run_normals(ctx, pb, &sink, out_normals, &stats, &needed, error);
         if (st == RSMOOTH_ERROR_OUT_OF_MEMORY && needed > 0)
             return rs_fail(error, st, where,
-                           "%zu points need %llu bytes on %s, more than it can hold (point "
-                           "clouds are not cut into tiles; rsmooth_smooth_points_reference "
-                           "takes them)",
+                           "%zu points need %llu bytes on %s, beyond its usable memory or "
+                           "the memory budget (point clouds are not cut into tiles; "
+                           "rsmooth_smooth_points_reference takes them)",
                            pb->vertex_count, (unsigned long long)needed, ctx->device_name);
     }
     if (st == RSMOOTH_OK && report)
