@@ -24,7 +24,8 @@ int cli_smooth_mesh(const options *opt, const rsmooth_mesh *mesh, double *out, f
 /* A mesh without triangles is a point cloud: it needs its normals, and a method without edges. */
 int cli_check_point_cloud(const options *opt, const rsmooth_mesh *mesh);
 
-/* The point-cloud filter, on the reference path: the OpenCL path does not take points yet. */
+/* The point-cloud filter on the chosen device (the reference path without one, or where the
+ * device cannot hold the cloud); fills `report`. */
 int cli_smooth_points(const options *opt, const rsmooth_mesh *mesh, double *out,
                       double *out_normals, float *confidence, rsmooth_report *report,
                       cli_progress *bar);

@@ -1,5 +1,5 @@
 /* The rsmooth command's filtering of one mesh in memory: the filter on the chosen device, the
- * Laplacian and Taubin baselines, and point clouds on the reference path (see cli_smooth.h). */
+ * Laplacian and Taubin baselines, and point clouds (see cli_smooth.h). */
 #define _POSIX_C_SOURCE 200809L
 #include "cli_smooth.h"
 #include "cli_files.h"
@@ -97,19 +97,34 @@ int cli_check_point_cloud(const options *opt, const rsmooth_mesh *mesh) {
     return EXIT_OK;
 }
 
+/* The point-cloud filter on `ctx` (NULL: the reference path). */
+static rsmooth_status filter_points(rsmooth_context *ctx, const rsmooth_mesh *mesh,
+                                    const rsmooth_params *params, double *out,
+                                    double *out_normals, float *confidence,
+                                    rsmooth_report *report, rsmooth_error *err) {
+    if (!ctx)
+        return rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, mesh->positions,
+                                               mesh->vertex_normals, mesh->vertex_count, params,
+                                               out, out_normals, confidence, report, err);
+    return rsmooth_smooth_points(ctx, RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_normals,
+                                 mesh->vertex_count, params, out, out_normals, confidence, report,
+                                 err);
+}
+
 int cli_smooth_points(const options *opt, const rsmooth_mesh *mesh, double *out,
                       double *out_normals, float *confidence, rsmooth_report *report,
                       cli_progress *bar) {
-    const char *device = opt->device ? opt->device : getenv("RSMOOTH_DEVICE");
+    rsmooth_context *ctx = NULL;
+    double ms_setup = 0;
+    int code = cli_open_device(opt, bar, &ctx, &ms_setup);
+    if (code >= 0)
+        return code;
     if (!opt->quiet) {
         cli_progress_clear(bar);
-        if (device && strcmp(device, "reference") != 0 && strcmp(device, "auto") != 0)
-            fprintf(stderr, "rsmooth: note: %s is a point cloud, which the OpenCL path does not "
-                            "take yet: filtering on the reference path, not on device '%s'\n",
-                    opt->input, device);
-        else if (!device || strcmp(device, "reference") != 0)
-            fprintf(stderr, "rsmooth: note: %s is a point cloud (no faces): filtering its points "
-                            "and normals on the reference path (CPU)\n", opt->input);
+        fprintf(stderr, "rsmooth: note: %s is a point cloud (no faces): filtering its points and "
+                        "normals %s%s%s\n",
+                opt->input, ctx ? "on device '" : "on the reference path (CPU)",
+                ctx ? rsmooth_context_device_name(ctx) : "", ctx ? "'" : "");
     }
     rsmooth_params params = opt->params;
     if (bar->enabled) {
@@ -117,13 +132,32 @@ int cli_smooth_points(const options *opt, const rsmooth_mesh *mesh, double *out,
         params.progress_user = bar;
     }
     rsmooth_error err;
-    rsmooth_status st = rsmooth_smooth_points_reference(
-        RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_normals, mesh->vertex_count, &params, out,
-        out_normals, confidence, report, &err);
+    rsmooth_status st =
+        filter_points(ctx, mesh, &params, out, out_normals, confidence, report, &err);
+    if (st == RSMOOTH_ERROR_OUT_OF_MEMORY && ctx) {
+        /* the device cannot hold the cloud (points are not cut into tiles): the host can */
+        if (!opt->quiet) {
+            cli_progress_clear(bar);
+            fprintf(stderr, "rsmooth: note: %s: %s; filtering on the reference path instead\n",
+                    opt->input, err.message);
+        }
+        rsmooth_context_destroy(ctx);
+        ctx = NULL;
+        st = filter_points(NULL, mesh, &params, out, out_normals, confidence, report, &err);
+    }
+    code = EXIT_OK;
     if (st != RSMOOTH_OK) {
         cli_progress_clear(bar);
-        fprintf(stderr, "rsmooth: %s: %s\n", opt->input, err.message);
-        return st == RSMOOTH_ERROR_INVALID_ARGUMENT ? EXIT_USAGE : EXIT_OTHER;
+        if (st == RSMOOTH_ERROR_OPENCL)
+            fprintf(stderr, "rsmooth: %s: device '%s': %s\n", opt->input,
+                    rsmooth_context_device_name(ctx), err.message);
+        else
+            fprintf(stderr, "rsmooth: %s: %s\n", opt->input, err.message);
+        code = st == RSMOOTH_ERROR_OPENCL             ? EXIT_DEVICE
+               : st == RSMOOTH_ERROR_INVALID_ARGUMENT ? EXIT_USAGE
+                                                      : EXIT_OTHER;
     }
-    return EXIT_OK;
+    report->ms_setup = ms_setup;
+    rsmooth_context_destroy(ctx);
+    return code;
 }

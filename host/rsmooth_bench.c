@@ -721,6 +721,210 @@ static int bench_filter(int argc, char **argv) {
     return code;
 }
 
+/* ---- points ---------------------------------------------------------------------------------- */
+
+/* rsmooth-bench points: the point-cloud filter on the device (rsmooth_smooth_points) on a mesh's
+ * vertices, with the normals of its noisy surface, against the mesh filter (rsmooth_smooth) on
+ * that mesh: the same vertex count, float32 arrays both, the same sigmas. One JSON object of
+ * medians over R runs after a first. */
+static const char points_usage[] =
+    "usage: rsmooth-bench points [MESH] [--vertices N] [--noise S] [--sigma-f X] [--sigma-g Y]\n"
+    "                            [--device D] [--repeat R]\n"
+    "  times rsmooth_smooth_points on a mesh's vertices (normals: the area-weighted ones of its\n"
+    "  surface) against rsmooth_smooth on the mesh itself (paper's mollification, and bilateral\n"
+    "  normals as the points take them): medians of R runs after a first, per-stage medians of\n"
+    "  the points, whether repeats are bit-identical (JSON)\n"
+    "  MESH            any mesh file rsmooth reads; default: the generated noisy closed cylinder\n"
+    "  --vertices N    generated mesh: about N vertices (default 200000)\n"
+    "  --noise S, --sigma-f X, --sigma-g Y, --device D, --repeat R: as 'filter' (default R 5)\n";
+
+typedef struct points_bench {
+    const char *mesh_path, *device;
+    double vertices, noise;
+    rsmooth_params params;
+    int repeat;
+    float *xyz, *normals, *out, *first;
+    uint32_t *indices;
+    size_t vertex_count, triangle_count;
+    rsmooth_context *ctx;
+} points_bench;
+
+static int points_args(int argc, char **argv, points_bench *b) {
+    rsmooth_params_init(&b->params);
+    b->vertices = 200000;
+    b->noise = 0.2;
+    b->repeat = 5;
+    for (int i = 2; i < argc; i++) {
+        const char *a = argv[i], *value = i + 1 < argc ? argv[i + 1] : NULL;
+        double x = 0;
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            fputs(points_usage, stdout);
+            return EXIT_OK;
+        } else if (!strcmp(a, "--device") && value) {
+            b->device = argv[++i];
+        } else if (value && (!strcmp(a, "--vertices") || !strcmp(a, "--noise") ||
+                             !strcmp(a, "--sigma-f") || !strcmp(a, "--sigma-g") ||
+                             !strcmp(a, "--repeat"))) {
+            i++;
+            bool ok = cli_parse_number(value, &x);
+            if (!strcmp(a, "--vertices") && (ok = ok && x >= 50 && x <= 5e8))
+                b->vertices = x;
+            else if (!strcmp(a, "--noise") && (ok = ok && x >= 0 && isfinite(x)))
+                b->noise = x;
+            else if (!strcmp(a, "--sigma-f") && (ok = ok && x > 0 && isfinite(x)))
+                b->params.sigma_f = x;
+            else if (!strcmp(a, "--sigma-g") && (ok = ok && x > 0))
+                b->params.sigma_g = x;
+            else if (!strcmp(a, "--repeat") && (ok = ok && x >= 1 && x <= 99 && x == floor(x)))
+                b->repeat = (int)x;
+            if (!ok) {
+                fprintf(stderr, "rsmooth-bench points: bad value for %s: '%s'\n", a, value);
+                return EXIT_USAGE;
+            }
+        } else if (a[0] != '-' && !b->mesh_path) {
+            b->mesh_path = a;
+        } else {
+            fprintf(stderr, "rsmooth-bench points: unexpected '%s'\nTry 'rsmooth-bench points "
+                            "--help'.\n", a);
+            return EXIT_USAGE;
+        }
+    }
+    return -1;
+}
+
+/* The mesh (read or generated), its float32 positions and its area-weighted vertex normals. */
+static int points_input(points_bench *b) {
+    shape_mesh shape;
+    memset(&shape, 0, sizeof shape);
+    rsmooth_mesh *mesh = NULL;
+    rsmooth_error err;
+    if (b->mesh_path) {
+        if (rsmooth_mesh_read_file(b->mesh_path, &mesh, &err) != RSMOOTH_OK) {
+            fprintf(stderr, "rsmooth-bench: %s: %s\n", b->mesh_path, err.message);
+            return EXIT_USAGE;
+        }
+        shape = (shape_mesh){mesh->vertex_count, mesh->positions, mesh->triangle_count,
+                             mesh->triangles};
+    } else if (shape_capped_cylinder(&shape, 1.0, 1.5, (size_t)(2 * b->vertices)) != 0 ||
+               shape_add_normal_noise(&shape, b->noise, 1) != 0) {
+        fprintf(stderr, "rsmooth-bench: cannot generate the cylinder\n");
+        return EXIT_OTHER;
+    }
+    size_t nv = shape.vertex_count, nt = shape.triangle_count;
+    double *normals = malloc((nv ? nv : 1) * 3 * sizeof *normals);
+    b->xyz = malloc((nv ? nv : 1) * 3 * sizeof *b->xyz);
+    b->normals = malloc((nv ? nv : 1) * 3 * sizeof *b->normals);
+    b->out = malloc((nv ? nv : 1) * 3 * sizeof *b->out);
+    b->first = malloc((nv ? nv : 1) * 3 * sizeof *b->first);
+    b->indices = malloc((nt ? nt : 1) * 3 * sizeof *b->indices);
+    int code = EXIT_OK;
+    if (!normals || !b->xyz || !b->normals || !b->out || !b->first || !b->indices ||
+        shape_vertex_normals(&shape, normals) != 0) {
+        fprintf(stderr, "rsmooth-bench: out of memory for the mesh\n");
+        code = EXIT_OTHER;
+    } else {
+        for (size_t i = 0; i < 3 * nv; i++) {
+            b->xyz[i] = (float)shape.xyz[i];
+            b->normals[i] = (float)normals[i];
+        }
+        memcpy(b->indices, shape.indices, nt * 3 * sizeof *b->indices);
+        b->vertex_count = nv;
+        b->triangle_count = nt;
+    }
+    free(normals);
+    if (mesh)
+        rsmooth_mesh_destroy(mesh);
+    else
+        shape_free(&shape);
+    return code;
+}
+
+/* One run of what `which` names (0 points, 1 mesh, 2 mesh with bilateral normals), timed. */
+static rsmooth_status points_run_one(points_bench *b, int which, rsmooth_report *r, double *ms) {
+    rsmooth_params p = b->params;
+    if (which == 2)
+        p.normal_filter = RSMOOTH_NORMALS_BILATERAL;
+    rsmooth_error err;
+    rsmooth_report_init(r);
+    double t0 = now_ms();
+    rsmooth_status st =
+        which == 0 ? rsmooth_smooth_points(b->ctx, RSMOOTH_FLOAT32, b->xyz, b->normals,
+                                           b->vertex_count, &p, b->out, NULL, NULL, r, &err)
+                   : rsmooth_smooth(b->ctx, RSMOOTH_FLOAT32, b->xyz, b->vertex_count, b->indices,
+                                    b->triangle_count, &p, b->out, NULL, NULL, r, &err);
+    *ms = now_ms() - t0;
+    if (st != RSMOOTH_OK)
+        fprintf(stderr, "rsmooth-bench: %s: %s\n", which ? "rsmooth_smooth" : "rsmooth_smooth_points",
+                err.message);
+    return st;
+}
+
+static void print_points_figures(const points_bench *b, double med[3], double stages[6],
+                                 bool identical) {
+    printf("{\"mode\":\"points\",\"device\":\"%s\",\"input\":\"%s\",\"points\":%zu,"
+           "\"triangles\":%zu,\"sigma_f\":%g,\"sigma_g\":%g,\"repeat\":%d,",
+           rsmooth_context_device_name(b->ctx), b->mesh_path ? b->mesh_path : "cylinder",
+           b->vertex_count, b->triangle_count, b->params.sigma_f, b->params.sigma_g, b->repeat);
+    const char *keys[5] = {"points_ms", "mesh_ms", "mesh_bilateral_ms", "points_over_mesh",
+                           "points_over_mesh_bilateral"};
+    double values[5] = {med[0], med[1], med[2], med[0] / med[1], med[0] / med[2]};
+    for (int k = 0; k < 5; k++) {
+        print_json_number(keys[k], values[k]);
+        printf(",");
+    }
+    static const char *const names[6] = {"spacing", "grid", "upload", "normals", "robust",
+                                         "download"};
+    printf("\"points_stages_ms\":{");
+    for (int s = 0; s < 6; s++)
+        printf("%s\"%s\":%.3f", s ? "," : "", names[s], stages[s]);
+    printf("},\"points_identical\":%s}\n", identical ? "true" : "false");
+}
+
+static int bench_points(int argc, char **argv) {
+    points_bench b;
+    memset(&b, 0, sizeof b);
+    int code = points_args(argc, argv, &b);
+    double ms_context = 0;
+    if (code < 0 && (code = points_input(&b)) == EXIT_OK &&
+        (code = create_context(b.device, &b.ctx, &ms_context)) == EXIT_OK) {
+        double runs[3][100], stage[6][100], med[3], stages[6];
+        bool identical = true;
+        rsmooth_report r;
+        /* the three interleaved, so a busy machine slows each alike */
+        for (int i = 0; i <= b.repeat && code == EXIT_OK; i++) /* the first not counted */
+            for (int which = 0; which < 3 && code == EXIT_OK; which++) {
+                double ms = 0;
+                if (points_run_one(&b, which, &r, &ms) != RSMOOTH_OK) {
+                    code = EXIT_OTHER;
+                    break;
+                }
+                if (which == 0 && i == 0)
+                    memcpy(b.first, b.out, b.vertex_count * 3 * sizeof *b.out);
+                else if (which == 0)
+                    identical &= !memcmp(b.first, b.out, b.vertex_count * 3 * sizeof *b.out);
+                if (i == 0)
+                    continue;
+                runs[which][i - 1] = ms;
+                if (which == 0) { /* ms_facets: the passes' spacings and areas (k-d tree) */
+                    double s[6] = {r.ms_facets, r.ms_grid,   r.ms_upload,
+                                   r.ms_mollify + r.ms_normals, r.ms_robust, r.ms_download};
+                    for (int k = 0; k < 6; k++)
+                        stage[k][i - 1] = s[k];
+                }
+            }
+        if (code == EXIT_OK) {
+            for (int w = 0; w < 3; w++)
+                med[w] = median(runs[w], b.repeat);
+            for (int k = 0; k < 6; k++)
+                stages[k] = median(stage[k], b.repeat);
+            print_points_figures(&b, med, stages, identical);
+        }
+    }
+    rsmooth_context_destroy(b.ctx);
+    free(b.xyz), free(b.normals), free(b.out), free(b.first), free(b.indices);
+    return code;
+}
+
 int main(int argc, char **argv) {
     if (argc >= 2 && !strcmp(argv[1], "io"))
         return bench_io(argc, argv);
@@ -728,14 +932,16 @@ int main(int argc, char **argv) {
         return bench_filter(argc, argv);
     if (argc >= 2 && !strcmp(argv[1], "best"))
         return bench_best(argc, argv);
+    if (argc >= 2 && !strcmp(argv[1], "points"))
+        return bench_points(argc, argv);
     bool help = argc >= 2 && (!strcmp(argv[1], "-h") || !strcmp(argv[1], "--help"));
     fprintf(help ? stdout : stderr,
             "%s%s"
             "  rsmooth-bench best [MESH] ...: the best mode against the paper filter, stage by "
             "stage\n"
+            "  rsmooth-bench points ...: a point cloud on the device against the mesh filter\n"
             "Each prints one JSON object of figures on stdout, never a pass or fail; "
-            "'rsmooth-bench io --help',\n'rsmooth-bench filter --help' and 'rsmooth-bench best "
-            "--help' print one mode's help.\n",
+            "'rsmooth-bench MODE --help'\n(io, filter, best, points) prints one mode's help.\n",
             io_usage, filter_usage);
     return help ? EXIT_OK : EXIT_USAGE;
 }

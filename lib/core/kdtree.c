@@ -9,6 +9,10 @@
 
 /* Points per leaf: below this, scanning beats descending. */
 #define LEAF_SIZE 8
+/* Levels split on one thread before the subtrees below them are built on every core (16 of
+ * them: each is independent, so the tree is the same whatever the thread count). */
+#define SERIAL_LEVELS 4
+#define SUBTREES (1 << SERIAL_LEVELS)
 
 static double coordinate(const rs_kdtree *tree, uint32_t i, int axis) {
     return tree->xyz[3 * (size_t)i + (size_t)axis];
@@ -49,10 +53,11 @@ static void select_middle(const rs_kdtree *tree, uint32_t *order, size_t lo, siz
     }
 }
 
-/* Splits node `node` over order[lo, hi) along its widest axis, then its children. */
-static void build_node(rs_kdtree *tree, size_t node, size_t lo, size_t hi) {
+/* Splits node `node` over order[lo, hi) along its widest axis (a leaf stays whole): false for
+ * a leaf. */
+static bool split_node(rs_kdtree *tree, size_t node, size_t lo, size_t hi) {
     if (hi - lo <= LEAF_SIZE)
-        return;
+        return false;
     double min[3], max[3];
     for (int k = 0; k < 3; k++)
         min[k] = max[k] = coordinate(tree, tree->order[lo], k);
@@ -71,8 +76,41 @@ static void build_node(rs_kdtree *tree, size_t node, size_t lo, size_t hi) {
     select_middle(tree, tree->order, lo, hi, mid, axis);
     /* kept: building the right child moves another point to order[mid] */
     tree->split[node] = coordinate(tree, tree->order[mid], axis);
+    return true;
+}
+
+/* Splits node `node` over order[lo, hi), then its children. */
+static void build_node(rs_kdtree *tree, size_t node, size_t lo, size_t hi) {
+    if (!split_node(tree, node, lo, hi))
+        return;
+    size_t mid = lo + (hi - lo) / 2;
     build_node(tree, 2 * node + 1, lo, mid);
     build_node(tree, 2 * node + 2, mid, hi);
+}
+
+/* The nodes at depth SERIAL_LEVELS and the ranges they hold (empty below a leaf). */
+typedef struct subtrees {
+    rs_kdtree *tree;
+    size_t lo[SUBTREES], hi[SUBTREES];
+} subtrees;
+
+/* The levels above the subtrees, on one thread, recording the subtrees' ranges. */
+static void build_top(subtrees *sub, size_t node, size_t depth, size_t lo, size_t hi) {
+    if (depth == SERIAL_LEVELS) {
+        sub->lo[node - (SUBTREES - 1)] = lo;
+        sub->hi[node - (SUBTREES - 1)] = hi;
+    } else if (split_node(sub->tree, node, lo, hi)) {
+        size_t mid = lo + (hi - lo) / 2;
+        build_top(sub, 2 * node + 1, depth + 1, lo, mid);
+        build_top(sub, 2 * node + 2, depth + 1, mid, hi);
+    }
+}
+
+static void build_subtrees(void *ctx, size_t begin, size_t end, size_t chunk) {
+    subtrees *sub = ctx;
+    (void)chunk;
+    for (size_t i = begin; i < end; i++)
+        build_node(sub->tree, SUBTREES - 1 + i, sub->lo[i], sub->hi[i]);
 }
 
 bool rs_kdtree_build(rs_kdtree *tree, const double *xyz, size_t count) {
@@ -95,7 +133,11 @@ bool rs_kdtree_build(rs_kdtree *tree, const double *xyz, size_t count) {
     }
     for (size_t i = 0; i < count; i++)
         tree->order[i] = (uint32_t)i;
-    build_node(tree, 0, 0, count);
+    subtrees sub;
+    memset(&sub, 0, sizeof sub);
+    sub.tree = tree;
+    build_top(&sub, 0, 0, 0, count);
+    rs_parallel_for(SUBTREES, 1, build_subtrees, &sub);
     return true;
 }
 

@@ -119,11 +119,18 @@ typedef struct rs_run_stats {
 #define RS_DEVICE_BYTES_PER_COLOR_FACET 16
 #define RS_DEVICE_BYTES_PER_COLOR_VERTEX 20
 
-/* One run of the whole pipeline on `problem` (facet_count > 0). When its buffers would exceed
- * rs_cl_usable_memory or the device's largest allocation, returns RSMOOTH_ERROR_OUT_OF_MEMORY
- * with `*needed` set to the bytes it wanted, having run nothing. */
+/* One run of the whole pipeline on `problem` (facet_count > 0). A problem without indices is a
+ * point cloud's (reference/points.c): facet q is vertex q, with its centroid, normal and area
+ * given (problem->centroid, normal, area), and the normal filter the bilateral one or none. When
+ * its buffers would exceed rs_cl_usable_memory or the device's largest allocation, returns
+ * RSMOOTH_ERROR_OUT_OF_MEMORY with `*needed` set to the bytes it wanted, having run nothing. */
 rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *problem, const rs_result_sink *sink,
                          rs_run_stats *stats, uint64_t *needed, rsmooth_error *error);
+/* rs_cl_run that also writes the predictors' unit normals, 3 doubles per facet in the problem's
+ * facet order, to out_normals when the run filtered them (mollify on; untouched otherwise). */
+rsmooth_status rs_cl_run_normals(rsmooth_context *ctx, const rs_problem *problem,
+                                 const rs_result_sink *sink, double *out_normals,
+                                 rs_run_stats *stats, uint64_t *needed, rsmooth_error *error);
 
 /* The filter on `problem`: one run when it fits the device, else spatial tiles, each with the
  * facets within reach of its vertices' results (tiles.c). */

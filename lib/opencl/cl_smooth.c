@@ -205,22 +205,30 @@ static void pack_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
     for (size_t q = begin; q < end; q++) {
         uint32_t j = pk->facet_place[q];
         const double *c = job->centroid + 3 * q;
-        const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
-        double n[3], area = 0;
-        rs_triangle_normal(pb->xyz, tri, n, &area);
+        double n[3], area = 0, color[3] = {0, 0, 0};
+        if (pb->indices) {
+            const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
+            rs_triangle_normal(pb->xyz, tri, n, &area);
+            if (pb->colors)
+                rs_triangle_color(pb->colors, tri, color);
+        } else { /* a point: its own normal, area and colour */
+            for (int k = 0; k < 3; k++) {
+                n[k] = pb->normal[3 * q + k];
+                color[k] = pb->colors ? (double)pb->colors[3 * q + k] : 0;
+            }
+            area = pb->area[q];
+        }
         int32_t cell[3];
         rs_grid_facet_cell(job->grid, c, cell);
         cl_float4 cen = local_point(job->grid, c, cell);
-        /* the ratio in double: area and mean area apart could each leave float's range */
-        cen.s[3] = (float)log2(area / pb->mean_area);
+        /* the ratio in double: area and mean area apart could each leave float's range; a point
+         * of zero area (7 or more in one place) weighs as little as the kernels' exp2 can give */
+        cen.s[3] = area > 0 ? (float)log2(area / pb->mean_area) : (float)-LOCAL_CLAMP;
         pk->facet_centroid[j] = cen;
         pk->facet_normal[j] = (cl_float4){{(float)n[0], (float)n[1], (float)n[2], 0}};
-        if (pb->colors) {
-            double color[3];
-            rs_triangle_color(pb->colors, tri, color);
+        if (pb->colors)
             pk->facet_color[j] =
                 (cl_float4){{(float)color[0], (float)color[1], (float)color[2], 0}};
-        }
     }
 }
 
@@ -230,7 +238,9 @@ static void facet_slots(void *ctx, size_t begin, size_t end, size_t chunk) {
     packed *pk = job->pk;
     (void)chunk;
     for (size_t q = begin; q < end; q++) {
-        const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
+        /* a point is its own three corners (only the paper's mollification reads them) */
+        const uint32_t point[3] = {(uint32_t)q, (uint32_t)q, (uint32_t)q};
+        const uint32_t *tri = pb->indices ? pb->indices + 3 * (size_t)pb->facet_triangle[q] : point;
         for (int corner = 0; corner < 3; corner++)
             pk->facet_vertices[3 * q + corner] = pk->slot[tri[corner]];
     }
@@ -299,8 +309,13 @@ static void centroids_and_box(void *ctx, size_t begin, size_t end, size_t chunk)
     const rs_problem *pb = job->pb;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t q = begin; q < end; q++) {
-        rs_facet_centroid(pb, q, job->centroid + 3 * q);
-        const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
+        /* a point is its own centroid and its one vertex */
+        const uint32_t point[3] = {(uint32_t)q, (uint32_t)q, (uint32_t)q};
+        const uint32_t *tri = pb->indices ? pb->indices + 3 * (size_t)pb->facet_triangle[q] : point;
+        if (pb->indices)
+            rs_facet_centroid(pb, q, job->centroid + 3 * q);
+        else
+            memcpy(job->centroid + 3 * q, pb->centroid + 3 * q, 3 * sizeof(double));
         for (int c = 0; c < 3; c++)
             for (int k = 0; k < 3; k++) {
                 double x = pb->xyz[3 * (size_t)tri[c] + k];
@@ -374,6 +389,20 @@ static void store_results(void *ctx, size_t begin, size_t end, size_t chunk) {
     }
 }
 
+typedef struct normal_job {
+    const packed *pk;
+    const cl_float4 *normal; /* mapped: the predictors' normals, in grid order */
+    double *out;             /* 3 per facet, in the problem's order */
+} normal_job;
+
+static void store_normals(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const normal_job *job = ctx;
+    (void)chunk;
+    for (size_t q = begin; q < end; q++)
+        for (int k = 0; k < 3; k++)
+            job->out[3 * q + k] = (double)job->normal[job->pk->facet_place[q]].s[k];
+}
+
 /* One run on the device, its steps below in order: the host-side grid and packing, the buffers,
  * the predictors' normals, the robust pass, the results. */
 typedef struct cl_run {
@@ -388,6 +417,8 @@ typedef struct cl_run {
     uint64_t bilateral_pairs;
     cl_float *result, *extra; /* mapped results, per block, as block_result and block_extra */
     cl_uint *pairs;           /* and block_pairs */
+    double *out_normals;      /* the caller's, for the predictors' normals (optional) */
+    cl_float4 *normal_map;    /* and those normals, mapped when out_normals takes them */
     double t_start, t_grid, t_upload, t_mollify, t_normals, t_robust;
 } cl_run;
 
@@ -622,8 +653,16 @@ static rsmooth_status collect_results(cl_run *r, rs_run_stats *stats) {
     if (err == CL_SUCCESS)
         r->pairs = clEnqueueMapBuffer(ctx->queue, r->buf[BUF_BLOCK_PAIRS], CL_TRUE, CL_MAP_READ,
                                       0, nb * 2 * sizeof(cl_uint), 0, NULL, NULL, &err);
+    if (err == CL_SUCCESS && r->out_normals && pb->mollify)
+        r->normal_map = clEnqueueMapBuffer(ctx->queue, r->normals, CL_TRUE, CL_MAP_READ, 0,
+                                           pb->facet_count * sizeof(cl_float4), 0, NULL, NULL,
+                                           &err);
     if (err != CL_SUCCESS)
         return rs_cl_fail(r->error, err, "clEnqueueMapBuffer", ctx->device_name);
+    if (r->normal_map) {
+        normal_job nj = {&r->pk, r->normal_map, r->out_normals};
+        rs_parallel_for(pb->facet_count, PARALLEL_GRAIN, store_normals, &nj);
+    }
     result_job rj = {pb, r->sink, &r->pk, r->result, r->extra, r->grid.cell_size};
     rs_parallel_for(r->sink->core_count < nv ? r->sink->core_count : nv, PARALLEL_GRAIN,
                     store_results, &rj);
@@ -653,7 +692,9 @@ static void release_run(cl_run *r) {
         clEnqueueUnmapMemObject(ctx->queue, r->buf[BUF_BLOCK_EXTRA], r->extra, 0, NULL, NULL);
     if (r->pairs)
         clEnqueueUnmapMemObject(ctx->queue, r->buf[BUF_BLOCK_PAIRS], r->pairs, 0, NULL, NULL);
-    if (r->result || r->extra || r->pairs)
+    if (r->normal_map)
+        clEnqueueUnmapMemObject(ctx->queue, r->normals, r->normal_map, 0, NULL, NULL);
+    if (r->result || r->extra || r->pairs || r->normal_map)
         clFinish(ctx->queue);
     for (int b = 0; b < BUF_COUNT; b++)
         if (r->buf[b])
@@ -664,9 +705,16 @@ static void release_run(cl_run *r) {
 
 rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *pb, const rs_result_sink *sink,
                          rs_run_stats *stats, uint64_t *needed, rsmooth_error *error) {
+    return rs_cl_run_normals(ctx, pb, sink, NULL, stats, needed, error);
+}
+
+rsmooth_status rs_cl_run_normals(rsmooth_context *ctx, const rs_problem *pb,
+                                 const rs_result_sink *sink, double *out_normals,
+                                 rs_run_stats *stats, uint64_t *needed, rsmooth_error *error) {
     cl_run r;
     memset(&r, 0, sizeof r);
     r.ctx = ctx;
+    r.out_normals = out_normals;
     r.pb = pb;
     r.sink = sink;
     r.error = error;

@@ -1,8 +1,10 @@
 /* Point clouds with normals (beyond the paper): the reference filter with the points as its facets.
  * A point is a facet whose centroid is the point, whose plane is its tangent plane and whose area
  * is estimated from how far its nearest neighbours are; rs_reference_solve then runs the bilateral
- * normal filter and Eq. 3 on them unchanged. Points always take the bilateral filter when they
- * take one at all: the paper's mollification moves triangle corners, and points have none. */
+ * normal filter and Eq. 3 on them unchanged (the device's pass, api/points.c, runs the same
+ * problem through the mesh path's kernels instead). Points always take the bilateral filter when
+ * they take one at all: the paper's mollification moves triangle corners, and points have none. */
+#include "reference/points.h"
 #include "core/spatial.h"
 
 #include <math.h>
@@ -17,8 +19,6 @@
 #define LATTICE_AREA 0.86602540378443864676
 /* Points per chunk of the threaded neighbour search. */
 #define SPACING_GRAIN 4096
-
-static const char where[] = "rsmooth_smooth_points_reference";
 
 typedef struct spacing_job {
     const rs_kdtree *tree;
@@ -146,28 +146,12 @@ static void free_arrays(point_arrays *a) {
     rs_free(a->color);
 }
 
-static rsmooth_status smooth_points(rsmooth_scalar scalar, const void *positions,
-                                    const void *normals, size_t point_count,
-                                    const rsmooth_params *params, void *out_positions,
-                                    void *out_normals, float *out_confidence,
-                                    rsmooth_report *report, rsmooth_error *error);
-
-rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void *positions,
-                                               const void *normals, size_t point_count,
-                                               const rsmooth_params *params, void *out_positions,
-                                               void *out_normals, float *out_confidence,
-                                               rsmooth_report *report, rsmooth_error *error) {
-    size_t caller_size = report ? report->struct_size : 0; /* the report's fillers reset it */
-    rsmooth_status st = smooth_points(scalar, positions, normals, point_count, params,
-                                      out_positions, out_normals, out_confidence, report, error);
-    if (report)
-        report->struct_size = caller_size;
-    return st;
-}
-
 /* One call of smooth_points: the caller's inputs, the resolved parameters and the state its
  * steps share across the passes. */
 typedef struct points_run {
+    rs_points_solve_fn solve; /* a pass's filter: the reference path's or the device's */
+    void *solve_ctx;
+    const char *where; /* the public function called */
     rsmooth_scalar scalar;
     const void *positions, *normals; /* the caller's */
     size_t n;                        /* points */
@@ -187,33 +171,34 @@ typedef struct points_run {
 } points_run;
 
 static rsmooth_status no_memory(points_run *r) {
-    return rs_fail(r->error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for %zu points", r->n);
+    return rs_fail(r->error, RSMOOTH_ERROR_OUT_OF_MEMORY, r->where, "no memory for %zu points",
+                   r->n);
 }
 
 /* Resolves the parameters and checks the caller's arrays, before anything is allocated. */
 static rsmooth_status check_call(points_run *r, const rsmooth_params *params, void *out_positions,
                                  void *out_normals, float *out_confidence) {
     rsmooth_error *error = r->error;
-    rsmooth_status st = rs_params_resolve(params, &r->p, error, where);
+    rsmooth_status st = rs_params_resolve(params, &r->p, error, r->where);
     if (st != RSMOOTH_OK)
         return st;
-    if ((st = check_positions(r->scalar, r->positions, r->n, &r->scale, error, where)) !=
+    if ((st = check_positions(r->scalar, r->positions, r->n, &r->scale, error, r->where)) !=
         RSMOOTH_OK)
         return st;
-    if ((st = rs_check_colors(r->p.colors, r->n, error, where)) != RSMOOTH_OK)
+    if ((st = rs_check_colors(r->p.colors, r->n, error, r->where)) != RSMOOTH_OK)
         return st;
     if (!r->normals)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, r->where,
                        "normals is NULL: a point cloud needs a normal per point");
     for (size_t i = 0; i < r->n; i++) {
         double n[3];
         const char *wrong = unit_normal(r->scalar, r->normals, i, n);
         if (wrong)
-            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, r->where,
                            "point %zu has a %s normal", i, wrong);
     }
     if (!out_positions)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_positions is NULL");
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, r->where, "out_positions is NULL");
     /* Every input is read before any output is written, so outputs may be the inputs; but two
      * outputs in one place would mix. */
     size_t vec_bytes = r->n * rs_vertex_bytes(r->scalar);
@@ -221,7 +206,7 @@ static rsmooth_status check_call(points_run *r, const rsmooth_params *params, vo
     if (rs_ranges_overlap(out_positions, vec_bytes, out_normals, vec_bytes) ||
         rs_ranges_overlap(out_positions, vec_bytes, out_confidence, conf_bytes) ||
         rs_ranges_overlap(out_normals, vec_bytes, out_confidence, conf_bytes))
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, r->where,
                        "out_positions, out_normals and out_confidence overlap");
     return RSMOOTH_OK;
 }
@@ -289,7 +274,7 @@ static rsmooth_status pass_problem(points_run *r, int pass, rs_problem *pb) {
     pb->area = a->area;
     pb->mean_edge_length = r->input_spacing; /* what the report gives as the unit */
     pb->mean_area = area_sum / (double)n;
-    rsmooth_status st = rs_problem_apply_params(pb, &r->p, r->unit, r->error, where);
+    rsmooth_status st = rs_problem_apply_params(pb, &r->p, r->unit, r->error, r->where);
     if (st != RSMOOTH_OK)
         return st;
     pb->facet_color = pb->colors ? a->color : NULL;
@@ -337,7 +322,7 @@ static rsmooth_status run_pass(points_run *r, int pass) {
     double t_pass = rs_now_ms();
     r->pp.pass = pass;
     if (r->reports && rs_report_pass_progress(&r->pp, 0) != 0)
-        return rs_cancelled(r->error, where);
+        return rs_cancelled(r->error, r->where);
     rs_problem pb;
     rsmooth_status st = pass_problem(r, pass, &pb);
     if (st != RSMOOTH_OK)
@@ -350,8 +335,8 @@ static rsmooth_status run_pass(points_run *r, int pass) {
      * writes the normals it predicted with; with no facet to weigh, they stay the input's. */
     point_arrays *a = &r->a;
     memcpy(a->filtered, a->input_normal, r->n * 3 * sizeof(double));
-    st = rs_reference_solve(&pb, RSMOOTH_FLOAT64, a->next, NULL, a->confidence, a->filtered,
-                            r->report ? &r->one : NULL, t_pass, r->error, where);
+    st = r->solve(r->solve_ctx, &pb, a->next, a->confidence, a->filtered,
+                  r->report ? &r->one : NULL, t_pass, r->error, r->where);
     if (st != RSMOOTH_OK)
         return st;
     if (r->report) {
@@ -379,10 +364,11 @@ static rsmooth_status write_points(points_run *r, void *out_positions, void *out
         r->report->ms_total = rs_now_ms() - t_start;
     }
     return rs_check_results(r->scalar, out_positions, NULL, out_confidence, r->n, "point", r->error,
-                            where);
+                            r->where);
 }
 
-static rsmooth_status smooth_points(rsmooth_scalar scalar, const void *positions,
+static rsmooth_status smooth_points(rs_points_solve_fn solve, void *solve_ctx, const char *where,
+                                    rsmooth_scalar scalar, const void *positions,
                                     const void *normals, size_t point_count,
                                     const rsmooth_params *params, void *out_positions,
                                     void *out_normals, float *out_confidence,
@@ -391,6 +377,9 @@ static rsmooth_status smooth_points(rsmooth_scalar scalar, const void *positions
     rs_error_clear(error);
     points_run r;
     memset(&r, 0, sizeof r);
+    r.solve = solve;
+    r.solve_ctx = solve_ctx;
+    r.where = where;
     r.scalar = scalar;
     r.positions = positions;
     r.normals = normals;
@@ -418,4 +407,39 @@ done:
     free_arrays(&r.a);
     rs_release_free_memory();
     return st;
+}
+
+rsmooth_status rs_smooth_points_with(rs_points_solve_fn solve, void *solve_ctx, const char *where,
+                                     rsmooth_scalar scalar, const void *positions,
+                                     const void *normals, size_t point_count,
+                                     const rsmooth_params *params, void *out_positions,
+                                     void *out_normals, float *out_confidence,
+                                     rsmooth_report *report, rsmooth_error *error) {
+    size_t caller_size = report ? report->struct_size : 0; /* the report's fillers reset it */
+    rsmooth_status st =
+        smooth_points(solve, solve_ctx, where, scalar, positions, normals, point_count, params,
+                      out_positions, out_normals, out_confidence, report, error);
+    if (report)
+        report->struct_size = caller_size;
+    return st;
+}
+
+/* The reference path's pass: rs_reference_solve in double on the host. */
+static rsmooth_status reference_pass(void *ctx, const rs_problem *pb, double *out_next,
+                                     float *out_confidence, double *out_normals,
+                                     rsmooth_report *report, double t_start, rsmooth_error *error,
+                                     const char *where) {
+    (void)ctx;
+    return rs_reference_solve(pb, RSMOOTH_FLOAT64, out_next, NULL, out_confidence, out_normals,
+                              report, t_start, error, where);
+}
+
+rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void *positions,
+                                               const void *normals, size_t point_count,
+                                               const rsmooth_params *params, void *out_positions,
+                                               void *out_normals, float *out_confidence,
+                                               rsmooth_report *report, rsmooth_error *error) {
+    return rs_smooth_points_with(reference_pass, NULL, "rsmooth_smooth_points_reference", scalar,
+                                 positions, normals, point_count, params, out_positions,
+                                 out_normals, out_confidence, report, error);
 }
