@@ -13,10 +13,11 @@
  * mesh's distance from the origin or with the cycles (the drift table in docs/best-mode.md).
  *
  * The program holds these kernels twice (cl_program.c): in float (names ending _f) and, where the
- * device has cl_khr_fp64, in double (_d), which the host picks by default: REAL32 does not drift
+ * device has cl_khr_fp64, in double (_d), which the host picks by default: float32 does not drift
  * over the cycles, but a patch's score can come out of float on the other side of a near tie and
  * pick another guidance than the double host would (docs/best-mode.md, the drift table). REAL,
- * REAL3, REAL4 and STAGE_NAME are defined before each copy.
+ * REAL4 and STAGE_NAME are defined before each copy. Vectors are 4-wide with w = 0 wherever a
+ * 3-vector is meant (Oclgrind's uninitialised-value checker crashes on 3-wide ones).
  *
  * Buffers (REAL4 unless said; scaled units, near 1: normal_update.c):
  *   facet_vertex[f]   uint4 (a, b, c, 0): the facet's three vertices
@@ -33,63 +34,65 @@
 /* Facet geometry from the displacements: centroid, area, unit normal; a facet whose cross product
  * vanishes keeps what it had (rs_facets_update). */
 __kernel void STAGE_NAME(stage_facets)(uint facet_count, __global const uint4 *facet_vertex,
-                           __global const REAL4 *facet_rest, __global const REAL4 *rest_centroid,
-                           __global const REAL4 *d, __global REAL4 *centroid,
-                           __global REAL4 *shift, __global REAL4 *normal) {
+                                       __global const REAL4 *facet_rest,
+                                       __global const REAL4 *rest_centroid,
+                                       __global const REAL4 *d, __global REAL4 *centroid,
+                                       __global REAL4 *shift, __global REAL4 *normal) {
     uint f = get_global_id(0);
     if (f >= facet_count)
         return;
     uint4 t = facet_vertex[f];
     REAL4 da = d[t.x], db = d[t.y], dc = d[t.z];
-    REAL3 e1 = facet_rest[2 * (size_t)f].xyz + (db - da).xyz;
-    REAL3 e2 = facet_rest[2 * (size_t)f + 1].xyz + (dc - da).xyz;
-    REAL3 n = cross(e1, e2);
+    REAL4 n = cross(facet_rest[2 * (size_t)f] + (db - da), facet_rest[2 * (size_t)f + 1] + (dc - da));
     REAL len = sqrt(dot(n, n));
     if (!(len > 0))
         return;
-    REAL3 s = (da.xyz + db.xyz + dc.xyz) / 3;
-    normal[f] = (REAL4)(n / len, 0);
-    shift[f] = (REAL4)(s, 0);
-    centroid[f] = (REAL4)(rest_centroid[f].xyz + s, (REAL)0.5 * len);
+    REAL4 s = (da + db + dc) / 3, c = rest_centroid[f] + s;
+    c.w = (REAL)0.5 * len;
+    normal[f] = n / len;
+    shift[f] = s;
+    centroid[f] = c;
 }
 
 /* Step 1: facet j's patch: its area-weighted mean normal and its score Phi R. */
 __kernel void STAGE_NAME(stage_patch)(uint facet_count, __global const uint *patch_start,
-                          __global const uint *patch, __global const uint *edge_start,
-                          __global const uint *edge, __global const REAL4 *centroid,
-                          __global const REAL4 *normal_in, __global REAL4 *patch_mean,
-                          __global REAL *patch_score) {
+                                      __global const uint *patch, __global const uint *edge_start,
+                                      __global const uint *edge, __global const REAL4 *centroid,
+                                      __global const REAL4 *normal_in, __global REAL4 *patch_mean,
+                                      __global REAL *patch_score) {
     uint j = get_global_id(0);
     if (j >= facet_count)
         return;
     uint first = patch_start[j], end = patch_start[j + 1];
-    REAL3 mean = (REAL3)(0);
+    REAL4 mean = (REAL4)(0);
     REAL phi2 = 0, edge_max = 0, edge_sum = 0;
     for (uint a = first; a < end; a++) {
         uint fa = patch[a];
-        REAL3 na = normal_in[fa].xyz;
+        REAL4 na = normal_in[fa];
         mean += centroid[fa].w * na;
         for (uint b = a + 1; b < end; b++) {
-            REAL3 g = na - normal_in[patch[b]].xyz;
+            REAL4 g = na - normal_in[patch[b]];
             phi2 = fmax(phi2, dot(g, g));
         }
     }
     for (uint e = edge_start[j]; e < edge_start[j + 1]; e++) {
-        REAL3 g = normal_in[edge[2 * e]].xyz - normal_in[edge[2 * e + 1]].xyz;
+        REAL4 g = normal_in[edge[2 * e]] - normal_in[edge[2 * e + 1]];
         REAL gap = sqrt(dot(g, g));
         edge_max = fmax(edge_max, gap);
         edge_sum += gap;
     }
     REAL len = sqrt(dot(mean, mean));
-    patch_mean[j] = len > 0 ? (REAL4)(mean / len, 0) : normal_in[j];
+    patch_mean[j] = len > 0 ? mean / len : normal_in[j];
     patch_score[j] = sqrt(phi2) * edge_max / ((REAL)1e-9 + edge_sum);
 }
 
 /* Step 2: facet i's guidance, the mean normal of the lowest-scored patch holding it (ties to the
  * lowest index). */
 __kernel void STAGE_NAME(stage_guidance)(uint facet_count, __global const uint *patch_start,
-                             __global const uint *patch, __global const REAL *patch_score,
-                             __global const REAL4 *patch_mean, __global REAL4 *guidance) {
+                                         __global const uint *patch,
+                                         __global const REAL *patch_score,
+                                         __global const REAL4 *patch_mean,
+                                         __global REAL4 *guidance) {
     uint i = get_global_id(0);
     if (i >= facet_count)
         return;
@@ -109,44 +112,46 @@ __kernel void STAGE_NAME(stage_guidance)(uint facet_count, __global const uint *
 /* Step 3: the joint bilateral filter over facet i's neighbours, its range from the guidance.
  * Exponents in base 2 (inv_2s2 and inv_2t2 carry log2 e). */
 __kernel void STAGE_NAME(stage_filter)(uint facet_count, __global const uint *near_start,
-                           __global const uint *near, __global const REAL4 *centroid,
-                           __global const REAL4 *guidance, __global const REAL4 *normal_in,
-                           REAL inv_2s2, REAL inv_2t2, __global REAL4 *normal_out) {
+                                       __global const uint *near, __global const REAL4 *centroid,
+                                       __global const REAL4 *guidance,
+                                       __global const REAL4 *normal_in, REAL inv_2s2,
+                                       REAL inv_2t2, __global REAL4 *normal_out) {
     uint i = get_global_id(0);
     if (i >= facet_count)
         return;
-    REAL3 ci = centroid[i].xyz, gi = guidance[i].xyz, acc = (REAL3)(0);
+    REAL4 ci = centroid[i], gi = guidance[i], acc = (REAL4)(0);
     for (uint k = near_start[i]; k < near_start[i + 1]; k++) {
         uint q = near[k];
-        REAL4 cq = centroid[q];
-        REAL3 dc = cq.xyz - ci, dg = guidance[q].xyz - gi;
-        REAL w = cq.w * exp2(-(dot(dc, dc) * inv_2s2 + dot(dg, dg) * inv_2t2));
-        acc += w * normal_in[q].xyz;
+        REAL4 dc = centroid[q] - ci, dg = guidance[q] - gi;
+        REAL area = dc.w + ci.w; /* centroid[q].w, without a second load */
+        dc.w = 0;
+        REAL w = area * exp2(-(dot(dc, dc) * inv_2s2 + dot(dg, dg) * inv_2t2));
+        acc += w * normal_in[q];
     }
     REAL len = sqrt(dot(acc, acc));
-    normal_out[i] = len > 0 ? (REAL4)(acc / len, 0) : normal_in[i];
+    normal_out[i] = len > 0 ? acc / len : normal_in[i];
 }
 
 /* Sun et al.'s vertex update, Jacobi style: x += mean over the welded vertex's facets of
  * n_f (n_f . (c_f - x)), c_f - x = (input offset) + (centroid's shift) - (vertex's); a vertex
  * whose `mask` byte is 0 stays (mask_on 0: every vertex moves). */
 __kernel void STAGE_NAME(stage_vertex)(uint vertex_count, __global const uint *rep,
-                           __global const uint *rep_start, __global const uint *rep_facet,
-                           __global const REAL4 *rep_offset, __global const REAL4 *shift,
-                           __global const REAL4 *normal, __global const uchar *mask,
-                           int mask_on, __global const REAL4 *d_in, __global REAL4 *d_out) {
+                                       __global const uint *rep_start,
+                                       __global const uint *rep_facet,
+                                       __global const REAL4 *rep_offset,
+                                       __global const REAL4 *shift, __global const REAL4 *normal,
+                                       __global const uchar *mask, int mask_on,
+                                       __global const REAL4 *d_in, __global REAL4 *d_out) {
     uint v = get_global_id(0);
     if (v >= vertex_count)
         return;
-    REAL4 dv = d_in[v];
+    REAL4 dv = d_in[v], move = (REAL4)(0);
     uint r = rep[v], first = rep_start[r], end = rep_start[r + 1];
-    REAL3 move = (REAL3)(0);
     for (uint i = first; i < end; i++) {
         uint f = rep_facet[i];
-        REAL3 nf = normal[f].xyz;
-        REAL3 gap = rep_offset[i].xyz + shift[f].xyz - dv.xyz;
-        move += dot(nf, gap) * nf;
+        REAL4 nf = normal[f];
+        move += dot(nf, rep_offset[i] + shift[f] - dv) * nf;
     }
     bool moves = end > first && (!mask_on || mask[v]);
-    d_out[v] = moves ? (REAL4)(dv.xyz + move / (REAL)(end - first), 0) : dv;
+    d_out[v] = moves ? dv + move / (REAL)(end - first) : dv;
 }

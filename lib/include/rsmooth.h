@@ -462,7 +462,7 @@ typedef struct rsmooth_report {
     double region_filter_share;   /**< that choice's mean weight of the filter's result over the
                                    * vertices (1: the filter's result everywhere, 0: Taubin's);
                                    * 0 when discrepancy_iterations is 0 (added in 0.11) */
-    /** @name The normal-update stage (the best mode's; added in 0.12)
+    /** @name The normal-update stage (the best mode's; added in 0.11)
      * Its whole time is also in ms_normals. 0 when the call ran no stage. @{ */
     double ms_stage;              /**< the whole stage */
     double ms_stage_lists;        /**< facets, adjacency and the guided filter's lists (host) */

@@ -21,12 +21,12 @@ extern const size_t rs_kernel_common_size, rs_kernel_mollify_size, rs_kernel_bil
 
 /* stage.cl's types and kernel names, per copy (kernels/stage.cl) */
 static const char stage_float[] =
-    "#define REAL float\n#define REAL3 float3\n#define REAL4 float4\n"
+    "#define REAL float\n#define REAL4 float4\n"
     "#define STAGE_NAME(name) name##_f\n";
 static const char stage_double[] =
-    "#undef REAL\n#undef REAL3\n#undef REAL4\n#undef STAGE_NAME\n#ifdef cl_khr_fp64\n"
+    "#undef REAL\n#undef REAL4\n#undef STAGE_NAME\n#ifdef cl_khr_fp64\n"
     "#pragma OPENCL EXTENSION cl_khr_fp64 : enable\n"
-    "#define REAL double\n#define REAL3 double3\n#define REAL4 double4\n"
+    "#define REAL double\n#define REAL4 double4\n"
     "#define STAGE_NAME(name) name##_d\n";
 static const char stage_end[] = "\n#endif\n";
 
