@@ -327,11 +327,11 @@ printf '%s\n' "$listing" | tee -a "$LOG" >&2
 for t in cl_vs_reference cl_beyond; do
     if [ $BUILT_HERE = 1 ]; then
         # the ctest names; -V prints each test's own lines (its device, each case's deviation)
-        run_step "test $t" 200 - env RSMOOTH_KERNEL_VARIANT=gpu bash -c \
+        run_step "test $t" 240 - env RSMOOTH_KERNEL_VARIANT=gpu bash -c \
             'cd "$1" && ctest -R "^$2\$" --output-on-failure -V' ctest "$BUILD" "$t"
     else
         # a carried build's CTestTestfile names the folders of the machine it was built on
-        run_step "test $t" 200 - env RSMOOTH_KERNEL_VARIANT=gpu "$BUILD/tests/test_$t"
+        run_step "test $t" 240 - env RSMOOTH_KERNEL_VARIANT=gpu "$BUILD/tests/test_$t"
     fi
 done
 DEVICE_NAME=$(grep -m 1 -E '^([0-9]+: )?device: ' "$LOG" | sed -E 's/^([0-9]+: )?device: //; s/ \(program build.*//')
