@@ -295,7 +295,7 @@ lists_device() { # $1: output of --list-devices
 CANDIDATES=()
 [ -n "${RSMOOTH_OPENCL_LIBRARY:-}" ] && CANDIDATES+=("$RSMOOTH_OPENCL_LIBRARY")
 p=$(cached_library libOpenCL.so.1) && [ -n "$p" ] && CANDIDATES+=("$p")
-for p in /usr/local/cuda/lib64/libOpenCL.so.1 /usr/local/cuda/targets/x86_64-linux/lib/libOpenCL.so.1 \
+for p in /usr/local/cuda*/lib64/libOpenCL.so.1 /usr/local/cuda*/targets/x86_64-linux/lib/libOpenCL.so.1 \
     "$CARRY/lib/libOpenCL.so.1"; do
     [ -f "$p" ] && CANDIDATES+=("$p")
 done
