@@ -246,7 +246,7 @@ export POCL_CACHE_DIR=$TMP/pocl-cache RSMOOTH_CACHE_DIR=$TMP/rsmooth-cache
 mkdir -p "$RSMOOTH_CACHE_DIR" && chmod 700 "$RSMOOTH_CACHE_DIR"
 
 # --- build, or the carried build ------------------------------------------------------------------
-TARGETS="rsmooth_cli rsmooth_bench rsmooth_demo_shape test_cl_vs_reference test_cl_beyond"
+TARGETS="rsmooth_cli rsmooth_bench rsmooth_demo_shape test_cl_vs_reference test_cl_beyond test_cl_stage"
 BUILT_HERE=0
 if [ $SKIP_BUILD = 0 ]; then
     SHARED_ARG=()
@@ -270,7 +270,8 @@ if [ $SKIP_BUILD = 0 ]; then
     [ -z "$FAILED" ] && BUILT_HERE=1
 fi
 RSMOOTH=$BUILD/rsmooth BENCH=$BUILD/rsmooth-bench SHAPE=$BUILD/rsmooth-demo-shape
-for p in "$RSMOOTH" "$BENCH" "$BUILD/tests/test_cl_vs_reference" "$BUILD/tests/test_cl_beyond"; do
+for p in "$RSMOOTH" "$BENCH" "$BUILD/tests/test_cl_vs_reference" "$BUILD/tests/test_cl_beyond" \
+    "$BUILD/tests/test_cl_stage"; do
     [ -x "$p" ] || { FAILED+=" programs"; say "FAILED: $p is missing (build failed, or the carried build lacks it)"; }
 done
 if [ -n "$FAILED" ]; then
@@ -324,14 +325,20 @@ say "list-devices: ok in ${secs}s with the loader $LOADER:"
 printf '%s\n' "$listing" | tee -a "$LOG" >&2
 
 # --- the tests, GPU kernel variant ----------------------------------------------------------------
-for t in cl_vs_reference cl_beyond; do
+# cl_stage: the best mode's normal-update stage on the device against the host's, both kernel
+# variants itself, at its smaller sizes (RSMOOTH_TEST_SMALL: Fandisk0.3 of the meshes, drift to
+# 100 cycles) to fit the budget
+for t in cl_vs_reference cl_beyond cl_stage; do
+    small=0
+    [ "$t" = cl_stage ] && small=1
     if [ $BUILT_HERE = 1 ]; then
         # the ctest names; -V prints each test's own lines (its device, each case's deviation)
-        run_step "test $t" 240 - env RSMOOTH_KERNEL_VARIANT=gpu bash -c \
+        run_step "test $t" 240 - env RSMOOTH_KERNEL_VARIANT=gpu RSMOOTH_TEST_SMALL=$small bash -c \
             'cd "$1" && ctest -R "^$2\$" --output-on-failure -V' ctest "$BUILD" "$t"
     else
         # a carried build's CTestTestfile names the folders of the machine it was built on
-        run_step "test $t" 240 - env RSMOOTH_KERNEL_VARIANT=gpu "$BUILD/tests/test_$t"
+        run_step "test $t" 240 - env RSMOOTH_KERNEL_VARIANT=gpu RSMOOTH_TEST_SMALL=$small \
+            "$BUILD/tests/test_$t"
     fi
 done
 DEVICE_NAME=$(grep -m 1 -E '^([0-9]+: )?device: ' "$LOG" | sed -E 's/^([0-9]+: )?device: //; s/ \(program build.*//')
@@ -359,15 +366,10 @@ run_step "bench 200k" 90 "$OUT_DIR/bench-200k.json" "$BENCH" filter --triangles 
 run_step "bench 1M" 90 "$OUT_DIR/bench-1M.json" "$BENCH" filter --triangles 1000000 --repeat 5 \
     --no-pairs
 run_step "bench bunny" 90 "$OUT_DIR/bench-bunny.json" "$BENCH" filter "$BUNNY" --repeat 9
-# --best through the command (the bench has no best mode): its --json stage times, three runs
-BEST_RUNS=""
-for i in 1 2 3; do
-    if run_step "best bunny #$i" 90 "$TMP/best-$i.json" "$RSMOOTH" "$BUNNY" -o "$TMP/best.obj" -f \
-        --best --json --device "$DEVICE"; then
-        BEST_RUNS+="${BEST_RUNS:+,}$(cat "$TMP/best-$i.json")"
-    fi
-done
-printf '[%s]\n' "$BEST_RUNS" >"$OUT_DIR/best-bunny.json"
+# --best against the paper filter, its normal-update stage on the host and on the device (double
+# and float32), part by part, with the bytes moved and the device's deviation from the host's
+run_step "best bunny" 120 "$OUT_DIR/best-bunny.json" "$BENCH" best "$BUNNY" --repeat 3 \
+    --device "$DEVICE"
 # last: the largest, capped, so that a slow device still leaves the figures above
 run_step "bench 16M" "$CAP_16M" "$OUT_DIR/bench-16M.json" "$BENCH" filter --triangles 16000000 \
     --repeat 3 --no-pairs
@@ -376,7 +378,7 @@ run_step "bench 16M" "$CAP_16M" "$OUT_DIR/bench-16M.json" "$BENCH" filter --tria
 embed() { # the JSON file $1, or null when it is missing or empty
     if [ -s "$1" ]; then cat "$1"; else echo null; fi
 }
-for f in bench-200k bench-1M bench-16M bench-bunny; do # a step cut short leaves no JSON
+for f in bench-200k bench-1M bench-16M bench-bunny best-bunny; do # a step cut short: no JSON
     [ -s "$OUT_DIR/$f.json" ] || rm -f "$OUT_DIR/$f.json"
 done
 TOTAL=$(elapsed)
