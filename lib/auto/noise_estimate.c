@@ -63,6 +63,7 @@
  * the positions alone and the medians on the samples alone, so the result is the same on every
  * run and for any thread count. */
 #include "auto/noise_estimate.h"
+#include "auto/eigen3.h"
 #include "core/spatial.h"
 
 #include <math.h>
@@ -87,55 +88,6 @@
 static const char where[] = "rsmooth_estimate_noise";
 
 /* ---- small linear algebra ------------------------------------------------------------------- */
-
-/* Eigenvectors of a symmetric 3x3 matrix by cyclic Jacobi rotations: vectors[k] (rows) belongs to
- * values[k], ascending. */
-static void symmetric_eigen3(double m[3][3], double values[3], double vectors[3][3]) {
-    double a[3][3], v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-    memcpy(a, m, sizeof a);
-    for (int sweep = 0; sweep < 50; sweep++) {
-        double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
-        double diag = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
-        if (off <= 1e-30 * diag || off == 0)
-            break;
-        for (int p = 0; p < 2; p++)
-            for (int q = p + 1; q < 3; q++) {
-                if (a[p][q] == 0)
-                    continue;
-                double theta = (a[q][q] - a[p][p]) / (2 * a[p][q]);
-                double t = (theta >= 0 ? 1 : -1) / (fabs(theta) + sqrt(theta * theta + 1));
-                double c = 1 / sqrt(t * t + 1), s = t * c;
-                for (int k = 0; k < 3; k++) { /* A <- A J */
-                    double akp = a[k][p], akq = a[k][q];
-                    a[k][p] = c * akp - s * akq;
-                    a[k][q] = s * akp + c * akq;
-                }
-                for (int k = 0; k < 3; k++) { /* A <- J^T A */
-                    double apk = a[p][k], aqk = a[q][k];
-                    a[p][k] = c * apk - s * aqk;
-                    a[q][k] = s * apk + c * aqk;
-                }
-                for (int k = 0; k < 3; k++) { /* V <- V J (columns are the vectors) */
-                    double vkp = v[k][p], vkq = v[k][q];
-                    v[k][p] = c * vkp - s * vkq;
-                    v[k][q] = s * vkp + c * vkq;
-                }
-            }
-    }
-    int order[3] = {0, 1, 2};
-    for (int i = 0; i < 2; i++)
-        for (int j = i + 1; j < 3; j++)
-            if (a[order[j]][order[j]] < a[order[i]][order[i]]) {
-                int t = order[i];
-                order[i] = order[j];
-                order[j] = t;
-            }
-    for (int k = 0; k < 3; k++) {
-        values[k] = a[order[k]][order[k]];
-        for (int c = 0; c < 3; c++)
-            vectors[k][c] = v[c][order[k]];
-    }
-}
 
 /* Cholesky factor L (lower) of the symmetric positive definite m, and the reciprocals of its
  * diagonal; false when a pivot falls below 1e-10 of the largest diagonal entry (too few or
@@ -196,10 +148,6 @@ static double inverse_diagonal(double l[TERMS][TERMS], const double inv[TERMS], 
     for (int i = k; i < TERMS; i++)
         sum += y[i] * y[i];
     return sum;
-}
-
-void rs_noise_eigen3(double m[3][3], double values[3], double vectors[3][3]) {
-    symmetric_eigen3(m, values, vectors);
 }
 
 /* ---- the points: welded vertices with normals ------------------------------------------------ */
@@ -499,7 +447,7 @@ static bool ball_frame(const double *d, size_t n, const double centre[3], double
         for (int c = 0; c <= r; c++)
             cov[r][c] = cov[c][r] = second[r][c] - (double)count * centroid[r] * centroid[c];
     double values[3];
-    symmetric_eigen3(cov, values, axes);
+    rs_symmetric_eigen3(cov, values, axes);
     return true;
 }
 

@@ -52,8 +52,4 @@ rsmooth_status rs_estimate_noise_details(rsmooth_scalar scalar, const void *posi
                                          size_t triangle_count, rs_noise_details *out,
                                          rsmooth_error *error, const char *caller);
 
-/* The eigenvalues of the symmetric m (ascending) and their unit eigenvectors (vectors[i] for
- * values[i]): noise_estimate.c's PCA, shared with noise_scales.c. */
-void rs_noise_eigen3(double m[3][3], double values[3], double vectors[3][3]);
-
 #endif

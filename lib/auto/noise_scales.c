@@ -19,7 +19,7 @@
  * stripes >= 6 edges wide) is smooth on the scale of these fits and is read as shape, not noise;
  * the figures scatter by tens of per cent from mesh to mesh. */
 #include "auto/noise_scales.h"
-#include "auto/noise_estimate.h"
+#include "auto/eigen3.h"
 #include "core/rsmooth_internal.h"
 #include "core/spatial.h"
 
@@ -169,7 +169,7 @@ static bool sample_scales(scales_job *job, size_t s, double **buf, size_t *cap) 
     for (int r = 0; r < 3; r++)
         for (int k = 0; k <= r; k++)
             cov[r][k] = cov[k][r] = second[r][k] - sum[r] * sum[k] / (double)inner;
-    rs_noise_eigen3(cov, values, axes); /* axes[0]: the normal (smallest) */
+    rs_symmetric_eigen3(cov, values, axes); /* axes[0]: the normal (smallest) */
     for (size_t j = 0; j < n; j++) {
         double *d = *buf + 3 * j, t[3] = {rs_dot3(d, axes[1]), rs_dot3(d, axes[2]),
                                          rs_dot3(d, axes[0])};
