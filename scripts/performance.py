@@ -40,7 +40,7 @@ RUN_FILES = {"cold": "program-build-cold", "s1M": "scaling-1M", "s4M": "scaling-
              "s16M": "scaling-16M", "tiled": "scaling-16M-256M"}
 HEADLINE_FILES = {"bunny": "bunny0.2-2-0.5", "g200k": "generated-200k-4-1",
                   "best_bunny": "best-bunny0.2", "best_auto_bunny": "best-auto-bunny0.2",
-                  "best_200k": "best-200k"}
+                  "best_200k": "best-200k", "points_200k": "points-200k"}
 # Issue 26's targets on this machine class (PoCL's CPU device): (key, what, target, at most?)
 TARGETS = [("g200k", "paper filter, 200k triangles at σ 4/1", 70, True),
            ("bunny", "paper filter, Bunny0.2 at σ 2/0.5", 18, True),
@@ -49,7 +49,8 @@ TARGETS = [("g200k", "paper filter, 200k triangles at σ 4/1", 70, True),
            ("best", "`--best` on Bunny0.2, × the paper filter", 3, True),
            ("best_auto", "`--best --auto` on Bunny0.2, × the paper filter", 3, True),
            ("best_device", "`--best` on Bunny0.2, stage on the device, × paper", 3, True),
-           ("best_200k", "`--best` on 200k triangles, × the paper filter", 3, True)]
+           ("best_200k", "`--best` on 200k triangles, × the paper filter", 3, True),
+           ("points", "200k-point cloud on the device, × the mesh filter", 2, True)]
 
 
 def bench(build, name, args, env=None):
@@ -96,14 +97,14 @@ def has_mode(build, mode):
     return r.returncode == 0
 
 
-def best_bench(build, name, args):
-    """rsmooth-bench best: the best mode against the paper filter, its stage on the host and on
-    the device, in one run."""
-    cmd = [os.path.join(build, "rsmooth-bench"), "best"] + args
+def best_bench(build, name, args, mode="best"):
+    """rsmooth-bench best (the best mode against the paper filter, its stage on the host and on
+    the device, in one run) or points (a 200k-point cloud against the mesh filter)."""
+    cmd = [os.path.join(build, "rsmooth-bench"), mode] + args
     print("running:", " ".join(cmd), file=sys.stderr)
     out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
     result = json.loads(out)
-    result["command"] = "rsmooth-bench best " + " ".join(args)
+    result["command"] = f"rsmooth-bench {mode} " + " ".join(args)
     with open(os.path.join(OUT, name + ".json"), "w") as f:
         json.dump(result, f, indent=1)
     return result
@@ -137,6 +138,9 @@ def headline(build, tag):
                 [bunny, "--repeat", "3", "--auto"])
         out["best_200k"] = best_bench(build, f"{tag}-{HEADLINE_FILES['best_200k']}",
                                       ["--triangles", "200000", "--repeat", "1"])
+    if has_mode(build, "points"):
+        out["points_200k"] = best_bench(build, f"{tag}-{HEADLINE_FILES['points_200k']}",
+                                        ["--repeat", "5"], mode="points")
     with open(os.path.join(OUT, f"{tag}-headline.json"), "w") as f:
         json.dump({k: v for k, v in out.items() if not isinstance(v, dict)}, f, indent=1)
     return out
@@ -209,6 +213,8 @@ def target_figures(r):
     if "best_200k" in r:
         f["best_200k"] = min(r["best_200k"][m]["ratio_to_paper"]
                              for m in ("best_stage_host", "best_stage_device"))
+    if "points_200k" in r:
+        f["points"] = r["points_200k"]["points_over_mesh"]
     return f
 
 
