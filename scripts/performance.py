@@ -222,8 +222,8 @@ def targets_table(before, after):
     """Each figure beside its target, before and after."""
     b, a = target_figures(before), target_figures(after)
     fmt = lambda key, v: "–" if v is None else (f"{v:.2f}" if key == "ratio" else
-                                                f"{v:.1f}×" if key.startswith("best") else
-                                                f"{v:.0f} ms")
+                                                f"{v:.1f}×" if key.startswith("best") or
+                                                key == "points" else f"{v:.0f} ms")
     lines = ["| figure | target | before | after | met |", "| --- | --- | --- | --- | --- |"]
     for key, what, target, at_most in TARGETS:
         v = a.get(key)
