@@ -298,12 +298,28 @@ static void morton_keys(void *ctx, size_t begin, size_t end, size_t chunk) {
     }
 }
 
-/* The cells of the points in their new order. */
+/* The inverse of spread_bits: every third bit of x gathered into the low 21. */
+static uint64_t compact_bits(uint64_t x) {
+    x &= 0x1249249249249249ull;
+    x = (x | x >> 2) & 0x10c30c30c30c30c3ull;
+    x = (x | x >> 4) & 0x100f00f00f00f00full;
+    x = (x | x >> 8) & 0x1f0000ff0000ffull;
+    x = (x | x >> 16) & 0x1f00000000ffffull;
+    x = (x | x >> 32) & 0x1fffff;
+    return x;
+}
+
+/* The cells of the points in their new order, read back from the sorted keys (sequential and
+ * exact: cells fit the 21 bits per axis a key holds) rather than found again from the points. */
 static void ordered_cells(void *ctx, size_t begin, size_t end, size_t chunk) {
     const key_job *job = ctx;
+    int32_t m = job->grid->split + 1;
     (void)chunk;
-    for (size_t i = begin; i < end; i++)
-        rs_grid_cell_of(job->grid, job->points + 3 * (size_t)job->order[i], job->cells + 3 * i);
+    for (size_t i = begin; i < end; i++) {
+        uint64_t key = job->keys[i];
+        for (int k = 0; k < 3; k++)
+            job->cells[3 * i + k] = (int32_t)compact_bits(key >> (2 - k)) - m;
+    }
 }
 
 rsmooth_status rs_grid_order_points(const rs_grid *grid, const double *points, size_t count,
