@@ -206,25 +206,38 @@ static size_t cell_at(const rs_grid *grid, size_t j) {
     return lo;
 }
 
-/* Facets [begin, end) in grid order: each one's cell is the grid's (cell_coord), not found again
- * from its centroid, and its place is written in the same pass. */
-static void pack_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
+/* Facets [begin, end) in grid order: each one's place, and its cell's number left in its centroid's
+ * slot for pack_facets (it reads it back just before overwriting that slot, so the grid's cell is
+ * reused rather than found again from the centroid, at no extra memory or cache line). */
+static void place_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
     const facet_job *job = ctx;
-    const rs_problem *pb = job->pb;
     const rs_grid *grid = job->grid;
-    packed *pk = job->pk;
     (void)chunk;
     size_t cell = cell_at(grid, begin);
     for (size_t j = begin; j < end; j++) {
         while (grid->cell_start[cell + 1] <= j)
             cell++;
-        uint32_t q = grid->facet_order[j];
-        pk->facet_place[q] = (uint32_t)j;
-        const double *c = job->centroid + 3 * (size_t)q;
+        job->pk->facet_place[grid->facet_order[j]] = (uint32_t)j;
+        uint32_t number = (uint32_t)cell;
+        memcpy(&job->pk->facet_centroid[j], &number, sizeof number);
+    }
+}
+
+/* Facets [begin, end) in the caller's order (mostly coherent in memory: their corners are read
+ * here), written to their places in grid order. */
+static void pack_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const facet_job *job = ctx;
+    const rs_problem *pb = job->pb;
+    packed *pk = job->pk;
+    (void)chunk;
+    for (size_t q = begin; q < end; q++) {
+        uint32_t j = pk->facet_place[q], cell;
+        memcpy(&cell, &pk->facet_centroid[j], sizeof cell); /* place_facets' */
+        const double *c = job->centroid + 3 * q;
         const uint32_t *tri = pb->indices + 3 * (size_t)pb->facet_triangle[q];
         double n[3], area = 0;
         rs_triangle_normal(pb->xyz, tri, n, &area);
-        cl_float4 cen = local_point(grid, c, grid->cell_coord + 4 * cell);
+        cl_float4 cen = local_point(job->grid, c, job->grid->cell_coord + 4 * (size_t)cell);
         /* the ratio in double: area and mean area apart could each leave float's range */
         cen.s[3] = (float)log2(area / pb->mean_area);
         pk->facet_centroid[j] = cen;
@@ -268,11 +281,12 @@ static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, double **c
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth",
                        "no memory for device staging arrays");
 
-    /* What the pair loops read (centroid, normal) is written in grid order; the vertex slots,
-     * which only the per-facet normals kernel reads, stay in the caller's order, with `place` to
-     * find the rest. The centroids go before the blocks are packed: 24 bytes per facet less at
-     * that peak. */
+    /* Facets are read in the caller's order. What the pair loops read (centroid, normal) goes to
+     * its place in grid order; the vertex slots, which only the per-facet normals kernel reads,
+     * stay in the caller's order, with `place` to find the rest. The centroids go before the
+     * blocks are packed: 24 bytes per facet less at that peak. */
     facet_job job = {pb, grid, *centroid, pk};
+    rs_parallel_for(nf, PARALLEL_GRAIN, place_facets, &job);
     rs_parallel_for(nf, PARALLEL_GRAIN, pack_facets, &job);
     rs_free(*centroid);
     *centroid = NULL;
