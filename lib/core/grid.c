@@ -103,7 +103,7 @@ static int32_t *new_table(size_t count, uint32_t *mask) {
 }
 
 /* The columns of occupied cells (cells are sorted by x, then y, then z). */
-static bool build_columns(rs_grid *grid) {
+bool rs_grid_index_columns(rs_grid *grid) {
     size_t columns = 0;
     const int32_t *c = grid->cell_coord;
     for (size_t i = 0; i < grid->cell_count; i++)
@@ -209,16 +209,15 @@ rsmooth_status rs_grid_build_columns(rs_grid *grid, const double *points, size_t
                                      double reach, int split, const double lo[3],
                                      const double hi[3], rsmooth_error *error) {
     rsmooth_status st = sort_into_cells(grid, points, count, reach, split, lo, hi, error);
-    if (st == RSMOOTH_OK && !build_columns(grid))
+    if (st == RSMOOTH_OK && !rs_grid_index_columns(grid))
         return out_of_memory(grid, count, error);
     return st;
 }
 
 /* Facets sorted by cell, and the occupied cells with their first facets: what both lookups
  * (cells, columns) index. */
-static rsmooth_status sort_into_cells(rs_grid *grid, const double *points, size_t count,
-                                      double reach, int split, const double lo[3],
-                                      const double hi[3], rsmooth_error *error) {
+void rs_grid_layout(rs_grid *grid, double reach, int split, const double lo[3],
+                    const double hi[3]) {
     memset(grid, 0, sizeof *grid);
     grid->split = split;
     /* A hair wider than the reach: a point and a centroid exactly `reach` apart must never round
@@ -238,6 +237,12 @@ static rsmooth_status sort_into_cells(rs_grid *grid, const double *points, size_
         grid->dims[k] =
             (int32_t)(floor(hi[k] * grid->inv_cell_size) - grid->origin_cell[k]) + 1;
     }
+}
+
+static rsmooth_status sort_into_cells(rs_grid *grid, const double *points, size_t count,
+                                      double reach, int split, const double lo[3],
+                                      const double hi[3], rsmooth_error *error) {
+    rs_grid_layout(grid, reach, split, lo, hi);
 
     uint64_t *keys = rs_alloc_array(count, sizeof *keys);
     grid->facet_order = rs_alloc_array(count, sizeof *grid->facet_order);

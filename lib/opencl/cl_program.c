@@ -12,9 +12,11 @@ extern const unsigned char rs_kernel_common[], rs_kernel_mollify[], rs_kernel_bi
     rs_kernel_estimate[];
 extern const size_t rs_kernel_common_size, rs_kernel_mollify_size, rs_kernel_bilateral_size,
     rs_kernel_estimate_size;
+extern const unsigned char rs_kernel_grid[];
+extern const size_t rs_kernel_grid_size;
 
 /* The kernel files in the order they are compiled, after the prelude and the device's shape. */
-#define KERNEL_FILES 4
+#define KERNEL_FILES 5
 
 /* Constants the host and kernels must agree on. Runtime values (sigmas, counts) are kernel
  * arguments, so changing them never rebuilds the program. */
@@ -61,17 +63,18 @@ static char *read_text_file(const char *dir, const char *name, size_t *size) {
 
 static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *error) {
     static const char *const names[KERNEL_FILES] = {"common.cl", "mollify.cl", "bilateral.cl",
-                                                    "estimate.cl"};
+                                                    "estimate.cl", "grid.cl"};
     /* the variant this device runs (cl_variant.c): its vector width and work-group size */
     char shape[96];
     snprintf(shape, sizeof shape, "#define RS_LANES %u\n#define RS_GROUP %zu\n", ctx->lanes,
              ctx->local_size);
     const char *sources[KERNEL_FILES + 2] = {
         prelude, shape, (const char *)rs_kernel_common, (const char *)rs_kernel_mollify,
-        (const char *)rs_kernel_bilateral, (const char *)rs_kernel_estimate};
+        (const char *)rs_kernel_bilateral, (const char *)rs_kernel_estimate,
+        (const char *)rs_kernel_grid};
     size_t sizes[KERNEL_FILES + 2] = {sizeof prelude - 1, strlen(shape), rs_kernel_common_size,
                                       rs_kernel_mollify_size, rs_kernel_bilateral_size,
-                                      rs_kernel_estimate_size};
+                                      rs_kernel_estimate_size, rs_kernel_grid_size};
     char *loaded[KERNEL_FILES] = {NULL};
     rsmooth_status st = RSMOOTH_OK;
     const char *dir = getenv("RSMOOTH_KERNEL_DIR");
@@ -137,7 +140,14 @@ kernels:;
         [RS_KERNEL_MOLLIFY] = "mollify_block",
         [RS_KERNEL_NORMALS] = "mollified_facet_normal",
         [RS_KERNEL_BILATERAL] = "bilateral_cell_normals",
-        [RS_KERNEL_ROBUST] = "robust_block"};
+        [RS_KERNEL_ROBUST] = "robust_block",
+        [RS_KERNEL_GRID_ZERO] = "grid_zero",
+        [RS_KERNEL_GRID_COUNT] = "grid_count",
+        [RS_KERNEL_GRID_CHUNK_SUMS] = "grid_chunk_sums",
+        [RS_KERNEL_GRID_CHUNK_SCAN] = "grid_chunk_scan",
+        [RS_KERNEL_GRID_CELLS] = "grid_cells",
+        [RS_KERNEL_GRID_SCATTER] = "grid_scatter",
+        [RS_KERNEL_GRID_SORT_CELLS] = "grid_sort_cells"};
     for (int k = 0; k < RS_KERNEL_COUNT; k++) {
         ctx->kernels[k] = clCreateKernel(ctx->program, kernel_names[k], &err);
         if (err != CL_SUCCESS) {

@@ -4,6 +4,7 @@
  * of the cell size, relative to a nearby cell's corner (see kernels/common.cl), so precision does
  * not depend on where the mesh sits; displacements return to double before they are added. */
 #include "opencl/cl_run.h"
+#include "opencl/cl_grid.h"
 
 #include <float.h>
 #include <math.h>
@@ -341,8 +342,8 @@ static void centroids_and_box(void *ctx, size_t begin, size_t end, size_t chunk)
     }
 }
 
-static rsmooth_status build_grid(const rs_problem *pb, rs_grid *grid, double **centroid_out,
-                                 rsmooth_error *error) {
+static rsmooth_status build_grid(rsmooth_context *ctx, const rs_problem *pb, rs_grid *grid,
+                                 double **centroid_out, rsmooth_error *error) {
     size_t nf = pb->facet_count, chunks = rs_parallel_chunks(nf, PARALLEL_GRAIN);
     double *centroid = rs_alloc_array(nf, 3 * sizeof *centroid);
     double(*box)[6] = rs_alloc_array(chunks, sizeof *box);
@@ -360,8 +361,16 @@ static rsmooth_status build_grid(const rs_problem *pb, rs_grid *grid, double **c
             lo[k] = box[c][k] < lo[k] ? box[c][k] : lo[k];
             hi[k] = box[c][3 + k] > hi[k] ? box[c][3 + k] : hi[k];
         }
-    rsmooth_status st = rs_grid_build_columns(grid, centroid, nf, pb->radius, cells_per_reach(pb),
-                                              lo, hi, error);
+    /* on the device where it sorts faster (rs_cl_device_grid), else (or where it declines the
+     * grid) on the host: the same grid either way */
+    int split = cells_per_reach(pb);
+    bool done = false;
+    rsmooth_status st = RSMOOTH_OK;
+    if (rs_cl_device_grid(ctx))
+        st = rs_cl_grid_build_columns(ctx, grid, centroid, nf, pb->radius, split, lo, hi, &done,
+                                      error);
+    if (st == RSMOOTH_OK && !done)
+        st = rs_grid_build_columns(grid, centroid, nf, pb->radius, split, lo, hi, error);
     *centroid_out = centroid;
     rs_free(box);
     return st;
@@ -423,7 +432,7 @@ static const char where[] = "rsmooth_smooth";
 /* The grid and the packed facets and vertex blocks, on the host. */
 static rsmooth_status prepare_host(cl_run *r) {
     double *centroid = NULL; /* build_grid's, for pack */
-    rsmooth_status st = build_grid(r->pb, &r->grid, &centroid, r->error);
+    rsmooth_status st = build_grid(r->ctx, r->pb, &r->grid, &centroid, r->error);
     if (st == RSMOOTH_OK)
         st = pack(r->pb, &r->grid, &centroid, r->ctx->lanes, &r->pk, r->error);
     rs_free(centroid);
