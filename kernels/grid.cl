@@ -17,7 +17,7 @@
  *                     host's stable sort gives whatever order the atomics took.
  * Cell lookups need double (cl_khr_fp64): without it the kernels are empty and never launched. */
 
-kernel void grid_zero(uint dense, global uint *cell_facets) {
+__kernel void grid_zero(uint dense, __global uint *cell_facets) {
     size_t d = get_global_id(0);
     if (d < dense)
         cell_facets[d] = 0;
@@ -26,9 +26,9 @@ kernel void grid_zero(uint dense, global uint *cell_facets) {
 #ifdef cl_khr_fp64
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 
-kernel void grid_count(uint count, double inv_h, double origin_x, double origin_y,
-                       double origin_z, int dx, int dy, int dz, global const double *points,
-                       global uint *key, global volatile uint *cell_facets) {
+__kernel void grid_count(uint count, double inv_h, double origin_x, double origin_y,
+                         double origin_z, int dx, int dy, int dz, __global const double *points,
+                         __global uint *key, __global volatile uint *cell_facets) {
     size_t i = get_global_id(0);
     if (i >= count)
         return;
@@ -48,15 +48,14 @@ kernel void grid_count(uint count, double inv_h, double origin_x, double origin_
 
 #else
 
-kernel void grid_count(uint count, float inv_h, float origin_x, float origin_y, float origin_z,
-                       int dx, int dy, int dz, global const float *points, global uint *key,
-                       global volatile uint *cell_facets) {
-}
+__kernel void grid_count(uint count, float inv_h, float origin_x, float origin_y, float origin_z,
+                         int dx, int dy, int dz, __global const float *points, __global uint *key,
+                         __global volatile uint *cell_facets) {}
 
 #endif
 
-kernel void grid_chunk_sums(uint dense, uint chunk, global const uint *cell_facets,
-                            global uint2 *chunk_sum) {
+__kernel void grid_chunk_sums(uint dense, uint chunk, __global const uint *cell_facets,
+                              __global uint2 *chunk_sum) {
     size_t g = get_global_id(0);
     size_t begin = g * chunk;
     if (begin >= dense)
@@ -71,8 +70,8 @@ kernel void grid_chunk_sums(uint dense, uint chunk, global const uint *cell_face
     chunk_sum[g] = sum;
 }
 
-kernel void grid_chunk_scan(uint chunks, global uint2 *chunk_sum, global uint *occupied,
-                            global uint *cell_start) {
+__kernel void grid_chunk_scan(uint chunks, __global uint2 *chunk_sum, __global uint *occupied,
+                              __global uint *cell_start) {
     if (get_global_id(0) != 0)
         return;
     uint2 run = (uint2)(0, 0);
@@ -85,30 +84,40 @@ kernel void grid_chunk_scan(uint chunks, global uint2 *chunk_sum, global uint *o
     cell_start[run.y] = run.x; /* the end of the last cell's range */
 }
 
-kernel void grid_cells(uint dense, uint chunk, int dy, int dz, global const uint *cell_facets,
-                       global const uint2 *chunk_sum, global uint *cursor, global int4 *cell_coord,
-                       global uint *cell_start) {
+__kernel void grid_cells(uint dense, uint chunk, int dy, int dz, __global const uint *cell_facets,
+                         __global const uint2 *chunk_sum, __global uint *cursor,
+                         __global int4 *cell_coord, __global uint *cell_start) {
     size_t g = get_global_id(0);
     size_t begin = g * chunk;
     if (begin >= dense)
         return;
     size_t end = min(begin + chunk, (size_t)dense);
     uint2 run = chunk_sum[g];
+    /* the chunk's first cell's coordinates, then stepped along z (divisions once per chunk, and
+     * no remainder, whose pairing with a division Oclgrind cannot run) */
+    uint yx = (uint)begin / (uint)dz, x = yx / (uint)dy;
+    int4 at = (int4)((int)x, (int)(yx - x * (uint)dy), (int)((uint)begin - yx * (uint)dz), 0);
     for (size_t d = begin; d < end; d++) {
         uint n = cell_facets[d];
         cursor[d] = run.x;
         if (n > 0) {
-            uint z = (uint)(d % (uint)dz), yx = (uint)(d / (uint)dz);
-            cell_coord[run.y] = (int4)((int)(yx / (uint)dy), (int)(yx % (uint)dy), (int)z, 0);
+            cell_coord[run.y] = at;
             cell_start[run.y] = run.x;
             run.y++;
         }
         run.x += n;
+        if (++at.z == dz) {
+            at.z = 0;
+            if (++at.y == dy) {
+                at.y = 0;
+                at.x++;
+            }
+        }
     }
 }
 
-kernel void grid_scatter(uint count, global const uint *key, global volatile uint *cursor,
-                         global uint *order) {
+__kernel void grid_scatter(uint count, __global const uint *key, __global volatile uint *cursor,
+                           __global uint *order) {
     size_t i = get_global_id(0);
     if (i >= count)
         return;
@@ -116,7 +125,7 @@ kernel void grid_scatter(uint count, global const uint *key, global volatile uin
 }
 
 /* Sifts a[root] down the max-heap a[0 .. n). */
-inline void sift_down(global uint *a, uint root, uint n) {
+inline void sift_down(__global uint *a, uint root, uint n) {
     uint v = a[root];
     for (;;) {
         uint child = 2 * root + 1;
@@ -134,11 +143,11 @@ inline void sift_down(global uint *a, uint root, uint n) {
 
 /* Cells are mostly a few dozen facets (insertion sort); a mesh far finer than the reach can put
  * thousands in one, which heapsort keeps at n log n without recursion or scratch. */
-kernel void grid_sort_cells(uint cells, global const uint *cell_start, global uint *order) {
+__kernel void grid_sort_cells(uint cells, __global const uint *cell_start, __global uint *order) {
     size_t c = get_global_id(0);
     if (c >= cells)
         return;
-    global uint *a = order + cell_start[c];
+    __global uint *a = order + cell_start[c];
     uint n = cell_start[c + 1] - cell_start[c];
     if (n <= 32) {
         for (uint i = 1; i < n; i++) {

@@ -51,9 +51,9 @@ static void check_grid(rsmooth_context *ctx, const char *name, const double *poi
     rsmooth_error err;
     CHECK_STATUS(rs_grid_build_columns(&host, points, n, reach, split, lo, hi, &err), RSMOOTH_OK);
     bool done = false;
-    CHECK_STATUS(rs_cl_grid_build_columns(ctx, &device, points, n, reach, split, lo, hi, &done,
-                                          &err),
-                 RSMOOTH_OK);
+    CHECK_STATUS(
+        rs_cl_grid_build_columns(ctx, &device, points, n, reach, split, lo, hi, &done, &err),
+        RSMOOTH_OK);
     CHECK(done);
     size_t cells = host.cell_count, largest = 0;
     for (size_t c = 0; c < cells; c++) {
@@ -72,8 +72,7 @@ static void check_grid(rsmooth_context *ctx, const char *name, const double *poi
     CHECK(same(device.facet_order, host.facet_order, n * sizeof(uint32_t)));
     CHECK(device.column_count == host.column_count);
     CHECK(device.column_mask == host.column_mask);
-    CHECK(same(device.column_first, host.column_first,
-               (host.column_count + 1) * sizeof(uint32_t)));
+    CHECK(same(device.column_first, host.column_first, (host.column_count + 1) * sizeof(uint32_t)));
     CHECK(same(device.column_table, host.column_table,
                ((size_t)host.column_mask + 1) * sizeof(int32_t)));
     rs_grid_free(&host);
@@ -91,10 +90,10 @@ static void mesh_centroids(rsmooth_context *ctx) {
     CHECK(c != NULL);
     for (size_t t = 0; t < n; t++)
         for (int k = 0; k < 3; k++)
-            c[3 * t + k] = (mesh.xyz[3 * mesh.indices[3 * t] + k] +
-                            mesh.xyz[3 * mesh.indices[3 * t + 1] + k] +
-                            mesh.xyz[3 * mesh.indices[3 * t + 2] + k]) /
-                           3;
+            c[3 * t + k] =
+                (mesh.xyz[3 * mesh.indices[3 * t] + k] + mesh.xyz[3 * mesh.indices[3 * t + 1] + k] +
+                 mesh.xyz[3 * mesh.indices[3 * t + 2] + k]) /
+                3;
     for (int split = 1; split <= 3; split++)
         check_grid(ctx, "cylinder centroids", c, n, 8 * edge, split);
     free(c);
@@ -120,8 +119,9 @@ static void point_sets(rsmooth_context *ctx) {
         for (int k = 0; k < 3; k++) {
             double x = ((double)(next_u64(&seed) % 21) - 10.0) * probe.cell_size;
             int side = (int)(next_u64(&seed) % 3);
-            p[3 * i + k] = side == 0 ? x : side == 1 ? nextafter(x, -INFINITY)
-                                                     : nextafter(x, INFINITY);
+            p[3 * i + k] = side == 0   ? x
+                           : side == 1 ? nextafter(x, -INFINITY)
+                                       : nextafter(x, INFINITY);
         }
     check_grid(ctx, "on cell boundaries", p, n, 0.1, 1);
 
@@ -162,15 +162,14 @@ static void whole_filter(rsmooth_context *ctx) {
         setenv("RSMOOTH_DEVICE_GRID", device ? "1" : "0", 1);
         rsmooth_error err;
         CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, mesh.xyz, nv, mesh.indices,
-                                    mesh.triangle_count, &params, out[device], weight[device],
-                                    NULL, NULL, &err),
+                                    mesh.triangle_count, &params, out[device], weight[device], NULL,
+                                    NULL, &err),
                      RSMOOTH_OK);
     }
     unsetenv("RSMOOTH_DEVICE_GRID");
     bool equal = memcmp(out[0], out[1], 3 * nv * sizeof(double)) == 0 &&
                  memcmp(weight[0], weight[1], nv * sizeof(float)) == 0;
-    printf("whole filter, %zu vertices: device grid %s host grid\n", nv,
-           equal ? "==" : "!=");
+    printf("whole filter, %zu vertices: device grid %s host grid\n", nv, equal ? "==" : "!=");
     CHECK(equal);
     for (int i = 0; i < 2; i++) {
         free(out[i]);

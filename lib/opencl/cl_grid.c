@@ -23,8 +23,8 @@ enum { G_POINTS, G_KEY, G_FACETS, G_CURSOR, G_CHUNKS, G_OCCUPIED, G_COORD, G_STA
 
 static bool has_fp64(const rsmooth_context *ctx) {
     cl_device_fp_config config = 0;
-    return clGetDeviceInfo(ctx->device, CL_DEVICE_DOUBLE_FP_CONFIG, sizeof config, &config,
-                           NULL) == CL_SUCCESS &&
+    return clGetDeviceInfo(ctx->device, CL_DEVICE_DOUBLE_FP_CONFIG, sizeof config, &config, NULL) ==
+               CL_SUCCESS &&
            config != 0;
 }
 
@@ -35,9 +35,9 @@ bool rs_cl_device_grid(const rsmooth_context *ctx) {
         want = forced[0] == '1';
     } else {
         cl_device_type type = 0;
-        want = clGetDeviceInfo(ctx->device, CL_DEVICE_TYPE, sizeof type, &type, NULL) ==
-                   CL_SUCCESS &&
-               (type & CL_DEVICE_TYPE_GPU);
+        want =
+            clGetDeviceInfo(ctx->device, CL_DEVICE_TYPE, sizeof type, &type, NULL) == CL_SUCCESS &&
+            (type & CL_DEVICE_TYPE_GPU);
     }
     return want && has_fp64(ctx);
 }
@@ -61,18 +61,21 @@ typedef struct device_sort {
 static cl_int create_buffers(device_sort *ds) {
     rsmooth_context *ctx = ds->ctx;
     size_t n = ds->count, cells = ds->count < ds->dense ? ds->count : ds->dense;
-    const size_t size[G_N] = {
-        [G_POINTS] = 3 * n * sizeof(cl_double), [G_KEY] = n * sizeof(cl_uint),
-        [G_FACETS] = ds->dense * sizeof(cl_uint), [G_CURSOR] = ds->dense * sizeof(cl_uint),
-        [G_CHUNKS] = ds->chunks * sizeof(cl_uint2), [G_OCCUPIED] = sizeof(cl_uint),
-        [G_COORD] = cells * sizeof(cl_int4), [G_START] = (cells + 1) * sizeof(cl_uint),
-        [G_ORDER] = n * sizeof(cl_uint)};
+    const size_t size[G_N] = {[G_POINTS] = 3 * n * sizeof(cl_double),
+                              [G_KEY] = n * sizeof(cl_uint),
+                              [G_FACETS] = ds->dense * sizeof(cl_uint),
+                              [G_CURSOR] = ds->dense * sizeof(cl_uint),
+                              [G_CHUNKS] = ds->chunks * sizeof(cl_uint2),
+                              [G_OCCUPIED] = sizeof(cl_uint),
+                              [G_COORD] = cells * sizeof(cl_int4),
+                              [G_START] = (cells + 1) * sizeof(cl_uint),
+                              [G_ORDER] = n * sizeof(cl_uint)};
     cl_int err = CL_SUCCESS;
     for (int b = 0; b < G_N && err == CL_SUCCESS; b++) {
         bool input = b == G_POINTS;
         cl_mem_flags flags = input ? CL_MEM_READ_ONLY | rs_cl_input_flags(ctx) : CL_MEM_READ_WRITE;
-        ds->buf[b] = clCreateBuffer(ctx->context, flags, size[b],
-                                    input ? (void *)ds->points : NULL, &err);
+        ds->buf[b] =
+            clCreateBuffer(ctx->context, flags, size[b], input ? (void *)ds->points : NULL, &err);
     }
     return err;
 }
@@ -146,18 +149,16 @@ static cl_int read_back(device_sort *ds, bool *no_memory) {
     return err == CL_SUCCESS ? finished : err;
 }
 
-rsmooth_status rs_cl_grid_build_columns(rsmooth_context *ctx, rs_grid *grid,
-                                        const double *points, size_t count, double reach,
-                                        int split, const double lo[3], const double hi[3],
-                                        bool *done, rsmooth_error *error) {
+rsmooth_status rs_cl_grid_build_columns(rsmooth_context *ctx, rs_grid *grid, const double *points,
+                                        size_t count, double reach, int split, const double lo[3],
+                                        const double hi[3], bool *done, rsmooth_error *error) {
     *done = false;
     rs_grid_layout(grid, reach, split, lo, hi);
     uint64_t dense = (uint64_t)grid->dims[0] * (uint64_t)grid->dims[1] * (uint64_t)grid->dims[2];
     uint64_t bytes = 8 * dense + 36 * (uint64_t)count;
-    if (count == 0 || count > UINT32_MAX / 2 || dense > DENSE_PER_FACET * (uint64_t)count +
-                                                           DENSE_SLACK ||
-        dense > (1u << 31) || 4 * dense > ctx->max_allocation ||
-        bytes > rs_cl_usable_memory(ctx) || !has_fp64(ctx))
+    if (count == 0 || count > UINT32_MAX / 2 ||
+        dense > DENSE_PER_FACET * (uint64_t)count + DENSE_SLACK || dense > (1u << 31) ||
+        4 * dense > ctx->max_allocation || bytes > rs_cl_usable_memory(ctx) || !has_fp64(ctx))
         return RSMOOTH_OK; /* the host's sort, then */
     device_sort ds = {ctx, grid, points, (cl_uint)count, (cl_uint)dense, SCAN_CHUNK, 0, {NULL}};
     if (dense / SCAN_CHUNK >= MAX_CHUNKS)

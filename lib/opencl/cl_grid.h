@@ -14,9 +14,8 @@ bool rs_cl_device_grid(const rsmooth_context *ctx);
  * empty) where the device does not take this grid: no facet, no double precision, or a box of
  * cells far larger than the facets (the counts are dense); the caller then builds it on the
  * host. On failure *grid is freed. Holds ctx's queue: the caller holds ctx's lock. */
-rsmooth_status rs_cl_grid_build_columns(rsmooth_context *ctx, rs_grid *grid,
-                                        const double *points, size_t count, double reach,
-                                        int split, const double lo[3], const double hi[3],
-                                        bool *done, rsmooth_error *error);
+rsmooth_status rs_cl_grid_build_columns(rsmooth_context *ctx, rs_grid *grid, const double *points,
+                                        size_t count, double reach, int split, const double lo[3],
+                                        const double hi[3], bool *done, rsmooth_error *error);
 
 #endif /* RSMOOTH_CL_GRID_H */
