@@ -178,9 +178,31 @@ static void whole_filter(rsmooth_context *ctx) {
     shape_free(&mesh);
 }
 
-int main(void) {
+/* A context made while RSMOOTH_DEVICE_GRID says no on a CPU device has no grid kernels: forced
+ * later, the device declines (the host sorts) rather than fail. */
+static void without_kernels(void) {
+    unsetenv("RSMOOTH_DEVICE_GRID");
     rsmooth_context *ctx = open_test_context();
+    bool made_with = rs_cl_device_grid(ctx); /* a GPU's program holds them anyway */
     setenv("RSMOOTH_DEVICE_GRID", "1", 1);
+    double p[6] = {0, 0, 0, 0.5, 0.5, 0.5}, lo[3] = {0, 0, 0}, hi[3] = {0.5, 0.5, 0.5};
+    rs_grid grid;
+    rsmooth_error err;
+    bool done = true;
+    CHECK_STATUS(rs_cl_grid_build_columns(ctx, &grid, p, 2, 1.0, 1, lo, hi, &done, &err),
+                 RSMOOTH_OK);
+    printf("forced on a context made without it: %s\n",
+           done ? "sorted on the device" : "declined (host sorts it)");
+    CHECK(done == made_with);
+    rs_grid_free(&grid);
+    unsetenv("RSMOOTH_DEVICE_GRID");
+    rsmooth_context_destroy(ctx);
+}
+
+int main(void) {
+    /* set before the context: its program then holds the grid's kernels (cl_program.c) */
+    setenv("RSMOOTH_DEVICE_GRID", "1", 1);
+    rsmooth_context *ctx = open_test_context();
     bool usable = rs_cl_device_grid(ctx);
     unsetenv("RSMOOTH_DEVICE_GRID");
     if (!usable) {
@@ -192,6 +214,7 @@ int main(void) {
     point_sets(ctx);
     whole_filter(ctx);
     rsmooth_context_destroy(ctx);
+    without_kernels();
     printf("device grid == host grid\n");
     return 0;
 }

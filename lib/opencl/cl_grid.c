@@ -19,6 +19,13 @@
 #define SCAN_CHUNK 256
 #define MAX_CHUNKS 65536
 
+/* The kernels, created for each call (as cl_bilateral.c's lists do): a CPU device, which never
+ * sorts its grid, creates none, and its context's setup pays for none. */
+enum { K_ZERO, K_COUNT, K_CHUNK_SUMS, K_CHUNK_SCAN, K_CELLS, K_SCATTER, K_SORT_CELLS, K_N };
+static const char *const kernel_names[K_N] = {"grid_zero",       "grid_count", "grid_chunk_sums",
+                                              "grid_chunk_scan", "grid_cells", "grid_scatter",
+                                              "grid_sort_cells"};
+
 enum { G_POINTS, G_KEY, G_FACETS, G_CURSOR, G_CHUNKS, G_OCCUPIED, G_COORD, G_START, G_ORDER, G_N };
 
 static bool has_fp64(const rsmooth_context *ctx) {
@@ -56,9 +63,11 @@ typedef struct device_sort {
     const double *points;
     cl_uint count, dense, chunk, chunks;
     cl_mem buf[G_N];
+    cl_kernel kernel[K_N];
 } device_sort;
 
-static cl_int create_buffers(device_sort *ds) {
+/* The call's kernels and buffers. */
+static cl_int create_objects(device_sort *ds) {
     rsmooth_context *ctx = ds->ctx;
     size_t n = ds->count, cells = ds->count < ds->dense ? ds->count : ds->dense;
     const size_t size[G_N] = {[G_POINTS] = 3 * n * sizeof(cl_double),
@@ -71,6 +80,10 @@ static cl_int create_buffers(device_sort *ds) {
                               [G_START] = (cells + 1) * sizeof(cl_uint),
                               [G_ORDER] = n * sizeof(cl_uint)};
     cl_int err = CL_SUCCESS;
+    for (int k = 0; k < K_N && err == CL_SUCCESS; k++)
+        ds->kernel[k] = clCreateKernel(ctx->program, kernel_names[k], &err);
+    if (err == CL_INVALID_KERNEL_NAME)
+        return err; /* a program built without grid.cl (cl_program.c): the host sorts */
     for (int b = 0; b < G_N && err == CL_SUCCESS; b++) {
         bool input = b == G_POINTS;
         cl_mem_flags flags = input ? CL_MEM_READ_ONLY | rs_cl_input_flags(ctx) : CL_MEM_READ_WRITE;
@@ -90,24 +103,24 @@ static cl_int enqueue_sort(device_sort *ds) {
     cl_double inv_h = g->inv_cell_size, ox = g->origin_cell[0], oy = g->origin_cell[1],
               oz = g->origin_cell[2];
     cl_int dx = g->dims[0], dy = g->dims[1], dz = g->dims[2];
-    arg_setter s = {ctx->kernels[RS_KERNEL_GRID_ZERO], 0, CL_SUCCESS};
+    arg_setter s = {ds->kernel[K_ZERO], 0, CL_SUCCESS};
     ARG(ds->dense), ARG(buf[G_FACETS]);
     cl_int err = s.err != CL_SUCCESS ? s.err : launch(ctx, s.kernel, ds->dense);
-    s = (arg_setter){ctx->kernels[RS_KERNEL_GRID_COUNT], 0, err};
+    s = (arg_setter){ds->kernel[K_COUNT], 0, err};
     ARG(ds->count), ARG(inv_h), ARG(ox), ARG(oy), ARG(oz), ARG(dx), ARG(dy), ARG(dz);
     ARG(buf[G_POINTS]), ARG(buf[G_KEY]), ARG(buf[G_FACETS]);
     err = s.err != CL_SUCCESS ? s.err : launch(ctx, s.kernel, ds->count);
-    s = (arg_setter){ctx->kernels[RS_KERNEL_GRID_CHUNK_SUMS], 0, err};
+    s = (arg_setter){ds->kernel[K_CHUNK_SUMS], 0, err};
     ARG(ds->dense), ARG(ds->chunk), ARG(buf[G_FACETS]), ARG(buf[G_CHUNKS]);
     err = s.err != CL_SUCCESS ? s.err : launch(ctx, s.kernel, ds->chunks);
-    s = (arg_setter){ctx->kernels[RS_KERNEL_GRID_CHUNK_SCAN], 0, err};
+    s = (arg_setter){ds->kernel[K_CHUNK_SCAN], 0, err};
     ARG(ds->chunks), ARG(buf[G_CHUNKS]), ARG(buf[G_OCCUPIED]), ARG(buf[G_START]);
     err = s.err != CL_SUCCESS ? s.err : launch(ctx, s.kernel, 1);
-    s = (arg_setter){ctx->kernels[RS_KERNEL_GRID_CELLS], 0, err};
+    s = (arg_setter){ds->kernel[K_CELLS], 0, err};
     ARG(ds->dense), ARG(ds->chunk), ARG(dy), ARG(dz), ARG(buf[G_FACETS]), ARG(buf[G_CHUNKS]);
     ARG(buf[G_CURSOR]), ARG(buf[G_COORD]), ARG(buf[G_START]);
     err = s.err != CL_SUCCESS ? s.err : launch(ctx, s.kernel, ds->chunks);
-    s = (arg_setter){ctx->kernels[RS_KERNEL_GRID_SCATTER], 0, err};
+    s = (arg_setter){ds->kernel[K_SCATTER], 0, err};
     ARG(ds->count), ARG(buf[G_KEY]), ARG(buf[G_CURSOR]), ARG(buf[G_ORDER]);
     err = s.err != CL_SUCCESS ? s.err : launch(ctx, s.kernel, ds->count);
     return err;
@@ -123,7 +136,7 @@ static cl_int read_back(device_sort *ds, bool *no_memory) {
     if (err != CL_SUCCESS)
         return err;
     /* each cell's facets in increasing index (the scatter's atomics took any order) */
-    arg_setter s = {ctx->kernels[RS_KERNEL_GRID_SORT_CELLS], 0, CL_SUCCESS};
+    arg_setter s = {ds->kernel[K_SORT_CELLS], 0, CL_SUCCESS};
     ARG(cells), ARG(ds->buf[G_START]), ARG(ds->buf[G_ORDER]);
     err = s.err != CL_SUCCESS ? s.err : launch(ctx, s.kernel, cells);
     if (err != CL_SUCCESS)
@@ -160,19 +173,32 @@ rsmooth_status rs_cl_grid_build_columns(rsmooth_context *ctx, rs_grid *grid, con
         dense > DENSE_PER_FACET * (uint64_t)count + DENSE_SLACK || dense > (1u << 31) ||
         4 * dense > ctx->max_allocation || bytes > rs_cl_usable_memory(ctx) || !has_fp64(ctx))
         return RSMOOTH_OK; /* the host's sort, then */
-    device_sort ds = {ctx, grid, points, (cl_uint)count, (cl_uint)dense, SCAN_CHUNK, 0, {NULL}};
+    device_sort ds = {.ctx = ctx,
+                      .grid = grid,
+                      .points = points,
+                      .count = (cl_uint)count,
+                      .dense = (cl_uint)dense,
+                      .chunk = SCAN_CHUNK};
     if (dense / SCAN_CHUNK >= MAX_CHUNKS)
         ds.chunk = (cl_uint)((dense + MAX_CHUNKS - 1) / MAX_CHUNKS);
     ds.chunks = (cl_uint)((dense + ds.chunk - 1) / ds.chunk);
     bool no_memory = false;
-    cl_int err = create_buffers(&ds);
-    if (err == CL_SUCCESS)
+    cl_int err = create_objects(&ds);
+    bool without = err == CL_INVALID_KERNEL_NAME;
+    if (without)
+        err = CL_SUCCESS;
+    else if (err == CL_SUCCESS)
         err = enqueue_sort(&ds);
-    if (err == CL_SUCCESS)
+    if (err == CL_SUCCESS && !without)
         err = read_back(&ds, &no_memory);
     for (int b = 0; b < G_N; b++)
         if (ds.buf[b])
             clReleaseMemObject(ds.buf[b]);
+    for (int k = 0; k < K_N; k++)
+        if (ds.kernel[k])
+            clReleaseKernel(ds.kernel[k]);
+    if (without)
+        return RSMOOTH_OK; /* *done stays false */
     if (err == CL_SUCCESS && !no_memory) {
         grid->cell_start[grid->cell_count] = (uint32_t)count;
         no_memory = !rs_grid_index_columns(grid);

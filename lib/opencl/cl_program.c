@@ -2,6 +2,7 @@
  * phase. Kernels are embedded at build time; RSMOOTH_KERNEL_DIR loads them from a directory instead. */
 #define _POSIX_C_SOURCE 200809L
 #include "opencl/cl_internal.h"
+#include "opencl/cl_grid.h"
 
 #include <stdint.h>
 #include <stdio.h>
@@ -17,6 +18,9 @@ extern const size_t rs_kernel_grid_size;
 
 /* The kernel files in the order they are compiled, after the prelude and the device's shape. */
 #define KERNEL_FILES 5
+/* grid.cl, the last, only where the grid is sorted on the device (rs_cl_device_grid): a CPU
+ * device's program stays without its kernels, whose loading would lengthen every setup */
+#define GRID_FILES 1
 
 /* Constants the host and kernels must agree on. Runtime values (sigmas, counts) are kernel
  * arguments, so changing them never rebuilds the program. */
@@ -76,10 +80,11 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
                                       rs_kernel_mollify_size, rs_kernel_bilateral_size,
                                       rs_kernel_estimate_size, rs_kernel_grid_size};
     char *loaded[KERNEL_FILES] = {NULL};
+    const int files = KERNEL_FILES - (rs_cl_device_grid(ctx) ? 0 : GRID_FILES);
     rsmooth_status st = RSMOOTH_OK;
     const char *dir = getenv("RSMOOTH_KERNEL_DIR");
     if (dir && *dir) {
-        for (int i = 0; i < KERNEL_FILES; i++) {
+        for (int i = 0; i < files; i++) {
             loaded[i] = read_text_file(dir, names[i], &sizes[i + 2]);
             if (!loaded[i]) {
                 st = rs_fail(error, RSMOOTH_ERROR_IO, "RSMOOTH_KERNEL_DIR",
@@ -98,7 +103,7 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
     /* rsmooth's binary cache (cl_program_cache.c), keyed by exactly the sources and options the
      * build from source below takes */
     rs_program_cache cache;
-    ctx->program_cache = rs_program_cache_open(&cache, ctx, KERNEL_FILES + 2, sources, sizes,
+    ctx->program_cache = rs_program_cache_open(&cache, ctx, files + 2, sources, sizes,
                                                options)
                              ? RS_PROGRAM_CACHE_MISS
                              : RS_PROGRAM_CACHE_OFF;
@@ -108,7 +113,7 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
     }
     if (cache.refused)
         ctx->program_cache = RS_PROGRAM_CACHE_REFUSED;
-    ctx->program = clCreateProgramWithSource(ctx->context, KERNEL_FILES + 2, sources, sizes, &err);
+    ctx->program = clCreateProgramWithSource(ctx->context, files + 2, sources, sizes, &err);
     if (err != CL_SUCCESS) {
         st = rs_cl_fail(error, err, "clCreateProgramWithSource", ctx->device_name);
         goto done;
@@ -140,14 +145,7 @@ kernels:;
         [RS_KERNEL_MOLLIFY] = "mollify_block",
         [RS_KERNEL_NORMALS] = "mollified_facet_normal",
         [RS_KERNEL_BILATERAL] = "bilateral_cell_normals",
-        [RS_KERNEL_ROBUST] = "robust_block",
-        [RS_KERNEL_GRID_ZERO] = "grid_zero",
-        [RS_KERNEL_GRID_COUNT] = "grid_count",
-        [RS_KERNEL_GRID_CHUNK_SUMS] = "grid_chunk_sums",
-        [RS_KERNEL_GRID_CHUNK_SCAN] = "grid_chunk_scan",
-        [RS_KERNEL_GRID_CELLS] = "grid_cells",
-        [RS_KERNEL_GRID_SCATTER] = "grid_scatter",
-        [RS_KERNEL_GRID_SORT_CELLS] = "grid_sort_cells"};
+        [RS_KERNEL_ROBUST] = "robust_block"};
     for (int k = 0; k < RS_KERNEL_COUNT; k++) {
         ctx->kernels[k] = clCreateKernel(ctx->program, kernel_names[k], &err);
         if (err != CL_SUCCESS) {
