@@ -18,9 +18,6 @@ extern const size_t rs_kernel_grid_size;
 
 /* The kernel files in the order they are compiled, after the prelude and the device's shape. */
 #define KERNEL_FILES 5
-/* grid.cl, the last, only where the grid is sorted on the device (rs_cl_device_grid): a CPU
- * device's program stays without its kernels, whose loading would lengthen every setup */
-#define GRID_FILES 1
 
 /* Constants the host and kernels must agree on. Runtime values (sigmas, counts) are kernel
  * arguments, so changing them never rebuilds the program. */
@@ -80,11 +77,15 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
                                       rs_kernel_mollify_size, rs_kernel_bilateral_size,
                                       rs_kernel_estimate_size, rs_kernel_grid_size};
     char *loaded[KERNEL_FILES] = {NULL};
-    const int files = KERNEL_FILES - (rs_cl_device_grid(ctx) ? 0 : GRID_FILES);
+    /* grid.cl only where the grid is sorted on the device (rs_cl_device_grid): a CPU device's
+     * program stays without its kernels, whose loading would lengthen every setup */
+    const bool grid = rs_cl_device_grid(ctx);
     rsmooth_status st = RSMOOTH_OK;
     const char *dir = getenv("RSMOOTH_KERNEL_DIR");
     if (dir && *dir) {
-        for (int i = 0; i < files; i++) {
+        for (int i = 0; i < KERNEL_FILES; i++) {
+            if (!grid && strcmp(names[i], "grid.cl") == 0)
+                continue;
             loaded[i] = read_text_file(dir, names[i], &sizes[i + 2]);
             if (!loaded[i]) {
                 st = rs_fail(error, RSMOOTH_ERROR_IO, "RSMOOTH_KERNEL_DIR",
@@ -94,6 +95,13 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
             sources[i + 2] = loaded[i];
         }
     }
+    int files = KERNEL_FILES;
+    for (int i = 0; !grid && i < files; i++)
+        if (strcmp(names[i], "grid.cl") == 0) { /* left out: the sources after it move up */
+            memmove(&sources[i + 2], &sources[i + 3], (size_t)(files - 1 - i) * sizeof *sources);
+            memmove(&sizes[i + 2], &sizes[i + 3], (size_t)(files - 1 - i) * sizeof *sizes);
+            files--;
+        }
 
     double t0 = rs_now_ms();
     cl_int err = CL_SUCCESS;
