@@ -1,6 +1,6 @@
-/* The facet grid sorted on the device (kernels/grid.cl): a counting sort by cell, for GPUs, where
- * the host's radix sort and its pass over the keys are what the host would otherwise spend while
- * the device idles. It gives rs_grid_build_columns' arrays bit for bit (tests/test_cl_grid.c):
+/* The facet grid sorted on the device (kernels/grid.cl): a counting sort by cell, for GPUs, to take
+ * the host's radix sort and its passes over the keys off the host (not yet timed on a GPU: none
+ * has run rsmooth). It gives rs_grid_build_columns' arrays bit for bit (tests/test_cl_grid.c):
  * the same layout (rs_grid_layout), cells in the same order, each cell's facets in increasing
  * index, as the host's stable sort leaves them. */
 #include "opencl/cl_grid.h"
