@@ -370,7 +370,7 @@ static size_t collect_names(const char *text, const char *marker, char end,
 /* Every __kernel the sources define. */
 static size_t source_kernels(char names[][64]) {
     static const char *const files[] = {"common.cl", "mollify.cl", "bilateral.cl", "estimate.cl",
-                                        "stage.cl"};
+                                        "stage.cl", "grid.cl"};
     size_t count = 0;
     for (size_t i = 0; i < sizeof files / sizeof *files; i++) {
         char path[4096];

@@ -103,7 +103,7 @@ static int32_t *new_table(size_t count, uint32_t *mask) {
 }
 
 /* The columns of occupied cells (cells are sorted by x, then y, then z). */
-static bool build_columns(rs_grid *grid) {
+bool rs_grid_index_columns(rs_grid *grid) {
     size_t columns = 0;
     const int32_t *c = grid->cell_coord;
     for (size_t i = 0; i < grid->cell_count; i++)
@@ -209,16 +209,15 @@ rsmooth_status rs_grid_build_columns(rs_grid *grid, const double *points, size_t
                                      double reach, int split, const double lo[3],
                                      const double hi[3], rsmooth_error *error) {
     rsmooth_status st = sort_into_cells(grid, points, count, reach, split, lo, hi, error);
-    if (st == RSMOOTH_OK && !build_columns(grid))
+    if (st == RSMOOTH_OK && !rs_grid_index_columns(grid))
         return out_of_memory(grid, count, error);
     return st;
 }
 
 /* Facets sorted by cell, and the occupied cells with their first facets: what both lookups
  * (cells, columns) index. */
-static rsmooth_status sort_into_cells(rs_grid *grid, const double *points, size_t count,
-                                      double reach, int split, const double lo[3],
-                                      const double hi[3], rsmooth_error *error) {
+void rs_grid_layout(rs_grid *grid, double reach, int split, const double lo[3],
+                    const double hi[3]) {
     memset(grid, 0, sizeof *grid);
     grid->split = split;
     /* A hair wider than the reach: a point and a centroid exactly `reach` apart must never round
@@ -238,6 +237,12 @@ static rsmooth_status sort_into_cells(rs_grid *grid, const double *points, size_
         grid->dims[k] =
             (int32_t)(floor(hi[k] * grid->inv_cell_size) - grid->origin_cell[k]) + 1;
     }
+}
+
+static rsmooth_status sort_into_cells(rs_grid *grid, const double *points, size_t count,
+                                      double reach, int split, const double lo[3],
+                                      const double hi[3], rsmooth_error *error) {
+    rs_grid_layout(grid, reach, split, lo, hi);
 
     uint64_t *keys = rs_alloc_array(count, sizeof *keys);
     grid->facet_order = rs_alloc_array(count, sizeof *grid->facet_order);
@@ -298,12 +303,28 @@ static void morton_keys(void *ctx, size_t begin, size_t end, size_t chunk) {
     }
 }
 
-/* The cells of the points in their new order. */
+/* The inverse of spread_bits: every third bit of x gathered into the low 21. */
+static uint64_t compact_bits(uint64_t x) {
+    x &= 0x1249249249249249ull;
+    x = (x | x >> 2) & 0x10c30c30c30c30c3ull;
+    x = (x | x >> 4) & 0x100f00f00f00f00full;
+    x = (x | x >> 8) & 0x1f0000ff0000ffull;
+    x = (x | x >> 16) & 0x1f00000000ffffull;
+    x = (x | x >> 32) & 0x1fffff;
+    return x;
+}
+
+/* The cells of the points in their new order, read back from the sorted keys (sequential and
+ * exact: cells fit the 21 bits per axis a key holds) rather than found again from the points. */
 static void ordered_cells(void *ctx, size_t begin, size_t end, size_t chunk) {
     const key_job *job = ctx;
+    int32_t m = job->grid->split + 1;
     (void)chunk;
-    for (size_t i = begin; i < end; i++)
-        rs_grid_cell_of(job->grid, job->points + 3 * (size_t)job->order[i], job->cells + 3 * i);
+    for (size_t i = begin; i < end; i++) {
+        uint64_t key = job->keys[i];
+        for (int k = 0; k < 3; k++)
+            job->cells[3 * i + k] = (int32_t)compact_bits(key >> (2 - k)) - m;
+    }
 }
 
 rsmooth_status rs_grid_order_points(const rs_grid *grid, const double *points, size_t count,

@@ -47,6 +47,15 @@ rsmooth_status rs_grid_build_columns(rs_grid *grid, const double *points, size_t
                                      const double hi[3], rsmooth_error *error);
 void rs_grid_free(rs_grid *grid);
 
+/* The steps of rs_grid_build_columns, for a caller that sorts the facets elsewhere (the device,
+ * lib/opencl/cl_grid.c): rs_grid_layout zeroes *grid and sets its cell size, origin and dims;
+ * the caller fills cell_count, cell_coord, cell_start and facet_order exactly as the host sort
+ * would (cells in x, y, z order, each cell's facets in increasing index, rs_alloc'ed);
+ * rs_grid_index_columns then adds the columns (false when out of memory). */
+void rs_grid_layout(rs_grid *grid, double reach, int split, const double lo[3],
+                    const double hi[3]);
+bool rs_grid_index_columns(rs_grid *grid);
+
 /* Cell coordinates of a point, clamped to [-split - 1, dims + split]: a point clamped there is more
  * than `split` cells away from every facet, so clamping never loses a neighbour. */
 void rs_grid_cell_of(const rs_grid *grid, const double p[3], int32_t cell[3]);

@@ -2,6 +2,7 @@
  * phase. Kernels are embedded at build time; RSMOOTH_KERNEL_DIR loads them from a directory instead. */
 #define _POSIX_C_SOURCE 200809L
 #include "opencl/cl_internal.h"
+#include "opencl/cl_grid.h"
 
 #include <stdint.h>
 #include <stdio.h>
@@ -12,11 +13,13 @@ extern const unsigned char rs_kernel_common[], rs_kernel_mollify[], rs_kernel_bi
     rs_kernel_estimate[], rs_kernel_stage[];
 extern const size_t rs_kernel_common_size, rs_kernel_mollify_size, rs_kernel_bilateral_size,
     rs_kernel_estimate_size, rs_kernel_stage_size;
+extern const unsigned char rs_kernel_grid[];
+extern const size_t rs_kernel_grid_size;
 
 /* The kernel files in the order they are compiled, after the prelude and the device's shape. */
-#define KERNEL_FILES 5
-/* The strings compiled: the prelude, the device's shape, the files, and stage.cl's second copy
- * with the definitions before each copy and the end of the double one's #if. */
+#define KERNEL_FILES 6
+/* The most strings compiled: the prelude, the device's shape, the files, and stage.cl's second
+ * copy with the definitions before each copy and the end of the double one's #if. */
 #define SOURCES (KERNEL_FILES + 6)
 
 /* stage.cl's types and kernel names, per copy (kernels/stage.cl) */
@@ -75,7 +78,7 @@ static char *read_text_file(const char *dir, const char *name, size_t *size) {
 
 static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *error) {
     static const char *const names[KERNEL_FILES] = {"common.cl", "mollify.cl", "bilateral.cl",
-                                                    "estimate.cl", "stage.cl"};
+                                                    "estimate.cl", "grid.cl", "stage.cl"};
     /* the variant this device runs (cl_variant.c): its vector width and work-group size */
     char shape[96];
     snprintf(shape, sizeof shape, "#define RS_LANES %u\n#define RS_GROUP %zu\n", ctx->lanes,
@@ -83,15 +86,20 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
     const char *sources[SOURCES] = {
         prelude, shape, (const char *)rs_kernel_common, (const char *)rs_kernel_mollify,
         (const char *)rs_kernel_bilateral, (const char *)rs_kernel_estimate,
-        (const char *)rs_kernel_stage};
+        (const char *)rs_kernel_grid, (const char *)rs_kernel_stage};
     size_t sizes[SOURCES] = {sizeof prelude - 1, strlen(shape), rs_kernel_common_size,
                              rs_kernel_mollify_size, rs_kernel_bilateral_size,
-                             rs_kernel_estimate_size, rs_kernel_stage_size};
+                             rs_kernel_estimate_size, rs_kernel_grid_size, rs_kernel_stage_size};
     char *loaded[KERNEL_FILES] = {NULL};
+    /* grid.cl only where the grid is sorted on the device (rs_cl_device_grid): a CPU device's
+     * program stays without its kernels, whose loading would lengthen every setup */
+    const bool grid = rs_cl_device_grid(ctx);
     rsmooth_status st = RSMOOTH_OK;
     const char *dir = getenv("RSMOOTH_KERNEL_DIR");
     if (dir && *dir) {
         for (int i = 0; i < KERNEL_FILES; i++) {
+            if (!grid && strcmp(names[i], "grid.cl") == 0)
+                continue;
             loaded[i] = read_text_file(dir, names[i], &sizes[i + 2]);
             if (!loaded[i]) {
                 st = rs_fail(error, RSMOOTH_ERROR_IO, "RSMOOTH_KERNEL_DIR",
@@ -101,16 +109,24 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
             sources[i + 2] = loaded[i];
         }
     }
+    int files = KERNEL_FILES;
+    for (int i = 0; !grid && i < files; i++)
+        if (strcmp(names[i], "grid.cl") == 0) { /* left out: the sources after it move up */
+            memmove(&sources[i + 2], &sources[i + 3], (size_t)(files - 1 - i) * sizeof *sources);
+            memmove(&sizes[i + 2], &sizes[i + 3], (size_t)(files - 1 - i) * sizeof *sizes);
+            files--;
+        }
     /* stage.cl, the last file, twice: in float, and in double where the device has it */
-    const char *stage = sources[KERNEL_FILES + 1];
-    size_t stage_size = sizes[KERNEL_FILES + 1];
+    const char *stage = sources[files + 1];
+    size_t stage_size = sizes[files + 1];
     const char *const tail[5] = {stage_float, stage, stage_double, stage, stage_end};
     const size_t tail_sizes[5] = {sizeof stage_float - 1, stage_size, sizeof stage_double - 1,
                                   stage_size, sizeof stage_end - 1};
     for (int i = 0; i < 5; i++) {
-        sources[KERNEL_FILES + 1 + i] = tail[i];
-        sizes[KERNEL_FILES + 1 + i] = tail_sizes[i];
+        sources[files + 1 + i] = tail[i];
+        sizes[files + 1 + i] = tail_sizes[i];
     }
+    const cl_uint count = (cl_uint)files + 6; /* the prelude, the shape, the files, 4 more */
 
     double t0 = rs_now_ms();
     cl_int err = CL_SUCCESS;
@@ -120,7 +136,7 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
     /* rsmooth's binary cache (cl_program_cache.c), keyed by exactly the sources and options the
      * build from source below takes */
     rs_program_cache cache;
-    ctx->program_cache = rs_program_cache_open(&cache, ctx, SOURCES, sources, sizes,
+    ctx->program_cache = rs_program_cache_open(&cache, ctx, count, sources, sizes,
                                                options)
                              ? RS_PROGRAM_CACHE_MISS
                              : RS_PROGRAM_CACHE_OFF;
@@ -130,7 +146,7 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
     }
     if (cache.refused)
         ctx->program_cache = RS_PROGRAM_CACHE_REFUSED;
-    ctx->program = clCreateProgramWithSource(ctx->context, SOURCES, sources, sizes, &err);
+    ctx->program = clCreateProgramWithSource(ctx->context, count, sources, sizes, &err);
     if (err != CL_SUCCESS) {
         st = rs_cl_fail(error, err, "clCreateProgramWithSource", ctx->device_name);
         goto done;

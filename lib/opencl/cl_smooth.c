@@ -4,6 +4,7 @@
  * of the cell size, relative to a nearby cell's corner (see kernels/common.cl), so precision does
  * not depend on where the mesh sits; displacements return to double before they are added. */
 #include "opencl/cl_run.h"
+#include "opencl/cl_grid.h"
 
 #include <float.h>
 #include <math.h>
@@ -76,18 +77,15 @@ static bool joins_block(size_t lanes, size_t width, const int32_t lo[3], const i
 }
 
 /* Cuts the vertices, in grid order (`cells` per position), into blocks: block b holds positions
- * start[b] .. start[b + 1] - 1 and its anchor (the lowest cell it spans) is anchor[b]. With NULL
- * arrays it only counts. Returns the block count. Blocks hold at most `width` vertices. */
-static size_t cut_blocks(const int32_t *cells, size_t count, size_t width, uint32_t *start,
-                         cl_int4 *anchor) {
+ * start[b] .. start[b + 1] - 1 (start has room for count + 1). Returns the block count. Blocks hold
+ * at most `width` vertices. One pass: each block's anchor is found again when it is filled. */
+static size_t cut_blocks(const int32_t *cells, size_t count, size_t width, uint32_t *start) {
     size_t blocks = 0, lanes = 0;
     int32_t lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
     for (size_t i = 0; i < count; i++) {
         const int32_t *c = cells + 3 * i;
         if (!joins_block(lanes, width, lo, hi, c)) {
-            if (start)
-                start[blocks] = (uint32_t)i;
-            blocks++;
+            start[blocks++] = (uint32_t)i;
             lanes = 0;
             memcpy(lo, c, sizeof lo);
             memcpy(hi, c, sizeof hi);
@@ -96,12 +94,9 @@ static size_t cut_blocks(const int32_t *cells, size_t count, size_t width, uint3
             lo[k] = c[k] < lo[k] ? c[k] : lo[k];
             hi[k] = c[k] > hi[k] ? c[k] : hi[k];
         }
-        if (anchor)
-            anchor[blocks - 1] = (cl_int4){{lo[0], lo[1], lo[2], 0}};
         lanes++;
     }
-    if (start)
-        start[blocks] = (uint32_t)count;
+    start[blocks] = (uint32_t)count;
     return blocks;
 }
 
@@ -126,7 +121,13 @@ static void fill_blocks(void *ctx, size_t begin, size_t end, size_t chunk) {
     for (size_t b = begin; b < end; b++) {
         cl_float *pos = pk->block_pos + 3 * width * b;
         cl_uchar *offset = pk->block_offset + 3 * width * b;
-        const cl_int *anchor = pk->block_cell[b].s;
+        cl_int4 low = {{INT32_MAX, INT32_MAX, INT32_MAX, 0}}; /* the anchor: the lowest cell */
+        for (uint32_t i = job->start[b]; i < job->start[b + 1]; i++)
+            for (int k = 0; k < 3; k++)
+                low.s[k] = job->cells[3 * (size_t)i + k] < low.s[k] ? job->cells[3 * (size_t)i + k]
+                                                                    : low.s[k];
+        pk->block_cell[b] = low;
+        const cl_int *anchor = low.s;
         for (uint32_t i = job->start[b]; i < job->start[b + 1]; i++) {
             uint32_t v = job->order[i], lane = i - job->start[b];
             const int32_t *cell = job->cells + 3 * (size_t)i;
@@ -160,20 +161,23 @@ static rsmooth_status pack_blocks(const rs_problem *pb, const rs_grid *grid, pac
     if ((st = rs_grid_order_points(grid, pb->xyz, nv, order, cells, error)) != RSMOOTH_OK)
         goto done;
     const size_t width = pk->lanes;
-    size_t blocks = cut_blocks(cells, nv, width, NULL, NULL);
+    start = rs_alloc_array(nv + 1, sizeof *start);
+    if (!start) {
+        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth", "no memory for blocks");
+        goto done;
+    }
+    size_t blocks = cut_blocks(cells, nv, width, start);
     pk->block_count = blocks;
     pk->block_cell = rs_alloc_array(blocks, sizeof(cl_int4));
     pk->block_pos = rs_alloc_array(blocks, 3 * width * sizeof(cl_float));
     pk->block_offset = rs_alloc_array(blocks, 3 * width * sizeof(cl_uchar));
     if (pb->colors)
         pk->block_color = rs_alloc_array(blocks, 3 * width * sizeof(cl_float));
-    start = rs_alloc_array(blocks + 1, sizeof *start);
-    if (!pk->block_cell || !pk->block_pos || !pk->block_offset || !start ||
+    if (!pk->block_cell || !pk->block_pos || !pk->block_offset ||
         (pb->colors && !pk->block_color)) {
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth", "no memory for blocks");
         goto done;
     }
-    cut_blocks(cells, nv, width, start, pk->block_cell);
     block_job job = {pb, grid, pk, order, start, cells};
     rs_parallel_for(blocks, PARALLEL_GRAIN / width, fill_blocks, &job);
 done:
@@ -190,20 +194,46 @@ typedef struct facet_job {
     packed *pk;
 } facet_job;
 
-static void place_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
-    const facet_job *job = ctx;
-    (void)chunk;
-    for (size_t j = begin; j < end; j++)
-        job->pk->facet_place[job->grid->facet_order[j]] = (uint32_t)j;
+/* The occupied cell holding grid position j: the last whose start is at or below it. */
+static size_t cell_at(const rs_grid *grid, size_t j) {
+    size_t lo = 0, hi = grid->cell_count; /* cell_start[lo] <= j < cell_start[hi] */
+    while (hi - lo > 1) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (grid->cell_start[mid] <= j)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
 }
 
+/* Facets [begin, end) in grid order: each one's place, and its cell's number left in its centroid's
+ * slot for pack_facets (it reads it back just before overwriting that slot, so the grid's cell is
+ * reused rather than found again from the centroid, at no extra memory or cache line). */
+static void place_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const facet_job *job = ctx;
+    const rs_grid *grid = job->grid;
+    (void)chunk;
+    size_t cell = cell_at(grid, begin);
+    for (size_t j = begin; j < end; j++) {
+        while (grid->cell_start[cell + 1] <= j)
+            cell++;
+        job->pk->facet_place[grid->facet_order[j]] = (uint32_t)j;
+        uint32_t number = (uint32_t)cell;
+        memcpy(&job->pk->facet_centroid[j], &number, sizeof number);
+    }
+}
+
+/* Facets [begin, end) in the caller's order (mostly coherent in memory: their corners are read
+ * here), written to their places in grid order. */
 static void pack_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
     const facet_job *job = ctx;
     const rs_problem *pb = job->pb;
     packed *pk = job->pk;
     (void)chunk;
     for (size_t q = begin; q < end; q++) {
-        uint32_t j = pk->facet_place[q];
+        uint32_t j = pk->facet_place[q], cell;
+        memcpy(&cell, &pk->facet_centroid[j], sizeof cell); /* place_facets' */
         const double *c = job->centroid + 3 * q;
         double n[3], area = 0, color[3] = {0, 0, 0};
         if (pb->indices) {
@@ -218,9 +248,7 @@ static void pack_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
             }
             area = pb->area[q];
         }
-        int32_t cell[3];
-        rs_grid_facet_cell(job->grid, c, cell);
-        cl_float4 cen = local_point(job->grid, c, cell);
+        cl_float4 cen = local_point(job->grid, c, job->grid->cell_coord + 4 * (size_t)cell);
         /* the ratio in double: area and mean area apart could each leave float's range; a point
          * of zero area (7 or more in one place) weighs as little as the kernels' exp2 can give */
         cen.s[3] = area > 0 ? (float)log2(area / pb->mean_area) : (float)-LOCAL_CLAMP;
@@ -264,10 +292,10 @@ static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, double **c
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, "rsmooth_smooth",
                        "no memory for device staging arrays");
 
-    /* Facets are read in the caller's order (mostly coherent in memory). What the pair loops read
-     * (centroid, normal) goes to its place in grid order; the vertex slots, which only the
-     * per-facet normals kernel reads, stay in the caller's order, with `place` to find the rest.
-     * The centroids go before the blocks are packed: 24 bytes per facet less at that peak. */
+    /* Facets are read in the caller's order. What the pair loops read (centroid, normal) goes to
+     * its place in grid order; the vertex slots, which only the per-facet normals kernel reads,
+     * stay in the caller's order, with `place` to find the rest. The centroids go before the
+     * blocks are packed: 24 bytes per facet less at that peak. */
     facet_job job = {pb, grid, *centroid, pk};
     rs_parallel_for(nf, PARALLEL_GRAIN, place_facets, &job);
     rs_parallel_for(nf, PARALLEL_GRAIN, pack_facets, &job);
@@ -329,8 +357,8 @@ static void centroids_and_box(void *ctx, size_t begin, size_t end, size_t chunk)
     }
 }
 
-static rsmooth_status build_grid(const rs_problem *pb, rs_grid *grid, double **centroid_out,
-                                 rsmooth_error *error) {
+static rsmooth_status build_grid(rsmooth_context *ctx, const rs_problem *pb, rs_grid *grid,
+                                 double **centroid_out, rsmooth_error *error) {
     size_t nf = pb->facet_count, chunks = rs_parallel_chunks(nf, PARALLEL_GRAIN);
     double *centroid = rs_alloc_array(nf, 3 * sizeof *centroid);
     double(*box)[6] = rs_alloc_array(chunks, sizeof *box);
@@ -348,8 +376,16 @@ static rsmooth_status build_grid(const rs_problem *pb, rs_grid *grid, double **c
             lo[k] = box[c][k] < lo[k] ? box[c][k] : lo[k];
             hi[k] = box[c][3 + k] > hi[k] ? box[c][3 + k] : hi[k];
         }
-    rsmooth_status st = rs_grid_build_columns(grid, centroid, nf, pb->radius, cells_per_reach(pb),
-                                              lo, hi, error);
+    /* on the device where it sorts faster (rs_cl_device_grid), else (or where it declines the
+     * grid) on the host: the same grid either way */
+    int split = cells_per_reach(pb);
+    bool done = false;
+    rsmooth_status st = RSMOOTH_OK;
+    if (rs_cl_device_grid(ctx))
+        st = rs_cl_grid_build_columns(ctx, grid, centroid, nf, pb->radius, split, lo, hi, &done,
+                                      error);
+    if (st == RSMOOTH_OK && !done)
+        st = rs_grid_build_columns(grid, centroid, nf, pb->radius, split, lo, hi, error);
     *centroid_out = centroid;
     rs_free(box);
     return st;
@@ -427,7 +463,7 @@ static const char where[] = "rsmooth_smooth";
 /* The grid and the packed facets and vertex blocks, on the host. */
 static rsmooth_status prepare_host(cl_run *r) {
     double *centroid = NULL; /* build_grid's, for pack */
-    rsmooth_status st = build_grid(r->pb, &r->grid, &centroid, r->error);
+    rsmooth_status st = build_grid(r->ctx, r->pb, &r->grid, &centroid, r->error);
     if (st == RSMOOTH_OK)
         st = pack(r->pb, &r->grid, &centroid, r->ctx->lanes, &r->pk, r->error);
     rs_free(centroid);

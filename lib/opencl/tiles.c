@@ -246,10 +246,11 @@ static rsmooth_status solve_region(tiler *t, uint32_t *verts, size_t n, const ui
 
 static rsmooth_status check_reach(const rs_problem *pb, rsmooth_error *error) {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t v = 0; v < pb->vertex_count; v++)
+    for (size_t v = 0; v < pb->vertex_count; v++) /* finite (checked): no fmin's NaN rules */
         for (int k = 0; k < 3; k++) {
-            lo[k] = fmin(lo[k], pb->xyz[3 * v + k]);
-            hi[k] = fmax(hi[k], pb->xyz[3 * v + k]);
+            double x = pb->xyz[3 * v + k];
+            lo[k] = x < lo[k] ? x : lo[k];
+            hi[k] = x > hi[k] ? x : hi[k];
         }
     double size = 0;
     for (int k = 0; k < 3; k++)
