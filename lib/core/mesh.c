@@ -264,9 +264,9 @@ static void find_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
         size_t n = 0, last = (b + 1) * GEOMETRY_BLOCK;
         double sum = 0;
         for (size_t t = b * GEOMETRY_BLOCK; t < last && t < job->triangle_count; t++) {
-            double c[3], normal[3], area = 0;
-            job->valid[t] = rs_triangle_geometry(job->problem->xyz, job->indices + 3 * t, c,
-                                                 normal, &area);
+            double normal[3], area = 0; /* (the centroid waits for the facets kept) */
+            job->valid[t] = rs_triangle_normal(job->problem->xyz, job->indices + 3 * t, normal,
+                                               &area);
             if (job->valid[t]) {
                 n++;
                 sum += area;

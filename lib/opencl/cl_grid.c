@@ -6,7 +6,6 @@
 #include "opencl/cl_grid.h"
 #include "opencl/cl_run.h"
 
-#include <stdlib.h>
 #include <string.h>
 
 /* Dense cells (every cell of the grid's box, occupied or not) per facet beyond which the counts
@@ -27,27 +26,6 @@ static const char *const kernel_names[K_N] = {"grid_zero",       "grid_count", "
                                               "grid_sort_cells"};
 
 enum { G_POINTS, G_KEY, G_FACETS, G_CURSOR, G_CHUNKS, G_OCCUPIED, G_COORD, G_START, G_ORDER, G_N };
-
-static bool has_fp64(const rsmooth_context *ctx) {
-    cl_device_fp_config config = 0;
-    return clGetDeviceInfo(ctx->device, CL_DEVICE_DOUBLE_FP_CONFIG, sizeof config, &config, NULL) ==
-               CL_SUCCESS &&
-           config != 0;
-}
-
-bool rs_cl_device_grid(const rsmooth_context *ctx) {
-    const char *forced = getenv("RSMOOTH_DEVICE_GRID");
-    bool want;
-    if (forced && (strcmp(forced, "0") == 0 || strcmp(forced, "1") == 0)) {
-        want = forced[0] == '1';
-    } else {
-        cl_device_type type = 0;
-        want =
-            clGetDeviceInfo(ctx->device, CL_DEVICE_TYPE, sizeof type, &type, NULL) == CL_SUCCESS &&
-            (type & CL_DEVICE_TYPE_GPU);
-    }
-    return want && has_fp64(ctx);
-}
 
 /* Launches `kernel` over `count` work-items (rounded up to whole groups; the kernels check). */
 static cl_int launch(rsmooth_context *ctx, cl_kernel kernel, size_t count) {
@@ -171,7 +149,7 @@ rsmooth_status rs_cl_grid_build_columns(rsmooth_context *ctx, rs_grid *grid, con
     uint64_t bytes = 8 * dense + 36 * (uint64_t)count;
     if (count == 0 || count > UINT32_MAX / 2 ||
         dense > DENSE_PER_FACET * (uint64_t)count + DENSE_SLACK || dense > (1u << 31) ||
-        4 * dense > ctx->max_allocation || bytes > rs_cl_usable_memory(ctx) || !has_fp64(ctx))
+        4 * dense > ctx->max_allocation || bytes > rs_cl_usable_memory(ctx))
         return RSMOOTH_OK; /* the host's sort, then */
     device_sort ds = {.ctx = ctx,
                       .grid = grid,

@@ -9,7 +9,7 @@
  * forces it either way. Never without double precision on the device (cl_khr_fp64). What it
  * says when the context is created also decides whether its program holds the grid's kernels
  * (cl_program.c). */
-bool rs_cl_device_grid(const rsmooth_context *ctx);
+bool rs_cl_device_grid(const rsmooth_context *ctx); /* (cl_variant.c) */
 
 /* rs_grid_build_columns with the facets counted, sorted and their cells listed on ctx's device:
  * the same arrays bit for bit. *done is false (and RSMOOTH_OK returned, *grid laid out but

@@ -9,6 +9,7 @@
  * stages their facets through local memory (kernels/common.cl, FOR_EACH_FACET_NEAR).
  * Both compute every vertex's sums in the same order over the same facets: they differ only in
  * how the work is spread. */
+#include "opencl/cl_grid.h"
 #include "opencl/cl_internal.h"
 
 #include <stdlib.h>
@@ -75,4 +76,27 @@ void rsmooth_context_kernel_shape(const rsmooth_context *ctx, unsigned *lanes, s
         *lanes = ctx ? ctx->lanes : 0;
     if (group)
         *group = ctx ? ctx->local_size : 0;
+}
+
+/* Whether the grid is sorted on the device too (cl_grid.c): a choice of what a device runs, as
+ * the variant is, and made here so that the program (cl_program.c) and the runs agree. */
+static bool has_fp64(const rsmooth_context *ctx) {
+    cl_device_fp_config config = 0;
+    return clGetDeviceInfo(ctx->device, CL_DEVICE_DOUBLE_FP_CONFIG, sizeof config, &config, NULL) ==
+               CL_SUCCESS &&
+           config != 0;
+}
+
+bool rs_cl_device_grid(const rsmooth_context *ctx) {
+    const char *forced = getenv("RSMOOTH_DEVICE_GRID");
+    bool want;
+    if (forced && (strcmp(forced, "0") == 0 || strcmp(forced, "1") == 0)) {
+        want = forced[0] == '1';
+    } else {
+        cl_device_type type = 0;
+        want =
+            clGetDeviceInfo(ctx->device, CL_DEVICE_TYPE, sizeof type, &type, NULL) == CL_SUCCESS &&
+            (type & CL_DEVICE_TYPE_GPU);
+    }
+    return want && has_fp64(ctx);
 }
