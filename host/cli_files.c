@@ -8,24 +8,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 
 #define READ_CHUNK (8u << 20)
-
-/* A regular file mapped rather than copied: the parser reads the page cache in place, with no
- * buffer the size of the file to allocate and fill (a file another process truncates while it
- * is parsed would end this process, as it would any reader of a mapping). NULL where it cannot
- * be mapped: the caller reads it. */
-static const char *map_file(FILE *f, size_t size) {
-    if (size == 0)
-        return NULL;
-    void *data = mmap(NULL, size, PROT_READ, MAP_PRIVATE, fileno(f), 0);
-    if (data == MAP_FAILED)
-        return NULL;
-    posix_madvise(data, size, POSIX_MADV_SEQUENTIAL);
-    return data;
-}
 
 int cli_read_mesh(const char *path, cli_progress *bar, rsmooth_mesh **mesh) {
     *mesh = NULL;
@@ -47,10 +32,9 @@ int cli_read_mesh(const char *path, cli_progress *bar, rsmooth_mesh **mesh) {
         return EXIT_USAGE;
     }
     size_t expected = S_ISREG(st.st_mode) ? (size_t)st.st_size : 0;
-    const char *mapped = map_file(f, expected);
     size_t capacity = expected + 1 > READ_CHUNK ? expected + 1 : READ_CHUNK;
-    size_t size = mapped ? expected : 0;
-    char *data = mapped ? NULL : malloc(capacity);
+    size_t size = 0;
+    char *data = malloc(capacity);
     int code = EXIT_OK;
     while (data) {
         if (size == capacity) {
@@ -77,8 +61,8 @@ int cli_read_mesh(const char *path, cli_progress *bar, rsmooth_mesh **mesh) {
         }
     }
     if (!standard_input)
-        fclose(f); /* a mapping outlives its descriptor */
-    if (!data && !mapped) {
+        fclose(f);
+    if (!data) {
         fprintf(stderr, "rsmooth: %s: out of memory reading it\n", path);
         return EXIT_OTHER;
     }
@@ -86,13 +70,8 @@ int cli_read_mesh(const char *path, cli_progress *bar, rsmooth_mesh **mesh) {
         free(data);
         return code;
     }
-    if (mapped && bar)
-        cli_progress_update(bar, 1.0);
     rsmooth_error err;
-    rsmooth_status status = rsmooth_mesh_read_memory(mapped ? mapped : data, size,
-                                                     RSMOOTH_FORMAT_AUTO, mesh, &err);
-    if (mapped)
-        munmap((void *)mapped, size);
+    rsmooth_status status = rsmooth_mesh_read_memory(data, size, RSMOOTH_FORMAT_AUTO, mesh, &err);
     free(data);
     if (status == RSMOOTH_OK)
         return EXIT_OK;

@@ -5,7 +5,6 @@
 
 #include <errno.h>
 #include <string.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 
 /* Reads the whole stream; regular files in one allocation of their size, others by doubling. */
@@ -77,20 +76,6 @@ rsmooth_status rsmooth_mesh_read_file(const char *path, rsmooth_mesh **mesh, rsm
     size_t hint = 0;
     if (S_ISREG(st.st_mode) && st.st_size > 0)
         hint = (uint64_t)st.st_size < SIZE_MAX ? (size_t)st.st_size : SIZE_MAX - 1;
-    /* A regular file is parsed from the page cache in place, mapped rather than copied into a
-     * buffer of its size (a file another process truncates meanwhile ends the caller, as with
-     * any mapping); read where it cannot be mapped. */
-    void *mapped = hint > 0 && (uint64_t)st.st_size == hint
-                       ? mmap(NULL, hint, PROT_READ, MAP_PRIVATE, fileno(file), 0)
-                       : MAP_FAILED;
-    if (mapped != MAP_FAILED) {
-        fclose(file);
-        posix_madvise(mapped, hint, POSIX_MADV_SEQUENTIAL);
-        rsmooth_status status =
-            rsmooth_mesh_read_memory(mapped, hint, RSMOOTH_FORMAT_AUTO, mesh, error);
-        munmap(mapped, hint);
-        return status;
-    }
     char *data = NULL;
     size_t size = 0;
     rsmooth_status status = read_all(file, path, hint, &data, &size, error);
