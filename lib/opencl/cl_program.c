@@ -76,6 +76,34 @@ static char *read_text_file(const char *dir, const char *name, size_t *size) {
     return text;
 }
 
+/* The program's kernels; the double ones may be missing (a device without fp64: NULL). */
+static rsmooth_status create_kernels(rsmooth_context *ctx, rsmooth_error *error) {
+    static const char *const kernel_names[RS_KERNEL_COUNT] = {
+        [RS_KERNEL_MOLLIFY] = "mollify_block",
+        [RS_KERNEL_NORMALS] = "mollified_facet_normal",
+        [RS_KERNEL_BILATERAL] = "bilateral_cell_normals",
+        [RS_KERNEL_ROBUST] = "robust_block",
+        [RS_KERNEL_STAGE_FLOAT + RS_STAGE_FACETS] = "stage_facets_f",
+        [RS_KERNEL_STAGE_FLOAT + RS_STAGE_PATCH] = "stage_patch_f",
+        [RS_KERNEL_STAGE_FLOAT + RS_STAGE_GUIDANCE] = "stage_guidance_f",
+        [RS_KERNEL_STAGE_FLOAT + RS_STAGE_FILTER] = "stage_filter_f",
+        [RS_KERNEL_STAGE_FLOAT + RS_STAGE_VERTEX] = "stage_vertex_f",
+        [RS_KERNEL_STAGE_DOUBLE + RS_STAGE_FACETS] = "stage_facets_d",
+        [RS_KERNEL_STAGE_DOUBLE + RS_STAGE_PATCH] = "stage_patch_d",
+        [RS_KERNEL_STAGE_DOUBLE + RS_STAGE_GUIDANCE] = "stage_guidance_d",
+        [RS_KERNEL_STAGE_DOUBLE + RS_STAGE_FILTER] = "stage_filter_d",
+        [RS_KERNEL_STAGE_DOUBLE + RS_STAGE_VERTEX] = "stage_vertex_d"};
+    for (int k = 0; k < RS_KERNEL_COUNT; k++) {
+        cl_int err = CL_SUCCESS;
+        ctx->kernels[k] = clCreateKernel(ctx->program, kernel_names[k], &err);
+        if (err != CL_SUCCESS && k >= RS_KERNEL_STAGE_DOUBLE) /* a device without fp64 */
+            ctx->kernels[k] = NULL;
+        else if (err != CL_SUCCESS)
+            return rs_cl_fail(error, err, "clCreateKernel", kernel_names[k]);
+    }
+    return RSMOOTH_OK;
+}
+
 static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *error) {
     static const char *const names[KERNEL_FILES] = {"common.cl", "mollify.cl", "bilateral.cl",
                                                     "estimate.cl", "grid.cl", "stage.cl"};
@@ -174,32 +202,8 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
     }
     rs_program_cache_store(&cache, ctx, ctx->program);
 kernels:;
-    static const char *const kernel_names[RS_KERNEL_COUNT] = {
-        [RS_KERNEL_MOLLIFY] = "mollify_block",
-        [RS_KERNEL_NORMALS] = "mollified_facet_normal",
-        [RS_KERNEL_BILATERAL] = "bilateral_cell_normals",
-        [RS_KERNEL_ROBUST] = "robust_block",
-        [RS_KERNEL_STAGE_FLOAT + RS_STAGE_FACETS] = "stage_facets_f",
-        [RS_KERNEL_STAGE_FLOAT + RS_STAGE_PATCH] = "stage_patch_f",
-        [RS_KERNEL_STAGE_FLOAT + RS_STAGE_GUIDANCE] = "stage_guidance_f",
-        [RS_KERNEL_STAGE_FLOAT + RS_STAGE_FILTER] = "stage_filter_f",
-        [RS_KERNEL_STAGE_FLOAT + RS_STAGE_VERTEX] = "stage_vertex_f",
-        [RS_KERNEL_STAGE_DOUBLE + RS_STAGE_FACETS] = "stage_facets_d",
-        [RS_KERNEL_STAGE_DOUBLE + RS_STAGE_PATCH] = "stage_patch_d",
-        [RS_KERNEL_STAGE_DOUBLE + RS_STAGE_GUIDANCE] = "stage_guidance_d",
-        [RS_KERNEL_STAGE_DOUBLE + RS_STAGE_FILTER] = "stage_filter_d",
-        [RS_KERNEL_STAGE_DOUBLE + RS_STAGE_VERTEX] = "stage_vertex_d"};
-    for (int k = 0; k < RS_KERNEL_COUNT; k++) {
-        ctx->kernels[k] = clCreateKernel(ctx->program, kernel_names[k], &err);
-        if (err != CL_SUCCESS && k >= RS_KERNEL_STAGE_DOUBLE) { /* a device without fp64 */
-            ctx->kernels[k] = NULL;
-            continue;
-        }
-        if (err != CL_SUCCESS) {
-            st = rs_cl_fail(error, err, "clCreateKernel", kernel_names[k]);
-            goto done;
-        }
-    }
+    if ((st = create_kernels(ctx, error)) != RSMOOTH_OK)
+        goto done;
     ctx->build_ms = rs_now_ms() - t0;
 done:
     for (int i = 0; i < KERNEL_FILES; i++)
