@@ -386,7 +386,7 @@ static size_t source_kernels(char names[][64]) {
         size_t stage_count = collect_names(text, "__kernel void STAGE_NAME(", ')', staged, 0);
         for (size_t k = 0; k < stage_count; k++)
             for (int precision = 0; precision < 2 && count < MAX_KERNELS; precision++)
-                snprintf(names[count++], 64, "%s_%c", staged[k], precision ? 'd' : 'f');
+                snprintf(names[count++], 64, "%.60s_%c", staged[k], precision ? 'd' : 'f');
         free(text);
     }
     size_t kept = 0; /* without the macro's own name */
