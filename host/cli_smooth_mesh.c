@@ -34,6 +34,22 @@ static int smooth_umbrella(const options *opt, const rsmooth_mesh *mesh, double 
     return EXIT_OK;
 }
 
+/* A filter call's status as the command's exit status, its failure said on stderr. */
+static int filter_status(const options *opt, rsmooth_context *ctx, cli_progress *bar,
+                         rsmooth_status st, const rsmooth_error *err) {
+    if (st == RSMOOTH_OK)
+        return EXIT_OK;
+    cli_progress_clear(bar);
+    if (st == RSMOOTH_ERROR_OPENCL)
+        fprintf(stderr, "rsmooth: %s: device '%s': %s\n", opt->input,
+                rsmooth_context_device_name(ctx), err->message);
+    else
+        fprintf(stderr, "rsmooth: %s: %s\n", opt->input, err->message);
+    return st == RSMOOTH_ERROR_OPENCL             ? EXIT_DEVICE
+           : st == RSMOOTH_ERROR_INVALID_ARGUMENT ? EXIT_USAGE
+                                                  : EXIT_OTHER;
+}
+
 int cli_smooth_mesh(const options *opt, const rsmooth_mesh *mesh, double *out, float *confidence,
                     rsmooth_report *report, cli_progress *bar) {
     if (cli_method_uses_edges(opt->method))
@@ -59,18 +75,7 @@ int cli_smooth_mesh(const options *opt, const rsmooth_mesh *mesh, double *out, f
         st = rsmooth_smooth(ctx, RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
                             mesh->triangles, mesh->triangle_count, &params, out, NULL, confidence,
                             report, &err);
-    code = EXIT_OK;
-    if (st != RSMOOTH_OK) {
-        cli_progress_clear(bar);
-        if (st == RSMOOTH_ERROR_OPENCL)
-            fprintf(stderr, "rsmooth: %s: device '%s': %s\n", opt->input,
-                    rsmooth_context_device_name(ctx), err.message);
-        else
-            fprintf(stderr, "rsmooth: %s: %s\n", opt->input, err.message);
-        code = st == RSMOOTH_ERROR_OPENCL             ? EXIT_DEVICE
-               : st == RSMOOTH_ERROR_INVALID_ARGUMENT ? EXIT_USAGE
-                                                      : EXIT_OTHER;
-    }
+    code = filter_status(opt, ctx, bar, st, &err);
     report->ms_setup = ms_setup;
     rsmooth_context_destroy(ctx);
     return code;
@@ -145,18 +150,7 @@ int cli_smooth_points(const options *opt, const rsmooth_mesh *mesh, double *out,
         ctx = NULL;
         st = filter_points(NULL, mesh, &params, out, out_normals, confidence, report, &err);
     }
-    code = EXIT_OK;
-    if (st != RSMOOTH_OK) {
-        cli_progress_clear(bar);
-        if (st == RSMOOTH_ERROR_OPENCL)
-            fprintf(stderr, "rsmooth: %s: device '%s': %s\n", opt->input,
-                    rsmooth_context_device_name(ctx), err.message);
-        else
-            fprintf(stderr, "rsmooth: %s: %s\n", opt->input, err.message);
-        code = st == RSMOOTH_ERROR_OPENCL             ? EXIT_DEVICE
-               : st == RSMOOTH_ERROR_INVALID_ARGUMENT ? EXIT_USAGE
-                                                      : EXIT_OTHER;
-    }
+    code = filter_status(opt, ctx, bar, st, &err);
     report->ms_setup = ms_setup;
     rsmooth_context_destroy(ctx);
     return code;

@@ -180,16 +180,14 @@ static void masked(rsmooth_context *const variants[2], const mesh_ref *m) {
     free(mask);
 }
 
-/* A budget too small for the stage's buffers: the host runs it (the reference's bytes); and a
- * cancel after the second cycle stops the device's. */
-static void fallback_and_cancel(rsmooth_context *ctx, const mesh_ref *m);
-
 static int cancel_after_two(void *user, double fraction) {
     int *calls = user;
     (*calls)++;
     return fraction >= 0.2 ? 1 : 0; /* 2 of 10 cycles */
 }
 
+/* A budget too small for the stage's buffers: the host runs it (the reference's bytes); and a
+ * cancel after the second cycle stops the device's. */
 static void fallback_and_cancel(rsmooth_context *ctx, const mesh_ref *m) {
     rsmooth_params p;
     stage_params(&p, &schedules[1]);

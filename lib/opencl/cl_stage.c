@@ -7,7 +7,6 @@
 #include "opencl/cl_run.h"
 #include "core/stage_plan.h"
 
-#include <math.h>
 #include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
@@ -179,7 +178,7 @@ static cl_int launch(rsmooth_context *ctx, cl_kernel kernel, size_t count) {
     return clEnqueueNDRangeKernel(ctx->queue, kernel, 1, NULL, &global, &local, 0, NULL, NULL);
 }
 
-/* Sets a kernel's buffer arguments after its first `skip` ones. */
+/* Sets the next `count` arguments of a kernel to buffers. */
 static void mem_args(arg_setter *s, int count, const cl_mem *const *mems) {
     for (int i = 0; i < count; i++)
         arg(s, sizeof(cl_mem), mems[i]);
