@@ -60,12 +60,16 @@ class Context:
         """Releases the device's context and buffers now (else when garbage-collected)."""
         self._capsule = None
 
-    def smooth(self, vertices: Any, faces: Any, **options: Any) -> Any:
-        """:func:`rsmooth.smooth` on this context's device (same arguments but ``device``)."""
+    def smooth(self, vertices: Any, faces: Any = None, **options: Any) -> Any:
+        """:func:`rsmooth.smooth` on this context's device (same arguments but ``device``; a mesh
+        object in, the same kind out)."""
         if self._capsule is None:
             raise ValueError("this rsmooth.Context is closed")
         if "device" in options:
             raise TypeError("Context.smooth takes no device: the context is one")
-        from ._filter import _smooth
+        from ._filter import _mesh_input, _mesh_output, _smooth
 
+        mesh = _mesh_input(vertices, faces, points=False)
+        if mesh is not None:
+            return _mesh_output(mesh, _smooth(self, mesh.vertices, mesh.faces, **options))
         return _smooth(self, vertices, faces, **options)

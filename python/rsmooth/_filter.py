@@ -7,20 +7,86 @@ import functools
 import numbers
 import os
 import warnings
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Any, Optional, Tuple, overload
 
 import numpy as np
 
 from . import _rsmooth
 from ._arrays import _colors, _faces, _mask, _vertices
 from ._context import Context, _check_device
+from ._meshes import MeshInput, is_mesh_object, read
 from ._options import _METHODS, Progress, _numpy_bool, _params, _progress_callable
 from ._rsmooth import DeviceError
+from ._typing import PointOptions, SmoothOptions
+
+if TYPE_CHECKING:
+    from typing import Literal
+
+    import meshio
+    import open3d
+    import pyvista
+    import trimesh
+
+    from numpy.typing import ArrayLike
+    from typing_extensions import Unpack
 
 
+# The types only: a mesh object alone comes back as its own type, arrays as an array, and
+# confidence=True adds the per-vertex confidence after either. One pair per library, not a
+# constrained TypeVar: a library without types (meshio) would make every result Any.
+@overload
+def smooth(
+    vertices: trimesh.Trimesh, faces: None = None, *, confidence: Literal[False] = False,
+    **options: Unpack[SmoothOptions],
+) -> trimesh.Trimesh: ...
+@overload
+def smooth(
+    vertices: trimesh.Trimesh, faces: None = None, *, confidence: Literal[True],
+    **options: Unpack[SmoothOptions],
+) -> Tuple[trimesh.Trimesh, np.ndarray]: ...
+@overload
+def smooth(
+    vertices: open3d.geometry.TriangleMesh, faces: None = None, *, confidence: Literal[False] = False,
+    **options: Unpack[SmoothOptions],
+) -> open3d.geometry.TriangleMesh: ...
+@overload
+def smooth(
+    vertices: open3d.geometry.TriangleMesh, faces: None = None, *, confidence: Literal[True],
+    **options: Unpack[SmoothOptions],
+) -> Tuple[open3d.geometry.TriangleMesh, np.ndarray]: ...
+@overload
+def smooth(
+    vertices: pyvista.PolyData, faces: None = None, *, confidence: Literal[False] = False,
+    **options: Unpack[SmoothOptions],
+) -> pyvista.PolyData: ...
+@overload
+def smooth(
+    vertices: pyvista.PolyData, faces: None = None, *, confidence: Literal[True],
+    **options: Unpack[SmoothOptions],
+) -> Tuple[pyvista.PolyData, np.ndarray]: ...
+@overload
+def smooth(
+    vertices: meshio.Mesh, faces: None = None, *, confidence: Literal[False] = False,
+    **options: Unpack[SmoothOptions],
+) -> meshio.Mesh: ...
+@overload
+def smooth(
+    vertices: meshio.Mesh, faces: None = None, *, confidence: Literal[True],
+    **options: Unpack[SmoothOptions],
+) -> Tuple[meshio.Mesh, np.ndarray]: ...
+@overload
+def smooth(
+    vertices: ArrayLike, faces: ArrayLike, *, confidence: Literal[False] = False,
+    **options: Unpack[SmoothOptions],
+) -> np.ndarray: ...
+@overload
+def smooth(
+    vertices: ArrayLike, faces: ArrayLike, *, confidence: Literal[True],
+    **options: Unpack[SmoothOptions],
+) -> Tuple[np.ndarray, np.ndarray]: ...
 def smooth(
     vertices: Any,
-    faces: Any,
+    faces: Any = None,
     *,
     sigma_f: Optional[float] = None,
     sigma_g: Optional[float] = None,
@@ -61,9 +127,13 @@ def smooth(
 
     Parameters
     ----------
-    vertices : (n, 3) float32 or float64 array-like, any strides or order.
+    vertices : (n, 3) float32 or float64 array-like, any strides or order; or a mesh object, with
+        no ``faces``: a ``trimesh.Trimesh``, ``open3d.geometry.TriangleMesh``, triangulated
+        ``pyvista.PolyData`` or ``meshio.Mesh`` (its triangle cells), for which a new object of
+        the same type comes back with every other attribute kept (normals recomputed where the
+        type stores them).
     faces : (m, 3) integer array-like (int32, int64, uint32...). A negative or out-of-range index
-        raises ValueError naming the face.
+        raises ValueError naming the face. None with a mesh object.
     sigma_f : spatial width: how far around a vertex triangles are consulted (ignored beyond
         ``cutoff * sigma_f``). Mean edge lengths unless ``absolute``. Default 2 (``best``: 0.8).
     sigma_g : influence width: how far a triangle's plane may lie from the vertex before it
@@ -137,8 +207,8 @@ def smooth(
 
     Returns
     -------
-    The smoothed vertices, a new array of the input's dtype and shape; with ``confidence=True``
-    the tuple ``(vertices, confidence)``.
+    The smoothed vertices, a new array of the input's dtype and shape (for a mesh object: a new
+    object of its type); with ``confidence=True`` the tuple ``(vertices, confidence)``.
 
     Raises
     ------
@@ -163,6 +233,9 @@ def smooth(
         mask=mask, method=method, iterations=iterations, lam=lam, mu=mu, progress=progress,
     )
     _check_device(device)
+    mesh = _mesh_input(vertices, faces, points=False)
+    if mesh is not None:
+        return _mesh_output(mesh, smooth(mesh.vertices, mesh.faces, device=device, **options))
     if device == "reference" or method in ("laplacian", "taubin"):
         return _smooth(None, vertices, faces, **options)
     try:
@@ -181,6 +254,29 @@ def smooth(
         )
         return _smooth(None, vertices, faces, **options)
     return _smooth(context, vertices, faces, **options)
+
+
+def _mesh_input(first: Any, second: Any, points: bool) -> Optional[MeshInput]:
+    """The arrays of a mesh object passed alone; None for arrays (which need their second)."""
+    if is_mesh_object(first):
+        if second is not None:
+            what = "normals" if points else "faces"
+            raise TypeError(f"{what}: not taken with a mesh object (its own are used)")
+        return read(first, points)
+    if second is None:
+        what = "normals" if points else "faces"
+        raise TypeError(
+            f"{what}: missing (arrays need it; the objects taken alone are trimesh, Open3D, "
+            f"PyVista and meshio meshes), got {type(first).__name__} alone"
+        )
+    return None
+
+
+def _mesh_output(mesh: MeshInput, result: Any) -> Any:
+    """The object of the input's type around the filtered positions (confidence kept beside)."""
+    if isinstance(result, tuple):
+        return (mesh.rebuild(result[0]), result[1])
+    return mesh.rebuild(result)
 
 
 @functools.lru_cache(maxsize=8)
@@ -250,9 +346,34 @@ def _smooth(
     return (out, conf) if confidence else out
 
 
+@overload
+def smooth_points(
+    points: open3d.geometry.PointCloud, normals: None = None, *, confidence: Literal[False] = False,
+    **options: Unpack[PointOptions],
+) -> open3d.geometry.PointCloud: ...
+@overload
+def smooth_points(
+    points: open3d.geometry.PointCloud, normals: None = None, *, confidence: Literal[True],
+    **options: Unpack[PointOptions],
+) -> Tuple[open3d.geometry.PointCloud, np.ndarray]: ...
+@overload
+def smooth_points(
+    points: pyvista.PolyData, normals: None = None, *, confidence: Literal[False] = False,
+    **options: Unpack[PointOptions],
+) -> pyvista.PolyData: ...
+@overload
+def smooth_points(
+    points: pyvista.PolyData, normals: None = None, *, confidence: Literal[True],
+    **options: Unpack[PointOptions],
+) -> Tuple[pyvista.PolyData, np.ndarray]: ...
+@overload
+def smooth_points(
+    points: ArrayLike, normals: ArrayLike, *, confidence: bool = False,
+    return_normals: bool = False, **options: Unpack[PointOptions],
+) -> Any: ...
 def smooth_points(
     points: Any,
-    normals: Any,
+    normals: Any = None,
     *,
     sigma_f: Optional[float] = None,
     sigma_g: Optional[float] = None,
@@ -282,9 +403,31 @@ def smooth_points(
     ``absolute``. With ``mollify`` (default) the normals are smoothed by the bilateral normal
     filter first. Runs on the CPU reference path (double precision).
 
+    ``points`` may instead be a point cloud object with normals, and no ``normals`` given: an
+    ``open3d.geometry.PointCloud`` or a ``pyvista.PolyData`` of vertices with
+    ``point_data["Normals"]``; a new object of its type comes back, its points and normals the
+    filtered ones, everything else kept.
+
     Returns the filtered points (the input's dtype), or a tuple adding the filtered unit normals
-    (``return_normals``) and the confidence (``confidence``), in that order.
+    (``return_normals``) and the confidence (``confidence``), in that order; for an object, the
+    object (with the confidence after it when asked for).
     """
+    cloud = _mesh_input(points, normals, points=True)
+    if cloud is not None:
+        if return_normals:
+            raise TypeError("smooth_points: return_normals is for arrays; the object returned "
+                            "carries the filtered normals")
+        arrays: Any = smooth_points  # (the arrays overload: the checker need not try them all)
+        result = arrays(
+            cloud.vertices, cloud.normals, sigma_f=sigma_f, sigma_g=sigma_g, absolute=absolute,
+            cutoff=cutoff, mollify=mollify, confidence=confidence, return_normals=True,
+            best=best, normal_sigma_s=normal_sigma_s, normal_sigma_n=normal_sigma_n,
+            normal_iterations=normal_iterations, influence=influence, passes=passes,
+            pass_confidence=pass_confidence, predictor=predictor, colors=colors,
+            sigma_c=sigma_c, mask=mask, progress=progress,
+        )
+        out = cloud.rebuild(result[0], result[1])
+        return (out, result[2]) if confidence else out
     p = _vertices(points, "points")
     n = _vertices(normals, "normals").astype(p.dtype, copy=False)
     if n.shape != p.shape:
