@@ -174,7 +174,10 @@ def main():
             failures.append(f"{mode}: mean |difference| {difference.mean():.3g} > {TOLERANCE}")
         # Edit > Undo brings the input back: the operator's step (bl_options UNDO) is undone to
         # the "input" step pushed above
-        bpy.ops.ed.undo()
+        try:
+            bpy.ops.ed.undo()
+        except RuntimeError as e:  # no step to undo: the operator pushed none
+            raise SystemExit(f"FAILED: {mode}: ed.undo(): {e} (is UNDO in bl_options?)")
         mesh = bpy.data.meshes["noisy"]  # undo rebuilds the data: take it again
         back = positions(mesh)
         print(f"{mode.lower()}: after ed.undo(): max |vertex - input| "
