@@ -7,8 +7,14 @@ DEMO ?= out/demo
 FUZZ_SECONDS ?= 60
 FUZZ_BUILD ?= $(BUILD)-fuzz
 FUZZERS = obj ply off stl auto
+# The Blender add-on's wheels (blender/README.md): the manylinux wheels `make wheels` leaves in
+# dist/, or any rsmooth wheels named here (WHEELS="a.whl b.whl")
+WHEELS ?= $(wildcard dist/rsmooth-*-manylinux*.whl)
+ADDON_VERSION := $(shell sed -n 's/^\#define RSMOOTH_VERSION_[A-Z]* //p' lib/include/rsmooth.h | paste -sd.)
+ADDON_ZIP ?= dist/rsmooth_blender-$(ADDON_VERSION).zip
 
-.PHONY: all deps configure build demo experiments check python-check sanitize fuzz docs install clean
+.PHONY: all deps configure build demo experiments check python-check sanitize fuzz docs install clean \
+  blender-addon blender-check
 
 all: build
 
@@ -97,6 +103,21 @@ docs:
 	  $(BUILD)-python/venv/bin/python -m pdoc rsmooth -o $(BUILD)/docs/python || exit 1; \
 	  echo "Python reference: $(BUILD)/docs/python/index.html"; \
 	else echo "no $(BUILD)-python/venv with rsmooth (make python-check): Python reference not built"; fi
+
+# The Blender add-on (blender/): $(ADDON_ZIP), the rsmooth package unpacked from $(WHEELS) inside
+# it (blender/make_addon.py prints its size and what each extension module needs of glibc).
+blender-addon:
+	@test -n "$(strip $(WHEELS))" || { echo "blender-addon: no wheels: dist/ has no" \
+	  "rsmooth-*-manylinux*.whl (make wheels), or name some: make blender-addon WHEELS=..." >&2; \
+	  exit 1; }
+	python3 blender/make_addon.py $(WHEELS) -o $(ADDON_ZIP)
+
+# The add-on in headless Blender (tests/blender/run.sh): installed from $(ADDON_ZIP), it must give
+# the command's result on the same file (paper and best, PoCL's CPU device), and undo it. Needs
+# Blender on PATH (`.ci/install-deps.sh blender`; BLENDER=PATH for another), else it says it
+# skipped. About 5 s with the kernels in $(BUILD)/pocl-cache, 12 s without.
+blender-check: build blender-addon
+	tests/blender/run.sh $(BUILD) $(ADDON_ZIP)
 
 # `make install PREFIX=/opt/rsmooth` installs the command (bin/rsmooth), the libraries, headers,
 # CMake package and pkg-config files under PREFIX (without PREFIX: CMAKE_INSTALL_PREFIX, by

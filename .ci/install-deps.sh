@@ -6,7 +6,9 @@
 # C API reference: `make docs`).
 # `install-deps.sh fuzz` (or FUZZ=1) also installs clang and its libFuzzer runtime, for `make fuzz`;
 # `install-deps.sh experiments` Python's numpy, scipy and matplotlib, for `make experiments`;
-# `install-deps.sh python` Python's headers and venv, for `make python-check` (the rest from PyPI).
+# `install-deps.sh python` Python's headers and venv, for `make python-check` (the rest from PyPI);
+# `install-deps.sh blender` Debian's Blender (3.4 on Debian 12, with the system Python and numpy), for
+# `make blender-check`.
 set -euo pipefail
 packages=(build-essential cmake pkg-config ocl-icd-opencl-dev opencl-c-headers pocl-opencl-icd clinfo libpng-dev
           libopenmpi-dev openmpi-bin oclgrind doxygen)
@@ -16,6 +18,9 @@ if [ "${1:-}" = fuzz ] || [ "${FUZZ:-0}" = 1 ]; then
 fi
 if [ "${1:-}" = python ]; then
   packages+=(python3 python3-dev python3-venv binutils libusb-1.0-0) # libusb: Open3D's wheel
+fi
+if [ "${1:-}" = blender ]; then
+  packages+=(blender)
 fi
 if [ "${1:-}" = experiments ]; then
   packages+=(python3 python3-numpy python3-scipy python3-matplotlib)
