@@ -21,7 +21,7 @@ static rsmooth_status cl_points_pass(void *context, const rs_problem *pb, double
         rs_store_unmoved(pb, RSMOOTH_FLOAT64, out_next, NULL, out_confidence);
     } else {
         rs_result_sink sink = {RSMOOTH_FLOAT64, out_next, NULL, out_confidence, NULL,
-                               pb->vertex_count};
+                               pb->vertex_count, NULL};
         uint64_t needed = 0;
         st = rs_cl_run_normals(ctx, pb, &sink, out_normals, &stats, &needed, error);
         if (st == RSMOOTH_ERROR_OUT_OF_MEMORY && needed > 0)

@@ -29,7 +29,7 @@ static rsmooth_status cl_pass(void *context, rsmooth_scalar scalar, const void *
         rs_store_unmoved(&pb, scalar, out_positions, out_weight, out_confidence);
     } else {
         rs_result_sink sink = {scalar, out_positions, out_weight, out_confidence, NULL,
-                               vertex_count};
+                               vertex_count, ctx->device_sink};
         st = rs_cl_filter(ctx, &pb, &sink, &stats, error);
     }
     if (st == RSMOOTH_OK) {
@@ -65,10 +65,22 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     rsmooth_status entered = rs_context_enter(ctx, "rsmooth_smooth", error);
     if (entered != RSMOOTH_OK)
         return entered;
+    rsmooth_status st = rs_smooth_entered(ctx, scalar, positions, vertex_count, indices,
+                                          triangle_count, params, out_positions, out_weight,
+                                          out_confidence, report, error);
+    rs_context_unlock(ctx);
+    return st;
+}
+
+rsmooth_status rs_smooth_entered(rsmooth_context *ctx, rsmooth_scalar scalar,
+                                 const void *positions, size_t vertex_count,
+                                 const uint32_t *indices, size_t triangle_count,
+                                 const rsmooth_params *params, void *out_positions,
+                                 float *out_weight, float *out_confidence,
+                                 rsmooth_report *report, rsmooth_error *error) {
     const char *stage_env = getenv("RSMOOTH_STAGE");
     if (stage_env && *stage_env && strcmp(stage_env, "host") != 0 &&
         strcmp(stage_env, "device") != 0) {
-        rs_context_unlock(ctx);
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_smooth",
                        "RSMOOTH_STAGE is \"%s\": use device (the normal-update stage on the "
                        "OpenCL device: the default on GPUs) or host (on the host's cores, in "
@@ -81,6 +93,5 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
                                          triangle_count, params, out_positions, out_weight,
                                          out_confidence, report, error, "rsmooth_smooth");
     rs_set_call_threads(threads_before);
-    rs_context_unlock(ctx);
     return st;
 }

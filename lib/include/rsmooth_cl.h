@@ -37,6 +37,28 @@ RSMOOTH_API rsmooth_status rsmooth_context_create_from_queue(cl_command_queue qu
                                                              rsmooth_context **ctx,
                                                              rsmooth_error *error);
 
+/** rsmooth_smooth on positions held in OpenCL buffers of the context's OpenCL context: `positions`
+ * holds vertex_count x 3 `scalar`s, packed (x, y, z per vertex, from offset 0), and the result
+ * goes to `out_positions` in the same layout (it may be `positions` itself). Indices stay on the
+ * host. The call enqueues its work on the context's queue after what the caller enqueued there
+ * (an in-order queue; on another queue of the same context, finish that first), and finishes
+ * the queue before it returns: the output is then ready. The input is read to the host once (the
+ * grid and facet data are built there by design). Where the filter solves the whole mesh in one
+ * run on a device with fp64 (one pass, no tiles, no normal update stage, no choice per region,
+ * no move mask: the paper's filter and its single-pass variants) the result is written into
+ * out_positions by a kernel on the device, from displacements already there, in the double
+ * arithmetic the host uses, so the bits equal rsmooth_smooth's; nothing of the output travels
+ * through the host, and the report's pair counts are 0. Otherwise the result is computed on the
+ * host as rsmooth_smooth computes it and written into out_positions. Fails like rsmooth_smooth,
+ * and with RSMOOTH_ERROR_INVALID_ARGUMENT when a buffer is NULL, not a buffer, of another OpenCL
+ * context, or smaller than vertex_count x 3 scalars (the message names it); out_positions is then
+ * untouched. No weight or confidence output: call rsmooth_smooth for those. (Added in 0.11) */
+RSMOOTH_API rsmooth_status rsmooth_smooth_cl(rsmooth_context *ctx, rsmooth_scalar scalar,
+                                             cl_mem positions, size_t vertex_count,
+                                             const uint32_t *indices, size_t triangle_count,
+                                             const rsmooth_params *params, cl_mem out_positions,
+                                             rsmooth_report *report, rsmooth_error *error);
+
 /** The queue the context runs on (owned by the context; retain it to keep it beyond the
  * context). */
 RSMOOTH_API cl_command_queue rsmooth_context_queue(const rsmooth_context *ctx);

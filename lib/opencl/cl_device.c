@@ -465,6 +465,11 @@ void rsmooth_context_destroy(rsmooth_context *ctx) {
             clReleaseKernel(ctx->kernels[k]);
     if (ctx->program)
         clReleaseProgram(ctx->program);
+    for (int k = 0; k < 2; k++)
+        if (ctx->store_kernels[k])
+            clReleaseKernel(ctx->store_kernels[k]);
+    if (ctx->store_program)
+        clReleaseProgram(ctx->store_program);
     if (ctx->queue)
         clReleaseCommandQueue(ctx->queue);
     if (ctx->context)

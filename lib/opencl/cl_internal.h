@@ -52,6 +52,13 @@ struct rsmooth_context {
                                * place (rs_cl_input_flags) */
     uint64_t memory_budget;   /* caller's or RSMOOTH_MEMORY_BUDGET's limit; 0: the device's */
     unsigned host_threads;    /* threads of the host stages of its calls; 0: every core */
+    /* rsmooth_smooth_cl's (cl_store.c): the program storing results into a caller's buffer,
+     * built on its first call (NULL before, and where the device has no fp64), its kernels by
+     * rsmooth_scalar, and the call's sink while it runs (NULL otherwise) */
+    cl_program store_program;
+    cl_kernel store_kernels[2];
+    bool store_tried;
+    struct rs_device_sink *device_sink;
 };
 
 /* Picks the kernel variant and vector width for ctx->device (cl_variant.c): sets ctx->lanes and
@@ -82,15 +89,47 @@ bool rs_parse_bytes(const char *text, uint64_t *bytes);
 
 /* ---- cl_smooth.c / tiles.c: the OpenCL path ------------------------------------------------- */
 
+/* rsmooth_smooth_cl's destination on the device: a run that solves every vertex in one piece
+ * (no tiles) writes the positions into `output` with a kernel instead of the host's array. */
+typedef struct rs_device_sink {
+    cl_mem input, output; /* the caller's: 3 scalars per vertex, packed; input as the host read it */
+    cl_kernel kernel;     /* the context's store kernel for the call's scalar */
+    bool written;         /* set by the run that wrote every position into output */
+    bool bad;             /* ... and found one not finite in the output's type */
+} rs_device_sink;
+
 /* Where a run's results go: vertex v < core_count of the problem it solved is written to entry
- * target[v] (v itself when target is NULL) of the caller's arrays; the others are a tile's halo. */
+ * target[v] (v itself when target is NULL) of the caller's arrays; the others are a tile's halo.
+ * With `device` set (rsmooth_smooth_cl), a single whole run writes the positions there instead
+ * and leaves `positions` untouched. */
 typedef struct rs_result_sink {
     rsmooth_scalar scalar;
     void *positions;
     float *weight, *confidence; /* optional */
     const uint32_t *target;
     size_t core_count;
+    rs_device_sink *device; /* optional */
 } rs_result_sink;
+
+/* Builds ctx's store program once (cl_store.c); false where it cannot (no fp64): the caller
+ * then uploads the host's result. */
+bool rs_cl_store_ready(rsmooth_context *ctx);
+
+/* Writes a whole run's positions into sink->output on the device (cl_store.c): vertex v's are
+ * (input_v * scale + result_v * h) / scale in double, as store_results computes them on the
+ * host, result_v the robust pass's displacement at slot[v] (`lanes` per block); sets
+ * sink->written and sink->bad. */
+rsmooth_status rs_cl_store_device(rsmooth_context *ctx, rs_device_sink *sink, cl_mem result,
+                                  const uint32_t *slot, size_t vertex_count, size_t lanes,
+                                  double scale, double h, rsmooth_error *error);
+
+/* rsmooth_smooth's work once ctx's lock is held (api/smooth.c). */
+rsmooth_status rs_smooth_entered(rsmooth_context *ctx, rsmooth_scalar scalar,
+                                 const void *positions, size_t vertex_count,
+                                 const uint32_t *indices, size_t triangle_count,
+                                 const rsmooth_params *params, void *out_positions,
+                                 float *out_weight, float *out_confidence,
+                                 rsmooth_report *report, rsmooth_error *error);
 
 /* Stage times and work, summed over the runs (tiles) of one call. */
 typedef struct rs_run_stats {

@@ -680,6 +680,27 @@ static rsmooth_status collect_results(cl_run *r, rs_run_stats *stats) {
     rsmooth_context *ctx = r->ctx;
     const rs_problem *pb = r->pb;
     size_t nv = pb->vertex_count, nb = r->pk.block_count, ns = nb * ctx->lanes;
+    const rs_result_sink *sink = r->sink;
+    if (sink->device && !sink->target && sink->core_count >= nv && !sink->weight &&
+        !sink->confidence && !r->out_normals) {
+        /* rsmooth_smooth_cl: the positions go to the caller's buffer on the device, nothing
+         * comes back (the pair counts, 8 bytes a block, are left out of the report too) */
+        rsmooth_status st = rs_cl_store_device(ctx, sink->device, r->buf[BUF_BLOCK_RESULT],
+                                               r->pk.slot, nv, ctx->lanes, pb->scale,
+                                               r->grid.cell_size, r->error);
+        if (st != RSMOOTH_OK)
+            return st;
+        stats->ms_grid += r->t_grid - r->t_start;
+        stats->ms_upload += r->t_upload - r->t_grid;
+        stats->ms_mollify += r->t_mollify - r->t_upload;
+        stats->ms_normals += r->t_normals - r->t_mollify;
+        stats->ms_robust += r->t_robust - r->t_normals;
+        stats->ms_download += rs_now_ms() - r->t_robust;
+        stats->pairs_mollify += r->bilateral_pairs;
+        stats->cells += r->grid.cell_count;
+        stats->tiles++;
+        return RSMOOTH_OK;
+    }
     cl_int err = CL_SUCCESS;
     r->result = clEnqueueMapBuffer(ctx->queue, r->buf[BUF_BLOCK_RESULT], CL_TRUE, CL_MAP_READ, 0,
                                    ns * 4 * sizeof(cl_float), 0, NULL, NULL, &err);

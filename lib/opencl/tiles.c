@@ -313,7 +313,8 @@ rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *pb, const rs
             facets[q] = (uint32_t)q;
         /* a little extra: a facet exactly at the halo must not round out of it */
         double halo = rs_halo_radius(pb, reach) * (1 + 1e-6);
-        rs_result_sink scratch = {RSMOOTH_FLOAT64, positions, weight, confidence, NULL, nv};
+        rs_result_sink scratch = {RSMOOTH_FLOAT64, positions, weight, confidence, NULL, nv,
+                                  NULL};
         tiler t = {ctx, pb, &scratch, stats, halo, budget, sub_index, 0, nv, error};
         st = solve_region(&t, verts, nv, facets, pb->facet_count, 0);
     }

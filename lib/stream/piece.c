@@ -220,7 +220,7 @@ rsmooth_status rsmooth_smooth_piece(rsmooth_context *ctx, const double *position
                                   1 / pb.scale);
         } else if (st == RSMOOTH_OK && info->core_count > 0) {
             rs_result_sink sink = {RSMOOTH_FLOAT64, out_positions, NULL, NULL, NULL,
-                                   info->core_count};
+                                   info->core_count, NULL};
             st = rs_cl_filter(ctx, &pb, &sink, &stats, error);
         }
         if (st == RSMOOTH_OK && report)

@@ -2,7 +2,13 @@
  * reference goes; the library serialises calls on one context, so threads may share it. */
 #include "ext.h"
 
+#ifndef CL_TARGET_OPENCL_VERSION
+#define CL_TARGET_OPENCL_VERSION 120 /* as the library's sources; only its types are used */
+#endif
+#include "rsmooth_cl.h"
+
 #include <stdlib.h>
+#include <string.h>
 
 static const char capsule_name[] = "rsmooth.context";
 
@@ -38,6 +44,90 @@ PyObject *ext_context_create(PyObject *self, PyObject *args) {
     if (!capsule)
         rsmooth_context_destroy(ctx);
     return capsule;
+}
+
+/* An OpenCL handle passed as an int (PyOpenCL's int_ptr): 0 and *out, or -1 with TypeError. */
+static int handle_arg(PyObject *obj, const char *name, void **out) {
+    if (!PyLong_Check(obj)) {
+        PyErr_Format(PyExc_TypeError, "%s: expected an int (an OpenCL handle's int_ptr), got %R",
+                     name, obj);
+        return -1;
+    }
+    *out = PyLong_AsVoidPtr(obj);
+    return *out == NULL && PyErr_Occurred() ? -1 : 0;
+}
+
+/* _context_from_queue(int_ptr) -> capsule: rsmooth_context_create_from_queue on the caller's
+ * cl_command_queue (retained by the context), kernels built with the GIL released. */
+PyObject *ext_context_from_queue(PyObject *self, PyObject *args) {
+    (void)self;
+    PyObject *handle;
+    void *queue;
+    if (!PyArg_ParseTuple(args, "O", &handle) || handle_arg(handle, "queue", &queue) != 0 ||
+        ext_refuse_inside_context_call("Context() made") != 0)
+        return NULL;
+    if (!queue) {
+        PyErr_SetString(PyExc_ValueError, "queue: its int_ptr is 0 (a released queue?)");
+        return NULL;
+    }
+    rsmooth_context *ctx = NULL;
+    rsmooth_error err;
+    rsmooth_status st;
+    Py_BEGIN_ALLOW_THREADS
+    st = rsmooth_context_create_from_queue((cl_command_queue)queue, &ctx, &err);
+    Py_END_ALLOW_THREADS
+    if (st != RSMOOTH_OK)
+        return ext_raise(st, &err);
+    PyObject *capsule = PyCapsule_New(ctx, capsule_name, destroy_capsule);
+    if (!capsule)
+        rsmooth_context_destroy(ctx);
+    return capsule;
+}
+
+/* _smooth_cl(context, double, positions, vertex_count, faces, out, params, progress) -> report
+ * dict: rsmooth_smooth_cl. positions and out: cl_mem int_ptrs of vertex_count x 3 floats (double
+ * True: doubles) on the context's OpenCL context (the library checks sizes and context); faces
+ * (m, 3) uint32 on the host. */
+PyObject *ext_smooth_cl(PyObject *self, PyObject *args, PyObject *kwargs) {
+    (void)self;
+    static char *keywords[] = {"context", "double", "positions", "vertex_count", "faces", "out",
+                               "params", "progress", NULL};
+    PyObject *cobj, *dobj, *pobj_in, *nobj, *fobj, *oobj, *pobj, *progress;
+    if (!PyArg_ParseTupleAndKeywords(args, kwargs, "OOOOOOOO", keywords, &cobj, &dobj, &pobj_in,
+                                     &nobj, &fobj, &oobj, &pobj, &progress))
+        return NULL;
+    rsmooth_context *ctx = ext_context_from(cobj);
+    if (!ctx || ext_refuse_inside_context_call("smooth() on an OpenCL context") != 0)
+        return NULL;
+    int is_double = PyObject_IsTrue(dobj);
+    void *in_mem, *out_mem;
+    long count;
+    if (is_double < 0 || handle_arg(pobj_in, "positions", &in_mem) != 0 ||
+        handle_arg(oobj, "out", &out_mem) != 0 ||
+        ext_whole_arg(nobj, "vertex_count", 0, 0x7fffffffL, &count) != 0)
+        return NULL;
+    ext_array f;
+    ext_param_arrays held;
+    memset(&held, 0, sizeof held);
+    PyObject *result = NULL;
+    if (ext_array_get(fobj, "faces", EXT_UINT32, 3, 0, 0, &f) != 0)
+        return NULL;
+    rsmooth_params p;
+    if (ext_params_from_dict(pobj, (Py_ssize_t)count, &p, &held) != 0 || ext_array_own(&f, 0) != 0)
+        goto done;
+    call_state call;
+    rsmooth_report rep;
+    rsmooth_report_init(&rep);
+    rsmooth_error err;
+    ext_start_call(&call, progress, &p, 1);
+    rsmooth_status st = rsmooth_smooth_cl(ctx, is_double ? RSMOOTH_FLOAT64 : RSMOOTH_FLOAT32,
+                                          (cl_mem)in_mem, (size_t)count, f.data, (size_t)f.rows,
+                                          &p, (cl_mem)out_mem, &rep, &err);
+    result = ext_finish_call(&call, st, &rep, &err);
+done:
+    ext_param_arrays_release(&held);
+    ext_array_release(&f);
+    return result;
 }
 
 /* _context_info(capsule) -> (device name, build ms, memory budget bytes). */

@@ -74,6 +74,23 @@ PyObject *ext_devices(PyObject *self, PyObject *args);                         /
 PyObject *ext_context_create(PyObject *self, PyObject *args);                  /* context.c */
 PyObject *ext_context_info(PyObject *self, PyObject *args);                    /* context.c */
 
+PyObject *ext_context_from_queue(PyObject *self, PyObject *args);              /* context.c */
+PyObject *ext_smooth_cl(PyObject *self, PyObject *args, PyObject *kwargs);     /* context.c */
+
+/* A filter call in progress (filter.c): the GIL let go, progress reports taking it back. */
+typedef struct call_state {
+    PyThreadState *thread; /* saved while the library runs */
+    PyObject *progress;    /* callable(fraction) or NULL */
+    int on_context;        /* the call holds an OpenCL context's lock until it returns */
+} call_state;
+
+/* Hands the library `progress` through p's progress_cancel and lets go of the GIL: the filter
+ * call follows, then ext_finish_call, which takes the GIL back and returns the report dict or
+ * raises what the status calls for. */
+void ext_start_call(call_state *c, PyObject *progress, rsmooth_params *p, int on_context);
+PyObject *ext_finish_call(call_state *c, rsmooth_status st, const rsmooth_report *rep,
+                          const rsmooth_error *err);
+
 /* The rsmooth_context a capsule from ext_context_create holds; NULL with TypeError if `obj` is
  * not one. */
 rsmooth_context *ext_context_from(PyObject *obj);

@@ -8,11 +8,6 @@
 
 #include <string.h>
 
-typedef struct call_state {
-    PyThreadState *thread; /* saved while the library runs */
-    PyObject *progress;    /* callable(fraction) or NULL */
-    int on_context;        /* the call holds an OpenCL context's lock until it returns */
-} call_state;
 
 /* The calls on an OpenCL context this thread is inside: Python code that runs on it meanwhile
  * (the progress callable, a signal handler) is inside them too. */
@@ -72,8 +67,8 @@ static PyObject *report_dict(const rsmooth_report *r) {
 }
 
 /* Hands the library `progress` through p's progress_cancel and lets go of the GIL: the filter
- * call follows, then finish_call. */
-static void start_call(call_state *c, PyObject *progress, rsmooth_params *p, int on_context) {
+ * call follows, then ext_finish_call. */
+void ext_start_call(call_state *c, PyObject *progress, rsmooth_params *p, int on_context) {
     c->progress = progress == Py_None ? NULL : progress;
     c->on_context = on_context;
     contexts_held += on_context;
@@ -84,8 +79,8 @@ static void start_call(call_state *c, PyObject *progress, rsmooth_params *p, int
 
 /* Takes the GIL back; the run's report, or the exception its status (or a pending one: a report
  * the library does not act on, the last at 1, may still have raised) calls for. */
-static PyObject *finish_call(call_state *c, rsmooth_status st, const rsmooth_report *rep,
-                             const rsmooth_error *err) {
+PyObject *ext_finish_call(call_state *c, rsmooth_status st, const rsmooth_report *rep,
+                          const rsmooth_error *err) {
     PyEval_RestoreThread(c->thread);
     contexts_held -= c->on_context;
     return st == RSMOOTH_OK && !PyErr_Occurred() ? report_dict(rep) : ext_raise(st, err);
@@ -134,14 +129,14 @@ PyObject *ext_smooth(PyObject *self, PyObject *args, PyObject *kwargs) {
     rsmooth_report_init(&rep); /* its struct_size says which fields this caller has */
     rsmooth_error err;
     rsmooth_status st;
-    start_call(&call, progress, &p, ctx != NULL);
+    ext_start_call(&call, progress, &p, ctx != NULL);
     if (ctx)
         st = rsmooth_smooth(ctx, v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows, &p,
                             out.data, NULL, conf.data, &rep, &err);
     else
         st = rsmooth_smooth_reference(v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows,
                                       &p, out.data, NULL, conf.data, &rep, &err);
-    result = finish_call(&call, st, &rep, &err);
+    result = ext_finish_call(&call, st, &rep, &err);
     if (result) {
         ext_array_publish(&out);
         ext_array_publish(&conf);
@@ -195,11 +190,11 @@ PyObject *ext_smooth_points(PyObject *self, PyObject *args, PyObject *kwargs) {
     rsmooth_report rep;
     rsmooth_report_init(&rep); /* its struct_size says which fields this caller has */
     rsmooth_error err;
-    start_call(&call, progress, &p, 0);
+    ext_start_call(&call, progress, &p, 0);
     rsmooth_status st = rsmooth_smooth_points_reference(v.scalar, v.data, n.data, (size_t)v.rows,
                                                         &p, out.data, out_n.data, conf.data, &rep,
                                                         &err);
-    result = finish_call(&call, st, &rep, &err);
+    result = ext_finish_call(&call, st, &rep, &err);
     if (result) {
         ext_array_publish(&out);
         ext_array_publish(&out_n);

@@ -58,6 +58,10 @@ static PyMethodDef methods[] = {
     {"_devices", ext_devices, METH_NOARGS, "OpenCL devices (internal)."},
     {"_context_create", ext_context_create, METH_VARARGS, "New context (internal)."},
     {"_context_info", ext_context_info, METH_VARARGS, "Context figures (internal)."},
+    {"_context_from_queue", ext_context_from_queue, METH_VARARGS,
+     "New context on a caller's cl_command_queue (internal)."},
+    {"_smooth_cl", KW(ext_smooth_cl), METH_VARARGS | METH_KEYWORDS,
+     "The mesh filter on OpenCL buffers (internal)."},
     {NULL, NULL, 0, NULL},
 };
 
