@@ -222,13 +222,15 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                      passes);
         goto done;
     }
+    /* Every pass reads and writes double: a pass writes in the scalar type it reads, so a
+     * float32 caller's first pass would otherwise leave floats where the next reads doubles. */
+    for (size_t i = 0; i < 3 * vertex_count; i++)
+        cur[i] = rs_coordinate(scalar, positions, i);
     rsmooth_report sum, one;
     memset(&sum, 0, sizeof sum);
     for (int pass = 0; pass < passes; pass++) {
         pp.pass = pass;
-        const void *from = pass == 0 ? positions : cur;
-        rsmooth_scalar from_scalar = pass == 0 ? scalar : RSMOOTH_FLOAT64;
-        st = one_pass(ctx, from_scalar, from, vertex_count, indices, triangle_count, &p, next,
+        st = one_pass(ctx, RSMOOTH_FLOAT64, cur, vertex_count, indices, triangle_count, &p, next,
                       weight, confidence, report ? &one : NULL, error);
         if (st != RSMOOTH_OK)
             goto done;

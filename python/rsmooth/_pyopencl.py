@@ -123,7 +123,7 @@ def smooth_array(
         params["move_mask"] = _mask(mask.get() if _is_device_array(mask) else mask, n)
     import pyopencl.array as cl_array  # the caller passed an array: pyopencl is there
 
-    out = cl_array.empty(queue, (n, 3), dtype)
+    out: Any = cl_array.empty(queue, (n, 3), dtype)  # (its base_data a buffer: made here)
     in_ptr = vertices.base_data.int_ptr if n else 0
     out_ptr = out.base_data.int_ptr if n else 0
     call, bar = _progress_callable(progress)
