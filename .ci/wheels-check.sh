@@ -148,7 +148,8 @@ t=$SECONDS
 py=$(first_python --dev 3.11)
 py=${py:-python3}
 venv "$work/venv-sdist" "$py"
-if pip_in "$work/venv-sdist" "$sdist" --config-settings=cmake.define.RSMOOTH_WERROR="$werror"; then
+# No cache: pip would reuse the wheel it built from an sdist of the same name before.
+if pip_in "$work/venv-sdist" --no-cache-dir "$sdist" --config-settings=cmake.define.RSMOOTH_WERROR="$werror"; then
   (cd / && "$work/venv-sdist/bin/python" - <<'PY'
 import numpy as np, rsmooth, sys
 assert rsmooth.__file__.startswith(sys.prefix), rsmooth.__file__
