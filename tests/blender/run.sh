@@ -4,13 +4,18 @@
 # `blender -b --factory-startup` with BLENDER_USER_SCRIPTS in a temporary folder (the zip is
 # installed there, not in the user's Blender), comparing the add-on with BUILD/rsmooth on the same
 # device (RSMOOTH_BLENDER_DEVICE, default cpu: PoCL's CPU device; or reference).
-# Skips (exit 0, with a message) where there is no Blender: $BLENDER, default `blender` on PATH.
+# Skips (exit 0, with a message) where there is no Blender: $BLENDER, default `blender` on PATH;
+# fails there instead with RSMOOTH_REQUIRE_BLENDER=1 (.ci/run).
 set -euo pipefail
 build=${1:?usage: tests/blender/run.sh BUILD ZIP}
 zip=${2:?usage: tests/blender/run.sh BUILD ZIP}
 blender=${BLENDER:-blender}
 device=${RSMOOTH_BLENDER_DEVICE:-cpu}
 if ! command -v "$blender" >/dev/null 2>&1; then
+  if [ "${RSMOOTH_REQUIRE_BLENDER:-0}" = 1 ]; then # CI: a missing Blender fails, not skips
+    echo "blender-check: no Blender ('$blender' not found) and RSMOOTH_REQUIRE_BLENDER=1" >&2
+    exit 1
+  fi
   echo "blender-check: skipped: no Blender ('$blender' not found; apt-get install blender, or BLENDER=PATH)"
   exit 0
 fi
