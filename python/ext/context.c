@@ -24,6 +24,16 @@ rsmooth_context *ext_context_from(PyObject *obj) {
     return PyCapsule_GetPointer(obj, capsule_name);
 }
 
+/* A created context in a capsule that destroys it, or the creation's error raised. */
+static PyObject *capsule_for(rsmooth_status st, rsmooth_context *ctx, const rsmooth_error *err) {
+    if (st != RSMOOTH_OK)
+        return ext_raise(st, err);
+    PyObject *capsule = PyCapsule_New(ctx, capsule_name, destroy_capsule);
+    if (!capsule)
+        rsmooth_context_destroy(ctx);
+    return capsule;
+}
+
 /* _context_create(device or None) -> capsule. Builds the kernels (seconds on a cold cache) with
  * the GIL released. */
 PyObject *ext_context_create(PyObject *self, PyObject *args) {
@@ -38,12 +48,7 @@ PyObject *ext_context_create(PyObject *self, PyObject *args) {
     Py_BEGIN_ALLOW_THREADS
     st = rsmooth_context_create(device, &ctx, &err);
     Py_END_ALLOW_THREADS
-    if (st != RSMOOTH_OK)
-        return ext_raise(st, &err);
-    PyObject *capsule = PyCapsule_New(ctx, capsule_name, destroy_capsule);
-    if (!capsule)
-        rsmooth_context_destroy(ctx);
-    return capsule;
+    return capsule_for(st, ctx, &err);
 }
 
 /* An OpenCL handle passed as an int (PyOpenCL's int_ptr): 0 and *out, or -1 with TypeError. */
@@ -76,12 +81,7 @@ PyObject *ext_context_from_queue(PyObject *self, PyObject *args) {
     Py_BEGIN_ALLOW_THREADS
     st = rsmooth_context_create_from_queue((cl_command_queue)queue, &ctx, &err);
     Py_END_ALLOW_THREADS
-    if (st != RSMOOTH_OK)
-        return ext_raise(st, &err);
-    PyObject *capsule = PyCapsule_New(ctx, capsule_name, destroy_capsule);
-    if (!capsule)
-        rsmooth_context_destroy(ctx);
-    return capsule;
+    return capsule_for(st, ctx, &err);
 }
 
 /* _smooth_cl(context, double, positions, vertex_count, faces, out, params, progress) -> report
