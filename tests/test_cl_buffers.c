@@ -196,8 +196,9 @@ int main(void) {
     uint64_t pairs = check_same(&fx, &cube, RSMOOTH_FLOAT32, &v, 0, "bilateral, Tukey");
     CHECK(!fp64 || pairs == 0);
     /* the paths that upload the host's result */
-    /* (passes > 1 upload too; left out here: two-pass results on one context are not always
-     * the same bits from call to call, on main as well, see the branch's report) */
+    v = p;
+    v.passes = 2; /* (float32: the case test_passes_scalar guards) */
+    CHECK(check_same(&fx, &cube, RSMOOTH_FLOAT32, &v, 0, "2 passes (uploaded)") > 0);
     uint8_t *mask = malloc(cube.vertex_count);
     CHECK(mask);
     for (size_t i = 0; i < cube.vertex_count; i++)
