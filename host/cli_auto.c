@@ -56,6 +56,8 @@ int cli_choose_params(options *opt, const rsmooth_mesh *mesh, bool points) {
     opt->noise = report.level;
     opt->noise_correlated = report.correlated_level;
     opt->noise_correlation_length = report.correlation_length;
+    opt->noise_shape_correlation = report.shape_correlation;
+    snprintf(opt->noise_preset, sizeof opt->noise_preset, "%s", report.preset);
     /* the correlated part, when there is one: what the rules (which read `level`) do not see */
     char correlated[128] = "";
     if (report.correlation_length > 0)

@@ -17,7 +17,7 @@ enum {
     OPT_ABSOLUTE, OPT_NO_MOLLIFY, OPT_ASCII, OPT_JSON, OPT_STATS, OPT_LIST_DEVICES, OPT_FORCE,
     OPT_QUIET, OPT_MASK, OPT_VERTEX_UPDATES, OPT_GUIDED_SIGMA_S, OPT_GUIDED_SIGMA_N,
     OPT_GUIDED_ROUNDS, OPT_STAGE_REPEATS, OPT_MAX_MEMORY, OPT_TMPDIR, OPT_PROGRESS,
-    OPT_GUIDED_RADIUS
+    OPT_GUIDED_RADIUS, OPT_NO_GUARD
 };
 
 static const cli_option table[] = {
@@ -58,6 +58,7 @@ static const cli_option table[] = {
     {"best", 0, false, OPT_BEST},
     {"absolute", 0, false, OPT_ABSOLUTE},
     {"no-mollify", 0, false, OPT_NO_MOLLIFY},
+    {"no-guard", 0, false, OPT_NO_GUARD},
     {"ascii", 0, false, OPT_ASCII},
     {"json", 0, false, OPT_JSON},
     {"stats", 0, false, OPT_STATS},
@@ -250,6 +251,7 @@ static int apply(options *opt, int id, const char *name, const char *value) {
     case OPT_BEST: break; /* applied before the others, so the options after it can change it */
     case OPT_ABSOLUTE: opt->params.absolute = 1; break;
     case OPT_NO_MOLLIFY: opt->params.mollify = 0; break;
+    case OPT_NO_GUARD: opt->params.guard = 0; break;
     case OPT_ASCII: opt->ascii = true; break;
     case OPT_JSON: opt->json = true; break;
     case OPT_STATS: opt->stats = true; break;

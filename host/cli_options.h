@@ -70,6 +70,8 @@ typedef struct options {
     double noise;           /* --auto's estimate */
     double noise_correlated; /* --auto's rms including the correlated part (= noise when none) */
     double noise_correlation_length; /* its correlation length, edges (0: uncorrelated) */
+    double noise_shape_correlation;  /* how alike neighbours bend (clean: 0.3 or more) */
+    char noise_preset[32];           /* what --auto chose ("clean": nothing to remove) */
 } options;
 
 /* Reads the command line into `opt` and checks it (cli_options_check). Returns -1 when the

@@ -59,6 +59,26 @@ void cli_confidence_colour(float c, uint8_t rgb[3]) {
         rgb[k] = (uint8_t)lrintf(stops[i][k] + t * (stops[i + 1][k] - stops[i][k]));
 }
 
+void cli_print_harm(const char *input, const rsmooth_report *r) {
+    if (r->parts > 1)
+        fprintf(stderr, "rsmooth: %s: %zu parts of very different size, each smoothed in its own "
+                        "unit with its own triangles only\n",
+                input, r->parts);
+    if (r->outliers > 0)
+        fprintf(stderr, "rsmooth: %s: %zu outlier vertices (every triangle they belong to out of "
+                        "scale with the surface around it) held where they were; their triangles "
+                        "moved no other vertex\n",
+                input, r->outliers);
+    if (r->guarded_vertices > 0)
+        fprintf(stderr, "rsmooth: %s: %zu vertices pulled back toward the input so that no "
+                        "triangle turned over (--no-guard: the filter's result as it came)\n",
+                input, r->guarded_vertices);
+    if (r->stage_skipped)
+        fprintf(stderr, "rsmooth: %s: the mesh reads clean: the normal update stage had nothing "
+                        "to remove and did not run (--no-guard runs it)\n",
+                input);
+}
+
 void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read,
                     double ms_write) {
     printf("{\"input\":");
@@ -97,8 +117,11 @@ void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read,
                    "\"discrepancy_iterations\":%d",
                    p->guided_sigma_s, p->guided_sigma_n, p->guided_radius, p->guided_rounds,
                    p->stage_repeats, p->discrepancy_level, r->discrepancy_iterations);
-        if (opt->auto_params)
-            printf(",\"noise_estimate\":%.9g", opt->noise);
+        if (opt->auto_params) {
+            printf(",\"noise_estimate\":%.9g,\"shape_correlation\":%.9g,\"preset\":",
+                   opt->noise, opt->noise_shape_correlation);
+            cli_print_json_string(opt->noise_preset);
+        }
         if (opt->auto_params && opt->noise_correlation_length > 0)
             printf(",\"noise_correlated\":%.9g,\"noise_correlation_length\":%.9g",
                    opt->noise_correlated, opt->noise_correlation_length);
@@ -110,8 +133,10 @@ void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read,
         printf("\"sigma_g\":null,");
     else
         printf("\"sigma_g\":%.9g,", r->sigma_g);
-    printf("\"radius\":%.9g,\"grid_cells\":%zu,\"pairs_robust\":%llu,\"tiles\":%zu,\"device\":", r->radius,
-           r->grid_cell_count, (unsigned long long)r->pairs_robust, r->tiles);
+    printf("\"radius\":%.9g,\"grid_cells\":%zu,\"pairs_robust\":%llu,\"tiles\":%zu,\"parts\":%zu,"
+           "\"outliers\":%zu,\"guarded_vertices\":%zu,\"stage_skipped\":%s,\"device\":",
+           r->radius, r->grid_cell_count, (unsigned long long)r->pairs_robust, r->tiles, r->parts,
+           r->outliers, r->guarded_vertices, r->stage_skipped ? "true" : "false");
     cli_print_json_string(r->device);
     if (r->stage_cycles > 0) /* the normal-update stage: where it ran, its parts, its traffic */
         printf(",\"stage\":{\"on_device\":%s,\"float_bits\":%d,\"cycles\":%d,"

@@ -185,6 +185,8 @@ static void report_file(const file_job *job) {
                         "scale of its triangles (organic parts coarse for their curvature), "
                         "blended between: the filter's weight %.0f%% on average\n",
                 opt->input, r->discrepancy_iterations, 100 * r->region_filter_share);
+    if (!opt->quiet)
+        cli_print_harm(opt->input, r);
     if (opt->json)
         cli_print_json(r, opt, job->ms_read, job->ms_write);
     if (opt->stats)

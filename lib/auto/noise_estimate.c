@@ -64,6 +64,8 @@
  * run and for any thread count. */
 #include "auto/noise_estimate.h"
 #include "auto/eigen3.h"
+#include "core/parts.h"
+#include "core/shape_correlation.h"
 #include "core/spatial.h"
 
 #include <math.h>
@@ -922,6 +924,7 @@ typedef struct estimate_run {
     size_t vertex_count, triangle_count;
     double scale;       /* internal units per caller unit (scale.c) */
     double unit;        /* the noisy mesh's mean edge length, internal units */
+    double shape_correlation; /* core/shape_correlation.h */
     uint32_t *point_of; /* per vertex: its point (UINT32_MAX: none), until the rings are built */
     point_set pts;
     rs_grid grid;
@@ -967,7 +970,9 @@ static rsmooth_status read_points(estimate_run *e, rsmooth_scalar scalar, const 
     }
     e->point_of = rs_alloc_array(vertex_count, sizeof *e->point_of);
     bool ok = e->point_of &&
-              build_points(xyz, vertex_count, e->indices, e->triangle_count, &e->pts, e->point_of);
+              build_points(xyz, vertex_count, e->indices, e->triangle_count, &e->pts, e->point_of) &&
+              rs_shape_correlation(xyz, vertex_count, e->indices, e->triangle_count,
+                                   &e->shape_correlation);
     rs_free(xyz);
     if (!ok)
         return rs_fail(e->error, RSMOOTH_ERROR_OUT_OF_MEMORY, e->caller,
@@ -1066,10 +1071,11 @@ static rsmooth_status correlated_part(estimate_run *e, rs_noise_details *out) {
     return RSMOOTH_OK;
 }
 
-rsmooth_status rs_estimate_noise_details(rsmooth_scalar scalar, const void *positions,
-                                         size_t vertex_count, const uint32_t *indices,
-                                         size_t triangle_count, rs_noise_details *out,
-                                         rsmooth_error *error, const char *caller) {
+/* The estimate on a whole mesh (one part). */
+static rsmooth_status estimate_mesh(rsmooth_scalar scalar, const void *positions,
+                                    size_t vertex_count, const uint32_t *indices,
+                                    size_t triangle_count, rs_noise_details *out,
+                                    rsmooth_error *error, const char *caller) {
     double magnitude = 0;
     estimate_run e;
     memset(&e, 0, sizeof e);
@@ -1089,7 +1095,9 @@ rsmooth_status rs_estimate_noise_details(rsmooth_scalar scalar, const void *posi
     memset(out, 0, sizeof *out);
     out->impulsive_fraction = 1;
     out->tangential_level = NAN;
+    e.shape_correlation = 1;
     st = read_points(&e, scalar, positions);
+    out->shape_correlation = e.shape_correlation;
     if (st == RSMOOTH_OK && e.unit > 0 && e.pts.count <= MIN_POINTS) {
         /* too few vertices for any fit: nothing measurable */
         out->mean_edge_noisy = out->mean_edge_clean = e.unit / e.scale;
@@ -1107,4 +1115,45 @@ rsmooth_status rs_estimate_noise_details(rsmooth_scalar scalar, const void *posi
     }
     free_estimate(&e);
     return st;
+}
+
+rsmooth_status rs_estimate_noise_details(rsmooth_scalar scalar, const void *positions,
+                                         size_t vertex_count, const uint32_t *indices,
+                                         size_t triangle_count, rs_noise_details *out,
+                                         rsmooth_error *error, const char *caller) {
+    rsmooth_status st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices,
+                                             triangle_count, NULL, error, caller);
+    rs_parts parts;
+    if (st == RSMOOTH_OK)
+        st = rs_parts_find(&parts, scalar, positions, vertex_count, indices, triangle_count,
+                           error, caller);
+    if (st != RSMOOTH_OK)
+        return st;
+    if (parts.whole) {
+        st = estimate_mesh(scalar, positions, vertex_count, indices, triangle_count, out, error,
+                           caller);
+    } else { /* the part that moves the most vertices, without outliers or other parts */
+        rs_submesh sub;
+        if (!rs_submesh_make(&sub, &parts, rs_parts_largest(&parts), scalar, positions,
+                             vertex_count, indices, triangle_count, NULL)) {
+            rs_parts_free(&parts);
+            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, caller, "no memory for a part");
+        }
+        st = estimate_mesh(scalar, sub.positions, sub.vertex_count, sub.indices,
+                           sub.triangle_count, out, error, caller);
+        rs_submesh_free(&sub);
+    }
+    if (st == RSMOOTH_OK) {
+        out->parts = parts.count;
+        out->outliers = parts.outliers;
+    }
+    rs_parts_free(&parts);
+    return st;
+}
+
+bool rs_noise_reads_clean(const rs_noise_details *d) {
+    if (!(d->level > 0) || d->shape_correlation >= RS_CLEAN_SHAPE_CORRELATION)
+        return true;
+    double low = d->profile.low[0], floor = d->profile.low_floor[0];
+    return !d->impulsive && isfinite(low) && isfinite(floor) && low <= RS_CLEAN_FLOOR * floor;
 }

@@ -43,7 +43,22 @@ typedef struct rs_noise_details {
     double correlation_length;
     /* What the two are read from (radii and figures in the noisy mesh's mean edge lengths). */
     rs_noise_profile profile;
+    /* core/shape_correlation.h's figure: near 1 where the roughness is shape, at or below 0 where
+     * it is noise. */
+    double shape_correlation;
+    /* The mesh's parts (core/parts.h) and outliers: the figures above are the largest part's. */
+    size_t parts, outliers;
 } rs_noise_details;
+
+/* Nothing to remove (rs_noise_reads_clean): the correlation of bends at or above
+ * RS_CLEAN_SHAPE_CORRELATION (core/shape_correlation.h), or (noise
+ * read as Gaussian) the small-scale residual within this factor of what a smoothed copy of the
+ * mesh leaves (the shape's own share, noise_scales.c). Chosen on the 28 clean meshes of
+ * ../shared/data/clean (clean: correlation 0.37-0.99 but one, decimated-knight at -0.07, whose
+ * residual is 1.37 times its floor), the 30 noisy accuracy cases (noisy: correlation at most
+ * 0.07, residuals 1.64 to 13 times the floor) and the two raw range scans (0.17, 0.10; 8 and 9
+ * times). */
+#define RS_CLEAN_FLOOR 1.4
 
 /* rsmooth_estimate_noise with the details; errors name `caller`. Deterministic for any thread
  * count. */
@@ -51,5 +66,9 @@ rsmooth_status rs_estimate_noise_details(rsmooth_scalar scalar, const void *posi
                                          size_t vertex_count, const uint32_t *indices,
                                          size_t triangle_count, rs_noise_details *out,
                                          rsmooth_error *error, const char *caller);
+
+/* Whether the estimate finds nothing to remove: no measurable noise, or roughness that reads as
+ * the mesh's own shape (a clean mesh, however coarse). */
+bool rs_noise_reads_clean(const rs_noise_details *d);
 
 #endif

@@ -3,6 +3,7 @@
  * cross-validation that leaves whole meshes out (scripts/calibrate.py; the figures of meshes the
  * rules never saw are in docs/experiments.md, section 7). */
 #include "auto/noise_estimate.h"
+#include "core/shape_correlation.h"
 #include "core/rsmooth_internal.h"
 
 #include <math.h>
@@ -84,6 +85,28 @@ static void describe(const rs_noise_details *d, char *out, size_t size) {
              d->tangential_level);
 }
 
+/* Nothing to remove: no pass and no stage, so the input comes back as it is. */
+static void choose_clean(rsmooth_params *params, const rs_noise_details *d, const char *what,
+                         char *preset, size_t preset_size, char *reason, size_t reason_size) {
+    params->vertex_updates = 0;
+    params->passes = 0;
+    params->discrepancy_level = 0;
+    params->discrepancy_gain = 0;
+    snprintf(preset, preset_size, "clean");
+    if (d->level > 0 && d->shape_correlation >= RS_CLEAN_SHAPE_CORRELATION)
+        snprintf(reason, reason_size, "noise estimate %.3g mean edge lengths, but the roughness "
+                 "reads as the mesh's shape (bends correlated %.2f across neighbours): nothing "
+                 "to remove, every vertex stays",
+                 d->level, d->shape_correlation);
+    else if (d->level > 0)
+        snprintf(reason, reason_size, "noise estimate %.3g mean edge lengths, but the roughness "
+                 "is %.2f times what the shape alone leaves (a smoothed copy's): nothing to "
+                 "remove, every vertex stays",
+                 d->level, d->profile.low[0] / d->profile.low_floor[0]);
+    else
+        snprintf(reason, reason_size, "%.100s: nothing to remove, every vertex stays", what);
+}
+
 /* Sets the fields of `params` the rule chooses for what `d` read, and says which and why. */
 static void choose(rsmooth_params *params, const rs_noise_details *d, char *preset,
                    size_t preset_size, char *reason, size_t reason_size) {
@@ -91,6 +114,10 @@ static void choose(rsmooth_params *params, const rs_noise_details *d, char *pres
     char what[128];
     describe(d, what, sizeof what);
     params->absolute = 0;
+    if (rs_noise_reads_clean(d)) {
+        choose_clean(params, d, what, preset, preset_size, reason, reason_size);
+        return;
+    }
     if (params->normal_filter == RSMOOTH_NORMALS_MOLLIFY && params->vertex_updates == 0) {
         params->sigma_f = PAPER_SIGMA_F_AT_0 + PAPER_SIGMA_F_PER_NOISE * n;
         if (n > 0)
@@ -168,14 +195,17 @@ rsmooth_status rsmooth_params_auto_report(rsmooth_scalar scalar, const void *pos
     params->struct_size = size;
     if (report) {
         r.level = d.level;
-        r.kind = !(d.level > 0) ? RSMOOTH_NOISE_NONE
-                 : d.impulsive  ? RSMOOTH_NOISE_IMPULSIVE
-                                : RSMOOTH_NOISE_GAUSSIAN;
+        r.kind = rs_noise_reads_clean(&d) ? RSMOOTH_NOISE_NONE
+                 : d.impulsive              ? RSMOOTH_NOISE_IMPULSIVE
+                                            : RSMOOTH_NOISE_GAUSSIAN;
         r.impulsive_fraction = d.impulsive_fraction;
         r.tangential_level = d.tangential_level;
         r.mean_edge_length = d.mean_edge_clean;
         r.correlated_level = d.correlated_level;
         r.correlation_length = d.correlation_length;
+        r.shape_correlation = d.shape_correlation;
+        r.outliers = d.outliers;
+        r.parts = d.parts;
         *report = r;
     }
     return RSMOOTH_OK;

@@ -95,6 +95,12 @@ static int compare_u32(const void *a, const void *b) {
 
 bool rs_mean_edge_length(const double *xyz, size_t vertex_count, const uint32_t *indices,
                          size_t triangle_count, double *out_length) {
+    return rs_mean_edge_length_below(xyz, vertex_count, indices, triangle_count, INFINITY,
+                                     out_length);
+}
+
+bool rs_mean_edge_length_below(const double *xyz, size_t vertex_count, const uint32_t *indices,
+                               size_t triangle_count, double limit, double *out_length) {
     /* Unique edges without a global sort: each edge goes to the bucket of its lower vertex (a
      * counting sort, linear time), and duplicates are removed within a bucket (a handful). */
     *out_length = 0;
@@ -140,7 +146,10 @@ bool rs_mean_edge_length(const double *xyz, size_t vertex_count, const uint32_t 
                 continue;
             double d[3];
             rs_sub3(xyz + 3 * v, xyz + 3 * (size_t)bucket[i], d);
-            sum += sqrt(rs_dot3(d, d));
+            double length = sqrt(rs_dot3(d, d));
+            if (!(length <= limit)) /* out of line: left out of the unit */
+                continue;
+            sum += length;
             unique++;
         }
     }

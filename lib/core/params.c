@@ -39,6 +39,7 @@ rsmooth_status rsmooth_params_init(rsmooth_params *params) {
     params->stage_repeats = 1;
     params->guided_radius = 2.0;
     params->discrepancy_gain = 0.0;
+    params->guard = 1;
     return RSMOOTH_OK;
 }
 
@@ -92,6 +93,9 @@ rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *o
     if (out->absolute != 0 && out->absolute != 1)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "absolute must be 0 or 1 (got %d)", out->absolute);
+    if (out->guard != 0 && out->guard != 1)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "guard must be 0 or 1 (got %d)", out->guard);
     if (out->mollify != 0 && out->mollify != 1)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "mollify must be 0 or 1 (got %d)", out->mollify);
@@ -121,11 +125,9 @@ rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *o
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "vertex_updates must be in [0, %d] (got %d)", RS_MAX_UPDATES,
                        out->vertex_updates);
-    if (out->passes < (out->vertex_updates > 0 ? 0 : 1) || out->passes > RS_MAX_ROUNDS)
+    if (out->passes < 0 || out->passes > RS_MAX_ROUNDS)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "passes must be in [%d, %d] (got %d)%s", out->vertex_updates > 0 ? 0 : 1,
-                       RS_MAX_ROUNDS, out->passes,
-                       out->vertex_updates > 0 ? "" : "; 0 needs vertex_updates > 0");
+                       "passes must be in [0, %d] (got %d)", RS_MAX_ROUNDS, out->passes);
     if (!(out->guided_sigma_s > 0) || !isfinite(out->guided_sigma_s))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "guided_sigma_s must be positive and finite (got %g)", out->guided_sigma_s);

@@ -102,3 +102,10 @@ void rs_report_unscale(rsmooth_report *report, double unscale) {
     report->radius *= unscale;
     report->mollify_radius *= unscale;
 }
+
+size_t rs_report_bytes(size_t struct_size) {
+    /* the sizes rsmooth_report had: 0.5's (up to tiles), 0.6's (discrepancy_iterations), this */
+    size_t v05 = offsetof(rsmooth_report, discrepancy_iterations);
+    size_t v06 = offsetof(rsmooth_report, region_filter_share);
+    return struct_size == v05 || struct_size == v06 ? struct_size : sizeof(rsmooth_report);
+}

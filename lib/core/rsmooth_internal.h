@@ -277,6 +277,9 @@ rsmooth_status rs_check_mesh_structure(rsmooth_scalar scalar, const void *positi
 /* Mean length of unique undirected edges over `xyz` (double). false on allocation failure. */
 bool rs_mean_edge_length(const double *xyz, size_t vertex_count, const uint32_t *indices,
                          size_t triangle_count, double *out_length);
+/* The same over the edges no longer than `limit` (INFINITY: every edge, the same bits). */
+bool rs_mean_edge_length_below(const double *xyz, size_t vertex_count, const uint32_t *indices,
+                               size_t triangle_count, double limit, double *out_length);
 
 /* Geometry helpers shared by the reference path and the host side of the OpenCL path. */
 static inline double rs_dot3(const double a[3], const double b[3]) {
@@ -362,6 +365,10 @@ void rs_store_position(rsmooth_scalar scalar, void *out_positions, size_t v, con
  * weight (no triangles, or all of zero area). */
 void rs_store_unmoved(const rs_problem *problem, rsmooth_scalar scalar, void *out_positions,
                       float *out_weight, float *out_confidence);
+
+/* How many bytes of an rsmooth_report a caller's struct_size says it holds: a size some version's
+ * struct had, else (a struct never initialised) this version's whole struct. */
+size_t rs_report_bytes(size_t struct_size);
 
 /* Fills the parts of a report both paths share (lengths in the caller's units). */
 void rs_report_problem(rsmooth_report *report, const rs_problem *problem, size_t cell_count,

@@ -39,6 +39,7 @@ struct rs_stage_stats {
     int cycles;             /* cycles run */
     int float_bits;         /* the precision they ran in: 64 (the host, a device with fp64), 32 */
     bool on_device;
+    bool skipped;           /* not run: the mesh reads clean (rsmooth_params.guard) */
     char device[128];       /* where the cycles ran */
 };
 

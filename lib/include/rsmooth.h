@@ -229,10 +229,13 @@ typedef struct rsmooth_params {
     int normal_iterations;        /**< bilateral: rounds, [1, 100]. Default 5 */
     int influence;                /**< an rsmooth_influence: the robust weight g. Default
                                    * RSMOOTH_INFLUENCE_GAUSSIAN (the paper's) */
-    int passes;                   /**< the whole filter this many times, [1, 100], each pass from
+    int passes;                   /**< the whole filter this many times, [0, 100], each pass from
                                    * the previous pass's positions (sigmas stay those of the input).
-                                   * Default 1. 0 only with vertex_updates > 0: the normal update
-                                   * stage alone (then weights are 0 and confidences 1) */
+                                   * Default 1. 0: no pass; with vertex_updates > 0 the normal
+                                   * update stage alone, without it nothing at all (the input
+                                   * comes back, as rsmooth_params_auto sets on a mesh with
+                                   * nothing to remove; changed in 0.11). Weights are then 0 and
+                                   * confidences 1 */
     double pass_confidence;       /**< 0 (default): every pass moves every vertex. In (0, 1]: passes
                                    * after the first move only the vertices whose confidence in the
                                    * previous pass was below this (low confidence: features and
@@ -316,6 +319,16 @@ typedef struct rsmooth_params {
                                    * (the authors'); 3-4 holds creases better under heavy noise.
                                    * (Added in 0.11) */
     /** @} */
+    int guard;                    /**< 1 (default): do no harm. A triangle the filter would turn by
+                                   * more than 90 degrees from the input's (unless the input had it
+                                   * folded against its neighbours already) has its vertices pulled
+                                   * back toward the input until none is reversed
+                                   * (rsmooth_report.guarded_vertices counts them), and the normal
+                                   * update stage does not run on a mesh whose noise estimate finds
+                                   * nothing to remove (rsmooth_report.stage_skipped). 0: the filter
+                                   * exactly as set (the paper's own, for comparisons). Parts and
+                                   * outliers (rsmooth_report.parts) are kept apart either way.
+                                   * (Added in 0.11) */
 } rsmooth_params;
 
 /** Fills `params` with the defaults above. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if params is
@@ -377,7 +390,10 @@ RSMOOTH_API rsmooth_status rsmooth_params_auto(rsmooth_scalar scalar, const void
 
 /** The kind of noise rsmooth_params_auto_report found in a mesh (added in 0.6). */
 typedef enum rsmooth_noise_kind {
-    RSMOOTH_NOISE_NONE = 0,      /**< nothing measurable (too few vertices, no edge) */
+    RSMOOTH_NOISE_NONE = 0,      /**< nothing to remove: nothing measurable (too few vertices,
+                                  * no edge), or roughness that reads as the mesh's own shape (a
+                                  * clean mesh, however coarse; see shape_correlation). Changed in
+                                  * 0.11: it meant only the former */
     RSMOOTH_NOISE_GAUSSIAN = 1,  /**< every vertex displaced */
     RSMOOTH_NOISE_IMPULSIVE = 2  /**< a share of the vertices thrown, the others (nearly) exact */
 } rsmooth_noise_kind;
@@ -409,6 +425,15 @@ typedef struct rsmooth_noise_report {
     double correlation_length; /**< the correlated part's correlation length, mean edge lengths
                                 * (about L for noise smoothed by a Gaussian of width L); 0 when
                                 * the noise reads uncorrelated. (Added in 0.11) */
+    double shape_correlation;  /**< how alike neighbouring vertices bend (the correlation of each
+                                * vertex's umbrella offset along its normal with its neighbours'
+                                * mean): 0.37-0.99 on clean meshes, at most 0.17 on noisy ones.
+                                * At 0.3 or more the mesh reads clean: kind RSMOOTH_NOISE_NONE,
+                                * nothing to remove. (Added in 0.11) */
+    size_t parts;              /**< the mesh's parts (rsmooth_report.parts); the figures above are
+                                * the largest's (Added in 0.11) */
+    size_t outliers;           /**< vertices left out as outliers (rsmooth_report.outliers)
+                                * (Added in 0.11) */
 } rsmooth_noise_report;
 
 /** Sets struct_size and clears the rest. */
@@ -476,6 +501,19 @@ typedef struct rsmooth_report {
                                    * without fp64) */
     uint64_t stage_bytes_to_device;   /**< bytes the stage copied to the device */
     uint64_t stage_bytes_from_device; /**< and back */
+    /** @} */
+    /** @name Do no harm (added in 0.11)
+     * What the call left alone (docs/do-no-harm.md). @{ */
+    size_t parts;                 /**< parts of the mesh smoothed each in its own unit: triangles
+                                   * whose sizes (median edge) differ by more than about 8 times,
+                                   * with no sizes between, are kept apart (1 for most meshes) */
+    size_t outliers;              /**< vertices held where they were: every triangle they belong to
+                                   * is out of scale with the surface around it (a vertex thrown
+                                   * far off it); their triangles move no other vertex */
+    size_t guarded_vertices;      /**< vertices rsmooth_params.guard pulled back so that no triangle
+                                   * came out reversed */
+    int stage_skipped;            /**< 1: the normal update stage was asked for but not run, the
+                                   * noise estimate finding nothing to remove (a clean mesh) */
     /** @} */
 } rsmooth_report;
 

@@ -2,6 +2,8 @@
  * output, optionally only where the previous pass had low confidence. Each pass recomputes facet
  * data, normals and the grid from the previous positions; the sigmas stay those the input's mean
  * edge length gave, so later passes do not shrink their reach as the mesh smooths. */
+#include "auto/noise_estimate.h"
+#include "passes/one_part.h"
 #include "passes/region_choice.h"
 #include "stages/normal_update.h"
 #include "core/stage_plan.h"
@@ -102,7 +104,16 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
     bool reports = pp.progress || pp.cancel;
     rs_stage_setting setting = {p.guided_sigma_s, p.guided_sigma_n, p.guided_radius,
                                 p.guided_rounds, p.vertex_updates, p.stage_repeats};
-    if (unit > 0) /* no edge: nothing to filter */
+    bool clean = false; /* do no harm: no stage where the noise estimate finds nothing */
+    if (p.guard && unit > 0) {
+        rs_noise_details noise;
+        st = rs_estimate_noise_details(scalar, positions, vertex_count, indices, triangle_count,
+                                       &noise, error, where);
+        clean = st == RSMOOTH_OK && rs_noise_reads_clean(&noise);
+        if (stage_stats)
+            stage_stats->skipped = clean;
+    }
+    if (st == RSMOOTH_OK && unit > 0 && !clean) /* no edge: nothing to filter */
         st = rs_normal_update_stage(staged, vertex_count, indices, triangle_count, &setting,
                                     p.move_mask, stage, reports ? report_cycle : NULL, &pp,
                                     stage_stats, error, where);
@@ -179,6 +190,23 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
         return staged_passes(one_pass, ctx, scalar, positions, vertex_count, indices,
                              triangle_count, &p, out_positions, out_weight, out_confidence,
                              report, error, where, stage, stage_stats);
+    if (p.passes == 0) { /* nothing to run: the input comes back */
+        memcpy(out_positions, positions, vertex_count * rs_vertex_bytes(scalar));
+        for (size_t v = 0; v < vertex_count; v++) {
+            if (out_weight)
+                out_weight[v] = 0;
+            if (out_confidence)
+                out_confidence[v] = 1;
+        }
+        if (report) {
+            rsmooth_report_init(report);
+            report->vertex_count = vertex_count;
+            report->triangle_count = triangle_count;
+            snprintf(report->device, sizeof report->device, "none (no pass)");
+            report->ms_total = rs_now_ms() - t_start;
+        }
+        return RSMOOTH_OK;
+    }
     if (p.passes == 1) /* the paper's single pass, exactly as it was */
         return one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, params,
                         out_positions, out_weight, out_confidence, report, error);
@@ -292,10 +320,10 @@ static void report_stage(rsmooth_report *report, const rs_stage_stats *stats) {
     report->stage_float_bits = stats->float_bits;
     report->stage_bytes_to_device = stats->bytes_to_device;
     report->stage_bytes_from_device = stats->bytes_from_device;
+    report->stage_skipped = stats->skipped;
 }
 
-/* The passes, then the last check of what they wrote (results.c): never a non-finite OK. */
-rsmooth_status rs_filter_passes(rs_filter_fn one_pass, rs_stage_runner stage, void *ctx,
+rsmooth_status rs_filter_one_part(rs_filter_fn one_pass, rs_stage_runner stage, void *ctx,
                                 rsmooth_scalar scalar, const void *positions, size_t vertex_count,
                                 const uint32_t *indices, size_t triangle_count,
                                 const rsmooth_params *params, void *out_positions,

@@ -1,42 +1,12 @@
 /* Which facets meet at each vertex, with vertices at exactly the same position taken as one (a
  * triangle soup's or an STL file's corners): the connectivity the normal update stage reads, so a
  * soup is filtered as the mesh it was cut from. */
+#include "core/weld.h"
 #include "stages/normal_update.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-typedef struct weld_key {
-    double xyz[3];
-    uint32_t vertex;
-} weld_key;
-
-static int compare_weld(const void *pa, const void *pb) {
-    const weld_key *a = pa, *b = pb;
-    for (int k = 0; k < 3; k++)
-        if (a->xyz[k] != b->xyz[k])
-            return a->xyz[k] < b->xyz[k] ? -1 : 1;
-    return a->vertex < b->vertex ? -1 : a->vertex > b->vertex;
-}
-
-/* rep[v]: the lowest-numbered vertex at v's position. */
-static bool weld(const double *xyz, size_t vertex_count, uint32_t *rep) {
-    weld_key *keys = rs_alloc_array(vertex_count ? vertex_count : 1, sizeof *keys);
-    if (!keys)
-        return false;
-    for (size_t v = 0; v < vertex_count; v++) {
-        memcpy(keys[v].xyz, xyz + 3 * v, sizeof keys[v].xyz);
-        keys[v].vertex = (uint32_t)v;
-    }
-    qsort(keys, vertex_count, sizeof *keys, compare_weld);
-    for (size_t i = 0; i < vertex_count; i++) {
-        bool same = i > 0 && !memcmp(keys[i].xyz, keys[i - 1].xyz, sizeof keys[i].xyz);
-        rep[keys[i].vertex] = same ? rep[keys[i - 1].vertex] : keys[i].vertex;
-    }
-    rs_free(keys);
-    return true;
-}
 
 /* Visits corner c of facet f unless an earlier corner welded to the same vertex. */
 static bool first_corner(const uint32_t *rep, const uint32_t *t, int c) {
@@ -51,7 +21,7 @@ bool rs_adjacency_build(rs_adjacency *adj, const double *xyz, size_t vertex_coun
     adj->start = rs_calloc_array(vertex_count + 1, sizeof *adj->start);
     adj->facet = rs_alloc_array(facets->count ? 3 * facets->count : 1, sizeof *adj->facet);
     size_t *fill = rs_alloc_array(vertex_count ? vertex_count : 1, sizeof *fill);
-    if (!adj->rep || !adj->start || !adj->facet || !fill || !weld(xyz, vertex_count, adj->rep)) {
+    if (!adj->rep || !adj->start || !adj->facet || !fill || !rs_weld(xyz, vertex_count, adj->rep)) {
         rs_free(fill);
         rs_adjacency_free(adj);
         return false;
