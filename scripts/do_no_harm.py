@@ -238,6 +238,29 @@ def read_any(rsmooth, path, tmp):
     return read_obj(out)
 
 
+def noisy_rows(run, manifest, modes):
+    """Per case and mode: triangles facing away from the truth's (normals over 90 degrees apart)
+    in the result and in the input, and E_v by `rsmooth compare`."""
+    rows = []
+    for case in json.load(open(manifest))["cases"]:
+        v_in, f = read_obj(case["noisy"])
+        truth = read_obj(case["truth"])[0]
+        n_truth = normals(truth, f)
+        flipped_in = int(np.sum(np.sum(normals(v_in, f) * n_truth, axis=1) < 0))
+        for mode in modes:
+            out, rep = run.smooth(v_in, f, MODES[mode], name="case")
+            if out is None:
+                rows.append({"case": case["name"], "mode": mode, "error": rep})
+                continue
+            m = json.loads(subprocess.run([run.rsmooth, "compare", os.path.join(run.tmp,
+                                           "case-out.obj"), case["truth"], "--json"],
+                                          capture_output=True, text=True, check=True).stdout)
+            rows.append({"case": case["name"], "mode": mode, "flipped_input": flipped_in,
+                         "flipped": int(np.sum(np.sum(normals(out, f) * n_truth, axis=1) < 0)),
+                         "ev": m["ev"], "guarded": rep.get("guarded_vertices", 0)})
+    return rows
+
+
 def load_clean(shared, names, rsmooth, tmp):
     meshes = [("cube-8", cube(1)), ("cube-98", cube(4)), ("cube-866", cube(12)),
               ("icosphere-642", icosphere(3)), ("icosphere-2562", icosphere(4))]
@@ -263,6 +286,10 @@ def main():
     ap.add_argument("--shared", default=SHARED)
     ap.add_argument("--json", default="")
     ap.add_argument("--only", default="clean,stray,parts,points")
+    ap.add_argument("--cases", default="",
+                    help="scripts/make_cases.py's manifest: the reversed-triangle table of the "
+                         "noisy cases (section 'noisy')")
+    ap.add_argument("--modes", default=",".join(MODES), help="modes of the noisy table")
     ap.add_argument("--clean", default=",".join(CLEAN),
                     help="clean meshes of SHARED/clean by name, or 'all' (default: %(default)s)")
     args = ap.parse_args()
@@ -316,6 +343,17 @@ def main():
                     continue
                 print("| %g | %s | %.4f | %.3g |" % (r["far"], r["mode"], r["radius"],
                                                      r["others_max_move"]))
+        if "noisy" in only and args.cases:
+            result["noisy"] = noisy_rows(run, args.cases, args.modes.split(","))
+            print("\n| case | mode | reversed (input) | E_v | vertices guarded |")
+            print("| --- | --- | --- | --- | --- |")
+            for r in result["noisy"]:
+                if "error" in r:
+                    print("| %s | %s | error: %s |" % (r["case"], r["mode"], r["error"]))
+                    continue
+                print("| %s | %s | %d (%d) | %.3f | %d |" % (
+                    r["case"], r["mode"], r["flipped"], r["flipped_input"], r["ev"],
+                    r["guarded"]))
     if args.json:
         with open(args.json, "w") as fh:
             json.dump(result, fh, indent=1)

@@ -119,6 +119,100 @@ def local_edges(x_in, rep, tri):
     return np.where(count > 0, total / np.maximum(count, 1), 0)
 
 
+def shape_correlation(x, faces):
+    """lib/core/shape_correlation.c in numpy: the correlation of each welded vertex's umbrella
+    offset along its (area-weighted) normal with its neighbours' mean."""
+    rep = weld(x)
+    t = rep[faces]
+    n = np.cross(x[faces[:, 1]] - x[faces[:, 0]], x[faces[:, 2]] - x[faces[:, 0]])
+    normal = np.zeros_like(x)
+    for c in range(3):
+        np.add.at(normal, t[:, c], n)
+    e = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
+    e = np.unique(e[e[:, 0] != e[:, 1]], axis=0)
+    total, degree = np.zeros_like(x), np.zeros(len(x))
+    np.add.at(total, e[:, 0], x[e[:, 1]])
+    np.add.at(total, e[:, 1], x[e[:, 0]])
+    np.add.at(degree, e[:, 0], 1)
+    np.add.at(degree, e[:, 1], 1)
+    length = np.linalg.norm(normal, axis=1)
+    valid = (rep == np.arange(len(x))) & (degree > 0) & (length > 0)
+    bend = np.zeros(len(x))
+    bend[valid] = np.sum((total[valid] / degree[valid, None] - x[valid]) * normal[valid], axis=1) \
+        / length[valid]
+    both = valid[e[:, 0]] & valid[e[:, 1]]
+    around, count = np.zeros(len(x)), np.zeros(len(x))
+    np.add.at(around, e[both, 0], bend[e[both, 1]])
+    np.add.at(around, e[both, 1], bend[e[both, 0]])
+    np.add.at(count, e[both, 0], 1)
+    np.add.at(count, e[both, 1], 1)
+    valid &= count > 0
+    a, b = bend[valid], around[valid] / count[valid]
+    if len(a) < 2 or a.var() <= 0 or b.var() <= 0:
+        return 1.0
+    return float(np.corrcoef(a, b)[0, 1])
+
+
+def fold_guard(x_in, out, faces, untangles=8, halvings=24):
+    """lib/stages/fold_guard.c in numpy. A clean input (bends correlated): a triangle turned by
+    more than 90 degrees from the input's is turned over; a noisy one: a triangle facing against
+    its neighbourhood in the result (the unit normals of the triangles at its corners, summed)
+    that did not in the input. Each round moves the vertices of every turned-over
+    triangle: on a noisy input first (`untangles` rounds) to the mean of the other corners of the
+    triangles at the welded vertex, then halfway back toward the input (after `halvings` such
+    rounds, snaps them and two rings of vertices around them to the input)."""
+    out = out.copy()
+    rep = weld(x_in)
+
+    def unit(x):
+        n = np.cross(x[faces[:, 1]] - x[faces[:, 0]], x[faces[:, 2]] - x[faces[:, 0]])
+        length = np.linalg.norm(n, axis=1)
+        ok = length > 0
+        return np.where(ok[:, None], n / np.where(ok, length, 1)[:, None], 0), ok
+
+    def facing(n):  # against the unit normals of the triangles at its corners, summed
+        at_vertex = np.zeros_like(x_in)
+        for c in range(3):
+            np.add.at(at_vertex, faces[:, c], n)
+        return np.sum(n * at_vertex[faces].sum(axis=1), axis=1)
+    n_in, ok_in = unit(x_in)
+    folded_in = facing(n_in) <= 0
+
+    def turned(reading):
+        n_out, ok_out = unit(out)
+        ok = ok_in & ok_out
+        clean = ok & (np.sum(n_out * n_in, axis=1) < 0)
+        noisy = ok & ~folded_in & (facing(n_out) < 0)
+        return {"clean": clean, "noisy": noisy, "either": clean | noisy}[reading]
+    if not turned("either").any():
+        return out
+    reading = "clean" if shape_correlation(x_in, faces) >= 0.3 else "noisy"
+    for round_ in itertools.count():
+        bad = turned(reading)
+        if not bad.any():
+            return out
+        if reading == "noisy" and round_ < untangles:
+            marked = np.zeros(len(x_in), bool)
+            marked[rep[faces[bad].ravel()]] = True
+            r = rep[faces]
+            total, count = np.zeros_like(x_in), np.zeros(len(x_in))
+            for c in range(3):
+                m = marked[r[:, c]]
+                np.add.at(total, r[m, c], out[faces[m, (c + 1) % 3]] + out[faces[m, (c + 2) % 3]])
+                np.add.at(count, r[m, c], 2)
+            v = np.flatnonzero(marked[rep] & (count[rep] > 0))
+            out[v] = total[rep[v]] / count[rep[v], None]
+        elif round_ < untangles * (reading == "noisy") + halvings:
+            v = np.unique(faces[bad])
+            out[v] = x_in[v] + (out[v] - x_in[v]) / 2
+        else:
+            seed = np.zeros(len(x_in), bool)
+            seed[faces[bad].ravel()] = True
+            for _ in range(2):  # and two rings of vertices around
+                seed[faces[seed[faces].any(axis=1)].ravel()] = True
+            out[seed] = x_in[seed]
+
+
 def blend(x_in, f_xyz, t_xyz, faces, level, low, high, rounds, parts=None):
     rep, tri, share, boundary = parts or vertex_shares(f_xyz, faces)
     s = spread(share, rep, tri, rounds)[rep]
@@ -130,7 +224,7 @@ def blend(x_in, f_xyz, t_xyz, faces, level, low, high, rounds, parts=None):
     move = np.linalg.norm(d, axis=1)
     clamp = b & (move > limit)
     out[clamp] = x_in[clamp] + d[clamp] * (limit[clamp] / move[clamp])[:, None]
-    return out, float(w.mean())
+    return fold_guard(x_in, out, faces), float(w.mean())
 
 
 def run(rsmooth, args):
@@ -148,7 +242,8 @@ def case_inputs(rsmooth, case, stage, tmp):
     """F, T, the level and the input, each as a vertex array, and the faces."""
     f_path, t_path = os.path.join(tmp, "f.obj"), os.path.join(tmp, "t.obj")
     stage = [o for o in stage if o != "--auto"]  # F: the stage and its pass, no choice
-    run(rsmooth, [case["noisy"], "-o", f_path, "-f", "-q"] + stage)
+    # (nor the fold guard, which the library runs after the choice, as blend() does)
+    run(rsmooth, [case["noisy"], "-o", f_path, "-f", "-q", "--no-guard"] + stage)
     p = run(rsmooth, [case["noisy"], "-o", os.path.join(tmp, "a.obj"), "-f", "--json", "--auto"]
             + stage)
     report = json.loads(p.stdout.strip().splitlines()[-1])

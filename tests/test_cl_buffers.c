@@ -1,7 +1,8 @@
 /* rsmooth_smooth_cl: positions in and out of the caller's OpenCL buffers on its own queue. The
  * result read back equals rsmooth_smooth's on host arrays bit for bit, in float32 and float64,
- * in place too, on the path that writes it on the device (one whole run: the report's pair
- * counts are 0) and on the paths that upload the host's (a move mask, tiles); bad
+ * in place too, on the path that writes it on the device (one whole run without the fold guard:
+ * the report's pair counts are 0) and on the paths that upload the host's (the guard, a move
+ * mask, tiles); bad
  * buffers (NULL, too small, another OpenCL context) are refused by name and leave the output
  * untouched. */
 #include "mesh_shapes.h"
@@ -182,6 +183,7 @@ int main(void) {
     CHECK(shape_add_normal_noise(&cube, 0.3, 11) == 0);
     rsmooth_params p;
     rsmooth_params_init(&p);
+    p.guard = 0; /* the fold guard reads the result on the host: the device keeps it only without */
     for (int s = 0; s < 2; s++) {
         rsmooth_scalar scalar = s ? RSMOOTH_FLOAT64 : RSMOOTH_FLOAT32;
         uint64_t pairs = check_same(&fx, &cube, scalar, &p, 0, "the paper's filter");
@@ -189,6 +191,9 @@ int main(void) {
             CHECK(pairs == 0);
         check_same(&fx, &cube, scalar, &p, 1, "the paper's filter");
     }
+    rsmooth_params guarded; /* the defaults: the host's guarded result uploaded */
+    rsmooth_params_init(&guarded);
+    CHECK(check_same(&fx, &cube, RSMOOTH_FLOAT32, &guarded, 0, "the paper's filter, guarded") > 0);
     /* single-pass variants: still one whole run */
     rsmooth_params v = p;
     v.normal_filter = RSMOOTH_NORMALS_BILATERAL;

@@ -15,7 +15,6 @@
 
 #define BIN_MIN (-4400) /* below log2 of the smallest double's quarter octaves */
 #define BIN_COUNT 6800  /* to above log2(4e150)'s */
-#define NO_BIN INT16_MIN
 #define SCALE_GRAIN 4096
 
 /* |a - b| for two vertices, without overflow or underflow of the squares. */
@@ -39,7 +38,7 @@ typedef struct scale_job {
     const void *positions;
     const uint32_t *indices;
     size_t triangle_count;
-    int16_t *bin;           /* per triangle: quarter-octave bin of its scale, NO_BIN when 0 */
+    int16_t *bin;           /* per triangle: quarter-octave bin of its scale, RS_NO_BIN when 0 */
     double *longest;        /* per chunk: its longest edge */
 } scale_job;
 
@@ -53,14 +52,17 @@ static void scale_range(void *ctx, size_t begin, size_t end, size_t chunk) {
         double e2 = edge_length(job->scalar, job->positions, tri[2], tri[0]);
         double lo = fmin(e0, fmin(e1, e2)), hi = fmax(e0, fmax(e1, e2));
         double median = e0 + e1 + e2 - lo - hi;
-        if (median > 0 && isfinite(median)) {
-            job->bin[t] = (int16_t)floor(RS_PART_BINS_PER_OCTAVE * log2(median));
+        job->bin[t] = rs_scale_bin(median);
+        if (job->bin[t] != RS_NO_BIN)
             worst = fmax(worst, hi);
-        } else {
-            job->bin[t] = NO_BIN;
-        }
     }
     job->longest[chunk] = worst;
+}
+
+int16_t rs_scale_bin(double scale) {
+    if (!(scale > 0) || !isfinite(scale))
+        return RS_NO_BIN;
+    return (int16_t)floor(RS_PART_BINS_PER_OCTAVE * log2(scale));
 }
 
 /* The parts as ranges of bins: part_of_bin[b - BIN_MIN] for every occupied bin, and each part's
@@ -213,7 +215,7 @@ rsmooth_status rs_parts_find(rs_parts *parts, rsmooth_scalar scalar, const void 
     for (size_t c = 0; c < chunks; c++)
         worst = fmax(worst, longest[c]);
     for (size_t t = 0; t < triangle_count; t++)
-        if (bin[t] != NO_BIN)
+        if (bin[t] != RS_NO_BIN)
             histogram[bin[t] - BIN_MIN]++;
     double limit_one = 0;
     parts->count = cut_parts(histogram, part_of_bin, &limit_one, 1);
@@ -234,7 +236,7 @@ rsmooth_status rs_parts_find(rs_parts *parts, rsmooth_scalar scalar, const void 
     }
     cut_parts(histogram, part_of_bin, parts->edge_limit, parts->count);
     for (size_t t = 0; t < triangle_count; t++)
-        parts->triangle_part[t] = bin[t] == NO_BIN ? RS_NO_PART : part_of_bin[bin[t] - BIN_MIN];
+        parts->triangle_part[t] = bin[t] == RS_NO_BIN ? RS_NO_PART : part_of_bin[bin[t] - BIN_MIN];
     if (!assign_vertices(parts, vertex_count, indices, triangle_count)) {
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the parts");
         goto done;
@@ -284,9 +286,11 @@ bool rs_submesh_make(rs_submesh *sub, const rs_parts *parts, uint32_t part, rsmo
         if (parts->triangle_part[t] == part) {
             triangles++;
             for (int c = 0; c < 3; c++)
-                if (local[indices[3 * t + c]] == RS_NO_PART)
-                    local[indices[3 * t + c]] = (uint32_t)vertices++;
+                local[indices[3 * t + c]] = 0; /* used */
         }
+    for (size_t v = 0; v < vertex_count; v++) /* numbered in the mesh's order */
+        if (local[v] == 0)
+            local[v] = (uint32_t)vertices++;
     size_t record = rs_vertex_bytes(scalar);
     sub->positions = rs_alloc_array(vertices ? vertices : 1, record);
     sub->indices = rs_alloc_array(triangles ? 3 * triangles : 1, sizeof *sub->indices);
@@ -326,4 +330,28 @@ void rs_submesh_free(rs_submesh *sub) {
     rs_free(sub->vertex);
     rs_free(sub->move);
     memset(sub, 0, sizeof *sub);
+}
+
+size_t rs_scale_parts(const int16_t *bin, size_t count, uint32_t *part, double **limit) {
+    size_t *histogram = rs_calloc_array(BIN_COUNT, sizeof *histogram);
+    uint32_t *part_of_bin = rs_alloc_array(BIN_COUNT, sizeof *part_of_bin);
+    size_t parts = SIZE_MAX;
+    *limit = NULL;
+    if (histogram && part_of_bin) {
+        for (size_t i = 0; i < count; i++)
+            if (bin[i] != RS_NO_BIN)
+                histogram[bin[i] - BIN_MIN]++;
+        parts = cut_parts(histogram, part_of_bin, NULL, 0);
+        *limit = rs_alloc_array(parts ? parts : 1, sizeof **limit);
+        if (*limit) {
+            cut_parts(histogram, part_of_bin, *limit, parts);
+            for (size_t i = 0; i < count; i++)
+                part[i] = bin[i] == RS_NO_BIN ? RS_NO_PART : part_of_bin[bin[i] - BIN_MIN];
+        } else {
+            parts = SIZE_MAX;
+        }
+    }
+    rs_free(histogram);
+    rs_free(part_of_bin);
+    return parts;
 }

@@ -59,4 +59,12 @@ void rs_submesh_free(rs_submesh *sub);
 /* The part that moves the most vertices (the lowest numbered of equals), or 0 when whole. */
 uint32_t rs_parts_largest(const rs_parts *parts);
 
+/* The same rule for any items with a scale (a point cloud's spacings): the quarter-octave bin of a
+ * scale (RS_NO_BIN for 0 or not finite), and the parts of `count` binned items: part[i] per item
+ * (RS_NO_PART for RS_NO_BIN) and *limit (allocated, rs_free it) the out-of-line limit of each.
+ * Returns the number of parts, SIZE_MAX when out of memory. */
+#define RS_NO_BIN INT16_MIN
+int16_t rs_scale_bin(double scale);
+size_t rs_scale_parts(const int16_t *bin, size_t count, uint32_t *part, double **limit);
+
 #endif /* RSMOOTH_PARTS_H */

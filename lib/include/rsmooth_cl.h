@@ -45,7 +45,8 @@ RSMOOTH_API rsmooth_status rsmooth_context_create_from_queue(cl_command_queue qu
  * the queue before it returns: the output is then ready. The input is read to the host once (the
  * grid and facet data are built there by design). Where the filter solves the whole mesh in one
  * run on a device with fp64 (one pass, no tiles, no normal update stage, no choice per region,
- * no move mask: the paper's filter and its single-pass variants) the result is written into
+ * no move mask, one part, and params.guard 0: the fold guard reads the result on the host; the
+ * paper's filter and its single-pass variants) the result is written into
  * out_positions by a kernel on the device, from displacements already there, in the double
  * arithmetic the host uses, so the bits equal rsmooth_smooth's; nothing of the output travels
  * through the host, and the report's pair counts are 0. Otherwise the result is computed on the

@@ -6,6 +6,7 @@
  * rsmooth_smooth would return. Where the result exists only on the host (tiles, passes, the
  * normal update stage, the choice per region, a move mask, a device without fp64), it is
  * uploaded into the output buffer instead. */
+#include "core/parts.h"
 #include "opencl/cl_internal.h"
 #include "rsmooth_cl.h"
 
@@ -163,13 +164,26 @@ static rsmooth_status check_buffer(const rsmooth_context *ctx, cl_mem mem, const
     return RSMOOTH_OK;
 }
 
-/* Whether the call's result can be written on the device: one pass of the filter and nothing
- * after it on the host (see the top). */
-static bool device_result_possible(const rsmooth_params *params) {
+/* Whether the call's result can be written on the device: one pass of the filter over the whole
+ * mesh (one part, core/parts.h) and nothing after it on the host (see the top; the fold guard
+ * reads the result on the host). */
+static bool device_result_possible(const rsmooth_params *params, rsmooth_scalar scalar,
+                                   const void *positions, size_t vertex_count,
+                                   const uint32_t *indices, size_t triangle_count) {
     rsmooth_params p;
     if (rs_params_resolve(params, &p, NULL, "rsmooth_smooth_cl") != RSMOOTH_OK)
         return false; /* the call fails on them, as rsmooth_smooth would */
-    return p.passes == 1 && p.vertex_updates == 0 && p.discrepancy_level == 0 && !p.move_mask;
+    if (p.passes != 1 || p.vertex_updates != 0 || p.discrepancy_level != 0 || p.move_mask ||
+        p.guard)
+        return false;
+    if (rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count, NULL,
+                             NULL, "rsmooth_smooth_cl") != RSMOOTH_OK)
+        return false; /* refused by the call itself */
+    rs_parts parts;
+    bool whole = rs_parts_find(&parts, scalar, positions, vertex_count, indices, triangle_count,
+                               NULL, "rsmooth_smooth_cl") == RSMOOTH_OK && parts.whole;
+    rs_parts_free(&parts);
+    return whole;
 }
 
 rsmooth_status rsmooth_smooth_cl(rsmooth_context *ctx, rsmooth_scalar scalar, cl_mem positions,
@@ -214,7 +228,9 @@ rsmooth_status rsmooth_smooth_cl(rsmooth_context *ctx, rsmooth_scalar scalar, cl
     }
     rs_device_sink sink = {positions, out_positions, NULL, false, false};
     if (st == RSMOOTH_OK) {
-        if (device_result_possible(params) && rs_cl_store_ready(ctx)) {
+        if (device_result_possible(params, scalar, host_in, vertex_count, indices,
+                                   triangle_count) &&
+            rs_cl_store_ready(ctx)) {
             sink.kernel = ctx->store_kernels[scalar];
             ctx->device_sink = &sink;
         }

@@ -39,8 +39,7 @@ static void spacing_range(void *ctx, size_t begin, size_t end, size_t chunk) {
     }
 }
 
-/* s_i of every point of the tree, and their mean (summed in point order: the same on every run). */
-static double point_spacings(const rs_kdtree *tree, double *spacing) {
+double rs_point_spacings(const rs_kdtree *tree, double *spacing) {
     spacing_job job = {tree, spacing};
     rs_parallel_for(tree->count, SPACING_GRAIN, spacing_range, &job);
     double sum = 0;
@@ -51,9 +50,9 @@ static double point_spacings(const rs_kdtree *tree, double *spacing) {
 
 /* Checks positions (what rs_check_mesh_arrays checks, worded for points) and chooses the scale
  * of internal units (scale.c). */
-static rsmooth_status check_positions(rsmooth_scalar scalar, const void *positions,
-                                      size_t point_count, double *scale, rsmooth_error *error,
-                                      const char *caller) {
+rsmooth_status rs_check_point_positions(rsmooth_scalar scalar, const void *positions,
+                                        size_t point_count, double *scale, rsmooth_error *error,
+                                        const char *caller) {
     if (scalar != RSMOOTH_FLOAT32 && scalar != RSMOOTH_FLOAT64)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller,
                        "scalar must be RSMOOTH_FLOAT32 or RSMOOTH_FLOAT64 (got %d)", (int)scalar);
@@ -75,8 +74,8 @@ static rsmooth_status check_positions(rsmooth_scalar scalar, const void *positio
 /* Normal i of the caller's array made unit length into out[0..2]; NULL, or what is wrong with it.
  * Scaled by its largest component first, so lengths near the double range neither overflow nor
  * vanish. */
-static const char *unit_normal(rsmooth_scalar scalar, const void *normals, size_t i,
-                               double out[3]) {
+const char *rs_point_unit_normal(rsmooth_scalar scalar, const void *normals, size_t i,
+                                 double out[3]) {
     double m = 0;
     for (int k = 0; k < 3; k++) {
         out[k] = rs_coordinate(scalar, normals, 3 * i + (size_t)k);
@@ -102,7 +101,8 @@ rsmooth_status rsmooth_point_spacing(rsmooth_scalar scalar, const void *position
     if (!out_spacing)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller, "out_spacing is NULL");
     double scale = 1;
-    rsmooth_status st = check_positions(scalar, positions, point_count, &scale, error, caller);
+    rsmooth_status st =
+        rs_check_point_positions(scalar, positions, point_count, &scale, error, caller);
     if (st != RSMOOTH_OK)
         return st;
     double *xyz = rs_alloc_array(point_count, 3 * sizeof *xyz);
@@ -114,7 +114,7 @@ rsmooth_status rsmooth_point_spacing(rsmooth_scalar scalar, const void *position
         ok = rs_kdtree_build(&tree, xyz, point_count);
     }
     if (ok) {
-        *out_spacing = point_spacings(&tree, spacing) / scale; /* exact: a power of two */
+        *out_spacing = rs_point_spacings(&tree, spacing) / scale; /* exact: a power of two */
         rs_kdtree_free(&tree);
     }
     rs_free(xyz);
@@ -182,8 +182,8 @@ static rsmooth_status check_call(points_run *r, const rsmooth_params *params, vo
     rsmooth_status st = rs_params_resolve(params, &r->p, error, r->where);
     if (st != RSMOOTH_OK)
         return st;
-    if ((st = check_positions(r->scalar, r->positions, r->n, &r->scale, error, r->where)) !=
-        RSMOOTH_OK)
+    if ((st = rs_check_point_positions(r->scalar, r->positions, r->n, &r->scale, error,
+                                       r->where)) != RSMOOTH_OK)
         return st;
     if ((st = rs_check_colors(r->p.colors, r->n, error, r->where)) != RSMOOTH_OK)
         return st;
@@ -192,7 +192,7 @@ static rsmooth_status check_call(points_run *r, const rsmooth_params *params, vo
                        "normals is NULL: a point cloud needs a normal per point");
     for (size_t i = 0; i < r->n; i++) {
         double n[3];
-        const char *wrong = unit_normal(r->scalar, r->normals, i, n);
+        const char *wrong = rs_point_unit_normal(r->scalar, r->normals, i, n);
         if (wrong)
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, r->where,
                            "point %zu has a %s normal", i, wrong);
@@ -238,7 +238,7 @@ static bool load_points(points_run *r) {
         return false;
     rs_scale_positions(r->scalar, r->positions, n, r->scale, a->xyz);
     for (size_t i = 0; i < n; i++)
-        unit_normal(r->scalar, r->normals, i, a->input_normal + 3 * i);
+        rs_point_unit_normal(r->scalar, r->normals, i, a->input_normal + 3 * i);
     return true;
 }
 
@@ -249,7 +249,7 @@ static rsmooth_status pass_problem(points_run *r, int pass, rs_problem *pb) {
     point_arrays *a = &r->a;
     if (!rs_kdtree_build(&r->tree, a->xyz, n))
         return no_memory(r);
-    double spacing = point_spacings(&r->tree, a->spacing);
+    double spacing = rs_point_spacings(&r->tree, a->spacing);
     if (pass == 0) {
         r->input_spacing = spacing;
         r->unit = r->p.absolute ? r->scale : spacing;
@@ -409,12 +409,13 @@ done:
     return st;
 }
 
-rsmooth_status rs_smooth_points_with(rs_points_solve_fn solve, void *solve_ctx, const char *where,
-                                     rsmooth_scalar scalar, const void *positions,
-                                     const void *normals, size_t point_count,
-                                     const rsmooth_params *params, void *out_positions,
-                                     void *out_normals, float *out_confidence,
-                                     rsmooth_report *report, rsmooth_error *error) {
+rsmooth_status rs_smooth_points_one_part(rs_points_solve_fn solve, void *solve_ctx,
+                                         const char *where, rsmooth_scalar scalar,
+                                         const void *positions, const void *normals,
+                                         size_t point_count, const rsmooth_params *params,
+                                         void *out_positions, void *out_normals,
+                                         float *out_confidence, rsmooth_report *report,
+                                         rsmooth_error *error) {
     size_t caller_size = report ? report->struct_size : 0; /* the report's fillers reset it */
     rsmooth_status st =
         smooth_points(solve, solve_ctx, where, scalar, positions, normals, point_count, params,

@@ -15,12 +15,38 @@ typedef rsmooth_status (*rs_points_solve_fn)(void *ctx, const rs_problem *pb, do
                                              rsmooth_error *error, const char *where);
 
 /* rsmooth_smooth_points_reference's whole call (checks, spacings, passes, outputs) with `solve`
- * (given `solve_ctx`) filtering each pass; errors name `where`. */
+ * (given `solve_ctx`) filtering each pass; errors name `where`. Part by part (point_parts.c):
+ * points whose spacings differ by more than about 8 times, with none between, are filtered apart,
+ * and parts of fewer than RS_MIN_PART_POINTS points are held as outliers. */
 rsmooth_status rs_smooth_points_with(rs_points_solve_fn solve, void *solve_ctx, const char *where,
                                      rsmooth_scalar scalar, const void *positions,
                                      const void *normals, size_t point_count,
                                      const rsmooth_params *params, void *out_positions,
                                      void *out_normals, float *out_confidence,
                                      rsmooth_report *report, rsmooth_error *error);
+
+/* The call on a cloud of one part (points.c). */
+rsmooth_status rs_smooth_points_one_part(rs_points_solve_fn solve, void *solve_ctx,
+                                         const char *where, rsmooth_scalar scalar,
+                                         const void *positions, const void *normals,
+                                         size_t point_count, const rsmooth_params *params,
+                                         void *out_positions, void *out_normals,
+                                         float *out_confidence, rsmooth_report *report,
+                                         rsmooth_error *error);
+
+/* Fewer points than this are no surface: a part that small is held (a point's spacing is its mean
+ * distance to its 6 nearest others). */
+#define RS_MIN_PART_POINTS 7
+
+/* Shared with point_parts.c: the positions' checks and internal scale, a normal made unit (NULL,
+ * or what is wrong with it), and each point's spacing over a k-d tree of the positions (their
+ * mean returned). */
+typedef struct rs_kdtree rs_kdtree;
+rsmooth_status rs_check_point_positions(rsmooth_scalar scalar, const void *positions,
+                                        size_t point_count, double *scale, rsmooth_error *error,
+                                        const char *caller);
+const char *rs_point_unit_normal(rsmooth_scalar scalar, const void *normals, size_t i,
+                                 double out[3]);
+double rs_point_spacings(const rs_kdtree *tree, double *spacing);
 
 #endif /* RSMOOTH_POINTS_H */

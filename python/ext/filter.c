@@ -56,14 +56,16 @@ static PyObject *report_dict(const rsmooth_report *r) {
     if (!stage)
         return NULL;
     return Py_BuildValue(
-        "{s:n,s:n,s:n,s:d,s:d,s:d,s:d,s:s,s:d,s:d,s:d,s:d,s:d,s:d,s:n,s:i,s:d,s:N}", "vertex_count",
-        (Py_ssize_t)r->vertex_count, "triangle_count", (Py_ssize_t)r->triangle_count,
-        "facet_count", (Py_ssize_t)r->facet_count, "mean_edge_length", r->mean_edge_length,
-        "sigma_f", r->sigma_f, "sigma_g", r->sigma_g, "radius", r->radius, "device", r->device,
-        "ms_setup", r->ms_setup, "ms_grid", r->ms_grid, "ms_mollify", r->ms_mollify,
-        "ms_robust", r->ms_robust, "ms_download", r->ms_download, "ms_total", r->ms_total,
-        "tiles", (Py_ssize_t)r->tiles, "discrepancy_iterations", r->discrepancy_iterations,
-        "region_filter_share", r->region_filter_share, "stage", stage);
+        "{s:n,s:n,s:n,s:d,s:d,s:d,s:d,s:s,s:d,s:d,s:d,s:d,s:d,s:d,s:n,s:i,s:d,s:N,s:n,s:n,s:n,s:O}",
+        "vertex_count", (Py_ssize_t)r->vertex_count, "triangle_count",
+        (Py_ssize_t)r->triangle_count, "facet_count", (Py_ssize_t)r->facet_count,
+        "mean_edge_length", r->mean_edge_length, "sigma_f", r->sigma_f, "sigma_g", r->sigma_g,
+        "radius", r->radius, "device", r->device, "ms_setup", r->ms_setup, "ms_grid", r->ms_grid,
+        "ms_mollify", r->ms_mollify, "ms_robust", r->ms_robust, "ms_download", r->ms_download,
+        "ms_total", r->ms_total, "tiles", (Py_ssize_t)r->tiles, "discrepancy_iterations",
+        r->discrepancy_iterations, "region_filter_share", r->region_filter_share, "stage", stage,
+        "parts", (Py_ssize_t)r->parts, "outliers", (Py_ssize_t)r->outliers, "guarded_vertices",
+        (Py_ssize_t)r->guarded_vertices, "stage_skipped", r->stage_skipped ? Py_True : Py_False);
 }
 
 /* Hands the library `progress` through p's progress_cancel and lets go of the GIL: the filter

@@ -35,7 +35,7 @@ static const field fields[] = {
     DOUBLE_FIELD(normal_sigma_n),
     INT_FIELD(normal_iterations, 1, 100),
     INT_FIELD(influence, RSMOOTH_INFLUENCE_GAUSSIAN, RSMOOTH_INFLUENCE_HUBER),
-    INT_FIELD(passes, 0, 100), /* 0 with vertex_updates only: the library checks that */
+    INT_FIELD(passes, 0, 100), /* 0: the stage alone, or (without it) nothing */
     DOUBLE_FIELD(pass_confidence),
     DOUBLE_FIELD(sigma_c),
     INT_FIELD(vertex_updates, 0, 1000),
@@ -46,6 +46,7 @@ static const field fields[] = {
     DOUBLE_FIELD(discrepancy_level),
     DOUBLE_FIELD(guided_radius),
     DOUBLE_FIELD(discrepancy_gain),
+    INT_FIELD(guard, 0, 1),
 };
 #define FIELD_COUNT (sizeof fields / sizeof fields[0])
 
@@ -219,18 +220,20 @@ PyObject *ext_default_params(PyObject *self, PyObject *args) {
     return ext_params_to_dict(&p);
 }
 
-/* The noise report as a dict: level, kind ("none", "gaussian" or "impulsive"),
- * impulsive_fraction, tangential_level (NaN when not measured), mean_edge_length, preset,
- * reason, correlated_level, correlation_length. */
+/* The noise report as a dict: level, kind ("none": nothing to remove, "gaussian" or
+ * "impulsive"), impulsive_fraction, tangential_level (NaN when not measured), mean_edge_length,
+ * preset, reason, correlated_level, correlation_length, shape_correlation, parts, outliers. */
 static PyObject *noise_report_to_dict(const rsmooth_noise_report *r) {
     const char *kind = r->kind == RSMOOTH_NOISE_GAUSSIAN    ? "gaussian"
                        : r->kind == RSMOOTH_NOISE_IMPULSIVE ? "impulsive"
                                                             : "none";
-    return Py_BuildValue("{sd,ss,sd,sd,sd,ss,ss,sd,sd}", "level", r->level, "kind", kind,
+    return Py_BuildValue("{sd,ss,sd,sd,sd,ss,ss,sd,sd,sd,sn,sn}", "level", r->level, "kind", kind,
                          "impulsive_fraction", r->impulsive_fraction, "tangential_level",
                          r->tangential_level, "mean_edge_length", r->mean_edge_length, "preset",
                          r->preset, "reason", r->reason, "correlated_level",
-                         r->correlated_level, "correlation_length", r->correlation_length);
+                         r->correlated_level, "correlation_length", r->correlation_length,
+                         "shape_correlation", r->shape_correlation, "parts",
+                         (Py_ssize_t)r->parts, "outliers", (Py_ssize_t)r->outliers);
 }
 
 /* _params_auto(vertices, faces, params) -> (params, report): rsmooth_params_auto_report's rule

@@ -112,6 +112,7 @@ def smooth(
     guided_radius: Optional[float] = None,
     discrepancy_level: Optional[float] = None,
     discrepancy_gain: Optional[float] = None,
+    guard: Optional[bool] = None,
     predictor: Optional[str] = None,
     mollify_cutoff: Optional[float] = None,
     colors: Any = None,
@@ -185,6 +186,11 @@ def smooth(
     discrepancy_gain : 0 (default). > 0: Taubin's side goes on until an iteration adds less than
         this (mean edge lengths) to the move (``auto`` sets 0.003 where the noise reads
         spatially correlated, as in range scans).
+    guard : True (default): do no harm. The vertices of a triangle the filter would turn over
+        are pulled back until none is, and the normal update stage does not run on a mesh that
+        reads clean (the report's ``guarded_vertices`` and ``stage_skipped``). False: the filter
+        exactly as set. Either way parts of very different size are smoothed apart, each in its
+        own unit, and a vertex thrown far off the surface is held (``parts``, ``outliers``).
     predictor : "projection" (the paper) or "centroid".
     mollify_cutoff : mollification reach in units of sigma_f, (0, cutoff]; default: cutoff.
     colors : (n, 3) per-vertex colours (floats in [0, 1], or uint8 0..255) weighing each
@@ -228,7 +234,7 @@ def smooth(
         pass_confidence=pass_confidence, vertex_updates=vertex_updates,
         guided_sigma_s=guided_sigma_s, guided_sigma_n=guided_sigma_n,
         guided_rounds=guided_rounds, stage_repeats=stage_repeats, guided_radius=guided_radius,
-        discrepancy_level=discrepancy_level, discrepancy_gain=discrepancy_gain,
+        discrepancy_level=discrepancy_level, discrepancy_gain=discrepancy_gain, guard=guard,
         predictor=predictor, mollify_cutoff=mollify_cutoff, colors=colors, sigma_c=sigma_c,
         mask=mask, method=method, iterations=iterations, lam=lam, mu=mu, progress=progress,
     )

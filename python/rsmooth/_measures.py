@@ -26,14 +26,18 @@ def auto_params(vertices: Any, faces: Any, *, best: bool = False) -> Dict[str, A
     Returns a dict: ``level`` (the noise's standard deviation along the surface normal, in mean
     edge lengths of the clean mesh; for impulsive noise that of the displaced vertices),
     ``kind`` ("gaussian": every vertex displaced, "impulsive": a share of them thrown and the
-    others nearly exact, "none": nothing measurable), ``impulsive_fraction`` (the share
+    others nearly exact, "none": nothing to remove, either nothing measurable or roughness that
+    reads as the mesh's own shape, and then the setting leaves every vertex where it is),
+    ``impulsive_fraction`` (the share
     displaced: 1 unless impulsive), ``tangential_level`` (the displacement along one tangent
     direction, same unit; NaN when not measured), ``mean_edge_length`` (the clean mesh's, as
     estimated, in the mesh's units), ``preset`` (the setting chosen, e.g. "paper" or
     "best: mid"), ``reason`` (why, in words), ``correlated_level`` (the rms along the normal
     including the noise's spatially correlated part, as real range scans have: ``level`` when the
-    noise reads uncorrelated), ``correlation_length`` (mean edge lengths; 0: uncorrelated), and
-    ``params``: the chosen setting as
+    noise reads uncorrelated), ``correlation_length`` (mean edge lengths; 0: uncorrelated),
+    ``shape_correlation`` (how alike neighbouring vertices bend: 0.3 or more reads clean),
+    ``parts`` and ``outliers`` (the mesh's parts by scale and the vertices held as outliers; the
+    figures are the largest part's), and ``params``: the chosen setting as
     keywords, so that ``rsmooth.smooth(vertices, faces, **report["params"])`` runs it."""
     v = _vertices(vertices)
     f = _faces(faces, v.shape[0])

@@ -50,7 +50,7 @@ def _params(
     ):
         if key in given:
             given[key] = _choice(given[key], table, key)
-    for key in ("absolute", "mollify"):
+    for key in ("absolute", "mollify", "guard"):
         if key in given:
             given[key] = int(bool(given[key]))
     report = None
@@ -73,7 +73,7 @@ def _keywords(params: Dict[str, Any]) -> Dict[str, Any]:
         ("predictor", _PREDICTORS),
     ):
         out[key] = next(name for name, value in table.items() if value == out[key])
-    for key in ("absolute", "mollify"):
+    for key in ("absolute", "mollify", "guard"):
         out[key] = bool(out[key])
     return out
 

@@ -46,6 +46,7 @@ class SmoothOptions(PointOptions, total=False):
     guided_radius: Optional[float]
     discrepancy_level: Optional[float]
     discrepancy_gain: Optional[float]
+    guard: Optional[bool]
     mollify_cutoff: Optional[float]
     method: str
     iterations: int
