@@ -45,6 +45,10 @@ int cli_stream_check(const options *opt) {
                        opt->format != RSMOOTH_FORMAT_PLY_BINARY))
         return cli_usage_error(NULL, "--max-memory writes the input's own binary PLY: drop "
                                      "--ascii and --format");
+    if (opt->params.guard && !opt->quiet) /* (what the pieces cannot do yet, said once) */
+        fprintf(stderr, "rsmooth: --max-memory: the fold guard does not run on pieces yet: the "
+                        "result is the in-memory one with --no-guard (triangles the filter turns "
+                        "over are not pulled back)\n");
     return -1;
 }
 

@@ -13,8 +13,8 @@
 #include <math.h>
 #include <string.h>
 
-#define BIN_MIN (-4400) /* below log2 of the smallest double's quarter octaves */
-#define BIN_COUNT 6800  /* to above log2(4e150)'s */
+#define BIN_MIN RS_PART_BIN_MIN
+#define BIN_COUNT RS_PART_BIN_COUNT
 #define SCALE_GRAIN 4096
 
 /* |a - b| for two vertices, without overflow or underflow of the squares. */
@@ -42,16 +42,22 @@ typedef struct scale_job {
     double *longest;        /* per chunk: its longest edge */
 } scale_job;
 
+double rs_triangle_scale(rsmooth_scalar scalar, const void *positions, const uint32_t tri[3],
+                         double *longest) {
+    double e0 = edge_length(scalar, positions, tri[0], tri[1]);
+    double e1 = edge_length(scalar, positions, tri[1], tri[2]);
+    double e2 = edge_length(scalar, positions, tri[2], tri[0]);
+    double lo = fmin(e0, fmin(e1, e2));
+    *longest = fmax(e0, fmax(e1, e2));
+    return e0 + e1 + e2 - lo - *longest; /* the median */
+}
+
 static void scale_range(void *ctx, size_t begin, size_t end, size_t chunk) {
     scale_job *job = ctx;
     double worst = 0;
     for (size_t t = begin; t < end; t++) {
-        const uint32_t *tri = job->indices + 3 * t;
-        double e0 = edge_length(job->scalar, job->positions, tri[0], tri[1]);
-        double e1 = edge_length(job->scalar, job->positions, tri[1], tri[2]);
-        double e2 = edge_length(job->scalar, job->positions, tri[2], tri[0]);
-        double lo = fmin(e0, fmin(e1, e2)), hi = fmax(e0, fmax(e1, e2));
-        double median = e0 + e1 + e2 - lo - hi;
+        double hi = 0;
+        double median = rs_triangle_scale(job->scalar, job->positions, job->indices + 3 * t, &hi);
         job->bin[t] = rs_scale_bin(median);
         if (job->bin[t] != RS_NO_BIN)
             worst = fmax(worst, hi);
@@ -354,4 +360,14 @@ size_t rs_scale_parts(const int16_t *bin, size_t count, uint32_t *part, double *
     rs_free(histogram);
     rs_free(part_of_bin);
     return parts;
+}
+
+bool rs_scales_whole(const size_t *histogram, double longest) {
+    uint32_t *part_of_bin = rs_alloc_array(BIN_COUNT, sizeof *part_of_bin);
+    if (!part_of_bin)
+        return false;
+    double limit = 0;
+    size_t parts = cut_parts(histogram, part_of_bin, &limit, 1);
+    rs_free(part_of_bin);
+    return parts <= 1 && longest <= limit;
 }

@@ -67,4 +67,15 @@ uint32_t rs_parts_largest(const rs_parts *parts);
 int16_t rs_scale_bin(double scale);
 size_t rs_scale_parts(const int16_t *bin, size_t count, uint32_t *part, double **limit);
 
+/* For meshes read piece by piece (stream/): a triangle's scale (its median edge) and longest
+ * edge, and the whole-mesh test of rs_parts_find from the histogram of the scales' bins (bin b
+ * counted at histogram[b - RS_PART_BIN_MIN], RS_PART_BIN_COUNT of them) and the longest edge of
+ * all: true when the mesh is one part with no edge out of line. (false also when out of
+ * memory.) */
+#define RS_PART_BIN_MIN (-4400) /* below log2 of the smallest double, in quarter octaves */
+#define RS_PART_BIN_COUNT 6800  /* to above log2(4e150)'s */
+double rs_triangle_scale(rsmooth_scalar scalar, const void *positions, const uint32_t tri[3],
+                         double *longest);
+bool rs_scales_whole(const size_t *histogram, double longest);
+
 #endif /* RSMOOTH_PARTS_H */

@@ -181,6 +181,7 @@ typedef struct rs_stream_stats {
     double reach;            /* largest centroid-to-corner distance of a facet */
     uint64_t facet_count;
     double lo[3], hi[3];     /* the vertices' bounding box */
+    bool whole;              /* one part, no edge out of line (core/parts.h): what streams */
 } rs_stream_stats;
 
 /* The figures of the mesh whose triangles are in `triangles_fd`, with at most `memory` bytes of

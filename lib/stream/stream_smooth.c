@@ -234,6 +234,12 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
                               &c->stats, error);
     if (st != RSMOOTH_OK)
         return st;
+    if (!c->stats.whole)
+        return rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, RS_STREAM_WHERE,
+                       "%s holds parts of very different size, or vertices far off the surface "
+                       "(triangles out of scale with the rest): streaming does not keep them "
+                       "apart yet; smooth it without --max-memory",
+                       c->input);
     c->rep.mean_edge_length = c->stats.mean_edge_length;
     c->rep.facet_count = c->stats.facet_count;
     st = rsmooth_piece_halo(&c->params, c->stats.mean_edge_length, c->stats.reach, &c->halo,

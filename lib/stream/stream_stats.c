@@ -8,6 +8,7 @@
  *
  * Both sum at the in-memory path's own power-of-two scale (scale.c, from the same sampled
  * triangles), so even where squares under- or overflow at other scales the figures agree. */
+#include "core/parts.h"
 #include "stream/stream_internal.h"
 
 #include <math.h>
@@ -162,13 +163,26 @@ static rsmooth_status facet_figures(const rs_stream_positions *pos, int fd, uint
     rs_stream_reader r;
     if (!rs_stream_triangles_open(&r, fd, triangles))
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
-    double area_sum = 0, block_sum = 0, reach = 0;
+    double area_sum = 0, block_sum = 0, reach = 0, longest = 0;
     uint64_t facets = 0;
+    size_t *histogram = rs_calloc_array(RS_PART_BIN_COUNT, sizeof *histogram);
+    if (!histogram) {
+        rs_stream_reader_close(&r);
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "scale histogram");
+    }
+    rsmooth_scalar scalar = pos->f32 ? RSMOOTH_FLOAT32 : RSMOOTH_FLOAT64;
     for (uint64_t t = 0; t < triangles; t++) {
         uint32_t tri[3];
         if (!rs_stream_next_triangle(&r, tri)) {
             rs_stream_reader_close(&r);
+            rs_free(histogram);
             return read_fail(error);
+        }
+        double hi = 0; /* the parts test (core/parts.h), in the caller's units as in memory */
+        int16_t bin = rs_scale_bin(rs_triangle_scale(scalar, pos->xyz, tri, &hi));
+        if (bin != RS_NO_BIN) {
+            histogram[bin - RS_PART_BIN_MIN]++;
+            longest = fmax(longest, hi);
         }
         double p[9], centroid[3], area = 0;
         if (rs_stream_facet(pos, tri, scale, p, centroid, &area)) {
@@ -186,6 +200,8 @@ static rsmooth_status facet_figures(const rs_stream_positions *pos, int fd, uint
         }
     }
     rs_stream_reader_close(&r);
+    stats->whole = rs_scales_whole(histogram, longest);
+    rs_free(histogram);
     stats->facet_count = facets;
     stats->scaled_mean_area = facets ? area_sum / (double)facets : 0;
     stats->mean_area = stats->scaled_mean_area / scale / scale;
