@@ -221,7 +221,8 @@ def gmnf_defaults(case):
     cycles of one guided step and 10 vertex updates, radius 2 and sigma_s 1 in mean
     adjacent-centroid distances, sigma_r 0.35), as rsmooth's stage spells it. Their program
     re-measures sigma_s on the current mesh each cycle; rsmooth keeps the input's."""
-    return stage_opts(20, 10, 2, 0.35, sigma_s=float("%.4g" % adjacent_ratio(case["noisy"])))
+    return stage_opts(20, 10, 2, 0.35, sigma_s=float("%.4g" % adjacent_ratio(case["noisy"]))) + [
+        "--no-guard"]  # their program has no fold guard
 
 
 def run_report(rsmooth, case, opts, out):

@@ -125,12 +125,12 @@ class Runner:
         report = json.loads(p.stdout.strip().splitlines()[-1]) if p.stdout.strip() else {}
         return read_obj(dst)[0], report
 
-    def smooth_points(self, p, n, mode):
+    def smooth_points(self, p, n, device):
         src, dst = os.path.join(self.tmp, "pts.obj"), os.path.join(self.tmp, "pts-out.obj")
         with open(src, "w") as fh:
             fh.write("".join("v %.17g %.17g %.17g\n" % tuple(a) for a in p))
             fh.write("".join("vn %.17g %.17g %.17g\n" % tuple(b) for b in n))
-        cmd = [self.rsmooth, src, "-o", dst, "-f", "--json", "--device", self.device] + mode
+        cmd = [self.rsmooth, src, "-o", dst, "-f", "--json", "--device", device]
         r = subprocess.run(cmd, capture_output=True, text=True)
         if r.returncode:
             return None, r.stderr.strip()
@@ -216,8 +216,8 @@ def points_rows(run):
         q = p.copy()
         if far:
             q[0] = np.array([far, 0, 0])
-        for mode, opts in (("paper", []), ("--auto", ["--auto"])):
-            out, _ = run.smooth_points(q, n, opts)
+        for mode, device in (("paper, reference", "reference"), ("paper, OpenCL", "auto")):
+            out, _ = run.smooth_points(q, n, device)
             if out is None:
                 rows.append({"far": far or 0, "mode": mode, "error": _})
                 continue

@@ -159,10 +159,18 @@ def fold_guard(x_in, out, faces, untangles=8, halvings=24):
     its neighbourhood in the result (the unit normals of the triangles at its corners, summed)
     that did not in the input. Each round moves the vertices of every turned-over
     triangle: on a noisy input first (`untangles` rounds) to the mean of the other corners of the
-    triangles at the welded vertex, then halfway back toward the input (after `halvings` such
+    triangles at the welded vertex (a boundary vertex: of its neighbours along the boundary, and
+    no farther from the input than the filter put it), then halfway back toward the input (after `halvings` such
     rounds, snaps them and two rings of vertices around them to the input)."""
     out = out.copy()
     rep = weld(x_in)
+    e = np.sort(rep[np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])], axis=1)
+    e = e[e[:, 0] != e[:, 1]]
+    edges, counts = np.unique(e, axis=0, return_counts=True)
+    boundary = np.zeros(len(x_in), bool)  # welded vertices on an edge of one triangle
+    border = edges[counts == 1]
+    boundary[border.ravel()] = True
+    reach = np.linalg.norm(out - x_in, axis=1)
 
     def unit(x):
         n = np.cross(x[faces[:, 1]] - x[faces[:, 0]], x[faces[:, 2]] - x[faces[:, 0]])
@@ -200,8 +208,17 @@ def fold_guard(x_in, out, faces, untangles=8, halvings=24):
                 m = marked[r[:, c]]
                 np.add.at(total, r[m, c], out[faces[m, (c + 1) % 3]] + out[faces[m, (c + 2) % 3]])
                 np.add.at(count, r[m, c], 2)
+            along, n_along = np.zeros_like(x_in), np.zeros(len(x_in))  # the boundary's: along it
+            for a, b in ((0, 1), (1, 0)):
+                np.add.at(along, border[:, a], out[border[:, b]])
+                np.add.at(n_along, border[:, a], 1)
+            total[boundary], count[boundary] = along[boundary], n_along[boundary]
             v = np.flatnonzero(marked[rep] & (count[rep] > 0))
             out[v] = total[rep[v]] / count[rep[v], None]
+            d = out[v] - x_in[v]  # a boundary vertex no farther than the filter put it
+            length = np.linalg.norm(d, axis=1)
+            clamp = boundary[rep[v]] & (length > reach[v])
+            out[v[clamp]] = x_in[v[clamp]] + d[clamp] * (reach[v[clamp]] / length[clamp])[:, None]
         elif round_ < untangles * (reading == "noisy") + halvings:
             v = np.unique(faces[bad])
             out[v] = x_in[v] + (out[v] - x_in[v]) / 2

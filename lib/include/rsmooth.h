@@ -325,7 +325,9 @@ typedef struct rsmooth_params {
                                    * back toward the input until none is reversed
                                    * (rsmooth_report.guarded_vertices counts them), and the normal
                                    * update stage does not run on a mesh whose noise estimate finds
-                                   * nothing to remove (rsmooth_report.stage_skipped). 0: the filter
+                                   * nothing to remove (rsmooth_report.stage_skipped; not measured
+                                   * when discrepancy_level gives the noise, as
+                                   * rsmooth_params_auto sets it where it found some). 0: the filter
                                    * exactly as set (the paper's own, for comparisons). Parts and
                                    * outliers (rsmooth_report.parts) are kept apart either way.
                                    * (Added in 0.11) */

@@ -104,8 +104,10 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
     bool reports = pp.progress || pp.cancel;
     rs_stage_setting setting = {p.guided_sigma_s, p.guided_sigma_n, p.guided_radius,
                                 p.guided_rounds, p.vertex_updates, p.stage_repeats};
-    bool clean = false; /* do no harm: no stage where the noise estimate finds nothing */
-    if (p.guard && unit > 0) {
+    /* do no harm: no stage where the noise estimate finds nothing to remove (a caller that gives
+     * the noise level, as rsmooth_params_auto does where it found noise, has measured it) */
+    bool clean = false;
+    if (p.guard && unit > 0 && !(p.discrepancy_level > 0)) {
         rs_noise_details noise;
         st = rs_estimate_noise_details(scalar, positions, vertex_count, indices, triangle_count,
                                        &noise, error, where);
@@ -168,6 +170,41 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
     return st;
 }
 
+/* Passes after the first: confident vertices keep what the pass before gave them. */
+static void keep_confident(const double *cur, double *next, float *weight, float *confidence,
+                           const float *prev_weight, const float *prev_confidence,
+                           size_t vertex_count, double threshold) {
+    for (size_t v = 0; v < vertex_count; v++)
+        if (prev_confidence[v] >= threshold) {
+            memcpy(next + 3 * v, cur + 3 * v, 3 * sizeof(double));
+            weight[v] = prev_weight[v];
+            confidence[v] = prev_confidence[v];
+        }
+}
+
+/* No pass and no stage: the input comes back, weights 0 and confidences 1 (what
+ * rsmooth_params_auto sets on a mesh with nothing to remove). */
+static rsmooth_status give_input(rsmooth_scalar scalar, const void *positions,
+                                 size_t vertex_count, size_t triangle_count, void *out_positions,
+                                 float *out_weight, float *out_confidence, rsmooth_report *report,
+                                 double t_start) {
+    memcpy(out_positions, positions, vertex_count * rs_vertex_bytes(scalar));
+    for (size_t v = 0; v < vertex_count; v++) {
+        if (out_weight)
+            out_weight[v] = 0;
+        if (out_confidence)
+            out_confidence[v] = 1;
+    }
+    if (report) {
+        rsmooth_report_init(report);
+        report->vertex_count = vertex_count;
+        report->triangle_count = triangle_count;
+        snprintf(report->device, sizeof report->device, "none (no pass)");
+        report->ms_total = rs_now_ms() - t_start;
+    }
+    return RSMOOTH_OK;
+}
+
 static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_scalar scalar,
                                     const void *positions, size_t vertex_count,
                                     const uint32_t *indices, size_t triangle_count,
@@ -190,23 +227,9 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
         return staged_passes(one_pass, ctx, scalar, positions, vertex_count, indices,
                              triangle_count, &p, out_positions, out_weight, out_confidence,
                              report, error, where, stage, stage_stats);
-    if (p.passes == 0) { /* nothing to run: the input comes back */
-        memcpy(out_positions, positions, vertex_count * rs_vertex_bytes(scalar));
-        for (size_t v = 0; v < vertex_count; v++) {
-            if (out_weight)
-                out_weight[v] = 0;
-            if (out_confidence)
-                out_confidence[v] = 1;
-        }
-        if (report) {
-            rsmooth_report_init(report);
-            report->vertex_count = vertex_count;
-            report->triangle_count = triangle_count;
-            snprintf(report->device, sizeof report->device, "none (no pass)");
-            report->ms_total = rs_now_ms() - t_start;
-        }
-        return RSMOOTH_OK;
-    }
+    if (p.passes == 0) /* nothing to run */
+        return give_input(scalar, positions, vertex_count, triangle_count, out_positions,
+                          out_weight, out_confidence, report, t_start);
     if (p.passes == 1) /* the paper's single pass, exactly as it was */
         return one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, params,
                         out_positions, out_weight, out_confidence, report, error);
@@ -264,15 +287,9 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
             goto done;
         if (report)
             rs_add_pass_report(&sum, &one);
-        if (pass > 0 && p.pass_confidence > 0) {
-            /* confident vertices keep what the pass before gave them */
-            for (size_t v = 0; v < vertex_count; v++)
-                if (prev_confidence[v] >= p.pass_confidence) {
-                    memcpy(next + 3 * v, cur + 3 * v, 3 * sizeof(double));
-                    weight[v] = prev_weight[v];
-                    confidence[v] = prev_confidence[v];
-                }
-        }
+        if (pass > 0 && p.pass_confidence > 0)
+            keep_confident(cur, next, weight, confidence, prev_weight, prev_confidence,
+                           vertex_count, p.pass_confidence);
         for (size_t v = 0; p.move_mask && v < vertex_count; v++)
             if (!p.move_mask[v]) /* held still: each pass sees it where the input has it */
                 for (int k = 0; k < 3; k++)

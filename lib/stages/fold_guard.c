@@ -12,7 +12,8 @@
  * Each round finds every triangle turned over and moves each of their vertices: on a noisy mesh
  * first, for UNTANGLES rounds, to the mean of its neighbours (a fold in a smoothed result is an
  * artefact, and the input there is noise: untangling it smooths, where pulling back would bring
- * the noise back); then halfway back toward the input (where none is turned over), and after
+ * the noise back; a boundary vertex along the boundary, no farther from the input than the
+ * filter put it, so holes do not open); then halfway back toward the input (where none is turned over), and after
  * HALVINGS such rounds to the input exactly, with two rings of vertices around. Host
  * code, double precision, one thread, in index order: the same bytes on every run and for both
  * paths. scripts/region_study.py carries an independent numpy copy (its --check compares).
@@ -67,6 +68,10 @@ typedef struct guard {
     uint8_t *corner;    /* per vertex: a corner of a triangle turned over this round */
     uint8_t *pulled;    /* per vertex: pulled back at least once */
     uint32_t *rep;      /* per vertex: its welded vertex (a noisy mesh's untangling) */
+    uint8_t *boundary;  /* per welded vertex: on an edge of one triangle */
+    uint64_t *edge;     /* the boundary's edges (welded vertices: low << 32 | high) */
+    size_t edge_count;
+    double *reach;      /* per vertex: its distance from the input in the filter's result */
     double *sum;        /* 3 per vertex, and the count: the neighbours of welded vertices */
     double *count;
     reading mesh;
@@ -127,6 +132,34 @@ static bool turned(const guard *g, size_t t) {
     return g->mesh == CLEAN ? turned_clean(g, t) : turned_noisy(g, t);
 }
 
+/* The welded vertices on an edge that one triangle alone has. false when out of memory. */
+static bool find_boundary(guard *g) {
+    size_t n = 3 * g->triangle_count, used = 0;
+    uint64_t *key = rs_alloc_array(n ? n : 1, sizeof *key);
+    uint32_t *unused = rs_calloc_array(n ? n : 1, sizeof *unused);
+    bool ok = key && unused;
+    if (!ok)
+        rs_free(key);
+    for (size_t t = 0; ok && t < g->triangle_count; t++)
+        for (int e = 0; e < 3; e++) {
+            uint32_t a = g->rep[g->indices[3 * t + e]], b = g->rep[g->indices[3 * t + (e + 1) % 3]];
+            if (a != b)
+                key[used++] = a < b ? (uint64_t)a << 32 | b : (uint64_t)b << 32 | a;
+        }
+    ok = ok && rs_radix_sort_u64(key, unused, used);
+    g->edge_count = 0;
+    for (size_t i = 0; ok && i < used; i++) {
+        bool single = (i == 0 || key[i - 1] != key[i]) && (i + 1 == used || key[i + 1] != key[i]);
+        if (single) {
+            g->boundary[key[i] >> 32] = g->boundary[key[i] & 0xffffffffu] = 1;
+            key[g->edge_count++] = key[i]; /* (behind i: the kept ones go first) */
+        }
+    }
+    g->edge = key;
+    rs_free(unused);
+    return ok;
+}
+
 /* Whether the input reads clean; only measured once a triangle is turned over either way. false
  * when out of memory. */
 static bool decide(guard *g, rsmooth_scalar scalar, const void *positions) {
@@ -155,7 +188,15 @@ static bool decide(guard *g, rsmooth_scalar scalar, const void *positions) {
         g->rep = rs_alloc_array(g->vertex_count, sizeof *g->rep);
         g->sum = rs_alloc_array(g->vertex_count, 3 * sizeof *g->sum);
         g->count = rs_alloc_array(g->vertex_count, sizeof *g->count);
-        ok = g->rep && g->sum && g->count && rs_weld(g->in, g->vertex_count, g->rep);
+        g->boundary = rs_calloc_array(g->vertex_count, 1);
+        g->reach = rs_alloc_array(g->vertex_count, sizeof *g->reach);
+        ok = g->rep && g->sum && g->count && g->boundary && g->reach &&
+             rs_weld(g->in, g->vertex_count, g->rep) && find_boundary(g);
+        for (size_t v = 0; ok && v < g->vertex_count; v++) {
+            double d[3];
+            rs_sub3(g->out + 3 * v, g->in + 3 * v, d);
+            g->reach[v] = sqrt(rs_dot3(d, d));
+        }
     }
     return ok;
 }
@@ -177,7 +218,9 @@ static void widen(guard *g, int rings) {
 }
 
 /* Moves every vertex welded to a marked one to the mean of the other corners of the triangles at
- * its welded vertex (each triangle's two, so an edge inside the mesh counts twice). */
+ * its welded vertex (each triangle's two, so an edge inside the mesh counts twice). On the
+ * boundary that mean lies inside, and a scan's holes would open: there, to the mean of its
+ * neighbours along the boundary, and no farther from the input than the filter put it. */
 static void untangle(guard *g) {
     memset(g->sum, 0, 3 * g->vertex_count * sizeof *g->sum);
     memset(g->count, 0, g->vertex_count * sizeof *g->count);
@@ -196,13 +239,36 @@ static void untangle(guard *g) {
             g->count[r] += 2;
         }
     }
+    for (size_t v = 0; v < g->vertex_count; v++) /* the boundary's: along the boundary */
+        if (g->corner[v] && g->boundary[v]) {
+            memset(g->sum + 3 * v, 0, 3 * sizeof *g->sum);
+            g->count[v] = 0;
+        }
+    for (size_t i = 0; i < g->edge_count; i++) {
+        size_t a = (size_t)(g->edge[i] >> 32), b = (size_t)(g->edge[i] & 0xffffffffu);
+        for (int end = 0; end < 2; end++) {
+            size_t r = end ? b : a, o = end ? a : b;
+            if (!g->corner[r])
+                continue;
+            for (int k = 0; k < 3; k++)
+                g->sum[3 * r + (size_t)k] += g->out[3 * o + (size_t)k];
+            g->count[r]++;
+        }
+    }
     for (size_t v = 0; v < g->vertex_count; v++) {
         uint32_t r = g->rep[v];
         if (!g->corner[r] || !(g->count[r] > 0))
             continue;
-        double *o = g->out + 3 * v;
-        for (int k = 0; k < 3; k++)
+        double *o = g->out + 3 * v, d[3];
+        const double *in = g->in + 3 * v;
+        for (int k = 0; k < 3; k++) {
             o[k] = g->sum[3 * (size_t)r + (size_t)k] / g->count[r];
+            d[k] = o[k] - in[k];
+        }
+        double length = sqrt(rs_dot3(d, d));
+        if (g->boundary[r] && length > g->reach[v])
+            for (int k = 0; k < 3; k++)
+                o[k] = in[k] + d[k] * (g->reach[v] / length);
         g->pulled[v] = 1;
     }
 }
@@ -251,6 +317,9 @@ static void free_guard(guard *g) {
     rs_free(g->corner);
     rs_free(g->pulled);
     rs_free(g->rep);
+    rs_free(g->boundary);
+    rs_free(g->edge);
+    rs_free(g->reach);
     rs_free(g->sum);
     rs_free(g->count);
 }

@@ -10,8 +10,10 @@ same numbers; the command smooths that file (paper defaults, then --best); the z
 and enabled (bpy.ops.preferences.addon_install, addon_enable); the mesh is built with
 Mesh.from_pydata (no importer: the vertex order and faces are checked to be the file's); the
 operator runs in each mode on the same device, and its positions are compared with the command's,
-in mean edge lengths (mean |difference| <= 1e-6); Edit > Undo must bring the input back; a device
-that does not exist must report an error naming the object and change nothing.
+in mean edge lengths (mean |difference| <= 1e-6); Edit > Undo must bring the input back;
+Blender's default cube keeps its corners within 1% of its diagonal in every mode but Paper
+without Auto, with no triangle turned over; a device that does not exist must report an error
+naming the object and change nothing.
 """
 
 import argparse
@@ -186,6 +188,42 @@ def main():
             failures.append(f"{mode}: undo did not restore the input")
             mesh.vertices.foreach_set("co", vertices.ravel())
             mesh.update()
+
+    # Blender's default cube: every mode but Paper at its fixed widths keeps its corners within
+    # 1% of its diagonal, and no mode turns a triangle over (docs/do-no-harm.md)
+    for obj in list(bpy.data.objects):
+        obj.select_set(False)
+    bpy.ops.mesh.primitive_cube_add()
+    cube = bpy.context.active_object
+    corners = positions(cube.data).astype(np.float64)
+    diagonal = np.linalg.norm(corners.max(axis=0) - corners.min(axis=0))
+    cube.data.calc_loop_triangles()
+    tris = np.empty(len(cube.data.loop_triangles) * 3, dtype=np.int32)
+    cube.data.loop_triangles.foreach_get("vertices", tris)
+    tris = tris.reshape(-1, 3)
+
+    def normals(x):
+        return np.cross(x[tris[:, 1]] - x[tris[:, 0]], x[tris[:, 2]] - x[tris[:, 0]])
+    for mode in ("PAPER", "BEST"):
+        for auto in (False, True):
+            cube.data.vertices.foreach_set("co", corners.astype(np.float32).ravel())
+            cube.data.update()
+            result = bpy.ops.object.rsmooth_denoise(mode=mode, auto=auto,
+                                                    device=args.device.upper())
+            assert result == {"FINISHED"}, f"operator {mode} on the cube: {result}"
+            got = positions(cube.data).astype(np.float64)
+            moved = np.linalg.norm(got - corners, axis=1).max() / diagonal
+            turned = int(np.sum(np.sum(normals(got) * normals(corners), axis=1) < 0))
+            name = mode.lower() + (" auto" if auto else "")
+            print(f"default cube, {name}: corners moved at most {100 * moved:.2f}% of the "
+                  f"diagonal, {turned} triangles turned over")
+            if turned:
+                failures.append(f"default cube, {name}: {turned} triangles turned over")
+            if (mode != "PAPER" or auto) and not moved <= 0.01:
+                failures.append(f"default cube, {name}: corners moved {100 * moved:.2f}% > 1%")
+    bpy.data.objects.remove(cube)
+    bpy.data.objects["Noisy"].select_set(True)
+    bpy.context.view_layer.objects.active = bpy.data.objects["Noisy"]
 
     # an error: named, and nothing changed
     try:
