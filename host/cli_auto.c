@@ -65,7 +65,10 @@ int cli_choose_params(options *opt, const rsmooth_mesh *mesh, bool points) {
                  "; with its spatially correlated part %.3g mean edge lengths rms (correlation "
                  "length %.2g edges)",
                  report.correlated_level, report.correlation_length);
-    if (!opt->quiet)
+    if (!opt->quiet && chosen.passes == 0 && chosen.vertex_updates == 0) /* nothing to run */
+        fprintf(stderr, "rsmooth: %s: --auto: %s%s -> %s\n", opt->input, report.reason,
+                correlated, report.preset);
+    else if (!opt->quiet)
         fprintf(stderr, "rsmooth: %s: --auto: %s%s -> %s (sigma_f %.3g, sigma_g %.3g)\n",
                 opt->input, report.reason, correlated, report.preset, chosen.sigma_f,
                 chosen.sigma_g);

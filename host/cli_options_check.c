@@ -29,6 +29,9 @@ static int check_params(options *opt) {
     if (!(p->pass_confidence >= 0 && p->pass_confidence <= 1))
         return cli_usage_error(NULL, "--pass-confidence must be in [0, 1] (got %g)",
                                p->pass_confidence);
+    if ((opt->given & GIVEN_PASSES) && p->passes == 0 && p->vertex_updates == 0)
+        return cli_usage_error(NULL, "--passes 0 runs the normal update stage alone: give "
+                                     "--vertex-updates (or --best) too");
     return -1;
 }
 

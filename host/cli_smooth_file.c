@@ -193,7 +193,12 @@ static void report_file(const file_job *job) {
         cli_print_stats(job->mesh, job->out, job->confidence, r);
     if (opt->quiet)
         return;
-    if (cli_method_uses_edges(opt->method))
+    if (!cli_method_uses_edges(opt->method) && opt->params.passes == 0 &&
+        opt->params.vertex_updates == 0) /* --auto found nothing to remove */
+        fprintf(stderr, "rsmooth: %s: %zu vertices, %zu triangles; nothing to remove: every "
+                        "vertex as it was; wrote %s%s%s\n",
+                opt->input, r->vertex_count, r->triangle_count, job->wrote, and, confidence);
+    else if (cli_method_uses_edges(opt->method))
         fprintf(stderr, "rsmooth: %s: %zu vertices, %zu triangles; %s: %.1f ms; wrote %s\n",
                 opt->input, r->vertex_count, r->triangle_count, r->device, r->ms_total,
                 job->wrote);

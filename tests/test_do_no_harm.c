@@ -267,8 +267,8 @@ static void check_parts(rsmooth_context *ctx, int levels) {
             bool same = memcmp(out + 3 * v0, alone, 3 * n * sizeof *out) == 0;
             printf("  %zu-vertex spheres, %-14s %-10s radius %g: centre off %.2g radii, radius "
                    "x %.4f, %s\n",
-                   n, mode_name[mode], ctx ? "device" : "reference", radius[i], off,
-                   r / radius[i], same ? "as smoothed alone" : "NOT AS ALONE");
+                   n, mode_name[mode], ctx ? "device" : "reference", radius[i], off, r / radius[i],
+                   same ? "as smoothed alone" : "NOT AS ALONE");
             CHECK(same);
             if (levels >= 4) {
                 CHECK_LE(off, 0.01);
@@ -301,13 +301,13 @@ static void check_points(rsmooth_context *ctx) {
     rsmooth_error err;
     rsmooth_report report;
     rsmooth_report_init(&report);
-    CHECK_STATUS(ctx ? rsmooth_smooth_points(ctx, RSMOOTH_FLOAT64, xyz, normal, n, NULL, out,
-                                             NULL, NULL, &report, &err)
+    CHECK_STATUS(ctx ? rsmooth_smooth_points(ctx, RSMOOTH_FLOAT64, xyz, normal, n, NULL, out, NULL,
+                                             NULL, &report, &err)
                      : rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, normal, n, NULL, out,
                                                        NULL, NULL, &report, &err),
                  RSMOOTH_OK);
-    CHECK_STATUS(ctx ? rsmooth_smooth_points(ctx, RSMOOTH_FLOAT64, xyz, normal, n - 1, NULL,
-                                             alone, NULL, NULL, NULL, &err)
+    CHECK_STATUS(ctx ? rsmooth_smooth_points(ctx, RSMOOTH_FLOAT64, xyz, normal, n - 1, NULL, alone,
+                                             NULL, NULL, NULL, &err)
                      : rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, normal, n - 1, NULL,
                                                        alone, NULL, NULL, NULL, &err),
                  RSMOOTH_OK);
@@ -355,8 +355,7 @@ static void check_guard(rsmooth_context *ctx) {
     }
     printf("  cube-8, --best %-10s turned over: %zu unguarded (stage run), %zu guarded (stage "
            "%s)\n",
-           ctx ? "device" : "reference", turned[0], turned[1],
-           skipped[1] ? "skipped" : "RUN");
+           ctx ? "device" : "reference", turned[0], turned[1], skipped[1] ? "skipped" : "RUN");
     CHECK(turned[0] > 0);
     CHECK_EQ_INT(skipped[0], 0);
     CHECK_EQ_INT(turned[1], 0);
@@ -398,8 +397,8 @@ static void all_checks(rsmooth_context *ctx) {
     bool small = test_small();
     printf("%s path\n", ctx ? "the device's" : "the reference");
     shape_mesh shapes[6];
-    const char *names[6] = {"cube-8", "cube-98", "cube-866", "icosphere-642", "icosphere-2562",
-                            "open grid 30x30"};
+    const char *names[6] = {"cube-8",        "cube-98",        "cube-866",
+                            "icosphere-642", "icosphere-2562", "open grid 30x30"};
     CHECK_EQ_INT(shape_cube(&shapes[0], 1, 2.0), 0);
     CHECK_EQ_INT(shape_cube(&shapes[1], 4, 2.0), 0);
     CHECK_EQ_INT(shape_cube(&shapes[2], 12, 2.0), 0);

@@ -80,14 +80,13 @@ static void clean_grid(void) {
     out[3 * v] += 0.25; /* across its right-hand neighbour */
     size_t turned = turned_over(&m, m.xyz, out);
     memcpy(before, out, 3 * n * sizeof *out);
-    long pulled = rs_fold_guard(RSMOOTH_FLOAT64, m.xyz, out, n, m.indices, m.triangle_count);
+    long pulled = rs_fold_guard(RSMOOTH_FLOAT64, m.xyz, out, n, m.indices, m.triangle_count, NULL);
     size_t changed = 0;
     for (size_t u = 0; u < n; u++)
         changed += memcmp(out + 3 * u, before + 3 * u, 3 * sizeof *out) != 0;
     printf("clean grid, a vertex dragged 2.5 cells: %zu triangles turned over, after the guard "
            "%zu; %ld vertex pulled back to %.3g cells from its place; %zu vertices changed\n",
-           turned, turned_over(&m, m.xyz, out), pulled, (out[3 * v] - m.xyz[3 * v]) / 0.1,
-           changed);
+           turned, turned_over(&m, m.xyz, out), pulled, (out[3 * v] - m.xyz[3 * v]) / 0.1, changed);
     CHECK(turned > 0);
     CHECK_EQ_INT(turned_over(&m, m.xyz, out), 0);
     CHECK_EQ_INT(pulled, 1);
@@ -101,14 +100,16 @@ static void clean_grid(void) {
         in32[i] = (float)m.xyz[i];
         out32[i] = (float)before[i];
     }
-    CHECK_EQ_INT(rs_fold_guard(RSMOOTH_FLOAT32, in32, out32, n, m.indices, m.triangle_count), 1);
+    CHECK_EQ_INT(rs_fold_guard(RSMOOTH_FLOAT32, in32, out32, n, m.indices, m.triangle_count, NULL),
+                 1);
     CHECK_NEAR(out32[3 * v], out[3 * v], 1e-6);
 
     /* nothing turned over: nothing changes */
     memcpy(out, m.xyz, 3 * n * sizeof *out);
     out[3 * v] += 0.04;
     memcpy(before, out, 3 * n * sizeof *out);
-    CHECK_EQ_INT(rs_fold_guard(RSMOOTH_FLOAT64, m.xyz, out, n, m.indices, m.triangle_count), 0);
+    CHECK_EQ_INT(rs_fold_guard(RSMOOTH_FLOAT64, m.xyz, out, n, m.indices, m.triangle_count, NULL),
+                 0);
     CHECK(memcmp(out, before, 3 * n * sizeof *out) == 0);
     printf("clean grid, a vertex moved 0.4 cells: nothing turned over, nothing changed\n");
     free(in32);
@@ -126,10 +127,10 @@ static void noisy_grid(void) {
     CHECK(out && flat);
     memcpy(flat, m.xyz, 3 * n * sizeof *flat);
     CHECK_EQ_INT(shape_add_normal_noise(&m, 0.3, 7), 0); /* the input: noisy along z */
-    memcpy(out, flat, 3 * n * sizeof *out);               /* the result: flat again */
+    memcpy(out, flat, 3 * n * sizeof *out);              /* the result: flat again */
     out[3 * v] += 0.25;
     size_t before = facing_against(&m, out), input = facing_against(&m, m.xyz);
-    long pulled = rs_fold_guard(RSMOOTH_FLOAT64, m.xyz, out, n, m.indices, m.triangle_count);
+    long pulled = rs_fold_guard(RSMOOTH_FLOAT64, m.xyz, out, n, m.indices, m.triangle_count, NULL);
     size_t after = facing_against(&m, out);
     double far = 0; /* the largest change more than 3 cells from the fold */
     for (size_t u = 0; u < n; u++)
@@ -144,6 +145,26 @@ static void noisy_grid(void) {
     CHECK(after <= input);
     CHECK(pulled > 0);
     CHECK_EQ_INT(far, 0);
+
+    /* held vertices (a caller's mask, outliers) stay where they are: hold every vertex but the
+     * dragged one; the guard must fix the fold with that one alone */
+    uint8_t *movable = calloc(n, 1);
+    CHECK(movable);
+    movable[v] = 1;
+    double *held = malloc(3 * n * sizeof *held);
+    CHECK(held);
+    memcpy(out, flat, 3 * n * sizeof *out);
+    out[3 * v] += 0.25;
+    memcpy(held, out, 3 * n * sizeof *out);
+    CHECK_EQ_INT(
+        rs_fold_guard(RSMOOTH_FLOAT64, m.xyz, out, n, m.indices, m.triangle_count, movable), 1);
+    for (size_t u = 0; u < n; u++)
+        if (u != v)
+            CHECK(memcmp(out + 3 * u, held + 3 * u, 3 * sizeof *out) == 0);
+    CHECK(facing_against(&m, out) <= input);
+    printf("the same with every other vertex held: only the dragged vertex moved, no fold left\n");
+    free(movable);
+    free(held);
     free(out);
     free(flat);
     shape_free(&m);

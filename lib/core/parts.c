@@ -17,40 +17,14 @@
 #define BIN_COUNT RS_PART_BIN_COUNT
 #define SCALE_GRAIN 4096
 
-/* |a - b| for two vertices, without overflow or underflow of the squares. */
-static double edge_length(rsmooth_scalar scalar, const void *positions, uint32_t a, uint32_t b) {
-    double d[3], m = 0;
-    for (int k = 0; k < 3; k++) {
-        d[k] = rs_coordinate(scalar, positions, 3 * (size_t)a + (size_t)k) -
-               rs_coordinate(scalar, positions, 3 * (size_t)b + (size_t)k);
-        m = fmax(m, fabs(d[k]));
-    }
-    if (!(m > 0))
-        return 0;
-    double s = 0;
-    for (int k = 0; k < 3; k++)
-        s += (d[k] / m) * (d[k] / m);
-    return m * sqrt(s);
-}
-
 typedef struct scale_job {
     rsmooth_scalar scalar;
     const void *positions;
     const uint32_t *indices;
     size_t triangle_count;
-    int16_t *bin;           /* per triangle: quarter-octave bin of its scale, RS_NO_BIN when 0 */
-    double *longest;        /* per chunk: its longest edge */
+    int16_t *bin;    /* per triangle: quarter-octave bin of its scale, RS_NO_BIN when 0 */
+    double *longest; /* per chunk: its longest edge */
 } scale_job;
-
-double rs_triangle_scale(rsmooth_scalar scalar, const void *positions, const uint32_t tri[3],
-                         double *longest) {
-    double e0 = edge_length(scalar, positions, tri[0], tri[1]);
-    double e1 = edge_length(scalar, positions, tri[1], tri[2]);
-    double e2 = edge_length(scalar, positions, tri[2], tri[0]);
-    double lo = fmin(e0, fmin(e1, e2));
-    *longest = fmax(e0, fmax(e1, e2));
-    return e0 + e1 + e2 - lo - *longest; /* the median */
-}
 
 static void scale_range(void *ctx, size_t begin, size_t end, size_t chunk) {
     scale_job *job = ctx;
@@ -63,54 +37,6 @@ static void scale_range(void *ctx, size_t begin, size_t end, size_t chunk) {
             worst = fmax(worst, hi);
     }
     job->longest[chunk] = worst;
-}
-
-int16_t rs_scale_bin(double scale) {
-    if (!(scale > 0) || !isfinite(scale))
-        return RS_NO_BIN;
-    return (int16_t)floor(RS_PART_BINS_PER_OCTAVE * log2(scale));
-}
-
-/* The parts as ranges of bins: part_of_bin[b - BIN_MIN] for every occupied bin, and each part's
- * edge limit. Returns the number of parts. */
-static size_t cut_parts(const size_t *histogram, uint32_t *part_of_bin, double *limit,
-                        size_t limit_capacity) {
-    size_t parts = 0;
-    int last = 0, first = 0;
-    size_t in_part = 0;
-    bool open = false;
-    for (int b = 0; b <= BIN_COUNT; b++) {
-        bool occupied = b < BIN_COUNT && histogram[b] > 0;
-        bool ends = open && (b == BIN_COUNT ||
-                             (occupied && b - last > RS_PART_GAP_OCTAVES * RS_PART_BINS_PER_OCTAVE));
-        if (ends) { /* the part [first, last]: its median bin bounds its typical scale */
-            size_t seen = 0;
-            int median = first;
-            for (int m = first; m <= last; m++) {
-                seen += histogram[m];
-                if (2 * seen >= in_part) {
-                    median = m;
-                    break;
-                }
-            }
-            if (parts < limit_capacity)
-                limit[parts] = RS_EDGE_OUT_OF_LINE *
-                               exp2((double)(median + BIN_MIN + 1) / RS_PART_BINS_PER_OCTAVE);
-            parts++;
-            open = false;
-            in_part = 0;
-        }
-        if (occupied) {
-            if (!open) {
-                open = true;
-                first = b;
-            }
-            part_of_bin[b] = (uint32_t)parts;
-            in_part += histogram[b];
-            last = b;
-        }
-    }
-    return parts;
 }
 
 /* The corners of triangle t that are not repeats of an earlier corner: 1 to 3 of them. */
@@ -224,14 +150,15 @@ rsmooth_status rs_parts_find(rs_parts *parts, rsmooth_scalar scalar, const void 
         if (bin[t] != RS_NO_BIN)
             histogram[bin[t] - BIN_MIN]++;
     double limit_one = 0;
-    parts->count = cut_parts(histogram, part_of_bin, &limit_one, 1);
+    parts->count = rs_cut_parts(histogram, part_of_bin, &limit_one, 1);
     if (parts->count <= 1 && worst <= limit_one) { /* no edge out of line either */
         parts->count = 1;
         goto done;
     }
     parts->whole = false;
     parts->triangle_part = rs_alloc_array(triangle_count, sizeof *parts->triangle_part);
-    parts->vertex_part = rs_alloc_array(vertex_count ? vertex_count : 1, sizeof *parts->vertex_part);
+    parts->vertex_part =
+        rs_alloc_array(vertex_count ? vertex_count : 1, sizeof *parts->vertex_part);
     parts->outlier = rs_calloc_array(vertex_count ? vertex_count : 1, 1);
     parts->edge_limit = rs_alloc_array(parts->count ? parts->count : 1, sizeof *parts->edge_limit);
     parts->vertices = rs_calloc_array(parts->count ? parts->count : 1, sizeof *parts->vertices);
@@ -240,7 +167,7 @@ rsmooth_status rs_parts_find(rs_parts *parts, rsmooth_scalar scalar, const void 
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the parts");
         goto done;
     }
-    cut_parts(histogram, part_of_bin, parts->edge_limit, parts->count);
+    rs_cut_parts(histogram, part_of_bin, parts->edge_limit, parts->count);
     for (size_t t = 0; t < triangle_count; t++)
         parts->triangle_part[t] = bin[t] == RS_NO_BIN ? RS_NO_PART : part_of_bin[bin[t] - BIN_MIN];
     if (!assign_vertices(parts, vertex_count, indices, triangle_count)) {
@@ -313,8 +240,8 @@ bool rs_submesh_make(rs_submesh *sub, const rs_parts *parts, uint32_t part, rsmo
             sub->vertex[s] = (uint32_t)v;
             memcpy((char *)sub->positions + s * record, (const char *)positions + v * record,
                    record);
-            sub->move[s] = parts->vertex_part[v] == part && !parts->outlier[v] &&
-                           (!move_mask || move_mask[v]);
+            sub->move[s] =
+                parts->vertex_part[v] == part && !parts->outlier[v] && (!move_mask || move_mask[v]);
             sub->moving += sub->move[s];
         }
     size_t out = 0;
@@ -336,38 +263,4 @@ void rs_submesh_free(rs_submesh *sub) {
     rs_free(sub->vertex);
     rs_free(sub->move);
     memset(sub, 0, sizeof *sub);
-}
-
-size_t rs_scale_parts(const int16_t *bin, size_t count, uint32_t *part, double **limit) {
-    size_t *histogram = rs_calloc_array(BIN_COUNT, sizeof *histogram);
-    uint32_t *part_of_bin = rs_alloc_array(BIN_COUNT, sizeof *part_of_bin);
-    size_t parts = SIZE_MAX;
-    *limit = NULL;
-    if (histogram && part_of_bin) {
-        for (size_t i = 0; i < count; i++)
-            if (bin[i] != RS_NO_BIN)
-                histogram[bin[i] - BIN_MIN]++;
-        parts = cut_parts(histogram, part_of_bin, NULL, 0);
-        *limit = rs_alloc_array(parts ? parts : 1, sizeof **limit);
-        if (*limit) {
-            cut_parts(histogram, part_of_bin, *limit, parts);
-            for (size_t i = 0; i < count; i++)
-                part[i] = bin[i] == RS_NO_BIN ? RS_NO_PART : part_of_bin[bin[i] - BIN_MIN];
-        } else {
-            parts = SIZE_MAX;
-        }
-    }
-    rs_free(histogram);
-    rs_free(part_of_bin);
-    return parts;
-}
-
-bool rs_scales_whole(const size_t *histogram, double longest) {
-    uint32_t *part_of_bin = rs_alloc_array(BIN_COUNT, sizeof *part_of_bin);
-    if (!part_of_bin)
-        return false;
-    double limit = 0;
-    size_t parts = cut_parts(histogram, part_of_bin, &limit, 1);
-    rs_free(part_of_bin);
-    return parts <= 1 && longest <= limit;
 }

@@ -18,17 +18,17 @@
 #define RS_NO_PART UINT32_MAX
 
 typedef struct rs_parts {
-    size_t count;            /* parts (each with at least one triangle) */
-    bool whole;              /* one part holds every triangle of non-zero scale and no edge is out
-                              * of line: the mesh is smoothed as it is, its unit its mean edge */
+    size_t count; /* parts (each with at least one triangle) */
+    bool whole;   /* one part holds every triangle of non-zero scale and no edge is out
+                   * of line: the mesh is smoothed as it is, its unit its mean edge */
     /* The rest is set only when !whole (NULL otherwise). */
-    uint32_t *triangle_part; /* per triangle: its part, RS_NO_PART when all three corners coincide */
-    uint32_t *vertex_part;   /* per vertex: the part that moves it; RS_NO_PART: no triangle uses it */
-    uint8_t *outlier;        /* per vertex: 1 when every triangle it belongs to reaches a vertex of
-                              * another part (a stray vertex far off the surface): held still */
-    size_t outliers;         /* how many */
-    double *edge_limit;      /* per part: longer edges are left out of its unit (caller's units) */
-    size_t *vertices;        /* per part: the vertices it moves (outliers not counted) */
+    uint32_t *triangle_part; /* per triangle: its part (RS_NO_PART: its corners coincide) */
+    uint32_t *vertex_part; /* per vertex: the part that moves it; RS_NO_PART: no triangle uses it */
+    uint8_t *outlier;      /* per vertex: 1 when every triangle it belongs to reaches a vertex of
+                            * another part (a stray vertex far off the surface): held still */
+    size_t outliers;       /* how many */
+    double *edge_limit;    /* per part: longer edges are left out of its unit (caller's units) */
+    size_t *vertices;      /* per part: the vertices it moves (outliers not counted) */
 } rs_parts;
 
 /* Finds the parts of a checked mesh (positions finite). Deterministic for any thread count.
@@ -77,5 +77,11 @@ size_t rs_scale_parts(const int16_t *bin, size_t count, uint32_t *part, double *
 double rs_triangle_scale(rsmooth_scalar scalar, const void *positions, const uint32_t tri[3],
                          double *longest);
 bool rs_scales_whole(const size_t *histogram, double longest);
+
+/* The parts of a histogram as ranges of bins: part_of_bin[b - RS_PART_BIN_MIN] for every occupied
+ * bin, and the first `limit_capacity` parts' edge limits into `limit` (may be NULL when 0).
+ * Returns the number of parts. (part_scales.c, with the three above and rs_scale_parts.) */
+size_t rs_cut_parts(const size_t *histogram, uint32_t *part_of_bin, double *limit,
+                    size_t limit_capacity);
 
 #endif /* RSMOOTH_PARTS_H */

@@ -111,7 +111,8 @@ static bool bends(const double *xyz, size_t vertex_count, const uint32_t *indice
         bend[v] = 0;
         if (valid[v])
             for (int k = 0; k < 3; k++)
-                bend[v] += (sum[3 * v + (size_t)k] / degree[v] - xyz[3 * v + (size_t)k]) * n[k] / len;
+                bend[v] +=
+                    (sum[3 * v + (size_t)k] / degree[v] - xyz[3 * v + (size_t)k]) * n[k] / len;
     }
     rs_free(normal);
     rs_free(sum);

@@ -120,7 +120,8 @@ static rsmooth_status filter_part(rs_filter_fn one_pass, rs_stage_runner stage, 
     p.move_mask = sub.move;
     if (colors) {
         for (size_t s = 0; s < n; s++)
-            memcpy(colors + 3 * s, resolved->colors + 3 * (size_t)sub.vertex[s], 3 * sizeof *colors);
+            memcpy(colors + 3 * s, resolved->colors + 3 * (size_t)sub.vertex[s],
+                   3 * sizeof *colors);
         p.colors = colors;
     }
     if (progress->progress || progress->cancel) {
@@ -163,8 +164,8 @@ static rsmooth_status filter_parts(rs_filter_fn one_pass, rs_stage_runner stage,
                                    const void *positions, size_t vertex_count,
                                    const uint32_t *indices, size_t triangle_count,
                                    const rsmooth_params *resolved, whole_outputs *whole,
-                                   rsmooth_report *report, size_t *smoothed,
-                                   rsmooth_error *error, const char *where) {
+                                   rsmooth_report *report, size_t *smoothed, rsmooth_error *error,
+                                   const char *where) {
     memcpy(whole->positions, positions, vertex_count * rs_vertex_bytes(scalar));
     if (whole->weight)
         memset(whole->weight, 0, vertex_count * sizeof *whole->weight);
@@ -182,8 +183,8 @@ static rsmooth_status filter_parts(rs_filter_fn one_pass, rs_stage_runner stage,
         progress.pass = (int)part;
         rsmooth_report_init(&one);
         rsmooth_status st = filter_part(one_pass, stage, ctx, scalar, parts, part, positions,
-                                        vertex_count, indices, triangle_count, resolved,
-                                        &progress, whole, report ? &one : NULL, error, where);
+                                        vertex_count, indices, triangle_count, resolved, &progress,
+                                        whole, report ? &one : NULL, error, where);
         if (st != RSMOOTH_OK)
             return st;
         if (report)
@@ -194,6 +195,25 @@ static rsmooth_status filter_parts(rs_filter_fn one_pass, rs_stage_runner stage,
     if (report && first) /* nothing to smooth: the whole mesh's counts */
         rsmooth_report_init(report);
     return RSMOOTH_OK;
+}
+
+/* The fold guard over the whole result, holding what the call holds: the caller's mask and the
+ * outliers. -1 when out of memory. */
+static long guard_folds(rsmooth_scalar scalar, const void *positions, void *out_positions,
+                        size_t vertex_count, const uint32_t *indices, size_t triangle_count,
+                        const rs_parts *parts, const uint8_t *mask) {
+    if (parts->whole || parts->outliers == 0)
+        return rs_fold_guard(scalar, positions, out_positions, vertex_count, indices,
+                             triangle_count, mask);
+    uint8_t *movable = rs_alloc_array(vertex_count, 1);
+    if (!movable)
+        return -1;
+    for (size_t v = 0; v < vertex_count; v++)
+        movable[v] = !parts->outlier[v] && (!mask || mask[v]);
+    long moved = rs_fold_guard(scalar, positions, out_positions, vertex_count, indices,
+                               triangle_count, movable);
+    rs_free(movable);
+    return moved;
 }
 
 /* The report's fields a caller's struct has room for (rs_report_bytes). */
@@ -257,12 +277,11 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, rs_stage_runner stage, vo
         rs_free(whole.confidence);
     }
     long guarded = 0;
-    if (st == RSMOOTH_OK && p.guard) {
-        guarded = rs_fold_guard(scalar, positions, out_positions, vertex_count, indices,
-                                triangle_count);
-        if (guarded < 0)
-            st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the fold guard");
-    }
+    if (st == RSMOOTH_OK && p.guard)
+        guarded = guard_folds(scalar, positions, out_positions, vertex_count, indices,
+                              triangle_count, &parts, p.move_mask);
+    if (guarded < 0)
+        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the fold guard");
     if (st == RSMOOTH_OK && report) {
         full.parts = smoothed;
         full.outliers = parts.outliers;

@@ -59,6 +59,22 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                                     const char *where, rsmooth_params *resolved,
                                     const rs_stage_place *stage, rs_stage_stats *stage_stats);
 
+/* What no pass of the filter leaves: weights 0, confidences 1, a report of the counts alone. */
+static void no_pass(float *out_weight, float *out_confidence, size_t vertex_count,
+                    size_t triangle_count, rsmooth_report *report) {
+    for (size_t v = 0; v < vertex_count; v++) {
+        if (out_weight)
+            out_weight[v] = 0;
+        if (out_confidence)
+            out_confidence[v] = 1;
+    }
+    if (report) {
+        rsmooth_report_init(report);
+        report->vertex_count = vertex_count;
+        report->triangle_count = triangle_count;
+    }
+}
+
 /* The stage's progress: the cycles done, as a fraction of the stage's half. */
 static int report_cycle(void *user, int done, int cycles) {
     return rs_report_pass_progress(user, (double)done / cycles);
@@ -121,17 +137,10 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                                     stage_stats, error, where);
     double t_stage = rs_now_ms();
     if (st == RSMOOTH_OK && p.passes == 0) { /* the stage alone */
-        for (size_t v = 0; v < vertex_count; v++) {
+        for (size_t v = 0; v < vertex_count; v++)
             rs_store_position(scalar, out_positions, v, staged + 3 * v, 1);
-            if (out_weight)
-                out_weight[v] = 0;
-            if (out_confidence)
-                out_confidence[v] = 1;
-        }
+        no_pass(out_weight, out_confidence, vertex_count, triangle_count, report);
         if (report) {
-            rsmooth_report_init(report);
-            report->vertex_count = vertex_count;
-            report->triangle_count = triangle_count;
             report->mean_edge_length = unit;
             if (stage_stats && stage_stats->device[0])
                 snprintf(report->device, sizeof report->device, "%.127s", stage_stats->device);
@@ -189,16 +198,8 @@ static rsmooth_status give_input(rsmooth_scalar scalar, const void *positions,
                                  float *out_weight, float *out_confidence, rsmooth_report *report,
                                  double t_start) {
     memcpy(out_positions, positions, vertex_count * rs_vertex_bytes(scalar));
-    for (size_t v = 0; v < vertex_count; v++) {
-        if (out_weight)
-            out_weight[v] = 0;
-        if (out_confidence)
-            out_confidence[v] = 1;
-    }
+    no_pass(out_weight, out_confidence, vertex_count, triangle_count, report);
     if (report) {
-        rsmooth_report_init(report);
-        report->vertex_count = vertex_count;
-        report->triangle_count = triangle_count;
         snprintf(report->device, sizeof report->device, "none (no pass)");
         report->ms_total = rs_now_ms() - t_start;
     }
@@ -341,11 +342,12 @@ static void report_stage(rsmooth_report *report, const rs_stage_stats *stats) {
 }
 
 rsmooth_status rs_filter_one_part(rs_filter_fn one_pass, rs_stage_runner stage, void *ctx,
-                                rsmooth_scalar scalar, const void *positions, size_t vertex_count,
-                                const uint32_t *indices, size_t triangle_count,
-                                const rsmooth_params *params, void *out_positions,
-                                float *out_weight, float *out_confidence, rsmooth_report *report,
-                                rsmooth_error *error, const char *where) {
+                                  rsmooth_scalar scalar, const void *positions,
+                                  size_t vertex_count, const uint32_t *indices,
+                                  size_t triangle_count, const rsmooth_params *params,
+                                  void *out_positions, float *out_weight, float *out_confidence,
+                                  rsmooth_report *report, rsmooth_error *error,
+                                  const char *where) {
     size_t caller_size = report ? report->struct_size : 0; /* the report's fillers reset it */
     rsmooth_params p;
     rs_stage_place place = {stage, ctx};

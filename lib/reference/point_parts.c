@@ -119,8 +119,7 @@ static rsmooth_status filter_parts(rs_points_solve_fn solve, void *solve_ctx, co
         rs_store_position(scalar, out->normals, i, u, 1);
         out->confidence[i] = 0;
     }
-    rs_pass_progress progress = {p->progress, p->progress_cancel, p->progress_user, 0,
-                                 (int)parts};
+    rs_pass_progress progress = {p->progress, p->progress_cancel, p->progress_user, 0, (int)parts};
     size_t largest = 0;
     bool first = true;
     for (uint32_t which = 0; which < parts; which++) {
@@ -209,8 +208,7 @@ rsmooth_status rs_smooth_points_with(rs_points_solve_fn solve, void *solve_ctx, 
                                        out_confidence, r, error);
     } else if (st == RSMOOTH_OK) {
         size_t record = rs_vertex_bytes(scalar);
-        cloud_out out = {rs_alloc_array(point_count, record),
-                         rs_alloc_array(point_count, record),
+        cloud_out out = {rs_alloc_array(point_count, record), rs_alloc_array(point_count, record),
                          rs_alloc_array(point_count, sizeof(float))};
         st = out.positions && out.normals && out.confidence
                  ? filter_parts(solve, solve_ctx, where, scalar, positions, normals, point_count,

@@ -1,7 +1,8 @@
 /* The fold guard: no triangle comes out turned over. What "turned over" means depends on what the
  * input is:
- *  - a clean mesh (its bends correlated, core/shape_correlation.h): the input is the shape, and a
- *    triangle whose normal turns by more than 90 degrees from the input's is turned over;
+ *  - a clean mesh (what the noise estimate reads as nothing to remove, rs_noise_reads_clean):
+ *    the input is the shape, and a triangle whose normal turns by more than 90 degrees from the
+ *    input's is turned over;
  *  - a noisy mesh: its triangles' normals scatter, and the filter may rightly turn one by more
  *    than 90 degrees (from one side of the true normal to the other, or unfolding one the noise
  *    folded); a triangle is turned over when it comes out facing against its neighbourhood (the
@@ -13,16 +14,16 @@
  * first, for UNTANGLES rounds, to the mean of its neighbours (a fold in a smoothed result is an
  * artefact, and the input there is noise: untangling it smooths, where pulling back would bring
  * the noise back; a boundary vertex along the boundary, no farther from the input than the
- * filter put it, so holes do not open); then halfway back toward the input (where none is turned over), and after
- * HALVINGS such rounds to the input exactly, with two rings of vertices around. Host
- * code, double precision, one thread, in index order: the same bytes on every run and for both
+ * filter put it, so holes do not open); then halfway back toward the input (where none is turned
+ * over), and after HALVINGS such rounds to the input exactly, with two rings of vertices around.
+ * Host code, double precision, one thread, in index order: the same bytes on every run and for both
  * paths. scripts/region_study.py carries an independent numpy copy (its --check compares).
  * (Snapping a triangle's corners and the ring of vertices around them to the input makes its
  * neighbourhood the input's, where it did not face against it: each snapping round snaps some
  * vertex anew, so the rounds end.) */
-#include "core/shape_correlation.h"
-#include "core/weld.h"
 #include "stages/fold_guard.h"
+#include "auto/noise_estimate.h"
+#include "core/weld.h"
 
 #include <math.h>
 #include <string.h>
@@ -59,20 +60,21 @@ typedef enum reading { UNDECIDED, CLEAN, NOISY } reading;
 typedef struct guard {
     size_t vertex_count, triangle_count;
     const uint32_t *indices;
-    double *in, *out;   /* 3 per vertex */
-    double *n_in;       /* 3 per triangle: the input's unit normal (0 when degenerate) */
-    double *n_out;      /* 3 per triangle: the result's, this round */
-    double *at_vertex;  /* 3 per vertex: scratch of the sums */
-    double *around;     /* 3 per triangle: the result's neighbourhood normal, this round */
-    uint8_t *folded_in; /* per triangle: the input faced against the input's neighbourhood */
-    uint8_t *corner;    /* per vertex: a corner of a triangle turned over this round */
-    uint8_t *pulled;    /* per vertex: pulled back at least once */
-    uint32_t *rep;      /* per vertex: its welded vertex (a noisy mesh's untangling) */
-    uint8_t *boundary;  /* per welded vertex: on an edge of one triangle */
-    uint64_t *edge;     /* the boundary's edges (welded vertices: low << 32 | high) */
+    double *in, *out;    /* 3 per vertex */
+    double *n_in;        /* 3 per triangle: the input's unit normal (0 when degenerate) */
+    double *n_out;       /* 3 per triangle: the result's, this round */
+    double *at_vertex;   /* 3 per vertex: scratch of the sums */
+    double *around;      /* 3 per triangle: the result's neighbourhood normal, this round */
+    uint8_t *folded_in;  /* per triangle: the input faced against the input's neighbourhood */
+    uint8_t *corner;     /* per vertex: a corner of a triangle turned over this round */
+    uint8_t *pulled;     /* per vertex: pulled back at least once */
+    const uint8_t *held; /* per vertex: 0 where the call holds it still (NULL: none held) */
+    uint32_t *rep;       /* per vertex: its welded vertex (a noisy mesh's untangling) */
+    uint8_t *boundary;   /* per welded vertex: on an edge of one triangle */
+    uint64_t *edge;      /* the boundary's edges (welded vertices: low << 32 | high) */
     size_t edge_count;
-    double *reach;      /* per vertex: its distance from the input in the filter's result */
-    double *sum;        /* 3 per vertex, and the count: the neighbours of welded vertices */
+    double *reach; /* per vertex: its distance from the input in the filter's result */
+    double *sum;   /* 3 per vertex, and the count: the neighbours of welded vertices */
     double *count;
     reading mesh;
 } guard;
@@ -170,20 +172,12 @@ static bool decide(guard *g, rsmooth_scalar scalar, const void *positions) {
         g->mesh = CLEAN; /* nothing to pull back either way */
         return true;
     }
-    /* internal units for the correlation's rounding floor (scale.c): a power of two */
-    int e = 0;
-    frexp(rs_typical_edge(scalar, positions, g->indices, g->triangle_count), &e);
-    double *xyz = rs_alloc_array(g->vertex_count, 3 * sizeof *xyz);
-    double correlation = 1;
-    bool ok = xyz != NULL;
-    if (ok) {
-        for (size_t i = 0; i < 3 * g->vertex_count; i++)
-            xyz[i] = ldexp(g->in[i], -e);
-        ok = rs_shape_correlation(xyz, g->vertex_count, g->indices, g->triangle_count,
-                                  &correlation);
-    }
-    rs_free(xyz);
-    g->mesh = correlation >= RS_CLEAN_SHAPE_CORRELATION ? CLEAN : NOISY;
+    /* what the noise estimate reads (auto/noise_estimate.h): the same verdict as --auto's */
+    rs_noise_details noise;
+    bool ok =
+        rs_estimate_noise_details(scalar, positions, g->vertex_count, g->indices, g->triangle_count,
+                                  &noise, NULL, "rs_fold_guard") == RSMOOTH_OK;
+    g->mesh = ok && rs_noise_reads_clean(&noise) ? CLEAN : NOISY;
     if (ok && g->mesh == NOISY) {
         g->rep = rs_alloc_array(g->vertex_count, sizeof *g->rep);
         g->sum = rs_alloc_array(g->vertex_count, 3 * sizeof *g->sum);
@@ -257,7 +251,7 @@ static void untangle(guard *g) {
     }
     for (size_t v = 0; v < g->vertex_count; v++) {
         uint32_t r = g->rep[v];
-        if (!g->corner[r] || !(g->count[r] > 0))
+        if (!g->corner[r] || !(g->count[r] > 0) || (g->held && !g->held[v]))
             continue;
         double *o = g->out + 3 * v, d[3];
         const double *in = g->in + 3 * v;
@@ -294,7 +288,7 @@ static size_t pull_back(guard *g, int round) {
     if (snap && found)
         widen(g, 2);
     for (size_t v = 0; found && v < g->vertex_count; v++) {
-        if (!g->corner[v])
+        if (!g->corner[v] || (g->held && !g->held[v]))
             continue;
         double *o = g->out + 3 * v;
         const double *i = g->in + 3 * v;
@@ -325,7 +319,8 @@ static void free_guard(guard *g) {
 }
 
 long rs_fold_guard(rsmooth_scalar scalar, const void *positions, void *out_positions,
-                   size_t vertex_count, const uint32_t *indices, size_t triangle_count) {
+                   size_t vertex_count, const uint32_t *indices, size_t triangle_count,
+                   const uint8_t *movable) {
     if (triangle_count == 0 || vertex_count == 0)
         return 0;
     guard g;
@@ -333,6 +328,7 @@ long rs_fold_guard(rsmooth_scalar scalar, const void *positions, void *out_posit
     g.vertex_count = vertex_count;
     g.triangle_count = triangle_count;
     g.indices = indices;
+    g.held = movable;
     g.in = rs_alloc_array(vertex_count, 3 * sizeof(double));
     g.out = rs_alloc_array(vertex_count, 3 * sizeof(double));
     g.n_in = rs_alloc_array(triangle_count, 3 * sizeof(double));

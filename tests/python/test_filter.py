@@ -197,11 +197,12 @@ def test_points():
 
 
 def test_mask(mesh):
-    """Only the selected vertices move; with one pass they move exactly as without a mask."""
+    """Only the selected vertices move; with one pass they move exactly as without a mask (the
+    filter's: the fold guard may pull back a triangle the selection's border folds)."""
     v, f = mesh
     selected = v[:, 0] > 0
-    full = rsmooth.smooth(v, f, device="reference")
-    out = rsmooth.smooth(v, f, device="reference", mask=selected)
+    full = rsmooth.smooth(v, f, device="reference", guard=False)
+    out = rsmooth.smooth(v, f, device="reference", mask=selected, guard=False)
     assert np.array_equal(out[~selected], v[~selected])
     assert np.array_equal(out[selected], full[selected])
     out32 = rsmooth.smooth(v.astype(np.float32), f, device="reference", mask=selected.astype(int),
