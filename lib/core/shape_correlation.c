@@ -14,39 +14,6 @@
 #include <math.h>
 #include <string.h>
 
-/* Unique welded edges as sorted (low << 32 | high) keys; *count of them. */
-static uint64_t *welded_edges(const uint32_t *rep, const uint32_t *indices, size_t triangle_count,
-                              size_t *count) {
-    uint64_t *key = rs_alloc_array(triangle_count ? 3 * triangle_count : 1, sizeof *key);
-    uint32_t *unused = rs_alloc_array(triangle_count ? 3 * triangle_count : 1, sizeof *unused);
-    if (!key || !unused) {
-        rs_free(key);
-        rs_free(unused);
-        return NULL;
-    }
-    size_t n = 0;
-    for (size_t t = 0; t < triangle_count; t++)
-        for (int e = 0; e < 3; e++) {
-            uint32_t a = rep[indices[3 * t + e]], b = rep[indices[3 * t + (e + 1) % 3]];
-            if (a != b) {
-                unused[n] = 0;
-                key[n++] = a < b ? (uint64_t)a << 32 | b : (uint64_t)b << 32 | a;
-            }
-        }
-    bool sorted = rs_radix_sort_u64(key, unused, n);
-    rs_free(unused);
-    if (!sorted) {
-        rs_free(key);
-        return NULL;
-    }
-    size_t unique = 0;
-    for (size_t i = 0; i < n; i++)
-        if (i == 0 || key[i] != key[i - 1])
-            key[unique++] = key[i];
-    *count = unique;
-    return key;
-}
-
 /* Pearson's correlation of x and y over the entries `valid` marks; 1 when either barely varies
  * (a mesh that bends alike everywhere, a plane, a sphere, a cube). */
 static double correlation(const double *x, const double *y, const uint8_t *valid, size_t count) {
@@ -120,20 +87,15 @@ static bool bends(const double *xyz, size_t vertex_count, const uint32_t *indice
     return true;
 }
 
-bool rs_shape_correlation(const double *xyz, size_t vertex_count, const uint32_t *indices,
-                          size_t triangle_count, double *out) {
+bool rs_shape_correlation_welded(const double *xyz, size_t vertex_count, const uint32_t *indices,
+                                 size_t triangle_count, const uint32_t *rep, const uint64_t *edge,
+                                 size_t edge_count, double *out) {
     *out = 1;
-    if (vertex_count == 0 || triangle_count == 0)
-        return true;
-    uint32_t *rep = rs_alloc_array(vertex_count, sizeof *rep);
-    double *bend = rs_alloc_array(vertex_count, sizeof *bend);
-    double *around = rs_calloc_array(vertex_count, sizeof *around);
-    double *count = rs_calloc_array(vertex_count, sizeof *count);
-    uint8_t *valid = rs_alloc_array(vertex_count, 1);
-    uint64_t *edge = NULL;
-    size_t edge_count = 0;
-    bool ok = rep && bend && around && count && valid && rs_weld(xyz, vertex_count, rep) &&
-              (edge = welded_edges(rep, indices, triangle_count, &edge_count)) != NULL &&
+    double *bend = rs_alloc_array(vertex_count ? vertex_count : 1, sizeof *bend);
+    double *around = rs_calloc_array(vertex_count ? vertex_count : 1, sizeof *around);
+    double *count = rs_calloc_array(vertex_count ? vertex_count : 1, sizeof *count);
+    uint8_t *valid = rs_alloc_array(vertex_count ? vertex_count : 1, 1);
+    bool ok = bend && around && count && valid &&
               bends(xyz, vertex_count, indices, triangle_count, rep, edge, edge_count, bend, valid);
     if (ok) {
         for (size_t i = 0; i < edge_count; i++) { /* the neighbours' mean bend */
@@ -151,11 +113,26 @@ bool rs_shape_correlation(const double *xyz, size_t vertex_count, const uint32_t
         }
         *out = correlation(bend, around, valid, vertex_count);
     }
-    rs_free(rep);
     rs_free(bend);
     rs_free(around);
     rs_free(count);
     rs_free(valid);
+    return ok;
+}
+
+bool rs_shape_correlation(const double *xyz, size_t vertex_count, const uint32_t *indices,
+                          size_t triangle_count, double *out) {
+    *out = 1;
+    if (vertex_count == 0 || triangle_count == 0)
+        return true;
+    uint32_t *rep = rs_alloc_array(vertex_count, sizeof *rep);
+    uint64_t *edge = NULL;
+    size_t edge_count = 0;
+    bool ok = rep && rs_weld(xyz, vertex_count, rep) &&
+              (edge = rs_welded_edges(rep, indices, triangle_count, &edge_count, NULL)) != NULL &&
+              rs_shape_correlation_welded(xyz, vertex_count, indices, triangle_count, rep, edge,
+                                          edge_count, out);
+    rs_free(rep);
     rs_free(edge);
     return ok;
 }

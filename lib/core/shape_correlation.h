@@ -13,4 +13,9 @@
 bool rs_shape_correlation(const double *xyz, size_t vertex_count, const uint32_t *indices,
                           size_t triangle_count, double *out);
 
+/* The same from a weld already made (core/weld.h: rep, and its edges from rs_welded_edges). */
+bool rs_shape_correlation_welded(const double *xyz, size_t vertex_count, const uint32_t *indices,
+                                 size_t triangle_count, const uint32_t *rep, const uint64_t *edge,
+                                 size_t edge_count, double *out);
+
 #endif /* RSMOOTH_SHAPE_CORRELATION_H */

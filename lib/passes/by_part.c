@@ -229,6 +229,7 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, rs_stage_runner stage, vo
                                 float *out_weight, float *out_confidence, rsmooth_report *report,
                                 rsmooth_error *error, const char *where) {
     rs_error_clear(error);
+    double t_start = rs_now_ms();
     rsmooth_params p;
     rsmooth_status st = rs_params_resolve(params, &p, error, where);
     if (st == RSMOOTH_OK)
@@ -283,6 +284,7 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, rs_stage_runner stage, vo
     if (guarded < 0)
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the fold guard");
     if (st == RSMOOTH_OK && report) {
+        full.ms_total = rs_now_ms() - t_start; /* the parts and the guard too */
         full.parts = smoothed;
         full.outliers = parts.outliers;
         full.guarded_vertices = guarded > 0 ? (size_t)guarded : 0;

@@ -1,8 +1,9 @@
 /* The fold guard: no triangle comes out turned over. What "turned over" means depends on what the
  * input is:
- *  - a clean mesh (what the noise estimate reads as nothing to remove, rs_noise_reads_clean):
- *    the input is the shape, and a triangle whose normal turns by more than 90 degrees from the
- *    input's is turned over;
+ *  - a clean mesh (its bends correlated, core/shape_correlation.h, or on a mesh of up to
+ *    ESTIMATE_VERTICES what the noise estimate reads as nothing to remove): the input is the
+ *    shape, and a triangle whose normal turns by more than 90 degrees from the input's is turned
+ *    over;
  *  - a noisy mesh: its triangles' normals scatter, and the filter may rightly turn one by more
  *    than 90 degrees (from one side of the true normal to the other, or unfolding one the noise
  *    folded); a triangle is turned over when it comes out facing against its neighbourhood (the
@@ -23,12 +24,20 @@
  * vertex anew, so the rounds end.) */
 #include "stages/fold_guard.h"
 #include "auto/noise_estimate.h"
+#include "core/shape_correlation.h"
 #include "core/weld.h"
 
 #include <math.h>
 #include <string.h>
 
+/* Up to this many vertices, a mesh whose bends do not correlate is read by the whole noise
+ * estimate (auto/noise_estimate.h, 81 ms on the 35k-vertex Bunny0.2): a coarse clean mesh, the
+ * decimated knight, reads clean that way. Larger ones are read by the correlation alone (the
+ * estimate would cost 0.66 s on 500k vertices, twice the filter's time); clean meshes that large
+ * are fine for their shape, and their bends correlate. */
+#define ESTIMATE_VERTICES 50000
 #define UNTANGLES 8
+#define NORMAL_GRAIN 8192 /* triangles per chunk of the threaded normals */
 #define HALVINGS 24
 
 /* The unit normal of triangle tri over xyz (double, 3 per vertex), or false when degenerate. The
@@ -71,12 +80,23 @@ typedef struct guard {
     const uint8_t *held; /* per vertex: 0 where the call holds it still (NULL: none held) */
     uint32_t *rep;       /* per vertex: its welded vertex (a noisy mesh's untangling) */
     uint8_t *boundary;   /* per welded vertex: on an edge of one triangle */
-    uint64_t *edge;      /* the boundary's edges (welded vertices: low << 32 | high) */
+    uint64_t *welded;    /* the welded mesh's edges (low << 32 | high), and how many */
+    size_t welded_count;
+    uint64_t *edge; /* the boundary's edges among them */
     size_t edge_count;
     double *reach; /* per vertex: its distance from the input in the filter's result */
     double *sum;   /* 3 per vertex, and the count: the neighbours of welded vertices */
     double *count;
     reading mesh;
+    /* Each round after the first tests only the triangles near what the round before moved: */
+    size_t *first;      /* vertex_count + 1: the triangles at vertex v are triangle[first[v] ..] */
+    uint32_t *triangle; /*   in index order (so sums over them run in the full pass's order) */
+    uint32_t *moved;    /* the vertices this round moved, and how many */
+    size_t moved_count;
+    uint32_t *check; /* the triangles the next round tests, and how many */
+    size_t check_count;
+    uint8_t *listed;  /* per triangle: in `check` (scratch) */
+    uint8_t *touched; /* per vertex: its sum redone this round (scratch) */
 } guard;
 
 /* Sums per-triangle vectors `from` at each triangle's vertices into at_vertex, then those sums
@@ -100,12 +120,25 @@ static void gather_ring(const guard *g, const double *from, double *at_vertex, d
  * neighbourhood normal into `around`: the unit normals of the triangles sharing a vertex with it,
  * summed. (Two rings read fewer folds under heavy noise but misread thin parts of coarse meshes,
  * a cow's legs, as folded: 13% more E_v on cow-n0.5.) */
-static void normals(const guard *g, const double *xyz, double *n, double *around) {
-    for (size_t t = 0; t < g->triangle_count; t++) {
-        double *nt = n + 3 * t;
-        if (!unit_normal(xyz, g->indices + 3 * t, nt))
+typedef struct normal_job {
+    const uint32_t *indices;
+    const double *xyz;
+    double *n;
+} normal_job;
+
+static void normal_range(void *ctx, size_t begin, size_t end, size_t chunk) {
+    const normal_job *job = ctx;
+    (void)chunk;
+    for (size_t t = begin; t < end; t++) {
+        double *nt = job->n + 3 * t;
+        if (!unit_normal(job->xyz, job->indices + 3 * t, nt))
             nt[0] = nt[1] = nt[2] = 0;
     }
+}
+
+static void normals(const guard *g, const double *xyz, double *n, double *around) {
+    normal_job job = {g->indices, xyz, n}; /* each triangle's own: any split gives the same */
+    rs_parallel_for(g->triangle_count, NORMAL_GRAIN, normal_range, &job);
     gather_ring(g, n, g->at_vertex, around);
 }
 
@@ -126,39 +159,33 @@ static bool turned_clean(const guard *g, size_t t) {
 
 static bool turned_noisy(const guard *g, size_t t) {
     const double *b = g->n_out + 3 * t;
-    return !degenerate(g->n_in + 3 * t) && !degenerate(b) && !g->folded_in[t] &&
-           facing(g->n_out, g->around, t) < 0;
+    if (degenerate(g->n_in + 3 * t) || degenerate(b))
+        return false;
+    return !g->folded_in[t] && facing(g->n_out, g->around, t) < 0;
 }
 
 static bool turned(const guard *g, size_t t) {
     return g->mesh == CLEAN ? turned_clean(g, t) : turned_noisy(g, t);
 }
 
-/* The welded vertices on an edge that one triangle alone has. false when out of memory. */
+/* The weld, its edges and the boundary (welded vertices on an edge one triangle alone has, and
+ * those edges). false when out of memory. */
 static bool find_boundary(guard *g) {
-    size_t n = 3 * g->triangle_count, used = 0;
-    uint64_t *key = rs_alloc_array(n ? n : 1, sizeof *key);
-    uint32_t *unused = rs_calloc_array(n ? n : 1, sizeof *unused);
-    bool ok = key && unused;
-    if (!ok)
-        rs_free(key);
-    for (size_t t = 0; ok && t < g->triangle_count; t++)
-        for (int e = 0; e < 3; e++) {
-            uint32_t a = g->rep[g->indices[3 * t + e]], b = g->rep[g->indices[3 * t + (e + 1) % 3]];
-            if (a != b)
-                key[used++] = a < b ? (uint64_t)a << 32 | b : (uint64_t)b << 32 | a;
+    g->rep = rs_alloc_array(g->vertex_count, sizeof *g->rep);
+    g->boundary = rs_calloc_array(g->vertex_count, 1);
+    uint8_t *single = NULL;
+    bool ok = g->rep && g->boundary && rs_weld(g->in, g->vertex_count, g->rep) &&
+              (g->welded = rs_welded_edges(g->rep, g->indices, g->triangle_count, &g->welded_count,
+                                           &single)) != NULL;
+    g->edge = ok ? rs_alloc_array(g->welded_count ? g->welded_count : 1, sizeof *g->edge) : NULL;
+    ok = ok && g->edge;
+    for (size_t i = 0; ok && i < g->welded_count; i++)
+        if (single[i]) {
+            uint64_t key = g->welded[i];
+            g->boundary[key >> 32] = g->boundary[key & 0xffffffffu] = 1;
+            g->edge[g->edge_count++] = key;
         }
-    ok = ok && rs_radix_sort_u64(key, unused, used);
-    g->edge_count = 0;
-    for (size_t i = 0; ok && i < used; i++) {
-        bool single = (i == 0 || key[i - 1] != key[i]) && (i + 1 == used || key[i + 1] != key[i]);
-        if (single) {
-            g->boundary[key[i] >> 32] = g->boundary[key[i] & 0xffffffffu] = 1;
-            key[g->edge_count++] = key[i]; /* (behind i: the kept ones go first) */
-        }
-    }
-    g->edge = key;
-    rs_free(unused);
+    rs_free(single);
     return ok;
 }
 
@@ -172,20 +199,31 @@ static bool decide(guard *g, rsmooth_scalar scalar, const void *positions) {
         g->mesh = CLEAN; /* nothing to pull back either way */
         return true;
     }
-    /* what the noise estimate reads (auto/noise_estimate.h): the same verdict as --auto's */
-    rs_noise_details noise;
-    bool ok =
-        rs_estimate_noise_details(scalar, positions, g->vertex_count, g->indices, g->triangle_count,
-                                  &noise, NULL, "rs_fold_guard") == RSMOOTH_OK;
-    g->mesh = ok && rs_noise_reads_clean(&noise) ? CLEAN : NOISY;
+    /* one weld for the reading and the untangling; internal units for the correlation's
+     * rounding floor (scale.c: a power of two) */
+    int e = 0;
+    frexp(rs_typical_edge(scalar, positions, g->indices, g->triangle_count), &e);
+    double *xyz = rs_alloc_array(g->vertex_count, 3 * sizeof *xyz);
+    double correlation = 1;
+    bool ok = xyz && find_boundary(g);
+    for (size_t i = 0; ok && i < 3 * g->vertex_count; i++)
+        xyz[i] = ldexp(g->in[i], -e);
+    ok = ok && rs_shape_correlation_welded(xyz, g->vertex_count, g->indices, g->triangle_count,
+                                           g->rep, g->welded, g->welded_count, &correlation);
+    rs_free(xyz);
+    g->mesh = correlation >= RS_CLEAN_SHAPE_CORRELATION ? CLEAN : NOISY;
+    if (ok && g->mesh == NOISY && g->vertex_count <= ESTIMATE_VERTICES) {
+        rs_noise_details noise; /* the same verdict as --auto's */
+        ok = rs_estimate_noise_details(scalar, positions, g->vertex_count, g->indices,
+                                       g->triangle_count, &noise, NULL,
+                                       "rs_fold_guard") == RSMOOTH_OK;
+        g->mesh = ok && rs_noise_reads_clean(&noise) ? CLEAN : NOISY;
+    }
     if (ok && g->mesh == NOISY) {
-        g->rep = rs_alloc_array(g->vertex_count, sizeof *g->rep);
         g->sum = rs_alloc_array(g->vertex_count, 3 * sizeof *g->sum);
         g->count = rs_alloc_array(g->vertex_count, sizeof *g->count);
-        g->boundary = rs_calloc_array(g->vertex_count, 1);
         g->reach = rs_alloc_array(g->vertex_count, sizeof *g->reach);
-        ok = g->rep && g->sum && g->count && g->boundary && g->reach &&
-             rs_weld(g->in, g->vertex_count, g->rep) && find_boundary(g);
+        ok = g->sum && g->count && g->reach;
         for (size_t v = 0; ok && v < g->vertex_count; v++) {
             double d[3];
             rs_sub3(g->out + 3 * v, g->in + 3 * v, d);
@@ -264,6 +302,7 @@ static void untangle(guard *g) {
             for (int k = 0; k < 3; k++)
                 o[k] = in[k] + d[k] * (g->reach[v] / length);
         g->pulled[v] = 1;
+        g->moved[g->moved_count++] = (uint32_t)v;
     }
 }
 
@@ -273,14 +312,18 @@ static void untangle(guard *g) {
  * does not depend on the triangles' order. Returns how many triangles were turned over. */
 static size_t pull_back(guard *g, int round) {
     bool snap = round >= (g->mesh == NOISY ? UNTANGLES : 0) + HALVINGS;
-    size_t found = 0;
+    size_t found = 0, tested = round == 0 ? g->triangle_count : g->check_count;
     memset(g->corner, 0, g->vertex_count);
-    for (size_t t = 0; t < g->triangle_count; t++)
+    g->moved_count = 0;
+    for (size_t i = 0; i < tested; i++) {
+        size_t t = round == 0 ? i : g->check[i];
         if (turned(g, t)) {
-            found++;
+            g->check[found++] = (uint32_t)t; /* (kept for the next round: i >= found) */
             for (int c = 0; c < 3; c++)
                 g->corner[g->indices[3 * t + c]] = 1;
         }
+    }
+    g->check_count = found;
     if (found && g->mesh == NOISY && round < UNTANGLES) {
         untangle(g);
         return found;
@@ -296,8 +339,91 @@ static size_t pull_back(guard *g, int round) {
             g->pulled[v] = 1; /* (a vertex the filter left in place is not counted) */
         for (int k = 0; k < 3; k++)
             o[k] = snap ? i[k] : i[k] + (o[k] - i[k]) / 2;
+        g->moved[g->moved_count++] = (uint32_t)v;
     }
     return found;
+}
+
+/* Which triangles meet at each vertex (each once, in index order). false when out of memory. */
+static bool build_incidence(guard *g) {
+    g->first = rs_calloc_array(g->vertex_count + 1, sizeof *g->first);
+    g->triangle = rs_alloc_array(3 * g->triangle_count, sizeof *g->triangle);
+    size_t *fill = rs_alloc_array(g->vertex_count, sizeof *fill);
+    bool ok = g->first && g->triangle && fill;
+    for (int pass = 0; ok && pass < 2; pass++) {
+        for (size_t t = 0; t < g->triangle_count; t++)
+            for (int c = 0; c < 3; c++) {
+                const uint32_t *tri = g->indices + 3 * t;
+                if ((c > 0 && tri[c] == tri[0]) || (c > 1 && tri[c] == tri[1]))
+                    continue; /* a repeated corner: once */
+                if (pass == 0)
+                    g->first[tri[c] + 1]++;
+                else
+                    g->triangle[fill[tri[c]]++] = (uint32_t)t;
+            }
+        if (pass == 0) {
+            for (size_t v = 0; v < g->vertex_count; v++)
+                g->first[v + 1] += g->first[v];
+            memcpy(fill, g->first, g->vertex_count * sizeof *fill);
+        }
+    }
+    rs_free(fill);
+    return ok;
+}
+
+/* After a round's moves: the normals of the triangles at the moved vertices, the sums at their
+ * corners and the neighbourhood normals that read them, each recomputed as the full pass does
+ * (the same sums in the same order); those triangles, and the ones turned this round, are what
+ * the next round tests. */
+static void refresh(guard *g) {
+    size_t listed = g->check_count;
+    for (size_t i = 0; i < listed; i++)
+        g->listed[g->check[i]] = 1;
+    for (size_t m = 0; m < g->moved_count; m++) { /* the moved vertices' triangles */
+        uint32_t v = g->moved[m];
+        for (size_t i = g->first[v]; i < g->first[v + 1]; i++) {
+            uint32_t t = g->triangle[i];
+            double *nt = g->n_out + 3 * (size_t)t;
+            if (!unit_normal(g->out, g->indices + 3 * (size_t)t, nt))
+                nt[0] = nt[1] = nt[2] = 0;
+            for (int c = 0; c < 3; c++)
+                g->touched[g->indices[3 * (size_t)t + c]] = 1;
+        }
+    }
+    for (size_t m = 0; m < g->moved_count; m++) /* the sums at their corners */
+        for (size_t i = g->first[g->moved[m]]; i < g->first[g->moved[m] + 1]; i++)
+            for (int c = 0; c < 3; c++) {
+                uint32_t v = g->indices[3 * (size_t)g->triangle[i] + c];
+                if (g->touched[v] != 1)
+                    continue;
+                g->touched[v] = 2; /* (done) */
+                double *a = g->at_vertex + 3 * (size_t)v;
+                a[0] = a[1] = a[2] = 0;
+                for (size_t j = g->first[v]; j < g->first[v + 1]; j++)
+                    for (int k = 0; k < 3; k++)
+                        a[k] += g->n_out[3 * (size_t)g->triangle[j] + (size_t)k];
+                for (size_t j = g->first[v]; j < g->first[v + 1]; j++) {
+                    uint32_t t = g->triangle[j]; /* the neighbourhoods that read the sum */
+                    if (!g->listed[t]) {
+                        g->listed[t] = 1;
+                        g->check[listed++] = t;
+                    }
+                }
+            }
+    for (size_t i = 0; i < listed; i++) {
+        size_t t = g->check[i];
+        const uint32_t *tri = g->indices + 3 * t;
+        for (int k = 0; k < 3; k++)
+            g->around[3 * t + (size_t)k] = g->at_vertex[3 * (size_t)tri[0] + (size_t)k] +
+                                           g->at_vertex[3 * (size_t)tri[1] + (size_t)k] +
+                                           g->at_vertex[3 * (size_t)tri[2] + (size_t)k];
+        g->listed[t] = 0;
+    }
+    for (size_t m = 0; m < g->moved_count; m++) /* clear the scratch */
+        for (size_t i = g->first[g->moved[m]]; i < g->first[g->moved[m] + 1]; i++)
+            for (int c = 0; c < 3; c++)
+                g->touched[g->indices[3 * (size_t)g->triangle[i] + c]] = 0;
+    g->check_count = listed;
 }
 
 static void free_guard(guard *g) {
@@ -313,7 +439,14 @@ static void free_guard(guard *g) {
     rs_free(g->rep);
     rs_free(g->boundary);
     rs_free(g->edge);
+    rs_free(g->welded);
     rs_free(g->reach);
+    rs_free(g->first);
+    rs_free(g->triangle);
+    rs_free(g->moved);
+    rs_free(g->check);
+    rs_free(g->listed);
+    rs_free(g->touched);
     rs_free(g->sum);
     rs_free(g->count);
 }
@@ -352,9 +485,18 @@ long rs_fold_guard(rsmooth_scalar scalar, const void *positions, void *out_posit
     normals(&g, g.out, g.n_out, g.around);
     if (!decide(&g, scalar, positions))
         goto done;
+    g.moved = rs_alloc_array(vertex_count, sizeof *g.moved);
+    g.check = rs_alloc_array(triangle_count, sizeof *g.check);
+    g.listed = rs_calloc_array(triangle_count, 1);
+    g.touched = rs_calloc_array(vertex_count, 1);
+    if (!g.moved || !g.check || !g.listed || !g.touched)
+        goto done;
+    for (int round = 0; pull_back(&g, round) > 0; round++) {
+        if (!g.first && !build_incidence(&g))
+            goto done;
+        refresh(&g);
+    }
     pulled = 0;
-    for (int round = 0; pull_back(&g, round) > 0; round++)
-        normals(&g, g.out, g.n_out, g.around);
     for (size_t v = 0; v < vertex_count; v++)
         if (g.pulled[v]) {
             pulled++;
