@@ -182,6 +182,9 @@ static rsmooth_status check_call(points_run *r, const rsmooth_params *params, vo
     rsmooth_status st = rs_params_resolve(params, &r->p, error, r->where);
     if (st != RSMOOTH_OK)
         return st;
+    if (r->p.passes < 1) /* (0 is a mesh's: its stage alone, or nothing) */
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, r->where,
+                       "passes must be at least 1 for a point cloud (got %d)", r->p.passes);
     if ((st = rs_check_point_positions(r->scalar, r->positions, r->n, &r->scale, error,
                                        r->where)) != RSMOOTH_OK)
         return st;
