@@ -380,7 +380,11 @@ RSMOOTH_API rsmooth_status rsmooth_estimate_noise(rsmooth_scalar scalar, const v
  *   the paper's filter (rsmooth_params_init: normal_filter RSMOOTH_NORMALS_MOLLIFY and no
  *     vertex_updates): sigma_f = 0.6 + 1.6 n, sigma_g = 4 n for noise n in mean edge lengths;
  *   otherwise the best mode (rsmooth_params_init_best's setting): the guided filter's rounds by
- *     noise class (gentle, medium, strong; impulsive noise its own).
+ *     noise class (gentle, medium, strong; impulsive noise its own);
+ *   either way, on a mesh that reads clean (its roughness is its own shape: see
+ *     rsmooth_noise_report.shape_correlation), no pass and no stage (passes 0, vertex_updates 0),
+ *     so the smoothing call returns the input as it is (added in 0.11).
+ * The estimate reads the mesh's largest part, outliers left out (rsmooth_report.parts).
  * Sigmas are relative (absolute = 0 after the call). Other fields are left as they are. Writes
  * the estimate to *out_noise when not NULL. Fails like rsmooth_estimate_noise, and on invalid
  * params; then `params` is unchanged. Thread-safe. rsmooth_params_auto_report also says what it
