@@ -1152,7 +1152,11 @@ rsmooth_status rs_estimate_noise_details(rsmooth_scalar scalar, const void *posi
 }
 
 bool rs_noise_reads_clean(const rs_noise_details *d) {
-    if (!(d->level > 0) || d->shape_correlation >= RS_CLEAN_SHAPE_CORRELATION)
+    if (!(d->level > 0))
+        return true;
+    if (d->impulsive && d->tail_share >= RS_CLEAR_IMPULSIVE_TAIL)
+        return false; /* vertices thrown unmistakably: the rest's shape does not hide them */
+    if (d->shape_correlation >= RS_CLEAN_SHAPE_CORRELATION)
         return true;
     double low = d->profile.low[0], floor = d->profile.low_floor[0];
     return !d->impulsive && isfinite(low) && isfinite(floor) && low <= RS_CLEAN_FLOOR * floor;
