@@ -8,6 +8,7 @@
  * Everything here is local to a triangle and its corners' triangles, and the parts come from a
  * histogram of integer counts, so the pieces of a streamed mesh can find them with a halo of one
  * ring and a sum of histograms, and get the same answer. */
+#include "core/incidence.h"
 #include "core/parts.h"
 
 #include <math.h>
@@ -39,48 +40,26 @@ static void scale_range(void *ctx, size_t begin, size_t end, size_t chunk) {
     job->longest[chunk] = worst;
 }
 
-/* The corners of triangle t that are not repeats of an earlier corner: 1 to 3 of them. */
-static int distinct_corners(const uint32_t *tri, uint32_t out[3]) {
-    int n = 0;
-    for (int c = 0; c < 3; c++)
-        if ((c < 1 || tri[c] != tri[0]) && (c < 2 || tri[c] != tri[1]))
-            out[n++] = tri[c];
-    return n;
-}
-
 /* Which part moves each vertex (the part of most of its triangles, the finer of equals), and the
  * outliers among them. */
 static bool assign_vertices(rs_parts *parts, size_t vertex_count, const uint32_t *indices,
                             size_t triangle_count) {
-    size_t *start = rs_calloc_array(vertex_count + 1, sizeof *start);
-    uint32_t *list = rs_alloc_array(triangle_count ? 3 * triangle_count : 1, sizeof *list);
+    size_t *start = NULL;
+    uint32_t *list = NULL;
     uint32_t *tally_part = rs_alloc_array(parts->count, sizeof *tally_part);
     size_t *tally = rs_alloc_array(parts->count, sizeof *tally);
-    if (!start || !list || !tally_part || !tally) {
-        rs_free(start);
-        rs_free(list);
+    if (!tally_part || !tally ||
+        !rs_vertex_triangles(indices, triangle_count, vertex_count, &start, &list)) {
         rs_free(tally_part);
         rs_free(tally);
         return false;
     }
-    uint32_t corner[3];
-    for (size_t t = 0; t < triangle_count; t++)
-        if (parts->triangle_part[t] != RS_NO_PART)
-            for (int c = 0, n = distinct_corners(indices + 3 * t, corner); c < n; c++)
-                start[corner[c] + 1]++;
-    for (size_t v = 0; v < vertex_count; v++)
-        start[v + 1] += start[v];
-    for (size_t t = 0; t < triangle_count; t++)
-        if (parts->triangle_part[t] != RS_NO_PART)
-            for (int c = 0, n = distinct_corners(indices + 3 * t, corner); c < n; c++)
-                list[start[corner[c]]++] = (uint32_t)t;
-    for (size_t v = vertex_count; v > 0; v--) /* the fill moved each start to the next's */
-        start[v] = start[v - 1];
-    start[0] = 0;
     for (size_t v = 0; v < vertex_count; v++) {
         size_t kinds = 0;
         for (size_t i = start[v]; i < start[v + 1]; i++) {
             uint32_t p = parts->triangle_part[list[i]];
+            if (p == RS_NO_PART)
+                continue; /* (its corners coincide: no part's) */
             size_t k = 0;
             while (k < kinds && tally_part[k] != p)
                 k++;

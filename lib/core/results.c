@@ -103,9 +103,11 @@ void rs_report_unscale(rsmooth_report *report, double unscale) {
     report->mollify_radius *= unscale;
 }
 
-size_t rs_report_bytes(size_t struct_size) {
+void rs_give_report(rsmooth_report *report, size_t struct_size, const rsmooth_report *full) {
     /* the sizes rsmooth_report had: 0.5's (up to tiles), 0.6's (discrepancy_iterations), this */
     size_t v05 = offsetof(rsmooth_report, discrepancy_iterations);
     size_t v06 = offsetof(rsmooth_report, region_filter_share);
-    return struct_size == v05 || struct_size == v06 ? struct_size : sizeof(rsmooth_report);
+    size_t n = struct_size == v05 || struct_size == v06 ? struct_size : sizeof *full;
+    memcpy(report, full, n);
+    report->struct_size = struct_size;
 }

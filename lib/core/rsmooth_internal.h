@@ -366,9 +366,10 @@ void rs_store_position(rsmooth_scalar scalar, void *out_positions, size_t v, con
 void rs_store_unmoved(const rs_problem *problem, rsmooth_scalar scalar, void *out_positions,
                       float *out_weight, float *out_confidence);
 
-/* How many bytes of an rsmooth_report a caller's struct_size says it holds: a size some version's
- * struct had, else (a struct never initialised) this version's whole struct. */
-size_t rs_report_bytes(size_t struct_size);
+/* Copies `full` into a caller's report as far as its struct_size says it holds (a size some
+ * version's struct had, else, a struct never initialised, this version's whole struct), and
+ * keeps that struct_size. */
+void rs_give_report(rsmooth_report *report, size_t struct_size, const rsmooth_report *full);
 
 /* Fills the parts of a report both paths share (lengths in the caller's units). */
 void rs_report_problem(rsmooth_report *report, const rs_problem *problem, size_t cell_count,

@@ -216,12 +216,6 @@ static long guard_folds(rsmooth_scalar scalar, const void *positions, void *out_
     return moved;
 }
 
-/* The report's fields a caller's struct has room for (rs_report_bytes). */
-static void give_report(rsmooth_report *report, size_t caller_size, const rsmooth_report *full) {
-    memcpy(report, full, rs_report_bytes(caller_size));
-    report->struct_size = caller_size;
-}
-
 rsmooth_status rs_filter_passes(rs_filter_fn one_pass, rs_stage_runner stage, void *ctx,
                                 rsmooth_scalar scalar, const void *positions, size_t vertex_count,
                                 const uint32_t *indices, size_t triangle_count,
@@ -288,7 +282,7 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, rs_stage_runner stage, vo
         full.parts = smoothed;
         full.outliers = parts.outliers;
         full.guarded_vertices = guarded > 0 ? (size_t)guarded : 0;
-        give_report(report, report->struct_size, &full);
+        rs_give_report(report, report->struct_size, &full);
     }
     rs_parts_free(&parts);
     return st;

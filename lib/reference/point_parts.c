@@ -232,8 +232,7 @@ rsmooth_status rs_smooth_points_with(rs_points_solve_fn solve, void *solve_ctx, 
             smoothed += size[q] >= RS_MIN_PART_POINTS;
         full.parts = size ? smoothed : 1;
         full.outliers = outliers;
-        memcpy(report, &full, rs_report_bytes(caller_size));
-        report->struct_size = caller_size;
+        rs_give_report(report, caller_size, &full);
     }
     rs_free(part);
     rs_free(size);

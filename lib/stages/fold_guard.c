@@ -24,6 +24,7 @@
  * vertex anew, so the rounds end.) */
 #include "stages/fold_guard.h"
 #include "auto/noise_estimate.h"
+#include "core/incidence.h"
 #include "core/shape_correlation.h"
 #include "core/weld.h"
 
@@ -344,33 +345,6 @@ static size_t pull_back(guard *g, int round) {
     return found;
 }
 
-/* Which triangles meet at each vertex (each once, in index order). false when out of memory. */
-static bool build_incidence(guard *g) {
-    g->first = rs_calloc_array(g->vertex_count + 1, sizeof *g->first);
-    g->triangle = rs_alloc_array(3 * g->triangle_count, sizeof *g->triangle);
-    size_t *fill = rs_alloc_array(g->vertex_count, sizeof *fill);
-    bool ok = g->first && g->triangle && fill;
-    for (int pass = 0; ok && pass < 2; pass++) {
-        for (size_t t = 0; t < g->triangle_count; t++)
-            for (int c = 0; c < 3; c++) {
-                const uint32_t *tri = g->indices + 3 * t;
-                if ((c > 0 && tri[c] == tri[0]) || (c > 1 && tri[c] == tri[1]))
-                    continue; /* a repeated corner: once */
-                if (pass == 0)
-                    g->first[tri[c] + 1]++;
-                else
-                    g->triangle[fill[tri[c]]++] = (uint32_t)t;
-            }
-        if (pass == 0) {
-            for (size_t v = 0; v < g->vertex_count; v++)
-                g->first[v + 1] += g->first[v];
-            memcpy(fill, g->first, g->vertex_count * sizeof *fill);
-        }
-    }
-    rs_free(fill);
-    return ok;
-}
-
 /* After a round's moves: the normals of the triangles at the moved vertices, the sums at their
  * corners and the neighbourhood normals that read them, each recomputed as the full pass does
  * (the same sums in the same order); those triangles, and the ones turned this round, are what
@@ -492,7 +466,8 @@ long rs_fold_guard(rsmooth_scalar scalar, const void *positions, void *out_posit
     if (!g.moved || !g.check || !g.listed || !g.touched)
         goto done;
     for (int round = 0; pull_back(&g, round) > 0; round++) {
-        if (!g.first && !build_incidence(&g))
+        if (!g.first &&
+            !rs_vertex_triangles(indices, triangle_count, vertex_count, &g.first, &g.triangle))
             goto done;
         refresh(&g);
     }
