@@ -198,16 +198,7 @@ static bool build_points(const double *xyz, size_t vertex_count, const uint32_t 
         memset(out, 0, sizeof *out);
         return false;
     }
-    for (size_t t = 0; t < triangle_count; t++) {
-        const uint32_t *tri = indices + 3 * t;
-        double e1[3], e2[3], n[3];
-        rs_sub3(xyz + 3 * (size_t)tri[1], xyz + 3 * (size_t)tri[0], e1);
-        rs_sub3(xyz + 3 * (size_t)tri[2], xyz + 3 * (size_t)tri[0], e2);
-        rs_cross3(e1, e2, n); /* twice the area times the unit normal */
-        for (int c = 0; c < 3; c++)
-            for (int k = 0; k < 3; k++)
-                normal[3 * (size_t)tri[c] + k] += n[k];
-    }
+    rs_add_area_normals(xyz, indices, triangle_count, NULL, normal);
     size_t used = 0;
     for (size_t v = 0; v < vertex_count; v++)
         point_of[v] = UINT32_MAX;

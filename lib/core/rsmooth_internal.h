@@ -208,6 +208,12 @@ bool rs_triangle_normal(const double *xyz, const uint32_t *tri, double normal[3]
 bool rs_triangle_geometry(const double *xyz, const uint32_t *tri, double centroid[3],
                           double normal[3], double *area);
 
+/* Adds each triangle's cross product (twice its area times its unit normal) to its corners' sums
+ * in `normal` (3 per vertex), in triangle order; corner v adds at rep[v] where rep is not NULL
+ * (welded vertices). Area-weighted vertex normals, once normalised. */
+void rs_add_area_normals(const double *xyz, const uint32_t *indices, size_t triangle_count,
+                         const uint32_t *rep, double *normal);
+
 /* The centroid alone, as rs_triangle_geometry computes it. */
 static inline void rs_triangle_centroid(const double *xyz, const uint32_t *tri,
                                         double centroid[3]) {

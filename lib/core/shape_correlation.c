@@ -52,16 +52,7 @@ static bool bends(const double *xyz, size_t vertex_count, const uint32_t *indice
         rs_free(degree);
         return false;
     }
-    for (size_t t = 0; t < triangle_count; t++) {
-        const uint32_t *tri = indices + 3 * t;
-        double e1[3], e2[3], n[3];
-        rs_sub3(xyz + 3 * (size_t)tri[1], xyz + 3 * (size_t)tri[0], e1);
-        rs_sub3(xyz + 3 * (size_t)tri[2], xyz + 3 * (size_t)tri[0], e2);
-        rs_cross3(e1, e2, n); /* area-weighted */
-        for (int c = 0; c < 3; c++)
-            for (int k = 0; k < 3; k++)
-                normal[3 * (size_t)rep[tri[c]] + (size_t)k] += n[k];
-    }
+    rs_add_area_normals(xyz, indices, triangle_count, rep, normal);
     for (size_t i = 0; i < edge_count; i++) {
         size_t a = (size_t)(edge[i] >> 32), b = (size_t)(edge[i] & 0xffffffffu);
         for (int k = 0; k < 3; k++) {
