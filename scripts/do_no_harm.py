@@ -279,6 +279,17 @@ def load_clean(shared, names, rsmooth, tmp):
     return meshes
 
 
+def print_table(header, rows, names, cells):
+    """A markdown table: per row its `names` columns, then cells(row) or the error that row met."""
+    print("| %s |" % " | ".join(header))
+    print("|%s" % (" --- |" * len(header)))
+    for r in rows:
+        lead = ["%g" % r[k] if isinstance(r[k], float) else str(r[k]) for k in names]
+        rest = ["error: %s" % r["error"]] if "error" in r else cells(r)
+        print("| %s |" % " | ".join(lead + rest))
+    print()
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--rsmooth", default="build/rsmooth")
@@ -300,60 +311,33 @@ def main():
         if "clean" in only:
             names = args.clean.split(",")
             result["clean"] = clean_rows(run, load_clean(args.shared, names, args.rsmooth, tmp))
-            print("| clean mesh | mode | largest move (local edges) | (% diagonal) | reversed | "
-                  "--auto chose |")
-            print("| --- | --- | --- | --- | --- | --- |")
-            for r in result["clean"]:
-                if "error" in r:
-                    print("| %s | %s | error: %s |" % (r["mesh"], r["mode"], r["error"]))
-                    continue
-                print("| %s | %s | %.3g | %.3g | %d of %d | %s |" % (
-                    r["mesh"], r["mode"], r["move_local"], r["move_diag_pct"], r["reversed"],
-                    r["triangles"], r["preset"]))
+            print_table(["clean mesh", "mode", "largest move (local edges)", "(% diagonal)",
+                         "reversed", "--auto chose"], result["clean"], ["mesh", "mode"],
+                        lambda r: ["%.3g" % r["move_local"], "%.3g" % r["move_diag_pct"],
+                                   "%d of %d" % (r["reversed"], r["triangles"]), r["preset"]])
         if "stray" in only:
             result["stray"] = stray_rows(run)
-            print("\n| K | mode | others' largest move | beyond 1 edge | vs the clean run | stray |")
-            print("| --- | --- | --- | --- | --- | --- |")
-            for r in result["stray"]:
-                if "error" in r:
-                    print("| %g | %s | error: %s |" % (r["k"], r["mode"], r["error"]))
-                    continue
-                print("| %g | %s | %.3g | %d | %.3g | %.3g |" % (
-                    r["k"], r["mode"], r["others_max_move"], r["others_beyond_1_edge"],
-                    r["others_vs_clean_run"], r["stray_move"]))
+            print_table(["K", "mode", "others' largest move", "beyond 1 edge", "vs the clean run",
+                         "stray"], result["stray"], ["k", "mode"],
+                        lambda r: ["%.3g" % r["others_max_move"], "%d" % r["others_beyond_1_edge"],
+                                   "%.3g" % r["others_vs_clean_run"], "%.3g" % r["stray_move"]])
         if "parts" in only:
             result["parts"] = parts_rows(run)
-            print("\n| mode | r 1e-3: centre / radius | r 1: centre / radius | r 1e3: centre / "
-                  "radius | reversed |")
-            print("| --- | --- | --- | --- | --- |")
-            for r in result["parts"]:
-                if "error" in r:
-                    print("| %s | error: %s |" % (r["mode"], r["error"]))
-                    continue
-                print("| %s | %.3g / %.4f | %.3g / %.4f | %.3g / %.4f | %d |" % (
-                    r["mode"], r["r0.001_centre"], r["r0.001_radius"], r["r1_centre"],
-                    r["r1_radius"], r["r1000_centre"], r["r1000_radius"], r["reversed"]))
+            print_table(["mode"] + ["r %s: centre / radius" % r for r in ("1e-3", "1", "1e3")] +
+                        ["reversed"], result["parts"], ["mode"],
+                        lambda r: ["%.3g / %.4f" % (r["r%s_centre" % k], r["r%s_radius" % k])
+                                   for k in ("0.001", "1", "1000")] + ["%d" % r["reversed"]])
         if "points" in only:
             result["points"] = points_rows(run)
-            print("\n| far point | mode | sphere's mean radius | others' largest move |")
-            print("| --- | --- | --- | --- |")
-            for r in result["points"]:
-                if "error" in r:
-                    print("| %g | %s | error: %s |" % (r["far"], r["mode"], r["error"]))
-                    continue
-                print("| %g | %s | %.4f | %.3g |" % (r["far"], r["mode"], r["radius"],
-                                                     r["others_max_move"]))
+            print_table(["far point", "mode", "sphere's mean radius", "others' largest move"],
+                        result["points"], ["far", "mode"],
+                        lambda r: ["%.4f" % r["radius"], "%.3g" % r["others_max_move"]])
         if "noisy" in only and args.cases:
             result["noisy"] = noisy_rows(run, args.cases, args.modes.split(","))
-            print("\n| case | mode | reversed (input) | E_v | vertices guarded |")
-            print("| --- | --- | --- | --- | --- |")
-            for r in result["noisy"]:
-                if "error" in r:
-                    print("| %s | %s | error: %s |" % (r["case"], r["mode"], r["error"]))
-                    continue
-                print("| %s | %s | %d (%d) | %.3f | %d |" % (
-                    r["case"], r["mode"], r["flipped"], r["flipped_input"], r["ev"],
-                    r["guarded"]))
+            print_table(["case", "mode", "reversed (input)", "E_v", "vertices guarded"],
+                        result["noisy"], ["case", "mode"],
+                        lambda r: ["%d (%d)" % (r["flipped"], r["flipped_input"]), "%.3f" % r["ev"],
+                                   "%d" % r["guarded"]])
     if args.json:
         with open(args.json, "w") as fh:
             json.dump(result, fh, indent=1)

@@ -60,7 +60,7 @@ static size_t facing_against(const shape_mesh *m, const double *xyz) {
     return count;
 }
 
-/* The grid's vertex nearest its middle, and the distance across two of its cells. */
+/* The grid's vertex nearest its middle. */
 static size_t middle(const shape_mesh *m) {
     size_t best = 0;
     for (size_t v = 0; v < m->vertex_count; v++)
