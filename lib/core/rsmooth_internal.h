@@ -428,6 +428,10 @@ typedef struct rs_pass_progress {
 /* A progress_cancel callback: forwards to both of the caller's, the fraction rescaled. */
 int rs_report_pass_progress(void *user, double fraction);
 
+/* `from`'s stage times and pairs added to `to`'s, and the larger tile count: what every sum of
+ * reports (passes, parts) adds alike. */
+void rs_add_report_times(rsmooth_report *to, const rsmooth_report *from);
+
 /* Adds one pass's stage times and work to `sum`, the passes' so far (all zero before the first):
  * counts, sigmas and device from the last pass, the facet count from the first. */
 void rs_add_pass_report(rsmooth_report *sum, const rsmooth_report *pass);

@@ -59,22 +59,12 @@ static void in_unit(rsmooth_params *p, double unit, double own) {
     p->discrepancy_gain *= unit / own;
 }
 
-/* `from`'s times and work added to `to`'s. */
+/* `from`'s times and work added to `to`'s: a part's facets, cells and stage are its own. */
 static void add_work(rsmooth_report *to, const rsmooth_report *from) {
+    rs_add_report_times(to, from);
     to->facet_count += from->facet_count;
     to->grid_cell_count += from->grid_cell_count;
-    to->ms_setup += from->ms_setup;
-    to->ms_facets += from->ms_facets;
-    to->ms_grid += from->ms_grid;
-    to->ms_upload += from->ms_upload;
-    to->ms_mollify += from->ms_mollify;
-    to->ms_normals += from->ms_normals;
-    to->ms_robust += from->ms_robust;
-    to->ms_download += from->ms_download;
     to->ms_total += from->ms_total;
-    to->pairs_mollify += from->pairs_mollify;
-    to->pairs_robust += from->pairs_robust;
-    to->tiles = from->tiles > to->tiles ? from->tiles : to->tiles;
     to->ms_stage += from->ms_stage;
     to->ms_stage_cycles += from->ms_stage_cycles;
 }

@@ -100,6 +100,15 @@ typedef struct guard {
     uint8_t *touched; /* per vertex: its sum redone this round (scratch) */
 } guard;
 
+/* The sums at_vertex over triangle t's corners into to[t]. */
+static void corner_sum(const guard *g, const double *at_vertex, size_t t, double *to) {
+    const uint32_t *tri = g->indices + 3 * t;
+    for (int k = 0; k < 3; k++)
+        to[3 * t + (size_t)k] = at_vertex[3 * (size_t)tri[0] + (size_t)k] +
+                                at_vertex[3 * (size_t)tri[1] + (size_t)k] +
+                                at_vertex[3 * (size_t)tri[2] + (size_t)k];
+}
+
 /* Sums per-triangle vectors `from` at each triangle's vertices into at_vertex, then those sums
  * over each triangle's corners into `to` (from and to may be one array). */
 static void gather_ring(const guard *g, const double *from, double *at_vertex, double *to) {
@@ -108,13 +117,8 @@ static void gather_ring(const guard *g, const double *from, double *at_vertex, d
         for (int c = 0; c < 3; c++)
             for (int k = 0; k < 3; k++)
                 at_vertex[3 * (size_t)g->indices[3 * t + c] + (size_t)k] += from[3 * t + (size_t)k];
-    for (size_t t = 0; t < g->triangle_count; t++) {
-        const uint32_t *tri = g->indices + 3 * t;
-        for (int k = 0; k < 3; k++)
-            to[3 * t + (size_t)k] = at_vertex[3 * (size_t)tri[0] + (size_t)k] +
-                                    at_vertex[3 * (size_t)tri[1] + (size_t)k] +
-                                    at_vertex[3 * (size_t)tri[2] + (size_t)k];
-    }
+    for (size_t t = 0; t < g->triangle_count; t++)
+        corner_sum(g, at_vertex, t, to);
 }
 
 /* Unit normals of every triangle over xyz into n (zeros where degenerate), and each triangle's
@@ -385,13 +389,8 @@ static void refresh(guard *g) {
                 }
             }
     for (size_t i = 0; i < listed; i++) {
-        size_t t = g->check[i];
-        const uint32_t *tri = g->indices + 3 * t;
-        for (int k = 0; k < 3; k++)
-            g->around[3 * t + (size_t)k] = g->at_vertex[3 * (size_t)tri[0] + (size_t)k] +
-                                           g->at_vertex[3 * (size_t)tri[1] + (size_t)k] +
-                                           g->at_vertex[3 * (size_t)tri[2] + (size_t)k];
-        g->listed[t] = 0;
+        corner_sum(g, g->at_vertex, g->check[i], g->around);
+        g->listed[g->check[i]] = 0;
     }
     for (size_t m = 0; m < g->moved_count; m++) /* clear the scratch */
         for (size_t i = g->first[g->moved[m]]; i < g->first[g->moved[m] + 1]; i++)
