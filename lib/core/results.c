@@ -111,3 +111,39 @@ void rs_give_report(rsmooth_report *report, size_t struct_size, const rsmooth_re
     memcpy(report, full, n);
     report->struct_size = struct_size;
 }
+
+void rs_add_report_times(rsmooth_report *to, const rsmooth_report *from) {
+    to->ms_setup += from->ms_setup;
+    to->ms_facets += from->ms_facets;
+    to->ms_grid += from->ms_grid;
+    to->ms_upload += from->ms_upload;
+    to->ms_mollify += from->ms_mollify;
+    to->ms_normals += from->ms_normals;
+    to->ms_robust += from->ms_robust;
+    to->ms_download += from->ms_download;
+    to->pairs_mollify += from->pairs_mollify;
+    to->pairs_robust += from->pairs_robust;
+    to->tiles = from->tiles > to->tiles ? from->tiles : to->tiles;
+}
+
+/* `from`'s times and work added to `to`'s: a part's facets, cells and stage are its own. */
+static void add_work(rsmooth_report *to, const rsmooth_report *from) {
+    rs_add_report_times(to, from);
+    to->facet_count += from->facet_count;
+    to->grid_cell_count += from->grid_cell_count;
+    to->ms_total += from->ms_total;
+    to->ms_stage += from->ms_stage;
+    to->ms_stage_cycles += from->ms_stage_cycles;
+}
+
+void rs_add_part_report(rsmooth_report *sum, const rsmooth_report *part, bool largest, bool first) {
+    if (first) {
+        *sum = *part;
+    } else if (largest) {
+        rsmooth_report others = *sum;
+        *sum = *part;
+        add_work(sum, &others);
+    } else {
+        add_work(sum, part);
+    }
+}

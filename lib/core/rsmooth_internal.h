@@ -377,6 +377,14 @@ void rs_store_unmoved(const rs_problem *problem, rsmooth_scalar scalar, void *ou
  * keeps that struct_size. */
 void rs_give_report(rsmooth_report *report, size_t struct_size, const rsmooth_report *full);
 
+/* `from`'s stage times and pairs added to `to`'s, and the larger tile count: what every sum of
+ * reports (passes, parts) adds alike. */
+void rs_add_report_times(rsmooth_report *to, const rsmooth_report *from);
+
+/* A part's report into the call's (`first`: the first part, which it replaces): times and work
+ * summed, widths, unit and device from the `largest` part (meshes' and point clouds' alike). */
+void rs_add_part_report(rsmooth_report *sum, const rsmooth_report *part, bool largest, bool first);
+
 /* Fills the parts of a report both paths share (lengths in the caller's units). */
 void rs_report_problem(rsmooth_report *report, const rs_problem *problem, size_t cell_count,
                        const char *device);
@@ -427,10 +435,6 @@ typedef struct rs_pass_progress {
 } rs_pass_progress;
 /* A progress_cancel callback: forwards to both of the caller's, the fraction rescaled. */
 int rs_report_pass_progress(void *user, double fraction);
-
-/* `from`'s stage times and pairs added to `to`'s, and the larger tile count: what every sum of
- * reports (passes, parts) adds alike. */
-void rs_add_report_times(rsmooth_report *to, const rsmooth_report *from);
 
 /* Adds one pass's stage times and work to `sum`, the passes' so far (all zero before the first):
  * counts, sigmas and device from the last pass, the facet count from the first. */

@@ -59,30 +59,6 @@ static void in_unit(rsmooth_params *p, double unit, double own) {
     p->discrepancy_gain *= unit / own;
 }
 
-/* `from`'s times and work added to `to`'s: a part's facets, cells and stage are its own. */
-static void add_work(rsmooth_report *to, const rsmooth_report *from) {
-    rs_add_report_times(to, from);
-    to->facet_count += from->facet_count;
-    to->grid_cell_count += from->grid_cell_count;
-    to->ms_total += from->ms_total;
-    to->ms_stage += from->ms_stage;
-    to->ms_stage_cycles += from->ms_stage_cycles;
-}
-
-/* A part's report into the call's: times and work summed, widths and units from the largest. */
-static void add_part_report(rsmooth_report *sum, const rsmooth_report *part, bool largest,
-                            bool first) {
-    if (first) {
-        *sum = *part;
-    } else if (largest) {
-        rsmooth_report others = *sum;
-        *sum = *part;
-        add_work(sum, &others);
-    } else {
-        add_work(sum, part);
-    }
-}
-
 /* One part through the passes, its results scattered into `whole`. */
 static rsmooth_status filter_part(rs_filter_fn one_pass, rs_stage_runner stage, void *ctx,
                                   rsmooth_scalar scalar, const rs_parts *parts, uint32_t part,
@@ -178,7 +154,7 @@ static rsmooth_status filter_parts(rs_filter_fn one_pass, rs_stage_runner stage,
         if (st != RSMOOTH_OK)
             return st;
         if (report)
-            add_part_report(report, &one, part == largest, first);
+            rs_add_part_report(report, &one, part == largest, first);
         first = false;
         ++*smoothed;
     }

@@ -21,20 +21,6 @@ int rs_report_pass_progress(void *user, double fraction) {
     return pp->cancel ? pp->cancel(pp->user, whole) : 0;
 }
 
-void rs_add_report_times(rsmooth_report *to, const rsmooth_report *from) {
-    to->ms_setup += from->ms_setup;
-    to->ms_facets += from->ms_facets;
-    to->ms_grid += from->ms_grid;
-    to->ms_upload += from->ms_upload;
-    to->ms_mollify += from->ms_mollify;
-    to->ms_normals += from->ms_normals;
-    to->ms_robust += from->ms_robust;
-    to->ms_download += from->ms_download;
-    to->pairs_mollify += from->pairs_mollify;
-    to->pairs_robust += from->pairs_robust;
-    to->tiles = from->tiles > to->tiles ? from->tiles : to->tiles;
-}
-
 void rs_add_pass_report(rsmooth_report *sum, const rsmooth_report *pass) {
     rsmooth_report keep = *sum;
     *sum = *pass;

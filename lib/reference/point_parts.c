@@ -120,7 +120,10 @@ static rsmooth_status filter_parts(rs_points_solve_fn solve, void *solve_ctx, co
         out->confidence[i] = 0;
     }
     rs_pass_progress progress = {p->progress, p->progress_cancel, p->progress_user, 0, (int)parts};
-    size_t largest = 0;
+    uint32_t largest = 0; /* the first of the most points */
+    for (uint32_t which = 1; which < parts; which++)
+        if (size[which] > size[largest])
+            largest = which;
     bool first = true;
     for (uint32_t which = 0; which < parts; which++) {
         if (size[which] < RS_MIN_PART_POINTS)
@@ -153,15 +156,8 @@ static rsmooth_status filter_parts(rs_points_solve_fn solve, void *solve_ctx, co
                        record);
                 out->confidence[i] = q.confidence[j];
             }
-        if (st == RSMOOTH_OK && report && (first || q.n > largest)) {
-            one.facet_count += first ? 0 : report->facet_count;
-            one.ms_total += first ? 0 : report->ms_total;
-            *report = one; /* the largest part's widths and unit */
-            largest = q.n;
-        } else if (st == RSMOOTH_OK && report) {
-            report->facet_count += one.facet_count;
-            report->ms_total += one.ms_total;
-        }
+        if (st == RSMOOTH_OK && report)
+            rs_add_part_report(report, &one, which == largest, first);
         first = false;
         free_part(&q);
         if (st != RSMOOTH_OK)
