@@ -10,16 +10,17 @@
 
 #include <string.h>
 
-/* Each point's part from its spacing in the input; *parts of them. */
+/* Each point's part from its spacing in the input; *parts of them. The spacings (internal
+ * units, rs_free them) are what a cloud of one part's first pass measures. */
 static rsmooth_status find_parts(rsmooth_scalar scalar, const void *positions, size_t n,
-                                 uint32_t *part, size_t *parts, rsmooth_error *error,
-                                 const char *where) {
+                                 uint32_t *part, size_t *parts, double **spacings,
+                                 rsmooth_error *error, const char *where) {
     double scale = 1;
     rsmooth_status st = rs_check_point_positions(scalar, positions, n, &scale, error, where);
     if (st != RSMOOTH_OK)
         return st;
     double *xyz = rs_alloc_array(n, 3 * sizeof *xyz);
-    double *spacing = rs_alloc_array(n, sizeof *spacing);
+    double *spacing = *spacings = rs_alloc_array(n, sizeof *spacing);
     int16_t *bin = rs_alloc_array(n, sizeof *bin);
     double *limit = NULL;
     rs_kdtree tree;
@@ -37,7 +38,6 @@ static rsmooth_status find_parts(rsmooth_scalar scalar, const void *positions, s
         ok = *parts != SIZE_MAX;
     }
     rs_free(xyz);
-    rs_free(spacing);
     rs_free(bin);
     rs_free(limit);
     return ok ? RSMOOTH_OK
@@ -145,8 +145,8 @@ static rsmooth_status filter_parts(rs_points_solve_fn solve, void *solve_ctx, co
         rsmooth_report one;
         rsmooth_report_init(&one);
         rsmooth_status st = rs_smooth_points_one_part(
-            solve, solve_ctx, where, scalar, q.positions, q.normals, q.n, &sub, q.out_positions,
-            q.out_normals, q.confidence, report ? &one : NULL, error);
+            solve, solve_ctx, where, scalar, q.positions, q.normals, q.n, NULL, &sub,
+            q.out_positions, q.out_normals, q.confidence, report ? &one : NULL, error);
         if (st == RSMOOTH_OK)
             for (size_t j = 0; j < q.n; j++) {
                 size_t i = q.point[j];
@@ -175,6 +175,7 @@ rsmooth_status rs_smooth_points_with(rs_points_solve_fn solve, void *solve_ctx, 
     size_t caller_size = report ? report->struct_size : 0;
     rsmooth_params p;
     uint32_t *part = NULL;
+    double *spacing = NULL; /* the input's: the whole cloud's first pass reads them */
     size_t *size = NULL, parts = 1;
     /* what the one-part call checks it reports itself, in its words */
     bool checked = rs_params_resolve(params, &p, NULL, where) == RSMOOTH_OK &&
@@ -183,7 +184,7 @@ rsmooth_status rs_smooth_points_with(rs_points_solve_fn solve, void *solve_ctx, 
     rsmooth_status st = RSMOOTH_OK;
     if (checked) {
         part = rs_alloc_array(point_count, sizeof *part);
-        st = part ? find_parts(scalar, positions, point_count, part, &parts, error, where)
+        st = part ? find_parts(scalar, positions, point_count, part, &parts, &spacing, error, where)
                   : rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for parts");
         size = st == RSMOOTH_OK ? rs_calloc_array(parts ? parts : 1, sizeof *size) : NULL;
         if (st == RSMOOTH_OK && !size)
@@ -200,7 +201,7 @@ rsmooth_status rs_smooth_points_with(rs_points_solve_fn solve, void *solve_ctx, 
     rsmooth_report *r = report ? &full : NULL;
     if (st == RSMOOTH_OK && (!checked || (parts <= 1 && outliers == 0))) {
         st = rs_smooth_points_one_part(solve, solve_ctx, where, scalar, positions, normals,
-                                       point_count, params, out_positions, out_normals,
+                                       point_count, spacing, params, out_positions, out_normals,
                                        out_confidence, r, error);
     } else if (st == RSMOOTH_OK) {
         size_t record = rs_vertex_bytes(scalar);
@@ -231,6 +232,7 @@ rsmooth_status rs_smooth_points_with(rs_points_solve_fn solve, void *solve_ctx, 
         rs_give_report(report, caller_size, &full);
     }
     rs_free(part);
+    rs_free(spacing);
     rs_free(size);
     return st;
 }

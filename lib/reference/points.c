@@ -39,13 +39,18 @@ static void spacing_range(void *ctx, size_t begin, size_t end, size_t chunk) {
     }
 }
 
+/* The mean of n spacings, summed in point order: the same on every run. */
+static double mean_spacing(const double *spacing, size_t n) {
+    double sum = 0;
+    for (size_t i = 0; i < n; i++)
+        sum += spacing[i];
+    return sum / (double)n;
+}
+
 double rs_point_spacings(const rs_kdtree *tree, double *spacing) {
     spacing_job job = {tree, spacing};
     rs_parallel_for(tree->count, SPACING_GRAIN, spacing_range, &job);
-    double sum = 0;
-    for (size_t i = 0; i < tree->count; i++)
-        sum += spacing[i];
-    return sum / (double)tree->count;
+    return mean_spacing(spacing, tree->count);
 }
 
 /* Checks positions (what rs_check_mesh_arrays checks, worded for points) and chooses the scale
@@ -159,6 +164,7 @@ typedef struct points_run {
     double scale;                    /* internal units per caller unit (scale.c) */
     point_arrays a;
     rs_kdtree tree; /* of the pass's positions, while the pass measures spacings */
+    const double *given_spacing; /* the input's, measured by the caller (point_parts.c), or NULL */
     /* The unit of relative sigmas: the input's spacing, kept through the passes (as meshes keep
      * their input's mean edge length), so later passes do not shrink their reach. */
     double unit, input_spacing;
@@ -250,9 +256,15 @@ static bool load_points(points_run *r) {
 static rsmooth_status pass_problem(points_run *r, int pass, rs_problem *pb) {
     size_t n = r->n;
     point_arrays *a = &r->a;
-    if (!rs_kdtree_build(&r->tree, a->xyz, n))
+    double spacing;
+    if (pass == 0 && r->given_spacing) { /* the same tree over the same positions gave them */
+        memcpy(a->spacing, r->given_spacing, n * sizeof *a->spacing);
+        spacing = mean_spacing(a->spacing, n);
+    } else if (rs_kdtree_build(&r->tree, a->xyz, n)) {
+        spacing = rs_point_spacings(&r->tree, a->spacing);
+    } else {
         return no_memory(r);
-    double spacing = rs_point_spacings(&r->tree, a->spacing);
+    }
     if (pass == 0) {
         r->input_spacing = spacing;
         r->unit = r->p.absolute ? r->scale : spacing;
@@ -373,6 +385,7 @@ static rsmooth_status write_points(points_run *r, void *out_positions, void *out
 static rsmooth_status smooth_points(rs_points_solve_fn solve, void *solve_ctx, const char *where,
                                     rsmooth_scalar scalar, const void *positions,
                                     const void *normals, size_t point_count,
+                                    const double *given_spacing,
                                     const rsmooth_params *params, void *out_positions,
                                     void *out_normals, float *out_confidence,
                                     rsmooth_report *report, rsmooth_error *error) {
@@ -387,6 +400,7 @@ static rsmooth_status smooth_points(rs_points_solve_fn solve, void *solve_ctx, c
     r.positions = positions;
     r.normals = normals;
     r.n = point_count;
+    r.given_spacing = given_spacing;
     r.scale = 1;
     r.report = report;
     r.error = error;
@@ -415,13 +429,14 @@ done:
 rsmooth_status rs_smooth_points_one_part(rs_points_solve_fn solve, void *solve_ctx,
                                          const char *where, rsmooth_scalar scalar,
                                          const void *positions, const void *normals,
-                                         size_t point_count, const rsmooth_params *params,
-                                         void *out_positions, void *out_normals,
-                                         float *out_confidence, rsmooth_report *report,
-                                         rsmooth_error *error) {
+                                         size_t point_count, const double *given_spacing,
+                                         const rsmooth_params *params, void *out_positions,
+                                         void *out_normals, float *out_confidence,
+                                         rsmooth_report *report, rsmooth_error *error) {
     size_t caller_size = report ? report->struct_size : 0; /* the report's fillers reset it */
     rsmooth_status st =
-        smooth_points(solve, solve_ctx, where, scalar, positions, normals, point_count, params,
+        smooth_points(solve, solve_ctx, where, scalar, positions, normals, point_count,
+                      given_spacing, params,
                       out_positions, out_normals, out_confidence, report, error);
     if (report)
         report->struct_size = caller_size;

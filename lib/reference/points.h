@@ -25,14 +25,16 @@ rsmooth_status rs_smooth_points_with(rs_points_solve_fn solve, void *solve_ctx, 
                                      void *out_normals, float *out_confidence,
                                      rsmooth_report *report, rsmooth_error *error);
 
-/* The call on a cloud of one part (points.c). */
+/* The call on a cloud of one part (points.c). given_spacing: the input's spacings in internal
+ * units (rs_point_spacings over its positions scaled as rs_check_point_positions says), which the
+ * first pass then does not measure again; NULL: it measures them. */
 rsmooth_status rs_smooth_points_one_part(rs_points_solve_fn solve, void *solve_ctx,
                                          const char *where, rsmooth_scalar scalar,
                                          const void *positions, const void *normals,
-                                         size_t point_count, const rsmooth_params *params,
-                                         void *out_positions, void *out_normals,
-                                         float *out_confidence, rsmooth_report *report,
-                                         rsmooth_error *error);
+                                         size_t point_count, const double *given_spacing,
+                                         const rsmooth_params *params, void *out_positions,
+                                         void *out_normals, float *out_confidence,
+                                         rsmooth_report *report, rsmooth_error *error);
 
 /* Fewer points than this are no surface: a part that small is held (a point's spacing is its mean
  * distance to its 6 nearest others). */
