@@ -15,11 +15,11 @@ int cli_list_devices(void);
 /* Red (low confidence) through yellow to blue (high), for c in [0, 1]. */
 void cli_confidence_colour(float c, uint8_t rgb[3]);
 
-/* --json: one object of counts, sigmas, device and stage times on stdout. */
 /* What the call left alone (parts, outliers, triangles kept from turning over, a skipped
  * stage), one line on stderr when there is any. */
 void cli_print_harm(const char *input, const rsmooth_report *r);
 
+/* --json: one object of counts, sigmas, device and stage times on stdout. */
 void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read,
                     double ms_write);
 
