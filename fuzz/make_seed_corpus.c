@@ -164,8 +164,8 @@ static void ply_ascii_seeds(corpus *c) {
                  "end_header\r\n");
     for (int i = 0; i < 5; i++) {
         char line[160];
-        snprintf(line, sizeof line, "0.5 %.17g %.17g -1 %.17g 0 %d\r\n", square[i][0],
-                 square[i][1], square[i][2], 10 * i);
+        snprintf(line, sizeof line, "0.5 %.17g %.17g -1 %.17g 0 %d\r\n", square[i][0], square[i][1],
+                 square[i][2], 10 * i);
         put_text(&b, line);
     }
     put_text(&b, "6 0 1 2 -1 3 4\r\n7 4 0 1 2 3 2 0.5 0.5\r\n1  3 0 1 4 0\n3 65 66 67 0.5\n");

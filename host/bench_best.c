@@ -177,8 +177,8 @@ static int load(const char *path, double triangles, mesh_in *m) {
 }
 
 /* Parses the options; returns -1 to go on, else the exit status. */
-static int parse(int argc, char **argv, const char **path, double *triangles,
-                 const char **device, int *repeat, bool *automatic, bool *drift) {
+static int parse(int argc, char **argv, const char **path, double *triangles, const char **device,
+                 int *repeat, bool *automatic, bool *drift) {
     for (int i = 2; i < argc; i++) {
         const char *a = argv[i];
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
@@ -200,8 +200,7 @@ static int parse(int argc, char **argv, const char **path, double *triangles,
                 *device = v;
             else if (*end || !(x >= (a[2] == 't' ? 100 : 1)) || x > (a[2] == 't' ? 1e9 : 99) ||
                      x != floor(x)) {
-                fprintf(stderr, "rsmooth-bench best: %s: not a whole number in range: %s\n", a,
-                        v);
+                fprintf(stderr, "rsmooth-bench best: %s: not a whole number in range: %s\n", a, v);
                 return 2;
             } else if (a[2] == 't') {
                 *triangles = x;
@@ -242,8 +241,8 @@ int bench_best(int argc, char **argv) {
     double ms_auto = 0;
     if (automatic) {
         double t0 = now_ms();
-        if (rsmooth_params_auto(RSMOOTH_FLOAT64, m.xyz, m.vertex_count, m.indices,
-                                m.triangle_count, &params[BEST_HOST], NULL, &err) != RSMOOTH_OK) {
+        if (rsmooth_params_auto(RSMOOTH_FLOAT64, m.xyz, m.vertex_count, m.indices, m.triangle_count,
+                                &params[BEST_HOST], NULL, &err) != RSMOOTH_OK) {
             fprintf(stderr, "rsmooth-bench best: --auto: %s\n", err.message);
             code = 1;
             goto done;

@@ -44,8 +44,10 @@ static inline float fast_exp2(float x) {
     float y = fminf(fmaxf(x, -126.0f), 127.0f);
     int32_t n = (int32_t)(y + 128.5f) - 128;
     float f = y - (float)n;
-    float p = 1.00000012f + f * (0.693146944f + f * (0.240221202f + f * (0.0555071346f +
-                                  f * (0.00967554096f + f * 0.00132764666f))));
+    float p =
+        1.00000012f +
+        f * (0.693146944f +
+             f * (0.240221202f + f * (0.0555071346f + f * (0.00967554096f + f * 0.00132764666f))));
     int32_t bits = (n + 127) << 23; /* n >= -126 after the clamp: never negative */
     float scale;
     memcpy(&scale, &bits, sizeof scale);
@@ -193,7 +195,8 @@ int bench_roofline_run(const bench_grid *grid, const float *positions, size_t ve
         goto done;
 
     /* As the kernels have them: coordinates in cell units (from the grid's corner rather than each
-     * cell's, as a window spans many cells), weights as log2(area / mean area), exponents in base 2 like the kernels'. */
+     * cell's, as a window spans many cells), weights as log2(area / mean area), exponents in base 2
+     * like the kernels'. */
     const double h = grid->cell_size;
     for (size_t q = 0; q < nf; q++) {
         for (int k = 0; k < 3; k++) {

@@ -4,11 +4,11 @@
 
 #include <ctype.h>
 #include <errno.h>
-#include <string.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 int cli_usage_error(const char *command, const char *format, ...) {
     const char *space = command ? " " : "";
@@ -115,8 +115,9 @@ int cli_check_environment(void) {
         errno = 0;
         long v = strtol(text, &end, 10);
         if (*end != '\0' || errno == ERANGE || v < knobs[i].lo || v > knobs[i].hi) {
-            fprintf(stderr, "rsmooth: %s='%s' is not an integer in [%ld, %ld] (unset it for the "
-                            "default)\n",
+            fprintf(stderr,
+                    "rsmooth: %s='%s' is not an integer in [%ld, %ld] (unset it for the "
+                    "default)\n",
                     knobs[i].name, text, knobs[i].lo, knobs[i].hi);
             return EXIT_USAGE;
         }

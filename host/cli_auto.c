@@ -1,15 +1,17 @@
 /* The rsmooth command's --auto: the parameters from the input's estimated noise (see
  * cli_smooth.h). */
 #define _POSIX_C_SOURCE 200809L
-#include "cli_smooth.h"
 #include "cli_files.h"
+#include "cli_smooth.h"
 
 #include <stdio.h>
 
 int cli_choose_params(options *opt, const rsmooth_mesh *mesh, bool points) {
     if (points) {
-        fprintf(stderr, "rsmooth: %s is a point cloud: --auto needs faces to estimate the noise; "
-                        "give --sigma-f and --sigma-g\n", opt->input);
+        fprintf(stderr,
+                "rsmooth: %s is a point cloud: --auto needs faces to estimate the noise; "
+                "give --sigma-f and --sigma-g\n",
+                opt->input);
         return EXIT_USAGE;
     }
     rsmooth_params chosen = opt->params;
@@ -66,8 +68,8 @@ int cli_choose_params(options *opt, const rsmooth_mesh *mesh, bool points) {
                  "length %.2g edges)",
                  report.correlated_level, report.correlation_length);
     if (!opt->quiet && chosen.passes == 0 && chosen.vertex_updates == 0) /* nothing to run */
-        fprintf(stderr, "rsmooth: %s: --auto: %s%s -> %s\n", opt->input, report.reason,
-                correlated, report.preset);
+        fprintf(stderr, "rsmooth: %s: --auto: %s%s -> %s\n", opt->input, report.reason, correlated,
+                report.preset);
     else if (!opt->quiet)
         fprintf(stderr, "rsmooth: %s: --auto: %s%s -> %s (sigma_f %.3g, sigma_g %.3g)\n",
                 opt->input, report.reason, correlated, report.preset, chosen.sigma_f,

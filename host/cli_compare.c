@@ -124,9 +124,9 @@ int cli_compare_main(int argc, char **argv) {
     }
     rsmooth_metrics m;
     rsmooth_error err;
-    rsmooth_status st = rsmooth_compare(RSMOOTH_FLOAT64, result->positions, truth->positions,
-                                        result->vertex_count, result->triangles,
-                                        result->triangle_count, &m, &err);
+    rsmooth_status st =
+        rsmooth_compare(RSMOOTH_FLOAT64, result->positions, truth->positions, result->vertex_count,
+                        result->triangles, result->triangle_count, &m, &err);
     if (st != RSMOOTH_OK) {
         /* The readers checked indices and coordinates: what is left is mostly memory. */
         fprintf(stderr, "rsmooth compare: %s, %s: %s\n", paths[0], paths[1],

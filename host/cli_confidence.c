@@ -1,9 +1,9 @@
 /* The rsmooth command's confidence mesh, --confidence (see cli_smooth.h). */
 #define _POSIX_C_SOURCE 200809L
-#include "cli_smooth.h"
 #include "cli_files.h"
 #include "cli_output.h"
 #include "cli_report.h"
+#include "cli_smooth.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -36,8 +36,8 @@ int cli_write_confidence(rsmooth_mesh *mesh, const options *opt, float *confiden
         cli_confidence_colour(x, colours + 3 * v);
     }
     if (!opt->quiet)
-        fprintf(stderr, "rsmooth: %s: confidence from %.3g (red) to %.3g (blue)\n",
-                opt->confidence, lo < hi ? lo : hi, hi);
+        fprintf(stderr, "rsmooth: %s: confidence from %.3g (red) to %.3g (blue)\n", opt->confidence,
+                lo < hi ? lo : hi, hi);
     float *quality = mesh->vertex_quality;
     uint8_t *input_colours = mesh->vertex_colors;
     struct rsmooth_mesh_extras *extras = mesh->extras;

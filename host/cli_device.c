@@ -38,8 +38,8 @@ int cli_open_device(const options *opt, cli_progress *bar, rsmooth_context **ctx
         } else if (st != RSMOOTH_OK) {
             cli_progress_clear(bar);
             fprintf(stderr, "rsmooth: device '%s'%s: %s: %s\n", device ? device : "auto",
-                    opt->device || !device ? "" : " (from RSMOOTH_DEVICE)",
-                    rsmooth_status_str(st), err.message);
+                    opt->device || !device ? "" : " (from RSMOOTH_DEVICE)", rsmooth_status_str(st),
+                    err.message);
             if (err.build_log[0])
                 fprintf(stderr, "%s\n", err.build_log);
             if (st == RSMOOTH_ERROR_NO_DEVICE) { /* the choice names nothing here: a usage error */

@@ -10,7 +10,6 @@
  * success, *ctx NULL for the reference path (asked for, or auto with no OpenCL: a warning); else
  * prints why and returns the exit status (2 for a device the choice does not name or a bad
  * setting, 3 for a device failure, 1 out of memory). *ms_setup: the time it took. */
-int cli_open_device(const options *opt, cli_progress *bar, rsmooth_context **ctx,
-                    double *ms_setup);
+int cli_open_device(const options *opt, cli_progress *bar, rsmooth_context **ctx, double *ms_setup);
 
 #endif

@@ -13,9 +13,9 @@
 /* Exit statuses of the command. */
 enum { EXIT_OK = 0, EXIT_OTHER = 1, EXIT_USAGE = 2, EXIT_DEVICE = 3 };
 
-/* Reads and parses `path` ("-": standard input, "<stdin>" in messages), reporting bytes read to `bar` (may be NULL: no progress). On failure
- * prints "rsmooth: PATH:LINE: message" (or the byte offset) and returns EXIT_USAGE (bad or
- * unreadable file) or EXIT_OTHER. */
+/* Reads and parses `path` ("-": standard input, "<stdin>" in messages), reporting bytes read to
+ * `bar` (may be NULL: no progress). On failure prints "rsmooth: PATH:LINE: message" (or the byte
+ * offset) and returns EXIT_USAGE (bad or unreadable file) or EXIT_OTHER. */
 int cli_read_mesh(const char *path, cli_progress *bar, rsmooth_mesh **mesh);
 
 /* The output format for `path` (by the extension of the file written: a symbolic link's target),
@@ -36,9 +36,10 @@ int cli_check_output(const char *path, const char *input, bool force, bool in_pl
 int cli_check_writable(const rsmooth_mesh *mesh, const char *path, rsmooth_format format,
                        const char *input);
 
-/* Writes `mesh` to standard output when `path` is "-", else through cli_write_atomically (`replace`: --force or --in-place; `quiet`: no
- * warning about an owner that could not be kept). Returns EXIT_OK, EXIT_USAGE (the file exists
- * and `replace` is off, or appeared meanwhile) or EXIT_OTHER. */
+/* Writes `mesh` to standard output when `path` is "-", else through cli_write_atomically
+ * (`replace`: --force or --in-place; `quiet`: no warning about an owner that could not be kept).
+ * Returns EXIT_OK, EXIT_USAGE (the file exists and `replace` is off, or appeared meanwhile) or
+ * EXIT_OTHER. */
 int cli_write_mesh(const rsmooth_mesh *mesh, const char *path, rsmooth_format format, bool replace,
                    bool quiet);
 

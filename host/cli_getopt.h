@@ -28,12 +28,12 @@ typedef struct cli_option {
 typedef struct cli_getopt_state {
     int argc;
     char **argv;
-    const char *command;   /* NULL for the main command, else "render" etc. (in messages) */
+    const char *command; /* NULL for the main command, else "render" etc. (in messages) */
     const cli_option *table;
-    int next;              /* the next argv index to look at */
-    const char *cluster;   /* the rest of a group of short flags ("-fq"), or NULL */
-    bool operands_only;    /* after "--" */
-    char spelled[64];      /* the option as to name it in messages: "--sigma-f", "-o" */
+    int next;            /* the next argv index to look at */
+    const char *cluster; /* the rest of a group of short flags ("-fq"), or NULL */
+    bool operands_only;  /* after "--" */
+    char spelled[64];    /* the option as to name it in messages: "--sigma-f", "-o" */
 } cli_getopt_state;
 
 enum {

@@ -1,7 +1,8 @@
 /* --mask FILE: a plain list of vertex indices, the simplest selection every tool can write (a
  * MeshLab or Blender selection exported as indices, a numpy savetxt, a grep of a PLY). The file is
  * read whole, then parsed: a regular file or a pipe, up to a size no honest list of this mesh's
- * vertices reaches, so a device (/dev/zero) or an endless pipe is refused instead of read forever. */
+ * vertices reaches, so a device (/dev/zero) or an endless pipe is refused instead of read forever.
+ */
 #define _POSIX_C_SOURCE 200809L
 #include "cli_mask.h"
 #include "cli_files.h"
@@ -18,7 +19,8 @@
 /* Room for every vertex listed with a comment of its own, and 1 MiB besides. */
 static size_t mask_limit(size_t vertex_count) {
     size_t per_vertex = 64, base = (size_t)1 << 20;
-    return vertex_count > (SIZE_MAX - base) / per_vertex ? SIZE_MAX : base + per_vertex * vertex_count;
+    return vertex_count > (SIZE_MAX - base) / per_vertex ? SIZE_MAX
+                                                         : base + per_vertex * vertex_count;
 }
 
 /* The whole file, NUL-terminated, in *text (its length in *size); prints why and returns a

@@ -106,16 +106,28 @@ static int parse_noise_args(int argc, char **argv, noise_args *a) {
     a->noise.direction = MESH_NOISE_NORMAL;
     a->noise.seed = DEFAULT_SEED;
     enum {
-        N_HELP = 1, N_SIGMA, N_IMPULSIVE, N_DIRECTION, N_SEED, N_ASCII, N_FORCE, N_QUIET,
-        N_CORRELATION, N_STRIPES
+        N_HELP = 1,
+        N_SIGMA,
+        N_IMPULSIVE,
+        N_DIRECTION,
+        N_SEED,
+        N_ASCII,
+        N_FORCE,
+        N_QUIET,
+        N_CORRELATION,
+        N_STRIPES
     };
-    static const cli_option table[] = {
-        {"help", 'h', false, N_HELP},          {"sigma", 0, true, N_SIGMA},
-        {"impulsive", 0, true, N_IMPULSIVE},   {"direction", 0, true, N_DIRECTION},
-        {"seed", 0, true, N_SEED},             {"ascii", 0, false, N_ASCII},
-        {"force", 'f', false, N_FORCE},        {"quiet", 'q', false, N_QUIET},
-        {"correlation", 0, true, N_CORRELATION}, {"stripes", 0, true, N_STRIPES},
-        {NULL, 0, false, 0}};
+    static const cli_option table[] = {{"help", 'h', false, N_HELP},
+                                       {"sigma", 0, true, N_SIGMA},
+                                       {"impulsive", 0, true, N_IMPULSIVE},
+                                       {"direction", 0, true, N_DIRECTION},
+                                       {"seed", 0, true, N_SEED},
+                                       {"ascii", 0, false, N_ASCII},
+                                       {"force", 'f', false, N_FORCE},
+                                       {"quiet", 'q', false, N_QUIET},
+                                       {"correlation", 0, true, N_CORRELATION},
+                                       {"stripes", 0, true, N_STRIPES},
+                                       {NULL, 0, false, 0}};
     cli_getopt_state s;
     cli_getopt_init(&s, argc, argv, "noise", table);
     const char *value;
@@ -154,7 +166,8 @@ static int parse_noise_args(int argc, char **argv, noise_args *a) {
              * cost nothing */
             double most = id == N_CORRELATION ? 100 : MAX_SIGMA;
             if (!cli_parse_number(value, &x) || !(x > 0 && x <= most))
-                return cli_usage_error("noise", "%s must be in (0, %g] mean edge lengths (got '%s')",
+                return cli_usage_error("noise",
+                                       "%s must be in (0, %g] mean edge lengths (got '%s')",
                                        s.spelled, most, value);
             if (id == N_CORRELATION)
                 a->noise.correlation = x;

@@ -10,64 +10,99 @@
 #include <string.h>
 
 enum {
-    OPT_HELP = 1, OPT_VERSION, OPT_OUTPUT, OPT_IN_PLACE, OPT_SUFFIX, OPT_FORMAT, OPT_CONFIDENCE,
-    OPT_DEVICE, OPT_MEMORY_BUDGET, OPT_METHOD, OPT_LAMBDA, OPT_MU, OPT_ITERATIONS, OPT_SIGMA_F,
-    OPT_SIGMA_G, OPT_CUTOFF, OPT_NORMALS, OPT_INFLUENCE, OPT_NORMAL_SIGMA_S, OPT_NORMAL_SIGMA_N,
-    OPT_PASS_CONFIDENCE, OPT_SIGMA_C, OPT_NORMAL_ITERATIONS, OPT_PASSES, OPT_AUTO, OPT_BEST,
-    OPT_ABSOLUTE, OPT_NO_MOLLIFY, OPT_ASCII, OPT_JSON, OPT_STATS, OPT_LIST_DEVICES, OPT_FORCE,
-    OPT_QUIET, OPT_MASK, OPT_VERTEX_UPDATES, OPT_GUIDED_SIGMA_S, OPT_GUIDED_SIGMA_N,
-    OPT_GUIDED_ROUNDS, OPT_STAGE_REPEATS, OPT_MAX_MEMORY, OPT_TMPDIR, OPT_PROGRESS,
-    OPT_GUIDED_RADIUS, OPT_NO_GUARD
+    OPT_HELP = 1,
+    OPT_VERSION,
+    OPT_OUTPUT,
+    OPT_IN_PLACE,
+    OPT_SUFFIX,
+    OPT_FORMAT,
+    OPT_CONFIDENCE,
+    OPT_DEVICE,
+    OPT_MEMORY_BUDGET,
+    OPT_METHOD,
+    OPT_LAMBDA,
+    OPT_MU,
+    OPT_ITERATIONS,
+    OPT_SIGMA_F,
+    OPT_SIGMA_G,
+    OPT_CUTOFF,
+    OPT_NORMALS,
+    OPT_INFLUENCE,
+    OPT_NORMAL_SIGMA_S,
+    OPT_NORMAL_SIGMA_N,
+    OPT_PASS_CONFIDENCE,
+    OPT_SIGMA_C,
+    OPT_NORMAL_ITERATIONS,
+    OPT_PASSES,
+    OPT_AUTO,
+    OPT_BEST,
+    OPT_ABSOLUTE,
+    OPT_NO_MOLLIFY,
+    OPT_ASCII,
+    OPT_JSON,
+    OPT_STATS,
+    OPT_LIST_DEVICES,
+    OPT_FORCE,
+    OPT_QUIET,
+    OPT_MASK,
+    OPT_VERTEX_UPDATES,
+    OPT_GUIDED_SIGMA_S,
+    OPT_GUIDED_SIGMA_N,
+    OPT_GUIDED_ROUNDS,
+    OPT_STAGE_REPEATS,
+    OPT_MAX_MEMORY,
+    OPT_TMPDIR,
+    OPT_PROGRESS,
+    OPT_GUIDED_RADIUS,
+    OPT_NO_GUARD
 };
 
-static const cli_option table[] = {
-    {"help", 'h', false, OPT_HELP},
-    {"version", 0, false, OPT_VERSION},
-    {"output", 'o', true, OPT_OUTPUT},
-    {"in-place", 0, false, OPT_IN_PLACE},
-    {"suffix", 0, true, OPT_SUFFIX},
-    {"format", 0, true, OPT_FORMAT},
-    {"confidence", 0, true, OPT_CONFIDENCE},
-    {"device", 0, true, OPT_DEVICE},
-    {"memory-budget", 0, true, OPT_MEMORY_BUDGET},
-    {"max-memory", 0, true, OPT_MAX_MEMORY},
-    {"tmpdir", 0, true, OPT_TMPDIR},
-    {"method", 0, true, OPT_METHOD},
-    {"lambda", 0, true, OPT_LAMBDA},
-    {"mu", 0, true, OPT_MU},
-    {"iterations", 0, true, OPT_ITERATIONS},
-    {"sigma-f", 0, true, OPT_SIGMA_F},
-    {"sigma-g", 0, true, OPT_SIGMA_G},
-    {"cutoff", 0, true, OPT_CUTOFF},
-    {"normals", 0, true, OPT_NORMALS},
-    {"influence", 0, true, OPT_INFLUENCE},
-    {"normal-sigma-s", 0, true, OPT_NORMAL_SIGMA_S},
-    {"normal-sigma-n", 0, true, OPT_NORMAL_SIGMA_N},
-    {"pass-confidence", 0, true, OPT_PASS_CONFIDENCE},
-    {"sigma-c", 0, true, OPT_SIGMA_C},
-    {"mask", 0, true, OPT_MASK},
-    {"normal-iterations", 0, true, OPT_NORMAL_ITERATIONS},
-    {"passes", 0, true, OPT_PASSES},
-    {"vertex-updates", 0, true, OPT_VERTEX_UPDATES},
-    {"guided-sigma-s", 0, true, OPT_GUIDED_SIGMA_S},
-    {"guided-sigma-n", 0, true, OPT_GUIDED_SIGMA_N},
-    {"guided-rounds", 0, true, OPT_GUIDED_ROUNDS},
-    {"stage-repeats", 0, true, OPT_STAGE_REPEATS},
-    {"guided-radius", 0, true, OPT_GUIDED_RADIUS},
-    {"auto", 0, false, OPT_AUTO},
-    {"best", 0, false, OPT_BEST},
-    {"absolute", 0, false, OPT_ABSOLUTE},
-    {"no-mollify", 0, false, OPT_NO_MOLLIFY},
-    {"no-guard", 0, false, OPT_NO_GUARD},
-    {"ascii", 0, false, OPT_ASCII},
-    {"json", 0, false, OPT_JSON},
-    {"stats", 0, false, OPT_STATS},
-    {"list-devices", 0, false, OPT_LIST_DEVICES},
-    {"force", 'f', false, OPT_FORCE},
-    {"quiet", 'q', false, OPT_QUIET},
-    {"progress", 0, false, OPT_PROGRESS},
-    {NULL, 0, false, 0}
-};
+static const cli_option table[] = {{"help", 'h', false, OPT_HELP},
+                                   {"version", 0, false, OPT_VERSION},
+                                   {"output", 'o', true, OPT_OUTPUT},
+                                   {"in-place", 0, false, OPT_IN_PLACE},
+                                   {"suffix", 0, true, OPT_SUFFIX},
+                                   {"format", 0, true, OPT_FORMAT},
+                                   {"confidence", 0, true, OPT_CONFIDENCE},
+                                   {"device", 0, true, OPT_DEVICE},
+                                   {"memory-budget", 0, true, OPT_MEMORY_BUDGET},
+                                   {"max-memory", 0, true, OPT_MAX_MEMORY},
+                                   {"tmpdir", 0, true, OPT_TMPDIR},
+                                   {"method", 0, true, OPT_METHOD},
+                                   {"lambda", 0, true, OPT_LAMBDA},
+                                   {"mu", 0, true, OPT_MU},
+                                   {"iterations", 0, true, OPT_ITERATIONS},
+                                   {"sigma-f", 0, true, OPT_SIGMA_F},
+                                   {"sigma-g", 0, true, OPT_SIGMA_G},
+                                   {"cutoff", 0, true, OPT_CUTOFF},
+                                   {"normals", 0, true, OPT_NORMALS},
+                                   {"influence", 0, true, OPT_INFLUENCE},
+                                   {"normal-sigma-s", 0, true, OPT_NORMAL_SIGMA_S},
+                                   {"normal-sigma-n", 0, true, OPT_NORMAL_SIGMA_N},
+                                   {"pass-confidence", 0, true, OPT_PASS_CONFIDENCE},
+                                   {"sigma-c", 0, true, OPT_SIGMA_C},
+                                   {"mask", 0, true, OPT_MASK},
+                                   {"normal-iterations", 0, true, OPT_NORMAL_ITERATIONS},
+                                   {"passes", 0, true, OPT_PASSES},
+                                   {"vertex-updates", 0, true, OPT_VERTEX_UPDATES},
+                                   {"guided-sigma-s", 0, true, OPT_GUIDED_SIGMA_S},
+                                   {"guided-sigma-n", 0, true, OPT_GUIDED_SIGMA_N},
+                                   {"guided-rounds", 0, true, OPT_GUIDED_ROUNDS},
+                                   {"stage-repeats", 0, true, OPT_STAGE_REPEATS},
+                                   {"guided-radius", 0, true, OPT_GUIDED_RADIUS},
+                                   {"auto", 0, false, OPT_AUTO},
+                                   {"best", 0, false, OPT_BEST},
+                                   {"absolute", 0, false, OPT_ABSOLUTE},
+                                   {"no-mollify", 0, false, OPT_NO_MOLLIFY},
+                                   {"no-guard", 0, false, OPT_NO_GUARD},
+                                   {"ascii", 0, false, OPT_ASCII},
+                                   {"json", 0, false, OPT_JSON},
+                                   {"stats", 0, false, OPT_STATS},
+                                   {"list-devices", 0, false, OPT_LIST_DEVICES},
+                                   {"force", 'f', false, OPT_FORCE},
+                                   {"quiet", 'q', false, OPT_QUIET},
+                                   {"progress", 0, false, OPT_PROGRESS},
+                                   {NULL, 0, false, 0}};
 
 /* Index of `value` among `count` names, or -1. */
 static int find_name(const char *value, const char *const *names, int count) {
@@ -111,13 +146,16 @@ static int apply_choice(options *opt, int id, const char *value) {
     case OPT_INFLUENCE: {
         int k = find_name(value, cli_influence_names, 4);
         if (k < 0)
-            return cli_usage_error(NULL, "--influence: '%s' is not gaussian, tukey, lorentzian "
-                                         "or huber", value);
+            return cli_usage_error(NULL,
+                                   "--influence: '%s' is not gaussian, tukey, lorentzian "
+                                   "or huber",
+                                   value);
         opt->params.influence = k;
         opt->given |= GIVEN_INFLUENCE;
         break;
     }
-    default: return NOT_HANDLED;
+    default:
+        return NOT_HANDLED;
     }
     return -1;
 }
@@ -127,8 +165,15 @@ static int apply_number(options *opt, int id, const char *name, const char *valu
     double x = 0;
     bool number = value && cli_parse_number(value, &x);
     switch (id) {
-    case OPT_LAMBDA: case OPT_MU: case OPT_ITERATIONS: case OPT_SIGMA_F: case OPT_SIGMA_G:
-    case OPT_CUTOFF: case OPT_NORMAL_SIGMA_S: case OPT_NORMAL_SIGMA_N: case OPT_PASS_CONFIDENCE:
+    case OPT_LAMBDA:
+    case OPT_MU:
+    case OPT_ITERATIONS:
+    case OPT_SIGMA_F:
+    case OPT_SIGMA_G:
+    case OPT_CUTOFF:
+    case OPT_NORMAL_SIGMA_S:
+    case OPT_NORMAL_SIGMA_N:
+    case OPT_PASS_CONFIDENCE:
         if (!number)
             return cli_usage_error(NULL, "%s: not a number: '%s'", name, value);
         if (id == OPT_LAMBDA)
@@ -137,8 +182,10 @@ static int apply_number(options *opt, int id, const char *name, const char *valu
             opt->mu = x, opt->umbrella_given = true;
         else if (id == OPT_ITERATIONS) {
             if (!(x >= 0 && x <= 1e6 && x == floor(x)))
-                return cli_usage_error(NULL, "--iterations must be a whole number in [0, 1e6] "
-                                             "(got '%s')", value);
+                return cli_usage_error(NULL,
+                                       "--iterations must be a whole number in [0, 1e6] "
+                                       "(got '%s')",
+                                       value);
             opt->iterations = (unsigned)x;
             opt->umbrella_given = true;
         } else if (id == OPT_SIGMA_F)
@@ -160,10 +207,11 @@ static int apply_number(options *opt, int id, const char *name, const char *valu
         opt->params.sigma_c = x;
         opt->colors = true;
         break;
-    case OPT_NORMAL_ITERATIONS: case OPT_PASSES: /* passes 0: --vertex-updates alone */
+    case OPT_NORMAL_ITERATIONS:
+    case OPT_PASSES: /* passes 0: --vertex-updates alone */
         if (!number || !(x >= (id == OPT_PASSES ? 0 : 1) && x <= 100 && x == floor(x)))
-            return cli_usage_error(NULL, "%s must be a whole number in [%d, 100] (got '%s')",
-                                   name, id == OPT_PASSES ? 0 : 1, value);
+            return cli_usage_error(NULL, "%s must be a whole number in [%d, 100] (got '%s')", name,
+                                   id == OPT_PASSES ? 0 : 1, value);
         if (id == OPT_PASSES)
             opt->params.passes = (int)x, opt->given |= GIVEN_PASSES;
         else
@@ -171,8 +219,8 @@ static int apply_number(options *opt, int id, const char *name, const char *valu
         break;
     case OPT_STAGE_REPEATS:
         if (!number || !(x >= 1 && x <= 1000 && x == floor(x)))
-            return cli_usage_error(NULL, "%s must be a whole number in [1, 1000] (got '%s')",
-                                   name, value);
+            return cli_usage_error(NULL, "%s must be a whole number in [1, 1000] (got '%s')", name,
+                                   value);
         opt->params.stage_repeats = (int)x, opt->given |= GIVEN_STAGE_REPEATS;
         break;
     case OPT_GUIDED_RADIUS:
@@ -180,7 +228,8 @@ static int apply_number(options *opt, int id, const char *name, const char *valu
             return cli_usage_error(NULL, "%s must be a number in [1, 8] (got '%s')", name, value);
         opt->params.guided_radius = x, opt->given |= GIVEN_GUIDED_RADIUS;
         break;
-    case OPT_VERTEX_UPDATES: case OPT_GUIDED_ROUNDS:
+    case OPT_VERTEX_UPDATES:
+    case OPT_GUIDED_ROUNDS:
         if (!number || !(x >= (id == OPT_VERTEX_UPDATES ? 0 : 1) &&
                          x <= (id == OPT_VERTEX_UPDATES ? 1000 : 100) && x == floor(x)))
             return cli_usage_error(NULL, "%s must be a whole number in [%d, %d] (got '%s')", name,
@@ -191,7 +240,8 @@ static int apply_number(options *opt, int id, const char *name, const char *valu
         else
             opt->params.guided_rounds = (int)x, opt->given |= GIVEN_GUIDED_ROUNDS;
         break;
-    case OPT_GUIDED_SIGMA_S: case OPT_GUIDED_SIGMA_N:
+    case OPT_GUIDED_SIGMA_S:
+    case OPT_GUIDED_SIGMA_N:
         if (!number || !(x > 0 && isfinite(x)) || (id == OPT_GUIDED_SIGMA_N && !(x <= 2)))
             return cli_usage_error(NULL, "%s must be a positive number%s (got '%s')", name,
                                    id == OPT_GUIDED_SIGMA_N ? " in (0, 2]" : "", value);
@@ -200,7 +250,8 @@ static int apply_number(options *opt, int id, const char *name, const char *valu
         else
             opt->params.guided_sigma_n = x, opt->given |= GIVEN_GUIDED_SIGMA_N;
         break;
-    default: return NOT_HANDLED;
+    default:
+        return NOT_HANDLED;
     }
     return -1;
 }
@@ -221,10 +272,18 @@ static int apply(options *opt, int id, const char *name, const char *value) {
         printf("rsmooth %d.%d.%d\n", RSMOOTH_VERSION_MAJOR, RSMOOTH_VERSION_MINOR,
                RSMOOTH_VERSION_PATCH);
         return EXIT_OK;
-    case OPT_OUTPUT: opt->output_option = value; break;
-    case OPT_CONFIDENCE: opt->confidence = value; break;
-    case OPT_MASK: opt->mask = value; break;
-    case OPT_DEVICE: opt->device = value; break;
+    case OPT_OUTPUT:
+        opt->output_option = value;
+        break;
+    case OPT_CONFIDENCE:
+        opt->confidence = value;
+        break;
+    case OPT_MASK:
+        opt->mask = value;
+        break;
+    case OPT_DEVICE:
+        opt->device = value;
+        break;
     case OPT_SUFFIX:
         if (!*value || strchr(value, '/'))
             return cli_usage_error(NULL, "--suffix: '%s' is not a file name's end (e.g. _smooth)",
@@ -233,34 +292,64 @@ static int apply(options *opt, int id, const char *name, const char *value) {
         break;
     case OPT_MEMORY_BUDGET:
         if (!cli_parse_bytes(value, &opt->memory_budget) || opt->memory_budget == 0)
-            return cli_usage_error(NULL, "--memory-budget: '%s' is not a byte count above 0 "
-                                         "(examples: 256M, 1.5G; leave it out for most of "
-                                         "the device's memory)", value);
+            return cli_usage_error(NULL,
+                                   "--memory-budget: '%s' is not a byte count above 0 "
+                                   "(examples: 256M, 1.5G; leave it out for most of "
+                                   "the device's memory)",
+                                   value);
         break;
     case OPT_MAX_MEMORY:
         if (!cli_parse_bytes(value, &opt->max_memory) || opt->max_memory == 0)
-            return cli_usage_error(NULL, "--max-memory: '%s' is not a byte count above 0 "
-                                         "(examples: 512M, 2G)", value);
+            return cli_usage_error(NULL,
+                                   "--max-memory: '%s' is not a byte count above 0 "
+                                   "(examples: 512M, 2G)",
+                                   value);
         break;
     case OPT_TMPDIR:
         if (!*value)
             return cli_usage_error(NULL, "--tmpdir: an empty folder name");
         opt->tmpdir = value;
         break;
-    case OPT_AUTO: opt->auto_params = true; break;
-    case OPT_BEST: break; /* applied before the others, so the options after it can change it */
-    case OPT_ABSOLUTE: opt->params.absolute = 1; break;
-    case OPT_NO_MOLLIFY: opt->params.mollify = 0; break;
-    case OPT_NO_GUARD: opt->params.guard = 0; break;
-    case OPT_ASCII: opt->ascii = true; break;
-    case OPT_JSON: opt->json = true; break;
-    case OPT_STATS: opt->stats = true; break;
-    case OPT_IN_PLACE: opt->in_place = true; break;
-    case OPT_LIST_DEVICES: opt->list_devices = true; break;
-    case OPT_FORCE: opt->force = true; break;
-    case OPT_QUIET: opt->quiet = true; break;
-    case OPT_PROGRESS: opt->progress = true; break;
-    default: break;
+    case OPT_AUTO:
+        opt->auto_params = true;
+        break;
+    case OPT_BEST:
+        break; /* applied before the others, so the options after it can change it */
+    case OPT_ABSOLUTE:
+        opt->params.absolute = 1;
+        break;
+    case OPT_NO_MOLLIFY:
+        opt->params.mollify = 0;
+        break;
+    case OPT_NO_GUARD:
+        opt->params.guard = 0;
+        break;
+    case OPT_ASCII:
+        opt->ascii = true;
+        break;
+    case OPT_JSON:
+        opt->json = true;
+        break;
+    case OPT_STATS:
+        opt->stats = true;
+        break;
+    case OPT_IN_PLACE:
+        opt->in_place = true;
+        break;
+    case OPT_LIST_DEVICES:
+        opt->list_devices = true;
+        break;
+    case OPT_FORCE:
+        opt->force = true;
+        break;
+    case OPT_QUIET:
+        opt->quiet = true;
+        break;
+    case OPT_PROGRESS:
+        opt->progress = true;
+        break;
+    default:
+        break;
     }
     return -1;
 }

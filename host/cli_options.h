@@ -44,16 +44,16 @@ enum {
 };
 
 typedef struct options {
-    const char **inputs;    /* the operands (argv's strings), input_count of them; "-": stdin */
+    const char **inputs; /* the operands (argv's strings), input_count of them; "-": stdin */
     size_t input_count;
     const char *input, *output; /* the file being worked on and its output ("-": stdout) */
     const char *output_option;  /* -o as given */
     const char *confidence, *device;
-    const char *mask;       /* --mask: a file of the vertex indices that may move */
-    const char *suffix;     /* --suffix: each result beside its input, the name + suffix */
-    bool output_dir;        /* -o names a folder (ends in '/' or is one): results go in there */
-    rsmooth_format format;  /* --format: AUTO when not given (then the extension, or for -o -
-                             * the input's format) */
+    const char *mask;      /* --mask: a file of the vertex indices that may move */
+    const char *suffix;    /* --suffix: each result beside its input, the name + suffix */
+    bool output_dir;       /* -o names a folder (ends in '/' or is one): results go in there */
+    rsmooth_format format; /* --format: AUTO when not given (then the extension, or for -o -
+                            * the input's format) */
     rsmooth_params params;
     method method;
     double lambda, mu;
@@ -64,10 +64,10 @@ typedef struct options {
     bool colors;            /* --sigma-c: the input's vertex colours in the weight */
     bool sigma_g_given, umbrella_given; /* for consistency checks against --method */
     bool ascii, json, force, quiet, in_place, stats, list_devices, best;
-    bool progress;          /* --progress: the bar even where stderr is no terminal */
-    bool auto_params;       /* --auto */
-    unsigned given;         /* GIVEN_* bits: parameters set on the command line */
-    double noise;           /* --auto's estimate */
+    bool progress;           /* --progress: the bar even where stderr is no terminal */
+    bool auto_params;        /* --auto */
+    unsigned given;          /* GIVEN_* bits: parameters set on the command line */
+    double noise;            /* --auto's estimate */
     double noise_correlated; /* --auto's rms including the correlated part (= noise when none) */
     double noise_correlation_length; /* its correlation length, edges (0: uncorrelated) */
     double noise_shape_correlation;  /* how alike neighbours bend (clean: 0.3 or more) */

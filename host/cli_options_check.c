@@ -1,9 +1,9 @@
 /* The rsmooth command's checks of what the command line asked for, and the output each input gets
  * (see cli_options.h). */
 #define _POSIX_C_SOURCE 200809L
-#include "cli_options.h"
 #include "cli_args.h"
 #include "cli_files.h"
+#include "cli_options.h"
 #include "cli_stream.h"
 
 #include <math.h>
@@ -102,8 +102,10 @@ static int check_files(options *opt) {
         return cli_usage_error(NULL, "standard input has no name to name its result after: "
                                      "give -o FILE or -o -");
     if (opt->input_count > 1 && out && !opt->output_dir)
-        return cli_usage_error(NULL, "%zu inputs: -o must be a folder (-o DIR/), or use --suffix "
-                                     "S or --in-place", opt->input_count);
+        return cli_usage_error(NULL,
+                               "%zu inputs: -o must be a folder (-o DIR/), or use --suffix "
+                               "S or --in-place",
+                               opt->input_count);
     if (opt->input_count > 1 && opt->confidence)
         return cli_usage_error(NULL, "--confidence names one file: give one input with it");
     bool to_stdout = out && !strcmp(out, "-");

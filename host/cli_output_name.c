@@ -1,8 +1,8 @@
 /* The rsmooth command's output names and formats: where each input's result goes and in what
  * format it is written (see cli_options.h). Called by the checks, the smoothing and streaming
  * flows; calls nothing of theirs. */
-#include "cli_options.h"
 #include "cli_files.h"
+#include "cli_options.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -10,11 +10,18 @@
 /* The file extension --format writes. */
 static const char *format_extension(rsmooth_format f) {
     switch (f) {
-    case RSMOOTH_FORMAT_OBJ: return ".obj";
-    case RSMOOTH_FORMAT_PLY_ASCII: case RSMOOTH_FORMAT_PLY_BINARY: return ".ply";
-    case RSMOOTH_FORMAT_OFF: return ".off";
-    case RSMOOTH_FORMAT_STL_ASCII: case RSMOOTH_FORMAT_STL_BINARY: return ".stl";
-    default: return "";
+    case RSMOOTH_FORMAT_OBJ:
+        return ".obj";
+    case RSMOOTH_FORMAT_PLY_ASCII:
+    case RSMOOTH_FORMAT_PLY_BINARY:
+        return ".ply";
+    case RSMOOTH_FORMAT_OFF:
+        return ".off";
+    case RSMOOTH_FORMAT_STL_ASCII:
+    case RSMOOTH_FORMAT_STL_BINARY:
+        return ".stl";
+    default:
+        return "";
     }
 }
 
@@ -29,8 +36,8 @@ bool cli_output_for(const options *opt, const char *input, char *out, size_t siz
     const char *dot = strrchr(base, '.');
     size_t stem = dot && dot != base ? (size_t)(dot - base) : strlen(base);
     const char *extension = opt->format != RSMOOTH_FORMAT_AUTO ? format_extension(opt->format)
-                            : dot && dot != base                ? dot
-                                                                : "";
+                            : dot && dot != base               ? dot
+                                                               : "";
     int folder = opt->output_dir ? (int)strlen(o) : slash ? (int)(slash - input + 1) : 0;
     const char *sep = opt->output_dir && o[strlen(o) - 1] != '/' ? "/" : "";
     int n = snprintf(out, size, "%.*s%s%.*s%s%s", folder, opt->output_dir ? o : input, sep,

@@ -8,7 +8,7 @@
 
 #define SHOW_AFTER_MS 1000.0 /* quick runs never show a bar */
 #define REDRAW_MS 100.0
-#define LINE_MS 1000.0       /* into a file: a line a second */
+#define LINE_MS 1000.0 /* into a file: a line a second */
 #define WIDTH 30
 
 double cli_now_ms(void) {

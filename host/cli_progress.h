@@ -7,8 +7,8 @@
 #include <stdbool.h>
 
 typedef struct cli_progress {
-    bool enabled;    /* stderr is a terminal (or --progress) and the user did not ask for quiet */
-    bool lines;      /* forced where stderr is no terminal: whole lines, no carriage returns */
+    bool enabled; /* stderr is a terminal (or --progress) and the user did not ask for quiet */
+    bool lines;   /* forced where stderr is no terminal: whole lines, no carriage returns */
     double show_after_ms, redraw_ms;
     bool drawn;      /* something is on the line, to be cleared */
     double start_ms; /* when the work began */

@@ -96,10 +96,10 @@ static int parse_render_args(int argc, char **argv, render_job *job) {
     int status = 0;
     enum { R_HELP = 1, R_OUTPUT, R_SIZE, R_AZIMUTH, R_ELEVATION, R_ORTHOGRAPHIC, R_FORCE };
     static const cli_option table[] = {
-        {"help", 'h', false, R_HELP},       {"output", 'o', true, R_OUTPUT},
-        {"size", 0, true, R_SIZE},          {"azimuth", 0, true, R_AZIMUTH},
+        {"help", 'h', false, R_HELP},        {"output", 'o', true, R_OUTPUT},
+        {"size", 0, true, R_SIZE},           {"azimuth", 0, true, R_AZIMUTH},
         {"elevation", 0, true, R_ELEVATION}, {"orthographic", 0, false, R_ORTHOGRAPHIC},
-        {"force", 'f', false, R_FORCE},     {NULL, 0, false, 0}};
+        {"force", 'f', false, R_FORCE},      {NULL, 0, false, 0}};
     cli_getopt_state s;
     cli_getopt_init(&s, argc, argv, "render", table);
     const char *value;
@@ -121,8 +121,8 @@ static int parse_render_args(int argc, char **argv, render_job *job) {
         } else if (id == R_ELEVATION) {
             if (!cli_parse_number(value, &options->elevation_deg) ||
                 !(options->elevation_deg > -90 && options->elevation_deg < 90))
-                status = cli_usage_error("render", "--elevation wants degrees in (-90, 90): %s",
-                                         value);
+                status =
+                    cli_usage_error("render", "--elevation wants degrees in (-90, 90): %s", value);
         } else if (id == R_ORTHOGRAPHIC) {
             options->orthographic = true;
         } else if (id == R_FORCE) {
@@ -148,8 +148,10 @@ static int check_picture(render_job *job) {
     if (total > MAX_SIDE && !job->width && n * 8 + (n - 1) * gap <= MAX_SIDE) {
         total = MAX_SIDE; /* many meshes: narrower panels by default */
     } else if (total > MAX_SIDE) {
-        return cli_usage_error("render", "%zu panels of %d pixels make a picture wider than %d: "
-                                         "give a smaller --size", n, panel_width, MAX_SIDE);
+        return cli_usage_error("render",
+                               "%zu panels of %d pixels make a picture wider than %d: "
+                               "give a smaller --size",
+                               n, panel_width, MAX_SIDE);
     }
     job->width = (int)total;
     job->height = panel_height;

@@ -61,26 +61,29 @@ void cli_confidence_colour(float c, uint8_t rgb[3]) {
 
 void cli_print_harm(const char *input, const rsmooth_report *r) {
     if (r->parts > 1)
-        fprintf(stderr, "rsmooth: %s: %zu parts of very different size, each smoothed in its own "
-                        "unit with its own triangles only\n",
+        fprintf(stderr,
+                "rsmooth: %s: %zu parts of very different size, each smoothed in its own "
+                "unit with its own triangles only\n",
                 input, r->parts);
     if (r->outliers > 0)
-        fprintf(stderr, "rsmooth: %s: %zu outlier vertices (every triangle they belong to out of "
-                        "scale with the surface around it) held where they were; their triangles "
-                        "moved no other vertex\n",
+        fprintf(stderr,
+                "rsmooth: %s: %zu outlier vertices (every triangle they belong to out of "
+                "scale with the surface around it) held where they were; their triangles "
+                "moved no other vertex\n",
                 input, r->outliers);
     if (r->guarded_vertices > 0)
-        fprintf(stderr, "rsmooth: %s: %zu vertices pulled back toward the input so that no "
-                        "triangle turned over (--no-guard: the filter's result as it came)\n",
+        fprintf(stderr,
+                "rsmooth: %s: %zu vertices pulled back toward the input so that no "
+                "triangle turned over (--no-guard: the filter's result as it came)\n",
                 input, r->guarded_vertices);
     if (r->stage_skipped)
-        fprintf(stderr, "rsmooth: %s: the mesh reads clean: the normal update stage had nothing "
-                        "to remove and did not run (--no-guard runs it)\n",
+        fprintf(stderr,
+                "rsmooth: %s: the mesh reads clean: the normal update stage had nothing "
+                "to remove and did not run (--no-guard runs it)\n",
                 input);
 }
 
-void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read,
-                    double ms_write) {
+void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read, double ms_write) {
     printf("{\"input\":");
     cli_print_json_string(opt->input);
     printf(",\"output\":");
@@ -88,7 +91,8 @@ void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read,
     printf(",\"method\":\"%s\"", cli_method_names[opt->method]);
     if (r->discrepancy_iterations > 0) /* --auto's choice per region: blended with Taubin's */
         printf(",\"region_choice\":{\"taubin_iterations\":%d,\"lambda\":0.5,\"mu\":-0.53,"
-               "\"filter_share\":%.4f}", r->discrepancy_iterations, r->region_filter_share);
+               "\"filter_share\":%.4f}",
+               r->discrepancy_iterations, r->region_filter_share);
     if (cli_method_uses_edges(opt->method))
         printf(",\"lambda\":%.9g,\"mu\":%.9g,\"iterations\":%u", opt->lambda, opt->mu,
                opt->iterations);
@@ -118,8 +122,8 @@ void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read,
                    p->guided_sigma_s, p->guided_sigma_n, p->guided_radius, p->guided_rounds,
                    p->stage_repeats, p->discrepancy_level, r->discrepancy_iterations);
         if (opt->auto_params) {
-            printf(",\"noise_estimate\":%.9g,\"shape_correlation\":%.9g,\"preset\":",
-                   opt->noise, opt->noise_shape_correlation);
+            printf(",\"noise_estimate\":%.9g,\"shape_correlation\":%.9g,\"preset\":", opt->noise,
+                   opt->noise_shape_correlation);
             cli_print_json_string(opt->noise_preset);
         }
         if (opt->auto_params && opt->noise_correlation_length > 0)
@@ -220,8 +224,8 @@ void cli_print_stats(const rsmooth_mesh *mesh, const double *out, const float *c
                 r->tiles == 1 ? "" : "s", r->triangle_count - r->facet_count);
     else if (!points)
         fprintf(stderr, "filter:      %s\n", r->device);
-    fprintf(stderr, "moved:       mean %.4f, median %.4f, max %.4f %s\n",
-            moved_sum / (double)nv, moved[nv / 2], moved[nv - 1], unit);
+    fprintf(stderr, "moved:       mean %.4f, median %.4f, max %.4f %s\n", moved_sum / (double)nv,
+            moved[nv / 2], moved[nv - 1], unit);
     if (confidence)
         fprintf(stderr, "confidence:  mean %.3f, min %.3f, %zu %s (%.1f%%) below 0.5\n",
                 conf_sum / (double)nv, conf_min, low, points ? "points" : "vertices",

@@ -20,15 +20,13 @@ void cli_confidence_colour(float c, uint8_t rgb[3]);
 void cli_print_harm(const char *input, const rsmooth_report *r);
 
 /* --json: one object of counts, sigmas, device and stage times on stdout. */
-void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read,
-                    double ms_write);
+void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read, double ms_write);
 
 /* --stats: what the mesh is and what the filter did to it (`out`: the result), on stderr. */
 void cli_print_stats(const rsmooth_mesh *mesh, const double *out, const float *confidence,
                      const rsmooth_report *r);
 
 /* Says on stderr what writing `mesh` as `format` to `path` drops (unless `quiet`). */
-void cli_warn_losses(const rsmooth_mesh *mesh, const char *path, rsmooth_format format,
-                     bool quiet);
+void cli_warn_losses(const rsmooth_mesh *mesh, const char *path, rsmooth_format format, bool quiet);
 
 #endif

@@ -2,11 +2,11 @@
  * read (with --sigma-c, --mask and --auto), the filter run, the results written, and what was done
  * reported (see cli_smooth.h). Under --max-memory the file goes to cli_stream.c instead. */
 #define _POSIX_C_SOURCE 200809L
-#include "cli_smooth.h"
 #include "cli_files.h"
 #include "cli_mask.h"
 #include "cli_output.h"
 #include "cli_report.h"
+#include "cli_smooth.h"
 #include "cli_stream.h"
 
 #include <stdint.h>
@@ -17,15 +17,15 @@
 /* Whether the output files' formats can hold the input (the result has its scale): refused before
  * any filtering. The confidence mesh is written without the input's extras, so checked so. */
 static int check_outputs_hold(const options *opt, rsmooth_mesh *mesh) {
-    int code = cli_check_writable(mesh, strcmp(opt->output, "-") ? opt->output : "<stdout>",
-                                  cli_result_format(opt, opt->output, mesh->source_format),
-                                  opt->input);
+    int code =
+        cli_check_writable(mesh, strcmp(opt->output, "-") ? opt->output : "<stdout>",
+                           cli_result_format(opt, opt->output, mesh->source_format), opt->input);
     if (code >= 0 || !opt->confidence)
         return code >= 0 ? code : EXIT_OK;
     struct rsmooth_mesh_extras *extras = mesh->extras;
     mesh->extras = NULL;
-    code = cli_check_writable(mesh, opt->confidence,
-                              cli_output_format(opt->confidence, opt->ascii), opt->input);
+    code = cli_check_writable(mesh, opt->confidence, cli_output_format(opt->confidence, opt->ascii),
+                              opt->input);
     mesh->extras = extras;
     return code >= 0 ? code : EXIT_OK;
 }
@@ -34,8 +34,10 @@ static int check_outputs_hold(const options *opt, rsmooth_mesh *mesh) {
 static int input_colors(const options *opt, const rsmooth_mesh *mesh, float **colors) {
     *colors = NULL;
     if (!mesh->vertex_colors) {
-        fprintf(stderr, "rsmooth: %s has no vertex colours: --sigma-c needs them (PLY red, "
-                        "green, blue; OBJ v x y z r g b; COFF)\n", opt->input);
+        fprintf(stderr,
+                "rsmooth: %s has no vertex colours: --sigma-c needs them (PLY red, "
+                "green, blue; OBJ v x y z r g b; COFF)\n",
+                opt->input);
         return EXIT_USAGE;
     }
     size_t n = 3 * mesh->vertex_count;
@@ -51,14 +53,14 @@ static int input_colors(const options *opt, const rsmooth_mesh *mesh, float **co
 
 /* One file's work in memory and what it holds, released by job_free. */
 typedef struct file_job {
-    options opt;          /* a copy: --auto changes the parameters for this file only */
-    const char *path;     /* what is read ("-": standard input) */
-    const char *wrote;    /* the output as the messages name it */
+    options opt;       /* a copy: --auto changes the parameters for this file only */
+    const char *path;  /* what is read ("-": standard input) */
+    const char *wrote; /* the output as the messages name it */
     cli_progress bar;
     rsmooth_mesh *mesh;
-    bool points;          /* a point cloud: its points and normals filtered */
-    float *colors;        /* --sigma-c */
-    uint8_t *mask;        /* --mask */
+    bool points;   /* a point cloud: its points and normals filtered */
+    float *colors; /* --sigma-c */
+    uint8_t *mask; /* --mask */
     double *out, *out_normals;
     float *confidence;
     rsmooth_report report;
@@ -109,8 +111,9 @@ static int read_input(file_job *job) {
     rsmooth_mesh *mesh = job->mesh;
     size_t cols, rows, samples;
     if (!opt->quiet && rsmooth_mesh_range_grid(mesh, &cols, &rows, &samples))
-        fprintf(stderr, "rsmooth: note: %s is a range grid (%zu x %zu cells, %zu samples): read as "
-                        "%zu triangles; the output is a triangle mesh, not a range grid\n",
+        fprintf(stderr,
+                "rsmooth: note: %s is a range grid (%zu x %zu cells, %zu samples): read as "
+                "%zu triangles; the output is a triangle mesh, not a range grid\n",
                 opt->input, cols, rows, samples, mesh->triangle_count);
     job->points = mesh->triangle_count == 0;
     if (job->points && (code = cli_check_point_cloud(opt, mesh)) != EXIT_OK)
@@ -120,8 +123,8 @@ static int read_input(file_job *job) {
     if (opt->colors && (code = input_colors(opt, mesh, &job->colors)) != EXIT_OK)
         return code;
     opt->params.colors = job->colors;
-    if (opt->mask && (code = cli_read_mask(opt->mask, mesh->vertex_count, job->path,
-                                           &job->mask)) != EXIT_OK)
+    if (opt->mask &&
+        (code = cli_read_mask(opt->mask, mesh->vertex_count, job->path, &job->mask)) != EXIT_OK)
         return code;
     opt->params.move_mask = job->mask;
     if (opt->auto_params && (code = cli_choose_params(opt, mesh, job->points)) != EXIT_OK)
@@ -179,11 +182,12 @@ static void report_file(const file_job *job) {
     const char *and = opt->confidence ? " and " : "";
     const char *confidence = opt->confidence ? opt->confidence : "";
     if (!opt->quiet && r->discrepancy_iterations > 0)
-        fprintf(stderr, "rsmooth: %s: --auto: a choice per region: the filter's result where it "
-                        "came out flat faces and creases, Taubin smoothing (%d iterations, until "
-                        "the vertices moved as far as the noise) where it came out curved at the "
-                        "scale of its triangles (organic parts coarse for their curvature), "
-                        "blended between: the filter's weight %.0f%% on average\n",
+        fprintf(stderr,
+                "rsmooth: %s: --auto: a choice per region: the filter's result where it "
+                "came out flat faces and creases, Taubin smoothing (%d iterations, until "
+                "the vertices moved as far as the noise) where it came out curved at the "
+                "scale of its triangles (organic parts coarse for their curvature), "
+                "blended between: the filter's weight %.0f%% on average\n",
                 opt->input, r->discrepancy_iterations, 100 * r->region_filter_share);
     if (!opt->quiet)
         cli_print_harm(opt->input, r);
@@ -195,13 +199,13 @@ static void report_file(const file_job *job) {
         return;
     if (!cli_method_uses_edges(opt->method) && opt->params.passes == 0 &&
         opt->params.vertex_updates == 0) /* --auto found nothing to remove */
-        fprintf(stderr, "rsmooth: %s: %zu vertices, %zu triangles; nothing to remove: every "
-                        "vertex as it was; wrote %s%s%s\n",
+        fprintf(stderr,
+                "rsmooth: %s: %zu vertices, %zu triangles; nothing to remove: every "
+                "vertex as it was; wrote %s%s%s\n",
                 opt->input, r->vertex_count, r->triangle_count, job->wrote, and, confidence);
     else if (cli_method_uses_edges(opt->method))
         fprintf(stderr, "rsmooth: %s: %zu vertices, %zu triangles; %s: %.1f ms; wrote %s\n",
-                opt->input, r->vertex_count, r->triangle_count, r->device, r->ms_total,
-                job->wrote);
+                opt->input, r->vertex_count, r->triangle_count, r->device, r->ms_total, job->wrote);
     else if (r->discrepancy_iterations > 0)
         fprintf(stderr,
                 "rsmooth: %s: %zu vertices, %zu triangles, mean edge %.6g; the filter (%.0f%%) "
@@ -214,14 +218,14 @@ static void report_file(const file_job *job) {
         fprintf(stderr,
                 "rsmooth: %s: %zu points with normals, spacing %.6g; sigma_f %.6g, sigma_g "
                 "%.6g (cloud units) on %s: filter %.1f ms; wrote %s%s%s\n",
-                opt->input, r->vertex_count, r->mean_edge_length, r->sigma_f, r->sigma_g,
-                r->device, r->ms_total, job->wrote, and, confidence);
+                opt->input, r->vertex_count, r->mean_edge_length, r->sigma_f, r->sigma_g, r->device,
+                r->ms_total, job->wrote, and, confidence);
     else
         fprintf(stderr,
                 "rsmooth: %s: %zu vertices, %zu triangles, mean edge %.6g; sigma_f %.6g, "
                 "sigma_g %.6g (mesh units) on %s: filter %.1f ms; wrote %s%s%s\n",
-                opt->input, r->vertex_count, r->triangle_count, r->mean_edge_length,
-                r->sigma_f, r->sigma_g, r->device, r->ms_total, job->wrote, and, confidence);
+                opt->input, r->vertex_count, r->triangle_count, r->mean_edge_length, r->sigma_f,
+                r->sigma_g, r->device, r->ms_total, job->wrote, and, confidence);
 }
 
 int cli_smooth_file(const options *opt, const char *path) {

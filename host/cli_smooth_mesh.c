@@ -1,9 +1,9 @@
 /* The rsmooth command's filtering of one mesh in memory: the filter on the chosen device, the
  * Laplacian and Taubin baselines, and point clouds (see cli_smooth.h). */
 #define _POSIX_C_SOURCE 200809L
-#include "cli_smooth.h"
-#include "cli_files.h"
 #include "cli_device.h"
+#include "cli_files.h"
+#include "cli_smooth.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -104,9 +104,8 @@ int cli_check_point_cloud(const options *opt, const rsmooth_mesh *mesh) {
 
 /* The point-cloud filter on `ctx` (NULL: the reference path). */
 static rsmooth_status filter_points(rsmooth_context *ctx, const rsmooth_mesh *mesh,
-                                    const rsmooth_params *params, double *out,
-                                    double *out_normals, float *confidence,
-                                    rsmooth_report *report, rsmooth_error *err) {
+                                    const rsmooth_params *params, double *out, double *out_normals,
+                                    float *confidence, rsmooth_report *report, rsmooth_error *err) {
     if (!ctx)
         return rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, mesh->positions,
                                                mesh->vertex_normals, mesh->vertex_count, params,
@@ -126,8 +125,9 @@ int cli_smooth_points(const options *opt, const rsmooth_mesh *mesh, double *out,
         return code;
     if (!opt->quiet) {
         cli_progress_clear(bar);
-        fprintf(stderr, "rsmooth: note: %s is a point cloud (no faces): filtering its points and "
-                        "normals %s%s%s\n",
+        fprintf(stderr,
+                "rsmooth: note: %s is a point cloud (no faces): filtering its points and "
+                "normals %s%s%s\n",
                 opt->input, ctx ? "on device '" : "on the reference path (CPU)",
                 ctx ? rsmooth_context_device_name(ctx) : "", ctx ? "'" : "");
     }

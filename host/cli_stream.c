@@ -11,16 +11,16 @@
 /* The option that needs the whole mesh in memory, or NULL. */
 static const char *whole_mesh_option(const options *opt) {
     const rsmooth_params *p = &opt->params;
-    return opt->best                                         ? "--best"
-           : opt->auto_params                                ? "--auto"
-           : p->vertex_updates > 0                           ? "--vertex-updates"
-           : p->passes != 1                                  ? "--passes"
-           : opt->colors                                     ? "--sigma-c"
-           : opt->mask                                       ? "--mask"
-           : opt->confidence                                 ? "--confidence"
-           : opt->stats                                      ? "--stats"
-           : cli_method_uses_edges(opt->method)              ? "--method"
-                                                             : NULL;
+    return opt->best                            ? "--best"
+           : opt->auto_params                   ? "--auto"
+           : p->vertex_updates > 0              ? "--vertex-updates"
+           : p->passes != 1                     ? "--passes"
+           : opt->colors                        ? "--sigma-c"
+           : opt->mask                          ? "--mask"
+           : opt->confidence                    ? "--confidence"
+           : opt->stats                         ? "--stats"
+           : cli_method_uses_edges(opt->method) ? "--method"
+                                                : NULL;
 }
 
 int cli_stream_check(const options *opt) {
@@ -32,17 +32,19 @@ int cli_stream_check(const options *opt) {
     }
     const char *option = whole_mesh_option(opt);
     if (option)
-        return cli_usage_error(NULL, "--max-memory filters each piece of the mesh in one pass "
-                                     "from the pieces around it: %s needs the whole mesh in "
-                                     "memory (drop one of them)", option);
+        return cli_usage_error(NULL,
+                               "--max-memory filters each piece of the mesh in one pass "
+                               "from the pieces around it: %s needs the whole mesh in "
+                               "memory (drop one of them)",
+                               option);
     bool std_stream = opt->output_option && !strcmp(opt->output_option, "-");
     for (size_t i = 0; i < opt->input_count; i++)
         std_stream = std_stream || !strcmp(opt->inputs[i], "-");
     if (std_stream)
         return cli_usage_error(NULL, "--max-memory reads its input several times and writes "
                                      "its output in place: give files, not '-'");
-    if (opt->ascii || (opt->format != RSMOOTH_FORMAT_AUTO &&
-                       opt->format != RSMOOTH_FORMAT_PLY_BINARY))
+    if (opt->ascii ||
+        (opt->format != RSMOOTH_FORMAT_AUTO && opt->format != RSMOOTH_FORMAT_PLY_BINARY))
         return cli_usage_error(NULL, "--max-memory writes the input's own binary PLY: drop "
                                      "--ascii and --format");
     if (opt->params.guard && !opt->quiet) /* (what the pieces cannot do yet, said once) */
@@ -103,8 +105,10 @@ void cli_stream_print_json(const rsmooth_stream_report *r, const options *opt, i
 int cli_stream_file(const options *opt, const char *path) {
     if (cli_result_format(opt, opt->output, RSMOOTH_FORMAT_PLY_BINARY) !=
         RSMOOTH_FORMAT_PLY_BINARY) {
-        fprintf(stderr, "rsmooth: %s: --max-memory writes the input's own binary PLY: name the "
-                        "output .ply\n", opt->output);
+        fprintf(stderr,
+                "rsmooth: %s: --max-memory writes the input's own binary PLY: name the "
+                "output .ply\n",
+                opt->output);
         return EXIT_USAGE;
     }
     cli_progress bar;

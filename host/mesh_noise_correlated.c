@@ -26,8 +26,8 @@ static double uniform01(uint64_t *state) {
 /* A uniform grid of cubes of side `cell`: the vertices sorted by cell. */
 typedef struct cell_grid {
     double cell, lo[3];
-    int64_t *key;     /* per sorted entry */
-    size_t *vertex;   /* per sorted entry */
+    int64_t *key;   /* per sorted entry */
+    size_t *vertex; /* per sorted entry */
     size_t count;
 } cell_grid;
 
@@ -43,8 +43,10 @@ static void cell_of(const cell_grid *g, const double *p, int64_t c[3]) {
 static const int64_t *sort_keys;
 static int compare_entries(const void *a, const void *b) {
     int64_t ka = sort_keys[*(const size_t *)a], kb = sort_keys[*(const size_t *)b];
-    return ka < kb ? -1 : ka > kb ? 1 : (*(const size_t *)a > *(const size_t *)b) -
-                                            (*(const size_t *)a < *(const size_t *)b);
+    return ka < kb   ? -1
+           : ka > kb ? 1
+                     : (*(const size_t *)a > *(const size_t *)b) -
+                           (*(const size_t *)a < *(const size_t *)b);
 }
 
 static int build_grid(cell_grid *g, const double *xyz, size_t n, double cell) {

@@ -1,8 +1,8 @@
 /* Digests of a rank's job, compared across ranks (see mpi_agree.h). */
 #define _POSIX_C_SOURCE 200809L
 #include "mpi_agree.h"
-#include "core/blake2b.h"
 #include "cli_files.h"
+#include "core/blake2b.h"
 
 #include <errno.h>
 #include <fcntl.h>

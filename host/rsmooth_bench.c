@@ -762,9 +762,9 @@ static int points_args(int argc, char **argv, points_bench *b) {
             return EXIT_OK;
         } else if (!strcmp(a, "--device") && value) {
             b->device = argv[++i];
-        } else if (value && (!strcmp(a, "--vertices") || !strcmp(a, "--noise") ||
-                             !strcmp(a, "--sigma-f") || !strcmp(a, "--sigma-g") ||
-                             !strcmp(a, "--repeat"))) {
+        } else if (value &&
+                   (!strcmp(a, "--vertices") || !strcmp(a, "--noise") || !strcmp(a, "--sigma-f") ||
+                    !strcmp(a, "--sigma-g") || !strcmp(a, "--repeat"))) {
             i++;
             bool ok = cli_parse_number(value, &x);
             if (!strcmp(a, "--vertices") && (ok = ok && x >= 50 && x <= 5e8))
@@ -784,8 +784,10 @@ static int points_args(int argc, char **argv, points_bench *b) {
         } else if (a[0] != '-' && !b->mesh_path) {
             b->mesh_path = a;
         } else {
-            fprintf(stderr, "rsmooth-bench points: unexpected '%s'\nTry 'rsmooth-bench points "
-                            "--help'.\n", a);
+            fprintf(stderr,
+                    "rsmooth-bench points: unexpected '%s'\nTry 'rsmooth-bench points "
+                    "--help'.\n",
+                    a);
             return EXIT_USAGE;
         }
     }
@@ -854,8 +856,8 @@ static rsmooth_status points_run_one(points_bench *b, int which, rsmooth_report 
                                     b->triangle_count, &p, b->out, NULL, NULL, r, &err);
     *ms = now_ms() - t0;
     if (st != RSMOOTH_OK)
-        fprintf(stderr, "rsmooth-bench: %s: %s\n", which ? "rsmooth_smooth" : "rsmooth_smooth_points",
-                err.message);
+        fprintf(stderr, "rsmooth-bench: %s: %s\n",
+                which ? "rsmooth_smooth" : "rsmooth_smooth_points", err.message);
     return st;
 }
 
@@ -872,8 +874,8 @@ static void print_points_figures(const points_bench *b, double med[3], double st
         print_json_number(keys[k], values[k]);
         printf(",");
     }
-    static const char *const names[6] = {"spacing", "grid", "upload", "normals", "robust",
-                                         "download"};
+    static const char *const names[6] = {"spacing", "grid",   "upload",
+                                         "normals", "robust", "download"};
     printf("\"points_stages_ms\":{");
     for (int s = 0; s < 6; s++)
         printf("%s\"%s\":%.3f", s ? "," : "", names[s], stages[s]);
@@ -906,8 +908,9 @@ static int bench_points(int argc, char **argv) {
                     continue;
                 runs[which][i - 1] = ms;
                 if (which == 0) { /* ms_facets: the passes' spacings and areas (k-d tree) */
-                    double s[6] = {r.ms_facets, r.ms_grid,   r.ms_upload,
-                                   r.ms_mollify + r.ms_normals, r.ms_robust, r.ms_download};
+                    double s[6] = {r.ms_facets, r.ms_grid,
+                                   r.ms_upload, r.ms_mollify + r.ms_normals,
+                                   r.ms_robust, r.ms_download};
                     for (int k = 0; k < 6; k++)
                         stage[k][i - 1] = s[k];
                 }

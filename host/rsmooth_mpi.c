@@ -69,13 +69,14 @@ static int parse(int argc, char **argv, int rank, options *opt) {
     }
     for (int i = 1; i < argc && strcmp(argv[i], "--") != 0; i++)
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
-            printf("usage: mpirun -n N rsmooth-mpi IN.ply -o OUT.ply [options]\n\n"
-                   "rsmooth --max-memory (a binary PLY streamed in pieces) with the pieces shared\n"
-                   "among MPI ranks: every rank reads the input (a shared file system), makes the\n"
-                   "same plan and filters its share on its own device; the output is the single\n"
-                   "process's byte for byte. --max-memory is each rank's cap (default 1G); '%%l' in\n"
-                   "--device is the rank's index on its node (--device 0:%%l: one GPU per rank).\n"
-                   "The options are rsmooth's:\n\n");
+            printf(
+                "usage: mpirun -n N rsmooth-mpi IN.ply -o OUT.ply [options]\n\n"
+                "rsmooth --max-memory (a binary PLY streamed in pieces) with the pieces shared\n"
+                "among MPI ranks: every rank reads the input (a shared file system), makes the\n"
+                "same plan and filters its share on its own device; the output is the single\n"
+                "process's byte for byte. --max-memory is each rank's cap (default 1G); '%%l' in\n"
+                "--device is the rank's index on its node (--device 0:%%l: one GPU per rank).\n"
+                "The options are rsmooth's:\n\n");
             break;
         }
     int code = cli_options_parse(argc, argv, opt);
@@ -172,12 +173,12 @@ int main(int argc, char **argv) {
         cli_stream_print_error(program, err.message);
     code = st == RSMOOTH_OK ? EXIT_OK : cli_stream_exit_code(st);
     if (st == RSMOOTH_OK && !quiet)
-        fprintf(stderr, "rsmooth-mpi: rank %d of %d on %s: %zu pieces, %llu facets with halos, "
-                        "assemble %.1f s, filter %.1f s, write %.1f s\n",
-                rank, ranks, rep.device[0] ? rep.device : "no device (no pieces)",
-                rep.pieces_here, (unsigned long long)rep.facets_filtered, rep.ms_assemble / 1000,
-                rep.ms_filter / 1000,
-                rep.ms_write / 1000);
+        fprintf(stderr,
+                "rsmooth-mpi: rank %d of %d on %s: %zu pieces, %llu facets with halos, "
+                "assemble %.1f s, filter %.1f s, write %.1f s\n",
+                rank, ranks, rep.device[0] ? rep.device : "no device (no pieces)", rep.pieces_here,
+                (unsigned long long)rep.facets_filtered, rep.ms_assemble / 1000,
+                rep.ms_filter / 1000, rep.ms_write / 1000);
     MPI_Barrier(MPI_COMM_WORLD); /* the ranks' lines before the summary */
     if (st == RSMOOTH_OK && rank == 0) {
         if (rep.notes[0] && !quiet)
@@ -190,8 +191,8 @@ int main(int argc, char **argv) {
                     "over %d ranks under --max-memory %llu MB each: read %.1f s, statistics "
                     "%.1f s, cut %.1f s, copy %.1f s, total %.1f s; wrote %s\n",
                     opt.input, (unsigned long long)rep.vertex_count,
-                    (unsigned long long)rep.triangle_count, rep.mean_edge_length, rep.pieces,
-                    ranks, (unsigned long long)(opt.max_memory >> 20), rep.ms_read / 1000,
+                    (unsigned long long)rep.triangle_count, rep.mean_edge_length, rep.pieces, ranks,
+                    (unsigned long long)(opt.max_memory >> 20), rep.ms_read / 1000,
                     rep.ms_statistics / 1000, rep.ms_buckets / 1000, rep.ms_copy / 1000,
                     rep.ms_total / 1000, opt.output);
     }

@@ -30,14 +30,12 @@ inline void store_group_normals(lanef ax, lanef ay, lanef az, lanef nx, lanef ny
         vstore4((float4)(mx[l], my[l], mz[l], 0.0f), first + l, (__global float *)normal_out);
 }
 
-__kernel void bilateral_cell_normals(uint cell_count, float reach2, float inv_2s2, float inv_2t2,
-                                     __global const float4 *facet_centroid,
-                                     __global const float4 *normal_in,
-                                     __global const int4 *cell_coord,
-                                     __global const uint *cell_start,
-                                     __global const uint *column_first,
-                                     __global const int *column_table, uint column_mask,
-                                     __global float4 *normal_out, __global ulong *cell_pairs) {
+__kernel void
+bilateral_cell_normals(uint cell_count, float reach2, float inv_2s2, float inv_2t2,
+                       __global const float4 *facet_centroid, __global const float4 *normal_in,
+                       __global const int4 *cell_coord, __global const uint *cell_start,
+                       __global const uint *column_first, __global const int *column_table,
+                       uint column_mask, __global float4 *normal_out, __global ulong *cell_pairs) {
     uint c = get_global_id(0);
     if (c >= cell_count)
         return;
@@ -63,25 +61,25 @@ __kernel void bilateral_cell_normals(uint cell_count, float reach2, float inv_2s
         float3 lo = (float3)(lane_min(px), lane_min(py), lane_min(pz));
         float3 hi = (float3)(lane_max(px), lane_max(py), lane_max(pz));
         lanef ax = 0.0f, ay = 0.0f, az = 0.0f;
-        FOR_EACH_CELL_NEAR(anchor, lo, hi, reach2, cell_coord, column_first, column_table,
-                           column_mask, {
-            lanef qx = px - (float)dx, qy = py - (float)dy, qz = pz - (float)dz;
-            uint begin = cell_start[cell], end = cell_start[cell + 1];
-            pairs += end - begin;
-            for (uint q = begin; q < end; q++) {
-                float4 cq = facet_centroid[q];
-                float4 nq = normal_in[q];
-                lanef ex = cq.x - qx, ey = cq.y - qy, ez = cq.z - qz;
-                lanef d2 = ex * ex + ey * ey + ez * ez;
-                lanef fx = nq.x - nx, fy = nq.y - ny, fz = nq.z - nz;
-                lanef m2 = fx * fx + fy * fy + fz * fz;
-                lanef w = select((lanef)0.0f, fast_exp2(cq.w - d2 * inv_2s2 - m2 * inv_2t2),
-                                 d2 <= reach2);
-                ax += w * nq.x;
-                ay += w * nq.y;
-                az += w * nq.z;
-            }
-        })
+        FOR_EACH_CELL_NEAR(
+            anchor, lo, hi, reach2, cell_coord, column_first, column_table, column_mask, {
+                lanef qx = px - (float)dx, qy = py - (float)dy, qz = pz - (float)dz;
+                uint begin = cell_start[cell], end = cell_start[cell + 1];
+                pairs += end - begin;
+                for (uint q = begin; q < end; q++) {
+                    float4 cq = facet_centroid[q];
+                    float4 nq = normal_in[q];
+                    lanef ex = cq.x - qx, ey = cq.y - qy, ez = cq.z - qz;
+                    lanef d2 = ex * ex + ey * ey + ez * ez;
+                    lanef fx = nq.x - nx, fy = nq.y - ny, fz = nq.z - nz;
+                    lanef m2 = fx * fx + fy * fy + fz * fz;
+                    lanef w = select((lanef)0.0f, fast_exp2(cq.w - d2 * inv_2s2 - m2 * inv_2t2),
+                                     d2 <= reach2);
+                    ax += w * nq.x;
+                    ay += w * nq.y;
+                    az += w * nq.z;
+                }
+            })
         store_group_normals(ax, ay, az, nx, ny, nz, normal_out, group, count);
     }
     cell_pairs[c] = pairs;
@@ -113,8 +111,10 @@ inline lanef bilateral_exp2(lanef x) {
     lanef y = fmax(x, -127.0f);
     lanei t = convert_lanei(y + 128.5f); /* n + 128, n = y rounded to nearest */
     lanef f = y - (convert_lanef(t) - 128.0f);
-    lanef p = 1.00000012f + f * (0.693146944f + f * (0.240221202f + f * (0.0555071346f +
-                                 f * (0.00967554096f + f * 0.00132764666f))));
+    lanef p =
+        1.00000012f +
+        f * (0.693146944f +
+             f * (0.240221202f + f * (0.0555071346f + f * (0.00967554096f + f * 0.00132764666f))));
     return p * as_lanef((t - 1) << 23);
 }
 
@@ -126,7 +126,7 @@ inline uint some_lane(lanei m) {
 /* The search of bilateral_cell_normals for group g: BODY runs for each facet q of each cell near
  * the group's box, with cq = facet_centroid[q], d2 its squared distance to each lane's centroid
  * and near = d2 <= reach2. */
-#define BILATERAL_GROUP_SEARCH(BODY)                                                              \
+#define BILATERAL_GROUP_SEARCH(BODY)                                                               \
     uint4 info = group_info[g];                                                                    \
     int4 anchor = cell_coord[info.z];                                                              \
     float rx[RS_LANES], ry[RS_LANES], rz[RS_LANES];                                                \
@@ -141,23 +141,22 @@ inline uint some_lane(lanei m) {
     float3 hi = (float3)(lane_max(px), lane_max(py), lane_max(pz));                                \
     FOR_EACH_CELL_NEAR(anchor, lo, hi, reach2, cell_coord, column_first, column_table,             \
                        column_mask, {                                                              \
-        lanef qx = px - (float)dx, qy = py - (float)dy, qz = pz - (float)dz;                       \
-        uint begin = cell_start[cell], end = cell_start[cell + 1];                                 \
-        for (uint q = begin; q < end; q++) {                                                       \
-            float4 cq = facet_centroid[q];                                                         \
-            lanef ex = cq.x - qx, ey = cq.y - qy, ez = cq.z - qz;                                  \
-            lanef d2 = ex * ex + ey * ey + ez * ez;                                                \
-            lanei near = d2 <= reach2;                                                             \
-            BODY                                                                                   \
-        }                                                                                          \
-    })
+                           lanef qx = px - (float)dx, qy = py - (float)dy, qz = pz - (float)dz;    \
+                           uint begin = cell_start[cell], end = cell_start[cell + 1];              \
+                           for (uint q = begin; q < end; q++) {                                    \
+                               float4 cq = facet_centroid[q];                                      \
+                               lanef ex = cq.x - qx, ey = cq.y - qy, ez = cq.z - qz;               \
+                               lanef d2 = ex * ex + ey * ey + ez * ez;                             \
+                               lanei near = d2 <= reach2;                                          \
+                               BODY                                                                \
+                           }                                                                       \
+                       })
 
 __kernel void bilateral_count(uint group_count, float reach2, __global const uint4 *group_info,
                               __global const float4 *facet_centroid,
                               __global const int4 *cell_coord, __global const uint *cell_start,
-                              __global const uint *column_first,
-                              __global const int *column_table, uint column_mask,
-                              __global uint *list_start) {
+                              __global const uint *column_first, __global const int *column_table,
+                              uint column_mask, __global uint *list_start) {
     uint g = get_global_id(0);
     if (g >= group_count)
         return;
@@ -168,11 +167,11 @@ __kernel void bilateral_count(uint group_count, float reach2, __global const uin
 
 __kernel void bilateral_fill(uint group_count, float reach2, float inv_2s2, float shift,
                              __global const uint4 *group_info,
-                             __global const float4 *facet_centroid,
-                             __global const int4 *cell_coord, __global const uint *cell_start,
-                             __global const uint *column_first, __global const int *column_table,
-                             uint column_mask, __global const uint *list_start,
-                             __global uint *list_facet, __global float *list_weight) {
+                             __global const float4 *facet_centroid, __global const int4 *cell_coord,
+                             __global const uint *cell_start, __global const uint *column_first,
+                             __global const int *column_table, uint column_mask,
+                             __global const uint *list_start, __global uint *list_facet,
+                             __global float *list_weight) {
     uint g = get_global_id(0);
     if (g >= group_count)
         return;
@@ -191,13 +190,11 @@ __kernel void bilateral_fill(uint group_count, float reach2, float inv_2s2, floa
  * is a row's value plus a dot product. That form loses about 2 inv_2t2 float ulps to
  * cancellation, so for narrow normal widths (large inv_2t2) the host asks for the difference
  * itself (`dot` 0, shift 0). */
-__kernel void bilateral_list_normals(uint group_count, float inv_2t2, int dot,
-                                     __global const uint4 *group_info,
-                                     __global const uint *list_start,
-                                     __global const uint *list_facet,
-                                     __global const float *list_weight,
-                                     __global const float4 *normal_in,
-                                     __global float4 *normal_out) {
+__kernel void
+bilateral_list_normals(uint group_count, float inv_2t2, int dot, __global const uint4 *group_info,
+                       __global const uint *list_start, __global const uint *list_facet,
+                       __global const float *list_weight, __global const float4 *normal_in,
+                       __global float4 *normal_out) {
     uint g = get_global_id(0);
     if (g >= group_count)
         return;
@@ -217,8 +214,8 @@ __kernel void bilateral_list_normals(uint group_count, float inv_2t2, int dot,
         lanef sx = nx * two_inv_2t2, sy = ny * two_inv_2t2, sz = nz * two_inv_2t2;
         for (uint row = begin; row < end; row++) {
             float4 nq = normal_in[list_facet[row]];
-            lanef w = bilateral_exp2(load_lanes(row, list_weight) + nq.x * sx + nq.y * sy +
-                                     nq.z * sz);
+            lanef w =
+                bilateral_exp2(load_lanes(row, list_weight) + nq.x * sx + nq.y * sy + nq.z * sz);
             ax += w * nq.x;
             ay += w * nq.y;
             az += w * nq.z;

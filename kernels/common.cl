@@ -8,12 +8,13 @@
  * and no area underflows; every exponent is in base 2 (see fast_exp2).
  *
  * Vertices travel in blocks of up to RS_LANES vertices spanning at most two cells per axis, one
- * block per work-item and one vertex per vector lane: the cells within reach of the block are looked
- * up once, and each facet is loaded once and evaluated against every lane at once (explicit
+ * block per work-item and one vertex per vector lane: the cells within reach of the block are
+ * looked up once, and each facet is loaded once and evaluated against every lane at once (explicit
  * vectors, which CPU devices run as SIMD instructions). Cells are a fraction of the reach wide
- * (the host picks how many per reach), so the cells searched hug the ball of reach around the block. A vertex's "slot" is block * RS_LANES + lane. Per-vertex arrays are stored
- * per block, component by component: the x of every lane, then every y, and so on. Unused lanes
- * repeat lane 0 and their results are never read.
+ * (the host picks how many per reach), so the cells searched hug the ball of reach around the
+ * block. A vertex's "slot" is block * RS_LANES + lane. Per-vertex arrays are stored per block,
+ * component by component: the x of every lane, then every y, and so on. Unused lanes repeat lane 0
+ * and their results are never read.
  *
  * Buffers (facets sorted by cell):
  *   facet_centroid[q]  float4 (c_q local to its cell, log area)
@@ -46,9 +47,15 @@ typedef int lanei;
 #define convert_lanef convert_float
 #define convert_lanei convert_int
 #define as_lanef as_float
-inline int lane_any(lanei m) { return m != 0; }
-inline float lane_min(lanef v) { return v; }
-inline float lane_max(lanef v) { return v; }
+inline int lane_any(lanei m) {
+    return m != 0;
+}
+inline float lane_min(lanef v) {
+    return v;
+}
+inline float lane_max(lanef v) {
+    return v;
+}
 #else
 typedef RS_CAT(float, RS_LANES) lanef;
 typedef RS_CAT(int, RS_LANES) lanei;
@@ -57,16 +64,32 @@ typedef RS_CAT(int, RS_LANES) lanei;
 #define convert_lanef RS_CAT(convert_float, RS_LANES)
 #define convert_lanei RS_CAT(convert_int, RS_LANES)
 #define as_lanef RS_CAT(as_float, RS_LANES)
-inline int lane_any(lanei m) { return any(m); }
+inline int lane_any(lanei m) {
+    return any(m);
+}
 /* Smallest and largest value over the lanes, halving the vector. */
-inline float min4(float4 m) { float2 n = fmin(m.lo, m.hi); return fmin(n.x, n.y); }
-inline float max4(float4 m) { float2 n = fmax(m.lo, m.hi); return fmax(n.x, n.y); }
+inline float min4(float4 m) {
+    float2 n = fmin(m.lo, m.hi);
+    return fmin(n.x, n.y);
+}
+inline float max4(float4 m) {
+    float2 n = fmax(m.lo, m.hi);
+    return fmax(n.x, n.y);
+}
 #if RS_LANES == 4
-inline float lane_min(lanef v) { return min4(v); }
-inline float lane_max(lanef v) { return max4(v); }
+inline float lane_min(lanef v) {
+    return min4(v);
+}
+inline float lane_max(lanef v) {
+    return max4(v);
+}
 #elif RS_LANES == 8
-inline float lane_min(lanef v) { return min4(fmin(v.lo, v.hi)); }
-inline float lane_max(lanef v) { return max4(fmax(v.lo, v.hi)); }
+inline float lane_min(lanef v) {
+    return min4(fmin(v.lo, v.hi));
+}
+inline float lane_max(lanef v) {
+    return max4(fmax(v.lo, v.hi));
+}
 #elif RS_LANES == 16
 /* The halves through a private array, not v.lo and v.hi: Oclgrind takes a lane picked from
  * element 11 of a vector for undefined (its error 7 in tests/test_oclgrind.c); compilers keep the
@@ -96,9 +119,11 @@ inline float lane_max(lanef v) {
 inline lanef fast_exp2(lanef x) {
     lanef y = clamp(x, -126.0f, 127.0f);
     lanei n = convert_lanei(y + 128.5f) - 128; /* round to nearest, through truncation of y > 0 */
-    lanef f = y - convert_lanef(n);          /* |f| <= 1/2 */
-    lanef p = 1.00000012f + f * (0.693146944f + f * (0.240221202f + f * (0.0555071346f +
-                                 f * (0.00967554096f + f * 0.00132764666f))));
+    lanef f = y - convert_lanef(n);            /* |f| <= 1/2 */
+    lanef p =
+        1.00000012f +
+        f * (0.693146944f +
+             f * (0.240221202f + f * (0.0555071346f + f * (0.00967554096f + f * 0.00132764666f))));
     return p * as_lanef((n + 127) << 23);
 }
 
@@ -187,8 +212,8 @@ inline lanei load_offsets(uint k, __global const uchar *offset) {
     lanef px = load_lanes(0, pos_), py = load_lanes(1, pos_), pz = load_lanes(2, pos_);            \
     __global const uchar *off_ = (block_offset) + 3 * RS_LANES * (size_t)(b);                      \
     lanei ox = load_offsets(0, off_), oy = load_offsets(1, off_), oz = load_offsets(2, off_);      \
-    lanef ax_ = px + convert_lanef(ox), ay_ = py + convert_lanef(oy),                            \
-          az_ = pz + convert_lanef(oz);                                                           \
+    lanef ax_ = px + convert_lanef(ox), ay_ = py + convert_lanef(oy),                              \
+          az_ = pz + convert_lanef(oz);                                                            \
     float3 lo = (float3)(lane_min(ax_), lane_min(ay_), lane_min(az_));                             \
     float3 hi = (float3)(lane_max(ax_), lane_max(ay_), lane_max(az_))
 
@@ -221,19 +246,18 @@ inline int4 slot_cell(__global const int4 *block_cell, __global const uchar *blo
 /* FOR_EACH_FACET_NEAR's walk for the lanes of one work-item alone, straight from global memory:
  * the block variant's, and the group variant's rare rescue. */
 #define FOR_EACH_FACET_OWN(REACH2, NORMALS, PAIRS, ...)                                            \
-    FOR_EACH_CELL_NEAR(anchor, lo, hi, REACH2, cell_coord, column_first, column_table,             \
-                       column_mask, {                                                              \
-        lanef qx = px - convert_lanef(dx - ox), qy = py - convert_lanef(dy - oy),                  \
-              qz = pz - convert_lanef(dz - oz);                                                    \
-        uint begin_ = cell_start[cell], end_ = cell_start[cell + 1];                               \
-        (PAIRS) += end_ - begin_;                                                                  \
-        for (uint q = begin_; q < end_; q++) {                                                     \
-            float4 c = facet_centroid[q];                                                          \
-            float4 n = (NORMALS)[q];                                                               \
-            __VA_ARGS__                                                                            \
-        }                                                                                          \
-    })
-
+    FOR_EACH_CELL_NEAR(                                                                            \
+        anchor, lo, hi, REACH2, cell_coord, column_first, column_table, column_mask, {             \
+            lanef qx = px - convert_lanef(dx - ox), qy = py - convert_lanef(dy - oy),              \
+                  qz = pz - convert_lanef(dz - oz);                                                \
+            uint begin_ = cell_start[cell], end_ = cell_start[cell + 1];                           \
+            (PAIRS) += end_ - begin_;                                                              \
+            for (uint q = begin_; q < end_; q++) {                                                 \
+                float4 c = facet_centroid[q];                                                      \
+                float4 n = (NORMALS)[q];                                                           \
+                __VA_ARGS__                                                                        \
+            }                                                                                      \
+        })
 
 #if RS_LANES == 1
 
@@ -254,9 +278,9 @@ inline int4 slot_cell(__global const int4 *block_cell, __global const uchar *blo
 
 /* Work-items past the last vertex repeat it (every work-item must reach the barriers), and their
  * results are never stored. The group's anchor is its lowest cell; work-item 0 forms the box. */
-#define BEGIN_BLOCK(b, block_count, block_pos, block_cell, block_offset)                          \
+#define BEGIN_BLOCK(b, block_count, block_pos, block_cell, block_offset)                           \
     DECLARE_STAGE;                                                                                 \
-    uint own_ = min((uint)(b), (block_count) - 1), lid_ = get_local_id(0);                         \
+    uint own_ = min((uint)(b), (block_count)-1), lid_ = get_local_id(0);                           \
     lanef px = (block_pos)[3 * own_], py = (block_pos)[3 * own_ + 1],                              \
           pz = (block_pos)[3 * own_ + 2];                                                          \
     int4 cell_ = (block_cell)[own_];                                                               \
@@ -288,7 +312,7 @@ inline int4 slot_cell(__global const int4 *block_cell, __global const uchar *blo
     barrier(CLK_LOCAL_MEM_FENCE);                                                                  \
     for (uint i_ = 0; i_ < filled_; i_++) {                                                        \
         uint q = stage_q[i_];                                                                      \
-        if (q != UINT_MAX) { /* within reach of the group's box: the same for every work-item */  \
+        if (q != UINT_MAX) { /* within reach of the group's box: the same for every work-item */   \
             int4 d_ = stage_d[i_];                                                                 \
             lanef qx = px - convert_lanef(d_.x - ox), qy = py - convert_lanef(d_.y - oy),          \
                   qz = pz - convert_lanef(d_.z - oz);                                              \
@@ -304,31 +328,31 @@ inline int4 slot_cell(__global const int4 *block_cell, __global const uchar *blo
 #define FOR_EACH_FACET_NEAR(REACH2, NORMALS, PAIRS, ...)                                           \
     {                                                                                              \
         uint filled_ = 0, slot_ = get_local_id(0);                                                 \
-        float cull2_ = (REACH2) * 1.001f + 1e-3f;                                                  \
-        FOR_EACH_CELL_NEAR(anchor, lo, hi, REACH2, cell_coord, column_first, column_table,         \
-                           column_mask, {                                                          \
-            uint next_ = cell_start[cell], end_ = cell_start[cell + 1];                            \
-            while (next_ < end_) {                                                                 \
-                uint take_ = min(end_ - next_, (uint)RS_GROUP - filled_);                          \
-                if (slot_ < take_) {                                                               \
-                    uint q_ = next_ + slot_;                                                       \
-                    float4 c_ = facet_centroid[q_];                                                \
-                    float3 g_ = convert_float3((int3)(dx, dy, dz)) + c_.xyz;                       \
-                    float3 gap_ = fmax((float3)0.0f, fmax(lo - g_, g_ - hi));                      \
-                    float gap2_ = gap_.x * gap_.x + gap_.y * gap_.y + gap_.z * gap_.z;             \
-                    stage_q[filled_ + slot_] = gap2_ <= cull2_ ? q_ : UINT_MAX;                    \
-                    stage_c[filled_ + slot_] = c_;                                                 \
-                    stage_n[filled_ + slot_] = (NORMALS)[q_];                                      \
-                    vstore4((int4)(dx, dy, dz, 0), filled_ + slot_, (__local int *)stage_d);       \
+        float cull2_ = (REACH2)*1.001f + 1e-3f;                                                    \
+        FOR_EACH_CELL_NEAR(                                                                        \
+            anchor, lo, hi, REACH2, cell_coord, column_first, column_table, column_mask, {         \
+                uint next_ = cell_start[cell], end_ = cell_start[cell + 1];                        \
+                while (next_ < end_) {                                                             \
+                    uint take_ = min(end_ - next_, (uint)RS_GROUP - filled_);                      \
+                    if (slot_ < take_) {                                                           \
+                        uint q_ = next_ + slot_;                                                   \
+                        float4 c_ = facet_centroid[q_];                                            \
+                        float3 g_ = convert_float3((int3)(dx, dy, dz)) + c_.xyz;                   \
+                        float3 gap_ = fmax((float3)0.0f, fmax(lo - g_, g_ - hi));                  \
+                        float gap2_ = gap_.x * gap_.x + gap_.y * gap_.y + gap_.z * gap_.z;         \
+                        stage_q[filled_ + slot_] = gap2_ <= cull2_ ? q_ : UINT_MAX;                \
+                        stage_c[filled_ + slot_] = c_;                                             \
+                        stage_n[filled_ + slot_] = (NORMALS)[q_];                                  \
+                        vstore4((int4)(dx, dy, dz, 0), filled_ + slot_, (__local int *)stage_d);   \
+                    }                                                                              \
+                    filled_ += take_;                                                              \
+                    next_ += take_;                                                                \
+                    if (filled_ == RS_GROUP) {                                                     \
+                        CONSUME_STAGE(PAIRS, __VA_ARGS__)                                          \
+                        filled_ = 0;                                                               \
+                    }                                                                              \
                 }                                                                                  \
-                filled_ += take_;                                                                  \
-                next_ += take_;                                                                    \
-                if (filled_ == RS_GROUP) {                                                         \
-                    CONSUME_STAGE(PAIRS, __VA_ARGS__)                                              \
-                    filled_ = 0;                                                                   \
-                }                                                                                  \
-            }                                                                                      \
-        })                                                                                         \
+            })                                                                                     \
         if (filled_ > 0) {                                                                         \
             CONSUME_STAGE(PAIRS, __VA_ARGS__)                                                      \
         }                                                                                          \
@@ -339,7 +363,7 @@ inline int4 slot_cell(__global const int4 *block_cell, __global const uchar *blo
 #define STAGE_PARAMS
 #define STAGE_ARGS
 
-#define BEGIN_BLOCK(b, block_count, block_pos, block_cell, block_offset)                          \
+#define BEGIN_BLOCK(b, block_count, block_pos, block_cell, block_offset)                           \
     if ((b) >= (block_count))                                                                      \
         return;                                                                                    \
     LOAD_BLOCK_LANES(b, block_pos, block_offset);                                                  \

@@ -1,5 +1,6 @@
 /* Mollification (Jones et al. 2003, Sec. 3.2): the predictors' normals come from a copy of the mesh
- * whose vertices moved to sum c_q a_q f_m / sum a_q f_m, f_m a Gaussian of width sigma_m = sigma_f/2.
+ * whose vertices moved to sum c_q a_q f_m / sum a_q f_m, f_m a Gaussian of width sigma_m =
+ * sigma_f/2.
  *
  * mollify_block: one work-item per vertex block writes each lane's displacement, in cell units, to
  *   block_shift (3 components per lane; 0 where no facet is within reach).
@@ -14,10 +15,9 @@
 __kernel void mollify_block(uint block_count, float reach2, float inv_2sigma2,
                             __global const float *block_pos, __global const int4 *block_cell,
                             __global const uchar *block_offset,
-                            __global const float4 *facet_centroid,
-                            __global const int4 *cell_coord, __global const uint *cell_start,
-                            __global const uint *column_first,
-                           __global const int *column_table, uint column_mask,
+                            __global const float4 *facet_centroid, __global const int4 *cell_coord,
+                            __global const uint *cell_start, __global const uint *column_first,
+                            __global const int *column_table, uint column_mask,
                             __global float *block_shift, __global uint *block_pairs) {
     uint b = get_global_id(0);
     BEGIN_BLOCK(b, block_count, block_pos, block_cell, block_offset);
@@ -44,7 +44,8 @@ __kernel void mollify_block(uint block_count, float reach2, float inv_2sigma2,
 
 /* The displacement of the vertex in `slot` (from mollify_block). */
 inline float3 slot_shift(__global const float *block_shift, uint slot) {
-    return (float3)(slot_component(block_shift, slot, 3, 0), slot_component(block_shift, slot, 3, 1),
+    return (float3)(slot_component(block_shift, slot, 3, 0),
+                    slot_component(block_shift, slot, 3, 1),
                     slot_component(block_shift, slot, 3, 2));
 }
 
@@ -53,9 +54,9 @@ inline float3 slot_shift(__global const float *block_shift, uint slot) {
 inline float3 slot_position(__global const float *block_pos, __global const int4 *block_cell,
                             __global const uchar *block_offset, uint slot, int4 origin) {
     int4 cell = slot_cell(block_cell, block_offset, slot) - origin;
-    return convert_float3(cell.xyz) +
-           (float3)(slot_component(block_pos, slot, 3, 0), slot_component(block_pos, slot, 3, 1),
-                    slot_component(block_pos, slot, 3, 2));
+    return convert_float3(cell.xyz) + (float3)(slot_component(block_pos, slot, 3, 0),
+                                               slot_component(block_pos, slot, 3, 1),
+                                               slot_component(block_pos, slot, 3, 2));
 }
 
 __kernel void mollified_facet_normal(uint facet_count, __global const uint *facet_vertices,

@@ -35,15 +35,16 @@
  * vanishes keeps what it had (rs_facets_update). */
 __kernel void STAGE_NAME(stage_facets)(uint facet_count, __global const uint4 *facet_vertex,
                                        __global const REAL4 *facet_rest,
-                                       __global const REAL4 *rest_centroid,
-                                       __global const REAL4 *d, __global REAL4 *centroid,
-                                       __global REAL4 *shift, __global REAL4 *normal) {
+                                       __global const REAL4 *rest_centroid, __global const REAL4 *d,
+                                       __global REAL4 *centroid, __global REAL4 *shift,
+                                       __global REAL4 *normal) {
     uint f = get_global_id(0);
     if (f >= facet_count)
         return;
     uint4 t = facet_vertex[f];
     REAL4 da = d[t.x], db = d[t.y], dc = d[t.z];
-    REAL4 n = cross(facet_rest[2 * (size_t)f] + (db - da), facet_rest[2 * (size_t)f + 1] + (dc - da));
+    REAL4 n =
+        cross(facet_rest[2 * (size_t)f] + (db - da), facet_rest[2 * (size_t)f + 1] + (dc - da));
     REAL len = sqrt(dot(n, n));
     if (!(len > 0))
         return;
@@ -114,8 +115,8 @@ __kernel void STAGE_NAME(stage_guidance)(uint facet_count, __global const uint *
 __kernel void STAGE_NAME(stage_filter)(uint facet_count, __global const uint *near_start,
                                        __global const uint *near, __global const REAL4 *centroid,
                                        __global const REAL4 *guidance,
-                                       __global const REAL4 *normal_in, REAL inv_2s2,
-                                       REAL inv_2t2, __global REAL4 *normal_out) {
+                                       __global const REAL4 *normal_in, REAL inv_2s2, REAL inv_2t2,
+                                       __global REAL4 *normal_out) {
     uint i = get_global_id(0);
     if (i >= facet_count)
         return;

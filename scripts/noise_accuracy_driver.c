@@ -1,5 +1,5 @@
-/* noise_accuracy driver: for each line "NOISY CLEAN" on stdin, the true noise of NOISY against CLEAN
- * and rs_estimate_noise_details on NOISY, as one JSON line. */
+/* noise_accuracy driver: for each line "NOISY CLEAN" on stdin, the true noise of NOISY against
+ * CLEAN and rs_estimate_noise_details on NOISY, as one JSON line. */
 #define _POSIX_C_SOURCE 200809L
 #include "auto/noise_estimate.h"
 #include "mesh_shapes.h"
@@ -66,18 +66,18 @@ int main(void) {
             return 1;
         }
         double ms = now_ms() - t0;
-        printf("{\"noisy\": \"%s\", \"vertices\": %zu, \"true_level\": %.6g, \"true_overall\": %.6g, "
-               "\"true_tangential\": %.6g, \"true_fraction\": %.6g, \"true_edge\": %.6g, "
-               "\"level\": %.6g, \"impulsive\": %s, \"fraction\": %.6g, \"tangential\": %.6g, "
-               "\"edge_clean\": %.6g, \"edge_noisy\": %.6g, \"overall\": %.6g, \"tail\": %.6g, "
-               "\"samples\": %zu, \"ms\": %.2f, \"correlated\": %.6g, \"length\": %.6g, "
-               "\"profile\": [%.6g, %.6g, %.6g], \"profile_floor\": [%.6g, %.6g, %.6g]}\n",
-               noisy_path, nv, t_n, t_all, t_tan, frac, edge, d.level,
-               d.impulsive ? "true" : "false", d.impulsive_fraction, d.tangential_level,
-               d.mean_edge_clean, d.mean_edge_noisy, d.overall_level, d.tail_share, d.samples, ms,
-               d.correlated_level, d.correlation_length, d.profile.low[0], d.profile.low[1],
-               d.profile.low[2], d.profile.low_floor[0], d.profile.low_floor[1],
-               d.profile.low_floor[2]);
+        printf(
+            "{\"noisy\": \"%s\", \"vertices\": %zu, \"true_level\": %.6g, \"true_overall\": %.6g, "
+            "\"true_tangential\": %.6g, \"true_fraction\": %.6g, \"true_edge\": %.6g, "
+            "\"level\": %.6g, \"impulsive\": %s, \"fraction\": %.6g, \"tangential\": %.6g, "
+            "\"edge_clean\": %.6g, \"edge_noisy\": %.6g, \"overall\": %.6g, \"tail\": %.6g, "
+            "\"samples\": %zu, \"ms\": %.2f, \"correlated\": %.6g, \"length\": %.6g, "
+            "\"profile\": [%.6g, %.6g, %.6g], \"profile_floor\": [%.6g, %.6g, %.6g]}\n",
+            noisy_path, nv, t_n, t_all, t_tan, frac, edge, d.level, d.impulsive ? "true" : "false",
+            d.impulsive_fraction, d.tangential_level, d.mean_edge_clean, d.mean_edge_noisy,
+            d.overall_level, d.tail_share, d.samples, ms, d.correlated_level, d.correlation_length,
+            d.profile.low[0], d.profile.low[1], d.profile.low[2], d.profile.low_floor[0],
+            d.profile.low_floor[1], d.profile.low_floor[2]);
         fflush(stdout);
         rsmooth_mesh_destroy(noisy);
         rsmooth_mesh_destroy(clean);

@@ -39,16 +39,14 @@ int main(void) {
         rsmooth_params_init(&p);
         p.sigma_f = -1;
         CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m.xyz, m.vertex_count, m.indices,
-                                              m.triangle_count, &p, out, NULL, NULL, &report,
-                                              &err),
+                                              m.triangle_count, &p, out, NULL, NULL, &report, &err),
                      RSMOOTH_ERROR_INVALID_ARGUMENT);
         CHECK_EQ_INT(err.struct_size, sizes[i]);
         CHECK(strstr(err.message, "sigma_f") != NULL);
         p.sigma_f = 2;
         p.passes = 1 + i; /* both ways the report is filled: one pass, and the passes' sum */
         CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m.xyz, m.vertex_count, m.indices,
-                                              m.triangle_count, &p, out, NULL, NULL, &report,
-                                              &err),
+                                              m.triangle_count, &p, out, NULL, NULL, &report, &err),
                      RSMOOTH_OK);
         CHECK_EQ_INT(err.struct_size, sizes[i]);
         CHECK_EQ_INT(report.struct_size, sizes[i] == sizeof err ? sizeof report : sizes[i]);
@@ -69,8 +67,7 @@ int main(void) {
     size_t n = rsmooth_list_devices(list, 4);
     for (size_t i = 0; i < n && i < 4; i++)
         CHECK_EQ_INT(list[i].struct_size, sizeof list[i]);
-    printf("abi: struct_size set by the _init functions and kept by every call (%zu devices)\n",
-           n);
+    printf("abi: struct_size set by the _init functions and kept by every call (%zu devices)\n", n);
     free(out);
     shape_free(&m);
     return 0;

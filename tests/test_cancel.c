@@ -11,12 +11,12 @@
 #include <string.h>
 
 typedef struct cancel_log {
-    int calls;          /* progress_cancel reports */
-    int plain_calls;    /* plain progress reports */
-    int stop_at;        /* ask to stop at this report (0: never) */
+    int calls;       /* progress_cancel reports */
+    int plain_calls; /* plain progress reports */
+    int stop_at;     /* ask to stop at this report (0: never) */
     double last;
     int backwards;
-    int after_stop;     /* reports after the one that asked to stop */
+    int after_stop; /* reports after the one that asked to stop */
 } cancel_log;
 
 static int on_report(void *user, double fraction) {
@@ -37,8 +37,8 @@ static void on_plain_report(void *user, double fraction) {
     ((cancel_log *)user)->plain_calls++;
 }
 
-typedef rsmooth_status (*run_fn)(rsmooth_context *ctx, const shape_mesh *m,
-                                 const rsmooth_params *p, double *out, rsmooth_error *err);
+typedef rsmooth_status (*run_fn)(rsmooth_context *ctx, const shape_mesh *m, const rsmooth_params *p,
+                                 double *out, rsmooth_error *err);
 
 static rsmooth_status run_reference(rsmooth_context *ctx, const shape_mesh *m,
                                     const rsmooth_params *p, double *out, rsmooth_error *err) {
@@ -47,19 +47,19 @@ static rsmooth_status run_reference(rsmooth_context *ctx, const shape_mesh *m,
                                     m->triangle_count, p, out, NULL, NULL, NULL, err);
 }
 
-static rsmooth_status run_opencl(rsmooth_context *ctx, const shape_mesh *m,
-                                 const rsmooth_params *p, double *out, rsmooth_error *err) {
+static rsmooth_status run_opencl(rsmooth_context *ctx, const shape_mesh *m, const rsmooth_params *p,
+                                 double *out, rsmooth_error *err) {
     return rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
                           m->triangle_count, p, out, NULL, NULL, NULL, err);
 }
 
 /* Points: the mesh's vertices with its vertex normals. */
 static const double *point_normals;
-static rsmooth_status run_points(rsmooth_context *ctx, const shape_mesh *m,
-                                 const rsmooth_params *p, double *out, rsmooth_error *err) {
+static rsmooth_status run_points(rsmooth_context *ctx, const shape_mesh *m, const rsmooth_params *p,
+                                 double *out, rsmooth_error *err) {
     (void)ctx;
-    return rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, m->xyz, point_normals,
-                                           m->vertex_count, p, out, NULL, NULL, NULL, err);
+    return rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, m->xyz, point_normals, m->vertex_count,
+                                           p, out, NULL, NULL, NULL, err);
 }
 
 static void check_path(const char *name, run_fn run, rsmooth_context *ctx, const shape_mesh *m,

@@ -62,9 +62,9 @@ static void smooth(rsmooth_context *ctx, const mesh_ref *m, const rsmooth_params
                                     out->confidence, &out->report, &err),
                      RSMOOTH_OK);
     else
-        CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count,
-                                              m->indices, m->triangle_count, params, out->xyz,
-                                              out->weight, out->confidence, &out->report, &err),
+        CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                              m->triangle_count, params, out->xyz, out->weight,
+                                              out->confidence, &out->report, &err),
                      RSMOOTH_OK);
 }
 
@@ -118,7 +118,9 @@ static double compare(rsmooth_context *ctx, const char *name, const mesh_ref *m,
     printf("%-52s V=%6zu max move %6.3f  deviation max %.3g (tol %.0e)  confidence %.2g  "
            "k/kf %.2g  unmoved %zu  %s",
            name, nv, moved, dev, MAX_DEVIATION, conf, k, stayed,
-           budget ? "" : same ? "rerun bit-identical" : "RERUN DIFFERS");
+           budget ? ""
+           : same ? "rerun bit-identical"
+                  : "RERUN DIFFERS");
     if (budget)
         printf("%zu tiles: deviation max %.3g", again.report.tiles, dev_again);
     printf("\n");
@@ -294,8 +296,7 @@ static void compare_colors(rsmooth_context *ctx, const char *mesh_name, const me
         if (quick)
             continue;
         p.predictor = RSMOOTH_PREDICT_CENTROID;
-        snprintf(name, sizeof name, "%s, colour 0.1, %s, centroid", mesh_name,
-                 influences[i].name);
+        snprintf(name, sizeof name, "%s, colour 0.1, %s, centroid", mesh_name, influences[i].name);
         compare(ctx, name, m, &p, 0);
     }
     rsmooth_params_init(&p);

@@ -94,8 +94,8 @@ static void check_errors(const fixture *fx, const shape_mesh *m) {
     cl_mem small = buffer_with(fx, bytes - 4, NULL);
     rsmooth_error err;
 
-    CHECK_STATUS(rsmooth_smooth_cl(fx->ctx, RSMOOTH_FLOAT32, din, n, m->indices,
-                                   m->triangle_count, NULL, small, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_cl(fx->ctx, RSMOOTH_FLOAT32, din, n, m->indices, m->triangle_count,
+                                   NULL, small, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     printf("output too small: %s\n", err.message);
     CHECK(strstr(err.message, "out_positions holds") != NULL);
@@ -105,12 +105,12 @@ static void check_errors(const fixture *fx, const shape_mesh *m) {
     printf("input too small: %s\n", err.message);
     CHECK(strstr(err.message, "positions holds") != NULL);
     /* float64 needs twice the bytes the float32 buffers hold */
-    CHECK_STATUS(rsmooth_smooth_cl(fx->ctx, RSMOOTH_FLOAT64, din, n, m->indices,
-                                   m->triangle_count, NULL, dout, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_cl(fx->ctx, RSMOOTH_FLOAT64, din, n, m->indices, m->triangle_count,
+                                   NULL, dout, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     printf("float64 on float32's bytes: %s\n", err.message);
-    CHECK_STATUS(rsmooth_smooth_cl(fx->ctx, RSMOOTH_FLOAT32, NULL, n, m->indices,
-                                   m->triangle_count, NULL, dout, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_cl(fx->ctx, RSMOOTH_FLOAT32, NULL, n, m->indices, m->triangle_count,
+                                   NULL, dout, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(err.message, "positions is NULL") != NULL);
     CHECK_STATUS(rsmooth_smooth_cl(NULL, RSMOOTH_FLOAT32, din, n, m->indices, m->triangle_count,
@@ -127,24 +127,24 @@ static void check_errors(const fixture *fx, const shape_mesh *m) {
     cl_int cl_err = CL_SUCCESS;
     cl_context foreign = clCreateContext(NULL, 1, &device, NULL, NULL, &cl_err);
     CHECK(cl_err == CL_SUCCESS);
-    cl_mem elsewhere = clCreateBuffer(foreign, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, bytes,
-                                      in, &cl_err);
+    cl_mem elsewhere =
+        clCreateBuffer(foreign, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, bytes, in, &cl_err);
     CHECK(cl_err == CL_SUCCESS);
     CHECK_STATUS(rsmooth_smooth_cl(fx->ctx, RSMOOTH_FLOAT32, elsewhere, n, m->indices,
                                    m->triangle_count, NULL, dout, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     printf("another context's buffer: %s\n", err.message);
     CHECK(strstr(err.message, "another OpenCL context") != NULL);
-    CHECK_STATUS(rsmooth_smooth_cl(fx->ctx, RSMOOTH_FLOAT32, din, n, m->indices,
-                                   m->triangle_count, NULL, elsewhere, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_cl(fx->ctx, RSMOOTH_FLOAT32, din, n, m->indices, m->triangle_count,
+                                   NULL, elsewhere, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(err.message, "out_positions belongs to another") != NULL);
 
     /* a bad index: the library's own message, the output untouched */
     uint32_t keep = m->indices[4];
     m->indices[4] = (uint32_t)n;
-    CHECK_STATUS(rsmooth_smooth_cl(fx->ctx, RSMOOTH_FLOAT32, din, n, m->indices,
-                                   m->triangle_count, NULL, dout, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_cl(fx->ctx, RSMOOTH_FLOAT32, din, n, m->indices, m->triangle_count,
+                                   NULL, dout, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     printf("index out of range: %s\n", err.message);
     m->indices[4] = keep;

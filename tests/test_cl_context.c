@@ -1,6 +1,7 @@
-/* The OpenCL context: device choice by spec, a caller's own queue (retained, never owned), bit-identical
- * repeated runs, threads sharing one context, calls from a call's own progress callback refused at
- * once instead of deadlocking, and argument errors that leave the output untouched. */
+/* The OpenCL context: device choice by spec, a caller's own queue (retained, never owned),
+ * bit-identical repeated runs, threads sharing one context, calls from a call's own progress
+ * callback refused at once instead of deadlocking, and argument errors that leave the output
+ * untouched. */
 #define _POSIX_C_SOURCE 200809L
 #include "mesh_shapes.h"
 #include "rsmooth_cl.h"
@@ -106,8 +107,8 @@ static void check_shared_context(rsmooth_context *ctx) {
         double *alone = malloc(n * sizeof *alone), *out = malloc(n * sizeof *out);
         CHECK(alone && out);
         CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, meshes[t].xyz, meshes[t].vertex_count,
-                                    meshes[t].indices, meshes[t].triangle_count, NULL, alone,
-                                    NULL, NULL, NULL, NULL),
+                                    meshes[t].indices, meshes[t].triangle_count, NULL, alone, NULL,
+                                    NULL, NULL, NULL),
                      RSMOOTH_OK);
         sharers[t] = (sharer){ctx, &meshes[t], alone, out, 0, 0};
     }
@@ -148,9 +149,9 @@ static void call_back_in(void *user, double fraction) {
     if (r->calls++)
         return;
     rsmooth_error err;
-    r->nested = rsmooth_smooth(r->ctx, RSMOOTH_FLOAT64, r->m->xyz, r->m->vertex_count,
-                               r->m->indices, r->m->triangle_count, NULL, r->scratch, NULL, NULL,
-                               NULL, &err);
+    r->nested =
+        rsmooth_smooth(r->ctx, RSMOOTH_FLOAT64, r->m->xyz, r->m->vertex_count, r->m->indices,
+                       r->m->triangle_count, NULL, r->scratch, NULL, NULL, NULL, &err);
     snprintf(r->message, sizeof r->message, "%s", err.message);
     rsmooth_piece_info info;
     rsmooth_piece_info_init(&info);
@@ -158,9 +159,9 @@ static void call_back_in(void *user, double fraction) {
     r->piece = rsmooth_smooth_piece(r->ctx, r->m->xyz, r->m->vertex_count, r->m->indices,
                                     r->m->triangle_count, &info, NULL, r->scratch, NULL, &err);
     /* another context is free: its call runs */
-    r->nested_other = rsmooth_smooth(r->other, RSMOOTH_FLOAT64, r->m->xyz, r->m->vertex_count,
-                                     r->m->indices, r->m->triangle_count, NULL, r->scratch, NULL,
-                                     NULL, NULL, &err);
+    r->nested_other =
+        rsmooth_smooth(r->other, RSMOOTH_FLOAT64, r->m->xyz, r->m->vertex_count, r->m->indices,
+                       r->m->triangle_count, NULL, r->scratch, NULL, NULL, NULL, &err);
     /* the getters and setters answer from inside the call, and destroy leaves it alone */
     r->budget = rsmooth_context_memory_budget(r->ctx);
     rsmooth_context_set_host_threads(r->ctx, rsmooth_context_host_threads(r->ctx));
@@ -227,9 +228,8 @@ int main(void) {
     {
         double *plain = malloc(n * sizeof *plain);
         CHECK(plain);
-        CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count,
-                                    cube.indices, cube.triangle_count, NULL, plain, NULL, NULL,
-                                    NULL, NULL),
+        CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count, cube.indices,
+                                    cube.triangle_count, NULL, plain, NULL, NULL, NULL, NULL),
                      RSMOOTH_OK);
         check_reentry(ctx, &cube, plain);
         free(plain);
@@ -297,11 +297,10 @@ int main(void) {
      * straight from OpenCL), snprintf's contract on short buffers, "" and 0 for no device */
     {
         cl_device_id device = NULL;
-        clGetCommandQueueInfo(rsmooth_context_queue(other), CL_QUEUE_DEVICE, sizeof device,
-                              &device, NULL);
+        clGetCommandQueueInfo(rsmooth_context_queue(other), CL_QUEUE_DEVICE, sizeof device, &device,
+                              NULL);
         char truth[1024] = "", whole[1024], cut[8] = "xxxxxxx";
-        CHECK(clGetDeviceInfo(device, CL_DEVICE_VERSION, sizeof truth, truth, NULL) ==
-              CL_SUCCESS);
+        CHECK(clGetDeviceInfo(device, CL_DEVICE_VERSION, sizeof truth, truth, NULL) == CL_SUCCESS);
         size_t length = rsmooth_device_version(0, 0, whole, sizeof whole);
         CHECK(length == strlen(truth) && strcmp(whole, truth) == 0);
         CHECK(strncmp(whole, devices[0].version, sizeof devices[0].version - 1) == 0);
@@ -356,8 +355,8 @@ int main(void) {
         clReleaseCommandQueue(queue);
         CHECK_STATUS(rsmooth_context_create_from_queue(NULL, &other, &err),
                      RSMOOTH_ERROR_INVALID_ARGUMENT);
-        printf("caller's queue: retained (%u -> %u) and released (%u), same result\n",
-               refs_before, refs_during, refs_after);
+        printf("caller's queue: retained (%u -> %u) and released (%u), same result\n", refs_before,
+               refs_during, refs_after);
     }
 
     /* Argument errors: status, message, and the output left as it was. */
@@ -395,7 +394,8 @@ int main(void) {
     printf("bad arguments: output untouched\n");
 
     /* Developer override: kernels from a directory. The source tree's copies give the same bits;
-     * a broken kernel gives a build error with the compiler's log; a missing directory an I/O error. */
+     * a broken kernel gives a build error with the compiler's log; a missing directory an I/O
+     * error. */
     setenv("RSMOOTH_KERNEL_DIR", RSMOOTH_KERNEL_SOURCE_DIR, 1);
     CHECK_STATUS(rsmooth_context_create(NULL, &other, &err), RSMOOTH_OK);
     smooth_cube(other, &cube, c);
@@ -403,8 +403,8 @@ int main(void) {
     rsmooth_context_destroy(other);
     char broken_dir[] = "/tmp/rsmooth-broken-kernels-XXXXXX";
     CHECK(mkdtemp(broken_dir) != NULL);
-    static const char *const names[] = {"common.cl", "mollify.cl", "bilateral.cl", "estimate.cl",
-                                        "stage.cl", "grid.cl"};
+    static const char *const names[] = {"common.cl",   "mollify.cl", "bilateral.cl",
+                                        "estimate.cl", "stage.cl",   "grid.cl"};
     const int files = (int)(sizeof names / sizeof *names);
     for (int i = 0; i < files; i++) {
         char path[256];

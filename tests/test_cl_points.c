@@ -23,7 +23,7 @@
  * benchmark meshes' vertices at sigma_f 2; a mesh's facets are half a point's area, so they
  * stay below 1e-3). */
 #define CUTOFF_FLIP 1e-2
-#define MAX_NORMAL 1e-3     /* per component of the unit normals */
+#define MAX_NORMAL 1e-3 /* per component of the unit normals */
 #define MAX_CONFIDENCE 1e-3
 /* A normal's change by a flip in the bilateral reach: the neighbour's share of the weights times
  * how far its normal is from the point's. */
@@ -50,15 +50,14 @@ typedef struct differences {
 /* Points off by more than the tolerances with a neighbour at a cutoff (of one pass: the input's
  * positions are that pass's) are flips: counted, their largest differences in flip_worst, and
  * taken out of `d` (set to 0). Returns how many. */
-static size_t take_out_flips(const double *xyz, size_t n, differences *d,
-                             const rsmooth_report *rr, int passes, double flip_worst[3]) {
+static size_t take_out_flips(const double *xyz, size_t n, differences *d, const rsmooth_report *rr,
+                             int passes, double flip_worst[3]) {
     size_t flips = 0;
     flip_worst[0] = flip_worst[1] = flip_worst[2] = 0;
     for (size_t i = 0; passes == 1 && i < n; i++) {
         bool off = d->position[i] > MAX_DEVIATION || d->normal[i] > MAX_NORMAL ||
                    d->confidence[i] > MAX_CONFIDENCE;
-        if (off &&
-            (at_cutoff(xyz, n, i, rr->radius) || at_cutoff(xyz, n, i, rr->mollify_radius))) {
+        if (off && (at_cutoff(xyz, n, i, rr->radius) || at_cutoff(xyz, n, i, rr->mollify_radius))) {
             flips++;
             flip_worst[0] = fmax(flip_worst[0], d->position[i]);
             flip_worst[1] = fmax(flip_worst[1], d->normal[i]);
@@ -117,8 +116,8 @@ static void compare(rsmooth_context *ctx, const char *name, const double *xyz,
     }
     printf("%-44s N=%7zu  mean move %.4f  deviation max %.3g spacings (tol %.0e)  normals max "
            "%.2g  confidence max %.2g  (reference %.0f ms, device %.0f ms)\n",
-           name, n, moved / (double)n, largest(d.position, n), MAX_DEVIATION,
-           largest(d.normal, n), largest(d.confidence, n), rr.ms_total, rd.ms_total);
+           name, n, moved / (double)n, largest(d.position, n), MAX_DEVIATION, largest(d.normal, n),
+           largest(d.confidence, n), rr.ms_total, rd.ms_total);
     CHECK(isfinite(largest(d.position, n)));
     double flip_worst[3];
     size_t flips = take_out_flips(xyz, n, &d, &rr, params->passes, flip_worst);
@@ -176,8 +175,7 @@ static void compare_float32(rsmooth_context *ctx, const char *name, const double
         }
         worst = fmax(worst, sqrt(d2) / spacing);
     }
-    printf("%-44s N=%7zu  deviation max %.3g spacings (tol %.0e)\n", name, n, worst,
-           MAX_DEVIATION);
+    printf("%-44s N=%7zu  deviation max %.3g spacings (tol %.0e)\n", name, n, worst, MAX_DEVIATION);
     CHECK_LE(worst, MAX_DEVIATION);
     free(x32), free(n32), free(ref), free(dev);
 }
@@ -285,8 +283,7 @@ static void benchmark_clouds(rsmooth_context *ctx) {
             p.sigma_f = settings[s][0];
             p.sigma_g = settings[s][1];
             char name[128];
-            snprintf(name, sizeof name, "%s vertices sf=%g sg=%g", models[i], p.sigma_f,
-                     p.sigma_g);
+            snprintf(name, sizeof name, "%s vertices sf=%g sg=%g", models[i], p.sigma_f, p.sigma_g);
             compare(ctx, name, mesh->positions, normals, mesh->vertex_count, &p);
         }
         free(normals);
@@ -304,8 +301,7 @@ int main(void) {
 
     compare_variants(ctx, "noisy sphere", &sphere, sphere_n);
     compare_variants(ctx, "noisy cube", &cube, cube_n);
-    compare_float32(ctx, "noisy sphere, float32 arrays", sphere.xyz, sphere_n,
-                    sphere.vertex_count);
+    compare_float32(ctx, "noisy sphere, float32 arrays", sphere.xyz, sphere_n, sphere.vertex_count);
 
     /* Duplicated points: a cluster of 8 in one place has spacing and area 0 (no weight). */
     for (size_t i = 1; i < 8; i++)
@@ -317,13 +313,13 @@ int main(void) {
     /* NULL context: refused */
     double one[3] = {0, 0, 0}, up[3] = {0, 0, 1}, out[3];
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, one, up, 1, NULL, out, NULL, NULL,
-                                       NULL, &err),
-                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK_STATUS(
+        rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, one, up, 1, NULL, out, NULL, NULL, NULL, &err),
+        RSMOOTH_ERROR_INVALID_ARGUMENT);
     /* one point: nothing to weigh it against, it stays */
-    CHECK_STATUS(rsmooth_smooth_points(ctx, RSMOOTH_FLOAT64, one, up, 1, NULL, out, NULL, NULL,
-                                       NULL, &err),
-                 RSMOOTH_OK);
+    CHECK_STATUS(
+        rsmooth_smooth_points(ctx, RSMOOTH_FLOAT64, one, up, 1, NULL, out, NULL, NULL, NULL, &err),
+        RSMOOTH_OK);
     CHECK(out[0] == 0 && out[1] == 0 && out[2] == 0);
 
     /* cancelled inside the device run: its status, and the context usable after it */

@@ -1,6 +1,6 @@
 /* Float32 kernels lose nothing to position: a float64 mesh translated by 1e6 gets the same
- * displacements as at the origin, an unindexed soup the same result as its indexed twin, and float32
- * input gives the float64 result rounded. All on the OpenCL path. */
+ * displacements as at the origin, an unindexed soup the same result as its indexed twin, and
+ * float32 input gives the float64 result rounded. All on the OpenCL path. */
 #include "mesh_shapes.h"
 #include "rsmooth.h"
 #include "test_cl_util.h"

@@ -1,13 +1,13 @@
-/* rsmooth's program cache (lib/opencl/cl_program_cache.c): a miss writes one file, the next context hits
- * it and smooths bit for bit as the source build; damaged files (truncated, flipped bytes, wrong
- * magic, empty, a folder in the file's place) are misses that get rewritten; folders that cannot be
- * made or written, and "off", build from source and leave nothing; the default folders; and
- * processes and threads starting together on an empty folder all succeed and leave one whole file
- * and no temporaries. Then trust (issue 23, item 1): a binary built from modified kernels, planted
- * under the genuine key with a valid digest, is refused in a folder another user owns or can write,
- * and in the home chain, said once on stderr, and the results are the genuine program's; a FIFO,
- * a link or a file of another user at the key's name is never opened as a cache file. Everything
- * happens in a fresh folder in the working directory. */
+/* rsmooth's program cache (lib/opencl/cl_program_cache.c): a miss writes one file, the next context
+ * hits it and smooths bit for bit as the source build; damaged files (truncated, flipped bytes,
+ * wrong magic, empty, a folder in the file's place) are misses that get rewritten; folders that
+ * cannot be made or written, and "off", build from source and leave nothing; the default folders;
+ * and processes and threads starting together on an empty folder all succeed and leave one whole
+ * file and no temporaries. Then trust (issue 23, item 1): a binary built from modified kernels,
+ * planted under the genuine key with a valid digest, is refused in a folder another user owns or
+ * can write, and in the home chain, said once on stderr, and the results are the genuine program's;
+ * a FIFO, a link or a file of another user at the key's name is never opened as a cache file.
+ * Everything happens in a fresh folder in the working directory. */
 #define _POSIX_C_SOURCE 200809L
 #include "core/blake2b.h"
 #include "mesh_shapes.h"
@@ -33,7 +33,8 @@
 
 static char base[256]; /* this run's folder, absolute */
 
-/* A context on the default device with the environment as it is, and where its program came from. */
+/* A context on the default device with the environment as it is, and where its program came from.
+ */
 static rsmooth_context *create(const char *expect) {
     rsmooth_context *ctx = NULL;
     rsmooth_error err;
@@ -124,12 +125,25 @@ static size_t file_size(const char *path) {
 }
 
 /* Damage kinds, each applied to a valid file. */
-enum { TRUNCATE_HALF, TRUNCATE_HEADER, EMPTY, FLIP_BINARY, FLIP_DIGEST, FLIP_KEY, WRONG_MAGIC,
-       LONGER, DAMAGE_COUNT };
-static const char *const damage_names[DAMAGE_COUNT] = {
-    "truncated to half", "truncated in the header", "empty", "a byte of the binary flipped",
-    "a byte of the digest flipped", "a byte of the key flipped", "wrong magic",
-    "a byte appended"};
+enum {
+    TRUNCATE_HALF,
+    TRUNCATE_HEADER,
+    EMPTY,
+    FLIP_BINARY,
+    FLIP_DIGEST,
+    FLIP_KEY,
+    WRONG_MAGIC,
+    LONGER,
+    DAMAGE_COUNT
+};
+static const char *const damage_names[DAMAGE_COUNT] = {"truncated to half",
+                                                       "truncated in the header",
+                                                       "empty",
+                                                       "a byte of the binary flipped",
+                                                       "a byte of the digest flipped",
+                                                       "a byte of the key flipped",
+                                                       "wrong magic",
+                                                       "a byte appended"};
 
 static void flip(int fd, off_t at) {
     unsigned char c;
@@ -210,7 +224,8 @@ static void remove_tree(const char *path) {
     }
 }
 
-/* ---- trust (issue 23, item 1) ------------------------------------------------------------------ */
+/* ---- trust (issue 23, item 1) ------------------------------------------------------------------
+ */
 
 static unsigned char *read_whole(const char *path, size_t *size) {
     *size = file_size(path);
@@ -231,8 +246,8 @@ static void write_whole(const char *path, const void *data, size_t size, mode_t 
 /* A copy of the kernels in `dir` whose fast_exp2 takes a quarter of its argument: Gaussians twice
  * as wide, so every vertex moves differently. What an attacker's binary would compute. */
 static void modified_kernels(const char *dir) {
-    static const char *const names[] = {"common.cl", "mollify.cl", "bilateral.cl", "estimate.cl",
-                                        "stage.cl", "grid.cl"};
+    static const char *const names[] = {"common.cl",   "mollify.cl", "bilateral.cl",
+                                        "estimate.cl", "stage.cl",   "grid.cl"};
     static const char anchor[] = "inline lanef fast_exp2(lanef x) {";
     CHECK(mkdir(dir, 0700) == 0);
     for (int i = 0; i < (int)(sizeof names / sizeof *names); i++) {
@@ -302,7 +317,8 @@ static void expect_refused(const shape_mesh *cube, const double *genuine, double
     CHECK(memcmp(out, genuine, 6 * cube->vertex_count * sizeof *out) == 0);
 }
 
-/* The planted file `payload` at `name` in a fresh folder `folder` (made 0700, then given `mode`). */
+/* The planted file `payload` at `name` in a fresh folder `folder` (made 0700, then given `mode`).
+ */
 static void plant(char *dir, size_t size, const char *folder, mode_t mode, const char *name,
                   const unsigned char *payload, size_t payload_size, mode_t file_mode) {
     make_dir(dir, size, folder);

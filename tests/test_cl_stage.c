@@ -4,8 +4,9 @@
  * a triangle soup (welded corners), with a move mask, and on ../shared's benchmark meshes when
  * present. Every case within 1e-3 mean edge lengths per vertex, for both kernel variants (CPU
  * blocks, GPU groups), bit-identical when rerun, in double (the default where the device has
- * fp64) and in float32; both measured against the cycle count up to 1000 (the drift); a stage too large for the device's budget runs on the host and equals
- * the reference bit for bit; a cancel after a cycle stops it. */
+ * fp64) and in float32; both measured against the cycle count up to 1000 (the drift); a stage too
+ * large for the device's budget runs on the host and equals the reference bit for bit; a cancel
+ * after a cycle stops it. */
 #define _POSIX_C_SOURCE 200809L
 #include "mesh_shapes.h"
 #include "rsmooth.h"
@@ -64,9 +65,8 @@ static double *run(rsmooth_context *ctx, const mesh_ref *m, const rsmooth_params
                                     m->triangle_count, p, out, NULL, NULL, report, &err),
                      RSMOOTH_OK);
     else
-        CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count,
-                                              m->indices, m->triangle_count, p, out, NULL, NULL,
-                                              report, &err),
+        CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                              m->triangle_count, p, out, NULL, NULL, report, &err),
                      RSMOOTH_OK);
     return out;
 }
@@ -99,8 +99,8 @@ static void compare(rsmooth_context *const variants[2], const char *mesh, const 
     double *again = run(variants[0], m, p, &again_report);
     bool same = memcmp(again, cl[0], 3 * nv * sizeof *again) == 0;
     bool variants_same = memcmp(cl[0], cl[1], 3 * nv * sizeof *again) == 0;
-    printf("%-14s %-26s V=%6zu moved %6.3f  deviation cpu %.2e gpu %.2e (tol %.0e)  %s  %s\n",
-           mesh, what, nv, moved, dev[0], dev[1], MAX_DEVIATION,
+    printf("%-14s %-26s V=%6zu moved %6.3f  deviation cpu %.2e gpu %.2e (tol %.0e)  %s  %s\n", mesh,
+           what, nv, moved, dev[0], dev[1], MAX_DEVIATION,
            same ? "rerun bit-identical" : "RERUN DIFFERS",
            variants_same ? "variants bit-identical" : "variants differ");
     CHECK(moved > 1e-2); /* the stage did something to compare */
@@ -226,8 +226,8 @@ static rsmooth_context *open_variant(const char *variant) {
 }
 
 static void benchmark_meshes(rsmooth_context *const variants[2]) {
-    static const char *const models[] = {"Fandisk0.3", "Twelve0.5Impulsive", "Bunny0.2",
-                                         "Block0.4", "SharpSphere0.3"};
+    static const char *const models[] = {"Fandisk0.3", "Twelve0.5Impulsive", "Bunny0.2", "Block0.4",
+                                         "SharpSphere0.3"};
     size_t count = test_small() ? 1 : sizeof models / sizeof *models;
     char dir[4096];
     if (!benchmark_dir(dir, sizeof dir))
@@ -239,7 +239,7 @@ static void benchmark_meshes(rsmooth_context *const variants[2]) {
         mesh_ref m = {mesh->positions, mesh->vertex_count, mesh->triangles, mesh->triangle_count};
         compare_schedules(variants, models[i], &m, i > 1);
         if (i == 1 && !test_small()) /* 100 cycles here (1000 on the cube below; the 1000-cycle
-                                          * table of every model: rsmooth-bench best --drift) */
+                                      * table of every model: rsmooth-bench best --drift) */
             drift(variants[0], models[i], &m, 100);
         rsmooth_mesh_destroy(mesh);
     }

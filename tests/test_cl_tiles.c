@@ -1,7 +1,7 @@
-/* Spatial tiles (lib/opencl/tiles.c): with a memory budget far below what a mesh needs, the OpenCL path
- * cuts it into tiles and must give the untiled run's positions bit for bit (grid cells count from
- * a lattice fixed in space and the kernels' differences do not depend on which vertices share a
- * block) and agree with the double-precision reference path (max deviation <= 1e-3 mean edge
+/* Spatial tiles (lib/opencl/tiles.c): with a memory budget far below what a mesh needs, the OpenCL
+ * path cuts it into tiles and must give the untiled run's positions bit for bit (grid cells count
+ * from a lattice fixed in space and the kernels' differences do not depend on which vertices share
+ * a block) and agree with the double-precision reference path (max deviation <= 1e-3 mean edge
  * lengths, as for untiled runs); a budget too small
  * for any tile fails cleanly with the caller's arrays untouched; RSMOOTH_MEMORY_BUDGET is read. */
 #define _POSIX_C_SOURCE 200809L
@@ -136,8 +136,8 @@ static void check_too_small(rsmooth_context *ctx, const shape_mesh *m) {
     }
     rsmooth_context_set_memory_budget(ctx, 1024);
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT32, xyz, nv, m->indices, m->triangle_count,
-                                NULL, out, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT32, xyz, nv, m->indices, m->triangle_count, NULL,
+                                out, NULL, NULL, NULL, &err),
                  RSMOOTH_ERROR_OUT_OF_MEMORY);
     printf("budget 1024 B: %s\n", err.message);
     CHECK(strstr(err.message, "budget") != NULL);

@@ -1,6 +1,6 @@
 /* Opening the OpenCL device for a test: prints platform and device first. With no OpenCL device the
- * test is skipped (exit 77) unless RSMOOTH_REQUIRE_OPENCL=1, as CI sets, so a missing PoCL cannot pass
- * as green. The device comes from RSMOOTH_DEVICE (default "auto"). */
+ * test is skipped (exit 77) unless RSMOOTH_REQUIRE_OPENCL=1, as CI sets, so a missing PoCL cannot
+ * pass as green. The device comes from RSMOOTH_DEVICE (default "auto"). */
 #ifndef RSMOOTH_TEST_CL_UTIL_H
 #define RSMOOTH_TEST_CL_UTIL_H
 

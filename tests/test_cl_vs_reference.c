@@ -1,5 +1,6 @@
 /* The OpenCL path equals the double-precision reference path: per-vertex deviation in mean edge
- * lengths (max <= 1e-3), on generated shapes and, when ../shared exists, on every benchmark mesh. */
+ * lengths (max <= 1e-3), on generated shapes and, when ../shared exists, on every benchmark mesh.
+ */
 #include "mesh_shapes.h"
 #include "rsmooth.h"
 #include "rsmooth_io.h"

@@ -419,7 +419,8 @@ int main(int argc, char **argv) {
             check_float(f);
     }
     double t4 = seconds();
-    for (long i = 0; i < 200000 * scale / divide; i++) { /* unit-vector components, as normals are */
+    for (long i = 0; i < 200000 * scale / divide;
+         i++) { /* unit-vector components, as normals are */
         double v = (double)(int64_t)next_u64() / 9223372036854775808.0;
         check_g9(v);
         check_g9(random_double());

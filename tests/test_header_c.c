@@ -1,4 +1,5 @@
-/* The public headers compile on their own as C11 (-Wpedantic) and, as test_header_cxx.cpp, as C++. */
+/* The public headers compile on their own as C11 (-Wpedantic) and, as test_header_cxx.cpp, as C++.
+ */
 #include "rsmooth.h"
 #include "rsmooth_cl.h"
 #include "rsmooth_io.h"

@@ -222,8 +222,8 @@ static void check_bad_options(const shape_mesh *m) {
         {-1, MESH_NOISE_NORMAL, 0, 1, 0, 0},        {NAN, MESH_NOISE_NORMAL, 0, 1, 0, 0},
         {INFINITY, MESH_NOISE_NORMAL, 0, 1, 0, 0},  {0.3, MESH_NOISE_NORMAL, -0.1, 1, 0, 0},
         {0.3, MESH_NOISE_NORMAL, 1.1, 1, 0, 0},     {0.3, MESH_NOISE_RANDOM, NAN, 1, 0, 0},
-        {0.3, (mesh_noise_direction)7, 0, 1, 0, 0},   {0.3, MESH_NOISE_NORMAL, 0, 1, -1, 0},
-        {0.3, MESH_NOISE_NORMAL, 0, 1, NAN, 0}, {0.3, MESH_NOISE_NORMAL, 0, 1, 0, -2},
+        {0.3, (mesh_noise_direction)7, 0, 1, 0, 0}, {0.3, MESH_NOISE_NORMAL, 0, 1, -1, 0},
+        {0.3, MESH_NOISE_NORMAL, 0, 1, NAN, 0},     {0.3, MESH_NOISE_NORMAL, 0, 1, 0, -2},
         {0.3, MESH_NOISE_NORMAL, 0, 1, 2, 3},
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++)

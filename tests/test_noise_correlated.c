@@ -73,14 +73,15 @@ static void test_generator(void) {
     double cw = edge_correlation(&plane, dw), cb = edge_correlation(&plane, db),
            cs = edge_correlation(&plane, ds);
     printf("plane: rms white %.4f band L=3 %.4f stripes W=6 %.4f (sigma 0.3); neighbour "
-           "correlation %.3f %.3f %.3f\n", rms(dw, nv), rms(db, nv), rms(ds, nv), cw, cb, cs);
+           "correlation %.3f %.3f %.3f\n",
+           rms(dw, nv), rms(db, nv), rms(ds, nv), cw, cb, cs);
     CHECK_NEAR(rms(dw, nv), 0.3, 0.3 * 0.02);
     /* each vertex has standard deviation sigma; the sample rms of a field with ~300 independent
      * patches scatters by a few per cent */
     CHECK_NEAR(rms(db, nv), 0.3, 0.3 * 0.08);
     CHECK_NEAR(rms(ds, nv), 0.3, 1e-9); /* rescaled to exactly sigma */
     CHECK(fabs(cw) < 0.03);
-    CHECK(cb > 0.9);  /* exp(-d^2 / 4 L^2) at d ~ 1.1: 0.97 */
+    CHECK(cb > 0.9); /* exp(-d^2 / 4 L^2) at d ~ 1.1: 0.97 */
     CHECK(cs > 0.8);
     /* reproducible with the seed, different with another */
     double *db2 = offsets(&plane, &band, NULL);
@@ -113,8 +114,8 @@ static void test_estimate(void) {
     CHECK_EQ_INT(shape_sphere(&sphere, 6, 100.0), 0);
     size_t nv = sphere.vertex_count;
     rsmooth_noise_report clean = read_noise(&sphere, sphere.xyz);
-    printf("sphere %zu vertices: clean level %.4f correlated %.4f length %.2f\n", nv,
-           clean.level, clean.correlated_level, clean.correlation_length);
+    printf("sphere %zu vertices: clean level %.4f correlated %.4f length %.2f\n", nv, clean.level,
+           clean.correlated_level, clean.correlation_length);
     CHECK(clean.correlated_level < 0.03);
     CHECK(clean.correlation_length == 0);
 

@@ -202,9 +202,11 @@ static void random_directions(void) {
             memcpy(noisy, shapes[s].xyz, 3 * nv * sizeof *noisy);
             mesh_noise_options o = {levels[l], MESH_NOISE_RANDOM, 0, 300 + l, 0, 0};
             CHECK_EQ_INT(mesh_add_noise(noisy, nv, shapes[s].indices, nt, &o), 0);
-            double truth = true_noise(&shapes[s], noisy), est = estimate(noisy, nv, shapes[s].indices, nt);
+            double truth = true_noise(&shapes[s], noisy),
+                   est = estimate(noisy, nv, shapes[s].indices, nt);
             printf("%-9s random directions %.1f: truth (normal part) %.4f  estimate %.4f  ratio "
-                   "%.3f\n", names[s], levels[l], truth, est, est / truth);
+                   "%.3f\n",
+                   names[s], levels[l], truth, est, est / truth);
             CHECK_NEAR(est / truth, 1, RANDOM_TOLERANCE);
             worst = fmax(worst, fabs(est / truth - 1));
             check_auto(names[s], noisy, nv, shapes[s].indices, nt, false);
@@ -249,8 +251,9 @@ static void check_kind(void) {
         for (int d = 0; d < 2; d++)
             for (size_t l = 0; l < sizeof gaussian / sizeof *gaussian; l += stride) {
                 memcpy(noisy, shapes[s].xyz, 3 * nv * sizeof *noisy);
-                mesh_noise_options o = {gaussian[l], d ? MESH_NOISE_RANDOM : MESH_NOISE_NORMAL, 0,
-                                        400 + 10 * (uint64_t)d + l, 0, 0};
+                mesh_noise_options o = {gaussian[l], d ? MESH_NOISE_RANDOM : MESH_NOISE_NORMAL,
+                                        0,           400 + 10 * (uint64_t)d + l,
+                                        0,           0};
                 CHECK_EQ_INT(mesh_add_noise(noisy, nv, shapes[s].indices, nt, &o), 0);
                 bool imp = reads_impulsive(&shapes[s], noisy);
                 printf("%-9s Gaussian %s %.2f: %s\n", names[s], d ? "random" : "normal",
@@ -260,8 +263,12 @@ static void check_kind(void) {
         for (size_t f = 0; f < sizeof fractions / sizeof *fractions; f++)
             for (size_t l = 0; l < sizeof impulsive / sizeof *impulsive; l += stride) {
                 memcpy(noisy, shapes[s].xyz, 3 * nv * sizeof *noisy);
-                mesh_noise_options o = {impulsive[l], MESH_NOISE_NORMAL, fractions[f],
-                                        500 + 10 * (uint64_t)f + l, 0, 0};
+                mesh_noise_options o = {impulsive[l],
+                                        MESH_NOISE_NORMAL,
+                                        fractions[f],
+                                        500 + 10 * (uint64_t)f + l,
+                                        0,
+                                        0};
                 CHECK_EQ_INT(mesh_add_noise(noisy, nv, shapes[s].indices, nt, &o), 0);
                 bool imp = reads_impulsive(&shapes[s], noisy);
                 printf("%-9s impulsive F %.2f %.1f: %s\n", names[s], fractions[f], impulsive[l],
@@ -318,9 +325,10 @@ static void check_sampled(void) {
     double t0 = now_ms();
     double est = estimate(noisy.xyz, noisy.vertex_count, noisy.indices, noisy.triangle_count);
     double truth = true_noise(&clean, noisy.xyz);
-    printf("plane %zu vertices (at most 6000 sampled), noise 0.3: truth %.4f estimate %.4f ratio %.3f "
-           "(%.0f ms)\n",
-           clean.vertex_count, truth, est, est / truth, now_ms() - t0);
+    printf(
+        "plane %zu vertices (at most 6000 sampled), noise 0.3: truth %.4f estimate %.4f ratio %.3f "
+        "(%.0f ms)\n",
+        clean.vertex_count, truth, est, est / truth, now_ms() - t0);
     CHECK_NEAR(est / truth, 1, SHAPE_TOLERANCE);
     shape_free(&clean);
     shape_free(&noisy);
@@ -342,8 +350,7 @@ static void check_edge_cases(void) {
                  RSMOOTH_OK);
     CHECK(noise == 0);
     noise = -1;
-    CHECK_STATUS(rsmooth_estimate_noise(RSMOOTH_FLOAT64, xyz, 4, tri, 1, &noise, &err),
-                 RSMOOTH_OK);
+    CHECK_STATUS(rsmooth_estimate_noise(RSMOOTH_FLOAT64, xyz, 4, tri, 1, &noise, &err), RSMOOTH_OK);
     CHECK(noise == 0);
     /* bad arrays */
     CHECK_STATUS(rsmooth_estimate_noise(RSMOOTH_FLOAT64, xyz, 4, tri, 1, NULL, &err),

@@ -1,8 +1,8 @@
 /* The normal update stage (guided normal filtering, then Sun et al.'s vertex update): each part
  * against a brute-force evaluation of its equations over every facet pair (no grid, no threads, no
- * welding shortcuts), a clean mesh as a fixed point, a soup equal to its indexed mesh, the same bytes
- * for any thread count, a noisy cube restored better than by the paper's filter with its edges
- * kept, the stage's cycles against brute force, the choice per region against Taubin's own
+ * welding shortcuts), a clean mesh as a fixed point, a soup equal to its indexed mesh, the same
+ * bytes for any thread count, a noisy cube restored better than by the paper's filter with its
+ * edges kept, the stage's cycles against brute force, the choice per region against Taubin's own
  * smoothing and the filter's result, the automatic choice's report, and the stage's parameters
  * checked. */
 #include "mesh_shapes.h"
@@ -11,7 +11,8 @@
 
 #include <string.h>
 
-/* ---- brute force: the equations of guided_normals.c's header, over every pair ----------------- */
+/* ---- brute force: the equations of guided_normals.c's header, over every pair -----------------
+ */
 
 static double gap(const double *a, const double *b) {
     double d[3] = {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
@@ -121,8 +122,7 @@ static void brute_update(double *xyz, size_t nv, const uint32_t *idx, const rs_f
         for (size_t q = 0; q < f->count; q++) {
             const uint32_t *t = idx + 3 * (size_t)f->triangle[q];
             for (int c = 0; c < 3; c++)
-                cent[3 * q + c] =
-                    (xyz[3 * t[0] + c] + xyz[3 * t[1] + c] + xyz[3 * t[2] + c]) / 3.0;
+                cent[3 * q + c] = (xyz[3 * t[0] + c] + xyz[3 * t[1] + c] + xyz[3 * t[2] + c]) / 3.0;
         }
         for (size_t v = 0; v < nv; v++) {
             double move[3] = {0, 0, 0};
@@ -165,7 +165,8 @@ static void test_against_brute_force(void) {
     CHECK(rs_facets_build(&f, cube.xyz, cube.indices, cube.triangle_count));
     CHECK(f.count == cube.triangle_count);
     CHECK(rs_adjacency_build(&adj, cube.xyz, cube.vertex_count, cube.indices, &f));
-    double *lib = malloc(f.count * 3 * sizeof(double)), *brute = malloc(f.count * 3 * sizeof(double));
+    double *lib = malloc(f.count * 3 * sizeof(double)),
+           *brute = malloc(f.count * 3 * sizeof(double));
     CHECK(lib && brute);
     CHECK(rs_guided_normals(&f, &adj, cube.indices, 0.8 * edge, 0.3, 3, lib));
     brute_guided(&f, cube.indices, 0.8 * edge, 0.3, 3, brute);
@@ -209,7 +210,8 @@ static void stage(rsmooth_scalar scalar, const void *xyz, const shape_mesh *m, i
 }
 
 /* A clean mesh stays nearly as it is: at corners no patch is free of an edge, so the guidance
- * there tilts and the corners round a little (as with the paper's guided filter on a coarse mesh). */
+ * there tilts and the corners round a little (as with the paper's guided filter on a coarse mesh).
+ */
 static void test_clean_stays(void) {
     shape_mesh cube;
     CHECK(shape_cube(&cube, 12, 2.0) == 0);
@@ -316,15 +318,15 @@ static void test_parameters_checked(void) {
     struct {
         int passes, updates, rounds, repeats;
         double s, n, level, radius;
-    } bad[] = {{1, 5, 5, 1, 1, 0.3, 0, 0.99}, {1, 5, 5, 1, 1, 0.3, 0, 8.01},
-               {1, 5, 5, 1, 1, 0.3, 0, NAN}, {-1, 0, 5, 1, 1, 0.3, 0, 2},
-               {1, -1, 5, 1, 1, 0.3, 0, 2}, {1, 1001, 5, 1, 1, 0.3, 0, 2},
-               {1, 5, 0, 1, 1, 0.3, 0, 2}, {1, 5, 101, 1, 1, 0.3, 0, 2},
-               {1, 5, 5, 1, 0, 0.3, 0, 2}, {1, 5, 5, 1, NAN, 0.3, 0, 2},
+    } bad[] = {{1, 5, 5, 1, 1, 0.3, 0, 0.99},     {1, 5, 5, 1, 1, 0.3, 0, 8.01},
+               {1, 5, 5, 1, 1, 0.3, 0, NAN},      {-1, 0, 5, 1, 1, 0.3, 0, 2},
+               {1, -1, 5, 1, 1, 0.3, 0, 2},       {1, 1001, 5, 1, 1, 0.3, 0, 2},
+               {1, 5, 0, 1, 1, 0.3, 0, 2},        {1, 5, 101, 1, 1, 0.3, 0, 2},
+               {1, 5, 5, 1, 0, 0.3, 0, 2},        {1, 5, 5, 1, NAN, 0.3, 0, 2},
                {1, 5, 5, 1, INFINITY, 0.3, 0, 2}, {1, 5, 5, 1, 1, 0, 0, 2},
-               {1, 5, 5, 1, 1, 2.5, 0, 2}, {1, 5, 5, 0, 1, 0.3, 0, 2},
-               {1, 5, 5, 1001, 1, 0.3, 0, 2}, {1, 5, 5, 1, 1, 0.3, -1, 2},
-               {1, 5, 5, 1, 1, 0.3, NAN, 2}, {1, 5, 5, 1, 1, 0.3, INFINITY, 2}};
+               {1, 5, 5, 1, 1, 2.5, 0, 2},        {1, 5, 5, 0, 1, 0.3, 0, 2},
+               {1, 5, 5, 1001, 1, 0.3, 0, 2},     {1, 5, 5, 1, 1, 0.3, -1, 2},
+               {1, 5, 5, 1, 1, 0.3, NAN, 2},      {1, 5, 5, 1, 1, 0.3, INFINITY, 2}};
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         rsmooth_params p;
         rsmooth_params_init(&p);
@@ -345,7 +347,6 @@ static void test_parameters_checked(void) {
     shape_free(&cube);
 }
 
-
 /* stage_repeats R is R chained calls of the stage alone (absolute widths: the same in each). */
 /* The stage's cycles against brute force: each cycle the facets' geometry from the current
  * positions, guided rounds over neighbour sets found once on the input, then the vertex update. */
@@ -355,13 +356,15 @@ static void test_cycles_against_brute_force(void) {
     CHECK(shape_add_normal_noise(&cube, 0.4, 5) == 0);
     size_t nv = cube.vertex_count, n = 3 * nv;
     double edge = shape_mean_edge_length(&cube);
-    rs_stage_setting setting = {0.7 * edge, 0.3, 3.0, 2, 3, 4}; /* s, t, radius, rounds, k, cycles */
+    rs_stage_setting setting = {0.7 * edge, 0.3, 3.0,
+                                2,          3,   4}; /* s, t, radius, rounds, k, cycles */
     double *lib = malloc(n * sizeof(double)), *brute = malloc(n * sizeof(double));
     CHECK(lib && brute);
     memcpy(lib, cube.xyz, n * sizeof(double));
     memcpy(brute, cube.xyz, n * sizeof(double));
     CHECK_STATUS(rs_normal_update_stage(lib, nv, cube.indices, cube.triangle_count, &setting, NULL,
-                                        NULL, NULL, NULL, NULL, NULL, "test"), RSMOOTH_OK);
+                                        NULL, NULL, NULL, NULL, NULL, "test"),
+                 RSMOOTH_OK);
     rs_facets input, now;
     CHECK(rs_facets_build(&input, cube.xyz, cube.indices, cube.triangle_count));
     double *normals = malloc(input.count * 3 * sizeof(double));
@@ -481,10 +484,12 @@ static void test_region_choice(void) {
     double unit = shape_mean_edge_length(&sphere);
     CHECK_STATUS(rsmooth_smooth_taubin(RSMOOTH_FLOAT64, sphere.xyz, ns, sphere.indices,
                                        sphere.triangle_count, 0.5, -0.53, (unsigned)k, taubin,
-                                       NULL), RSMOOTH_OK);
+                                       NULL),
+                 RSMOOTH_OK);
     CHECK_STATUS(rsmooth_smooth_taubin(RSMOOTH_FLOAT64, sphere.xyz, ns, sphere.indices,
                                        sphere.triangle_count, 0.5, -0.53, (unsigned)k - 1, fewer,
-                                       NULL), RSMOOTH_OK);
+                                       NULL),
+                 RSMOOTH_OK);
     CHECK(rms_move(taubin, sphere.xyz, ns) >= level * unit);
     CHECK(rms_move(fewer, sphere.xyz, ns) < level * unit);
     size_t as_taubin = same_vertices(chosen, taubin, ns);
@@ -500,14 +505,15 @@ static void test_region_choice(void) {
     p.discrepancy_gain = gain;
     rsmooth_report_init(&r);
     CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, sphere.xyz, ns, sphere.indices,
-                                          sphere.triangle_count, &p, chosen, NULL, NULL, &r,
-                                          NULL), RSMOOTH_OK);
+                                          sphere.triangle_count, &p, chosen, NULL, NULL, &r, NULL),
+                 RSMOOTH_OK);
     int g = r.discrepancy_iterations;
     double moved[3];
     for (int i = 0; i < 3; i++) {
         CHECK_STATUS(rsmooth_smooth_taubin(RSMOOTH_FLOAT64, sphere.xyz, ns, sphere.indices,
                                            sphere.triangle_count, 0.5, -0.53, (unsigned)(g - i),
-                                           taubin, NULL), RSMOOTH_OK);
+                                           taubin, NULL),
+                     RSMOOTH_OK);
         moved[i] = rms_move(taubin, sphere.xyz, ns) / unit;
     }
     printf("region: gain %.2f -> %d Taubin iterations (the last added %.4f, the one before %.4f)\n",
@@ -528,8 +534,8 @@ static void test_region_choice(void) {
     best_on(&both, 0, alone, &r);
     size_t cube_kept = same_vertices(chosen + 3 * ns, alone + 3 * ns, nc);
     size_t sphere_moved = ns - same_vertices(chosen, alone, ns);
-    printf("region: sphere + cube -> cube %zu of %zu kept, sphere %zu of %zu replaced\n",
-           cube_kept, nc, sphere_moved, ns);
+    printf("region: sphere + cube -> cube %zu of %zu kept, sphere %zu of %zu replaced\n", cube_kept,
+           nc, sphere_moved, ns);
     CHECK(cube_kept >= nc * 8 / 10 && sphere_moved >= ns * 9 / 10);
     free(alone);
     free(plain);
@@ -578,7 +584,8 @@ static void test_boundary_limit(void) {
     for (size_t v = 0; v < nv; v++) {
         if (!rim[v])
             continue;
-        double limit = level * sum[v] / (double)edges[v], move = gap(out + 3 * v, plane.xyz + 3 * v);
+        double limit = level * sum[v] / (double)edges[v],
+               move = gap(out + 3 * v, plane.xyz + 3 * v);
         CHECK_LE(move, limit * (1 + 1e-9));
         on_rim++;
         at_limit += move > limit * 0.999;
@@ -616,14 +623,16 @@ static void test_auto_report(void) {
     rsmooth_params_init(&paper);
     CHECK_STATUS(rsmooth_params_auto_report(RSMOOTH_FLOAT64, sphere.xyz, sphere.vertex_count,
                                             sphere.indices, sphere.triangle_count, &paper, &r,
-                                            NULL), RSMOOTH_OK);
+                                            NULL),
+                 RSMOOTH_OK);
     CHECK(strcmp(r.preset, "paper") == 0);
     CHECK_EQ_INT(paper.vertex_updates, 0);
     CHECK(paper.discrepancy_level == 0);
     r.struct_size = 8; /* an uninitialised report is refused */
     CHECK_STATUS(rsmooth_params_auto_report(RSMOOTH_FLOAT64, sphere.xyz, sphere.vertex_count,
                                             sphere.indices, sphere.triangle_count, &paper, &r,
-                                            NULL), RSMOOTH_ERROR_INVALID_ARGUMENT);
+                                            NULL),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
     shape_free(&sphere);
 }
 

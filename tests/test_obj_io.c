@@ -446,8 +446,8 @@ static void test_create_and_triangulate(void) {
     CHECK(m == NULL);
 }
 
-
-/* ---- lossless OBJ: the faithful writer -------------------------------------------------------- */
+/* ---- lossless OBJ: the faithful writer --------------------------------------------------------
+ */
 
 static const char rich_obj[] = "# exported by hand\n"
                                "mtllib scene.mtl\n"
@@ -479,7 +479,8 @@ static const char rich_obj[] = "# exported by hand\n"
                                "f -2/1/2 -1/2/1 1/3/2 # trailing\n";
 
 /* What the test reads of an OBJ text by itself: the lines other than v, vn and f (in order), the
- * vt and vn lines' values, and per face corner the vt and vn indices (absolute, 0-based, -1 none). */
+ * vt and vn lines' values, and per face corner the vt and vn indices (absolute, 0-based, -1 none).
+ */
 typedef struct obj_text {
     char other[64][128];
     size_t other_count;
@@ -627,8 +628,8 @@ static void check_faithful_round_trip(const char *input) {
 
     /* Conversion losses name the OBJ-only content, not colours or normals (PLY holds them). */
     char losses[512];
-    size_t lost = rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_PLY_BINARY, losses,
-                                                 sizeof losses);
+    size_t lost =
+        rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_PLY_BINARY, losses, sizeof losses);
     CHECK_EQ_INT(lost, 6);
     CHECK(strstr(losses, "OBJ texture coordinates") != NULL);
     CHECK(strstr(losses, "OBJ groups and objects") != NULL);

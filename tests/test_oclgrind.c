@@ -2,11 +2,11 @@
  * barrier semantics, as a GPU does (PoCL's CPU device checks none of it), with its checks on:
  * memory accesses out of bounds, API misuse (OCLGRIND_CHECK_API), data races
  * (OCLGRIND_DATA_RACES) and uses of uninitialised values (OCLGRIND_UNINITIALIZED). Each kernel
- * variant (lib/opencl/cl_variant.c: vertex blocks 4 and 16 wide, and the GPU's work-groups) runs in a
- * child process of its own, on a small noisy cylinder: the paper's filter, the bilateral normal filter from lists
- * and searching, every influence function, both predictors, the underflow rescue with and
- * without colour. Each case must agree with the double-precision reference path, Oclgrind must
- * report nothing (OCLGRIND_LOG), and every __kernel in kernels/ must have run (Oclgrind's
+ * variant (lib/opencl/cl_variant.c: vertex blocks 4 and 16 wide, and the GPU's work-groups) runs in
+ * a child process of its own, on a small noisy cylinder: the paper's filter, the bilateral normal
+ * filter from lists and searching, every influence function, both predictors, the underflow rescue
+ * with and without colour. Each case must agree with the double-precision reference path, Oclgrind
+ * must report nothing (OCLGRIND_LOG), and every __kernel in kernels/ must have run (Oclgrind's
  * OCLGRIND_INST_COUNTS names each kernel it ran). Skipped (77) where Oclgrind's runtime library
  * is not installed (Debian's oclgrind package; RSMOOTH_TEST_OCLGRIND names another one), unless
  * RSMOOTH_REQUIRE_OPENCL=1.
@@ -125,8 +125,8 @@ static rsmooth_context *oclgrind_context(const char *variant) {
     rsmooth_error err;
     rsmooth_status st = rsmooth_context_create(NULL, &ctx, &err);
     if (st != RSMOOTH_OK) {
-        fprintf(stderr, "no context on Oclgrind: %s: %s\n%s\n", rsmooth_status_str(st),
-                err.message, err.build_log);
+        fprintf(stderr, "no context on Oclgrind: %s: %s\n%s\n", rsmooth_status_str(st), err.message,
+                err.build_log);
         exit(1);
     }
     unsigned lanes = 0;
@@ -190,9 +190,8 @@ static uint64_t run_case(const char *variant, const char *name, const test_mesh 
     CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->shape.xyz, nv, m->shape.indices, nt,
                                           p, ref, NULL, ref_conf, &report, &err),
                  RSMOOTH_OK);
-    rsmooth_status st = rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->shape.xyz, nv, m->shape.indices,
-                                       nt, p, cl, NULL, confidence ? cl_conf : NULL, &cl_report,
-                                       &err);
+    rsmooth_status st = rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->shape.xyz, nv, m->shape.indices, nt,
+                                       p, cl, NULL, confidence ? cl_conf : NULL, &cl_report, &err);
     rsmooth_context_destroy(ctx);
     take_reports(name, log, kept);
     if (st != RSMOOTH_OK)
@@ -301,8 +300,8 @@ static int run_variant(const char *variant, const char *runtime) {
         setenv("RSMOOTH_LANES", variant_lanes(variant), 1);
     else
         unsetenv("RSMOOTH_LANES");
-    unsetenv("RSMOOTH_DEVICE");         /* Oclgrind's is the only device */
-    unsetenv("RSMOOTH_MEMORY_BUDGET");  /* one run per case: no tiles */
+    unsetenv("RSMOOTH_DEVICE");            /* Oclgrind's is the only device */
+    unsetenv("RSMOOTH_MEMORY_BUDGET");     /* one run per case: no tiles */
     setenv("RSMOOTH_CACHE_DIR", "off", 1); /* every run compiles the source through Oclgrind */
     setenv("OCLGRIND_CHECK_API", "1", 1);
     setenv("OCLGRIND_DATA_RACES", "1", 1);
@@ -349,8 +348,8 @@ static int run_variant(const char *variant, const char *runtime) {
 /* ---- The parent: each variant in a child, then what it printed ------------------------------- */
 
 /* The names after `marker` up to the next `end` in `text`, each once, added to names[]. */
-static size_t collect_names(const char *text, const char *marker, char end,
-                            char names[][64], size_t count) {
+static size_t collect_names(const char *text, const char *marker, char end, char names[][64],
+                            size_t count) {
     for (const char *at = text; (at = strstr(at, marker)) != NULL;) {
         at += strlen(marker);
         size_t len = strcspn(at, (char[]){end, '\n', '\0'});
@@ -369,8 +368,8 @@ static size_t collect_names(const char *text, const char *marker, char end,
 
 /* Every __kernel the sources define. */
 static size_t source_kernels(char names[][64]) {
-    static const char *const files[] = {"common.cl", "mollify.cl", "bilateral.cl", "estimate.cl",
-                                        "stage.cl", "grid.cl"};
+    static const char *const files[] = {"common.cl",   "mollify.cl", "bilateral.cl",
+                                        "estimate.cl", "stage.cl",   "grid.cl"};
     size_t count = 0;
     for (size_t i = 0; i < sizeof files / sizeof *files; i++) {
         char path[4096];
@@ -467,10 +466,10 @@ static const char *find_runtime(void) {
     const char *chosen = getenv("RSMOOTH_TEST_OCLGRIND");
     if (chosen && *chosen)
         return chosen;
-    static const char *const places[] = {
-        "/usr/lib/oclgrind/liboclgrind-rt.so", /* Debian, Ubuntu */
-        "/usr/local/lib/liboclgrind-rt.so",    /* built from source */
-        "/usr/lib64/liboclgrind-rt.so", "/usr/lib/liboclgrind-rt.so"};
+    static const char *const places[] = {"/usr/lib/oclgrind/liboclgrind-rt.so", /* Debian, Ubuntu */
+                                         "/usr/local/lib/liboclgrind-rt.so", /* built from source */
+                                         "/usr/lib64/liboclgrind-rt.so",
+                                         "/usr/lib/liboclgrind-rt.so"};
     for (size_t i = 0; i < sizeof places / sizeof *places; i++)
         if (access(places[i], R_OK) == 0)
             return places[i];

@@ -105,9 +105,8 @@ static void test_variants(void) {
     check_color(m, 2, 51, 102, 153);
     CHECK(m->extras != NULL);
     char losses[256];
-    CHECK_EQ_INT(rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_PLY_BINARY, losses,
-                                                sizeof losses),
-                 2);
+    CHECK_EQ_INT(
+        rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_PLY_BINARY, losses, sizeof losses), 2);
     CHECK(strstr(losses, "OFF face colours") && strstr(losses, "OFF colour alpha"));
     CHECK_EQ_INT(rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_OFF, losses, sizeof losses), 0);
     rsmooth_mesh_destroy(m);
@@ -373,9 +372,9 @@ static uint32_t lcg(void) {
 }
 
 static void test_garbage(void) {
-    static const char *const words[] = {"OFF", "COFF", "NOFF", "3",  "0", "1",  "2",  "-1",
-                                        "4",   "#",    "nan",  "\n", " ", "\t", "0.5", "255",
-                                        "1e9", "x",    "\r\n", "99999999999"};
+    static const char *const words[] = {"OFF", "COFF", "NOFF", "3",   "0",    "1",          "2",
+                                        "-1",  "4",    "#",    "nan", "\n",   " ",          "\t",
+                                        "0.5", "255",  "1e9",  "x",   "\r\n", "99999999999"};
     for (int round = 0; round < 4000; round++) {
         size_t len = lcg() % 300;
         char *buf = malloc(len ? len : 1);

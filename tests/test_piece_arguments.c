@@ -109,10 +109,14 @@ static void check_info_fields(rsmooth_context *ctx, piece_case *c) {
     const struct {
         const char *field;
         double value;
-    } scales[] = {{"info->scale", ldexp(1, -1030)}, {"info->scale", ldexp(1, -501)},
-                  {"info->scale", ldexp(1, 1001)},  {"info->scale", 3.0},
-                  {"info->scale", -1.0},            {"info->scale", NAN},
-                  {"info->scale", INFINITY},        {"typical edge", ldexp(1, 300)},
+    } scales[] = {{"info->scale", ldexp(1, -1030)},
+                  {"info->scale", ldexp(1, -501)},
+                  {"info->scale", ldexp(1, 1001)},
+                  {"info->scale", 3.0},
+                  {"info->scale", -1.0},
+                  {"info->scale", NAN},
+                  {"info->scale", INFINITY},
+                  {"typical edge", ldexp(1, 300)},
                   {"typical edge", ldexp(1, -300)}};
     for (size_t i = 0; i < sizeof scales / sizeof *scales; i++) {
         bad = good;
@@ -185,8 +189,7 @@ static void check_early_refusals(rsmooth_context *ctx, piece_case *c) {
     CHECK_STATUS(smooth(ctx, c, &c->info, &two, c->out, &err), RSMOOTH_ERROR_UNSUPPORTED);
     CHECK(strstr(err.message, "passes") != NULL);
     dirty_stack();
-    CHECK_STATUS(smooth(ctx, c, &c->info, NULL, c->mesh.xyz, &err),
-                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK_STATUS(smooth(ctx, c, &c->info, NULL, c->mesh.xyz, &err), RSMOOTH_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(err.message, "overlaps") != NULL);
     printf("  %s: NULL out_positions, passes 2, overlapping buffers refused\n",
            ctx ? "device" : "reference");
@@ -208,15 +211,14 @@ static void check_halo(void) {
 static void write_mesh(const shape_mesh *m, const char *path) {
     rsmooth_mesh *mesh = NULL;
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_mesh_create(m->vertex_count, m->triangle_count, 3 * m->triangle_count,
-                                     &mesh, &err),
-                 RSMOOTH_OK);
+    CHECK_STATUS(
+        rsmooth_mesh_create(m->vertex_count, m->triangle_count, 3 * m->triangle_count, &mesh, &err),
+        RSMOOTH_OK);
     memcpy(mesh->positions, m->xyz, m->vertex_count * 3 * sizeof *m->xyz);
     for (size_t f = 0; f <= m->triangle_count; f++)
         mesh->face_offsets[f] = (uint32_t)(3 * f);
     memcpy(mesh->face_indices, m->indices, 3 * m->triangle_count * sizeof *m->indices);
-    CHECK_STATUS(rsmooth_mesh_write_file(mesh, path, RSMOOTH_FORMAT_PLY_BINARY, &err),
-                 RSMOOTH_OK);
+    CHECK_STATUS(rsmooth_mesh_write_file(mesh, path, RSMOOTH_FORMAT_PLY_BINARY, &err), RSMOOTH_OK);
     rsmooth_mesh_destroy(mesh);
 }
 
@@ -240,8 +242,8 @@ static void check_stream_ranks(const shape_mesh *m) {
         so.ranks = cases[i].ranks;
         rsmooth_error err;
         rsmooth_status st = rsmooth_stream_smooth(NULL, in, out, NULL, &so, NULL, &err);
-        printf("stream rank %d of %d, no sync: %s: %s\n", so.rank, so.ranks,
-               rsmooth_status_str(st), err.message);
+        printf("stream rank %d of %d, no sync: %s: %s\n", so.rank, so.ranks, rsmooth_status_str(st),
+               err.message);
         CHECK_EQ_INT(st, RSMOOTH_ERROR_INVALID_ARGUMENT);
         CHECK(strstr(err.message, cases[i].needle) != NULL);
         CHECK(access(out, F_OK) != 0);

@@ -36,10 +36,10 @@ static size_t tsize(const char *type, bool *is_signed, bool *is_float) {
         const char *a, *b;
         size_t size;
         bool sign, flt;
-    } t[] = {{"char", "int8", 1, true, false},     {"uchar", "uint8", 1, false, false},
-             {"short", "int16", 2, true, false},   {"ushort", "uint16", 2, false, false},
-             {"int", "int32", 4, true, false},     {"uint", "uint32", 4, false, false},
-             {"float", "float32", 4, true, true},  {"double", "float64", 8, true, true}};
+    } t[] = {{"char", "int8", 1, true, false},    {"uchar", "uint8", 1, false, false},
+             {"short", "int16", 2, true, false},  {"ushort", "uint16", 2, false, false},
+             {"int", "int32", 4, true, false},    {"uint", "uint32", 4, false, false},
+             {"float", "float32", 4, true, true}, {"double", "float64", 8, true, true}};
     for (size_t i = 0; i < sizeof t / sizeof t[0]; i++) {
         if (!strcmp(type, t[i].a) || !strcmp(type, t[i].b)) {
             *is_signed = t[i].sign;
@@ -118,7 +118,9 @@ static tply *tparse(const unsigned char *data, size_t size) {
         if (!strcmp(line, "end_header"))
             break;
         if (sscanf(line, "format %63s", a) == 1) {
-            p->format = !strcmp(a, "ascii") ? T_ASCII : !strcmp(a, "binary_big_endian") ? T_BE : T_LE;
+            p->format = !strcmp(a, "ascii")               ? T_ASCII
+                        : !strcmp(a, "binary_big_endian") ? T_BE
+                                                          : T_LE;
         } else if (sscanf(line, "element %63s %63s", a, b) == 2) {
             telem *e = &p->elems[p->nelems++];
             snprintf(e->name, sizeof e->name, "%s", a);
@@ -175,7 +177,7 @@ static size_t tprop_index(const telem *e, const char *name) {
 #define NV 6
 #define NF 3
 
-static const float positions[NV][3] = {{0, 0, 0},       {1.5f, 0, 0},  {1.5f, 1.25f, 0},
+static const float positions[NV][3] = {{0, 0, 0},         {1.5f, 0, 0},   {1.5f, 1.25f, 0},
                                        {0, 1.25f, -0.5f}, {0.25f, -1, 3}, {2, 0.5f, 0.125f}};
 static const float quality[NV] = {0.1f, 1e-30f, -3.4e38f, 1.0f / 3, 7, 0};
 static const int32_t labels[NV] = {-7, 0, 2147483647, -2147483647 - 1, 12, 99};
@@ -335,8 +337,8 @@ static void check_faithful(const tply *in, const tply *out, const rsmooth_mesh *
                 }
                 for (size_t j = 0; j < n; j++, at++) {
                     double expected = a->values[at];
-                    bool f32 = !strcmp(a->props[k].type, "float") ||
-                               !strcmp(a->props[k].type, "float32");
+                    bool f32 =
+                        !strcmp(a->props[k].type, "float") || !strcmp(a->props[k].type, "float32");
                     if (vertex && strlen(name) == 1 && strchr("xyz", name[0]))
                         expected = mesh->positions[3 * i + (size_t)(name[0] - 'x')];
                     else if (vertex && strlen(name) == 2 && name[0] == 'n' &&
@@ -347,7 +349,8 @@ static void check_faithful(const tply *in, const tply *out, const rsmooth_mesh *
                     if (f32)
                         expected = (float)expected;
                     if (!same_bits(expected, b->values[at])) {
-                        fprintf(stderr, "element %s item %zu property %s: %.17g expected, %.17g written\n",
+                        fprintf(stderr,
+                                "element %s item %zu property %s: %.17g expected, %.17g written\n",
                                 a->name, i, name, expected, b->values[at]);
                         exit(1);
                     }
@@ -387,8 +390,8 @@ static void test_rich_round_trip(void) {
         CHECK(strstr(lost, "'alpha'") != NULL);
         CHECK(strstr(lost, "comments") != NULL);
         CHECK(strstr(lost, "red") == NULL && strstr(lost, "'nx'") == NULL);
-        CHECK_EQ_INT(rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_PLY_BINARY, lost, sizeof lost),
-                     0);
+        CHECK_EQ_INT(
+            rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_PLY_BINARY, lost, sizeof lost), 0);
 
         for (size_t i = 0; i < 3 * m->vertex_count; i++)
             m->positions[i] = (float)(m->positions[i] + 0.5 + 0.001 * (double)i); /* see below */
@@ -521,7 +524,8 @@ static void test_many_losses(void) {
     bytes_free(&b);
 }
 
-/* Faces that no longer fit the file's list types widen them; integer coordinates round and must fit. */
+/* Faces that no longer fit the file's list types widen them; integer coordinates round and must
+ * fit. */
 static void test_widening_and_integer_positions(void) {
     bytes b = {0};
     put_text(&b, "ply\nformat ascii 1.0\nelement vertex 300\n"
@@ -589,7 +593,7 @@ static void test_generic_normals(void) {
                 CHECK(same_bits(v->values[6 * i + 3 + c], normals[3 * i + c]));
         rsmooth_mesh *back = read_ok(w.data, w.size);
         CHECK_EQ_INT(back->has_vertex_normals, 1);
-        CHECK(back->extras != NULL); /* normals are beyond the plain layout */
+        CHECK(back->extras != NULL);    /* normals are beyond the plain layout */
         check_faithful(out, out, back); /* its own normals again on a second write */
         rsmooth_mesh_destroy(back);
         tfree(out);
@@ -629,8 +633,9 @@ static void test_bad_values(void) {
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         rsmooth_mesh *m = NULL;
         rsmooth_error err;
-        CHECK_EQ_INT(rsmooth_mesh_read_memory(bad[i], strlen(bad[i]), RSMOOTH_FORMAT_AUTO, &m, &err),
-                     RSMOOTH_ERROR_PARSE);
+        CHECK_EQ_INT(
+            rsmooth_mesh_read_memory(bad[i], strlen(bad[i]), RSMOOTH_FORMAT_AUTO, &m, &err),
+            RSMOOTH_ERROR_PARSE);
         CHECK(strstr(err.message, "does not fit") != NULL);
         CHECK(m == NULL);
     }
@@ -738,8 +743,8 @@ static void test_corruption(void) {
         }
         rsmooth_mesh *m = NULL;
         rsmooth_error err;
-        rsmooth_status s = rsmooth_mesh_read_memory(good.data, good.size, RSMOOTH_FORMAT_AUTO, &m,
-                                                    &err);
+        rsmooth_status s =
+            rsmooth_mesh_read_memory(good.data, good.size, RSMOOTH_FORMAT_AUTO, &m, &err);
         CHECK(s == RSMOOTH_OK || s == RSMOOTH_ERROR_PARSE);
         if (s == RSMOOTH_OK) {
             FILE *f = tmpfile();

@@ -320,7 +320,8 @@ static void test_oracle(void) {
             }
         }
         free(want), free(want_n), free(want_c), free(got), free(got_n), free(got_c);
-        free(xyz32), free(nrm32), free(got32), free(got32_n), free(xyz64), free(nrm64), free(colors);
+        free(xyz32), free(nrm32), free(got32), free(got32_n), free(xyz64), free(nrm64),
+            free(colors);
         free(normals[m]);
         shape_free(&meshes[m]);
     }

@@ -108,9 +108,10 @@ static double bf_influence(int influence, double x2) {
 static double bf_color_dist2(const float *colors, const uint32_t *tri, const float *cp) {
     double s = 0;
     for (int k = 0; k < 3; k++) {
-        double mean = ((double)colors[3 * (size_t)tri[0] + k] +
-                       (double)colors[3 * (size_t)tri[1] + k] +
-                       (double)colors[3 * (size_t)tri[2] + k]) / 3;
+        double mean =
+            ((double)colors[3 * (size_t)tri[0] + k] + (double)colors[3 * (size_t)tri[1] + k] +
+             (double)colors[3 * (size_t)tri[2] + k]) /
+            3;
         s += (mean - cp[k]) * (mean - cp[k]);
     }
     return s;
@@ -201,8 +202,7 @@ static void brute_force(const double *xyz, size_t vc, const uint32_t *idx, size_
     const int centroid = prm->predictor == RSMOOTH_PREDICT_CENTROID; /* predict c_q, not Pi_q(p) */
     if (prm->mollify && !centroid && prm->normal_filter == RSMOOTH_NORMALS_BILATERAL)
         bf_bilateral(cen, nrm, area, fc, prm->cutoff * prm->normal_sigma_s * unit,
-                     prm->normal_sigma_s * unit, prm->normal_sigma_n, prm->normal_iterations,
-                     mnrm);
+                     prm->normal_sigma_s * unit, prm->normal_sigma_n, prm->normal_iterations, mnrm);
     const int influence = isinf(sg) ? RSMOOTH_INFLUENCE_GAUSSIAN : prm->influence;
     /* colour factor exp(-|C_q - C_p|^2 / 2 sigma_c^2), C_q the mean of q's corners' colours:
      * with the Gaussian its exponent joins the influence's (and its shift) */
@@ -245,9 +245,9 @@ static void brute_force(const double *xyz, size_t vc, const uint32_t *idx, size_
             double t = dot(n, d);
             double r2 = centroid ? d2 : t * t;
             double e = isinf(sg) ? 0 : r2 / (2 * sg * sg);
-            double ec = col ? bf_color_dist2(col, idx + 3 * (size_t)tri[q], col + 3 * v) /
-                                  (2 * sc * sc)
-                            : 0;
+            double ec =
+                col ? bf_color_dist2(col, idx + 3 * (size_t)tri[q], col + 3 * v) / (2 * sc * sc)
+                    : 0;
             double af = area[q] * exp(-d2 / (2 * sf * sf));
             double w = af * (influence == RSMOOTH_INFLUENCE_GAUSSIAN
                                  ? exp(-(e + ec - e_min))
@@ -357,8 +357,8 @@ static void run_case(const char *name, const double *xyz, size_t vc, const uint3
      * back triangles the filter turns over, is tested in test_do_no_harm */
     rsmooth_params unguarded = *prm;
     unguarded.guard = 0;
-    rsmooth_status s = rsmooth_smooth_reference(RSMOOTH_FLOAT64, xyz, vc, idx, tc, &unguarded,
-                                                ref, rk, rc, &report, &err);
+    rsmooth_status s = rsmooth_smooth_reference(RSMOOTH_FLOAT64, xyz, vc, idx, tc, &unguarded, ref,
+                                                rk, rc, &report, &err);
     if (s != RSMOOTH_OK)
         fprintf(stderr, "%s: %s\n", name, err.message);
     CHECK_STATUS(s, RSMOOTH_OK);
@@ -546,19 +546,19 @@ static void colour_edge_plane(void) {
     double *wide = malloc(3 * nv * sizeof *wide);
     CHECK(plain && narrow && wide);
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m.xyz, nv, m.indices,
-                                          m.triangle_count, &p, plain, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m.xyz, nv, m.indices, m.triangle_count,
+                                          &p, plain, NULL, NULL, NULL, &err),
                  RSMOOTH_OK);
     p.colors = col;
     p.sigma_c = 0.05;
     run_case("colour-edge plane, centroid, sigma_c 0.05", m.xyz, nv, m.indices, m.triangle_count,
              &p, 0);
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m.xyz, nv, m.indices,
-                                          m.triangle_count, &p, narrow, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m.xyz, nv, m.indices, m.triangle_count,
+                                          &p, narrow, NULL, NULL, NULL, &err),
                  RSMOOTH_OK);
     p.sigma_c = 1e8;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m.xyz, nv, m.indices,
-                                          m.triangle_count, &p, wide, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m.xyz, nv, m.indices, m.triangle_count,
+                                          &p, wide, NULL, NULL, NULL, &err),
                  RSMOOTH_OK);
     /* the edge's vertices away from the plane's border (2 sigma_f = reach of 2.3 units) */
     double plain_dx = 0, narrow_dx = -INFINITY, wide_dev = 0;
@@ -587,8 +587,8 @@ static void colour_edge_plane(void) {
     run_case("colour-edge plane, defaults, sigma_c 0.05", m.xyz, nv, m.indices, m.triangle_count,
              &p, 0);
     p.sigma_c = 1e8;
-    run_case("colour-edge plane, defaults, sigma_c 1e8", m.xyz, nv, m.indices, m.triangle_count,
-             &p, 0);
+    run_case("colour-edge plane, defaults, sigma_c 1e8", m.xyz, nv, m.indices, m.triangle_count, &p,
+             0);
     free(plain);
     free(narrow);
     free(wide);

@@ -49,10 +49,10 @@ static double rms_error(const roof *r, const double *xyz, double s) {
 }
 
 typedef struct sweep {
-    double worst_cl;        /* largest OpenCL - reference difference, mean edge lengths */
+    double worst_cl; /* largest OpenCL - reference difference, mean edge lengths */
     int worst_cl_decade;
-    double worst_scaled;    /* largest |result / s - result at 1|, spacings (reference path) */
-    double worst_gain;      /* largest error after / error before */
+    double worst_scaled; /* largest |result / s - result at 1|, spacings (reference path) */
+    double worst_gain;   /* largest error after / error before */
     int decades;
 } sweep;
 
@@ -71,9 +71,9 @@ static void smooth_both(rsmooth_context *ctx, rsmooth_scalar scalar, const void 
                         const shape_mesh *m, void *out_ref, void *out_cl, double *edge) {
     rsmooth_error err;
     rsmooth_report report;
-    rsmooth_status st = rsmooth_smooth_reference(scalar, xyz, m->vertex_count, m->indices,
-                                                 m->triangle_count, NULL, out_ref, NULL, NULL,
-                                                 &report, &err);
+    rsmooth_status st =
+        rsmooth_smooth_reference(scalar, xyz, m->vertex_count, m->indices, m->triangle_count, NULL,
+                                 out_ref, NULL, NULL, &report, &err);
     if (st != RSMOOTH_OK)
         fprintf(stderr, "reference: %s\n", err.message);
     CHECK_STATUS(st, RSMOOTH_OK);
@@ -190,13 +190,13 @@ static void test_unrepresentable(rsmooth_context *ctx) {
     p.sigma_g = INFINITY;
     p.mollify = 0;
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, d_xyz, 4, tri, 1, &p, d_out, NULL,
-                                          NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, d_xyz, 4, tri, 1, &p, d_out, NULL, NULL,
+                                          NULL, &err),
                  RSMOOTH_OK);
     printf("lone vertex projected to z = %.4g (float64)\n", d_out[11]);
     CHECK(d_out[11] > FLT_MAX && isfinite(d_out[11]));
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT32, f_xyz, 4, tri, 1, &p, f_out, NULL,
-                                          NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT32, f_xyz, 4, tri, 1, &p, f_out, NULL, NULL,
+                                          NULL, &err),
                  RSMOOTH_ERROR_NUMERICAL);
     printf("float32 reference: %s\n", err.message);
     if (ctx) {
@@ -218,8 +218,8 @@ static void test_unrepresentable(rsmooth_context *ctx) {
             big[i] = r.noisy.xyz[i] * pow(10, decade);
         rsmooth_status want = decade == 0 ? RSMOOTH_OK : RSMOOTH_ERROR_NUMERICAL;
         CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, big, n, r.noisy.indices,
-                                              r.noisy.triangle_count, NULL, out, weight, NULL,
-                                              NULL, &err),
+                                              r.noisy.triangle_count, NULL, out, weight, NULL, NULL,
+                                              &err),
                      want);
         if (ctx)
             CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, big, n, r.noisy.indices,
@@ -230,17 +230,17 @@ static void test_unrepresentable(rsmooth_context *ctx) {
             printf("weights at spacing 1e%d: %s\n", decade, err.message);
         /* and without weights the same call succeeds */
         CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, big, n, r.noisy.indices,
-                                              r.noisy.triangle_count, NULL, out, NULL, NULL,
-                                              NULL, &err),
+                                              r.noisy.triangle_count, NULL, out, NULL, NULL, NULL,
+                                              &err),
                      RSMOOTH_OK);
     }
     /* Taubin's inflating step pushes a float32 vertex past FLT_MAX. */
     const float spike[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 3e38f};
     const uint32_t faces[12] = {0, 2, 1, 0, 1, 3, 1, 2, 3, 2, 0, 3};
     float spiked[12];
-    CHECK_STATUS(rsmooth_smooth_taubin(RSMOOTH_FLOAT32, spike, 4, faces, 4, 1e-6, -1, 1, spiked,
-                                       &err),
-                 RSMOOTH_ERROR_NUMERICAL);
+    CHECK_STATUS(
+        rsmooth_smooth_taubin(RSMOOTH_FLOAT32, spike, 4, faces, 4, 1e-6, -1, 1, spiked, &err),
+        RSMOOTH_ERROR_NUMERICAL);
     printf("taubin: %s\n", err.message);
     free(big);
     free(out);
@@ -306,15 +306,14 @@ static void test_points_and_noise(const roof *r) {
     CHECK_STATUS(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, m->xyz, normals, n, NULL, at_one,
                                                  NULL, NULL, NULL, &err),
                  RSMOOTH_OK);
-    CHECK_STATUS(rsmooth_point_spacing(RSMOOTH_FLOAT64, m->xyz, n, &spacing_one, &err),
-                 RSMOOTH_OK);
+    CHECK_STATUS(rsmooth_point_spacing(RSMOOTH_FLOAT64, m->xyz, n, &spacing_one, &err), RSMOOTH_OK);
     static const int decades[] = {SMALLEST_DECADE, -150, -20, 20, 150 - 2};
     for (size_t i = 0; i < sizeof decades / sizeof *decades; i++) {
         double s = pow(10, decades[i]), noise = 0, spacing = 0, moved = 0;
         for (size_t k = 0; k < 3 * n; k++)
             xyz[k] = m->xyz[k] * s;
-        CHECK_STATUS(rsmooth_estimate_noise(RSMOOTH_FLOAT64, xyz, n, m->indices,
-                                            m->triangle_count, &noise, &err),
+        CHECK_STATUS(rsmooth_estimate_noise(RSMOOTH_FLOAT64, xyz, n, m->indices, m->triangle_count,
+                                            &noise, &err),
                      RSMOOTH_OK);
         CHECK_STATUS(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, normals, n, NULL, out,
                                                      NULL, NULL, NULL, &err),

@@ -151,9 +151,9 @@ static void test_float32(const shape_mesh *mesh, const rsmooth_params *p) {
 }
 
 /* Any finite coordinates are valid input. Two unit triangles in the planes x = -B and x = +B, and a
- * vertex lying in the second: everything is flat, so nothing moves and every confidence is 1. Beyond
- * 1e150 the library refuses the input (RSMOOTH_ERROR_INVALID_ARGUMENT, documented), which is fine;
- * a wrong answer is not: (a + b + c) / 3 and the grid's extent hi - lo must not overflow. */
+ * vertex lying in the second: everything is flat, so nothing moves and every confidence is 1.
+ * Beyond 1e150 the library refuses the input (RSMOOTH_ERROR_INVALID_ARGUMENT, documented), which is
+ * fine; a wrong answer is not: (a + b + c) / 3 and the grid's extent hi - lo must not overflow. */
 static void test_extreme_coordinates(void) {
     static const double extremes[] = {1e100, 1e150, 1e300, 1.7e308};
     for (size_t i = 0; i < sizeof extremes / sizeof extremes[0]; i++) {

@@ -144,7 +144,8 @@ static rsmooth_error expect_ascii_error(int at, const char *body, const char *ne
 #define EXPECT_ASCII_ERROR(body, needle) expect_ascii_error(__LINE__, body, needle)
 
 #define GOOD_FACET                                                                                 \
-    "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
+    "facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 "                      \
+    "0\nendloop\nendfacet\n"
 
 static bool contains(const bytes *b, const char *needle) {
     size_t n = strlen(needle);
@@ -163,11 +164,11 @@ static void test_ascii(void) {
     CHECK_EQ_INT(m->precision, RSMOOTH_FLOAT64);
     CHECK_EQ_INT(m->source_format, RSMOOTH_FORMAT_STL_ASCII);
     char losses[128];
-    CHECK_EQ_INT(rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_PLY_BINARY, losses, sizeof losses),
-                 1);
+    CHECK_EQ_INT(
+        rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_PLY_BINARY, losses, sizeof losses), 1);
     CHECK(strcmp(losses, "STL header") == 0);
-    CHECK_EQ_INT(rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_STL_BINARY, losses, sizeof losses),
-                 0);
+    CHECK_EQ_INT(
+        rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_STL_BINARY, losses, sizeof losses), 0);
     rsmooth_mesh_destroy(m);
     /* Either STL format reads it: the content decides. */
     m = parse_ok(b.data, b.size, RSMOOTH_FORMAT_STL_BINARY);
@@ -222,8 +223,8 @@ static void test_binary(void) {
     CHECK_EQ_INT(rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_STL_ASCII, losses, sizeof losses),
                  1);
     CHECK(strcmp(losses, "STL facet attributes") == 0);
-    CHECK_EQ_INT(rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_STL_BINARY, losses, sizeof losses),
-                 0);
+    CHECK_EQ_INT(
+        rsmooth_mesh_conversion_losses(m, RSMOOTH_FORMAT_STL_BINARY, losses, sizeof losses), 0);
 
     /* Written back: the same header and attributes, normals recomputed. */
     bytes out = {0};
@@ -326,13 +327,15 @@ static void test_errors(void) {
                                         "vertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n",
                              "facet 1 has a non-finite vertex");
     CHECK_EQ_INT(err.line, 11);
-    CHECK_EQ_INT(err.byte_offset, strlen("solid t\n" GOOD_FACET "facet normal 0 0 1\nouter loop\n"));
+    CHECK_EQ_INT(err.byte_offset,
+                 strlen("solid t\n" GOOD_FACET "facet normal 0 0 1\nouter loop\n"));
     EXPECT_ASCII_ERROR("facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 inf\n"
                        "vertex 0 1 0\nendloop\nendfacet\n",
                        "facet 0 has a non-finite vertex");
-    err = EXPECT_ASCII_ERROR(GOOD_FACET GOOD_FACET "facet normal 0 0 1\nouter loop\n"
-                                                   "vertex 0 0 0\nvertex 1 0 0\nendloop\nendfacet\n",
-                             "facet 2 has 2 vertices");
+    err =
+        EXPECT_ASCII_ERROR(GOOD_FACET GOOD_FACET "facet normal 0 0 1\nouter loop\n"
+                                                 "vertex 0 0 0\nvertex 1 0 0\nendloop\nendfacet\n",
+                           "facet 2 has 2 vertices");
     CHECK_EQ_INT(err.line, 16);
     EXPECT_ASCII_ERROR("facet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
                        "vertex 0 1 0\nvertex 1 1 0\nendloop\nendfacet\n",

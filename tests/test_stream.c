@@ -136,10 +136,9 @@ static double *smooth_in_memory(rsmooth_context *ctx, const char *path,
                                     &rep, &err),
                      RSMOOTH_OK);
     else
-        CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, mesh->positions,
-                                              mesh->vertex_count, mesh->triangles,
-                                              mesh->triangle_count, params, out, NULL, NULL, &rep,
-                                              &err),
+        CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
+                                              mesh->triangles, mesh->triangle_count, params, out,
+                                              NULL, NULL, &rep, &err),
                      RSMOOTH_OK);
     *mean_edge = rep.mean_edge_length;
     rsmooth_mesh_destroy(mesh);
@@ -164,9 +163,9 @@ static double deviation(const char *path, const double *expected, double mean_ed
     return worst / mean_edge;
 }
 
-static rsmooth_status stream(rsmooth_context *ctx, const char *in, const char *out,
-                             uint64_t cap, const rsmooth_params *params,
-                             rsmooth_stream_report *rep, rsmooth_error *err) {
+static rsmooth_status stream(rsmooth_context *ctx, const char *in, const char *out, uint64_t cap,
+                             const rsmooth_params *params, rsmooth_stream_report *rep,
+                             rsmooth_error *err) {
     rsmooth_stream_options so;
     rsmooth_stream_options_init(&so);
     so.max_memory = cap;
@@ -241,7 +240,7 @@ static void check_refusal(rsmooth_context *ctx, const char *in, uint64_t cap,
     printf("refused %-40s %s: %s\n", needle, rsmooth_status_str(st), err.message);
     CHECK_EQ_INT(st, expected);
     CHECK(strstr(err.message, needle) != NULL);
-    CHECK(access(out, F_OK) != 0);       /* nothing written */
+    CHECK(access(out, F_OK) != 0);        /* nothing written */
     CHECK_EQ_INT(files_in_dir(), before); /* nothing left behind */
 }
 
@@ -266,8 +265,8 @@ int main(void) {
     printf("cylinder V=%zu T=%zu cap %llu MB: %zu pieces (largest %llu facets), planned %llu MB, "
            "mean edge %.17g vs %.17g; deviation %.3g mean edge lengths\n",
            cyl.vertex_count, cyl.triangle_count, (unsigned long long)(cap >> 20), rep.pieces,
-           (unsigned long long)rep.piece_facets_max,
-           (unsigned long long)(rep.memory_planned >> 20), rep.mean_edge_length, edge, dev);
+           (unsigned long long)rep.piece_facets_max, (unsigned long long)(rep.memory_planned >> 20),
+           rep.mean_edge_length, edge, dev);
     CHECK(rep.pieces >= 10);
     CHECK_LE(rep.memory_planned, cap);
     CHECK(rep.mean_edge_length == edge); /* summed in the same order: the same bits */
@@ -296,8 +295,7 @@ int main(void) {
     char *in = strdup(path_in_dir("small.ply"));
     write_ply(in, &small, false, false, false, false);
     expected = smooth_in_memory(NULL, in, NULL, &edge);
-    CHECK_STATUS(stream(NULL, in, path_in_dir("ref.ply"), 12u << 20, NULL, &rep, &err),
-                 RSMOOTH_OK);
+    CHECK_STATUS(stream(NULL, in, path_in_dir("ref.ply"), 12u << 20, NULL, &rep, &err), RSMOOTH_OK);
     dev = deviation(path_in_dir("ref.ply"), expected, edge);
     printf("reference: %zu pieces; deviation %.3g (0: the same bits)\n", rep.pieces, dev);
     CHECK(rep.pieces >= 2);

@@ -76,9 +76,10 @@ static void expect_refused(const char *out, int replace, const char *tmpdir, rsm
 static void write_ply(const char *path, const shape_mesh *m) {
     FILE *f = fopen(path, "wb");
     CHECK(f);
-    fprintf(f, "ply\nformat binary_little_endian 1.0\nelement vertex %zu\nproperty double x\n"
-               "property double y\nproperty double z\nelement face %zu\n"
-               "property list uchar int vertex_indices\nend_header\n",
+    fprintf(f,
+            "ply\nformat binary_little_endian 1.0\nelement vertex %zu\nproperty double x\n"
+            "property double y\nproperty double z\nelement face %zu\n"
+            "property list uchar int vertex_indices\nend_header\n",
             m->vertex_count, m->triangle_count);
     CHECK(fwrite(m->xyz, 3 * sizeof(double), m->vertex_count, f) == m->vertex_count);
     for (size_t t = 0; t < m->triangle_count; t++) {
@@ -161,8 +162,8 @@ int main(void) {
     char notes[400];
     CHECK_STATUS(stream(in_dir("kept.ply"), 1, NULL, notes, &err), RSMOOTH_OK);
     CHECK(stat(in_dir("kept.ply"), &st) == 0);
-    printf("  mode %o, owner %ld:%ld; notes: %s\n", (unsigned)(st.st_mode & 07777),
-           (long)st.st_uid, (long)st.st_gid, notes);
+    printf("  mode %o, owner %ld:%ld; notes: %s\n", (unsigned)(st.st_mode & 07777), (long)st.st_uid,
+           (long)st.st_gid, notes);
     CHECK_EQ_INT(st.st_mode & 07777, 0640);
     if (root)
         CHECK(st.st_uid == 65534 && st.st_gid == 65534);

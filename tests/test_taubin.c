@@ -35,9 +35,9 @@ static void dense_taubin(const shape_mesh *m, double lambda, double mu, unsigned
                         count++;
                     }
                 for (int c = 0; c < 3; c++)
-                    next[3 * v + c] = count ? out[3 * v + c] + factor * (sum[c] / count -
-                                                                         out[3 * v + c])
-                                            : out[3 * v + c];
+                    next[3 * v + c] =
+                        count ? out[3 * v + c] + factor * (sum[c] / count - out[3 * v + c])
+                              : out[3 * v + c];
             }
             memcpy(out, next, 3 * n * sizeof *out);
         }
@@ -78,13 +78,13 @@ int main(void) {
     static const double settings[][2] = {{0.5, 0}, {0.5, -0.53}, {0.33, -0.34}, {1, -1}};
     for (size_t s = 0; s < sizeof settings / sizeof settings[0]; s++) {
         CHECK_STATUS(rsmooth_smooth_taubin(RSMOOTH_FLOAT64, sphere.xyz, n, sphere.indices,
-                                           sphere.triangle_count, settings[s][0], settings[s][1],
-                                           7, got, NULL),
+                                           sphere.triangle_count, settings[s][0], settings[s][1], 7,
+                                           got, NULL),
                      RSMOOTH_OK);
         dense_taubin(&sphere, settings[s][0], settings[s][1], 7, want);
         double diff = max_abs_diff(got, want, 3 * n);
-        printf("sphere lambda %g mu %g, 7 iterations: max |library - dense| %.3g\n",
-               settings[s][0], settings[s][1], diff);
+        printf("sphere lambda %g mu %g, 7 iterations: max |library - dense| %.3g\n", settings[s][0],
+               settings[s][1], diff);
         CHECK_LE(diff, 1e-12);
     }
 
@@ -125,9 +125,10 @@ int main(void) {
                  RSMOOTH_OK);
     radius_stats(got, n, &r_tau, &sd_tau);
     printf("noisy unit sphere: radius %.4f (sd %.4f); Laplacian x30 %.4f (sd %.4f); "
-           "Taubin x30 %.4f (sd %.4f)\n", r0, sd0, r_lap, sd_lap, r_tau, sd_tau);
-    CHECK_LE(r_lap, 0.9 * r0);                /* shrinks */
-    CHECK_LE(fabs(r_tau - r0), 0.03 * r0);    /* keeps its size */
+           "Taubin x30 %.4f (sd %.4f)\n",
+           r0, sd0, r_lap, sd_lap, r_tau, sd_tau);
+    CHECK_LE(r_lap, 0.9 * r0);             /* shrinks */
+    CHECK_LE(fabs(r_tau - r0), 0.03 * r0); /* keeps its size */
     CHECK_LE(sd_lap, 0.5 * sd0);
     CHECK_LE(sd_tau, 0.5 * sd0);
 
@@ -177,9 +178,9 @@ int main(void) {
         CHECK_STATUS(rsmooth_smooth_taubin(RSMOOTH_FLOAT64, xyz, 4, bad, 1, 0.5, 0, 1, out, &err),
                      RSMOOTH_ERROR_INVALID_ARGUMENT);
         CHECK(strstr(err.message, "index 4") != NULL);
-        CHECK_STATUS(rsmooth_smooth_taubin(RSMOOTH_FLOAT64, xyz, 4, idx, 2, 0.5, 0, 1, xyz + 3,
-                                           &err),
-                     RSMOOTH_ERROR_INVALID_ARGUMENT);
+        CHECK_STATUS(
+            rsmooth_smooth_taubin(RSMOOTH_FLOAT64, xyz, 4, idx, 2, 0.5, 0, 1, xyz + 3, &err),
+            RSMOOTH_ERROR_INVALID_ARGUMENT);
         CHECK(strstr(err.message, "overlaps") != NULL);
         CHECK_STATUS(rsmooth_smooth_taubin(RSMOOTH_FLOAT64, xyz, 4, idx, 2, 0.5, 0, 1, NULL, &err),
                      RSMOOTH_ERROR_INVALID_ARGUMENT);

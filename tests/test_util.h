@@ -1,5 +1,6 @@
-/* Checks for the test programs: always on (no assert, which release builds compile out), each failure
- * printing the file, line and both values. A test returns 0 on success, 77 to be skipped. */
+/* Checks for the test programs: always on (no assert, which release builds compile out), each
+ * failure printing the file, line and both values. A test returns 0 on success, 77 to be skipped.
+ */
 #ifndef RSMOOTH_TEST_UTIL_H
 #define RSMOOTH_TEST_UTIL_H
 
@@ -39,7 +40,7 @@ static inline int test_small(void) {
 #define CHECK_NEAR(a, b, tol)                                                                      \
     do {                                                                                           \
         double check_a_ = (double)(a), check_b_ = (double)(b), check_t_ = (double)(tol);           \
-        if (!(fabs(check_a_ - check_b_) <= check_t_)) {                                           \
+        if (!(fabs(check_a_ - check_b_) <= check_t_)) {                                            \
             fprintf(stderr, "%s:%d: CHECK_NEAR failed: %s = %.17g, %s = %.17g, tol %g\n",          \
                     __FILE__, __LINE__, #a, check_a_, #b, check_b_, check_t_);                     \
             exit(1);                                                                               \
@@ -51,8 +52,8 @@ static inline int test_small(void) {
     do {                                                                                           \
         double check_a_ = (double)(a), check_b_ = (double)(b);                                     \
         if (!(check_a_ <= check_b_)) {                                                             \
-            fprintf(stderr, "%s:%d: CHECK_LE failed: %s = %.9g > %s = %.9g\n", __FILE__,           \
-                    __LINE__, #a, check_a_, #b, check_b_);                                         \
+            fprintf(stderr, "%s:%d: CHECK_LE failed: %s = %.9g > %s = %.9g\n", __FILE__, __LINE__, \
+                    #a, check_a_, #b, check_b_);                                                   \
             exit(1);                                                                               \
         }                                                                                          \
     } while (0)

@@ -83,13 +83,12 @@ static void check_view_equals_packed(rsmooth_context *ctx, const shape_mesh *m, 
     CHECK(packed_out && packed_conf && view_conf && before);
     memcpy(before, x.buffer, n * FLOATS_PER_VERTEX * sizeof(float));
     rsmooth_error err;
-    CHECK_STATUS(ctx ? rsmooth_smooth(ctx, RSMOOTH_FLOAT32, x.packed, n, m->indices,
-                                      m->triangle_count, &p, packed_out, NULL, packed_conf, NULL,
-                                      &err)
-                     : rsmooth_smooth_reference(RSMOOTH_FLOAT32, x.packed, n, m->indices,
-                                                m->triangle_count, &p, packed_out, NULL,
-                                                packed_conf, NULL, &err),
-                 RSMOOTH_OK);
+    CHECK_STATUS(
+        ctx ? rsmooth_smooth(ctx, RSMOOTH_FLOAT32, x.packed, n, m->indices, m->triangle_count, &p,
+                             packed_out, NULL, packed_conf, NULL, &err)
+            : rsmooth_smooth_reference(RSMOOTH_FLOAT32, x.packed, n, m->indices, m->triangle_count,
+                                       &p, packed_out, NULL, packed_conf, NULL, &err),
+        RSMOOTH_OK);
     rsmooth_mesh_view view = view_of(m, &x, int32);
     /* in place: the result goes back into the vertex buffer it came from */
     CHECK_STATUS(rsmooth_smooth_view(ctx, &view, &p, x.buffer, FLOATS_PER_VERTEX * sizeof(float),
@@ -99,8 +98,8 @@ static void check_view_equals_packed(rsmooth_context *ctx, const shape_mesh *m, 
     for (size_t v = 0; v < n; v++)
         for (int k = 0; k < FLOATS_PER_VERTEX; k++) {
             float got = x.buffer[v * FLOATS_PER_VERTEX + (size_t)k];
-            float want = k < 3 ? packed_out[3 * v + (size_t)k]
-                               : before[v * FLOATS_PER_VERTEX + (size_t)k];
+            float want =
+                k < 3 ? packed_out[3 * v + (size_t)k] : before[v * FLOATS_PER_VERTEX + (size_t)k];
             CHECK(memcmp(&got, &want, sizeof got) == 0);
             moved += k < 3 && got != before[v * FLOATS_PER_VERTEX + (size_t)k];
         }
@@ -151,8 +150,7 @@ static void check_view_refusals(const shape_mesh *m) {
     CHECK_STATUS(rsmooth_smooth_view(NULL, &view, NULL, out, 0, NULL, NULL, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     view = view_of(m, &x, 0);
-    CHECK_STATUS(rsmooth_smooth_view(NULL, &view, NULL, out, 0, (float *)out + 5, NULL, NULL,
-                                     &err),
+    CHECK_STATUS(rsmooth_smooth_view(NULL, &view, NULL, out, 0, (float *)out + 5, NULL, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT); /* out_weight inside out_positions */
     CHECK(strstr(err.message, "overlap") != NULL);
     CHECK_STATUS(rsmooth_smooth_view(NULL, NULL, NULL, out, 0, NULL, NULL, NULL, &err),
@@ -205,8 +203,8 @@ static void check_mask(rsmooth_context *ctx, const shape_mesh *m, const char *na
 
     /* Two passes, sigmas fixed in mesh units as the passes fix them. */
     double unit;
-    CHECK_STATUS(rsmooth_mean_edge_length(RSMOOTH_FLOAT64, m->xyz, n, m->indices,
-                                          m->triangle_count, &unit, &err),
+    CHECK_STATUS(rsmooth_mean_edge_length(RSMOOTH_FLOAT64, m->xyz, n, m->indices, m->triangle_count,
+                                          &unit, &err),
                  RSMOOTH_OK);
     rsmooth_params one;
     rsmooth_params_init(&one);
@@ -254,8 +252,8 @@ static void check_points_mask(const shape_mesh *m) {
     rsmooth_params_init_best(&p);
     p.move_mask = mask;
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, m->xyz, normals, n, &p, out,
-                                                 NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, m->xyz, normals, n, &p, out, NULL,
+                                                 NULL, NULL, &err),
                  RSMOOTH_OK);
     size_t moved = 0;
     for (size_t v = 0; v < n; v++) {
@@ -308,8 +306,8 @@ int main(void) {
     CHECK(strcmp(version, expected) == 0);
     CHECK(major == RSMOOTH_VERSION_MAJOR && minor == RSMOOTH_VERSION_MINOR &&
           patch == RSMOOTH_VERSION_PATCH);
-    CHECK(rsmooth_version(NULL, NULL, NULL) == version || strcmp(rsmooth_version(NULL, NULL, NULL),
-                                                                 version) == 0);
+    CHECK(rsmooth_version(NULL, NULL, NULL) == version ||
+          strcmp(rsmooth_version(NULL, NULL, NULL), version) == 0);
 
     shape_mesh m;
     CHECK(shape_cube(&m, 12, 2.0) == 0);

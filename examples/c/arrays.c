@@ -74,8 +74,8 @@ int main(void) {
     }
     printf("%zu vertices, %zu triangles; vertices moved: RMS %.3f, at most %.3f edge lengths\n",
            vertex_count, triangle_count, sqrt(moved / (double)vertex_count), farthest);
-    printf("distance to the plane (RMS): %.3f -> %.3f edge lengths\n", rms_height(xyz, vertex_count),
-           rms_height(out, vertex_count));
+    printf("distance to the plane (RMS): %.3f -> %.3f edge lengths\n",
+           rms_height(xyz, vertex_count), rms_height(out, vertex_count));
     free(xyz), free(out), free(indices);
     return EXIT_SUCCESS;
 }

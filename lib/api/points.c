@@ -20,7 +20,7 @@ static rsmooth_status cl_points_pass(void *context, const rs_problem *pb, double
     if (pb->facet_count == 0) { /* nothing carries weight: every point stays */
         rs_store_unmoved(pb, RSMOOTH_FLOAT64, out_next, NULL, out_confidence);
     } else {
-        rs_result_sink sink = {RSMOOTH_FLOAT64, out_next, NULL, out_confidence, NULL,
+        rs_result_sink sink = {RSMOOTH_FLOAT64,  out_next, NULL, out_confidence, NULL,
                                pb->vertex_count, NULL};
         uint64_t needed = 0;
         st = rs_cl_run_normals(ctx, pb, &sink, out_normals, &stats, &needed, error);
@@ -37,11 +37,10 @@ static rsmooth_status cl_points_pass(void *context, const rs_problem *pb, double
 }
 
 rsmooth_status rsmooth_smooth_points(rsmooth_context *ctx, rsmooth_scalar scalar,
-                                     const void *positions, const void *normals,
-                                     size_t point_count, const rsmooth_params *params,
-                                     void *out_positions, void *out_normals,
-                                     float *out_confidence, rsmooth_report *report,
-                                     rsmooth_error *error) {
+                                     const void *positions, const void *normals, size_t point_count,
+                                     const rsmooth_params *params, void *out_positions,
+                                     void *out_normals, float *out_confidence,
+                                     rsmooth_report *report, rsmooth_error *error) {
     static const char where[] = "rsmooth_smooth_points";
     rs_error_clear(error);
     if (!ctx)
@@ -51,9 +50,9 @@ rsmooth_status rsmooth_smooth_points(rsmooth_context *ctx, rsmooth_scalar scalar
     if (entered != RSMOOTH_OK)
         return entered;
     size_t threads_before = rs_set_call_threads(ctx->host_threads);
-    rsmooth_status st = rs_smooth_points_with(cl_points_pass, ctx, where, scalar, positions,
-                                              normals, point_count, params, out_positions,
-                                              out_normals, out_confidence, report, error);
+    rsmooth_status st =
+        rs_smooth_points_with(cl_points_pass, ctx, where, scalar, positions, normals, point_count,
+                              params, out_positions, out_normals, out_confidence, report, error);
     rs_set_call_threads(threads_before);
     rs_context_unlock(ctx);
     return st;

@@ -17,9 +17,9 @@ static rsmooth_status cl_pass(void *context, rsmooth_scalar scalar, const void *
     double t_start = rs_now_ms();
     rs_error_clear(error);
     rs_problem pb;
-    rsmooth_status st = rs_problem_prepare(&pb, scalar, positions, vertex_count, indices,
-                                           triangle_count, params, out_positions, false, error,
-                                           where);
+    rsmooth_status st =
+        rs_problem_prepare(&pb, scalar, positions, vertex_count, indices, triangle_count, params,
+                           out_positions, false, error, where);
     if (st != RSMOOTH_OK)
         return st;
     double t_facets = rs_now_ms();
@@ -28,8 +28,8 @@ static rsmooth_status cl_pass(void *context, rsmooth_scalar scalar, const void *
     if (pb.facet_count == 0) {
         rs_store_unmoved(&pb, scalar, out_positions, out_weight, out_confidence);
     } else {
-        rs_result_sink sink = {scalar, out_positions, out_weight, out_confidence, NULL,
-                               vertex_count, ctx->device_sink};
+        rs_result_sink sink = {scalar, out_positions, out_weight,      out_confidence,
+                               NULL,   vertex_count,  ctx->device_sink};
         st = rs_cl_filter(ctx, &pb, &sink, &stats, error);
     }
     if (st == RSMOOTH_OK) {
@@ -65,18 +65,17 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     rsmooth_status entered = rs_context_enter(ctx, "rsmooth_smooth", error);
     if (entered != RSMOOTH_OK)
         return entered;
-    rsmooth_status st = rs_smooth_entered(ctx, scalar, positions, vertex_count, indices,
-                                          triangle_count, params, out_positions, out_weight,
-                                          out_confidence, report, error);
+    rsmooth_status st =
+        rs_smooth_entered(ctx, scalar, positions, vertex_count, indices, triangle_count, params,
+                          out_positions, out_weight, out_confidence, report, error);
     rs_context_unlock(ctx);
     return st;
 }
 
-rsmooth_status rs_smooth_entered(rsmooth_context *ctx, rsmooth_scalar scalar,
-                                 const void *positions, size_t vertex_count,
-                                 const uint32_t *indices, size_t triangle_count,
-                                 const rsmooth_params *params, void *out_positions,
-                                 float *out_weight, float *out_confidence,
+rsmooth_status rs_smooth_entered(rsmooth_context *ctx, rsmooth_scalar scalar, const void *positions,
+                                 size_t vertex_count, const uint32_t *indices,
+                                 size_t triangle_count, const rsmooth_params *params,
+                                 void *out_positions, float *out_weight, float *out_confidence,
                                  rsmooth_report *report, rsmooth_error *error) {
     const char *stage_env = getenv("RSMOOTH_STAGE");
     if (stage_env && *stage_env && strcmp(stage_env, "host") != 0 &&
@@ -89,8 +88,8 @@ rsmooth_status rs_smooth_entered(rsmooth_context *ctx, rsmooth_scalar scalar,
     }
     rs_stage_runner stage = stage_on_device(ctx, stage_env) ? rs_cl_stage_run : NULL;
     size_t threads_before = rs_set_call_threads(ctx->host_threads);
-    rsmooth_status st = rs_filter_passes(cl_pass, stage, ctx, scalar, positions, vertex_count, indices,
-                                         triangle_count, params, out_positions, out_weight,
+    rsmooth_status st = rs_filter_passes(cl_pass, stage, ctx, scalar, positions, vertex_count,
+                                         indices, triangle_count, params, out_positions, out_weight,
                                          out_confidence, report, error, "rsmooth_smooth");
     rs_set_call_threads(threads_before);
     return st;

@@ -109,8 +109,8 @@ rsmooth_status rsmooth_smooth_view(rsmooth_context *ctx, const rsmooth_mesh_view
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_positions is NULL");
     if (ostride < record || rs_mul_overflows(n, ostride))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "out_stride %zu is smaller than a vertex (%zu bytes) or overflows",
-                       ostride, record);
+                       "out_stride %zu is smaller than a vertex (%zu bytes) or overflows", ostride,
+                       record);
     size_t out_span = span(n, ostride, record), per_vertex = n * sizeof(float);
     if (rs_ranges_overlap(out_positions, out_span, out_weight, per_vertex) ||
         rs_ranges_overlap(out_positions, out_span, out_confidence, per_vertex) ||
@@ -119,8 +119,8 @@ rsmooth_status rsmooth_smooth_view(rsmooth_context *ctx, const rsmooth_mesh_view
                        "out_positions, out_weight and out_confidence overlap");
 
     unsigned char *positions = rs_alloc_array(n, record), *result = rs_alloc_array(n, record);
-    uint32_t *indices = rs_alloc_array(mesh->triangle_count ? mesh->triangle_count : 1,
-                                       3 * sizeof *indices);
+    uint32_t *indices =
+        rs_alloc_array(mesh->triangle_count ? mesh->triangle_count : 1, 3 * sizeof *indices);
     float *weight = out_weight ? rs_alloc_array(n, sizeof *weight) : NULL;
     float *confidence = out_confidence ? rs_alloc_array(n, sizeof *confidence) : NULL;
     if (!positions || !result || !indices || (out_weight && !weight) ||
@@ -136,9 +136,8 @@ rsmooth_status rsmooth_smooth_view(rsmooth_context *ctx, const rsmooth_mesh_view
     /* the weights and confidences go to copies too: the caller's may share the vertex buffer */
     st = ctx ? rsmooth_smooth(ctx, mesh->scalar, positions, n, indices, mesh->triangle_count,
                               params, result, weight, confidence, report, error)
-             : rsmooth_smooth_reference(mesh->scalar, positions, n, indices,
-                                        mesh->triangle_count, params, result, weight, confidence,
-                                        report, error);
+             : rsmooth_smooth_reference(mesh->scalar, positions, n, indices, mesh->triangle_count,
+                                        params, result, weight, confidence, report, error);
     if (st == RSMOOTH_OK) {
         for (size_t v = 0; v < n; v++)
             memcpy((unsigned char *)out_positions + v * ostride, result + v * record, record);

@@ -8,7 +8,8 @@
  *  1. Frame: the plane of the vertices within RADIUS (mean edge lengths) of v, by PCA; then again
  *     with the ball centred on v's projection onto that plane instead of v, so that which
  *     neighbours are used does not depend on v's own noise (a ball around a noisy v holds more of
- *     the surface on v's side; the screening in 4 then kept vertices with large noise, +15% at 0.7).
+ *     the surface on v's side; the screening in 4 then kept vertices with large noise, +15% at
+ * 0.7).
  *  2. Neighbours: the other vertices within a cylinder of radius RADIUS around v's axis along that
  *     normal, within SLAB of the neighbours' centroid. Vertices whose normal faces away from v's
  *     (cosine <= FACING) are left out: the far wall of a slot, the back of a thin fin.
@@ -22,21 +23,21 @@
  *     fits show it in their residual variance s^2 over the neighbours, which for a least-squares
  *     fit is independent of the prediction at v (Cochran's theorem) and of v's noise: keeping only
  *     the vertices with s^2 <= KAPPA sigma^2 (sigma the current estimate) removes them without
- *     biasing the rest. sigma starts from the median s^2 and is refined ROUNDS times as 1.4826 x the
- *     median standardised |residual| of the kept vertices (a normal's median |value| is 0.6745
+ *     biasing the rest. sigma starts from the median s^2 and is refined ROUNDS times as 1.4826 x
+ * the median standardised |residual| of the kept vertices (a normal's median |value| is 0.6745
  *     sigma).
  *
- * Calibration (tests/test_noise_estimate.c; the benchmark models' Original.obj with generated noise,
- * 3 seeds each): Gaussian noise of 0.1 to 0.7 mean edge lengths along the normals reads within 5%
- * of the truth on planes, spheres, cubes and capped cylinders of ~10k vertices and on Fandisk,
- * Block, Bunny, SharpSphere and Twelve; a 602-vertex cube, most of whose vertices are near an edge,
- * within 15%. KAPPA = 1.25 was chosen there (1 and 1.5 do nearly as well but for the coarse cube); no
- * other factor is fitted. Choosing, per vertex, the best of the whole disc and half discs on either
- * side of a crease instead of screening read 5-10% high at low noise: the choice depends on the
- * neighbours' noise.
+ * Calibration (tests/test_noise_estimate.c; the benchmark models' Original.obj with generated
+ * noise, 3 seeds each): Gaussian noise of 0.1 to 0.7 mean edge lengths along the normals reads
+ * within 5% of the truth on planes, spheres, cubes and capped cylinders of ~10k vertices and on
+ * Fandisk, Block, Bunny, SharpSphere and Twelve; a 602-vertex cube, most of whose vertices are near
+ * an edge, within 15%. KAPPA = 1.25 was chosen there (1 and 1.5 do nearly as well but for the
+ * coarse cube); no other factor is fitted. Choosing, per vertex, the best of the whole disc and
+ * half discs on either side of a crease instead of screening read 5-10% high at low noise: the
+ * choice depends on the neighbours' noise.
  *
- * 5. Unit (lib/auto/noise_estimate.h): the level is in mean edge lengths of the CLEAN mesh, which noise
- *    lengthens (E|e'|^2 = |e|^2 + 2 tr Cov per edge). Each sampled vertex's mesh edges are
+ * 5. Unit (lib/auto/noise_estimate.h): the level is in mean edge lengths of the CLEAN mesh, which
+ * noise lengthens (E|e'|^2 = |e|^2 + 2 tr Cov per edge). Each sampled vertex's mesh edges are
  *    measured in its frame: the tangential part as it is, the normal part from the quadric (less
  *    its own noise, s^2 (a_u - a_0)^T M^-1 (a_u - a_0)): the normal noise drops out. The
  *    tangential noise (6) is then taken out of the mean square (4 t^2 per edge, t per axis), the
@@ -56,11 +57,12 @@
  *    regular mesh passes the first test). The level and the share displaced then come from a
  *    two-normal mixture fitted by EM to the least-squares residuals (impulsive_mixture).
  * Apart from IMPULSIVE_SHARE no constant was fitted in 5-8 (TRIM 5, MIX_SCREEN 2, ROBUST_CUT 2.5,
- * OUTLIER_Z 6, IMPULSIVE_TANGENTIAL 0.5 chosen, not fitted); scripts/noise_accuracy.py measures the table (docs/results/noise_accuracy.json).
+ * OUTLIER_Z 6, IMPULSIVE_TANGENTIAL 0.5 chosen, not fitted); scripts/noise_accuracy.py measures the
+ * table (docs/results/noise_accuracy.json).
  *
  * Exact duplicate positions are welded first (a triangle soup's corners), so a vertex's copies are
- * not its neighbours. Up to MAX_SAMPLES vertices are used, at a fixed stride; each sample depends on
- * the positions alone and the medians on the samples alone, so the result is the same on every
+ * not its neighbours. Up to MAX_SAMPLES vertices are used, at a fixed stride; each sample depends
+ * on the positions alone and the medians on the samples alone, so the result is the same on every
  * run and for any thread count. */
 #include "auto/noise_estimate.h"
 #include "auto/eigen3.h"
@@ -72,18 +74,21 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define RADIUS 2.5        /* fit radius, mean edge lengths */
-#define SLAB 2.5          /* half-height of the cylinder around the neighbours' centroid */
-#define MARGIN 1.0        /* how far v's frame centre may lie from v, beyond which a neighbour of
-                           * the cylinder is missed: > 2 sigma even at noise 0.5 */
-#define FACING (-0.5)     /* neighbours whose normal is > 120 degrees from v's are left out */
-#define MIN_POINTS 10     /* fewest points a quadric (6 coefficients) is fitted to */
-#define KAPPA 1.25        /* vertices whose fit's residual variance exceeds KAPPA sigma^2 are left
-                           * out (their neighbourhood is no quadric: an edge, a corner) */
-#define ROUNDS 3          /* refinements of sigma and of the screening */
-#define MAX_SAMPLES 6000 /* vertices used at most (50000 before: 4x the time on a 36k-vertex mesh
+#define RADIUS 2.5 /* fit radius, mean edge lengths */
+#define SLAB 2.5   /* half-height of the cylinder around the neighbours' centroid */
+#define MARGIN                                                                                     \
+    1.0               /* how far v's frame centre may lie from v, beyond which a neighbour of      \
+                       * the cylinder is missed: > 2 sigma even at noise 0.5 */
+#define FACING (-0.5) /* neighbours whose normal is > 120 degrees from v's are left out */
+#define MIN_POINTS 10 /* fewest points a quadric (6 coefficients) is fitted to */
+#define KAPPA                                                                                      \
+    1.25         /* vertices whose fit's residual variance exceeds KAPPA sigma^2 are left          \
+                  * out (their neighbourhood is no quadric: an edge, a corner) */
+#define ROUNDS 3 /* refinements of sigma and of the screening */
+#define MAX_SAMPLES                                                                                \
+    6000                 /* vertices used at most (50000 before: 4x the time on a 36k-vertex mesh  \
                           * for the same table) */
-#define SAMPLE_GRAIN 256  /* samples per chunk below which a thread does not pay */
+#define SAMPLE_GRAIN 256 /* samples per chunk below which a thread does not pay */
 #define MAD_TO_SIGMA 1.482602218505602 /* 1 / Phi^-1(3/4) */
 #define TERMS 6
 
@@ -273,7 +278,8 @@ static bool sort_points(point_set *points, const uint32_t *order) {
 }
 
 /* The mesh's edges between points, both ways, as lists per point (start has count + 1 entries),
- * duplicates removed; false when out of memory. point_of maps vertices to points (UINT32_MAX: none). */
+ * duplicates removed; false when out of memory. point_of maps vertices to points (UINT32_MAX:
+ * none). */
 static bool build_rings(const uint32_t *indices, size_t triangle_count, const uint32_t *point_of,
                         size_t count, uint32_t **start_out, uint32_t **ring_out) {
     uint32_t *start = rs_calloc_array(count + 1, sizeof *start);
@@ -286,7 +292,8 @@ static bool build_rings(const uint32_t *indices, size_t triangle_count, const ui
     for (int pass = 0; pass < 2; pass++) {
         for (size_t t = 0; t < triangle_count; t++)
             for (int e = 0; e < 3; e++) {
-                uint32_t a = point_of[indices[3 * t + e]], b = point_of[indices[3 * t + (e + 1) % 3]];
+                uint32_t a = point_of[indices[3 * t + e]],
+                         b = point_of[indices[3 * t + (e + 1) % 3]];
                 if (a == UINT32_MAX || b == UINT32_MAX || a == b)
                     continue;
                 if (pass == 0) {
@@ -330,11 +337,11 @@ static bool build_rings(const uint32_t *indices, size_t triangle_count, const ui
 /* What a sample's mesh edges say about the clean mesh's edge lengths and the tangential noise
  * (header comment, 5 and 6). */
 typedef struct edge_sums {
-    double raw;       /* sum of the edges' lengths as they are */
-    double raw2;      /* ... of their squares */
-    double clean;     /* sum of the lengths with the normal noise taken out */
-    double clean2;    /* ... of their squares */
-    double umbrella;  /* |tangential offset from the ring's centroid|^2 / (1 + 1/k); NAN: none */
+    double raw;      /* sum of the edges' lengths as they are */
+    double raw2;     /* ... of their squares */
+    double clean;    /* sum of the lengths with the normal noise taken out */
+    double clean2;   /* ... of their squares */
+    double umbrella; /* |tangential offset from the ring's centroid|^2 / (1 + 1/k); NAN: none */
     uint32_t edges;
 } edge_sums;
 
@@ -342,23 +349,23 @@ typedef struct sample_job {
     const point_set *points;
     const rs_grid *grid;
     const uint32_t *ring_start, *ring; /* the mesh's edges, per point */
-    edge_sums *edges;     /* per sample */
-    double unit;          /* mean edge length */
+    edge_sums *edges;                  /* per sample */
+    double unit;                       /* mean edge length */
     size_t sample_count;
-    double *residual;     /* per sample: standardised |residual|, mesh units, or NAN (no fit) */
-    double *variance;     /* per sample: the fit's residual variance s^2, mesh units squared */
-    double *robust;       /* per sample: |residual| of the robust refit (robust_residual) */
-    double *rscale;       /* per sample: the refit's inliers' rms residual (NAN: no refit) */
-    double *rshare;       /* per sample: the share of the points the refit kept */
-    bool failed[64];      /* per chunk: out of memory */
+    double *residual; /* per sample: standardised |residual|, mesh units, or NAN (no fit) */
+    double *variance; /* per sample: the fit's residual variance s^2, mesh units squared */
+    double *robust;   /* per sample: |residual| of the robust refit (robust_residual) */
+    double *rscale;   /* per sample: the refit's inliers' rms residual (NAN: no refit) */
+    double *rshare;   /* per sample: the share of the points the refit kept */
+    bool failed[64];  /* per chunk: out of memory */
 } sample_job;
 
 /* A sample's neighbours, offsets from it in mesh units (grown as needed, one per thread). */
 typedef struct workspace {
     size_t capacity;
-    double *d;   /* 3 per neighbour */
-    double *c;   /* 3 per cylinder point: x, y (mean edge lengths), z (mesh units) */
-    double *e;   /* per cylinder point: |residual| (scratch) */
+    double *d; /* 3 per neighbour */
+    double *c; /* 3 per cylinder point: x, y (mean edge lengths), z (mesh units) */
+    double *e; /* per cylinder point: |residual| (scratch) */
 } workspace;
 
 static bool reserve(workspace *w, size_t n) {
@@ -497,8 +504,8 @@ static double quadric_at(double x, double y, const double *beta, double row[TERM
  * a least-squares fit is pulled by the displaced neighbours. */
 #define ROBUST_CUT 2.5
 #define ROBUST_ROUNDS 2
-static double robust_residual(workspace *w, size_t count, const double beta_ls[TERMS],
-                              double unit, double *scale_out, double *share_out) {
+static double robust_residual(workspace *w, size_t count, const double beta_ls[TERMS], double unit,
+                              double *scale_out, double *share_out) {
     double beta[TERMS], result = NAN;
     *scale_out = NAN;
     *share_out = NAN;
@@ -651,8 +658,8 @@ static bool sample_residual(const sample_job *job, size_t v, workspace *w, bool 
         cy += yt;
     }
     uint32_t k = es->edges;
-    es->umbrella = k >= 3 ? (cx * cx + cy * cy) / ((double)k * (double)k) / (1 + 1 / (double)k)
-                          : NAN;
+    es->umbrella =
+        k >= 3 ? (cx * cx + cy * cy) / ((double)k * (double)k) / (1 + 1 / (double)k) : NAN;
     return true;
 }
 
@@ -677,7 +684,6 @@ static void sample_range(void *ctx, size_t begin, size_t end, size_t chunk) {
 }
 
 /* ---- the robust scale ------------------------------------------------------------------------ */
-
 
 /* Median of values[0 .. n) (n > 0), reordering them (by selection: linear time). */
 static double median(double *values, size_t n) {
@@ -722,7 +728,8 @@ static double robust_sigma(const double *residual, const double *variance, size_
  * included: their refit keeps one side and the sample sits on it). IMPULSIVE_SHARE was fitted on
  * docs/results/noise_accuracy.json with cross-validation leaving each of its 13 meshes out (the
  * geometric mean of the largest Gaussian share and the smallest impulsive one above it, fitted on
- * the other 12: 0.0055-0.0063; no Gaussian case of the left-out mesh read impulsive), and rounded. */
+ * the other 12: 0.0055-0.0063; no Gaussian case of the left-out mesh read impulsive), and rounded.
+ */
 #define OUTLIER_Z 6.0
 #define IMPULSIVE_SHARE 0.006
 #define IMPULSIVE_TANGENTIAL 0.5 /* chosen, not fitted (as before, commit 19d703f) */
@@ -913,8 +920,8 @@ rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positi
 typedef struct estimate_run {
     const uint32_t *indices;
     size_t vertex_count, triangle_count;
-    double scale;       /* internal units per caller unit (scale.c) */
-    double unit;        /* the noisy mesh's mean edge length, internal units */
+    double scale;             /* internal units per caller unit (scale.c) */
+    double unit;              /* the noisy mesh's mean edge length, internal units */
     double shape_correlation; /* core/shape_correlation.h */
     uint32_t *point_of; /* per vertex: its point (UINT32_MAX: none), until the rings are built */
     point_set pts;
@@ -960,10 +967,11 @@ static rsmooth_status read_points(estimate_run *e, rsmooth_scalar scalar, const 
         return RSMOOTH_OK;
     }
     e->point_of = rs_alloc_array(vertex_count, sizeof *e->point_of);
-    bool ok = e->point_of &&
-              build_points(xyz, vertex_count, e->indices, e->triangle_count, &e->pts, e->point_of) &&
-              rs_shape_correlation(xyz, vertex_count, e->indices, e->triangle_count,
-                                   &e->shape_correlation);
+    bool ok =
+        e->point_of &&
+        build_points(xyz, vertex_count, e->indices, e->triangle_count, &e->pts, e->point_of) &&
+        rs_shape_correlation(xyz, vertex_count, e->indices, e->triangle_count,
+                             &e->shape_correlation);
     rs_free(xyz);
     if (!ok)
         return rs_fail(e->error, RSMOOTH_ERROR_OUT_OF_MEMORY, e->caller,
@@ -1047,8 +1055,7 @@ static size_t keep_fitted(sample_job *job) {
 /* The correlated noise (noise_scales.c) into out, in the clean mesh's mean edge lengths. */
 static rsmooth_status correlated_part(estimate_run *e, rs_noise_details *out) {
     rsmooth_status st = rs_noise_scales(e->pts.xyz, e->pts.normal, e->pts.count, e->unit,
-                                        e->ring_start, e->ring, &out->profile, e->error,
-                                        e->caller);
+                                        e->ring_start, e->ring, &out->profile, e->error, e->caller);
     if (st != RSMOOTH_OK)
         return st;
     double noisy_per_clean = out->mean_edge_noisy / out->mean_edge_clean; /* level's unit */
@@ -1116,8 +1123,8 @@ rsmooth_status rs_estimate_noise_details(rsmooth_scalar scalar, const void *posi
                                              triangle_count, NULL, error, caller);
     rs_parts parts;
     if (st == RSMOOTH_OK)
-        st = rs_parts_find(&parts, scalar, positions, vertex_count, indices, triangle_count,
-                           error, caller);
+        st = rs_parts_find(&parts, scalar, positions, vertex_count, indices, triangle_count, error,
+                           caller);
     if (st != RSMOOTH_OK)
         return st;
     if (parts.whole) {
@@ -1130,8 +1137,8 @@ rsmooth_status rs_estimate_noise_details(rsmooth_scalar scalar, const void *posi
             rs_parts_free(&parts);
             return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, caller, "no memory for a part");
         }
-        st = estimate_mesh(scalar, sub.positions, sub.vertex_count, sub.indices,
-                           sub.triangle_count, out, error, caller);
+        st = estimate_mesh(scalar, sub.positions, sub.vertex_count, sub.indices, sub.triangle_count,
+                           out, error, caller);
         rs_submesh_free(&sub);
     }
     if (st == RSMOOTH_OK) {

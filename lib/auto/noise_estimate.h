@@ -1,5 +1,5 @@
-/* The noise estimate's details (internal): what rsmooth_estimate_noise measures, and how it read the
- * noise's kind. See the header comment of noise_estimate.c for how each figure is measured. */
+/* The noise estimate's details (internal): what rsmooth_estimate_noise measures, and how it read
+ * the noise's kind. See the header comment of noise_estimate.c for how each figure is measured. */
 #ifndef RSMOOTH_NOISE_ESTIMATE_H
 #define RSMOOTH_NOISE_ESTIMATE_H
 
@@ -14,7 +14,8 @@ typedef struct rs_noise_details {
     /* The standard deviation of the vertices' displacement along the surface normal, in mean edge
      * lengths of the CLEAN mesh (estimated: the noisy mesh's edges are longer). Random-direction
      * noise of total standard deviation s reads s / sqrt(3). For impulsive noise, that of the
-     * displaced vertices only. rsmooth_estimate_noise returns this. 0 when nothing is measurable. */
+     * displaced vertices only. rsmooth_estimate_noise returns this. 0 when nothing is measurable.
+     */
     double level;
     /* A share of the vertices displaced and the rest (nearly) exact. */
     bool impulsive;
@@ -36,8 +37,8 @@ typedef struct rs_noise_details {
     double tail_share;
     /* Vertices whose residual was measured. */
     size_t samples;
-    /* The rms of the noise along the normals including its spatially correlated part (noise_scales.c),
-     * clean mean edge lengths: level when the noise reads uncorrelated. */
+    /* The rms of the noise along the normals including its spatially correlated part
+     * (noise_scales.c), clean mean edge lengths: level when the noise reads uncorrelated. */
     double correlated_level;
     /* The correlated part's correlation length (mean edge lengths; 0: uncorrelated). */
     double correlation_length;

@@ -29,7 +29,7 @@
 #include <string.h>
 
 #define MAX_TERMS 6
-#define SAMPLES 1500    /* vertices sampled at most, at a fixed stride */
+#define SAMPLES 1500 /* vertices sampled at most, at a fixed stride */
 #define SAMPLE_GRAIN 64
 #define FRAME_RADIUS 2.5 /* the normal's ball, mean edge lengths */
 #define MAD_TO_SIGMA 1.482602218505602
@@ -171,8 +171,8 @@ static bool sample_scales(scales_job *job, size_t s, double **buf, size_t *cap) 
             cov[r][k] = cov[k][r] = second[r][k] - sum[r] * sum[k] / (double)inner;
     rs_symmetric_eigen3(cov, values, axes); /* axes[0]: the normal (smallest) */
     for (size_t j = 0; j < n; j++) {
-        double *d = *buf + 3 * j, t[3] = {rs_dot3(d, axes[1]), rs_dot3(d, axes[2]),
-                                         rs_dot3(d, axes[0])};
+        double *d = *buf + 3 * j,
+               t[3] = {rs_dot3(d, axes[1]), rs_dot3(d, axes[2]), rs_dot3(d, axes[0])};
         memcpy(d, t, sizeof t);
     }
     for (int k = 0; k < RS_NOISE_SCALE_COUNT; k++)
@@ -209,9 +209,9 @@ static double robust_sd(const double *values, size_t n, size_t stride, double *s
 }
 
 /* The profile figures of the points xyz into low/high (grid built over xyz). */
-static rsmooth_status profile_of(const double *xyz, const double *normal, size_t count,
-                                 double unit, double *low, size_t *samples,
-                                 rsmooth_error *error, const char *caller) {
+static rsmooth_status profile_of(const double *xyz, const double *normal, size_t count, double unit,
+                                 double *low, size_t *samples, rsmooth_error *error,
+                                 const char *caller) {
     scales_job job;
     memset(&job, 0, sizeof job);
     job.xyz = xyz;
@@ -219,8 +219,8 @@ static rsmooth_status profile_of(const double *xyz, const double *normal, size_t
     job.count = count;
     job.unit = unit;
     job.sample_count = count < SAMPLES ? count : SAMPLES;
-    rsmooth_status st = rs_grid_build(&job.grid, xyz, count,
-                                      RADII[RS_NOISE_SCALE_COUNT - 1] * SQRT2 * unit, error);
+    rsmooth_status st =
+        rs_grid_build(&job.grid, xyz, count, RADII[RS_NOISE_SCALE_COUNT - 1] * SQRT2 * unit, error);
     if (st != RSMOOTH_OK)
         return st;
     size_t cells = job.sample_count * RS_NOISE_SCALE_COUNT;
@@ -264,8 +264,8 @@ static void taubin(double *xyz, double *tmp, size_t count, const uint32_t *ring_
                 for (int d = 0; d < 3; d++)
                     c[d] += xyz[3 * (size_t)ring[j] + d];
             for (int d = 0; d < 3; d++)
-                tmp[3 * v + d] = k ? xyz[3 * v + d] + f * (c[d] / k - xyz[3 * v + d])
-                                   : xyz[3 * v + d];
+                tmp[3 * v + d] =
+                    k ? xyz[3 * v + d] + f * (c[d] / k - xyz[3 * v + d]) : xyz[3 * v + d];
         }
         memcpy(xyz, tmp, 3 * count * sizeof *xyz);
     }
@@ -309,13 +309,15 @@ rsmooth_status rs_noise_scales(const double *xyz, const double *normal, size_t c
  * its rms distance to the Stanford reconstruction), and checked on the other meshes of
  * scripts/noise_accuracy.py, bun045 among them (docs/accuracy.md, "Correlated noise").
  * WHITE_SHARE was chosen; HALF_TO_LENGTH is beetle-alt's L = 1. */
-#define GAIN 10.5         /* correlated variance per unit of excess growth at RADII[1] */
-#define GROWTH 1.1        /* what the profile grows from RADII[0] to RADII[1] for white noise and
-                           * a sampled surface: more is correlated noise */
-#define FLOOR_SHARE 0.8   /* the smoothed copy reads at most this share of the mesh at RADII[1]:
-                           * beyond, the shape dominates there and nothing is claimed */
-#define EXCESS_SHARE 0.7  /* the growth must exceed this share of the floor's variance */
-#define WHITE_SHARE 1.0   /* and the correlated variance the white variance, times this squared */
+#define GAIN 10.5 /* correlated variance per unit of excess growth at RADII[1] */
+#define GROWTH                                                                                     \
+    1.1 /* what the profile grows from RADII[0] to RADII[1] for white noise and                    \
+         * a sampled surface: more is correlated noise */
+#define FLOOR_SHARE                                                                                \
+    0.8                    /* the smoothed copy reads at most this share of the mesh at RADII[1]:  \
+                            * beyond, the shape dominates there and nothing is claimed */
+#define EXCESS_SHARE 0.7   /* the growth must exceed this share of the floor's variance */
+#define WHITE_SHARE 1.0    /* and the correlated variance the white variance, times this squared */
 #define HALF_TO_LENGTH 4.2 /* half-growth radius per unit of correlation length */
 
 void rs_noise_correlated(const rs_noise_profile *profile, double level, double *correlated_level,

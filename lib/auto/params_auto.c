@@ -3,8 +3,8 @@
  * cross-validation that leaves whole meshes out (scripts/calibrate.py; the figures of meshes the
  * rules never saw are in docs/experiments.md, section 7). */
 #include "auto/noise_estimate.h"
-#include "core/shape_correlation.h"
 #include "core/rsmooth_internal.h"
+#include "core/shape_correlation.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -24,12 +24,12 @@
  * calibration cases (the figures of cases left out of the fit: docs/accuracy.md). */
 typedef struct best_preset {
     const char *name;
-    double below;         /* for Gaussian levels below this (the last: any) */
-    int cycles;           /* stage_repeats */
-    int updates;          /* vertex_updates per cycle */
-    double radius;        /* guided_radius */
-    double sigma_n;       /* guided_sigma_n */
-    int passes;           /* robust passes after the stage */
+    double below;   /* for Gaussian levels below this (the last: any) */
+    int cycles;     /* stage_repeats */
+    int updates;    /* vertex_updates per cycle */
+    double radius;  /* guided_radius */
+    double sigma_n; /* guided_sigma_n */
+    int passes;     /* robust passes after the stage */
 } best_preset;
 
 #define STAGE_SIGMA_S 1.0 /* guided_sigma_s, mean edge lengths */
@@ -52,8 +52,9 @@ static bool reads_correlated(const rs_noise_details *d) {
     return d->correlation_length > 0 && d->correlated_level > CORRELATED_SHARE * d->level;
 }
 
-#define TANGENTIAL_SHARE 0.5 /* tangential / normal level above which noise reads as random
-                              * in direction (for the report only) */
+#define TANGENTIAL_SHARE                                                                           \
+    0.5 /* tangential / normal level above which noise reads as random                             \
+         * in direction (for the report only) */
 
 void rsmooth_noise_report_init(rsmooth_noise_report *report) {
     if (!report)
@@ -71,8 +72,10 @@ static void describe(const rs_noise_details *d, char *out, size_t size) {
         return;
     }
     if (d->impulsive) {
-        snprintf(out, size, "noise estimate %.3g mean edge lengths, impulsive (%.0f%% of the "
-                 "vertices thrown)", n, 100 * d->impulsive_fraction);
+        snprintf(out, size,
+                 "noise estimate %.3g mean edge lengths, impulsive (%.0f%% of the "
+                 "vertices thrown)",
+                 n, 100 * d->impulsive_fraction);
         return;
     }
     if (!isfinite(d->tangential_level)) {
@@ -81,7 +84,7 @@ static void describe(const rs_noise_details *d, char *out, size_t size) {
     }
     snprintf(out, size, "noise estimate %.3g mean edge lengths, Gaussian %s (tangential %.2g)", n,
              d->tangential_level > TANGENTIAL_SHARE * n ? "in random directions"
-                                                         : "along the normals",
+                                                        : "along the normals",
              d->tangential_level);
 }
 
@@ -94,12 +97,14 @@ static void choose_clean(rsmooth_params *params, const rs_noise_details *d, cons
     params->discrepancy_gain = 0;
     snprintf(preset, preset_size, "clean");
     if (d->level > 0 && d->shape_correlation >= RS_CLEAN_SHAPE_CORRELATION)
-        snprintf(reason, reason_size, "noise estimate %.3g mean edge lengths, but the roughness "
+        snprintf(reason, reason_size,
+                 "noise estimate %.3g mean edge lengths, but the roughness "
                  "reads as the mesh's shape (bends correlated %.2f across neighbours): nothing "
                  "to remove, every vertex stays",
                  d->level, d->shape_correlation);
     else if (d->level > 0)
-        snprintf(reason, reason_size, "noise estimate %.3g mean edge lengths, but the roughness "
+        snprintf(reason, reason_size,
+                 "noise estimate %.3g mean edge lengths, but the roughness "
                  "is %.2f times what the shape alone leaves (a smoothed copy's): nothing to "
                  "remove, every vertex stays",
                  d->level, d->profile.low[0] / d->profile.low_floor[0]);
@@ -176,7 +181,8 @@ rsmooth_status rsmooth_params_auto_report(rsmooth_scalar scalar, const void *pos
     if (report && report->struct_size < sizeof *report)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "report.struct_size %zu is not sizeof(rsmooth_noise_report): call "
-                       "rsmooth_noise_report_init first", report->struct_size);
+                       "rsmooth_noise_report_init first",
+                       report->struct_size);
     rsmooth_params checked;
     rsmooth_status st = rs_params_resolve(params, &checked, error, where);
     if (st != RSMOOTH_OK)
@@ -196,8 +202,8 @@ rsmooth_status rsmooth_params_auto_report(rsmooth_scalar scalar, const void *pos
     if (report) {
         r.level = d.level;
         r.kind = rs_noise_reads_clean(&d) ? RSMOOTH_NOISE_NONE
-                 : d.impulsive              ? RSMOOTH_NOISE_IMPULSIVE
-                                            : RSMOOTH_NOISE_GAUSSIAN;
+                 : d.impulsive            ? RSMOOTH_NOISE_IMPULSIVE
+                                          : RSMOOTH_NOISE_GAUSSIAN;
         r.impulsive_fraction = d.impulsive_fraction;
         r.tangential_level = d.tangential_level;
         r.mean_edge_length = d.mean_edge_clean;
@@ -213,8 +219,8 @@ rsmooth_status rsmooth_params_auto_report(rsmooth_scalar scalar, const void *pos
 
 rsmooth_status rsmooth_params_auto(rsmooth_scalar scalar, const void *positions,
                                    size_t vertex_count, const uint32_t *indices,
-                                   size_t triangle_count, rsmooth_params *params,
-                                   double *out_noise, rsmooth_error *error) {
+                                   size_t triangle_count, rsmooth_params *params, double *out_noise,
+                                   rsmooth_error *error) {
     rsmooth_noise_report r;
     rsmooth_noise_report_init(&r);
     rsmooth_status st = rsmooth_params_auto_report(scalar, positions, vertex_count, indices,

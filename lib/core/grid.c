@@ -234,8 +234,7 @@ void rs_grid_layout(rs_grid *grid, double reach, int split, const double lo[3],
     for (int k = 0; k < 3; k++) {
         grid->origin_cell[k] = floor(lo[k] * grid->inv_cell_size);
         grid->origin[k] = grid->origin_cell[k] * h;
-        grid->dims[k] =
-            (int32_t)(floor(hi[k] * grid->inv_cell_size) - grid->origin_cell[k]) + 1;
+        grid->dims[k] = (int32_t)(floor(hi[k] * grid->inv_cell_size) - grid->origin_cell[k]) + 1;
     }
 }
 

@@ -1,4 +1,5 @@
-/* Argument checks and per-facet data (centroid c_q, area a_q, unit normal n_q) shared by both paths. */
+/* Argument checks and per-facet data (centroid c_q, area a_q, unit normal n_q) shared by both
+ * paths. */
 #include "core/rsmooth_internal.h"
 
 #include <math.h>
@@ -40,14 +41,13 @@ rsmooth_status rs_check_mesh_structure(rsmooth_scalar scalar, const void *positi
 
 rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions,
                                     size_t vertex_count, const uint32_t *indices,
-                                    size_t triangle_count, double *magnitude,
-                                    rsmooth_error *error, const char *where) {
+                                    size_t triangle_count, double *magnitude, rsmooth_error *error,
+                                    const char *where) {
     rsmooth_status st = rs_check_mesh_structure(scalar, positions, vertex_count, indices,
                                                 triangle_count, error, where);
     if (st != RSMOOTH_OK)
         return st;
-    return rs_check_coordinates(scalar, positions, vertex_count, "vertex", magnitude, error,
-                                where);
+    return rs_check_coordinates(scalar, positions, vertex_count, "vertex", magnitude, error, where);
 }
 
 rsmooth_status rs_check_coordinates(rsmooth_scalar scalar, const void *positions, size_t count,
@@ -274,8 +274,8 @@ static void find_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
         double sum = 0;
         for (size_t t = b * GEOMETRY_BLOCK; t < last && t < job->triangle_count; t++) {
             double normal[3], area = 0; /* (the centroid waits for the facets kept) */
-            job->valid[t] = rs_triangle_normal(job->problem->xyz, job->indices + 3 * t, normal,
-                                               &area);
+            job->valid[t] =
+                rs_triangle_normal(job->problem->xyz, job->indices + 3 * t, normal, &area);
             if (job->valid[t]) {
                 n++;
                 sum += area;
@@ -307,12 +307,11 @@ static void store_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
 
 const char rs_unchecked_output[1];
 
-rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
-                                  const void *positions, size_t vertex_count,
-                                  const uint32_t *indices, size_t triangle_count,
-                                  const rsmooth_params *params, const void *out_positions,
-                                  bool keep_facet_data, rsmooth_error *error,
-                                  const char *where) {
+rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar, const void *positions,
+                                  size_t vertex_count, const uint32_t *indices,
+                                  size_t triangle_count, const rsmooth_params *params,
+                                  const void *out_positions, bool keep_facet_data,
+                                  rsmooth_error *error, const char *where) {
     return rs_problem_prepare_within(problem, scalar, positions, vertex_count, indices,
                                      triangle_count, params, out_positions, keep_facet_data, NULL,
                                      error, where);
@@ -337,8 +336,8 @@ rsmooth_status rs_problem_prepare_within(rs_problem *problem, rsmooth_scalar sca
     if (st != RSMOOTH_OK)
         return st;
     double magnitude = 0;
-    st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count,
-                              &magnitude, error, where);
+    st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count, &magnitude,
+                              error, where);
     if (st != RSMOOTH_OK)
         return st;
     if (out_positions != RS_UNCHECKED_OUTPUT)
@@ -373,8 +372,8 @@ rsmooth_status rs_problem_prepare_within(rs_problem *problem, rsmooth_scalar sca
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for facet data");
     }
     size_t blocks = (triangle_count + GEOMETRY_BLOCK - 1) / GEOMETRY_BLOCK;
-    geometry_job job = {problem, scalar, positions, indices, keep_facet_data, triangle_count,
-                        NULL, NULL, NULL};
+    geometry_job job = {problem,        scalar, positions, indices, keep_facet_data,
+                        triangle_count, NULL,   NULL,      NULL};
     job.valid = rs_alloc_array(triangle_count, 1);
     job.count = rs_calloc_array(blocks, sizeof *job.count);
     job.area_sum = rs_calloc_array(blocks, sizeof *job.area_sum);
@@ -429,8 +428,8 @@ rsmooth_status rs_problem_prepare_within(rs_problem *problem, rsmooth_scalar sca
     return RSMOOTH_OK;
 }
 
-rsmooth_status rs_problem_apply_params(rs_problem *problem, const rsmooth_params *p,
-                                       double unit, rsmooth_error *error, const char *where) {
+rsmooth_status rs_problem_apply_params(rs_problem *problem, const rsmooth_params *p, double unit,
+                                       rsmooth_error *error, const char *where) {
     problem->sigma_f = p->sigma_f * unit;
     problem->sigma_g = isinf(p->sigma_g) ? INFINITY : p->sigma_g * unit;
     problem->sigma_m = problem->sigma_f / 2;

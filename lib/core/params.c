@@ -102,12 +102,14 @@ rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *o
     if (out->predictor != RSMOOTH_PREDICT_PROJECTION && out->predictor != RSMOOTH_PREDICT_CENTROID)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "predictor must be RSMOOTH_PREDICT_PROJECTION or RSMOOTH_PREDICT_CENTROID "
-                       "(got %d)", out->predictor);
+                       "(got %d)",
+                       out->predictor);
     if (out->normal_filter != RSMOOTH_NORMALS_MOLLIFY &&
         out->normal_filter != RSMOOTH_NORMALS_BILATERAL)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "normal_filter must be RSMOOTH_NORMALS_MOLLIFY or RSMOOTH_NORMALS_BILATERAL "
-                       "(got %d)", out->normal_filter);
+                       "(got %d)",
+                       out->normal_filter);
     if (!(out->normal_sigma_s > 0) || !isfinite(out->normal_sigma_s))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "normal_sigma_s must be positive and finite (got %g)", out->normal_sigma_s);
@@ -158,6 +160,7 @@ rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *o
     if (!(out->sigma_c > 0)) /* NaN fails too; +INFINITY turns the colour factor off */
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "sigma_c must be positive, or +infinity to turn the colour factor off "
-                       "(got %g)", out->sigma_c);
+                       "(got %g)",
+                       out->sigma_c);
     return RSMOOTH_OK;
 }

@@ -8,8 +8,8 @@
  * Everything here is local to a triangle and its corners' triangles, and the parts come from a
  * histogram of integer counts, so the pieces of a streamed mesh can find them with a halo of one
  * ring and a sum of histograms, and get the same answer. */
-#include "core/incidence.h"
 #include "core/parts.h"
+#include "core/incidence.h"
 
 #include <math.h>
 #include <string.h>

@@ -38,9 +38,8 @@ float rs_weight_value(double k, double unscale) {
 }
 
 rsmooth_status rs_check_results(rsmooth_scalar scalar, const void *out_positions,
-                                const float *out_weight, const float *out_confidence,
-                                size_t count, const char *noun, rsmooth_error *error,
-                                const char *where) {
+                                const float *out_weight, const float *out_confidence, size_t count,
+                                const char *noun, rsmooth_error *error, const char *where) {
     for (size_t i = 0; i < 3 * count; i++) {
         double x = rs_coordinate(scalar, out_positions, i);
         if (!isfinite(x))

@@ -8,13 +8,15 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* ---- status.c: error detail -------------------------------------------------------------------- */
+/* ---- status.c: error detail --------------------------------------------------------------------
+ */
 
 /* Resets `error` (if non-NULL) to success. */
 void rs_error_clear(rsmooth_error *error);
 
 /* Records a failure in `error` (if non-NULL) and returns `status`, so call sites read
- * `return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_smooth", "sigma_f %g <= 0", s);` */
+ * `return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_smooth", "sigma_f %g <= 0", s);`
+ */
 rsmooth_status rs_fail(rsmooth_error *error, rsmooth_status status, const char *where,
                        const char *format, ...)
 #if defined(__GNUC__)
@@ -30,9 +32,11 @@ rsmooth_status rs_fail_parse(rsmooth_error *error, int64_t line, int64_t byte_of
 #endif
     ;
 
-/* ---- alloc.c: the one allocation pair (a per-object allocator can replace it later) ----------- */
+/* ---- alloc.c: the one allocation pair (a per-object allocator can replace it later) -----------
+ */
 
-/* count * size bytes, NULL on overflow or failure. Never call with both 0 expecting non-NULL use. */
+/* count * size bytes, NULL on overflow or failure. Never call with both 0 expecting non-NULL use.
+ */
 void *rs_alloc_array(size_t count, size_t size);
 /* Same, zero-filled. */
 void *rs_calloc_array(size_t count, size_t size);
@@ -51,14 +55,16 @@ static inline bool rs_mul_overflows(size_t a, size_t b) {
 /* Monotonic clock in milliseconds. */
 double rs_now_ms(void);
 
-/* ---- file_io.c: whole positioned reads and writes ---------------------------------------------- */
+/* ---- file_io.c: whole positioned reads and writes ----------------------------------------------
+ */
 
 /* Writes or reads all n bytes at `offset` (EINTR and short counts retried); false with errno on
  * failure (EIO: the file ended first). */
 bool rs_pwrite_all(int fd, const void *data, size_t n, uint64_t offset);
 bool rs_pread_all(int fd, void *data, size_t n, uint64_t offset);
 
-/* ---- parallel.c: host loops on every core ------------------------------------------------------ */
+/* ---- parallel.c: host loops on every core ------------------------------------------------------
+ */
 
 /* Elements [begin, end) of a loop, as chunk number `chunk` (chunks are contiguous and in order). */
 typedef void (*rs_range_fn)(void *ctx, size_t begin, size_t end, size_t chunk);
@@ -79,13 +85,15 @@ size_t rs_parallel_chunks(size_t count, size_t min_per_chunk);
  * results combined in chunk order are the same on every run. */
 void rs_parallel_for(size_t count, size_t min_per_chunk, rs_range_fn fn, void *ctx);
 
-/* ---- sort.c ------------------------------------------------------------------------------------ */
+/* ---- sort.c ------------------------------------------------------------------------------------
+ */
 
 /* Stable LSD radix sort of `keys` carrying `values` along. Returns false when scratch memory cannot
  * be allocated (arrays unchanged then). */
 bool rs_radix_sort_u64(uint64_t *keys, uint32_t *values, size_t count);
 
-/* ---- params.c ---------------------------------------------------------------------------------- */
+/* ---- params.c ----------------------------------------------------------------------------------
+ */
 
 /* Most bilateral rounds and filter passes one call may ask for. */
 #define RS_MAX_ROUNDS 100
@@ -98,43 +106,44 @@ bool rs_radix_sort_u64(uint64_t *keys, uint32_t *values, size_t count);
 rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *out,
                                  rsmooth_error *error, const char *where);
 
-/* ---- mesh.c: the validated problem both paths solve ------------------------------------------- */
+/* ---- mesh.c: the validated problem both paths solve -------------------------------------------
+ */
 
 /* A facet is a triangle of non-zero area; zero-area triangles carry no weight and are left out.
  * Every length in a problem is in internal units: the caller's times `scale` (scale.c). */
 typedef struct rs_problem {
     size_t vertex_count;
-    double scale;                /* internal units per caller unit: a power of two */
-    double *xyz;                 /* 3 * vertex_count, the input in double, times `scale` (owned) */
+    double scale; /* internal units per caller unit: a power of two */
+    double *xyz;  /* 3 * vertex_count, the input in double, times `scale` (owned) */
     size_t triangle_count;
-    const uint32_t *indices;     /* borrowed from the caller */
+    const uint32_t *indices; /* borrowed from the caller */
     size_t facet_count;
-    uint32_t *facet_triangle;    /* triangle index of each facet */
+    uint32_t *facet_triangle; /* triangle index of each facet */
     /* Kept only when asked (the reference path); the OpenCL path computes them where it needs
      * them (rs_facet_centroid, rs_triangle_normal), which saves 56 bytes per triangle. */
-    double *centroid;            /* 3 per facet: c_q */
-    double *normal;              /* 3 per facet: unit n_q of the input */
-    double *area;                /* per facet: a_q > 0 */
+    double *centroid; /* 3 per facet: c_q */
+    double *normal;   /* 3 per facet: unit n_q of the input */
+    double *area;     /* per facet: a_q > 0 */
     double mean_edge_length;
-    double mean_area;            /* of the facets (a tile keeps its whole mesh's) */
+    double mean_area; /* of the facets (a tile keeps its whole mesh's) */
     /* absolute parameters, mesh units */
-    double sigma_f, sigma_g;     /* sigma_g is +INFINITY when the influence weight is off */
-    double sigma_m;              /* mollification width: sigma_f / 2 */
-    double radius;               /* cutoff * sigma_f: reach of the robust pass */
-    double mollify_radius;       /* reach of the mollification pass (<= radius) */
-    bool mollify;                /* false also when the predictor needs no normals (centroid) */
-    bool predict_centroid;       /* predict c_q instead of Pi_q(p) */
-    bool bilateral;              /* with `mollify`: bilateral normal filter instead of the paper's */
-    double normal_sigma_s;       /* bilateral spatial width, mesh units */
-    double normal_sigma_n;       /* bilateral width on normal differences */
-    double normal_radius;        /* bilateral reach: cutoff * normal_sigma_s (0 when off) */
+    double sigma_f, sigma_g; /* sigma_g is +INFINITY when the influence weight is off */
+    double sigma_m;          /* mollification width: sigma_f / 2 */
+    double radius;           /* cutoff * sigma_f: reach of the robust pass */
+    double mollify_radius;   /* reach of the mollification pass (<= radius) */
+    bool mollify;            /* false also when the predictor needs no normals (centroid) */
+    bool predict_centroid;   /* predict c_q instead of Pi_q(p) */
+    bool bilateral;          /* with `mollify`: bilateral normal filter instead of the paper's */
+    double normal_sigma_s;   /* bilateral spatial width, mesh units */
+    double normal_sigma_n;   /* bilateral width on normal differences */
+    double normal_radius;    /* bilateral reach: cutoff * normal_sigma_s (0 when off) */
     int normal_iterations;
-    int influence;               /* an rsmooth_influence */
+    int influence; /* an rsmooth_influence */
     /* The colour factor of the robust weight (rsmooth_params.colors), NULL when off: */
-    const float *colors;         /* 3 per vertex, borrowed (a tile's: its own copy) */
-    double *facet_color;         /* 3 per facet, the mean of its corners' colours; kept with the
-                                  * facet data (reference path), owned */
-    double sigma_c;              /* colour width, finite when colors is not NULL */
+    const float *colors;          /* 3 per vertex, borrowed (a tile's: its own copy) */
+    double *facet_color;          /* 3 per facet, the mean of its corners' colours; kept with the
+                                   * facet data (reference path), owned */
+    double sigma_c;               /* colour width, finite when colors is not NULL */
     rsmooth_progress_fn progress; /* optional, from the params */
     rsmooth_progress_cancel_fn progress_cancel; /* optional, from the params */
     void *progress_user;
@@ -160,11 +169,11 @@ extern const char rs_unchecked_output[1];
 /* Checks every argument of a smoothing call (nothing is written on failure), converts positions to
  * double, finds the facets, computes the mean edge length and area and the absolute parameters,
  * and with keep_facet_data the facets' centroids, normals and areas. */
-rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
-                                  const void *positions, size_t vertex_count,
-                                  const uint32_t *indices, size_t triangle_count,
-                                  const rsmooth_params *params, const void *out_positions,
-                                  bool keep_facet_data, rsmooth_error *error, const char *where);
+rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar, const void *positions,
+                                  size_t vertex_count, const uint32_t *indices,
+                                  size_t triangle_count, const rsmooth_params *params,
+                                  const void *out_positions, bool keep_facet_data,
+                                  rsmooth_error *error, const char *where);
 
 /* rs_problem_prepare for a piece of a larger mesh: the whole mesh's figures stand in for the
  * problem's own (its mean edge length and mean area are not computed), and its scale is used
@@ -195,7 +204,8 @@ rsmooth_status rs_check_colors(const float *colors, size_t vertex_count, rsmooth
 static inline void rs_triangle_color(const float *colors, const uint32_t *tri, double out[3]) {
     for (int k = 0; k < 3; k++)
         out[k] = ((double)colors[3 * (size_t)tri[0] + k] + (double)colors[3 * (size_t)tri[1] + k] +
-                  (double)colors[3 * (size_t)tri[2] + k]) / 3.0;
+                  (double)colors[3 * (size_t)tri[2] + k]) /
+                 3.0;
 }
 
 /* Unit normal and area of the triangle with vertex indices tri[0..2] over `xyz`; false (outputs
@@ -225,8 +235,8 @@ static inline void rs_triangle_centroid(const double *xyz, const uint32_t *tri,
 
 /* The centroid of facet q of a problem. */
 static inline void rs_facet_centroid(const rs_problem *problem, size_t q, double centroid[3]) {
-    rs_triangle_centroid(problem->xyz,
-                         problem->indices + 3 * (size_t)problem->facet_triangle[q], centroid);
+    rs_triangle_centroid(problem->xyz, problem->indices + 3 * (size_t)problem->facet_triangle[q],
+                         centroid);
 }
 void rs_problem_free(rs_problem *problem);
 
@@ -269,8 +279,8 @@ rsmooth_status rs_check_coordinates(rsmooth_scalar scalar, const void *positions
  * rs_check_coordinates gives it. */
 rsmooth_status rs_check_mesh_arrays(rsmooth_scalar scalar, const void *positions,
                                     size_t vertex_count, const uint32_t *indices,
-                                    size_t triangle_count, double *magnitude,
-                                    rsmooth_error *error, const char *where);
+                                    size_t triangle_count, double *magnitude, rsmooth_error *error,
+                                    const char *where);
 
 /* rs_check_mesh_arrays without the coordinates: the scalar type, positions present, the counts,
  * indices present and in range. For calls that check several position arrays over one index
@@ -302,9 +312,9 @@ static inline void rs_cross3(const double a[3], const double b[3], double out[3]
     out[2] = a[0] * b[1] - a[1] * b[0];
 }
 
-/* A mollified facet is degenerate, and its input normal is used instead, when the sine of its corner
- * angle falls below RS_DEGENERATE_SINE or its area shrank below RS_DEGENERATE_AREA_RATIO of the
- * input facet's (an isolated triangle collapses onto its centroid; what remains of its edges is
+/* A mollified facet is degenerate, and its input normal is used instead, when the sine of its
+ * corner angle falls below RS_DEGENERATE_SINE or its area shrank below RS_DEGENERATE_AREA_RATIO of
+ * the input facet's (an isolated triangle collapses onto its centroid; what remains of its edges is
  * rounding noise, float32's included). Shared by both paths so they decide alike. */
 #define RS_DEGENERATE_SINE 1e-6
 #define RS_DEGENERATE_AREA_RATIO 1e-5
@@ -320,16 +330,17 @@ static inline void rs_cross3(const double a[3], const double b[3], double out[3]
  * smallest value, so the result is the mathematically defined weighted average. */
 #define RS_UNDERFLOW_RATIO 1e-30
 
-/* ---- scale.c: internal units ------------------------------------------------------------------ */
+/* ---- scale.c: internal units ------------------------------------------------------------------
+ */
 
 /* The power of two both paths multiply coordinates by (and divide results by), chosen so a
  * typical edge (of sampled triangles; for points, the distance between consecutive points) is
  * about 1 long while the largest coordinate, `magnitude` (rs_check_coordinates), stays below
  * 2^500. Exact, so results do not depend on it. RSMOOTH_ERROR_INVALID_ARGUMENT when no power of
  * two fits both (a coordinate more than about 1e225 typical edges from the origin). */
-rsmooth_status rs_mesh_scale(rsmooth_scalar scalar, const void *positions,
-                             const uint32_t *indices, size_t triangle_count, double magnitude,
-                             double *scale, rsmooth_error *error, const char *where);
+rsmooth_status rs_mesh_scale(rsmooth_scalar scalar, const void *positions, const uint32_t *indices,
+                             size_t triangle_count, double magnitude, double *scale,
+                             rsmooth_error *error, const char *where);
 rsmooth_status rs_points_scale(rsmooth_scalar scalar, const void *positions, size_t count,
                                double magnitude, double *scale, rsmooth_error *error,
                                const char *where);
@@ -358,9 +369,8 @@ float rs_weight_value(double k, double unscale);
  * range, is RSMOOTH_ERROR_NUMERICAL naming the vertex) and every confidence in [0, 1]. Any array
  * but out_positions may be NULL. */
 rsmooth_status rs_check_results(rsmooth_scalar scalar, const void *out_positions,
-                                const float *out_weight, const float *out_confidence,
-                                size_t count, const char *noun, rsmooth_error *error,
-                                const char *where);
+                                const float *out_weight, const float *out_confidence, size_t count,
+                                const char *noun, rsmooth_error *error, const char *where);
 
 /* Writes the result for vertex v (double xyz, internal units) into the caller's array of type
  * `scalar`, times `unscale` (1 / the problem's scale; 1 for values in the caller's units). */
@@ -405,7 +415,8 @@ rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positi
                                        size_t triangle_count, rs_noise_stats *out,
                                        rsmooth_error *error, const char *caller);
 
-/* ---- taubin.c --------------------------------------------------------------------------------- */
+/* ---- taubin.c ---------------------------------------------------------------------------------
+ */
 
 /* Taubin's lambda|mu smoothing of xyz (double, in place) until the RMS distance of the vertices
  * from where they started reaches target_move (mesh units) and, when min_gain > 0, an iteration
@@ -457,16 +468,15 @@ typedef int (*rs_cycle_fn)(void *user, int done, int cycles);
  * positions (the stage's units) to xyz. A runner that cannot take the plan (too large for its
  * device) returns RSMOOTH_ERROR_OUT_OF_MEMORY having changed nothing: the host runs it then. */
 typedef rsmooth_status (*rs_stage_runner)(void *ctx, const rs_stage_plan *plan, double *xyz,
-                                          rs_cycle_fn cycle_done, void *user,
-                                          rs_stage_stats *stats, rsmooth_error *error);
+                                          rs_cycle_fn cycle_done, void *user, rs_stage_stats *stats,
+                                          rsmooth_error *error);
 
 /* Runs `one_pass` params->passes times (once, unchanged, when passes is 1), each pass from the
  * previous pass's positions with the sigmas of the input, honouring pass_confidence; the
  * normal-update stage before them, if params ask for it, through `stage` (NULL: on the host),
  * both with `ctx`. The caller's outputs are written only when every pass succeeded. */
 rsmooth_status rs_filter_passes(rs_filter_fn one_pass, rs_stage_runner stage, void *ctx,
-                                rsmooth_scalar scalar,
-                                const void *positions, size_t vertex_count,
+                                rsmooth_scalar scalar, const void *positions, size_t vertex_count,
                                 const uint32_t *indices, size_t triangle_count,
                                 const rsmooth_params *params, void *out_positions,
                                 float *out_weight, float *out_confidence, rsmooth_report *report,

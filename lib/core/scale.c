@@ -22,8 +22,7 @@
 
 /* The larger of |a_k - b_k|: a length that cannot overflow or underflow where the Euclidean one's
  * square could. */
-static double chebyshev_distance(rsmooth_scalar scalar, const void *positions, size_t a,
-                                 size_t b) {
+static double chebyshev_distance(rsmooth_scalar scalar, const void *positions, size_t a, size_t b) {
     double d = 0;
     for (int k = 0; k < 3; k++)
         d = fmax(d, fabs(rs_coordinate(scalar, positions, 3 * a + (size_t)k) -
@@ -129,9 +128,9 @@ double rs_typical_edge(rsmooth_scalar scalar, const void *positions, const uint3
     return typical_distance(scalar, positions, triangle_count, triangle_edge, indices);
 }
 
-rsmooth_status rs_mesh_scale(rsmooth_scalar scalar, const void *positions,
-                             const uint32_t *indices, size_t triangle_count, double magnitude,
-                             double *scale, rsmooth_error *error, const char *where) {
+rsmooth_status rs_mesh_scale(rsmooth_scalar scalar, const void *positions, const uint32_t *indices,
+                             size_t triangle_count, double magnitude, double *scale,
+                             rsmooth_error *error, const char *where) {
     double typical = typical_distance(scalar, positions, triangle_count, triangle_edge, indices);
     return scale_for(typical, magnitude, "the mesh's", "its typical edge length", scale, error,
                      where);

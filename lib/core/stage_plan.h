@@ -11,36 +11,36 @@
  * units (scaled near 1 by a power of two: normal_update.c). */
 struct rs_stage_plan {
     size_t vertex_count, facet_count;
-    const double *xyz;             /* 3 per vertex: the input, in the stage's units */
-    const uint32_t *facet_vertex;  /* 3 per facet */
-    const double *facet_normal;    /* 3 per facet: the input's unit normals */
+    const double *xyz;            /* 3 per vertex: the input, in the stage's units */
+    const uint32_t *facet_vertex; /* 3 per facet */
+    const double *facet_normal;   /* 3 per facet: the input's unit normals */
     const double *facet_area;
-    const double *facet_centroid;  /* 3 per facet */
-    const uint32_t *rep;           /* per vertex: its welded vertex */
-    const size_t *rep_start;       /* vertex_count + 1 */
+    const double *facet_centroid; /* 3 per facet */
+    const uint32_t *rep;          /* per vertex: its welded vertex */
+    const size_t *rep_start;      /* vertex_count + 1 */
     const uint32_t *rep_facet;
-    const size_t *patch_start;     /* facet_count + 1 */
+    const size_t *patch_start; /* facet_count + 1 */
     const uint32_t *patch;
-    const size_t *edge_start;      /* facet_count + 1: edges, 2 facets each in `edge` */
+    const size_t *edge_start; /* facet_count + 1: edges, 2 facets each in `edge` */
     const uint32_t *edge;
-    const size_t *near_start;      /* facet_count + 1 */
+    const size_t *near_start; /* facet_count + 1 */
     const uint32_t *near;
-    bool filter;                   /* false: the normals stay the facets' own (no shared edge) */
-    double inv_2s2, inv_2t2;       /* the guided filter's 1 / 2 sigma^2, natural exponents */
+    bool filter;             /* false: the normals stay the facets' own (no shared edge) */
+    double inv_2s2, inv_2t2; /* the guided filter's 1 / 2 sigma^2, natural exponents */
     int rounds, updates, cycles;
-    const uint8_t *move_mask;      /* NULL: every vertex moves */
+    const uint8_t *move_mask; /* NULL: every vertex moves */
 };
 
 /* What a run of the stage measured. */
 struct rs_stage_stats {
-    double ms_lists;        /* facets, adjacency and the guided lists, on the host */
+    double ms_lists; /* facets, adjacency and the guided lists, on the host */
     double ms_upload, ms_cycles, ms_download;
     uint64_t bytes_to_device, bytes_from_device;
-    int cycles;             /* cycles run */
-    int float_bits;         /* the precision they ran in: 64 (the host, a device with fp64), 32 */
+    int cycles;     /* cycles run */
+    int float_bits; /* the precision they ran in: 64 (the host, a device with fp64), 32 */
     bool on_device;
-    bool skipped;           /* not run: the mesh reads clean (rsmooth_params.guard) */
-    char device[128];       /* where the cycles ran */
+    bool skipped;     /* not run: the mesh reads clean (rsmooth_params.guard) */
+    char device[128]; /* where the cycles ran */
 };
 
 #endif /* RSMOOTH_STAGE_PLAN_H */

@@ -80,7 +80,7 @@ extern "C" {
 #endif
 
 /* ---------------------------------------------------------------------------------------------- */
-/* Status and error detail                                                                          */
+/* Status and error detail */
 /* ---------------------------------------------------------------------------------------------- */
 
 /** Every call that can fail returns one of these; RSMOOTH_OK (0) is success. They name classes of
@@ -142,7 +142,7 @@ typedef struct rsmooth_error {
 RSMOOTH_API void rsmooth_error_init(rsmooth_error *error);
 
 /* ---------------------------------------------------------------------------------------------- */
-/* Parameters                                                                                       */
+/* Parameters */
 /* ---------------------------------------------------------------------------------------------- */
 
 /** The type of the coordinates in the caller's position arrays (inputs and outputs alike). */
@@ -220,26 +220,26 @@ typedef struct rsmooth_params {
     /** @name Beyond the paper
      * Beyond the paper (added in 0.4; callers with an older struct_size get the defaults, which
      * are the paper's filter exactly). @{ */
-    int normal_filter;            /**< an rsmooth_normal_filter: how the predictors' normals are
-                                   * smoothed when `mollify` is 1. Default
-                                   * RSMOOTH_NORMALS_MOLLIFY */
-    double normal_sigma_s;        /**< bilateral: spatial width, units of sigma_f. Default 1 */
-    double normal_sigma_n;        /**< bilateral: width on |n_q - n_r| between unit normals, (0, 2].
-                                   * Default 0.35 */
-    int normal_iterations;        /**< bilateral: rounds, [1, 100]. Default 5 */
-    int influence;                /**< an rsmooth_influence: the robust weight g. Default
-                                   * RSMOOTH_INFLUENCE_GAUSSIAN (the paper's) */
-    int passes;                   /**< the whole filter this many times, [0, 100], each pass from
-                                   * the previous pass's positions (sigmas stay those of the input).
-                                   * Default 1. 0: no pass; with vertex_updates > 0 the normal
-                                   * update stage alone, without it nothing at all (the input
-                                   * comes back, as rsmooth_params_auto sets on a mesh with
-                                   * nothing to remove; changed in 0.11). Weights are then 0 and
-                                   * confidences 1 */
-    double pass_confidence;       /**< 0 (default): every pass moves every vertex. In (0, 1]: passes
-                                   * after the first move only the vertices whose confidence in the
-                                   * previous pass was below this (low confidence: features and
-                                   * outliers, the paper's Sec. 5 suggestion) */
+    int normal_filter;      /**< an rsmooth_normal_filter: how the predictors' normals are
+                             * smoothed when `mollify` is 1. Default
+                             * RSMOOTH_NORMALS_MOLLIFY */
+    double normal_sigma_s;  /**< bilateral: spatial width, units of sigma_f. Default 1 */
+    double normal_sigma_n;  /**< bilateral: width on |n_q - n_r| between unit normals, (0, 2].
+                             * Default 0.35 */
+    int normal_iterations;  /**< bilateral: rounds, [1, 100]. Default 5 */
+    int influence;          /**< an rsmooth_influence: the robust weight g. Default
+                             * RSMOOTH_INFLUENCE_GAUSSIAN (the paper's) */
+    int passes;             /**< the whole filter this many times, [0, 100], each pass from
+                             * the previous pass's positions (sigmas stay those of the input).
+                             * Default 1. 0: no pass; with vertex_updates > 0 the normal
+                             * update stage alone, without it nothing at all (the input
+                             * comes back, as rsmooth_params_auto sets on a mesh with
+                             * nothing to remove; changed in 0.11). Weights are then 0 and
+                             * confidences 1 */
+    double pass_confidence; /**< 0 (default): every pass moves every vertex. In (0, 1]: passes
+                             * after the first move only the vertices whose confidence in the
+                             * previous pass was below this (low confidence: features and
+                             * outliers, the paper's Sec. 5 suggestion) */
     /** @} */
     /** @name Colour in the influence weight
      * Colour in the influence weight (the paper's future work; added in 0.4). With a colour C_p
@@ -251,23 +251,24 @@ typedef struct rsmooth_params {
      * bilateral filter) ignore colour. The confidence k / sum a f counts the factor in k only,
      * so it drops where neighbouring triangles differ in colour. For point clouds
      * (rsmooth_smooth_points_reference) a point's own colour is its facet's C_q. @{ */
-    const float *colors;          /**< NULL (default): off. Else 3 * vertex_count floats, a colour
-                                   * per vertex (e.g. RGB in [0, 1]; any finite values of
-                                   * magnitude <= 1e15), in the positions' vertex order. Borrowed:
-                                   * read during the call only. A bad one is an
-                                   * RSMOOTH_ERROR_INVALID_ARGUMENT naming its vertex */
-    double sigma_c;               /**< colour width, in the colours' units, > 0; +INFINITY turns the
-                                   * colour factor off (the result is then exactly that of colors
-                                   * = NULL). Default 0.1 */
+    const float *colors; /**< NULL (default): off. Else 3 * vertex_count floats, a colour
+                          * per vertex (e.g. RGB in [0, 1]; any finite values of
+                          * magnitude <= 1e15), in the positions' vertex order. Borrowed:
+                          * read during the call only. A bad one is an
+                          * RSMOOTH_ERROR_INVALID_ARGUMENT naming its vertex */
+    double sigma_c;      /**< colour width, in the colours' units, > 0; +INFINITY turns the
+                          * colour factor off (the result is then exactly that of colors
+                          * = NULL). Default 0.1 */
     /** @} */
-    rsmooth_progress_cancel_fn progress_cancel; /**< optional (NULL, default): progress reports that
-                                   * may stop the call (see the type); called with progress_user,
-                                   * after `progress` when both are set. (Added in 0.5) */
-    const uint8_t *move_mask;     /**< NULL (default): every vertex moves. Else vertex_count bytes
-                                   * (points: point_count): a vertex whose byte is 0 keeps its
-                                   * input position bit for bit in every pass, while its triangles
-                                   * still support the others (smoothing a selection). Its weight
-                                   * and confidence are still computed. Borrowed. (Added in 0.5) */
+    rsmooth_progress_cancel_fn
+        progress_cancel;      /**< optional (NULL, default): progress reports that
+                               * may stop the call (see the type); called with progress_user,
+                               * after `progress` when both are set. (Added in 0.5) */
+    const uint8_t *move_mask; /**< NULL (default): every vertex moves. Else vertex_count bytes
+                               * (points: point_count): a vertex whose byte is 0 keeps its
+                               * input position bit for bit in every pass, while its triangles
+                               * still support the others (smoothing a selection). Its weight
+                               * and confidence are still computed. Borrowed. (Added in 0.5) */
     /** @name The normal update stage
      * The normal update stage (added in 0.6; off by default, so older callers and the paper's
      * filter are unchanged). With vertex_updates > 0, before the passes: the facet normals are
@@ -276,61 +277,61 @@ typedef struct rsmooth_params {
      * survive heavy noise), guided_rounds times, and then the vertices are moved to agree with
      * those normals by Sun et al. 2007's iterative update, vertex_updates times. The passes then
      * start from the updated positions. Runs on the host's cores, in double precision. @{ */
-    int vertex_updates;           /**< 0 (default): no stage. [1, 1000]: update iterations */
-    double guided_sigma_s;        /**< spatial width of the guided filter's Gaussian, in mean edge
-                                   * lengths (absolute = 0) or mesh units (absolute = 1), > 0; its
-                                   * reach is guided_radius times the mean distance between the
-                                   * centroids of facets sharing an edge, so 2 (default) weighs
-                                   * the default reach nearly evenly */
-    double guided_sigma_n;        /**< width on the difference of guidance normals, (0, 2].
-                                   * Default 0.2 */
-    int guided_rounds;            /**< guided filter rounds, [1, 100]. Default 20 */
-    int stage_repeats;            /**< the stage's cycles, [1, 1000]: each cycle reads fresh facet
-                                   * normals, areas and centroids from the current positions, runs
-                                   * guided_rounds rounds and then vertex_updates updates (the
-                                   * guided filter's authors run hundreds of cycles of one round
-                                   * and a few updates). What depends only on connectivity, and
-                                   * each facet's neighbour set, is built once on the input.
-                                   * Default 1 */
-    double discrepancy_level;     /**< 0 (default): off. > 0: the noise level, in mean edge lengths
-                                   * of the input (rsmooth_params_auto sets it to the estimate in
-                                   * the best mode): a choice per region. Taubin's lambda|mu
-                                   * smoothing (0.5, -0.53) of the input is run until the vertices
-                                   * moved (RMS) this far (the discrepancy principle, at most 40
-                                   * iterations), and each vertex's result is a blend of the
-                                   * filter's and Taubin's, the filter's weight rising with the
-                                   * share of its neighbourhood's facet pairs that meet within 2
-                                   * degrees in the filter's result (flat faces and creases: the
-                                   * filter's; curved at the scale of the triangles, as organic
-                                   * meshes coarse for their curvature: Taubin's). Boundary
-                                   * vertices then move at most this level (in their local edge
-                                   * length) from the input. Changed in 0.11: it swapped the
-                                   * whole mesh before. Needs connected triangles (a soup keeps
-                                   * the filter's result) */
-    double discrepancy_gain;      /**< 0 (default): Taubin's side of discrepancy_level's choice stops
-                                   * when the vertices moved that level. > 0: it goes on until one
-                                   * more iteration adds less than this (mean edge lengths) to
-                                   * their RMS move: for spatially correlated noise (range
-                                   * scans), whose low frequencies the level alone stops short
-                                   * of; rsmooth_params_auto sets it where the noise reads
-                                   * correlated. (Added in 0.11) */
-    double guided_radius;         /**< the guided filter's neighbourhood, in mean distances between
-                                   * the centroids of facets sharing an edge, [1, 8]. Default 2
-                                   * (the authors'); 3-4 holds creases better under heavy noise.
-                                   * (Added in 0.11) */
+    int vertex_updates;       /**< 0 (default): no stage. [1, 1000]: update iterations */
+    double guided_sigma_s;    /**< spatial width of the guided filter's Gaussian, in mean edge
+                               * lengths (absolute = 0) or mesh units (absolute = 1), > 0; its
+                               * reach is guided_radius times the mean distance between the
+                               * centroids of facets sharing an edge, so 2 (default) weighs
+                               * the default reach nearly evenly */
+    double guided_sigma_n;    /**< width on the difference of guidance normals, (0, 2].
+                               * Default 0.2 */
+    int guided_rounds;        /**< guided filter rounds, [1, 100]. Default 20 */
+    int stage_repeats;        /**< the stage's cycles, [1, 1000]: each cycle reads fresh facet
+                               * normals, areas and centroids from the current positions, runs
+                               * guided_rounds rounds and then vertex_updates updates (the
+                               * guided filter's authors run hundreds of cycles of one round
+                               * and a few updates). What depends only on connectivity, and
+                               * each facet's neighbour set, is built once on the input.
+                               * Default 1 */
+    double discrepancy_level; /**< 0 (default): off. > 0: the noise level, in mean edge lengths
+                               * of the input (rsmooth_params_auto sets it to the estimate in
+                               * the best mode): a choice per region. Taubin's lambda|mu
+                               * smoothing (0.5, -0.53) of the input is run until the vertices
+                               * moved (RMS) this far (the discrepancy principle, at most 40
+                               * iterations), and each vertex's result is a blend of the
+                               * filter's and Taubin's, the filter's weight rising with the
+                               * share of its neighbourhood's facet pairs that meet within 2
+                               * degrees in the filter's result (flat faces and creases: the
+                               * filter's; curved at the scale of the triangles, as organic
+                               * meshes coarse for their curvature: Taubin's). Boundary
+                               * vertices then move at most this level (in their local edge
+                               * length) from the input. Changed in 0.11: it swapped the
+                               * whole mesh before. Needs connected triangles (a soup keeps
+                               * the filter's result) */
+    double discrepancy_gain;  /**< 0 (default): Taubin's side of discrepancy_level's choice stops
+                               * when the vertices moved that level. > 0: it goes on until one
+                               * more iteration adds less than this (mean edge lengths) to
+                               * their RMS move: for spatially correlated noise (range
+                               * scans), whose low frequencies the level alone stops short
+                               * of; rsmooth_params_auto sets it where the noise reads
+                               * correlated. (Added in 0.11) */
+    double guided_radius;     /**< the guided filter's neighbourhood, in mean distances between
+                               * the centroids of facets sharing an edge, [1, 8]. Default 2
+                               * (the authors'); 3-4 holds creases better under heavy noise.
+                               * (Added in 0.11) */
     /** @} */
-    int guard;                    /**< 1 (default): do no harm. A triangle the filter would turn by
-                                   * more than 90 degrees from the input's (unless the input had it
-                                   * folded against its neighbours already) has its vertices pulled
-                                   * back toward the input until none is reversed
-                                   * (rsmooth_report.guarded_vertices counts them), and the normal
-                                   * update stage does not run on a mesh whose noise estimate finds
-                                   * nothing to remove (rsmooth_report.stage_skipped; not measured
-                                   * when discrepancy_level gives the noise, as
-                                   * rsmooth_params_auto sets it where it found some). 0: the filter
-                                   * exactly as set (the paper's own, for comparisons). Parts and
-                                   * outliers (rsmooth_report.parts) are kept apart either way.
-                                   * (Added in 0.11) */
+    int guard; /**< 1 (default): do no harm. A triangle the filter would turn by
+                * more than 90 degrees from the input's (unless the input had it
+                * folded against its neighbours already) has its vertices pulled
+                * back toward the input until none is reversed
+                * (rsmooth_report.guarded_vertices counts them), and the normal
+                * update stage does not run on a mesh whose noise estimate finds
+                * nothing to remove (rsmooth_report.stage_skipped; not measured
+                * when discrepancy_level gives the noise, as
+                * rsmooth_params_auto sets it where it found some). 0: the filter
+                * exactly as set (the paper's own, for comparisons). Parts and
+                * outliers (rsmooth_report.parts) are kept apart either way.
+                * (Added in 0.11) */
 } rsmooth_params;
 
 /** Fills `params` with the defaults above. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if params is
@@ -353,7 +354,7 @@ RSMOOTH_API rsmooth_status rsmooth_mean_edge_length(rsmooth_scalar scalar, const
                                                     rsmooth_error *error);
 
 /* ---------------------------------------------------------------------------------------------- */
-/* Noise estimate                                                                                   */
+/* Noise estimate */
 /* ---------------------------------------------------------------------------------------------- */
 
 /** Estimates the mesh's noise: the standard deviation of its vertices' displacement along the
@@ -396,12 +397,12 @@ RSMOOTH_API rsmooth_status rsmooth_params_auto(rsmooth_scalar scalar, const void
 
 /** The kind of noise rsmooth_params_auto_report found in a mesh (added in 0.6). */
 typedef enum rsmooth_noise_kind {
-    RSMOOTH_NOISE_NONE = 0,      /**< nothing to remove: nothing measurable (too few vertices,
-                                  * no edge), or roughness that reads as the mesh's own shape (a
-                                  * clean mesh, however coarse; see shape_correlation). Changed in
-                                  * 0.11: it meant only the former */
-    RSMOOTH_NOISE_GAUSSIAN = 1,  /**< every vertex displaced */
-    RSMOOTH_NOISE_IMPULSIVE = 2  /**< a share of the vertices thrown, the others (nearly) exact */
+    RSMOOTH_NOISE_NONE = 0,     /**< nothing to remove: nothing measurable (too few vertices,
+                                 * no edge), or roughness that reads as the mesh's own shape (a
+                                 * clean mesh, however coarse; see shape_correlation). Changed in
+                                 * 0.11: it meant only the former */
+    RSMOOTH_NOISE_GAUSSIAN = 1, /**< every vertex displaced */
+    RSMOOTH_NOISE_IMPULSIVE = 2 /**< a share of the vertices thrown, the others (nearly) exact */
 } rsmooth_noise_kind;
 
 /** What rsmooth_params_auto_report read from a mesh and chose (added in 0.6): initialise it with
@@ -447,79 +448,77 @@ RSMOOTH_API void rsmooth_noise_report_init(rsmooth_noise_report *report);
 
 /** rsmooth_params_auto, also saying what it read and chose in *report (when not NULL; initialise
  * it with rsmooth_noise_report_init). (Added in 0.6.) */
-RSMOOTH_API rsmooth_status rsmooth_params_auto_report(rsmooth_scalar scalar,
-                                                      const void *positions, size_t vertex_count,
-                                                      const uint32_t *indices,
-                                                      size_t triangle_count,
-                                                      rsmooth_params *params,
+RSMOOTH_API rsmooth_status rsmooth_params_auto_report(rsmooth_scalar scalar, const void *positions,
+                                                      size_t vertex_count, const uint32_t *indices,
+                                                      size_t triangle_count, rsmooth_params *params,
                                                       rsmooth_noise_report *report,
                                                       rsmooth_error *error);
 
 /** Figures of one filter run, filled when a non-NULL pointer is passed. Times in milliseconds;
  * stages a path does not have are 0. */
 typedef struct rsmooth_report {
-    size_t struct_size;           /**< sizeof(rsmooth_report): rsmooth_report_init (added in 0.5) */
-    size_t vertex_count;          /**< vertices given */
-    size_t triangle_count;        /**< triangles given */
-    size_t facet_count;           /**< triangles with non-zero area: the ones that carry weight */
-    double mean_edge_length;      /**< in mesh units */
-    double sigma_f;               /**< absolute, mesh units */
-    double sigma_g;               /**< absolute, mesh units (+INFINITY when the influence is off) */
-    double radius;                /**< cutoff * sigma_f: the reach of a vertex, mesh units */
-    size_t grid_cell_count;       /**< occupied grid cells */
-    char device[128];             /**< "reference (double, 1 thread)" or the OpenCL device name */
-    double ms_setup;              /**< program build / context work done for this call */
-    double ms_facets;             /**< facet data and mean edge length */
-    double ms_grid;               /**< grid build and vertex ordering */
-    double ms_upload;             /**< copying the inputs to the device */
-    double ms_mollify;            /**< vertex mollification */
-    double ms_normals;            /**< normals of the mollified copy */
-    double ms_robust;             /**< robust estimation */
-    double ms_download;           /**< copying the results back */
-    double ms_total;              /**< the whole filter call */
+    size_t struct_size;      /**< sizeof(rsmooth_report): rsmooth_report_init (added in 0.5) */
+    size_t vertex_count;     /**< vertices given */
+    size_t triangle_count;   /**< triangles given */
+    size_t facet_count;      /**< triangles with non-zero area: the ones that carry weight */
+    double mean_edge_length; /**< in mesh units */
+    double sigma_f;          /**< absolute, mesh units */
+    double sigma_g;          /**< absolute, mesh units (+INFINITY when the influence is off) */
+    double radius;           /**< cutoff * sigma_f: the reach of a vertex, mesh units */
+    size_t grid_cell_count;  /**< occupied grid cells */
+    char device[128];        /**< "reference (double, 1 thread)" or the OpenCL device name */
+    double ms_setup;         /**< program build / context work done for this call */
+    double ms_facets;        /**< facet data and mean edge length */
+    double ms_grid;          /**< grid build and vertex ordering */
+    double ms_upload;        /**< copying the inputs to the device */
+    double ms_mollify;       /**< vertex mollification */
+    double ms_normals;       /**< normals of the mollified copy */
+    double ms_robust;        /**< robust estimation */
+    double ms_download;      /**< copying the results back */
+    double ms_total;         /**< the whole filter call */
     /** @name Work counts
      * 0 where a path does not count them; the reference path does not. @{ */
-    double mollify_radius;        /**< reach of the mollification pass (of one round of the
-                                   * bilateral normal filter when it replaces it), mesh units */
-    uint64_t pairs_mollify;       /**< vertex-facet pairs the mollification pass evaluated */
-    uint64_t pairs_robust;        /**< vertex-facet pairs the robust pass evaluated (each of them,
-                                     within reach or not: the grid's waste is counted) */
-    size_t tiles;                 /**< spatial tiles the mesh was cut into to fit the device (1 when
-                                     it fitted whole) */
+    double mollify_radius;  /**< reach of the mollification pass (of one round of the
+                             * bilateral normal filter when it replaces it), mesh units */
+    uint64_t pairs_mollify; /**< vertex-facet pairs the mollification pass evaluated */
+    uint64_t pairs_robust;  /**< vertex-facet pairs the robust pass evaluated (each of them,
+                               within reach or not: the grid's waste is counted) */
+    size_t tiles;           /**< spatial tiles the mesh was cut into to fit the device (1 when
+                               it fitted whole) */
     /** @} */
-    int discrepancy_iterations;   /**< params.discrepancy_level's choice per region: the Taubin
-                                   * iterations blended with the filter's result, 0 when it was off
-                                   * or had nothing to smooth (added in 0.6) */
-    double region_filter_share;   /**< that choice's mean weight of the filter's result over the
-                                   * vertices (1: the filter's result everywhere, 0: Taubin's);
-                                   * 0 when discrepancy_iterations is 0 (added in 0.11) */
+    int discrepancy_iterations; /**< params.discrepancy_level's choice per region: the Taubin
+                                 * iterations blended with the filter's result, 0 when it was off
+                                 * or had nothing to smooth (added in 0.6) */
+    double region_filter_share; /**< that choice's mean weight of the filter's result over the
+                                 * vertices (1: the filter's result everywhere, 0: Taubin's);
+                                 * 0 when discrepancy_iterations is 0 (added in 0.11) */
     /** @name The normal-update stage (the best mode's; added in 0.11)
      * Its whole time is also in ms_normals. 0 when the call ran no stage. @{ */
-    double ms_stage;              /**< the whole stage */
-    double ms_stage_lists;        /**< facets, adjacency and the guided filter's lists (host) */
-    double ms_stage_upload;       /**< the lists and the input to the device */
-    double ms_stage_cycles;       /**< every cycle (on the device, or on the host) */
-    double ms_stage_download;     /**< the positions back */
-    int stage_cycles;             /**< cycles run */
-    int stage_on_device;          /**< 1: the cycles ran on the call's OpenCL device; 0: host */
-    int stage_float_bits;         /**< their precision: 64 (the host; a device with fp64, by
-                                   * default), 32 (RSMOOTH_STAGE_PRECISION=float, or a device
-                                   * without fp64) */
+    double ms_stage;                  /**< the whole stage */
+    double ms_stage_lists;            /**< facets, adjacency and the guided filter's lists (host) */
+    double ms_stage_upload;           /**< the lists and the input to the device */
+    double ms_stage_cycles;           /**< every cycle (on the device, or on the host) */
+    double ms_stage_download;         /**< the positions back */
+    int stage_cycles;                 /**< cycles run */
+    int stage_on_device;              /**< 1: the cycles ran on the call's OpenCL device; 0: host */
+    int stage_float_bits;             /**< their precision: 64 (the host; a device with fp64, by
+                                       * default), 32 (RSMOOTH_STAGE_PRECISION=float, or a device
+                                       * without fp64) */
     uint64_t stage_bytes_to_device;   /**< bytes the stage copied to the device */
     uint64_t stage_bytes_from_device; /**< and back */
     /** @} */
     /** @name Do no harm (added in 0.11)
      * What the call left alone (docs/do-no-harm.md). @{ */
-    size_t parts;                 /**< parts of the mesh smoothed each in its own unit: triangles
-                                   * whose sizes (median edge) differ by more than about 8 times,
-                                   * with no sizes between, are kept apart (1 for most meshes) */
-    size_t outliers;              /**< vertices held where they were: every triangle they belong to
-                                   * is out of scale with the surface around it (a vertex thrown
-                                   * far off it); their triangles move no other vertex */
-    size_t guarded_vertices;      /**< vertices rsmooth_params.guard pulled back so that no triangle
-                                   * came out reversed */
-    int stage_skipped;            /**< 1: the normal update stage was asked for but not run, the
-                                   * noise estimate finding nothing to remove (a clean mesh) */
+    size_t parts;            /**< parts of the mesh smoothed each in its own unit: triangles
+                              * whose sizes (median edge) differ by more than about 8 times,
+                              * with no sizes between, are kept apart (1 for most meshes) */
+    size_t outliers;         /**< vertices held where they were: every triangle they belong to
+                              * is out of scale with the surface around it (a vertex thrown
+                              * far off it); their triangles move no other vertex */
+    size_t guarded_vertices; /**< vertices rsmooth_params.guard pulled back so that no triangle
+                              * came out reversed */
+    int stage_skipped;       /**< 1: the normal update stage was asked for but not run, the
+                              * noise estimate finding nothing to remove (a clean mesh) */
     /** @} */
 } rsmooth_report;
 
@@ -527,7 +526,7 @@ typedef struct rsmooth_report {
 RSMOOTH_API void rsmooth_report_init(rsmooth_report *report);
 
 /* ---------------------------------------------------------------------------------------------- */
-/* Error metrics                                                                                    */
+/* Error metrics */
 /* ---------------------------------------------------------------------------------------------- */
 
 /** How far a result (a denoised mesh) is from its ground truth, both made of the same triangles
@@ -539,23 +538,23 @@ RSMOOTH_API void rsmooth_report_init(rsmooth_report *report);
 typedef struct rsmooth_metrics {
     size_t vertex_count;   /**< vertices compared */
     size_t triangle_count; /**< triangles of the meshes */
-    double theta;       /**< mean angle between corresponding face normals, degrees, over the
-                         * triangles with non-zero area in both meshes (NAN when there is none) */
-    size_t theta_count; /**< how many triangles theta averages */
-    double ev;          /**< Sun et al. 2007 E_v: sqrt(sum_v A_v d_v^2 / sum_v A_v), A_v the area of
-                         * the result's triangles around v, d_v the distance from result vertex v
-                         * to the ground-truth surface (exact), over vertices with A_v > 0; in
-                         * thousandths of bbox_diag (NAN when no vertex has A_v > 0) */
-    double rms_v;       /**< RMS distance between corresponding vertices (all of them), in
-                         * mean_edge (mean edge lengths of the truth) */
-    double hausdorff;   /**< symmetric Hausdorff distance sampled at the vertices: the larger of the
-                         * farthest result vertex from the ground-truth surface and the farthest
-                         * ground-truth vertex from the result surface (vertices used by some
-                         * triangle); in thousandths of bbox_diag */
-    double mean_edge;   /**< mean length of the truth's unique undirected edges (an edge shared by
-                         * two triangles counts once; a repeated index is no edge), mesh units */
-    double bbox_diag;   /**< diagonal of the truth's axis-aligned bounding box (all vertices), mesh
-                         * units */
+    double theta;          /**< mean angle between corresponding face normals, degrees, over the
+                            * triangles with non-zero area in both meshes (NAN when there is none) */
+    size_t theta_count;    /**< how many triangles theta averages */
+    double ev;        /**< Sun et al. 2007 E_v: sqrt(sum_v A_v d_v^2 / sum_v A_v), A_v the area of
+                       * the result's triangles around v, d_v the distance from result vertex v
+                       * to the ground-truth surface (exact), over vertices with A_v > 0; in
+                       * thousandths of bbox_diag (NAN when no vertex has A_v > 0) */
+    double rms_v;     /**< RMS distance between corresponding vertices (all of them), in
+                       * mean_edge (mean edge lengths of the truth) */
+    double hausdorff; /**< symmetric Hausdorff distance sampled at the vertices: the larger of the
+                       * farthest result vertex from the ground-truth surface and the farthest
+                       * ground-truth vertex from the result surface (vertices used by some
+                       * triangle); in thousandths of bbox_diag */
+    double mean_edge; /**< mean length of the truth's unique undirected edges (an edge shared by
+                       * two triangles counts once; a repeated index is no edge), mesh units */
+    double bbox_diag; /**< diagonal of the truth's axis-aligned bounding box (all vertices), mesh
+                       * units */
 } rsmooth_metrics;
 
 /** Compares `result_positions` with `truth_positions` (3 * vertex_count floats or doubles each, as
@@ -580,7 +579,7 @@ RSMOOTH_API rsmooth_status rsmooth_compare(rsmooth_scalar scalar, const void *re
                                            rsmooth_metrics *out, rsmooth_error *error);
 
 /* ---------------------------------------------------------------------------------------------- */
-/* Layer 1: arrays in, arrays out                                                                   */
+/* Layer 1: arrays in, arrays out */
 /* ---------------------------------------------------------------------------------------------- */
 
 /** The filter in double precision on one CPU thread: the oracle of the OpenCL path and the fallback
@@ -594,31 +593,24 @@ RSMOOTH_API rsmooth_status rsmooth_compare(rsmooth_scalar scalar, const void *re
  *                lies more than 1e225 typical edges from the origin is refused.
  * vertex_count   >= 1 and < 2^32.
  * indices        3 * triangle_count vertex indices, each < vertex_count. May be NULL only when
- *                triangle_count is 0 (then nothing moves). Any soup is fine: duplicated, unreferenced
- *                or disconnected vertices, non-manifold edges, zero-area triangles.
- * params         NULL means defaults (rsmooth_params_init).
- * out_positions  3 * vertex_count values of `scalar`, in the input's vertex order. Must not overlap
- *                `positions`.
- * out_weight     optional (NULL): vertex_count floats receiving k(p) = sum a f g (area units;
- *                a k beyond FLT_MAX, e.g. on a mesh with edges of 1e20, is
- *                RSMOOTH_ERROR_NUMERICAL, one below float's range rounds to 0: the confidence
- *                is the scale-free measure).
- * out_confidence optional (NULL): vertex_count floats receiving k(p) / sum a f, in [0, 1]; 0 where
- *                no facet is within reach (such vertices keep their position).
- * report         optional (NULL): figures of the run.
- * error          optional (NULL): detail on failure.
+ *                triangle_count is 0 (then nothing moves). Any soup is fine: duplicated,
+ * unreferenced or disconnected vertices, non-manifold edges, zero-area triangles. params NULL means
+ * defaults (rsmooth_params_init). out_positions  3 * vertex_count values of `scalar`, in the
+ * input's vertex order. Must not overlap `positions`. out_weight     optional (NULL): vertex_count
+ * floats receiving k(p) = sum a f g (area units; a k beyond FLT_MAX, e.g. on a mesh with edges of
+ * 1e20, is RSMOOTH_ERROR_NUMERICAL, one below float's range rounds to 0: the confidence is the
+ * scale-free measure). out_confidence optional (NULL): vertex_count floats receiving k(p) / sum a
+ * f, in [0, 1]; 0 where no facet is within reach (such vertices keep their position). report
+ * optional (NULL): figures of the run. error          optional (NULL): detail on failure.
  *
  * Returns RSMOOTH_OK, RSMOOTH_ERROR_INVALID_ARGUMENT (then no output is written),
  * RSMOOTH_ERROR_OUT_OF_MEMORY or RSMOOTH_ERROR_NUMERICAL (a float32 result beyond FLT_MAX, a
  * weight beyond float's range; outputs undefined). RSMOOTH_OK guarantees every output is finite.
  * Thread-safe (no shared state). */
-RSMOOTH_API rsmooth_status rsmooth_smooth_reference(rsmooth_scalar scalar, const void *positions,
-                                                    size_t vertex_count, const uint32_t *indices,
-                                                    size_t triangle_count,
-                                                    const rsmooth_params *params,
-                                                    void *out_positions, float *out_weight,
-                                                    float *out_confidence, rsmooth_report *report,
-                                                    rsmooth_error *error);
+RSMOOTH_API rsmooth_status rsmooth_smooth_reference(
+    rsmooth_scalar scalar, const void *positions, size_t vertex_count, const uint32_t *indices,
+    size_t triangle_count, const rsmooth_params *params, void *out_positions, float *out_weight,
+    float *out_confidence, rsmooth_report *report, rsmooth_error *error);
 
 /** The isotropic baselines people already use, for comparison only: `iterations` rounds of
  * p += lambda * U(p), each followed, when mu != 0, by p += mu * U(p) (Taubin's lambda|mu smoothing,
@@ -684,7 +676,7 @@ RSMOOTH_API rsmooth_status rsmooth_point_spacing(rsmooth_scalar scalar, const vo
                                                  rsmooth_error *error);
 
 /* ---------------------------------------------------------------------------------------------- */
-/* Layer 2: an OpenCL context object                                                                */
+/* Layer 2: an OpenCL context object */
 /* ---------------------------------------------------------------------------------------------- */
 
 /** Owns (or shares) an OpenCL context, device, queue and the built program. */
@@ -715,15 +707,15 @@ RSMOOTH_API rsmooth_status rsmooth_context_create(const char *device, rsmooth_co
 
 /** One OpenCL device as rsmooth_list_devices reports it. */
 typedef struct rsmooth_device_info {
-    size_t struct_size;      /**< sizeof(rsmooth_device_info), rsmooth_device_info_init: the first
-                              * entry's says how large every entry of the array is (added in 0.5) */
-    int platform_index;      /**< the P of a "P:D" device choice */
-    int device_index;        /**< the D */
-    char name[256];          /**< "platform name / device name", what a name choice matches */
-    char type[8];            /**< "gpu", "cpu", "accel" or "other" */
-    char version[64];        /**< CL_DEVICE_VERSION, e.g. "OpenCL 3.0 PoCL ..." */
-    unsigned compute_units;  /**< CL_DEVICE_MAX_COMPUTE_UNITS */
-    uint64_t global_memory;  /**< bytes */
+    size_t struct_size;     /**< sizeof(rsmooth_device_info), rsmooth_device_info_init: the first
+                             * entry's says how large every entry of the array is (added in 0.5) */
+    int platform_index;     /**< the P of a "P:D" device choice */
+    int device_index;       /**< the D */
+    char name[256];         /**< "platform name / device name", what a name choice matches */
+    char type[8];           /**< "gpu", "cpu", "accel" or "other" */
+    char version[64];       /**< CL_DEVICE_VERSION, e.g. "OpenCL 3.0 PoCL ..." */
+    unsigned compute_units; /**< CL_DEVICE_MAX_COMPUTE_UNITS */
+    uint64_t global_memory; /**< bytes */
 } rsmooth_device_info;
 
 /** Zeroes `info` and sets its struct_size. Accepts NULL. (Added in 0.5) */
@@ -827,7 +819,7 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_points(rsmooth_context *ctx, rsmooth_s
                                                  rsmooth_error *error);
 
 /* ---------------------------------------------------------------------------------------------- */
-/* Meshes as host applications hold them: strided vertices, any index type                          */
+/* Meshes as host applications hold them: strided vertices, any index type */
 /* ---------------------------------------------------------------------------------------------- */
 
 /** The type of a mesh view's indices. */
@@ -842,15 +834,15 @@ typedef enum rsmooth_index_type {
  * triangle t's three indices of `index_type` at byte t * index_stride of `indices`. Strides of 0
  * mean packed. Nothing need be aligned. (Added in 0.5) */
 typedef struct rsmooth_mesh_view {
-    size_t struct_size;            /**< sizeof(rsmooth_mesh_view): set by rsmooth_mesh_view_init */
-    rsmooth_scalar scalar;         /**< float32 or float64 coordinates */
-    const void *positions;         /**< vertex 0's x; borrowed, read during the call only */
-    size_t position_stride;        /**< bytes; 0, or >= 3 * sizeof(scalar) */
-    size_t vertex_count;           /**< >= 1 and < 2^32 */
-    const void *indices;           /**< may be NULL only when triangle_count is 0 */
-    int index_type;                /**< an rsmooth_index_type */
-    size_t index_stride;           /**< bytes; 0, or >= 3 * sizeof(index) */
-    size_t triangle_count;         /**< triangles (index triples) */
+    size_t struct_size;     /**< sizeof(rsmooth_mesh_view): set by rsmooth_mesh_view_init */
+    rsmooth_scalar scalar;  /**< float32 or float64 coordinates */
+    const void *positions;  /**< vertex 0's x; borrowed, read during the call only */
+    size_t position_stride; /**< bytes; 0, or >= 3 * sizeof(scalar) */
+    size_t vertex_count;    /**< >= 1 and < 2^32 */
+    const void *indices;    /**< may be NULL only when triangle_count is 0 */
+    int index_type;         /**< an rsmooth_index_type */
+    size_t index_stride;    /**< bytes; 0, or >= 3 * sizeof(index) */
+    size_t triangle_count;  /**< triangles (index triples) */
 } rsmooth_mesh_view;
 
 /** Sets struct_size and packed float32 with uint32 indices, everything else 0 / NULL. Returns
@@ -873,7 +865,7 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_view(rsmooth_context *ctx, const rsmoo
                                                rsmooth_error *error);
 
 /* ---------------------------------------------------------------------------------------------- */
-/* Pieces of a larger mesh (out-of-core and distributed filtering)                                 */
+/* Pieces of a larger mesh (out-of-core and distributed filtering) */
 /* ---------------------------------------------------------------------------------------------- */
 
 /** What a piece of a larger mesh is filtered with, besides its own arrays. (Added in 0.7) */
@@ -906,9 +898,8 @@ RSMOOTH_API rsmooth_status rsmooth_piece_info_init(rsmooth_piece_info *info);
  * that need the whole mesh (passes above 1, the normal update stage, colours, a move mask) are
  * RSMOOTH_ERROR_UNSUPPORTED naming the field; figures that give a halo beyond double range
  * (mean_edge_length 1e308) RSMOOTH_ERROR_INVALID_ARGUMENT. (Added in 0.7) */
-RSMOOTH_API rsmooth_status rsmooth_piece_halo(const rsmooth_params *params,
-                                              double mean_edge_length, double reach,
-                                              double *out_halo, rsmooth_error *error);
+RSMOOTH_API rsmooth_status rsmooth_piece_halo(const rsmooth_params *params, double mean_edge_length,
+                                              double reach, double *out_halo, rsmooth_error *error);
 
 /** The filter on a piece of a larger mesh: its first info->core_count vertices move as they would
  * in a run on the whole mesh, provided the piece holds every triangle whose centroid lies within
@@ -923,9 +914,8 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_piece(rsmooth_context *ctx, const doub
                                                 size_t vertex_count, const uint32_t *indices,
                                                 size_t triangle_count,
                                                 const rsmooth_piece_info *info,
-                                                const rsmooth_params *params,
-                                                double *out_positions, rsmooth_report *report,
-                                                rsmooth_error *error);
+                                                const rsmooth_params *params, double *out_positions,
+                                                rsmooth_report *report, rsmooth_error *error);
 
 #ifdef __cplusplus
 }

@@ -4,8 +4,8 @@
  *
  *     rsmooth_context *ctx;
  *     rsmooth_context_create_from_queue(my_queue, &ctx, &err);  // retains my_queue
- *     rsmooth_smooth(ctx, ...);                                  // runs on my_queue, then finishes it
- *     rsmooth_context_destroy(ctx);                              // releases what it retained
+ *     rsmooth_smooth(ctx, ...);                                  // runs on my_queue, then finishes
+ * it rsmooth_context_destroy(ctx);                              // releases what it retained
  *
  * The OpenCL version is the includer's choice: define CL_TARGET_OPENCL_VERSION (e.g. 120, 200, 300)
  * before this header as before <CL/cl.h>; this header defines none. rsmooth needs only OpenCL 1.2's

@@ -43,40 +43,40 @@ extern "C" {
 
 /** A mesh file format: what rsmooth_mesh_read_memory expects, rsmooth_mesh_write_file writes. */
 typedef enum rsmooth_format {
-    RSMOOTH_FORMAT_AUTO = 0,       /**< reading: from the content; writing: from the path's
-                                    * extension */
-    RSMOOTH_FORMAT_OBJ = 1,        /**< Wavefront OBJ (text) */
-    RSMOOTH_FORMAT_PLY_ASCII = 2,  /**< Stanford PLY, ascii */
-    RSMOOTH_FORMAT_PLY_BINARY = 3, /**< little-endian on output; either endianness on input */
+    RSMOOTH_FORMAT_AUTO = 0,          /**< reading: from the content; writing: from the path's
+                                       * extension */
+    RSMOOTH_FORMAT_OBJ = 1,           /**< Wavefront OBJ (text) */
+    RSMOOTH_FORMAT_PLY_ASCII = 2,     /**< Stanford PLY, ascii */
+    RSMOOTH_FORMAT_PLY_BINARY = 3,    /**< little-endian on output; either endianness on input */
     RSMOOTH_FORMAT_PLY_BINARY_BE = 4, /**< input only */
-    RSMOOTH_FORMAT_OFF = 5,        /**< OFF and its COFF / NOFF / CNOFF variants */
-    RSMOOTH_FORMAT_STL_ASCII = 6,  /**< STL, ascii (an unindexed triangle soup) */
-    RSMOOTH_FORMAT_STL_BINARY = 7  /**< STL, binary (an unindexed triangle soup) */
+    RSMOOTH_FORMAT_OFF = 5,           /**< OFF and its COFF / NOFF / CNOFF variants */
+    RSMOOTH_FORMAT_STL_ASCII = 6,     /**< STL, ascii (an unindexed triangle soup) */
+    RSMOOTH_FORMAT_STL_BINARY = 7     /**< STL, binary (an unindexed triangle soup) */
 } rsmooth_format;
 
 /** A mesh read from a file. All arrays are owned by the mesh and freed by rsmooth_mesh_destroy. */
 typedef struct rsmooth_mesh {
-    size_t vertex_count;        /**< vertices in the file (unreferenced ones included) */
-    double *positions;          /**< 3 * vertex_count: x, y, z per vertex, file order */
-    rsmooth_scalar precision;   /**< precision the file stored positions in: FLOAT32 for PLY float,
-                                 * FLOAT64 for PLY double and for text (OBJ) coordinates */
-    size_t face_count;          /**< polygons as in the file */
-    uint32_t *face_offsets;     /**< face_count + 1 entries: face i is
-                                 * face_indices[face_offsets[i] .. face_offsets[i + 1]) */
-    uint32_t *face_indices;     /**< 0-based vertex indices */
-    size_t triangle_count;      /**< the faces fanned into triangles (v0, vi, vi+1) */
-    uint32_t *triangles;        /**< 3 * triangle_count */
+    size_t vertex_count;      /**< vertices in the file (unreferenced ones included) */
+    double *positions;        /**< 3 * vertex_count: x, y, z per vertex, file order */
+    rsmooth_scalar precision; /**< precision the file stored positions in: FLOAT32 for PLY float,
+                               * FLOAT64 for PLY double and for text (OBJ) coordinates */
+    size_t face_count;        /**< polygons as in the file */
+    uint32_t *face_offsets;   /**< face_count + 1 entries: face i is
+                               * face_indices[face_offsets[i] .. face_offsets[i + 1]) */
+    uint32_t *face_indices;   /**< 0-based vertex indices */
+    size_t triangle_count;    /**< the faces fanned into triangles (v0, vi, vi+1) */
+    uint32_t *triangles;      /**< 3 * triangle_count */
     rsmooth_format source_format; /**< format it was read from */
-    int has_vertex_normals;     /**< the file carried vertex normals: writers that can hold them
-                                 * write normals recomputed from `positions` (area-weighted face
-                                 * normals) */
+    int has_vertex_normals;       /**< the file carried vertex normals: writers that can hold them
+                                   * write normals recomputed from `positions` (area-weighted face
+                                   * normals) */
 
     /** @name Per-vertex attributes
      * Per-vertex attributes writers of every format that can hold them write when non-NULL.
      * Readers fill vertex_colors when the file has vertex colours (PLY red/green/blue, OBJ
      * "v x y z r g b", COFF); vertex_quality is for callers (the confidence output). @{ */
-    float *vertex_quality;      /**< vertex_count values: PLY "quality" property */
-    uint8_t *vertex_colors;     /**< 3 * vertex_count RGB bytes */
+    float *vertex_quality;  /**< vertex_count values: PLY "quality" property */
+    uint8_t *vertex_colors; /**< 3 * vertex_count RGB bytes */
     /** @} */
 
     /** What the file held beyond the fields above, kept by the reader so writing back to the same
@@ -216,21 +216,21 @@ RSMOOTH_API rsmooth_status rsmooth_mesh_vertex_normals(const rsmooth_mesh *mesh,
 RSMOOTH_API void rsmooth_mesh_destroy(rsmooth_mesh *mesh);
 
 /* ---------------------------------------------------------------------------------------------- */
-/* Streaming: meshes larger than memory (added in 0.7)                                             */
+/* Streaming: meshes larger than memory (added in 0.7) */
 /* ---------------------------------------------------------------------------------------------- */
 
 /** How rsmooth_stream_smooth may use memory, disk and other processes. */
 typedef struct rsmooth_stream_options {
-    size_t struct_size;    /**< sizeof(rsmooth_stream_options): set by
-                            * rsmooth_stream_options_init */
-    uint64_t max_memory;   /**< bytes the call may hold at its peak, besides the OpenCL runtime's
-                            * own (docs: README "Large meshes"); 0: 1 GiB */
-    const char *tmpdir;    /**< folder of the temporary files (all unnamed: nothing is left behind,
-                            * however the process ends); an existing folder, or NULL: the
-                            * output's folder. "" is refused */
-    int replace;           /**< non-zero: an existing output (a regular file, or a symbolic link to
-                            * one: written through) is replaced atomically, keeping its mode,
-                            * owner and group; nothing else is ever replaced */
+    size_t struct_size;  /**< sizeof(rsmooth_stream_options): set by
+                          * rsmooth_stream_options_init */
+    uint64_t max_memory; /**< bytes the call may hold at its peak, besides the OpenCL runtime's
+                          * own (docs: README "Large meshes"); 0: 1 GiB */
+    const char *tmpdir;  /**< folder of the temporary files (all unnamed: nothing is left behind,
+                          * however the process ends); an existing folder, or NULL: the
+                          * output's folder. "" is refused */
+    int replace;         /**< non-zero: an existing output (a regular file, or a symbolic link to
+                          * one: written through) is replaced atomically, keeping its mode,
+                          * owner and group; nothing else is ever replaced */
     /** @{ */
     /** Several processes sharing the pieces (the MPI driver): each calls with the same arguments,
      * its own rank in [0, ranks), and `sync`, which every rank calls at the same points and which
@@ -248,7 +248,7 @@ RSMOOTH_API rsmooth_status rsmooth_stream_options_init(rsmooth_stream_options *o
 
 /** What a streaming call did. */
 typedef struct rsmooth_stream_report {
-    size_t struct_size;        /**< sizeof(rsmooth_stream_report): rsmooth_stream_report_init */
+    size_t struct_size; /**< sizeof(rsmooth_stream_report): rsmooth_stream_report_init */
     /** @{ */
     /** The input's vertices, faces, triangles (faces fanned) and triangles of non-zero area */
     uint64_t vertex_count, face_count, triangle_count, facet_count;
@@ -268,8 +268,8 @@ typedef struct rsmooth_stream_report {
      * rsmooth_smooth_piece; write: results into the copy; total: the whole call */
     double ms_read, ms_statistics, ms_buckets, ms_copy, ms_assemble, ms_filter, ms_write, ms_total;
     /** @} */
-    char device[128];          /**< "reference ..." or the OpenCL device's name, as
-                                * rsmooth_report */
+    char device[128]; /**< "reference ..." or the OpenCL device's name, as
+                       * rsmooth_report */
     /** What the caller should tell its user about the output it replaced: other hard links that
      * keep the old content, an owner or group that could not be kept (only root can give a file
      * away). "" when nothing. (Added in 0.9) */
@@ -311,8 +311,7 @@ RSMOOTH_API void rsmooth_stream_report_init(rsmooth_stream_report *report);
  * max_memory cannot hold the positions and one piece. Progress and cancellation through params'
  * callbacks. */
 RSMOOTH_API rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input,
-                                                 const char *output,
-                                                 const rsmooth_params *params,
+                                                 const char *output, const rsmooth_params *params,
                                                  const rsmooth_stream_options *options,
                                                  rsmooth_stream_report *report,
                                                  rsmooth_error *error);

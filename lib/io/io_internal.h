@@ -210,8 +210,8 @@ bool rs_io_put_bom(const rsmooth_mesh *mesh, rsmooth_format format, FILE *stream
 /* The body of a text mesh file (OBJ, OFF): writes `mesh` through `out`, with `extras` the format's
  * record of what the file was read with (NULL: none) and `normals` per-vertex normals (or NULL). */
 struct rs_io_text_out;
-typedef void (*rs_io_text_body)(const rsmooth_mesh *mesh, const void *extras,
-                                const double *normals, bool as_float, struct rs_io_text_out *out);
+typedef void (*rs_io_text_body)(const rsmooth_mesh *mesh, const void *extras, const double *normals,
+                                bool as_float, struct rs_io_text_out *out);
 
 /* Writes a text mesh file to `stream`: its byte-order mark (rs_io_put_bom), then `body` through a
  * buffered text writer, then flushes the stream. RSMOOTH_ERROR_IO ("writing NAME: reason") when

@@ -109,8 +109,8 @@ struct rsmooth_mesh_extras *rs_io_mesh_extras(rsmooth_mesh *mesh) {
     return mesh->extras;
 }
 
-size_t rsmooth_mesh_conversion_losses(const rsmooth_mesh *mesh, rsmooth_format format,
-                                      char *buffer, size_t size) {
+size_t rsmooth_mesh_conversion_losses(const rsmooth_mesh *mesh, rsmooth_format format, char *buffer,
+                                      size_t size) {
     char scratch[1];
     if (!buffer || size == 0) {
         buffer = scratch;

@@ -1,4 +1,5 @@
-/* OBJ extras: texture coordinates, groups, objects, materials and smoothing groups of an OBJ file. */
+/* OBJ extras: texture coordinates, groups, objects, materials and smoothing groups of an OBJ file.
+ */
 #include "io/obj_format.h"
 
 void rs_io_obj_extras_free(rs_obj_extras *extras) {
@@ -19,14 +20,11 @@ size_t rs_io_obj_losses(const rs_obj_extras *extras, rsmooth_format target, char
     static const struct {
         unsigned kind;
         const char *what;
-    } kinds[] = {{RS_OBJ_TEXCOORDS, "OBJ texture coordinates"},
-                 {RS_OBJ_GROUPS, "OBJ groups and objects"},
-                 {RS_OBJ_MATERIALS, "OBJ materials"},
-                 {RS_OBJ_SMOOTHING, "OBJ smoothing groups"},
-                 {RS_OBJ_LINES, "OBJ lines and points"},
-                 {RS_OBJ_COMMENTS, "OBJ comments"},
-                 {RS_OBJ_VERTEX_W, "OBJ vertex w coordinates"},
-                 {RS_OBJ_OTHER, "OBJ other statements"}};
+    } kinds[] = {
+        {RS_OBJ_TEXCOORDS, "OBJ texture coordinates"}, {RS_OBJ_GROUPS, "OBJ groups and objects"},
+        {RS_OBJ_MATERIALS, "OBJ materials"},           {RS_OBJ_SMOOTHING, "OBJ smoothing groups"},
+        {RS_OBJ_LINES, "OBJ lines and points"},        {RS_OBJ_COMMENTS, "OBJ comments"},
+        {RS_OBJ_VERTEX_W, "OBJ vertex w coordinates"}, {RS_OBJ_OTHER, "OBJ other statements"}};
     size_t lost = 0;
     for (size_t i = 0; i < sizeof kinds / sizeof kinds[0]; i++)
         if (extras->kinds & kinds[i].kind)

@@ -6,16 +6,16 @@
 
 /* Kinds of content an OBJ file held beyond v and f (bits of rs_obj_extras.kinds). */
 enum {
-    RS_OBJ_TEXCOORDS = 1u << 0,  /* vt lines or vt indices in faces */
-    RS_OBJ_NORMALS = 1u << 1,    /* vn lines */
-    RS_OBJ_GROUPS = 1u << 2,     /* g, o */
-    RS_OBJ_MATERIALS = 1u << 3,  /* mtllib, usemtl */
-    RS_OBJ_SMOOTHING = 1u << 4,  /* s */
-    RS_OBJ_LINES = 1u << 5,      /* l, p */
-    RS_OBJ_COMMENTS = 1u << 6,   /* # lines and trailing comments */
-    RS_OBJ_COLORS = 1u << 7,     /* v x y z r g b */
-    RS_OBJ_VERTEX_W = 1u << 8,   /* v x y z w (or other trailing fields) */
-    RS_OBJ_OTHER = 1u << 9       /* statements this library does not interpret */
+    RS_OBJ_TEXCOORDS = 1u << 0, /* vt lines or vt indices in faces */
+    RS_OBJ_NORMALS = 1u << 1,   /* vn lines */
+    RS_OBJ_GROUPS = 1u << 2,    /* g, o */
+    RS_OBJ_MATERIALS = 1u << 3, /* mtllib, usemtl */
+    RS_OBJ_SMOOTHING = 1u << 4, /* s */
+    RS_OBJ_LINES = 1u << 5,     /* l, p */
+    RS_OBJ_COMMENTS = 1u << 6,  /* # lines and trailing comments */
+    RS_OBJ_COLORS = 1u << 7,    /* v x y z r g b */
+    RS_OBJ_VERTEX_W = 1u << 8,  /* v x y z w (or other trailing fields) */
+    RS_OBJ_OTHER = 1u << 9      /* statements this library does not interpret */
 };
 
 /* The file as a sequence of runs: of plain v lines ("v x y z", nothing after), of plain f lines
@@ -34,16 +34,16 @@ typedef struct rs_obj_run {
  * the coordinates kept), replaces the vn lines by the recomputed normals and rewrites f lines
  * (absolute indices, trailing comment kept); every other line is copied verbatim. */
 struct rs_obj_extras {
-    char *text;              /* the text runs, back to back (owned, not NUL-terminated) */
+    char *text; /* the text runs, back to back (owned, not NUL-terminated) */
     size_t size;
     rs_obj_run *runs;
     size_t run_count;
-    bool crlf;               /* plain lines end in "\r\n" (else "\n") */
-    size_t vertex_count;     /* the mesh's counts at read time: the faithful path needs them */
+    bool crlf;           /* plain lines end in "\r\n" (else "\n") */
+    size_t vertex_count; /* the mesh's counts at read time: the faithful path needs them */
     size_t face_count;
-    uint64_t offsets_hash;   /* of face_offsets at read time, so vt per corner still lines up */
-    uint32_t *corner_vt;     /* per face corner: absolute 0-based vt index or RS_OBJ_NO_VT; NULL
-                              * when no face names a vt */
+    uint64_t offsets_hash; /* of face_offsets at read time, so vt per corner still lines up */
+    uint32_t *corner_vt;   /* per face corner: absolute 0-based vt index or RS_OBJ_NO_VT; NULL
+                            * when no face names a vt */
     unsigned kinds;
 };
 

@@ -1,4 +1,5 @@
-/* Wavefront OBJ parser over a memory buffer: v (with colours) and f; everything else kept as text. */
+/* Wavefront OBJ parser over a memory buffer: v (with colours) and f; everything else kept as text.
+ */
 #include "io/obj_format.h"
 
 #include <math.h>
@@ -18,10 +19,10 @@ typedef struct obj_state {
     size_t position_capacity; /* in vertices */
     rs_io_u32vec offsets;
     rs_io_u32vec indices;
-    uint64_t max_index; /* largest 0-based positive index seen */
+    uint64_t max_index;     /* largest 0-based positive index seen */
     int64_t max_vt, max_vn; /* largest 1-based vt, vn index seen (0: none) */
-    size_t vt_count;    /* vt lines so far: negative vt indices count back from it */
-    size_t vn_count;    /* vn lines so far: the same for vn */
+    size_t vt_count;        /* vt lines so far: negative vt indices count back from it */
+    size_t vn_count;        /* vn lines so far: the same for vn */
     /* The first statement OBJ does not know: where a file without vertices is blamed. */
     int64_t unknown_line;
     const char *unknown;

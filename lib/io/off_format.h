@@ -16,15 +16,15 @@ typedef struct rs_off_texts {
  * the file wrote it (float or integer colours, alpha, texture coordinates, face colours), so the
  * faithful writer can put it back verbatim. */
 struct rs_off_extras {
-    char keyword[16];     /* "STCNOFF" and its kin, as in the file */
-    bool normals;         /* N: each vertex line carries nx ny nz (recomputed on output) */
-    bool texcoords;       /* ST */
-    bool alpha;           /* some vertex colour has a fourth component */
-    size_t vertex_count;  /* the mesh's counts at read time: the faithful path needs them */
+    char keyword[16];    /* "STCNOFF" and its kin, as in the file */
+    bool normals;        /* N: each vertex line carries nx ny nz (recomputed on output) */
+    bool texcoords;      /* ST */
+    bool alpha;          /* some vertex colour has a fourth component */
+    size_t vertex_count; /* the mesh's counts at read time: the faithful path needs them */
     size_t face_count;
-    uint64_t edge_count;  /* as declared (OFF files rarely fill it in) */
-    rs_off_texts vertex;  /* per vertex: what follows x y z (and the normal): colour, s t */
-    rs_off_texts face;    /* per face: what follows the indices (a colour or colormap index) */
+    uint64_t edge_count; /* as declared (OFF files rarely fill it in) */
+    rs_off_texts vertex; /* per vertex: what follows x y z (and the normal): colour, s t */
+    rs_off_texts face;   /* per face: what follows the indices (a colour or colormap index) */
 };
 
 #endif /* RSMOOTH_OFF_FORMAT_H */

@@ -12,7 +12,7 @@ static const char where[] = "rsmooth_mesh_read (OFF)";
 /* Lines hold whitespace-separated tokens; '#' starts a comment. */
 typedef struct off_reader {
     const char *data, *p, *end;
-    int64_t line;   /* of the line last returned by next_line */
+    int64_t line; /* of the line last returned by next_line */
 } off_reader;
 
 static bool is_space(char c) {
@@ -222,8 +222,8 @@ static rsmooth_status parse_header(off_reader *r, off_header *h, rsmooth_error *
 /* The parse in progress; freed whole on failure. */
 typedef struct off_state {
     double *positions;
-    double *normals;    /* NOFF: 3 per vertex as written */
-    float *raw_colors;  /* 3 per vertex as written; bytes once the file's convention is known */
+    double *normals;   /* NOFF: 3 per vertex as written */
+    float *raw_colors; /* 3 per vertex as written; bytes once the file's convention is known */
     bool color_above_one;
     uint32_t *offsets;
     rs_io_u32vec indices;
@@ -345,8 +345,7 @@ static rsmooth_status parse_vertex(off_reader *r, const off_header *h, off_state
     if (count > base) { /* colour and texture coordinates, kept as written */
         const char *from = tokens[base];
         const char *last_end = tokens[count - 1] + lens[count - 1];
-        if (!texts_append(&st->extras->vertex, v, h->vertex_count, from,
-                          (size_t)(last_end - from)))
+        if (!texts_append(&st->extras->vertex, v, h->vertex_count, from, (size_t)(last_end - from)))
             return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "OFF vertex extras");
     } else if (st->extras->vertex.offsets) {
         texts_append(&st->extras->vertex, v, h->vertex_count, "", 0);
@@ -434,9 +433,9 @@ static rsmooth_status parse_face(off_reader *r, const off_header *h, off_state *
     rsmooth_status status = check_face_color(r, f, p, stop, &from, &last_end, error);
     if (status != RSMOOTH_OK)
         return status;
-    bool ok = from ? texts_append(&st->extras->face, f, h->face_count, from,
-                                  (size_t)(last_end - from))
-                   : texts_append(&st->extras->face, f, h->face_count, "", 0);
+    bool ok =
+        from ? texts_append(&st->extras->face, f, h->face_count, from, (size_t)(last_end - from))
+             : texts_append(&st->extras->face, f, h->face_count, "", 0);
     if (!ok)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "OFF face colours");
     return RSMOOTH_OK;

@@ -33,8 +33,8 @@ static rsmooth_status check_folder(const rs_output *o, const char *where, rsmoot
     folder_of(o->target, dir, sizeof dir);
     struct stat st;
     if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
-        return rs_fail(error, RSMOOTH_ERROR_IO, where, "%s: cannot write there: '%s': %s",
-                       o->path, dir, stat(dir, &st) != 0 ? strerror(errno) : "not a folder");
+        return rs_fail(error, RSMOOTH_ERROR_IO, where, "%s: cannot write there: '%s': %s", o->path,
+                       dir, stat(dir, &st) != 0 ? strerror(errno) : "not a folder");
     if (access(dir, W_OK | X_OK) != 0)
         return rs_fail(error, RSMOOTH_ERROR_IO, where, "%s: cannot write in folder '%s': %s",
                        o->path, dir, strerror(errno));
@@ -67,8 +67,7 @@ static rsmooth_status follow_link(rs_output *o, const char *where, rsmooth_error
         strcpy(o->target, resolved);
     free(resolved);
     if (!fits)
-        return rs_fail(error, RSMOOTH_ERROR_IO, where, "%s: path of its target too long",
-                       o->path);
+        return rs_fail(error, RSMOOTH_ERROR_IO, where, "%s: path of its target too long", o->path);
     return RSMOOTH_OK;
 }
 
@@ -264,8 +263,9 @@ rsmooth_status rs_output_create_partial(rs_output *o, bool make, const char *whe
             errno = EINVAL;
         }
         if (o->fd < 0)
-            return rs_fail(error, RSMOOTH_ERROR_IO, where, "%s: cannot open the partial output %s: %s",
-                           o->path, o->temporary, strerror(errno));
+            return rs_fail(error, RSMOOTH_ERROR_IO, where,
+                           "%s: cannot open the partial output %s: %s", o->path, o->temporary,
+                           strerror(errno));
         return RSMOOTH_OK;
     }
     o->guard = rs_guard_add(o->temporary); /* before it exists: see rs_output_create */
@@ -273,8 +273,9 @@ rsmooth_status rs_output_create_partial(rs_output *o, bool make, const char *whe
     if (o->fd < 0) {
         rs_guard_remove(o->guard);
         o->guard = -1;
-        return rs_fail(error, RSMOOTH_ERROR_IO, where, "%s: cannot create the partial output %s: %s%s",
-                       o->path, o->temporary, strerror(errno),
+        return rs_fail(error, RSMOOTH_ERROR_IO, where,
+                       "%s: cannot create the partial output %s: %s%s", o->path, o->temporary,
+                       strerror(errno),
                        errno == EEXIST ? " (another run is writing this output, or a run that "
                                          "was killed left it: remove it)"
                                        : "");

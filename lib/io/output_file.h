@@ -18,19 +18,19 @@
 #define RS_OUTPUT_PATH_MAX 4096
 
 typedef struct rs_output {
-    const char *path;                 /* as the caller named it, for messages */
-    const char *hint;                 /* how the caller asks for replacing ("use --force") */
-    char target[RS_OUTPUT_PATH_MAX];  /* the file written: `path`, or the final target of a link */
-    bool exists, link;                /* the target exists (`st` then holds its status); `path`
-                                       * is a symbolic link */
+    const char *path;                /* as the caller named it, for messages */
+    const char *hint;                /* how the caller asks for replacing ("use --force") */
+    char target[RS_OUTPUT_PATH_MAX]; /* the file written: `path`, or the final target of a link */
+    bool exists, link;               /* the target exists (`st` then holds its status); `path`
+                                      * is a symbolic link */
     struct stat st;
-    int fd;                           /* the new content; -1 when none */
-    char proc[32];                    /* "/proc/self/fd/N" of an unnamed file (O_TMPFILE), or "" */
+    int fd;        /* the new content; -1 when none */
+    char proc[32]; /* "/proc/self/fd/N" of an unnamed file (O_TMPFILE), or "" */
     char temporary[RS_OUTPUT_PATH_MAX + 48]; /* the named temporary (or partial), or "" */
-    bool own_temporary;               /* this process made it, and removes it when abandoned */
-    int guard;                        /* its slot in the signal guard, or -1 */
-    char notes[400];                  /* what the user should be told: hard links, an owner that
-                                       * could not be kept ("" when nothing) */
+    bool own_temporary; /* this process made it, and removes it when abandoned */
+    int guard;          /* its slot in the signal guard, or -1 */
+    char notes[400];    /* what the user should be told: hard links, an owner that
+                         * could not be kept ("" when nothing) */
 } rs_output;
 
 /* Checks that `path` may be written, and finds what it leads to. `hint` completes the refusals

@@ -1,4 +1,5 @@
-/* PLY extras: the elements, properties and comments a PLY file carries beyond positions and faces. */
+/* PLY extras: the elements, properties and comments a PLY file carries beyond positions and faces.
+ */
 #include "io/ply_format.h"
 
 #include <stdio.h>

@@ -1,4 +1,5 @@
-/* PLY types and the extras record shared by the PLY reader, writer and loss report (not installed). */
+/* PLY types and the extras record shared by the PLY reader, writer and loss report (not installed).
+ */
 #ifndef RSMOOTH_PLY_FORMAT_H
 #define RSMOOTH_PLY_FORMAT_H
 
@@ -51,8 +52,8 @@ static inline bool rs_ply_type_is_float(rs_ply_type t) {
 
 static inline const char *rs_ply_spelling(unsigned spelling) {
     static const char *const names[RS_PLY_SPELLING_COUNT] = {
-        "char",   "int8",   "uchar", "uint8",   "short",  "int16",   "ushort", "uint16",
-        "int",    "int32",  "uint",  "uint32",  "float",  "float32", "double", "float64"};
+        "char", "int8",  "uchar", "uint8",  "short", "int16",   "ushort", "uint16",
+        "int",  "int32", "uint",  "uint32", "float", "float32", "double", "float64"};
     return spelling < RS_PLY_SPELLING_COUNT ? names[spelling] : "?";
 }
 
@@ -122,11 +123,11 @@ typedef enum rs_ply_role {
     RS_PLY_X,          /* vertex positions: mesh->positions, not kept here */
     RS_PLY_Y,
     RS_PLY_Z,
-    RS_PLY_NX,         /* vertex normals (float or double): recomputed by writers, not kept */
+    RS_PLY_NX, /* vertex normals (float or double): recomputed by writers, not kept */
     RS_PLY_NY,
     RS_PLY_NZ,
-    RS_PLY_FACE_LIST,  /* the face element's vertex indices: mesh->face_*, not kept here */
-    RS_PLY_GRID_LIST   /* a range_grid element's vertex indices: triangulated (ply_range_grid.c) */
+    RS_PLY_FACE_LIST, /* the face element's vertex indices: mesh->face_*, not kept here */
+    RS_PLY_GRID_LIST  /* a range_grid element's vertex indices: triangulated (ply_range_grid.c) */
 } rs_ply_role;
 
 typedef struct rs_ply_property {
@@ -136,7 +137,7 @@ typedef struct rs_ply_property {
     uint8_t spelling, count_spelling; /* the header's words for them (rs_ply_spelling) */
     uint8_t role;                     /* rs_ply_role */
     bool color;                       /* a stored vertex colour channel (also in vertex_colors) */
-    size_t row_offset;                /* STORED: where its value (a list: its count) sits in a row */
+    size_t row_offset; /* STORED: where its value (a list: its count) sits in a row */
 } rs_ply_property;
 
 /* One element of the header with its stored values. Values are in host byte order, each in the

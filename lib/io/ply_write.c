@@ -7,11 +7,11 @@
 #include <math.h>
 #include <string.h>
 
-/* Faithful path: a mesh whose PLY extras (ply_format.h) still match it (same vertex and face counts)
- * is written with the input's header (comments, obj_info, elements, properties and their type
- * words, in order) and every kept value as read; positions come from mesh->positions in the x/y/z
- * types, normals are recomputed from them in the nx/ny/nz types, faces come from mesh->face_* in the
- * list's types (widened when a value does not fit). There the extras win: caller-set
+/* Faithful path: a mesh whose PLY extras (ply_format.h) still match it (same vertex and face
+ * counts) is written with the input's header (comments, obj_info, elements, properties and their
+ * type words, in order) and every kept value as read; positions come from mesh->positions in the
+ * x/y/z types, normals are recomputed from them in the nx/ny/nz types, faces come from mesh->face_*
+ * in the list's types (widened when a value does not fit). There the extras win: caller-set
  * vertex_quality and vertex_colors are ignored (set mesh->extras to NULL to write them instead).
  * Otherwise the generic path writes positions, faces, recomputed normals when has_vertex_normals,
  * vertex_quality and vertex_colors. */
@@ -109,8 +109,8 @@ static bool write_header(FILE *stream, const generic_header *h) {
               fprintf(stream,
                       "ply\nformat %s 1.0\ncomment written by rsmooth\nelement vertex %zu\n"
                       "property %s x\nproperty %s y\nproperty %s z\n",
-                      h->binary ? "binary_little_endian" : "ascii", h->vertex_count, scalar,
-                      scalar, scalar) >= 0;
+                      h->binary ? "binary_little_endian" : "ascii", h->vertex_count, scalar, scalar,
+                      scalar) >= 0;
     if (ok && h->normals)
         ok = fprintf(stream, "property %s nx\nproperty %s ny\nproperty %s nz\n", scalar, scalar,
                      scalar) >= 0;
@@ -241,8 +241,15 @@ static rsmooth_status write_generic(const rsmooth_mesh *mesh, FILE *stream, bool
     const bool f32 = use_float(mesh);
     const generic_header h = {
         rs_io_keeps_bom(mesh, binary ? RSMOOTH_FORMAT_PLY_BINARY : RSMOOTH_FORMAT_PLY_ASCII),
-        binary, f32, normals != NULL, mesh->vertex_quality != NULL, mesh->vertex_colors != NULL,
-        wide_count, unsigned_index, mesh->vertex_count, mesh->face_count};
+        binary,
+        f32,
+        normals != NULL,
+        mesh->vertex_quality != NULL,
+        mesh->vertex_colors != NULL,
+        wide_count,
+        unsigned_index,
+        mesh->vertex_count,
+        mesh->face_count};
     errno = 0;
     bool ok = write_header(stream, &h);
     if (ok)
@@ -376,8 +383,7 @@ static rsmooth_status check_component(const rs_ply_property *p, const double *va
         if (!holds_written(p, value))
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                            "vertex %zu: %s = %.17g does not fit the file's '%s' type",
-                           ids ? (size_t)ids[i] : i, p->name, value,
-                           rs_ply_spelling(p->spelling));
+                           ids ? (size_t)ids[i] : i, p->name, value, rs_ply_spelling(p->spelling));
     }
     return RSMOOTH_OK;
 }
@@ -386,9 +392,8 @@ static rsmooth_status check_component(const rs_ply_property *p, const double *va
  * hold the positions (addressed as check_component's) at the scale of `largest`, the mesh's
  * largest coordinate magnitude (rs_io_float32_misfit), vertex by vertex. */
 static rsmooth_status check_float32_scale(const double *xyz, size_t count, const uint32_t *ids,
-                                          unsigned float_axes,
-                                          const rs_ply_property *const axis[3], double largest,
-                                          rsmooth_error *error) {
+                                          unsigned float_axes, const rs_ply_property *const axis[3],
+                                          double largest, rsmooth_error *error) {
     const double tolerance = rs_io_float32_tolerance(largest);
     for (size_t i = 0; float_axes && i < count; i++)
         for (int c = 0; c < 3; c++) {
@@ -425,8 +430,8 @@ static rsmooth_status check_vertex_values(const rsmooth_mesh *mesh, const rs_ply
                 float_axes |= 1u << c;
             status = check_component(p, mesh->positions, c, mesh->vertex_count, NULL, error);
         } else if (p->role >= RS_PLY_NX && p->role <= RS_PLY_NZ && normals) {
-            status = check_component(p, normals, p->role - RS_PLY_NX, mesh->vertex_count, NULL,
-                                     error);
+            status =
+                check_component(p, normals, p->role - RS_PLY_NX, mesh->vertex_count, NULL, error);
         }
         if (status != RSMOOTH_OK)
             return status;
@@ -434,8 +439,8 @@ static rsmooth_status check_vertex_values(const rsmooth_mesh *mesh, const rs_ply
     double largest = 0;
     for (size_t i = 0; float_axes && i < 3 * mesh->vertex_count; i++)
         largest = fmax(largest, fabs(mesh->positions[i]));
-    return check_float32_scale(mesh->positions, mesh->vertex_count, NULL, float_axes, axis,
-                               largest, error);
+    return check_float32_scale(mesh->positions, mesh->vertex_count, NULL, float_axes, axis, largest,
+                               error);
 }
 
 rsmooth_status rs_io_ply_check_positions(const double *xyz, size_t count, const uint32_t *ids,
@@ -454,9 +459,9 @@ rsmooth_status rs_io_ply_check_positions(const double *xyz, size_t count, const 
             float_axes |= 1u << c;
         status = check_component(p, xyz, c, count, ids, error);
     }
-    return status != RSMOOTH_OK ? status
-                                : check_float32_scale(xyz, count, ids, float_axes, axis, largest,
-                                                      error);
+    return status != RSMOOTH_OK
+               ? status
+               : check_float32_scale(xyz, count, ids, float_axes, axis, largest, error);
 }
 
 static bool write_faithful_header(const rs_ply_extras *x, FILE *stream, bool bom, bool binary,
@@ -480,15 +485,15 @@ static bool write_faithful_header(const rs_ply_extras *x, FILE *stream, bool bom
         for (size_t k = 0; ok && k < e->property_count; k++) {
             const rs_ply_property *p = &e->properties[k];
             if (p->count_type == RS_PLY_NONE)
-                ok = fprintf(stream, "property %s %s\n", rs_ply_spelling(p->spelling), p->name) >= 0;
+                ok =
+                    fprintf(stream, "property %s %s\n", rs_ply_spelling(p->spelling), p->name) >= 0;
             else if (p->role == RS_PLY_FACE_LIST)
-                ok = fprintf(stream, "property list %s %s %s\n",
-                             rs_ply_spelling(ft->count_spelling), rs_ply_spelling(ft->spelling),
-                             p->name) >= 0;
+                ok =
+                    fprintf(stream, "property list %s %s %s\n", rs_ply_spelling(ft->count_spelling),
+                            rs_ply_spelling(ft->spelling), p->name) >= 0;
             else
-                ok = fprintf(stream, "property list %s %s %s\n",
-                             rs_ply_spelling(p->count_spelling), rs_ply_spelling(p->spelling),
-                             p->name) >= 0;
+                ok = fprintf(stream, "property list %s %s %s\n", rs_ply_spelling(p->count_spelling),
+                             rs_ply_spelling(p->spelling), p->name) >= 0;
         }
     }
     return ok && fputs("end_header\n", stream) >= 0;
@@ -499,9 +504,16 @@ bool rs_io_ply_write_binary_header(FILE *stream, const rs_ply_extras *x, bool pl
     const rs_ply_element *v = &x->elements[x->vertex_element];
     bool faces = x->face_element < x->element_count;
     if (plain) { /* as write_generic: no normals, quality or colours; counts of uchar */
-        const generic_header h = {bom,   true,  f32,   false,
-                                  false, false, false, v->count > (uint64_t)INT32_MAX,
-                                  (size_t)v->count, faces ? (size_t)x->elements[1].count : 0};
+        const generic_header h = {bom,
+                                  true,
+                                  f32,
+                                  false,
+                                  false,
+                                  false,
+                                  false,
+                                  v->count > (uint64_t)INT32_MAX,
+                                  (size_t)v->count,
+                                  faces ? (size_t)x->elements[1].count : 0};
         return write_header(stream, &h);
     }
     /* the list's own types: the values read from them fit them (choose_face_types keeps them) */
@@ -619,9 +631,8 @@ static const rs_ply_extras *faithful_extras(const rsmooth_mesh *mesh) {
     const rs_ply_extras *x = mesh->extras ? mesh->extras->ply : NULL;
     if (x && x->vertex_element < x->element_count &&
         x->elements[x->vertex_element].count == mesh->vertex_count &&
-        (x->face_element < x->element_count
-             ? x->elements[x->face_element].count == mesh->face_count
-             : mesh->face_count == 0))
+        (x->face_element < x->element_count ? x->elements[x->face_element].count == mesh->face_count
+                                            : mesh->face_count == 0))
         return x;
     return NULL;
 }

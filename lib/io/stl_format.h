@@ -1,5 +1,5 @@
-/* What an STL file keeps beyond its triangles (header, solid names, facet attributes), shared by the
- * STL reader and writer (not installed). */
+/* What an STL file keeps beyond its triangles (header, solid names, facet attributes), shared by
+ * the STL reader and writer (not installed). */
 #ifndef RSMOOTH_STL_FORMAT_H
 #define RSMOOTH_STL_FORMAT_H
 
@@ -22,9 +22,9 @@ struct rs_stl_extras {
     bool binary;           /* what the file was */
     size_t triangle_count; /* the file's facets: details are written back only while unchanged */
     unsigned char header[RS_STL_HEADER_SIZE]; /* binary only */
-    rs_stl_solid *solids;  /* ascii only: solid_count entries, in file order */
+    rs_stl_solid *solids;                     /* ascii only: solid_count entries, in file order */
     size_t solid_count;
-    uint16_t *attributes;  /* triangle_count values; NULL when every one is 0 */
+    uint16_t *attributes; /* triangle_count values; NULL when every one is 0 */
 };
 
 /* A binary header of spaces and NULs only: nothing worth keeping. */

@@ -122,8 +122,8 @@ static rsmooth_status read_binary(const unsigned char *data, size_t size, rsmoot
             float f = get_f32(record + 12 + 4 * k);
             if (!isfinite(f)) {
                 soup_free(&soup);
-                return rs_fail_parse(error, -1, (int64_t)(record - data) + 12 + 12 * (k / 3),
-                                     where, "facet %zu has a non-finite vertex", i);
+                return rs_fail_parse(error, -1, (int64_t)(record - data) + 12 + 12 * (k / 3), where,
+                                     "facet %zu has a non-finite vertex", i);
             }
             xyz[k] = f;
         }
@@ -148,7 +148,8 @@ static rsmooth_status read_binary(const unsigned char *data, size_t size, rsmoot
                                t);
             }
             for (size_t i = 0; i < t; i++) {
-                const unsigned char *a = data + RS_STL_HEADER_SIZE + 4 + RS_STL_RECORD_SIZE * i + 48;
+                const unsigned char *a =
+                    data + RS_STL_HEADER_SIZE + 4 + RS_STL_RECORD_SIZE * i + 48;
                 attributes[i] = (uint16_t)(a[0] | a[1] << 8);
             }
             soup.extras->attributes = attributes;

@@ -198,8 +198,8 @@ static bool write_facets(const rsmooth_mesh *mesh, size_t first, size_t count, b
                 written = fprintf(stream, "      vertex %.9g %.9g %.9g\n", (double)(float)v[c][0],
                                   (double)(float)v[c][1], (double)(float)v[c][2]);
             else
-                written = fprintf(stream, "      vertex %.17g %.17g %.17g\n", v[c][0], v[c][1],
-                                  v[c][2]);
+                written =
+                    fprintf(stream, "      vertex %.17g %.17g %.17g\n", v[c][0], v[c][1], v[c][2]);
             if (written < 0)
                 return false;
         }

@@ -64,7 +64,8 @@ static void catch_signals(void) {
 static void release_signals(void) {
     for (int i = 0; i < 3; i++) {
         struct sigaction now;
-        /* the previous action back only where ours is still there (the program may have moved on) */
+        /* the previous action back only where ours is still there (the program may have moved on)
+         */
         if (caught[i] && sigaction(guarded[i], NULL, &now) == 0 && is_ours(&now))
             sigaction(guarded[i], &previous[i], NULL);
         caught[i] = 0;

@@ -2,8 +2,8 @@
  * number (most of a text mesh's writing time was spent in fprintf). */
 #include "io/text_out.h"
 
-#include "io/io_internal.h"
 #include "core/rsmooth_internal.h"
+#include "io/io_internal.h"
 
 #include <errno.h>
 #include <stdarg.h>

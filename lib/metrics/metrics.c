@@ -11,8 +11,8 @@
  * digit, while squared distances and cross products (edge lengths to the fourth power) neither
  * overflow nor underflow at any scale the library accepts. mean_edge and bbox_diag are divided by
  * it again. */
-#include "metrics/surface_index.h"
 #include "core/rsmooth_internal.h"
+#include "metrics/surface_index.h"
 
 #include <math.h>
 #include <stdbool.h>

@@ -1,7 +1,7 @@
 /* Choosing an OpenCL device and owning (or sharing) its context and queue. */
 #define _POSIX_C_SOURCE 200809L
-#include "rsmooth_cl.h"
 #include "opencl/cl_internal.h"
+#include "rsmooth_cl.h"
 
 #include <ctype.h>
 #include <stdio.h>
@@ -62,7 +62,7 @@ static size_t info_string(cl_platform_id platform, cl_device_id device, cl_uint 
 static cl_ulong device_ulong(cl_device_id device, cl_device_info param, cl_ulong fallback) {
     cl_ulong value = 0;
     return clGetDeviceInfo(device, param, sizeof value, &value, NULL) == CL_SUCCESS ? value
-                                                                                   : fallback;
+                                                                                    : fallback;
 }
 
 /* Every device of every platform, in clGetPlatformIDs / clGetDeviceIDs order. */
@@ -249,11 +249,13 @@ static rsmooth_status read_memory_limits(rsmooth_context *ctx, rsmooth_error *er
     if (budget && *budget && !rs_parse_bytes(budget, &ctx->memory_budget))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_context_create",
                        "RSMOOTH_MEMORY_BUDGET='%s' is not a byte count (examples: 268435456, "
-                       "256M, 1.5G; unset it for the device's own limit)", budget);
+                       "256M, 1.5G; unset it for the device's own limit)",
+                       budget);
     if (budget && *budget && ctx->memory_budget == 0) /* as the command's --memory-budget 0 */
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_context_create",
                        "RSMOOTH_MEMORY_BUDGET='%s' leaves no memory: unset it for the device's "
-                       "own limit", budget);
+                       "own limit",
+                       budget);
     return RSMOOTH_OK;
 }
 
@@ -296,7 +298,7 @@ unsigned rsmooth_context_host_threads(const rsmooth_context *ctx) {
     if (!ctx)
         return 0;
     rsmooth_context *shared = (rsmooth_context *)ctx; /* the lock is the one mutable part */
-    bool mine = rs_context_held_here(ctx); /* from a callback of a call on ctx */
+    bool mine = rs_context_held_here(ctx);            /* from a callback of a call on ctx */
     if (!mine)
         rs_context_lock(shared);
     unsigned threads = ctx->host_threads;
@@ -309,7 +311,7 @@ uint64_t rsmooth_context_memory_budget(const rsmooth_context *ctx) {
     if (!ctx)
         return 0;
     rsmooth_context *shared = (rsmooth_context *)ctx; /* the lock is the one mutable part */
-    bool mine = rs_context_held_here(ctx); /* from a callback of a call on ctx */
+    bool mine = rs_context_held_here(ctx);            /* from a callback of a call on ctx */
     if (!mine)
         rs_context_lock(shared);
     uint64_t bytes = rs_cl_usable_memory(ctx);

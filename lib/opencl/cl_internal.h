@@ -5,35 +5,41 @@
 
 #include "core/rsmooth_internal.h"
 
-/* ---- cl_device.c / cl_program.c: the OpenCL context object ------------------------------------ */
+/* ---- cl_device.c / cl_program.c: the OpenCL context object ------------------------------------
+ */
 
 #ifndef CL_TARGET_OPENCL_VERSION
 #define CL_TARGET_OPENCL_VERSION 120
 #endif
-#include <CL/cl.h>
 #include "opencl/cl_loader.h" /* the cl* calls below go to the loader opened at run time */
+#include <CL/cl.h>
 #include <pthread.h>
 #include <stdatomic.h>
 
-
 /* The normal-update stage's kernels (stage.cl, cl_stage.c), in this order in each precision. */
-enum { RS_STAGE_FACETS, RS_STAGE_PATCH, RS_STAGE_GUIDANCE, RS_STAGE_FILTER, RS_STAGE_VERTEX,
-       RS_STAGE_KERNELS };
+enum {
+    RS_STAGE_FACETS,
+    RS_STAGE_PATCH,
+    RS_STAGE_GUIDANCE,
+    RS_STAGE_FILTER,
+    RS_STAGE_VERTEX,
+    RS_STAGE_KERNELS
+};
 
 enum {
     RS_KERNEL_MOLLIFY,
     RS_KERNEL_NORMALS,
     RS_KERNEL_BILATERAL,
     RS_KERNEL_ROBUST,
-    RS_KERNEL_STAGE_FLOAT,  /* RS_STAGE_KERNELS of them, float */
+    RS_KERNEL_STAGE_FLOAT, /* RS_STAGE_KERNELS of them, float */
     RS_KERNEL_STAGE_DOUBLE = RS_KERNEL_STAGE_FLOAT + RS_STAGE_KERNELS, /* double: NULL where the
-                                                                       * device has no fp64 */
+                                                                        * device has no fp64 */
     RS_KERNEL_COUNT = RS_KERNEL_STAGE_DOUBLE + RS_STAGE_KERNELS
 };
 
 struct rsmooth_context {
-    pthread_mutex_t lock;     /* serialises the calls of threads sharing the context */
-    pthread_t owner;          /* the thread holding `lock`, while `busy` */
+    pthread_mutex_t lock; /* serialises the calls of threads sharing the context */
+    pthread_t owner;      /* the thread holding `lock`, while `busy` */
     _Atomic int busy;
     cl_context context;
     cl_device_id device;
@@ -42,16 +48,16 @@ struct rsmooth_context {
     cl_kernel kernels[RS_KERNEL_COUNT];
     char device_name[256];
     double build_ms;
-    int program_cache;        /* RS_PROGRAM_CACHE_: whether the program came from rsmooth's cache */
-    size_t local_size;        /* work-group size used for every kernel */
-    unsigned lanes;           /* vertices per block: the kernels' vector width (RS_LANES, see
-                               * cl_variant.c); 1 is the GPU variant, one vertex per work-item */
-    uint64_t global_memory;   /* CL_DEVICE_GLOBAL_MEM_SIZE */
-    uint64_t max_allocation;  /* CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest one buffer may be */
-    bool host_unified;        /* CL_DEVICE_HOST_UNIFIED_MEMORY: the device reads host arrays in
-                               * place (rs_cl_input_flags) */
-    uint64_t memory_budget;   /* caller's or RSMOOTH_MEMORY_BUDGET's limit; 0: the device's */
-    unsigned host_threads;    /* threads of the host stages of its calls; 0: every core */
+    int program_cache;       /* RS_PROGRAM_CACHE_: whether the program came from rsmooth's cache */
+    size_t local_size;       /* work-group size used for every kernel */
+    unsigned lanes;          /* vertices per block: the kernels' vector width (RS_LANES, see
+                              * cl_variant.c); 1 is the GPU variant, one vertex per work-item */
+    uint64_t global_memory;  /* CL_DEVICE_GLOBAL_MEM_SIZE */
+    uint64_t max_allocation; /* CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest one buffer may be */
+    bool host_unified;       /* CL_DEVICE_HOST_UNIFIED_MEMORY: the device reads host arrays in
+                              * place (rs_cl_input_flags) */
+    uint64_t memory_budget;  /* caller's or RSMOOTH_MEMORY_BUDGET's limit; 0: the device's */
+    unsigned host_threads;   /* threads of the host stages of its calls; 0: every core */
     /* rsmooth_smooth_cl's (cl_store.c): the program storing results into a caller's buffer,
      * built on its first call (NULL before, and where the device has no fp64), its kernels by
      * rsmooth_scalar, and the call's sink while it runs (NULL otherwise) */
@@ -92,10 +98,11 @@ bool rs_parse_bytes(const char *text, uint64_t *bytes);
 /* rsmooth_smooth_cl's destination on the device: a run that solves every vertex in one piece
  * (no tiles) writes the positions into `output` with a kernel instead of the host's array. */
 typedef struct rs_device_sink {
-    cl_mem input, output; /* the caller's: 3 scalars per vertex, packed; input as the host read it */
-    cl_kernel kernel;     /* the context's store kernel for the call's scalar */
-    bool written;         /* set by the run that wrote every position into output */
-    bool bad;             /* ... and found one not finite in the output's type */
+    cl_mem input,
+        output;       /* the caller's: 3 scalars per vertex, packed; input as the host read it */
+    cl_kernel kernel; /* the context's store kernel for the call's scalar */
+    bool written;     /* set by the run that wrote every position into output */
+    bool bad;         /* ... and found one not finite in the output's type */
 } rs_device_sink;
 
 /* Where a run's results go: vertex v < core_count of the problem it solved is written to entry
@@ -124,18 +131,17 @@ rsmooth_status rs_cl_store_device(rsmooth_context *ctx, rs_device_sink *sink, cl
                                   double scale, double h, rsmooth_error *error);
 
 /* rsmooth_smooth's work once ctx's lock is held (api/smooth.c). */
-rsmooth_status rs_smooth_entered(rsmooth_context *ctx, rsmooth_scalar scalar,
-                                 const void *positions, size_t vertex_count,
-                                 const uint32_t *indices, size_t triangle_count,
-                                 const rsmooth_params *params, void *out_positions,
-                                 float *out_weight, float *out_confidence,
+rsmooth_status rs_smooth_entered(rsmooth_context *ctx, rsmooth_scalar scalar, const void *positions,
+                                 size_t vertex_count, const uint32_t *indices,
+                                 size_t triangle_count, const rsmooth_params *params,
+                                 void *out_positions, float *out_weight, float *out_confidence,
                                  rsmooth_report *report, rsmooth_error *error);
 
 /* Stage times and work, summed over the runs (tiles) of one call. */
 typedef struct rs_run_stats {
     double ms_grid, ms_upload, ms_mollify, ms_normals, ms_robust, ms_download;
     uint64_t pairs_mollify, pairs_robust; /* vertex-facet pairs each pass evaluated */
-    size_t cells;      /* occupied grid cells */
+    size_t cells;                         /* occupied grid cells */
     size_t tiles;
 } rs_run_stats;
 
@@ -149,9 +155,10 @@ typedef struct rs_run_stats {
  * a reach of r mean edge lengths (measured on the benchmark meshes: 11 to 14 at r = 2, 76 to 96
  * at r = 6), and a spare row. Past 128 rows the estimate stops growing (a run whose lists do not
  * fit searches in every round instead). Uses fmin and pow (math.h). */
-#define RS_DEVICE_BYTES_PER_BILATERAL_LIST_FACET(pb)                                              \
-    ((uint64_t)(20 + 36 * (1 + fmin(128.0, pow(1.5 * (pb)->normal_radius /                        \
-                                                    (pb)->mean_edge_length + 1.5, 2)))))
+#define RS_DEVICE_BYTES_PER_BILATERAL_LIST_FACET(pb)                                               \
+    ((uint64_t)(20 + 36 * (1 + fmin(128.0,                                                         \
+                                    pow(1.5 * (pb)->normal_radius / (pb)->mean_edge_length + 1.5,  \
+                                        2)))))
 #define RS_DEVICE_BYTES_PER_VERTEX 72
 /* What the colour factor adds: a float4 mean colour per facet, three floats per vertex slot
  * (about 1.5 slots per vertex). */
@@ -163,8 +170,9 @@ typedef struct rs_run_stats {
  * given (problem->centroid, normal, area), and the normal filter the bilateral one or none. When
  * its buffers would exceed rs_cl_usable_memory or the device's largest allocation, returns
  * RSMOOTH_ERROR_OUT_OF_MEMORY with `*needed` set to the bytes it wanted, having run nothing. */
-rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *problem, const rs_result_sink *sink,
-                         rs_run_stats *stats, uint64_t *needed, rsmooth_error *error);
+rsmooth_status rs_cl_run(rsmooth_context *ctx, const rs_problem *problem,
+                         const rs_result_sink *sink, rs_run_stats *stats, uint64_t *needed,
+                         rsmooth_error *error);
 /* rs_cl_run that also writes the predictors' unit normals, 3 doubles per facet in the problem's
  * facet order, to out_normals when the run filtered them (mollify on; untouched otherwise). */
 rsmooth_status rs_cl_run_normals(rsmooth_context *ctx, const rs_problem *problem,
@@ -195,9 +203,15 @@ rsmooth_status rs_cl_stage_run(void *ctx, const rs_stage_plan *plan, double *xyz
 /* Builds the program from the embedded kernels (or RSMOOTH_KERNEL_DIR) and creates the kernels. */
 rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error);
 
-/* ---- cl_program_cache.c: rsmooth's cache of program binaries ---------------------------------- */
+/* ---- cl_program_cache.c: rsmooth's cache of program binaries ----------------------------------
+ */
 
-enum { RS_PROGRAM_CACHE_OFF, RS_PROGRAM_CACHE_MISS, RS_PROGRAM_CACHE_HIT, RS_PROGRAM_CACHE_REFUSED };
+enum {
+    RS_PROGRAM_CACHE_OFF,
+    RS_PROGRAM_CACHE_MISS,
+    RS_PROGRAM_CACHE_HIT,
+    RS_PROGRAM_CACHE_REFUSED
+};
 
 /* One program's entry: where its folder is (`top`, then the folders `below` it that must be the
  * user's own), the file's name, and the key the file must hold. */

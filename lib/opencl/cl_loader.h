@@ -45,10 +45,10 @@
       (cl_command_queue, cl_kernel, cl_uint, const size_t *, const size_t *, const size_t *,       \
        cl_uint, const cl_event *, cl_event *))                                                     \
     X(cl_int, EnqueueCopyBuffer,                                                                   \
-      (cl_command_queue, cl_mem, cl_mem, size_t, size_t, size_t, cl_uint, const cl_event *,       \
+      (cl_command_queue, cl_mem, cl_mem, size_t, size_t, size_t, cl_uint, const cl_event *,        \
        cl_event *))                                                                                \
     X(cl_int, EnqueueReadBuffer,                                                                   \
-      (cl_command_queue, cl_mem, cl_bool, size_t, size_t, void *, cl_uint, const cl_event *,      \
+      (cl_command_queue, cl_mem, cl_bool, size_t, size_t, void *, cl_uint, const cl_event *,       \
        cl_event *))                                                                                \
     X(cl_int, EnqueueUnmapMemObject,                                                               \
       (cl_command_queue, cl_mem, void *, cl_uint, const cl_event *, cl_event *))                   \

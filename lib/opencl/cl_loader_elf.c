@@ -51,7 +51,7 @@ typedef struct library_file {
     uint64_t size;
     elf_segment segments[MAX_SEGMENTS];
     unsigned segment_count;
-    bool text_relocations; /* DT_TEXTREL: relocations may aim at read-only segments */
+    bool text_relocations;         /* DT_TEXTREL: relocations may aim at read-only segments */
     uint64_t symbols, string_size; /* DT_SYMTAB's address, DT_STRSZ */
     /* the constructor and destructor slots (DT_INIT_ARRAY, DT_FINI_ARRAY) of a library loaded
      * anywhere hold offsets until a relocation makes them addresses: which ones one does */
@@ -78,7 +78,8 @@ static bool writable(const library_file *f, uint64_t address, uint64_t bytes) {
     for (unsigned i = 0; i < f->segment_count; i++) {
         const elf_segment *s = &f->segments[i];
         if (s->p_type == PT_LOAD && (f->text_relocations || (s->p_flags & PF_W)) &&
-            address >= s->p_vaddr && bytes <= s->p_memsz && address - s->p_vaddr <= s->p_memsz - bytes)
+            address >= s->p_vaddr && bytes <= s->p_memsz &&
+            address - s->p_vaddr <= s->p_memsz - bytes)
             return true;
     }
     return false;
@@ -113,9 +114,10 @@ static bool plain_code_section(const library_file *f, const elf_section *names,
     static const char *const known[] = {".text", ".init", ".fini", ".plt", ".plt.got", ".plt.sec"};
     char name[16] = {0};
     if (sec->sh_name >= names->sh_size ||
-        !rs_pread_all(f->fd, name, names->sh_size - sec->sh_name < sizeof name - 1
-                                       ? (size_t)(names->sh_size - sec->sh_name)
-                                       : sizeof name - 1,
+        !rs_pread_all(f->fd, name,
+                      names->sh_size - sec->sh_name < sizeof name - 1
+                          ? (size_t)(names->sh_size - sec->sh_name)
+                          : sizeof name - 1,
                       names->sh_offset + sec->sh_name))
         return false;
     for (size_t k = 0; k < sizeof known / sizeof *known; k++)
@@ -252,8 +254,8 @@ static const char *check_hash(const library_file *f, const dynamic_tags *t) {
         /* nbuckets, symoffset, bloom_size, bloom_shift; then the filter and the buckets */
         if (at < 0 || !rs_pread_all(f->fd, words, 16, (uint64_t)at) || words[0] == 0 ||
             words[2] == 0 || (words[2] & (words[2] - 1)) != 0 || words[3] >= 8 * sizeof(void *) ||
-            file_offset(f, t->gnu_hash, 16 + (uint64_t)words[2] * sizeof(void *) +
-                                            4 * (uint64_t)words[0]) < 0)
+            file_offset(f, t->gnu_hash,
+                        16 + (uint64_t)words[2] * sizeof(void *) + 4 * (uint64_t)words[0]) < 0)
             return bad;
     }
     return NULL;
@@ -340,7 +342,8 @@ static const char *check_dynamic(library_file *f) {
     if (!dynamic)
         return "not a dynamic library (no dynamic section)";
     uint64_t count = dynamic->p_filesz / sizeof(elf_dynamic);
-    if (count == 0 || count > MAX_DYNAMIC || file_offset(f, dynamic->p_vaddr, dynamic->p_filesz) < 0)
+    if (count == 0 || count > MAX_DYNAMIC ||
+        file_offset(f, dynamic->p_vaddr, dynamic->p_filesz) < 0)
         return "damaged (its dynamic section lies outside the file)";
     elf_dynamic entries[MAX_DYNAMIC];
     if (!rs_pread_all(f->fd, entries, count * sizeof *entries, dynamic->p_offset))
@@ -364,8 +367,8 @@ static const char *check_dynamic(library_file *f) {
         seen[DT_REL] != seen[DT_RELSZ] ||
         (seen[DT_REL] && (!seen[DT_RELENT] || value[DT_RELENT] != sizeof(elf_rel))) ||
         seen[DT_JMPREL] != seen[DT_PLTRELSZ] ||
-        (seen[DT_JMPREL] && (!seen[DT_PLTREL] ||
-                             (value[DT_PLTREL] != DT_RELA && value[DT_PLTREL] != DT_REL))) ||
+        (seen[DT_JMPREL] &&
+         (!seen[DT_PLTREL] || (value[DT_PLTREL] != DT_RELA && value[DT_PLTREL] != DT_REL))) ||
         (seen[DT_SYMENT] && value[DT_SYMENT] != sizeof(elf_symbol)))
         return "damaged (its dynamic section describes its relocations or symbols in part)";
     if (seen[DT_PLTGOT] && !writable(f, value[DT_PLTGOT], 3 * sizeof(void *)))
@@ -378,17 +381,17 @@ static const char *check_dynamic(library_file *f) {
         return "damaged (it has symbol versions without their table)";
     const char *versions = NULL;
     if (t.has_verdef)
-        versions = check_versions(f, t.verdef, t.verdefnum, value[DT_STRSZ], sizeof(Elf64_Verdef),
-                                  offsetof(Elf64_Verdef, vd_cnt), offsetof(Elf64_Verdef, vd_aux),
-                                  offsetof(Elf64_Verdef, vd_next), sizeof(Elf64_Verdaux),
-                                  offsetof(Elf64_Verdaux, vda_name),
-                                  offsetof(Elf64_Verdaux, vda_next));
+        versions =
+            check_versions(f, t.verdef, t.verdefnum, value[DT_STRSZ], sizeof(Elf64_Verdef),
+                           offsetof(Elf64_Verdef, vd_cnt), offsetof(Elf64_Verdef, vd_aux),
+                           offsetof(Elf64_Verdef, vd_next), sizeof(Elf64_Verdaux),
+                           offsetof(Elf64_Verdaux, vda_name), offsetof(Elf64_Verdaux, vda_next));
     if (!versions && t.has_verneed)
-        versions = check_versions(f, t.verneed, t.verneednum, value[DT_STRSZ],
-                                  sizeof(Elf64_Verneed), offsetof(Elf64_Verneed, vn_cnt),
-                                  offsetof(Elf64_Verneed, vn_aux), offsetof(Elf64_Verneed, vn_next),
-                                  sizeof(Elf64_Vernaux), offsetof(Elf64_Vernaux, vna_name),
-                                  offsetof(Elf64_Vernaux, vna_next));
+        versions =
+            check_versions(f, t.verneed, t.verneednum, value[DT_STRSZ], sizeof(Elf64_Verneed),
+                           offsetof(Elf64_Verneed, vn_cnt), offsetof(Elf64_Verneed, vn_aux),
+                           offsetof(Elf64_Verneed, vn_next), sizeof(Elf64_Vernaux),
+                           offsetof(Elf64_Vernaux, vna_name), offsetof(Elf64_Vernaux, vna_next));
     if (versions)
         return versions;
     f->text_relocations = seen[DT_TEXTREL];

@@ -1,8 +1,9 @@
-/* Assembling and building the OpenCL program: a generated prelude, then common.cl, then one file per
- * phase. Kernels are embedded at build time; RSMOOTH_KERNEL_DIR loads them from a directory instead. */
+/* Assembling and building the OpenCL program: a generated prelude, then common.cl, then one file
+ * per phase. Kernels are embedded at build time; RSMOOTH_KERNEL_DIR loads them from a directory
+ * instead. */
 #define _POSIX_C_SOURCE 200809L
-#include "opencl/cl_internal.h"
 #include "opencl/cl_grid.h"
+#include "opencl/cl_internal.h"
 
 #include <stdint.h>
 #include <stdio.h>
@@ -23,9 +24,8 @@ extern const size_t rs_kernel_grid_size;
 #define SOURCES (KERNEL_FILES + 6)
 
 /* stage.cl's types and kernel names, per copy (kernels/stage.cl) */
-static const char stage_float[] =
-    "#define REAL float\n#define REAL4 float4\n"
-    "#define STAGE_NAME(name) name##_f\n";
+static const char stage_float[] = "#define REAL float\n#define REAL4 float4\n"
+                                  "#define STAGE_NAME(name) name##_f\n";
 static const char stage_double[] =
     "#undef REAL\n#undef REAL4\n#undef STAGE_NAME\n#ifdef cl_khr_fp64\n"
     "#pragma OPENCL EXTENSION cl_khr_fp64 : enable\n"
@@ -38,11 +38,12 @@ static const char stage_end[] = "\n#endif\n";
 #define STRINGIFY(x) #x
 #define EXPANDED_STRING(x) STRINGIFY(x)
 #define FLOAT_DEFINE(name, value) "#define " #name " " STRINGIFY(value) "f\n"
-static const char prelude[] = FLOAT_DEFINE(RS_DEGENERATE_SINE, RS_DEGENERATE_SINE)
-    FLOAT_DEFINE(RS_DEGENERATE_AREA_RATIO, RS_DEGENERATE_AREA_RATIO)
-    "#define RS_RESCUE_WEIGHT 1e-20f\n"
-    "#define RS_INFLUENCE_GAUSSIAN 0\n" "#define RS_INFLUENCE_TUKEY 1\n"
-    "#define RS_INFLUENCE_LORENTZIAN 2\n" "#define RS_INFLUENCE_HUBER 3\n";
+static const char prelude[] = FLOAT_DEFINE(RS_DEGENERATE_SINE, RS_DEGENERATE_SINE) FLOAT_DEFINE(
+    RS_DEGENERATE_AREA_RATIO, RS_DEGENERATE_AREA_RATIO) "#define RS_RESCUE_WEIGHT 1e-20f\n"
+                                                        "#define RS_INFLUENCE_GAUSSIAN 0\n"
+                                                        "#define RS_INFLUENCE_TUKEY 1\n"
+                                                        "#define RS_INFLUENCE_LORENTZIAN 2\n"
+                                                        "#define RS_INFLUENCE_HUBER 3\n";
 /* enum constants do not stringify: the values above are written out, and checked here */
 _Static_assert(RSMOOTH_INFLUENCE_GAUSSIAN == 0 && RSMOOTH_INFLUENCE_TUKEY == 1 &&
                    RSMOOTH_INFLUENCE_LORENTZIAN == 2 && RSMOOTH_INFLUENCE_HUBER == 3,
@@ -105,19 +106,24 @@ static rsmooth_status create_kernels(rsmooth_context *ctx, rsmooth_error *error)
 }
 
 static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *error) {
-    static const char *const names[KERNEL_FILES] = {"common.cl", "mollify.cl", "bilateral.cl",
-                                                    "estimate.cl", "grid.cl", "stage.cl"};
+    static const char *const names[KERNEL_FILES] = {"common.cl",   "mollify.cl", "bilateral.cl",
+                                                    "estimate.cl", "grid.cl",    "stage.cl"};
     /* the variant this device runs (cl_variant.c): its vector width and work-group size */
     char shape[96];
     snprintf(shape, sizeof shape, "#define RS_LANES %u\n#define RS_GROUP %zu\n", ctx->lanes,
              ctx->local_size);
-    const char *sources[SOURCES] = {
-        prelude, shape, (const char *)rs_kernel_common, (const char *)rs_kernel_mollify,
-        (const char *)rs_kernel_bilateral, (const char *)rs_kernel_estimate,
-        (const char *)rs_kernel_grid, (const char *)rs_kernel_stage};
-    size_t sizes[SOURCES] = {sizeof prelude - 1, strlen(shape), rs_kernel_common_size,
-                             rs_kernel_mollify_size, rs_kernel_bilateral_size,
-                             rs_kernel_estimate_size, rs_kernel_grid_size, rs_kernel_stage_size};
+    const char *sources[SOURCES] = {prelude,
+                                    shape,
+                                    (const char *)rs_kernel_common,
+                                    (const char *)rs_kernel_mollify,
+                                    (const char *)rs_kernel_bilateral,
+                                    (const char *)rs_kernel_estimate,
+                                    (const char *)rs_kernel_grid,
+                                    (const char *)rs_kernel_stage};
+    size_t sizes[SOURCES] = {sizeof prelude - 1,       strlen(shape),
+                             rs_kernel_common_size,    rs_kernel_mollify_size,
+                             rs_kernel_bilateral_size, rs_kernel_estimate_size,
+                             rs_kernel_grid_size,      rs_kernel_stage_size};
     char *loaded[KERNEL_FILES] = {NULL};
     /* grid.cl only where the grid is sorted on the device (rs_cl_device_grid): a CPU device's
      * program stays without its kernels, whose loading would lengthen every setup */
@@ -130,8 +136,8 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
                 continue;
             loaded[i] = read_text_file(dir, names[i], &sizes[i + 2]);
             if (!loaded[i]) {
-                st = rs_fail(error, RSMOOTH_ERROR_IO, "RSMOOTH_KERNEL_DIR",
-                             "cannot read %s/%s", dir, names[i]);
+                st = rs_fail(error, RSMOOTH_ERROR_IO, "RSMOOTH_KERNEL_DIR", "cannot read %s/%s",
+                             dir, names[i]);
                 goto done;
             }
             sources[i + 2] = loaded[i];
@@ -164,8 +170,7 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
     /* rsmooth's binary cache (cl_program_cache.c), keyed by exactly the sources and options the
      * build from source below takes */
     rs_program_cache cache;
-    ctx->program_cache = rs_program_cache_open(&cache, ctx, count, sources, sizes,
-                                               options)
+    ctx->program_cache = rs_program_cache_open(&cache, ctx, count, sources, sizes, options)
                              ? RS_PROGRAM_CACHE_MISS
                              : RS_PROGRAM_CACHE_OFF;
     if ((ctx->program = rs_program_cache_load(&cache, ctx, options))) {

@@ -22,8 +22,8 @@
  * Writers write a temporary file beside the final one and rename it over it, so readers see a
  * whole file or none, and concurrent writers of one key leave one of their (equal) files. */
 #define _POSIX_C_SOURCE 200809L
-#include "opencl/cl_internal.h"
 #include "core/blake2b.h"
+#include "opencl/cl_internal.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -98,7 +98,8 @@ static void hash_bytes(hash2 *h, const void *data, size_t n) {
     h->bytes += n;
 }
 
-/* One field of the key, its length first, so that no two sequences of fields hash the same bytes. */
+/* One field of the key, its length first, so that no two sequences of fields hash the same bytes.
+ */
 static void hash_field(hash2 *h, const void *data, size_t n) {
     unsigned char length[8];
     put_u64(length, n);
@@ -226,7 +227,8 @@ static int open_cache_dir(const rs_program_cache *cache, bool create, int *dir_f
         snprintf(path + used, sizeof path - used, "/%s", name);
         const int flags = O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC;
         int sub = openat(fd, name, flags);
-        if (sub < 0 && errno == ENOENT && create && (mkdirat(fd, name, 0700) == 0 || errno == EEXIST))
+        if (sub < 0 && errno == ENOENT && create &&
+            (mkdirat(fd, name, 0700) == 0 || errno == EEXIST))
             sub = openat(fd, name, flags);
         int open_errno = errno;
         close(fd);
@@ -282,9 +284,14 @@ bool rs_program_cache_open(rs_program_cache *cache, const rsmooth_context *ctx, 
 /* The header's first 64 bytes for this key and binary size. */
 static void header_words(const rs_program_cache *cache, uint64_t binary_size,
                          unsigned char *header) {
-    const uint64_t words[HEADER_WORDS] = {0,           FORMAT_VERSION,   cache->key[0],
-                                          cache->key[1], cache->key_bytes, cache->key_fields,
-                                          binary_size, 0};
+    const uint64_t words[HEADER_WORDS] = {0,
+                                          FORMAT_VERSION,
+                                          cache->key[0],
+                                          cache->key[1],
+                                          cache->key_bytes,
+                                          cache->key_fields,
+                                          binary_size,
+                                          0};
     memcpy(header, magic, 8);
     for (int i = 1; i < HEADER_WORDS; i++)
         put_u64(header + 8 * i, words[i]);
@@ -357,8 +364,8 @@ cl_program rs_program_cache_load(rs_program_cache *cache, const rsmooth_context 
         return NULL;
     const unsigned char *binaries[1] = {binary};
     cl_int status = CL_SUCCESS, err = CL_SUCCESS;
-    cl_program program = clCreateProgramWithBinary(ctx->context, 1, &ctx->device, &size, binaries,
-                                                   &status, &err);
+    cl_program program =
+        clCreateProgramWithBinary(ctx->context, 1, &ctx->device, &size, binaries, &status, &err);
     rs_free(binary);
     if (err != CL_SUCCESS || status != CL_SUCCESS || !program ||
         clBuildProgram(program, 1, &ctx->device, options, NULL, NULL) != CL_SUCCESS) {
@@ -372,8 +379,7 @@ cl_program rs_program_cache_load(rs_program_cache *cache, const rsmooth_context 
 /* ---- writing ------------------------------------------------------------------------------- */
 
 /* The binary of `program` for ctx's device (to rs_free), or NULL. */
-static unsigned char *program_binary(const rsmooth_context *ctx, cl_program program,
-                                     size_t *size) {
+static unsigned char *program_binary(const rsmooth_context *ctx, cl_program program, size_t *size) {
     cl_uint device_count = 0;
     if (clGetProgramInfo(program, CL_PROGRAM_NUM_DEVICES, sizeof device_count, &device_count,
                          NULL) != CL_SUCCESS ||
@@ -415,8 +421,8 @@ static int create_temporary(int dir_fd, const char *name, char *temporary, size_
     for (int attempt = 0; attempt < 100; attempt++) {
         state = state * 6364136223846793005u + 1442695040888963407u;
         snprintf(temporary, size, "%s.%08llx", name, (unsigned long long)(state >> 32));
-        int fd = openat(dir_fd, temporary, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC,
-                        0600);
+        int fd =
+            openat(dir_fd, temporary, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600);
         if (fd >= 0 || errno != EEXIST)
             return fd;
     }

@@ -3,8 +3,8 @@
 #ifndef RSMOOTH_CL_RUN_H
 #define RSMOOTH_CL_RUN_H
 
-#include "opencl/cl_internal.h"
 #include "core/spatial.h"
+#include "opencl/cl_internal.h"
 
 #define LOG2_E 1.4426950408889634
 

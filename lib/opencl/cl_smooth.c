@@ -3,13 +3,13 @@
  * mapped and scattered back to the caller's vertex order. Coordinates travel as float32 in units
  * of the cell size, relative to a nearby cell's corner (see kernels/common.cl), so precision does
  * not depend on where the mesh sits; displacements return to double before they are added. */
-#include "opencl/cl_run.h"
 #include "opencl/cl_grid.h"
+#include "opencl/cl_run.h"
 
 #include <float.h>
 #include <math.h>
-#include <stdlib.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* Exponents reach the kernels in base 2: natural ones times log2(e). */
@@ -22,19 +22,19 @@
 
 typedef struct packed {
     cl_float4 *facet_centroid, *facet_normal; /* in grid order */
-    cl_uint *facet_vertices;  /* in the caller's facet order: slots of the three vertices */
-    cl_uint *facet_place;     /* caller's facet -> its place in grid order */
-    size_t lanes;             /* vertices per block (the context's) */
+    cl_uint *facet_vertices; /* in the caller's facet order: slots of the three vertices */
+    cl_uint *facet_place;    /* caller's facet -> its place in grid order */
+    size_t lanes;            /* vertices per block (the context's) */
     size_t block_count;
-    cl_int4 *block_cell;      /* per block: its anchor, the lowest cell it spans */
-    cl_float *block_pos;      /* per block: `lanes` x, then y, then z, each local to its
-                               * vertex's own cell (so no float depends on the block it is in) */
-    cl_uchar *block_offset;   /* per block, as block_pos: each vertex's cell minus the anchor,
-                               * 0 or 1 per axis */
-    uint32_t *slot;           /* caller's vertex index -> block * lanes + lane */
+    cl_int4 *block_cell;    /* per block: its anchor, the lowest cell it spans */
+    cl_float *block_pos;    /* per block: `lanes` x, then y, then z, each local to its
+                             * vertex's own cell (so no float depends on the block it is in) */
+    cl_uchar *block_offset; /* per block, as block_pos: each vertex's cell minus the anchor,
+                             * 0 or 1 per axis */
+    uint32_t *slot;         /* caller's vertex index -> block * lanes + lane */
     /* the colour factor's, NULL when it is off */
-    cl_float4 *facet_color;   /* in grid order: the mean colour of the facet's corners, 0 */
-    cl_float *block_color;    /* per block, as block_pos: `lanes` first components, ... */
+    cl_float4 *facet_color; /* in grid order: the mean colour of the facet's corners, 0 */
+    cl_float *block_color;  /* per block, as block_pos: `lanes` first components, ... */
 } packed;
 
 static void packed_free(packed *pk) {
@@ -309,7 +309,6 @@ static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, double **c
     return RSMOOTH_OK;
 }
 
-
 /* Grid cells per reach: small cells hug the ball of reach around a block (less work wasted on
  * facets out of reach), large ones hold more vertices per block; measured on PoCL's CPU device
  * (rsmooth-bench filter), cells about two mean edges wide did best. RSMOOTH_CELLS_PER_REACH
@@ -449,7 +448,7 @@ typedef struct cl_run {
     rs_grid grid;
     packed pk;
     cl_mem buf[BUF_COUNT];
-    cl_mem normals;           /* the predictors' normals, once filtered */
+    cl_mem normals; /* the predictors' normals, once filtered */
     uint64_t bilateral_pairs;
     cl_float *result, *extra; /* mapped results, per block, as block_result and block_extra */
     cl_uint *pairs;           /* and block_pairs */
@@ -500,8 +499,8 @@ static rsmooth_status create_buffers(cl_run *r, uint64_t *needed) {
         [BUF_CELL_START] = {(nc + 1) * sizeof(cl_uint), grid->cell_start, CL_MEM_READ_ONLY},
         [BUF_COLUMN_FIRST] = {(grid->column_count + 1) * sizeof(cl_uint), grid->column_first,
                               CL_MEM_READ_ONLY},
-        [BUF_COLUMN_TABLE] = {((size_t)grid->column_mask + 1) * sizeof(cl_int),
-                              grid->column_table, CL_MEM_READ_ONLY},
+        [BUF_COLUMN_TABLE] = {((size_t)grid->column_mask + 1) * sizeof(cl_int), grid->column_table,
+                              CL_MEM_READ_ONLY},
         [BUF_BLOCK_POS] = {ns * 3 * sizeof(cl_float), pk->block_pos, CL_MEM_READ_ONLY},
         [BUF_BLOCK_CELL] = {nb * sizeof(cl_int4), pk->block_cell, CL_MEM_READ_ONLY},
         [BUF_BLOCK_OFFSET] = {ns * 3 * sizeof(cl_uchar), pk->block_offset, CL_MEM_READ_ONLY},
@@ -510,8 +509,7 @@ static rsmooth_status create_buffers(cl_run *r, uint64_t *needed) {
         [BUF_BLOCK_RESULT] = {ns * 4 * sizeof(cl_float), NULL, CL_MEM_WRITE_ONLY},
         [BUF_BLOCK_EXTRA] = {ns * 2 * sizeof(cl_float), NULL, CL_MEM_WRITE_ONLY},
         [BUF_BLOCK_PAIRS] = {nb * 2 * sizeof(cl_uint), NULL, CL_MEM_WRITE_ONLY},
-        [BUF_FACET_SCRATCH] = {pb->bilateral ? nf * sizeof(cl_float4) : 0, NULL,
-                               CL_MEM_READ_WRITE},
+        [BUF_FACET_SCRATCH] = {pb->bilateral ? nf * sizeof(cl_float4) : 0, NULL, CL_MEM_READ_WRITE},
         [BUF_CELL_PAIRS] = {pb->bilateral ? nc * sizeof(cl_ulong) : 0, NULL, CL_MEM_WRITE_ONLY},
         [BUF_FACET_COLOR] = {pb->colors ? nf * sizeof(cl_float4) : 0, pk->facet_color,
                              CL_MEM_READ_ONLY},
@@ -576,9 +574,9 @@ static rsmooth_status run_mollify(cl_run *r) {
     arg_grid(&s, buf, &mask);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_SHIFT]);
     arg(&s, sizeof(cl_mem), &buf[BUF_BLOCK_PAIRS]);
-    cl_int err = s.err != CL_SUCCESS ? s.err
-                                     : rs_cl_run_1d(ctx, pb, s.kernel, r->pk.block_count, 0,
-                                                    MOLLIFY_SHARE);
+    cl_int err = s.err != CL_SUCCESS
+                     ? s.err
+                     : rs_cl_run_1d(ctx, pb, s.kernel, r->pk.block_count, 0, MOLLIFY_SHARE);
     if (err != CL_SUCCESS)
         return rs_cl_fail(r->error, err, "mollify_block", ctx->device_name);
     r->t_mollify = rs_now_ms();
@@ -606,8 +604,8 @@ static rsmooth_status run_normals(cl_run *r) {
     r->normals = r->buf[BUF_FACET_NORMAL];
     r->t_mollify = r->t_normals = r->t_upload;
     if (r->pb->bilateral) {
-        cl_int err = rs_cl_run_bilateral(r->ctx, r->pb, &r->grid, r->buf, &r->normals,
-                                         &r->bilateral_pairs);
+        cl_int err =
+            rs_cl_run_bilateral(r->ctx, r->pb, &r->grid, r->buf, &r->normals, &r->bilateral_pairs);
         if (err != CL_SUCCESS)
             return rs_cl_fail(r->error, err, "bilateral_cell_normals", r->ctx->device_name);
         r->t_mollify = rs_now_ms();
@@ -685,9 +683,9 @@ static rsmooth_status collect_results(cl_run *r, rs_run_stats *stats) {
         !sink->confidence && !r->out_normals) {
         /* rsmooth_smooth_cl: the positions go to the caller's buffer on the device, nothing
          * comes back (the pair counts, 8 bytes a block, are left out of the report too) */
-        rsmooth_status st = rs_cl_store_device(ctx, sink->device, r->buf[BUF_BLOCK_RESULT],
-                                               r->pk.slot, nv, ctx->lanes, pb->scale,
-                                               r->grid.cell_size, r->error);
+        rsmooth_status st =
+            rs_cl_store_device(ctx, sink->device, r->buf[BUF_BLOCK_RESULT], r->pk.slot, nv,
+                               ctx->lanes, pb->scale, r->grid.cell_size, r->error);
         if (st != RSMOOTH_OK)
             return st;
         stats->ms_grid += r->t_grid - r->t_start;
@@ -705,15 +703,15 @@ static rsmooth_status collect_results(cl_run *r, rs_run_stats *stats) {
     r->result = clEnqueueMapBuffer(ctx->queue, r->buf[BUF_BLOCK_RESULT], CL_TRUE, CL_MAP_READ, 0,
                                    ns * 4 * sizeof(cl_float), 0, NULL, NULL, &err);
     if (err == CL_SUCCESS)
-        r->extra = clEnqueueMapBuffer(ctx->queue, r->buf[BUF_BLOCK_EXTRA], CL_TRUE, CL_MAP_READ,
-                                      0, ns * 2 * sizeof(cl_float), 0, NULL, NULL, &err);
+        r->extra = clEnqueueMapBuffer(ctx->queue, r->buf[BUF_BLOCK_EXTRA], CL_TRUE, CL_MAP_READ, 0,
+                                      ns * 2 * sizeof(cl_float), 0, NULL, NULL, &err);
     if (err == CL_SUCCESS)
-        r->pairs = clEnqueueMapBuffer(ctx->queue, r->buf[BUF_BLOCK_PAIRS], CL_TRUE, CL_MAP_READ,
-                                      0, nb * 2 * sizeof(cl_uint), 0, NULL, NULL, &err);
+        r->pairs = clEnqueueMapBuffer(ctx->queue, r->buf[BUF_BLOCK_PAIRS], CL_TRUE, CL_MAP_READ, 0,
+                                      nb * 2 * sizeof(cl_uint), 0, NULL, NULL, &err);
     if (err == CL_SUCCESS && r->out_normals && pb->mollify)
-        r->normal_map = clEnqueueMapBuffer(ctx->queue, r->normals, CL_TRUE, CL_MAP_READ, 0,
-                                           pb->facet_count * sizeof(cl_float4), 0, NULL, NULL,
-                                           &err);
+        r->normal_map =
+            clEnqueueMapBuffer(ctx->queue, r->normals, CL_TRUE, CL_MAP_READ, 0,
+                               pb->facet_count * sizeof(cl_float4), 0, NULL, NULL, &err);
     if (err != CL_SUCCESS)
         return rs_cl_fail(r->error, err, "clEnqueueMapBuffer", ctx->device_name);
     if (r->normal_map) {

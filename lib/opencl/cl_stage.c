@@ -4,35 +4,55 @@
  * (stages/normal_update.c) is what this is verified against; a plan too large for the device is
  * refused with RSMOOTH_ERROR_OUT_OF_MEMORY, and the host runs it instead (the stage's reach grows
  * with its cycles, so it is not cut into tiles). */
-#include "opencl/cl_run.h"
 #include "core/stage_plan.h"
+#include "opencl/cl_run.h"
 
-#include <stdlib.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const char where[] = "rsmooth_smooth (normal update stage)";
 
 enum {
-    SB_FACET_VERTEX, SB_FACET_REST, SB_REST_CENTROID, SB_CENTROID, SB_SHIFT, SB_NORMAL,
-    SB_REP, SB_REP_START, SB_REP_FACET, SB_REP_OFFSET, SB_PATCH_START, SB_PATCH, SB_EDGE_START,
-    SB_EDGE, SB_NEAR_START, SB_NEAR, SB_MASK, SB_D0,
+    SB_FACET_VERTEX,
+    SB_FACET_REST,
+    SB_REST_CENTROID,
+    SB_CENTROID,
+    SB_SHIFT,
+    SB_NORMAL,
+    SB_REP,
+    SB_REP_START,
+    SB_REP_FACET,
+    SB_REP_OFFSET,
+    SB_PATCH_START,
+    SB_PATCH,
+    SB_EDGE_START,
+    SB_EDGE,
+    SB_NEAR_START,
+    SB_NEAR,
+    SB_MASK,
+    SB_D0,
     SB_UPLOADED, /* the buffers above start from the host; those below are the device's own */
-    SB_D1 = SB_UPLOADED, SB_PATCH_MEAN, SB_PATCH_SCORE, SB_GUIDANCE, SB_FILTERED0, SB_FILTERED1,
+    SB_D1 = SB_UPLOADED,
+    SB_PATCH_MEAN,
+    SB_PATCH_SCORE,
+    SB_GUIDANCE,
+    SB_FILTERED0,
+    SB_FILTERED1,
     SB_COUNT
 };
 
 typedef struct stage_run {
     rsmooth_context *ctx;
     const rs_stage_plan *plan;
-    void *packed[SB_UPLOADED];   /* the host arrays this file packed (the rest are the plan's) */
+    void *packed[SB_UPLOADED]; /* the host arrays this file packed (the rest are the plan's) */
     const void *from[SB_UPLOADED];
-    size_t data[SB_UPLOADED];    /* bytes of each host array */
-    size_t size[SB_COUNT];       /* bytes of each buffer: at least 16, an empty list's too */
+    size_t data[SB_UPLOADED]; /* bytes of each host array */
+    size_t size[SB_COUNT];    /* bytes of each buffer: at least 16, an empty list's too */
     cl_mem buf[SB_COUNT];
-    bool dbl;                    /* the kernels in double (else float) */
-    size_t real;                 /* bytes of one REAL: 8 or 4 */
-    const cl_kernel *kernels;    /* RS_STAGE_KERNELS of them, in the run's precision */
+    bool dbl;                 /* the kernels in double (else float) */
+    size_t real;              /* bytes of one REAL: 8 or 4 */
+    const cl_kernel *kernels; /* RS_STAGE_KERNELS of them, in the run's precision */
 } stage_run;
 
 /* Element i of an array of REAL4 (x, y, z, w). */
@@ -114,8 +134,8 @@ static bool pack_plan(stage_run *r) {
     void *cen = packed_buffer(r, SB_CENTROID, nf, r4);
     void *normal = packed_buffer(r, SB_NORMAL, nf, r4);
     void *offset = packed_buffer(r, SB_REP_OFFSET, ni, r4);
-    bool zeros = packed_buffer(r, SB_SHIFT, nf, r4) &&
-                 packed_buffer(r, SB_D0, nv, r4); /* d starts at 0 */
+    bool zeros =
+        packed_buffer(r, SB_SHIFT, nf, r4) && packed_buffer(r, SB_D0, nv, r4); /* d starts at 0 */
     if (!lists || !zeros || !fv || !rest || !rc || !cen || !normal || !offset ||
         !starts32(r, SB_REP_START, p->rep_start, nv))
         return false;
@@ -152,15 +172,14 @@ static rsmooth_status create_buffers(stage_run *r, rs_stage_stats *stats, rsmoot
     }
     if (total > rs_cl_usable_memory(ctx) || largest > ctx->max_allocation)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where,
-                       "the stage needs %llu bytes on %s (usable %llu)",
-                       (unsigned long long)total, ctx->device_name,
-                       (unsigned long long)rs_cl_usable_memory(ctx));
+                       "the stage needs %llu bytes on %s (usable %llu)", (unsigned long long)total,
+                       ctx->device_name, (unsigned long long)rs_cl_usable_memory(ctx));
     for (int b = 0; b < SB_COUNT; b++) {
         cl_int err = CL_SUCCESS;
         r->buf[b] = clCreateBuffer(ctx->context, CL_MEM_READ_WRITE, r->size[b], NULL, &err);
         if (err == CL_SUCCESS && b < SB_UPLOADED && r->data[b] > 0) {
-            err = clEnqueueWriteBuffer(ctx->queue, r->buf[b], CL_FALSE, 0, r->data[b],
-                                       r->from[b], 0, NULL, NULL);
+            err = clEnqueueWriteBuffer(ctx->queue, r->buf[b], CL_FALSE, 0, r->data[b], r->from[b],
+                                       0, NULL, NULL);
             stats->bytes_to_device += r->data[b];
         }
         if (err != CL_SUCCESS)
@@ -183,8 +202,8 @@ static void mem_args(arg_setter *s, int count, const cl_mem *const *mems) {
     for (int i = 0; i < count; i++)
         arg(s, sizeof(cl_mem), mems[i]);
 }
-#define MEMS(s, ...)                                                                             \
-    mem_args(s, (int)(sizeof((const cl_mem *[]){__VA_ARGS__}) / sizeof(cl_mem *)),              \
+#define MEMS(s, ...)                                                                               \
+    mem_args(s, (int)(sizeof((const cl_mem *[]){__VA_ARGS__}) / sizeof(cl_mem *)),                 \
              (const cl_mem *const[]){__VA_ARGS__})
 
 /* Facet geometry from the displacements in `d` (stage_facets). */
@@ -208,8 +227,8 @@ static cl_int enqueue_round(stage_run *r, const cl_mem *in, const cl_mem *out) {
     cl_float inv_2s2_f = (cl_float)inv_2s2, inv_2t2_f = (cl_float)inv_2t2;
     arg_setter s = {r->kernels[RS_STAGE_PATCH], 0, CL_SUCCESS};
     arg(&s, sizeof nf, &nf);
-    MEMS(&s, &b[SB_PATCH_START], &b[SB_PATCH], &b[SB_EDGE_START], &b[SB_EDGE], &b[SB_CENTROID],
-         in, &b[SB_PATCH_MEAN], &b[SB_PATCH_SCORE]);
+    MEMS(&s, &b[SB_PATCH_START], &b[SB_PATCH], &b[SB_EDGE_START], &b[SB_EDGE], &b[SB_CENTROID], in,
+         &b[SB_PATCH_MEAN], &b[SB_PATCH_SCORE]);
     cl_int err = s.err != CL_SUCCESS ? s.err : launch(r->ctx, s.kernel, nf);
     s = (arg_setter){r->kernels[RS_STAGE_GUIDANCE], 0, err};
     arg(&s, sizeof nf, &nf);
@@ -292,10 +311,9 @@ static rsmooth_status read_back(stage_run *r, int d, double *xyz, rs_stage_stats
     size_t nv = r->plan->vertex_count, bytes = nv * 4 * r->real;
     void *shift = rs_alloc_array(nv ? nv : 1, 4 * r->real);
     if (!shift)
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for %zu vertices",
-                       nv);
-    cl_int err = clEnqueueReadBuffer(r->ctx->queue, r->buf[d], CL_TRUE, 0, bytes, shift, 0, NULL,
-                                     NULL);
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for %zu vertices", nv);
+    cl_int err =
+        clEnqueueReadBuffer(r->ctx->queue, r->buf[d], CL_TRUE, 0, bytes, shift, 0, NULL, NULL);
     if (err == CL_SUCCESS) {
         stats->bytes_from_device += bytes;
         for (size_t v = 0; v < nv; v++)
@@ -315,7 +333,8 @@ static bool choose_precision(stage_run *r, rsmooth_error *error) {
     if (asked && *asked && strcmp(asked, "float") != 0 && strcmp(asked, "double") != 0) {
         rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                 "RSMOOTH_STAGE_PRECISION is \"%s\": use double (the default where the device "
-                "has it) or float", asked);
+                "has it) or float",
+                asked);
         return false;
     }
     bool has_double = r->ctx->kernels[RS_KERNEL_STAGE_DOUBLE] != NULL;

@@ -47,8 +47,8 @@ static const char store_source[] =
 
 static bool device_has_fp64(const rsmooth_context *ctx) {
     cl_device_fp_config config = 0;
-    return clGetDeviceInfo(ctx->device, CL_DEVICE_DOUBLE_FP_CONFIG, sizeof config, &config,
-                           NULL) == CL_SUCCESS &&
+    return clGetDeviceInfo(ctx->device, CL_DEVICE_DOUBLE_FP_CONFIG, sizeof config, &config, NULL) ==
+               CL_SUCCESS &&
            config != 0;
 }
 
@@ -176,12 +176,13 @@ static bool device_result_possible(const rsmooth_params *params, rsmooth_scalar 
     if (p.passes != 1 || p.vertex_updates != 0 || p.discrepancy_level != 0 || p.move_mask ||
         p.guard)
         return false;
-    if (rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count, NULL,
-                             NULL, "rsmooth_smooth_cl") != RSMOOTH_OK)
+    if (rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count, NULL, NULL,
+                             "rsmooth_smooth_cl") != RSMOOTH_OK)
         return false; /* refused by the call itself */
     rs_parts parts;
     bool whole = rs_parts_find(&parts, scalar, positions, vertex_count, indices, triangle_count,
-                               NULL, "rsmooth_smooth_cl") == RSMOOTH_OK && parts.whole;
+                               NULL, "rsmooth_smooth_cl") == RSMOOTH_OK &&
+                 parts.whole;
     rs_parts_free(&parts);
     return whole;
 }
@@ -196,8 +197,8 @@ rsmooth_status rsmooth_smooth_cl(rsmooth_context *ctx, rsmooth_scalar scalar, cl
     if (!ctx)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "ctx is NULL");
     if (scalar != RSMOOTH_FLOAT32 && scalar != RSMOOTH_FLOAT64)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "scalar %d is no rsmooth_scalar",
-                       (int)scalar);
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "scalar %d is no rsmooth_scalar", (int)scalar);
     size_t record = rs_vertex_bytes(scalar);
     if (vertex_count > SIZE_MAX / record)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "%zu vertices overflow size_t",
@@ -234,8 +235,8 @@ rsmooth_status rsmooth_smooth_cl(rsmooth_context *ctx, rsmooth_scalar scalar, cl
             sink.kernel = ctx->store_kernels[scalar];
             ctx->device_sink = &sink;
         }
-        st = rs_smooth_entered(ctx, scalar, host_in, vertex_count, indices, triangle_count,
-                               params, host_out, NULL, NULL, report, error);
+        st = rs_smooth_entered(ctx, scalar, host_in, vertex_count, indices, triangle_count, params,
+                               host_out, NULL, NULL, report, error);
         ctx->device_sink = NULL;
     }
     if (st == RSMOOTH_OK && sink.written && sink.bad)
@@ -243,8 +244,8 @@ rsmooth_status rsmooth_smooth_cl(rsmooth_context *ctx, rsmooth_scalar scalar, cl
                      "a smoothed position is not finite in the output's type");
     if (st == RSMOOTH_OK && !sink.written && bytes > 0) {
         /* tiles, passes, the stage, a move mask or the choice per region: the host has it */
-        err = clEnqueueWriteBuffer(ctx->queue, out_positions, CL_TRUE, 0, bytes, host_out, 0,
-                                   NULL, NULL);
+        err = clEnqueueWriteBuffer(ctx->queue, out_positions, CL_TRUE, 0, bytes, host_out, 0, NULL,
+                                   NULL);
         if (err != CL_SUCCESS)
             st = rs_cl_fail(error, err, "clEnqueueWriteBuffer (out_positions)", ctx->device_name);
     }

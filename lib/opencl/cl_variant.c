@@ -45,7 +45,8 @@ rsmooth_status rs_cl_choose_variant(rsmooth_context *ctx, rsmooth_error *error) 
         if (strcmp(variant, "gpu") != 0 && strcmp(variant, "cpu") != 0)
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                            "RSMOOTH_KERNEL_VARIANT is \"%s\": use gpu (one vertex per work-item) "
-                           "or cpu (vector blocks)", variant);
+                           "or cpu (vector blocks)",
+                           variant);
         group_variant = variant[0] == 'g';
     }
     if (group_variant) {
@@ -63,7 +64,8 @@ rsmooth_status rs_cl_choose_variant(rsmooth_context *ctx, rsmooth_error *error) 
         if (strcmp(lanes, "4") != 0 && strcmp(lanes, "8") != 0 && strcmp(lanes, "16") != 0)
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                            "RSMOOTH_LANES is \"%s\": use 4, 8 or 16 (vertices per block on a "
-                           "CPU device)", lanes);
+                           "CPU device)",
+                           lanes);
         ctx->lanes = (unsigned)atoi(lanes);
     }
     /* an explicit work-group size helps PoCL vectorize across work-items */

@@ -43,7 +43,6 @@ static int report_tile_progress(void *user, double fraction) {
     return !rs_progress(tp->whole, tp->from + tp->span * fraction);
 }
 
-
 /* Device bytes a tile of `vertices` core vertices and `facets` facets is expected to need (a
  * facet brings about half a vertex of its own). The bilateral rounds' lists are planned for only
  * in tiles of at least 256 halo discs of facets, at least half of them the tile's own (about two
@@ -241,7 +240,8 @@ static rsmooth_status solve_region(tiler *t, uint32_t *verts, size_t n, const ui
 /* Reaches far beyond the mesh (a spatial width thousands of times its size) make every facet
  * weigh alike, and the kernels' float sums of those weights lose the result (0.14 edge lengths
  * off at sigma_f 1e5 on a 2,000-triangle shape, measured against the reference path; within
- * 1e-3 up to reaches of 2,000 mesh sizes): the device refuses them, the reference path runs them. */
+ * 1e-3 up to reaches of 2,000 mesh sizes): the device refuses them, the reference path runs them.
+ */
 #define MAX_REACH_PER_SIZE 1024.0
 
 static rsmooth_status check_reach(const rs_problem *pb, rsmooth_error *error) {
@@ -313,8 +313,7 @@ rsmooth_status rs_cl_filter(rsmooth_context *ctx, const rs_problem *pb, const rs
             facets[q] = (uint32_t)q;
         /* a little extra: a facet exactly at the halo must not round out of it */
         double halo = rs_halo_radius(pb, reach) * (1 + 1e-6);
-        rs_result_sink scratch = {RSMOOTH_FLOAT64, positions, weight, confidence, NULL, nv,
-                                  NULL};
+        rs_result_sink scratch = {RSMOOTH_FLOAT64, positions, weight, confidence, NULL, nv, NULL};
         tiler t = {ctx, pb, &scratch, stats, halo, budget, sub_index, 0, nv, error};
         st = solve_region(&t, verts, nv, facets, pb->facet_count, 0);
     }

@@ -3,10 +3,10 @@
  * data, normals and the grid from the previous positions; the sigmas stay those the input's mean
  * edge length gave, so later passes do not shrink their reach as the mesh smooths. */
 #include "auto/noise_estimate.h"
+#include "core/stage_plan.h"
 #include "passes/one_part.h"
 #include "passes/region_choice.h"
 #include "stages/normal_update.h"
-#include "core/stage_plan.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -44,9 +44,9 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                                     const uint32_t *indices, size_t triangle_count,
                                     const rsmooth_params *params, void *out_positions,
                                     float *out_weight, float *out_confidence,
-                                    rsmooth_report *report, rsmooth_error *error,
-                                    const char *where, rsmooth_params *resolved,
-                                    const rs_stage_place *stage, rs_stage_stats *stage_stats);
+                                    rsmooth_report *report, rsmooth_error *error, const char *where,
+                                    rsmooth_params *resolved, const rs_stage_place *stage,
+                                    rs_stage_stats *stage_stats);
 
 /* What no pass of the filter leaves: weights 0, confidences 1, a report of the counts alone. */
 static void no_pass(float *out_weight, float *out_confidence, size_t vertex_count,
@@ -76,9 +76,8 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                                     const uint32_t *indices, size_t triangle_count,
                                     const rsmooth_params *resolved, void *out_positions,
                                     float *out_weight, float *out_confidence,
-                                    rsmooth_report *report, rsmooth_error *error,
-                                    const char *where, const rs_stage_place *stage,
-                                    rs_stage_stats *stage_stats) {
+                                    rsmooth_report *report, rsmooth_error *error, const char *where,
+                                    const rs_stage_place *stage, rs_stage_stats *stage_stats) {
     double t_start = rs_now_ms();
     rsmooth_status st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices,
                                              triangle_count, NULL, error, where);
@@ -108,7 +107,7 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
     rs_pass_progress pp = {p.progress, p.progress_cancel, p.progress_user, 0, halves};
     bool reports = pp.progress || pp.cancel;
     rs_stage_setting setting = {p.guided_sigma_s, p.guided_sigma_n, p.guided_radius,
-                                p.guided_rounds, p.vertex_updates, p.stage_repeats};
+                                p.guided_rounds,  p.vertex_updates, p.stage_repeats};
     /* do no harm: no stage where the noise estimate finds nothing to remove (a caller that gives
      * the noise level, as rsmooth_params_auto does where it found noise, has measured it) */
     bool clean = false;
@@ -156,8 +155,8 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
         }
         rsmooth_params unused;
         st = filter_passes(one_pass, ctx, scalar, from, vertex_count, indices, triangle_count, &p,
-                           out_positions, out_weight, out_confidence, report, error, where,
-                           &unused, NULL, NULL);
+                           out_positions, out_weight, out_confidence, report, error, where, &unused,
+                           NULL, NULL);
     }
     if (st == RSMOOTH_OK && report) {
         report->ms_normals += t_stage - t_start; /* the stage counts as normal filtering */
@@ -182,10 +181,9 @@ static void keep_confident(const double *cur, double *next, float *weight, float
 
 /* No pass and no stage: the input comes back, weights 0 and confidences 1 (what
  * rsmooth_params_auto sets on a mesh with nothing to remove). */
-static rsmooth_status give_input(rsmooth_scalar scalar, const void *positions,
-                                 size_t vertex_count, size_t triangle_count, void *out_positions,
-                                 float *out_weight, float *out_confidence, rsmooth_report *report,
-                                 double t_start) {
+static rsmooth_status give_input(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
+                                 size_t triangle_count, void *out_positions, float *out_weight,
+                                 float *out_confidence, rsmooth_report *report, double t_start) {
     memcpy(out_positions, positions, vertex_count * rs_vertex_bytes(scalar));
     no_pass(out_weight, out_confidence, vertex_count, triangle_count, report);
     if (report) {
@@ -200,9 +198,9 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                                     const uint32_t *indices, size_t triangle_count,
                                     const rsmooth_params *params, void *out_positions,
                                     float *out_weight, float *out_confidence,
-                                    rsmooth_report *report, rsmooth_error *error,
-                                    const char *where, rsmooth_params *resolved,
-                                    const rs_stage_place *stage, rs_stage_stats *stage_stats) {
+                                    rsmooth_report *report, rsmooth_error *error, const char *where,
+                                    rsmooth_params *resolved, const rs_stage_place *stage,
+                                    rs_stage_stats *stage_stats) {
     double t_start = rs_now_ms();
     rs_error_clear(error);
     rsmooth_params p;
@@ -215,16 +213,16 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
         return st;
     if (p.vertex_updates > 0)
         return staged_passes(one_pass, ctx, scalar, positions, vertex_count, indices,
-                             triangle_count, &p, out_positions, out_weight, out_confidence,
-                             report, error, where, stage, stage_stats);
+                             triangle_count, &p, out_positions, out_weight, out_confidence, report,
+                             error, where, stage, stage_stats);
     if (p.passes == 0) /* nothing to run */
         return give_input(scalar, positions, vertex_count, triangle_count, out_positions,
                           out_weight, out_confidence, report, t_start);
     if (p.passes == 1) /* the paper's single pass, exactly as it was */
         return one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, params,
                         out_positions, out_weight, out_confidence, report, error);
-    if ((st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count,
-                                   NULL, error, where)) != RSMOOTH_OK)
+    if ((st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count, NULL,
+                                   error, where)) != RSMOOTH_OK)
         return st; /* (the outputs were checked above) */
 
     /* Fix the sigmas in mesh units once, from the input. */
@@ -259,8 +257,7 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
     float *prev_weight = rs_alloc_array(vertex_count, sizeof(float));
     float *prev_confidence = rs_alloc_array(vertex_count, sizeof(float));
     if (!cur || !next || !weight || !confidence || !prev_weight || !prev_confidence) {
-        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for %d passes",
-                     passes);
+        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for %d passes", passes);
         goto done;
     }
     /* Every pass reads and writes double: a pass writes in the scalar type it reads, so a
@@ -331,21 +328,19 @@ static void report_stage(rsmooth_report *report, const rs_stage_stats *stats) {
 }
 
 rsmooth_status rs_filter_one_part(rs_filter_fn one_pass, rs_stage_runner stage, void *ctx,
-                                  rsmooth_scalar scalar, const void *positions,
-                                  size_t vertex_count, const uint32_t *indices,
-                                  size_t triangle_count, const rsmooth_params *params,
-                                  void *out_positions, float *out_weight, float *out_confidence,
-                                  rsmooth_report *report, rsmooth_error *error,
-                                  const char *where) {
+                                  rsmooth_scalar scalar, const void *positions, size_t vertex_count,
+                                  const uint32_t *indices, size_t triangle_count,
+                                  const rsmooth_params *params, void *out_positions,
+                                  float *out_weight, float *out_confidence, rsmooth_report *report,
+                                  rsmooth_error *error, const char *where) {
     size_t caller_size = report ? report->struct_size : 0; /* the report's fillers reset it */
     rsmooth_params p;
     rs_stage_place place = {stage, ctx};
     rs_stage_stats stage_stats;
     memset(&stage_stats, 0, sizeof stage_stats);
-    rsmooth_status st = filter_passes(one_pass, ctx, scalar, positions, vertex_count, indices,
-                                      triangle_count, params, out_positions, out_weight,
-                                      out_confidence, report, error, where, &p, &place,
-                                      &stage_stats);
+    rsmooth_status st = filter_passes(
+        one_pass, ctx, scalar, positions, vertex_count, indices, triangle_count, params,
+        out_positions, out_weight, out_confidence, report, error, where, &p, &place, &stage_stats);
     if (report)
         report->struct_size = caller_size;
     if (st != RSMOOTH_OK)
@@ -355,9 +350,9 @@ rsmooth_status rs_filter_one_part(rs_filter_fn one_pass, rs_stage_runner stage, 
         report_stage(report, &stage_stats);
     if (p.discrepancy_level > 0 && vertex_count > 0) {
         double share = 0;
-        int iterations = rs_region_choice(scalar, positions, vertex_count, indices,
-                                          triangle_count, p.discrepancy_level,
-                                          p.discrepancy_gain, out_positions, &share);
+        int iterations =
+            rs_region_choice(scalar, positions, vertex_count, indices, triangle_count,
+                             p.discrepancy_level, p.discrepancy_gain, out_positions, &share);
         if (iterations < 0)
             return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the guard");
         if (report && caller_size >= offsetof(rsmooth_report, discrepancy_iterations) +

@@ -28,10 +28,11 @@
 #define SHARE_LOW 0.2
 #define SHARE_HIGH 0.8
 #define SHARE_SPREAD 6
-#define DISCREPANCY_MAX_ITERATIONS 40 /* tuned Taubin needed 5-50 on the calibration meshes; at
-                                     * high noise the move saturates below the level and more
-                                     * iterations only shrink detail (the Stanford bunny at 0.5:
-                                     * E_v 0.93 at 40, 1.35 at 200) */
+#define DISCREPANCY_MAX_ITERATIONS                                                                 \
+    40 /* tuned Taubin needed 5-50 on the calibration meshes; at                                   \
+        * high noise the move saturates below the level and more                                   \
+        * iterations only shrink detail (the Stanford bunny at 0.5:                                \
+        * E_v 0.93 at 40, 1.35 at 200) */
 
 /* Per welded vertex r: flat[r] and pairs[r], the pairs of its facets sharing an edge at r; and
  * whether r is on the boundary (an edge at r that one facet has). */
@@ -52,8 +53,7 @@ static void count_pairs(const rs_facets *facets, const rs_adjacency *adj, const 
                 size_t holders = 0;
                 for (size_t j = adj->start[r]; j < adj->start[r + 1]; j++) {
                     const uint32_t *tg = indices + 3 * (size_t)facets->triangle[adj->facet[j]];
-                    bool has = adj->rep[tg[0]] == o || adj->rep[tg[1]] == o ||
-                               adj->rep[tg[2]] == o;
+                    bool has = adj->rep[tg[0]] == o || adj->rep[tg[1]] == o || adj->rep[tg[2]] == o;
                     holders += has;
                     if (has && j > i) {
                         pairs++;
@@ -97,8 +97,8 @@ static bool spread(const rs_facets *facets, const rs_adjacency *adj, const uint3
 }
 
 /* The mean length of the edges at welded vertex r (input positions). */
-static double local_edge(const rs_adjacency *adj, const rs_facets *facets,
-                         const uint32_t *indices, const double *xyz, size_t r) {
+static double local_edge(const rs_adjacency *adj, const rs_facets *facets, const uint32_t *indices,
+                         const double *xyz, size_t r) {
     double sum = 0;
     size_t n = 0;
     for (size_t i = adj->start[r]; i < adj->start[r + 1]; i++) {
@@ -122,8 +122,8 @@ static double region_weight(double share) {
 }
 
 int rs_region_choice(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
-                     const uint32_t *indices, size_t triangle_count, double level,
-                     double min_gain, void *out_positions, double *out_mean_weight) {
+                     const uint32_t *indices, size_t triangle_count, double level, double min_gain,
+                     void *out_positions, double *out_mean_weight) {
     double *input = rs_alloc_array(vertex_count, 3 * sizeof(double));
     double *filtered = rs_alloc_array(vertex_count, 3 * sizeof(double));
     double *share = rs_alloc_array(vertex_count, sizeof(double));

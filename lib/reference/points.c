@@ -163,7 +163,7 @@ typedef struct points_run {
     rsmooth_params p;                /* resolved */
     double scale;                    /* internal units per caller unit (scale.c) */
     point_arrays a;
-    rs_kdtree tree; /* of the pass's positions, while the pass measures spacings */
+    rs_kdtree tree;              /* of the pass's positions, while the pass measures spacings */
     const double *given_spacing; /* the input's, measured by the caller (point_parts.c), or NULL */
     /* The unit of relative sigmas: the input's spacing, kept through the passes (as meshes keep
      * their input's mean edge length), so later passes do not shrink their reach. */
@@ -385,9 +385,8 @@ static rsmooth_status write_points(points_run *r, void *out_positions, void *out
 static rsmooth_status smooth_points(rs_points_solve_fn solve, void *solve_ctx, const char *where,
                                     rsmooth_scalar scalar, const void *positions,
                                     const void *normals, size_t point_count,
-                                    const double *given_spacing,
-                                    const rsmooth_params *params, void *out_positions,
-                                    void *out_normals, float *out_confidence,
+                                    const double *given_spacing, const rsmooth_params *params,
+                                    void *out_positions, void *out_normals, float *out_confidence,
                                     rsmooth_report *report, rsmooth_error *error) {
     double t_start = rs_now_ms();
     rs_error_clear(error);
@@ -434,10 +433,9 @@ rsmooth_status rs_smooth_points_one_part(rs_points_solve_fn solve, void *solve_c
                                          void *out_normals, float *out_confidence,
                                          rsmooth_report *report, rsmooth_error *error) {
     size_t caller_size = report ? report->struct_size : 0; /* the report's fillers reset it */
-    rsmooth_status st =
-        smooth_points(solve, solve_ctx, where, scalar, positions, normals, point_count,
-                      given_spacing, params,
-                      out_positions, out_normals, out_confidence, report, error);
+    rsmooth_status st = smooth_points(solve, solve_ctx, where, scalar, positions, normals,
+                                      point_count, given_spacing, params, out_positions,
+                                      out_normals, out_confidence, report, error);
     if (report)
         report->struct_size = caller_size;
     return st;

@@ -205,8 +205,7 @@ static void estimate_vertex_robust_norm(const rs_problem *pb, const neighbours *
             k += w;
             kf += af;
         }
-        if (!color || round > 0 || !(kf > 0) || k > kf * RS_UNDERFLOW_RATIO ||
-            !(ec_min < INFINITY))
+        if (!color || round > 0 || !(kf > 0) || k > kf * RS_UNDERFLOW_RATIO || !(ec_min < INFINITY))
             break;
         shift = ec_min;
     }
@@ -302,8 +301,8 @@ rsmooth_status rs_reference_solve(const rs_problem *problem, rsmooth_scalar scal
     }
 
     /* one grid serves every reach: the robust pass's and the bilateral filter's */
-    st = rs_grid_build(&grid, pb.centroid, pb.facet_count, fmax(pb.radius, pb.normal_radius),
-                       error);
+    st =
+        rs_grid_build(&grid, pb.centroid, pb.facet_count, fmax(pb.radius, pb.normal_radius), error);
     if (st != RSMOOTH_OK)
         goto fail;
     t_grid = rs_now_ms();
@@ -392,17 +391,16 @@ cleanup:
 static rsmooth_status reference_pass(void *unused, rsmooth_scalar scalar, const void *positions,
                                      size_t vertex_count, const uint32_t *indices,
                                      size_t triangle_count, const rsmooth_params *params,
-                                     void *out_positions, float *out_weight,
-                                     float *out_confidence, rsmooth_report *report,
-                                     rsmooth_error *error) {
+                                     void *out_positions, float *out_weight, float *out_confidence,
+                                     rsmooth_report *report, rsmooth_error *error) {
     static const char where[] = "rsmooth_smooth_reference";
     (void)unused;
     double t_start = rs_now_ms();
     rs_error_clear(error);
     rs_problem pb;
-    rsmooth_status st = rs_problem_prepare(&pb, scalar, positions, vertex_count, indices,
-                                           triangle_count, params, out_positions, true, error,
-                                           where);
+    rsmooth_status st =
+        rs_problem_prepare(&pb, scalar, positions, vertex_count, indices, triangle_count, params,
+                           out_positions, true, error, where);
     if (st != RSMOOTH_OK)
         return st;
     st = rs_reference_solve(&pb, scalar, out_positions, out_weight, out_confidence, NULL, report,

@@ -26,29 +26,29 @@
  * (init once, then one step per cycle, which re-reads the facets' areas and centroids for the
  * weights). Each facet's result depends only on the previous round's arrays, so any thread count
  * gives the same bytes. */
-#include "stages/normal_update.h"
 #include "core/spatial.h"
+#include "stages/normal_update.h"
 
 #include <math.h>
 #include <string.h>
 
-#define PATCH_MAX 128      /* facets of a patch looked at, at most (a vertex of very high valence
-                            * keeps its first ones in facet order: the score only needs a sample) */
-#define TV_EPSILON 1e-9    /* the paper's epsilon in R */
-#define GRAIN 512          /* facets per chunk below which a thread does not pay */
+#define PATCH_MAX                                                                                  \
+    128                 /* facets of a patch looked at, at most (a vertex of very high valence     \
+                         * keeps its first ones in facet order: the score only needs a sample) */
+#define TV_EPSILON 1e-9 /* the paper's epsilon in R */
+#define GRAIN 512       /* facets per chunk below which a thread does not pay */
 
 /* What does not change between rounds: each facet's patch and the patch's interior edges, and
- * each facet's neighbours within the filter's reach on the input (their spatial exponents follow the
- * geometry each cycle).
- * CSR lists: the entries of facet f are [start[f], start[f + 1]). */
+ * each facet's neighbours within the filter's reach on the input (their spatial exponents follow
+ * the geometry each cycle). CSR lists: the entries of facet f are [start[f], start[f + 1]). */
 typedef struct guided_lists {
     size_t *patch_start;
-    uint32_t *patch;        /* the patch's facets, f first */
+    uint32_t *patch; /* the patch's facets, f first */
     size_t *edge_start;
-    uint32_t *edge;         /* 2 per interior edge: the facets on either side */
+    uint32_t *edge; /* 2 per interior edge: the facets on either side */
     size_t *near_start;
     uint32_t *near;
-    double *near_exponent;  /* each neighbour's spatial exponent: weight_range */
+    double *near_exponent; /* each neighbour's spatial exponent: weight_range */
 } guided_lists;
 
 typedef struct guided_job {
@@ -58,11 +58,11 @@ typedef struct guided_job {
     const rs_grid *grid;
     double reach, inv_2s2, inv_2t2;
     guided_lists lists;
-    const double *normal;   /* this round's input normals, 3 per facet */
-    double *patch_mean;     /* 3 per facet */
-    double *patch_score;    /* per facet */
-    double *guidance;       /* 3 per facet */
-    double *out;            /* 3 per facet */
+    const double *normal; /* this round's input normals, 3 per facet */
+    double *patch_mean;   /* 3 per facet */
+    double *patch_score;  /* per facet */
+    double *guidance;     /* 3 per facet */
+    double *out;          /* 3 per facet */
 } guided_job;
 
 static double gap2(const double *a, const double *b) {
@@ -110,8 +110,8 @@ static bool share_edge(const uint32_t a[3], const uint32_t b[3]) {
 typedef struct chunk_list {
     uint32_t *item;
     size_t count, capacity;
-    size_t first;   /* the chunk's first facet */
-    bool failed;    /* out of memory */
+    size_t first; /* the chunk's first facet */
+    bool failed;  /* out of memory */
 } chunk_list;
 
 static void chunk_push(chunk_list *c, uint32_t item) {
@@ -132,8 +132,8 @@ static void chunk_push(chunk_list *c, uint32_t item) {
 
 /* Per-chunk lists and per-facet counts, joined into one CSR list (start: count + 1 entries;
  * `per` items per counted entry), the chunks' arrays freed. false when out of memory. */
-static bool join_chunks(chunk_list *chunks, size_t chunk_count, const size_t *counts,
-                        size_t count, size_t per, size_t *start, uint32_t **list) {
+static bool join_chunks(chunk_list *chunks, size_t chunk_count, const size_t *counts, size_t count,
+                        size_t per, size_t *start, uint32_t **list) {
     bool ok = true;
     start[0] = 0;
     for (size_t f = 0; f < count; f++)
@@ -202,14 +202,13 @@ static bool patch_lists_build(guided_job *job) {
                     rs_calloc_array(chunks ? chunks : 1, sizeof(chunk_list)),
                     rs_alloc_array(nf ? nf : 1, sizeof(size_t)),
                     rs_alloc_array(nf ? nf : 1, sizeof(size_t))};
-    bool ok = l->patch_start && l->edge_start && pj.patch && pj.edge && pj.patch_count &&
-              pj.edge_count;
+    bool ok =
+        l->patch_start && l->edge_start && pj.patch && pj.edge && pj.patch_count && pj.edge_count;
     if (ok) { /* both joined, so both chunks' arrays are freed */
         rs_parallel_for(nf, GRAIN, patch_lists_range, &pj);
-        bool patches = join_chunks(pj.patch, chunks, pj.patch_count, nf, 1, l->patch_start,
-                                   &l->patch);
-        ok = join_chunks(pj.edge, chunks, pj.edge_count, nf, 2, l->edge_start, &l->edge) &&
-             patches;
+        bool patches =
+            join_chunks(pj.patch, chunks, pj.patch_count, nf, 1, l->patch_start, &l->patch);
+        ok = join_chunks(pj.edge, chunks, pj.edge_count, nf, 2, l->edge_start, &l->edge) && patches;
     }
     rs_free(pj.patch);
     rs_free(pj.edge);
@@ -378,8 +377,8 @@ static void filter_range(void *ctx, size_t begin, size_t end, size_t chunk) {
 struct rs_guided {
     guided_job job;
     rs_grid grid;
-    bool filter;   /* false when no two facets share an edge: the normals stay the facets' own */
-    double *prev;  /* the round's input normals */
+    bool filter;  /* false when no two facets share an edge: the normals stay the facets' own */
+    double *prev; /* the round's input normals */
 };
 
 void rs_guided_destroy(rs_guided *g) {
@@ -412,8 +411,8 @@ rs_guided *rs_guided_create(const rs_facets *facets, const rs_adjacency *adj,
     job->patch_mean = rs_alloc_array(nf, 3 * sizeof(double));
     job->patch_score = rs_alloc_array(nf, sizeof(double));
     job->guidance = rs_alloc_array(nf, 3 * sizeof(double));
-    bool ok = g->prev && job->patch_mean && job->patch_score && job->guidance &&
-              patch_lists_build(job);
+    bool ok =
+        g->prev && job->patch_mean && job->patch_score && job->guidance && patch_lists_build(job);
     job->reach = ok ? radius * adjacent_distance(job) : 0;
     g->filter = job->reach > 0;
     if (ok && g->filter)
@@ -447,8 +446,8 @@ void rs_guided_step(rs_guided *g, const rs_facets *facets, int rounds, double *n
 
 bool rs_guided_normals(const rs_facets *facets, const rs_adjacency *adj, const uint32_t *indices,
                        double sigma_s, double sigma_n, int rounds, double *normals) {
-    rs_guided *g = rs_guided_create(facets, adj, indices, sigma_s, sigma_n,
-                                    RS_GUIDED_RADIUS_DEFAULT);
+    rs_guided *g =
+        rs_guided_create(facets, adj, indices, sigma_s, sigma_n, RS_GUIDED_RADIUS_DEFAULT);
     if (!g)
         return false;
     rs_guided_step(g, facets, rounds, normals);

@@ -1,6 +1,7 @@
 /* The normal-driven update stage (normal_update.h): facet geometry, then guided normal filtering
  * and the vertex update on positions brought near unit size by a power of two, so that squared
- * distances neither overflow nor underflow whatever the mesh's units (and scaling back is exact). */
+ * distances neither overflow nor underflow whatever the mesh's units (and scaling back is exact).
+ */
 #include "stages/normal_update.h"
 
 #include <math.h>
@@ -107,8 +108,8 @@ rsmooth_status rs_normal_update_stage(double *xyz, size_t vertex_count, const ui
         if (c > 0) /* the cycle reads the geometry the one before left */
             rs_facets_update(&facets, xyz, indices);
         rs_guided_step(guided, &facets, setting->rounds, normals);
-        ok = rs_vertex_update(xyz, vertex_count, indices, &facets, &adj, normals,
-                              setting->updates, move_mask);
+        ok = rs_vertex_update(xyz, vertex_count, indices, &facets, &adj, normals, setting->updates,
+                              move_mask);
         stats->cycles = c + 1;
         cancelled = ok && cycle_done && cycle_done(user, c + 1, setting->cycles) != 0;
     }

@@ -26,9 +26,9 @@ void rs_facets_free(rs_facets *facets);
 
 /* Which facets meet at each vertex, vertices at the same position welded (facet_adjacency.c). */
 typedef struct rs_adjacency {
-    uint32_t *rep;   /* per vertex: the lowest-numbered vertex at its position */
-    size_t *start;   /* vertex_count + 1: the facets at welded vertex r are facet[start[r] ..
-                      * start[r + 1]), in facet order */
+    uint32_t *rep; /* per vertex: the lowest-numbered vertex at its position */
+    size_t *start; /* vertex_count + 1: the facets at welded vertex r are facet[start[r] ..
+                    * start[r + 1]), in facet order */
     uint32_t *facet;
 } rs_adjacency;
 
@@ -47,8 +47,7 @@ void rs_adjacency_free(rs_adjacency *adj);
  * sigma_s absolute (mesh units), sigma_n the guidance width. NULL when out of memory. */
 typedef struct rs_guided rs_guided;
 rs_guided *rs_guided_create(const rs_facets *facets, const rs_adjacency *adj,
-                            const uint32_t *indices, double sigma_s, double sigma_n,
-                            double radius);
+                            const uint32_t *indices, double sigma_s, double sigma_n, double radius);
 /* `rounds` rounds from the facets' own normals, the weights from their current areas and
  * centroids (`facets` is the one the filter was made with, updated in place); writes 3 doubles
  * per facet to `normals`. */
@@ -65,9 +64,9 @@ bool rs_guided_normals(const rs_facets *facets, const rs_adjacency *adj, const u
  * facets f of n_f (n_f . (c_f - x)), c_f the facets' current centroids (`facets` is updated), n_f
  * the given normals. Welded vertices move together. Vertices whose move_mask byte is 0 stay. xyz
  * is updated in place. false when out of memory (xyz unchanged). */
-bool rs_vertex_update(double *xyz, size_t vertex_count, const uint32_t *indices,
-                      rs_facets *facets, const rs_adjacency *adj, const double *normals,
-                      int iterations, const uint8_t *move_mask);
+bool rs_vertex_update(double *xyz, size_t vertex_count, const uint32_t *indices, rs_facets *facets,
+                      const rs_adjacency *adj, const double *normals, int iterations,
+                      const uint8_t *move_mask);
 
 /* What the stage runs: `cycles` times (fresh facet geometry from the current positions; `rounds`
  * guided rounds; `updates` vertex updates), the lists built once. sigma_s absolute (mesh units),

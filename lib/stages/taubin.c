@@ -9,7 +9,7 @@
 
 /* Edge neighbours of every vertex, compressed: those of v are neighbour[first[v] .. first[v+1]). */
 typedef struct adjacency {
-    size_t *first;      /* vertex_count + 1 */
+    size_t *first; /* vertex_count + 1 */
     uint32_t *neighbour;
 } adjacency;
 

@@ -16,10 +16,10 @@
 #define GRAIN 1024 /* vertices per chunk below which a thread does not pay */
 
 typedef struct update_job {
-    const double *from;       /* positions before this iteration */
+    const double *from; /* positions before this iteration */
     double *to;
     const uint32_t *rep;
-    const size_t *start;      /* CSR of the welded vertices' facets */
+    const size_t *start; /* CSR of the welded vertices' facets */
     const uint32_t *facet;
     const rs_facets *facets;
     const double *normal;
@@ -46,9 +46,9 @@ static void update_range(void *ctx, size_t begin, size_t end, size_t chunk) {
     }
 }
 
-bool rs_vertex_update(double *xyz, size_t vertex_count, const uint32_t *indices,
-                      rs_facets *facets, const rs_adjacency *adj, const double *normals,
-                      int iterations, const uint8_t *move_mask) {
+bool rs_vertex_update(double *xyz, size_t vertex_count, const uint32_t *indices, rs_facets *facets,
+                      const rs_adjacency *adj, const double *normals, int iterations,
+                      const uint8_t *move_mask) {
     if (iterations < 1 || facets->count == 0)
         return true;
     double *next = rs_alloc_array(vertex_count, 3 * sizeof(double));

@@ -34,7 +34,7 @@ static rsmooth_status check_piece_params(const rsmooth_params *params, rsmooth_p
     rsmooth_status st = rs_params_resolve(params, p, error, caller);
     if (st != RSMOOTH_OK)
         return st;
-    const char *field = p->passes != 1            ? "passes (other than 1)"
+    const char *field = p->passes != 1             ? "passes (other than 1)"
                         : p->vertex_updates != 0   ? "vertex_updates (the normal update stage)"
                         : p->colors                ? "colors"
                         : p->move_mask             ? "move_mask"
@@ -55,8 +55,8 @@ rsmooth_status rsmooth_piece_halo(const rsmooth_params *params, double mean_edge
     if (!(mean_edge_length >= 0) || !isfinite(mean_edge_length) || !(reach >= 0) ||
         !isfinite(reach))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, caller,
-                       "mean_edge_length %g and reach %g must be finite and >= 0",
-                       mean_edge_length, reach);
+                       "mean_edge_length %g and reach %g must be finite and >= 0", mean_edge_length,
+                       reach);
     rsmooth_params p;
     rsmooth_status st = check_piece_params(params, &p, error, caller);
     if (st != RSMOOTH_OK)
@@ -91,8 +91,7 @@ static rsmooth_status check_info(const rsmooth_piece_info *info, size_t vertex_c
                        vertex_count);
     if (!(info->mean_edge_length > 0) || !isfinite(info->mean_edge_length))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "info->mean_edge_length %g must be finite and > 0",
-                       info->mean_edge_length);
+                       "info->mean_edge_length %g must be finite and > 0", info->mean_edge_length);
     if (!(info->mean_area > 0) || !isfinite(info->mean_area))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "info->mean_area %g must be finite and > 0", info->mean_area);
@@ -126,8 +125,7 @@ static bool exact_in_internal_units(double figure) {
 static rsmooth_status check_scale_fits(const rs_problem *pb, const double *positions,
                                        const uint32_t *indices, size_t triangle_count,
                                        const rsmooth_piece_info *info, rsmooth_error *error) {
-    if (!exact_in_internal_units(pb->mean_edge_length) ||
-        !exact_in_internal_units(pb->mean_area))
+    if (!exact_in_internal_units(pb->mean_edge_length) || !exact_in_internal_units(pb->mean_area))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "info->mean_edge_length %g and info->mean_area %g at scale %g are %g and "
                        "%g internal units, beyond double's normal range: give positions times "
@@ -151,9 +149,9 @@ static rsmooth_status check_scale_fits(const rs_problem *pb, const double *posit
 
 /* The piece's problem with the whole mesh's scale, unit and mean area in place of its own. */
 static rsmooth_status prepare_piece(rs_problem *pb, const double *positions, size_t vertex_count,
-                                   const uint32_t *indices, size_t triangle_count,
-                                   const rsmooth_piece_info *info, const rsmooth_params *params,
-                                   double *out_positions, bool keep, rsmooth_error *error) {
+                                    const uint32_t *indices, size_t triangle_count,
+                                    const rsmooth_piece_info *info, const rsmooth_params *params,
+                                    double *out_positions, bool keep, rsmooth_error *error) {
     rsmooth_params p;
     rsmooth_status st = check_piece_params(params, &p, error, where);
     if (st != RSMOOTH_OK)
@@ -216,10 +214,9 @@ rsmooth_status rsmooth_smooth_piece(rsmooth_context *ctx, const double *position
         memset(&stats, 0, sizeof stats);
         if (st == RSMOOTH_OK && pb.facet_count == 0) {
             for (size_t v = 0; v < info->core_count; v++)
-                rs_store_position(RSMOOTH_FLOAT64, out_positions, v, pb.xyz + 3 * v,
-                                  1 / pb.scale);
+                rs_store_position(RSMOOTH_FLOAT64, out_positions, v, pb.xyz + 3 * v, 1 / pb.scale);
         } else if (st == RSMOOTH_OK && info->core_count > 0) {
-            rs_result_sink sink = {RSMOOTH_FLOAT64, out_positions, NULL, NULL, NULL,
+            rs_result_sink sink = {RSMOOTH_FLOAT64,  out_positions, NULL, NULL, NULL,
                                    info->core_count, NULL};
             st = rs_cl_filter(ctx, &pb, &sink, &stats, error);
         }

@@ -93,13 +93,13 @@ typedef struct rs_stream_ply {
     bool out_swap;        /* the output (little-endian) in the other byte order than the host's */
     uint64_t vertex_count, face_count;
     uint64_t data_start, data_end; /* the elements' data (data_end: once the faces are read) */
-    uint64_t vertex_start; /* the vertex block */
-    size_t vertex_stride;  /* bytes per vertex row */
+    uint64_t vertex_start;         /* the vertex block */
+    size_t vertex_stride;          /* bytes per vertex row */
     size_t xyz_offset[3];
-    rs_ply_type xyz_type;  /* FLOAT32 or FLOAT64, the same for x, y and z */
-    uint64_t face_start;   /* the face block */
-    double magnitude;      /* the largest |coordinate| read: the mesh's scale for float32 */
-    char *out_header;      /* the output's header bytes, its mark included */
+    rs_ply_type xyz_type; /* FLOAT32 or FLOAT64, the same for x, y and z */
+    uint64_t face_start;  /* the face block */
+    double magnitude;     /* the largest |coordinate| read: the mesh's scale for float32 */
+    char *out_header;     /* the output's header bytes, its mark included */
     size_t out_header_size;
 } rs_stream_ply;
 
@@ -121,8 +121,8 @@ typedef struct rs_stream_extent {
 
 /* Reads every vertex's x, y, z into `xyz` (3 per vertex, floats when xyz_type is FLOAT32, else
  * doubles), checking each, and measures their extent on the way. */
-rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz,
-                                           rs_stream_extent *extent, rsmooth_error *error);
+rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz, rs_stream_extent *extent,
+                                           rsmooth_error *error);
 
 /* Reads the faces, fans each into triangles as the in-memory reader does, and writes their
  * vertex indices (3 uint32 each) to `triangles_fd`; *triangle_count receives how many. */
@@ -178,18 +178,17 @@ typedef struct rs_stream_stats {
     /* the two at `scale` (internal units), as the in-memory path holds them: in the caller's
      * units a mesh at 1e-300 has no representable area */
     double scaled_mean_edge_length, scaled_mean_area;
-    double reach;            /* largest centroid-to-corner distance of a facet */
+    double reach; /* largest centroid-to-corner distance of a facet */
     uint64_t facet_count;
-    double lo[3], hi[3];     /* the vertices' bounding box */
-    bool whole;              /* one part, no edge out of line (core/parts.h): what streams */
+    double lo[3], hi[3]; /* the vertices' bounding box */
+    bool whole;          /* one part, no edge out of line (core/parts.h): what streams */
 } rs_stream_stats;
 
 /* The figures of the mesh whose triangles are in `triangles_fd`, with at most `memory` bytes of
  * working memory for the unique edges. */
 rsmooth_status rs_stream_statistics(const rs_stream_positions *positions, int triangles_fd,
                                     uint64_t triangle_count, const rs_stream_extent *extent,
-                                    uint64_t memory, rs_stream_stats *stats,
-                                    rsmooth_error *error);
+                                    uint64_t memory, rs_stream_stats *stats, rsmooth_error *error);
 
 /* ---- stream_pieces.c ----------------------------------------------------------------------- */
 
@@ -212,8 +211,8 @@ typedef struct rs_stream_pieces {
 rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int triangles_fd,
                                       uint64_t triangle_count, const rs_stream_stats *stats,
                                       double halo, uint64_t piece_vertices, size_t buffer_memory,
-                                      int rank, int ranks, const char *dir,
-                                      rs_stream_pieces *out, rsmooth_error *error);
+                                      int rank, int ranks, const char *dir, rs_stream_pieces *out,
+                                      rsmooth_error *error);
 void rs_stream_pieces_free(rs_stream_pieces *pieces);
 
 #endif /* RSMOOTH_STREAM_INTERNAL_H */

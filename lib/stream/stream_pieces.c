@@ -16,8 +16,8 @@
 typedef struct cell_grid {
     double lo[3], size[3];
     int32_t dims[3];
-    uint32_t *count;  /* vertices per cell */
-    int32_t *piece;   /* per cell: its piece, -1 for none */
+    uint32_t *count; /* vertices per cell */
+    int32_t *piece;  /* per cell: its piece, -1 for none */
 } cell_grid;
 
 typedef struct box {
@@ -175,8 +175,8 @@ static size_t pieces_near(const cell_grid *g, const box *boxes, const double c[3
                 bool inside = true; /* the box's own bounds, grown by the halo */
                 for (int k = 0; k < 3 && inside; k++) {
                     double lo = bx->a[k] == 0 ? -INFINITY : g->lo[k] + bx->a[k] * g->size[k];
-                    double hi = bx->b[k] == g->dims[k] ? INFINITY
-                                                       : g->lo[k] + bx->b[k] * g->size[k];
+                    double hi =
+                        bx->b[k] == g->dims[k] ? INFINITY : g->lo[k] + bx->b[k] * g->size[k];
                     inside = c[k] >= lo - halo && c[k] <= hi + halo;
                 }
                 if (inside && n < max)
@@ -263,8 +263,8 @@ static rsmooth_status no_memory(rsmooth_error *error) {
 rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int triangles_fd,
                                       uint64_t triangle_count, const rs_stream_stats *stats,
                                       double halo, uint64_t piece_vertices, size_t buffer_memory,
-                                      int rank, int ranks, const char *dir,
-                                      rs_stream_pieces *out, rsmooth_error *error) {
+                                      int rank, int ranks, const char *dir, rs_stream_pieces *out,
+                                      rsmooth_error *error) {
     memset(out, 0, sizeof *out);
     out->vertex_fd = out->facet_fd = -1;
     cell_grid g;
@@ -288,8 +288,8 @@ rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int 
     }
     /* a little beyond the halo: a facet exactly at it must not round out (as tiles.c) */
     double reach = halo * (1 + 1e-6);
-    st = facet_pass(positions, triangles_fd, triangle_count, &g, ct.boxes, ct.pieces,
-                    stats->scale, reach, rank, NULL, error);
+    st = facet_pass(positions, triangles_fd, triangle_count, &g, ct.boxes, ct.pieces, stats->scale,
+                    reach, rank, NULL, error);
     if (st != RSMOOTH_OK)
         goto done;
     if (!share(ct.pieces, ct.count, ranks < 1 ? 1 : ranks)) {
@@ -345,8 +345,8 @@ rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int 
         st = no_memory(error);
         goto done;
     }
-    st = facet_pass(positions, triangles_fd, triangle_count, &g, ct.boxes, ct.pieces,
-                    stats->scale, reach, rank, &fw, error);
+    st = facet_pass(positions, triangles_fd, triangle_count, &g, ct.boxes, ct.pieces, stats->scale,
+                    reach, rank, &fw, error);
     if (st == RSMOOTH_OK && !rs_region_writer_finish(&fw))
         st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
                      "cannot write a temporary file in %s (disk full?)", dir);

@@ -248,8 +248,7 @@ rsmooth_status rs_stream_ply_open(rs_stream_ply *ply, const char *path, uint64_t
     if (fstat(ply->fd, &sb) != 0)
         return io_fail(path, "cannot stat", error);
     if (!S_ISREG(sb.st_mode))
-        return unsupported(path, "needs a regular file (it reads the file more than once)",
-                           error);
+        return unsupported(path, "needs a regular file (it reads the file more than once)", error);
     ply->size = (uint64_t)sb.st_size;
     char magic[7] = {0}; /* a byte-order mark, as the in-memory reader takes it, then "ply" */
     size_t got = ply->size < sizeof magic ? (size_t)ply->size : sizeof magic;
@@ -257,8 +256,7 @@ rsmooth_status rs_stream_ply_open(rs_stream_ply *ply, const char *path, uint64_t
         return io_fail(path, "cannot read", error);
     ply->bom = got >= RS_IO_UTF8_BOM_SIZE && !memcmp(magic, RS_IO_UTF8_BOM, RS_IO_UTF8_BOM_SIZE);
     const char *m = magic + (ply->bom ? RS_IO_UTF8_BOM_SIZE : 0);
-    if (got < (size_t)(m - magic) + 4 || memcmp(m, "ply", 3) != 0 ||
-        (m[3] != '\n' && m[3] != '\r'))
+    if (got < (size_t)(m - magic) + 4 || memcmp(m, "ply", 3) != 0 || (m[3] != '\n' && m[3] != '\r'))
         return unsupported(path, "reads binary PLY only, and this is not a PLY file", error);
     rsmooth_status st = read_header(ply, header_memory, error);
     if (st != RSMOOTH_OK)
@@ -278,8 +276,7 @@ rsmooth_status rs_stream_ply_open(rs_stream_ply *ply, const char *path, uint64_t
         int64_t offset = detail.byte_offset;
         if (offset >= 0 && ply->bom) /* offsets count from the file's first byte */
             offset += RS_IO_UTF8_BOM_SIZE;
-        rs_fail_parse(error, detail.line, offset, RS_STREAM_WHERE, "%s: %s", path,
-                      detail.message);
+        rs_fail_parse(error, detail.line, offset, RS_STREAM_WHERE, "%s: %s", path, detail.message);
         return st;
     }
     if (rs_ply_range_grid_element(ply->header.x)) /* not a point cloud: refused, not misread */
@@ -300,8 +297,8 @@ void rs_stream_ply_close(rs_stream_ply *ply) {
     memset(ply, 0, sizeof *ply);
 }
 
-rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz,
-                                           rs_stream_extent *extent, rsmooth_error *error) {
+rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz, rs_stream_extent *extent,
+                                           rsmooth_error *error) {
     uint64_t end = ply->vertex_start + ply->vertex_count * ply->vertex_stride;
     if (end > ply->size)
         return rs_fail_parse(error, -1, (int64_t)ply->size, RS_STREAM_WHERE,
@@ -436,8 +433,8 @@ rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_f
             }
             if (n < 3) {
                 st = rs_fail_parse(error, -1, (int64_t)at, RS_STREAM_WHERE,
-                                   "%s: face %llu has %llu vertices (at least 3 needed)",
-                                   ply->path, (unsigned long long)i, (unsigned long long)n);
+                                   "%s: face %llu has %llu vertices (at least 3 needed)", ply->path,
+                                   (unsigned long long)i, (unsigned long long)n);
                 break;
             }
             uint32_t first = 0, previous = 0;
@@ -466,7 +463,7 @@ rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_f
                     t[2] = index;
                     if (buffered == OUT_TRIANGLES) {
                         if (!rs_pwrite_all(triangles_fd, out, buffered * 3 * sizeof *out,
-                                              written * 3 * sizeof *out))
+                                           written * 3 * sizeof *out))
                             st = io_fail("temporary file", "cannot write", error);
                         written += buffered;
                         buffered = 0;
@@ -477,8 +474,7 @@ rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_f
         }
     }
     if (st == RSMOOTH_OK && buffered > 0 &&
-        !rs_pwrite_all(triangles_fd, out, buffered * 3 * sizeof *out,
-                          written * 3 * sizeof *out))
+        !rs_pwrite_all(triangles_fd, out, buffered * 3 * sizeof *out, written * 3 * sizeof *out))
         st = io_fail("temporary file", "cannot write", error);
     written += buffered;
     uint64_t face_end = rs_stream_reader_offset(&r);
@@ -538,11 +534,11 @@ static double copy_value(rs_stream_reader *r, swapped_writer *w, rs_ply_type t, 
 
 /* The data into the output little-endian from a big-endian input: value by value, lists walked. */
 static bool copy_swapped(const rs_stream_ply *ply, int out_fd) {
-    swapped_writer w = {out_fd, output_offset(ply, ply->data_start),
-                        rs_alloc_array(READ_BUFFER, 1), 0, true};
+    swapped_writer w = {out_fd, output_offset(ply, ply->data_start), rs_alloc_array(READ_BUFFER, 1),
+                        0, true};
     rs_stream_reader r;
-    if (!w.buf || !rs_stream_reader_open(&r, ply->fd, ply->path, ply->data_start,
-                                         ply->data_end, READ_BUFFER)) {
+    if (!w.buf || !rs_stream_reader_open(&r, ply->fd, ply->path, ply->data_start, ply->data_end,
+                                         READ_BUFFER)) {
         rs_free(w.buf);
         return false;
     }
@@ -552,9 +548,8 @@ static bool copy_swapped(const rs_stream_ply *ply, int out_fd) {
         for (uint64_t i = 0; w.ok && i < e->count && e->property_count > 0; i++)
             for (size_t k = 0; w.ok && k < e->property_count; k++) {
                 const rs_ply_property *p = &e->properties[k];
-                double n = p->count_type == RS_PLY_NONE ? 1
-                                                        : copy_value(&r, &w, p->count_type,
-                                                                     ply->swap);
+                double n =
+                    p->count_type == RS_PLY_NONE ? 1 : copy_value(&r, &w, p->count_type, ply->swap);
                 for (double j = 0; w.ok && j < n; j++)
                     copy_value(&r, &w, p->type, ply->swap);
             }
@@ -587,8 +582,8 @@ rsmooth_status rs_stream_ply_check_positions(const rs_stream_ply *ply, const uin
                        "%s: cannot write: streaming keeps the input's float x y z (without "
                        "--max-memory they are written as double): %s",
                        output, detail.message);
-    return rs_fail(error, RSMOOTH_ERROR_NUMERICAL, RS_STREAM_WHERE, "%s: cannot write: %s",
-                   output, detail.message);
+    return rs_fail(error, RSMOOTH_ERROR_NUMERICAL, RS_STREAM_WHERE, "%s: cannot write: %s", output,
+                   detail.message);
 }
 
 bool rs_stream_ply_write_positions(const rs_stream_ply *ply, int out_fd, const uint32_t *ids,

@@ -11,8 +11,8 @@
  * Ranks (the MPI driver) run 1-3 alike, rank 0 makes the copy, and each writes its own pieces'
  * rows: disjoint bytes of one file. */
 #define _GNU_SOURCE /* O_TMPFILE, linkat, renameat2 */
-#include "stream/stream_internal.h"
 #include "io/output_file.h"
+#include "stream/stream_internal.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -59,12 +59,12 @@ typedef struct stream_call {
     const rsmooth_params *caller_params;
     rsmooth_stream_options opt;
     rsmooth_stream_report rep;
-    char dir[4096];        /* temporaries */
+    char dir[4096]; /* temporaries */
     rs_stream_ply ply;
     void *xyz;
     rs_stream_positions positions;
     int triangles_fd;
-    rs_output out;         /* the output: its target, and the copy the results go into */
+    rs_output out; /* the output: its target, and the copy the results go into */
     uint64_t triangle_count;
     rs_stream_stats stats;
     double halo;
@@ -101,7 +101,8 @@ static void output_dir(const char *output, char *dir, size_t size) {
         *slash = 0;
 }
 
-/* The temporaries' folder: options->tmpdir (an existing folder, its name whole), else the output's. */
+/* The temporaries' folder: options->tmpdir (an existing folder, its name whole), else the output's.
+ */
 static rsmooth_status check_tmpdir(stream_call *c, rsmooth_error *error) {
     if (!c->opt.tmpdir) {
         output_dir(c->output, c->dir, sizeof c->dir);
@@ -116,19 +117,18 @@ static rsmooth_status check_tmpdir(stream_call *c, rsmooth_error *error) {
                        sizeof c->dir - 1);
     struct stat sb;
     if (stat(c->opt.tmpdir, &sb) != 0 || !S_ISDIR(sb.st_mode))
-        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                       "options->tmpdir %s: %s", c->opt.tmpdir,
+        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "options->tmpdir %s: %s",
+                       c->opt.tmpdir,
                        stat(c->opt.tmpdir, &sb) != 0 ? strerror(errno) : "not a folder");
     snprintf(c->dir, sizeof c->dir, "%s", c->opt.tmpdir);
     return RSMOOTH_OK;
 }
 
 static rsmooth_status check_arguments(stream_call *c, const rsmooth_params *params,
-                                      const rsmooth_stream_options *options,
-                                      rsmooth_error *error) {
+                                      const rsmooth_stream_options *options, rsmooth_error *error) {
     if (!c->input || !c->output)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, RS_STREAM_WHERE,
-                       "%s is NULL", c->input ? "output" : "input");
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, RS_STREAM_WHERE, "%s is NULL",
+                       c->input ? "output" : "input");
     rsmooth_stream_options_init(&c->opt);
     if (options) {
         if (options->struct_size < sizeof *options)
@@ -147,8 +147,8 @@ static rsmooth_status check_arguments(stream_call *c, const rsmooth_params *para
                        c->opt.ranks);
     if (c->opt.ranks <= 1 && c->opt.rank != 0)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, RS_STREAM_WHERE,
-                       "options->rank %d with options->ranks %d: alone, the rank is 0",
-                       c->opt.rank, c->opt.ranks);
+                       "options->rank %d with options->ranks %d: alone, the rank is 0", c->opt.rank,
+                       c->opt.ranks);
     if (c->opt.ranks > 1 && !c->opt.sync) /* each rank would write its own pieces only */
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, RS_STREAM_WHERE,
                        "options->ranks %d without options->sync: the ranks cannot agree, and "
@@ -242,8 +242,7 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
                        c->input);
     c->rep.mean_edge_length = c->stats.mean_edge_length;
     c->rep.facet_count = c->stats.facet_count;
-    st = rsmooth_piece_halo(&c->params, c->stats.mean_edge_length, c->stats.reach, &c->halo,
-                            error);
+    st = rsmooth_piece_halo(&c->params, c->stats.mean_edge_length, c->stats.reach, &c->halo, error);
     if (st != RSMOOTH_OK)
         return st;
     c->rep.halo = c->halo;
@@ -253,11 +252,11 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
 
     double t2 = now_ms();
     c->piece_vertices = (cap - position_bytes - FIXED_BYTES) / PIECE_BYTES_PER_VERTEX;
-    c->rep.memory_planned = position_bytes + FIXED_BYTES +
-                            c->piece_vertices * PIECE_BYTES_PER_VERTEX;
+    c->rep.memory_planned =
+        position_bytes + FIXED_BYTES + c->piece_vertices * PIECE_BYTES_PER_VERTEX;
     st = rs_stream_pieces_build(&c->positions, c->triangles_fd, c->triangle_count, &c->stats,
-                                c->halo, c->piece_vertices, GRID_BYTES, c->opt.rank,
-                                c->opt.ranks, c->dir, &c->pieces, error);
+                                c->halo, c->piece_vertices, GRID_BYTES, c->opt.rank, c->opt.ranks,
+                                c->dir, &c->pieces, error);
     if (st != RSMOOTH_OK)
         return st;
     c->rep.pieces = c->pieces.count;
@@ -278,8 +277,8 @@ static rsmooth_status make_copy(stream_call *c, rsmooth_error *error) {
     if (st != RSMOOTH_OK)
         return st;
     if (!rs_stream_ply_write_copy(&c->ply, c->out.fd))
-        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",
-                       c->output, strerror(errno));
+        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s", c->output,
+                       strerror(errno));
     return RSMOOTH_OK;
 }
 
@@ -343,8 +342,8 @@ static rsmooth_status filter_piece(stream_call *c, double *xyz, size_t k, const 
     info.scale = 1;
     rsmooth_report rep;
     rsmooth_report_init(&rep);
-    rsmooth_status st = rsmooth_smooth_piece(c->ctx, xyz, k, tri, m, &info, &params, out, &rep,
-                                             error);
+    rsmooth_status st =
+        rsmooth_smooth_piece(c->ctx, xyz, k, tri, m, &info, &params, out, &rep, error);
     if (st != RSMOOTH_OK)
         return st;
     if (!c->rep.device[0])
@@ -375,8 +374,8 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
     }
     if (!rs_pread_all(c->pieces.vertex_fd, core, n * 4, p->vertex_start * 4) ||
         !rs_pread_all(c->pieces.facet_fd, tri, m * 12, p->facet_start * 12)) {
-        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                     "cannot read a temporary file: %s", strerror(errno));
+        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot read a temporary file: %s",
+                     strerror(errno));
         goto done;
     }
     size_t k = 0;
@@ -423,8 +422,8 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
         goto done;
     double t = now_ms();
     if (!rs_stream_ply_write_positions(&c->ply, c->out.fd, core, n, out))
-        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",
-                     c->output, strerror(errno));
+        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s", c->output,
+                     strerror(errno));
     c->rep.ms_write += now_ms() - t;
 done:
     id_table_free(&table);

@@ -24,8 +24,7 @@ static int compare_u32(const void *a, const void *b) {
     return (x > y) - (x < y);
 }
 
-static void scaled_position(const rs_stream_positions *p, uint32_t v, double scale,
-                            double out[3]) {
+static void scaled_position(const rs_stream_positions *p, uint32_t v, double scale, double out[3]) {
     rs_stream_position(p, v, out);
     for (int k = 0; k < 3; k++)
         out[k] *= scale;
@@ -108,9 +107,9 @@ static rsmooth_status edge_range(const rs_stream_positions *pos, int fd, uint64_
     return RSMOOTH_OK;
 }
 
-static rsmooth_status mean_edge_length(const rs_stream_positions *pos, int fd,
-                                       uint64_t triangles, double scale, uint64_t memory,
-                                       double *out, rsmooth_error *error) {
+static rsmooth_status mean_edge_length(const rs_stream_positions *pos, int fd, uint64_t triangles,
+                                       double scale, uint64_t memory, double *out,
+                                       rsmooth_error *error) {
     uint64_t v_count = pos->count;
     /* a first guess at the run of vertices that fits: each holds about 3 T / V upper ends */
     double per_vertex = 8 + 4 * (v_count ? 3.0 * (double)triangles / (double)v_count : 0) * 1.25;
@@ -137,8 +136,8 @@ static rsmooth_status mean_edge_length(const rs_stream_positions *pos, int fd,
                            (unsigned long long)(hi - lo));
         }
         bool fits = false;
-        rsmooth_status st = edge_range(pos, fd, triangles, scale, (uint32_t)lo, (uint32_t)hi,
-                                       start, upper, capacity, &sum, &unique, &fits, error);
+        rsmooth_status st = edge_range(pos, fd, triangles, scale, (uint32_t)lo, (uint32_t)hi, start,
+                                       upper, capacity, &sum, &unique, &fits, error);
         rs_free(start);
         rs_free(upper);
         if (st != RSMOOTH_OK)
@@ -232,8 +231,7 @@ static rsmooth_status whole_scale(const rs_stream_positions *pos, int fd, uint64
 
 rsmooth_status rs_stream_statistics(const rs_stream_positions *positions, int triangles_fd,
                                     uint64_t triangle_count, const rs_stream_extent *extent,
-                                    uint64_t memory, rs_stream_stats *stats,
-                                    rsmooth_error *error) {
+                                    uint64_t memory, rs_stream_stats *stats, rsmooth_error *error) {
     memset(stats, 0, sizeof *stats);
     memcpy(stats->lo, extent->lo, sizeof stats->lo);
     memcpy(stats->hi, extent->hi, sizeof stats->hi);

@@ -45,10 +45,8 @@ PyObject *ext_context_create(PyObject *self, PyObject *args) {
     rsmooth_context *ctx = NULL;
     rsmooth_error err;
     rsmooth_status st;
-    Py_BEGIN_ALLOW_THREADS
-    st = rsmooth_context_create(device, &ctx, &err);
-    Py_END_ALLOW_THREADS
-    return capsule_for(st, ctx, &err);
+    Py_BEGIN_ALLOW_THREADS st = rsmooth_context_create(device, &ctx, &err);
+    Py_END_ALLOW_THREADS return capsule_for(st, ctx, &err);
 }
 
 /* An OpenCL handle passed as an int (PyOpenCL's int_ptr): 0 and *out, or -1 with TypeError. */
@@ -78,10 +76,9 @@ PyObject *ext_context_from_queue(PyObject *self, PyObject *args) {
     rsmooth_context *ctx = NULL;
     rsmooth_error err;
     rsmooth_status st;
-    Py_BEGIN_ALLOW_THREADS
-    st = rsmooth_context_create_from_queue((cl_command_queue)queue, &ctx, &err);
-    Py_END_ALLOW_THREADS
-    return capsule_for(st, ctx, &err);
+    Py_BEGIN_ALLOW_THREADS st =
+        rsmooth_context_create_from_queue((cl_command_queue)queue, &ctx, &err);
+    Py_END_ALLOW_THREADS return capsule_for(st, ctx, &err);
 }
 
 /* _smooth_cl(context, double, positions, vertex_count, faces, out, params, progress) -> report
@@ -90,8 +87,8 @@ PyObject *ext_context_from_queue(PyObject *self, PyObject *args) {
  * (m, 3) uint32 on the host. */
 PyObject *ext_smooth_cl(PyObject *self, PyObject *args, PyObject *kwargs) {
     (void)self;
-    static char *keywords[] = {"context", "double", "positions", "vertex_count", "faces", "out",
-                               "params", "progress", NULL};
+    static char *keywords[] = {"context", "double",   "positions", "vertex_count", "faces", "out",
+                               "params",  "progress", NULL};
     PyObject *cobj, *dobj, *pobj_in, *nobj, *fobj, *oobj, *pobj, *progress;
     if (!PyArg_ParseTupleAndKeywords(args, kwargs, "OOOOOOOO", keywords, &cobj, &dobj, &pobj_in,
                                      &nobj, &fobj, &oobj, &pobj, &progress))
@@ -120,9 +117,9 @@ PyObject *ext_smooth_cl(PyObject *self, PyObject *args, PyObject *kwargs) {
     rsmooth_report_init(&rep);
     rsmooth_error err;
     ext_start_call(&call, progress, &p, 1);
-    rsmooth_status st = rsmooth_smooth_cl(ctx, is_double ? RSMOOTH_FLOAT64 : RSMOOTH_FLOAT32,
-                                          (cl_mem)in_mem, (size_t)count, f.data, (size_t)f.rows,
-                                          &p, (cl_mem)out_mem, &rep, &err);
+    rsmooth_status st =
+        rsmooth_smooth_cl(ctx, is_double ? RSMOOTH_FLOAT64 : RSMOOTH_FLOAT32, (cl_mem)in_mem,
+                          (size_t)count, f.data, (size_t)f.rows, &p, (cl_mem)out_mem, &rep, &err);
     result = ext_finish_call(&call, st, &rep, &err);
 done:
     ext_param_arrays_release(&held);
@@ -142,11 +139,10 @@ PyObject *ext_context_info(PyObject *self, PyObject *args) {
     /* the budget is read under the context's lock, which a call on another thread may hold
      * until its progress callable has had the GIL */
     uint64_t budget;
-    Py_BEGIN_ALLOW_THREADS
-    budget = rsmooth_context_memory_budget(ctx);
-    Py_END_ALLOW_THREADS
-    return Py_BuildValue("(sdK)", rsmooth_context_device_name(ctx), rsmooth_context_build_ms(ctx),
-                         (unsigned long long)budget);
+    Py_BEGIN_ALLOW_THREADS budget = rsmooth_context_memory_budget(ctx);
+    Py_END_ALLOW_THREADS return Py_BuildValue("(sdK)", rsmooth_context_device_name(ctx),
+                                              rsmooth_context_build_ms(ctx),
+                                              (unsigned long long)budget);
 }
 
 /* _devices() -> list of dicts, one per OpenCL device ([] without OpenCL). */
@@ -154,32 +150,29 @@ PyObject *ext_devices(PyObject *self, PyObject *args) {
     (void)self;
     (void)args;
     size_t count;
-    Py_BEGIN_ALLOW_THREADS
-    count = rsmooth_list_devices(NULL, 0);
-    Py_END_ALLOW_THREADS
-    rsmooth_device_info *info = count ? calloc(count, sizeof *info) : NULL;
+    Py_BEGIN_ALLOW_THREADS count = rsmooth_list_devices(NULL, 0);
+    Py_END_ALLOW_THREADS rsmooth_device_info *info = count ? calloc(count, sizeof *info) : NULL;
     if (count && !info)
         return PyErr_NoMemory();
     if (count) {
-        Py_BEGIN_ALLOW_THREADS
-        size_t again = rsmooth_list_devices(info, count);
+        Py_BEGIN_ALLOW_THREADS size_t again = rsmooth_list_devices(info, count);
         count = again < count ? again : count;
         Py_END_ALLOW_THREADS
     }
     PyObject *list = PyList_New(0);
     for (size_t i = 0; list && i < count; i++) {
         const rsmooth_device_info *d = info + i;
-        PyObject *item = Py_BuildValue(
-            "{s:s,s:i,s:i,s:s,s:s,s:I,s:K}", "id", "", "platform", d->platform_index, "device",
-            d->device_index, "name", d->name, "type", d->type, "compute_units", d->compute_units,
-            "global_memory", (unsigned long long)d->global_memory);
-        PyObject *id = item ? PyUnicode_FromFormat("%d:%d", d->platform_index, d->device_index)
-                            : NULL;
+        PyObject *item = Py_BuildValue("{s:s,s:i,s:i,s:s,s:s,s:I,s:K}", "id", "", "platform",
+                                       d->platform_index, "device", d->device_index, "name",
+                                       d->name, "type", d->type, "compute_units", d->compute_units,
+                                       "global_memory", (unsigned long long)d->global_memory);
+        PyObject *id =
+            item ? PyUnicode_FromFormat("%d:%d", d->platform_index, d->device_index) : NULL;
         char whole[1024]; /* d->version holds 63 bytes of it */
-        const char *v = rsmooth_device_version(d->platform_index, d->device_index, whole,
-                                               sizeof whole) > 0
-                            ? whole
-                            : d->version;
+        const char *v =
+            rsmooth_device_version(d->platform_index, d->device_index, whole, sizeof whole) > 0
+                ? whole
+                : d->version;
         PyObject *version = item ? PyUnicode_FromString(v) : NULL;
         if (!id || !version || PyDict_SetItemString(item, "id", id) != 0 ||
             PyDict_SetItemString(item, "version", version) != 0 || PyList_Append(list, item) != 0) {

@@ -74,8 +74,8 @@ PyObject *ext_devices(PyObject *self, PyObject *args);                         /
 PyObject *ext_context_create(PyObject *self, PyObject *args);                  /* context.c */
 PyObject *ext_context_info(PyObject *self, PyObject *args);                    /* context.c */
 
-PyObject *ext_context_from_queue(PyObject *self, PyObject *args);              /* context.c */
-PyObject *ext_smooth_cl(PyObject *self, PyObject *args, PyObject *kwargs);     /* context.c */
+PyObject *ext_context_from_queue(PyObject *self, PyObject *args);          /* context.c */
+PyObject *ext_smooth_cl(PyObject *self, PyObject *args, PyObject *kwargs); /* context.c */
 
 /* A filter call in progress (filter.c): the GIL let go, progress reports taking it back. */
 typedef struct call_state {

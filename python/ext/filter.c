@@ -8,7 +8,6 @@
 
 #include <string.h>
 
-
 /* The calls on an OpenCL context this thread is inside: Python code that runs on it meanwhile
  * (the progress callable, a signal handler) is inside them too. */
 static _Thread_local int contexts_held;
@@ -43,8 +42,8 @@ static int report(void *user, double fraction) {
 /* The normal-update stage's figures: where its cycles ran, in what precision, its parts. */
 static PyObject *stage_dict(const rsmooth_report *r) {
     return Py_BuildValue("{s:O,s:i,s:i,s:K,s:K,s:d,s:d,s:d,s:d,s:d}", "on_device",
-                         r->stage_on_device ? Py_True : Py_False, "float_bits",
-                         r->stage_float_bits, "cycles", r->stage_cycles, "bytes_to_device",
+                         r->stage_on_device ? Py_True : Py_False, "float_bits", r->stage_float_bits,
+                         "cycles", r->stage_cycles, "bytes_to_device",
                          (unsigned long long)r->stage_bytes_to_device, "bytes_from_device",
                          (unsigned long long)r->stage_bytes_from_device, "ms", r->ms_stage,
                          "ms_lists", r->ms_stage_lists, "ms_upload", r->ms_stage_upload,
@@ -93,11 +92,11 @@ PyObject *ext_finish_call(call_state *c, rsmooth_status st, const rsmooth_report
  * (n, 3) of one float type; faces (m, 3) uint32; confidence (n,) float32 or None. */
 PyObject *ext_smooth(PyObject *self, PyObject *args, PyObject *kwargs) {
     (void)self;
-    static char *keywords[] = {"context", "vertices", "faces", "out", "confidence", "params",
-                               "progress", NULL};
+    static char *keywords[] = {"context",    "vertices", "faces",    "out",
+                               "confidence", "params",   "progress", NULL};
     PyObject *cobj, *vobj, *fobj, *oobj, *kobj, *pobj, *progress;
-    if (!PyArg_ParseTupleAndKeywords(args, kwargs, "OOOOOOO", keywords, &cobj, &vobj, &fobj,
-                                     &oobj, &kobj, &pobj, &progress))
+    if (!PyArg_ParseTupleAndKeywords(args, kwargs, "OOOOOOO", keywords, &cobj, &vobj, &fobj, &oobj,
+                                     &kobj, &pobj, &progress))
         return NULL;
     rsmooth_context *ctx = NULL;
     if (cobj != Py_None && (!(ctx = ext_context_from(cobj)) ||
@@ -114,8 +113,8 @@ PyObject *ext_smooth(PyObject *self, PyObject *args, PyObject *kwargs) {
         return NULL;
     rsmooth_params p;
     if (ext_array_get(fobj, "faces", EXT_UINT32, 3, 0, 0, &f) != 0 ||
-        ext_array_get(oobj, "out", v.scalar == RSMOOTH_FLOAT32 ? EXT_FLOAT32 : EXT_FLOAT64, 3, 1,
-                      0, &out) != 0 ||
+        ext_array_get(oobj, "out", v.scalar == RSMOOTH_FLOAT32 ? EXT_FLOAT32 : EXT_FLOAT64, 3, 1, 0,
+                      &out) != 0 ||
         ext_array_get(kobj, "confidence", EXT_FLOAT32, 0, 1, 1, &conf) != 0 ||
         ext_params_from_dict(pobj, v.rows, &p, &held) != 0)
         goto done;
@@ -136,8 +135,8 @@ PyObject *ext_smooth(PyObject *self, PyObject *args, PyObject *kwargs) {
         st = rsmooth_smooth(ctx, v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows, &p,
                             out.data, NULL, conf.data, &rep, &err);
     else
-        st = rsmooth_smooth_reference(v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows,
-                                      &p, out.data, NULL, conf.data, &rep, &err);
+        st = rsmooth_smooth_reference(v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows, &p,
+                                      out.data, NULL, conf.data, &rep, &err);
     result = ext_finish_call(&call, st, &rep, &err);
     if (result) {
         ext_array_publish(&out);
@@ -156,11 +155,11 @@ done:
  * points, normals, out, out_normals: (n, 3) of one float type; confidence (n,) float32 or None. */
 PyObject *ext_smooth_points(PyObject *self, PyObject *args, PyObject *kwargs) {
     (void)self;
-    static char *keywords[] = {"points", "normals", "out", "out_normals", "confidence",
-                               "params", "progress", NULL};
+    static char *keywords[] = {"points",     "normals", "out",      "out_normals",
+                               "confidence", "params",  "progress", NULL};
     PyObject *vobj, *nobj, *oobj, *onobj, *kobj, *pobj, *progress;
-    if (!PyArg_ParseTupleAndKeywords(args, kwargs, "OOOOOOO", keywords, &vobj, &nobj, &oobj,
-                                     &onobj, &kobj, &pobj, &progress))
+    if (!PyArg_ParseTupleAndKeywords(args, kwargs, "OOOOOOO", keywords, &vobj, &nobj, &oobj, &onobj,
+                                     &kobj, &pobj, &progress))
         return NULL;
     ext_array v, n, out, out_n, conf;
     ext_param_arrays held;
@@ -193,9 +192,8 @@ PyObject *ext_smooth_points(PyObject *self, PyObject *args, PyObject *kwargs) {
     rsmooth_report_init(&rep); /* its struct_size says which fields this caller has */
     rsmooth_error err;
     ext_start_call(&call, progress, &p, 0);
-    rsmooth_status st = rsmooth_smooth_points_reference(v.scalar, v.data, n.data, (size_t)v.rows,
-                                                        &p, out.data, out_n.data, conf.data, &rep,
-                                                        &err);
+    rsmooth_status st = rsmooth_smooth_points_reference(
+        v.scalar, v.data, n.data, (size_t)v.rows, &p, out.data, out_n.data, conf.data, &rep, &err);
     result = ext_finish_call(&call, st, &rep, &err);
     if (result) {
         ext_array_publish(&out);
@@ -220,8 +218,8 @@ PyObject *ext_taubin(PyObject *self, PyObject *args, PyObject *kwargs) {
     PyObject *vobj, *fobj, *oobj, *lobj, *mobj, *iobj;
     double lam, mu;
     long iterations;
-    if (!PyArg_ParseTupleAndKeywords(args, kwargs, "OOOOOO", keywords, &vobj, &fobj, &oobj,
-                                     &lobj, &mobj, &iobj) ||
+    if (!PyArg_ParseTupleAndKeywords(args, kwargs, "OOOOOO", keywords, &vobj, &fobj, &oobj, &lobj,
+                                     &mobj, &iobj) ||
         ext_real_arg(lobj, "lam", &lam) != 0 || ext_real_arg(mobj, "mu", &mu) != 0 ||
         ext_whole_arg(iobj, "iterations", 0, EXT_MAX_ITERATIONS, &iterations) != 0)
         return NULL;
@@ -240,8 +238,8 @@ PyObject *ext_taubin(PyObject *self, PyObject *args, PyObject *kwargs) {
     if (ext_array_get(vobj, "vertices", EXT_REAL, 3, 0, 0, &v) != 0)
         return NULL;
     if (ext_array_get(fobj, "faces", EXT_UINT32, 3, 0, 0, &f) != 0 ||
-        ext_array_get(oobj, "out", v.scalar == RSMOOTH_FLOAT32 ? EXT_FLOAT32 : EXT_FLOAT64, 3, 1,
-                      0, &out) != 0)
+        ext_array_get(oobj, "out", v.scalar == RSMOOTH_FLOAT32 ? EXT_FLOAT32 : EXT_FLOAT64, 3, 1, 0,
+                      &out) != 0)
         goto done;
     if (out.rows != v.rows) {
         PyErr_SetString(PyExc_ValueError, "out must have a row per vertex");
@@ -252,15 +250,15 @@ PyObject *ext_taubin(PyObject *self, PyObject *args, PyObject *kwargs) {
         goto done;
     rsmooth_error err;
     rsmooth_status st;
-    Py_BEGIN_ALLOW_THREADS
-    st = rsmooth_smooth_taubin(v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows, lam, mu,
-                               (unsigned)iterations, out.data, &err);
-    Py_END_ALLOW_THREADS
-    if (st == RSMOOTH_OK) {
+    Py_BEGIN_ALLOW_THREADS st =
+        rsmooth_smooth_taubin(v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows, lam, mu,
+                              (unsigned)iterations, out.data, &err);
+    Py_END_ALLOW_THREADS if (st == RSMOOTH_OK) {
         ext_array_publish(&out);
         Py_INCREF(Py_None);
         result = Py_None;
-    } else {
+    }
+    else {
         ext_raise(st, &err);
     }
 done:

@@ -23,8 +23,8 @@ static PyObject *measure_mesh(PyObject *args, mesh_measure measure) {
     rsmooth_error err;
     rsmooth_status st = RSMOOTH_ERROR_OUT_OF_MEMORY;
     if (ext_array_own(&v, 0) == 0 && ext_array_own(&f, 0) == 0) {
-        Py_BEGIN_ALLOW_THREADS
-        st = measure(v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows, &value, &err);
+        Py_BEGIN_ALLOW_THREADS st =
+            measure(v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows, &value, &err);
         Py_END_ALLOW_THREADS
     }
     ext_array_release(&f);
@@ -57,8 +57,8 @@ PyObject *ext_point_spacing(PyObject *self, PyObject *args) {
     rsmooth_error err;
     rsmooth_status st = RSMOOTH_ERROR_OUT_OF_MEMORY;
     if (ext_array_own(&v, 0) == 0) {
-        Py_BEGIN_ALLOW_THREADS
-        st = rsmooth_point_spacing(v.scalar, v.data, (size_t)v.rows, &value, &err);
+        Py_BEGIN_ALLOW_THREADS st =
+            rsmooth_point_spacing(v.scalar, v.data, (size_t)v.rows, &value, &err);
         Py_END_ALLOW_THREADS
     }
     ext_array_release(&v);
@@ -77,8 +77,8 @@ PyObject *ext_compare(PyObject *self, PyObject *args) {
     PyObject *result = NULL;
     if (ext_array_get(robj, "result", EXT_REAL, 3, 0, 0, &r) != 0)
         return NULL;
-    if (ext_array_get(tobj, "truth", r.scalar == RSMOOTH_FLOAT32 ? EXT_FLOAT32 : EXT_FLOAT64, 3,
-                      0, 0, &t) != 0 ||
+    if (ext_array_get(tobj, "truth", r.scalar == RSMOOTH_FLOAT32 ? EXT_FLOAT32 : EXT_FLOAT64, 3, 0,
+                      0, &t) != 0 ||
         ext_array_get(fobj, "faces", EXT_UINT32, 3, 0, 0, &f) != 0)
         goto done;
     if (t.rows != r.rows) {
@@ -90,18 +90,14 @@ PyObject *ext_compare(PyObject *self, PyObject *args) {
     rsmooth_metrics m;
     rsmooth_error err;
     rsmooth_status st;
-    Py_BEGIN_ALLOW_THREADS
-    st = rsmooth_compare(r.scalar, r.data, t.data, (size_t)r.rows, f.data, (size_t)f.rows, &m,
-                         &err);
-    Py_END_ALLOW_THREADS
-    if (st != RSMOOTH_OK)
-        ext_raise(st, &err);
-    else
-        result = Py_BuildValue("{s:d,s:d,s:d,s:d,s:n,s:d,s:d,s:n,s:n}", "theta", m.theta, "ev",
-                               m.ev, "rms_v", m.rms_v, "hausdorff", m.hausdorff, "theta_count",
-                               (Py_ssize_t)m.theta_count, "mean_edge", m.mean_edge, "bbox_diag",
-                               m.bbox_diag, "vertex_count", (Py_ssize_t)m.vertex_count,
-                               "triangle_count", (Py_ssize_t)m.triangle_count);
+    Py_BEGIN_ALLOW_THREADS st =
+        rsmooth_compare(r.scalar, r.data, t.data, (size_t)r.rows, f.data, (size_t)f.rows, &m, &err);
+    Py_END_ALLOW_THREADS if (st != RSMOOTH_OK) ext_raise(st, &err);
+    else result = Py_BuildValue("{s:d,s:d,s:d,s:d,s:n,s:d,s:d,s:n,s:n}", "theta", m.theta, "ev",
+                                m.ev, "rms_v", m.rms_v, "hausdorff", m.hausdorff, "theta_count",
+                                (Py_ssize_t)m.theta_count, "mean_edge", m.mean_edge, "bbox_diag",
+                                m.bbox_diag, "vertex_count", (Py_ssize_t)m.vertex_count,
+                                "triangle_count", (Py_ssize_t)m.triangle_count);
 done:
     ext_array_release(&f);
     ext_array_release(&t);

@@ -66,9 +66,15 @@ static PyMethodDef methods[] = {
 };
 
 static struct PyModuleDef module = {
-    PyModuleDef_HEAD_INIT, "_rsmooth",
-    "rsmooth's C extension: the library behind the rsmooth package (use rsmooth, not this).", -1,
-    methods, NULL, NULL, NULL, NULL,
+    PyModuleDef_HEAD_INIT,
+    "_rsmooth",
+    "rsmooth's C extension: the library behind the rsmooth package (use rsmooth, not this).",
+    -1,
+    methods,
+    NULL,
+    NULL,
+    NULL,
+    NULL,
 };
 
 PyMODINIT_FUNC PyInit__rsmooth(void); /* (the only symbol the module exports) */

@@ -15,8 +15,10 @@ typedef struct field {
     int min, max; /* FIELD_INT's range */
 } field;
 
-#define DOUBLE_FIELD(f) {#f, offsetof(rsmooth_params, f), FIELD_DOUBLE, 0, 0}
-#define INT_FIELD(f, min, max) {#f, offsetof(rsmooth_params, f), FIELD_INT, min, max}
+#define DOUBLE_FIELD(f)                                                                            \
+    { #f, offsetof(rsmooth_params, f), FIELD_DOUBLE, 0, 0 }
+#define INT_FIELD(f, min, max)                                                                     \
+    { #f, offsetof(rsmooth_params, f), FIELD_INT, min, max }
 
 /* The ranges of the int fields are the command's (host/cli_options.c) and the library's
  * (RS_MAX_ROUNDS 100 and RS_MAX_UPDATES 1000, lib/core/params.c): checked here too, so that a
@@ -64,13 +66,13 @@ int ext_whole_arg(PyObject *value, const char *name, long min, long max, long *o
         }
     }
     if (!whole) {
-        PyErr_Format(PyExc_TypeError, "%s must be a whole number in [%ld, %ld] (got %R)", name,
-                     min, max, value);
+        PyErr_Format(PyExc_TypeError, "%s must be a whole number in [%ld, %ld] (got %R)", name, min,
+                     max, value);
         return -1;
     }
     if (overflow) { /* (no repr: past 4300 digits Python refuses to write one) */
-        PyErr_Format(PyExc_ValueError, "%s must be in [%ld, %ld] (got a number %s)", name, min,
-                     max, overflow > 0 ? "beyond a C long" : "below a C long");
+        PyErr_Format(PyExc_ValueError, "%s must be in [%ld, %ld] (got a number %s)", name, min, max,
+                     overflow > 0 ? "beyond a C long" : "below a C long");
         return -1;
     }
     if (v < min || v > max) {
@@ -90,8 +92,7 @@ int ext_real_arg(PyObject *value, const char *name, double *out) {
         }
         if (PyErr_ExceptionMatches(PyExc_OverflowError)) { /* an int past 1.8e308 */
             PyErr_Clear();
-            PyErr_Format(PyExc_ValueError, "%s: the number given is beyond a double's range",
-                         name);
+            PyErr_Format(PyExc_ValueError, "%s: the number given is beyond a double's range", name);
             return -1;
         }
         if (!PyErr_ExceptionMatches(PyExc_TypeError))
@@ -230,10 +231,10 @@ static PyObject *noise_report_to_dict(const rsmooth_noise_report *r) {
     return Py_BuildValue("{sd,ss,sd,sd,sd,ss,ss,sd,sd,sd,sn,sn}", "level", r->level, "kind", kind,
                          "impulsive_fraction", r->impulsive_fraction, "tangential_level",
                          r->tangential_level, "mean_edge_length", r->mean_edge_length, "preset",
-                         r->preset, "reason", r->reason, "correlated_level",
-                         r->correlated_level, "correlation_length", r->correlation_length,
-                         "shape_correlation", r->shape_correlation, "parts",
-                         (Py_ssize_t)r->parts, "outliers", (Py_ssize_t)r->outliers);
+                         r->preset, "reason", r->reason, "correlated_level", r->correlated_level,
+                         "correlation_length", r->correlation_length, "shape_correlation",
+                         r->shape_correlation, "parts", (Py_ssize_t)r->parts, "outliers",
+                         (Py_ssize_t)r->outliers);
 }
 
 /* _params_auto(vertices, faces, params) -> (params, report): rsmooth_params_auto_report's rule
@@ -260,13 +261,12 @@ PyObject *ext_params_auto(PyObject *self, PyObject *args) {
         rsmooth_noise_report_init(&report);
         rsmooth_error err;
         rsmooth_status st;
-        Py_BEGIN_ALLOW_THREADS
-        st = rsmooth_params_auto_report(v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows,
-                                        &p, &report, &err);
-        Py_END_ALLOW_THREADS
-        if (st != RSMOOTH_OK) {
+        Py_BEGIN_ALLOW_THREADS st = rsmooth_params_auto_report(
+            v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows, &p, &report, &err);
+        Py_END_ALLOW_THREADS if (st != RSMOOTH_OK) {
             ext_raise(st, &err);
-        } else {
+        }
+        else {
             PyObject *dict = ext_params_to_dict(&p);
             PyObject *said = dict ? noise_report_to_dict(&report) : NULL;
             if (said)

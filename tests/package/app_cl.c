@@ -37,8 +37,8 @@ int main(void) {
     rsmooth_context *ctx = NULL;
     rsmooth_status st = rsmooth_context_create_from_queue(queue, &ctx, &err);
     if (st == RSMOOTH_OK) {
-        st = rsmooth_smooth(ctx, RSMOOTH_FLOAT32, xyz, 4, idx, 4, NULL, out, NULL, NULL, NULL,
-                            &err);
+        st =
+            rsmooth_smooth(ctx, RSMOOTH_FLOAT32, xyz, 4, idx, 4, NULL, out, NULL, NULL, NULL, &err);
         rsmooth_context_destroy(ctx);
     }
     clReleaseCommandQueue(queue);

@@ -12,7 +12,8 @@ int main(void) {
                               "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
     rsmooth_error err;
     rsmooth_mesh *mesh = NULL;
-    rsmooth_status st = rsmooth_mesh_read_memory(obj, strlen(obj), RSMOOTH_FORMAT_AUTO, &mesh, &err);
+    rsmooth_status st =
+        rsmooth_mesh_read_memory(obj, strlen(obj), RSMOOTH_FORMAT_AUTO, &mesh, &err);
     if (st != RSMOOTH_OK) {
         fprintf(stderr, "app_io: read: %s\n", err.message);
         return 1;
