@@ -3,6 +3,7 @@
  * facet data, then the tiles (opencl/tiles.c) that each run the kernels (opencl/cl_smooth.c).
  * The reference path's entry point is rsmooth_smooth_reference (reference/reference.c). */
 #include "opencl/cl_run.h"
+#include "passes/passes.h"
 
 #include <stdlib.h>
 #include <string.h>

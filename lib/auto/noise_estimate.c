@@ -894,25 +894,11 @@ rsmooth_status rsmooth_estimate_noise(rsmooth_scalar scalar, const void *positio
     rs_error_clear(error);
     if (!out_noise)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_noise is NULL");
-    rs_noise_stats stats;
-    rsmooth_status st = rs_estimate_noise_stats(scalar, positions, vertex_count, indices,
-                                                triangle_count, &stats, error, where);
-    if (st == RSMOOTH_OK)
-        *out_noise = stats.noise;
-    return st;
-}
-
-rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positions,
-                                       size_t vertex_count, const uint32_t *indices,
-                                       size_t triangle_count, rs_noise_stats *out,
-                                       rsmooth_error *error, const char *caller) {
     rs_noise_details details;
     rsmooth_status st = rs_estimate_noise_details(scalar, positions, vertex_count, indices,
-                                                  triangle_count, &details, error, caller);
-    if (st == RSMOOTH_OK) {
-        out->noise = details.level;
-        out->impulsive = details.impulsive;
-    }
+                                                  triangle_count, &details, error, where);
+    if (st == RSMOOTH_OK)
+        *out_noise = details.level;
     return st;
 }
 

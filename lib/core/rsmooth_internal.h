@@ -1,4 +1,6 @@
-/* Declarations shared by the library's own files (not installed). Prefix rs_. */
+/* What every layer of the library shares: core/ only (the layers above declare their own in their
+ * folders: passes/passes.h, reference/reference.h, stages/, auto/, opencl/). Not installed; prefix
+ * rs_. */
 #ifndef RSMOOTH_INTERNAL_H
 #define RSMOOTH_INTERNAL_H
 
@@ -400,86 +402,5 @@ void rs_report_problem(rsmooth_report *report, const rs_problem *problem, size_t
                        const char *device);
 /* Multiplies a report's lengths by `unscale`: internal units to the caller's. */
 void rs_report_unscale(rsmooth_report *report, double unscale);
-
-/* ---- noise_estimate.c / params_auto.c: automatic parameters -------------------------------- */
-
-typedef struct rs_noise_stats {
-    double noise;   /* rsmooth_estimate_noise's estimate, mean edge lengths */
-    bool impulsive; /* the residuals' tail beyond 4 robust sigmas is far heavier than a
-                     * Gaussian's: a few vertices thrown far */
-} rs_noise_stats;
-
-/* rsmooth_estimate_noise with the tail statistic; errors name `caller`. */
-rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positions,
-                                       size_t vertex_count, const uint32_t *indices,
-                                       size_t triangle_count, rs_noise_stats *out,
-                                       rsmooth_error *error, const char *caller);
-
-/* ---- taubin.c ---------------------------------------------------------------------------------
- */
-
-/* Taubin's lambda|mu smoothing of xyz (double, in place) until the RMS distance of the vertices
- * from where they started reaches target_move (mesh units) and, when min_gain > 0, an iteration
- * adds less than min_gain to it; or max_iterations. Returns the iterations run, -1 when out of
- * memory (xyz unchanged). */
-int rs_taubin_until(double *xyz, size_t vertex_count, const uint32_t *indices,
-                    size_t triangle_count, double lambda, double mu, double target_move,
-                    double min_gain, int max_iterations);
-
-/* ---- reference.c / passes.c: the filter on a prepared problem, and repeated passes ----------- */
-
-/* The reference filter on a prepared problem (with its facet data kept), written to the caller's
- * arrays; out_normals (optional) receives the predictors' unit normals, 3 per facet, when there
- * are facets. t_start is when the call began, for the report. The caller frees the problem. */
-rsmooth_status rs_reference_solve(const rs_problem *problem, rsmooth_scalar scalar,
-                                  void *out_positions, float *out_weight, float *out_confidence,
-                                  double *out_normals, rsmooth_report *report, double t_start,
-                                  rsmooth_error *error, const char *where);
-
-/* The caller's progress callback seen through pass `pass` of `count` (rs_report_pass_progress
- * is the callback to give the pass, with this as its user pointer). */
-typedef struct rs_pass_progress {
-    rsmooth_progress_fn progress;
-    rsmooth_progress_cancel_fn cancel;
-    void *user;
-    int pass, count;
-} rs_pass_progress;
-/* A progress_cancel callback: forwards to both of the caller's, the fraction rescaled. */
-int rs_report_pass_progress(void *user, double fraction);
-
-/* Adds one pass's stage times and work to `sum`, the passes' so far (all zero before the first):
- * counts, sigmas and device from the last pass, the facet count from the first. */
-void rs_add_pass_report(rsmooth_report *sum, const rsmooth_report *pass);
-
-/* One pass of a filter path, with rsmooth_smooth_reference's arguments; `ctx` is the path's own. */
-typedef rsmooth_status (*rs_filter_fn)(void *ctx, rsmooth_scalar scalar, const void *positions,
-                                       size_t vertex_count, const uint32_t *indices,
-                                       size_t triangle_count, const rsmooth_params *params,
-                                       void *out_positions, float *out_weight,
-                                       float *out_confidence, rsmooth_report *report,
-                                       rsmooth_error *error);
-
-/* The normal-update stage's plan and figures (stage_plan.h). */
-typedef struct rs_stage_plan rs_stage_plan;
-typedef struct rs_stage_stats rs_stage_stats;
-/* Called after each cycle with the cycles done; non-zero stops the stage (RSMOOTH_CANCELLED). */
-typedef int (*rs_cycle_fn)(void *user, int done, int cycles);
-/* Runs every cycle of `plan` elsewhere (the device: opencl/cl_stage.c), writing the final
- * positions (the stage's units) to xyz. A runner that cannot take the plan (too large for its
- * device) returns RSMOOTH_ERROR_OUT_OF_MEMORY having changed nothing: the host runs it then. */
-typedef rsmooth_status (*rs_stage_runner)(void *ctx, const rs_stage_plan *plan, double *xyz,
-                                          rs_cycle_fn cycle_done, void *user, rs_stage_stats *stats,
-                                          rsmooth_error *error);
-
-/* Runs `one_pass` params->passes times (once, unchanged, when passes is 1), each pass from the
- * previous pass's positions with the sigmas of the input, honouring pass_confidence; the
- * normal-update stage before them, if params ask for it, through `stage` (NULL: on the host),
- * both with `ctx`. The caller's outputs are written only when every pass succeeded. */
-rsmooth_status rs_filter_passes(rs_filter_fn one_pass, rs_stage_runner stage, void *ctx,
-                                rsmooth_scalar scalar, const void *positions, size_t vertex_count,
-                                const uint32_t *indices, size_t triangle_count,
-                                const rsmooth_params *params, void *out_positions,
-                                float *out_weight, float *out_confidence, rsmooth_report *report,
-                                rsmooth_error *error, const char *where);
 
 #endif /* RSMOOTH_INTERNAL_H */

@@ -7,6 +7,18 @@
 
 #include "core/rsmooth_internal.h"
 
+/* The plan and the figures (below). */
+typedef struct rs_stage_plan rs_stage_plan;
+typedef struct rs_stage_stats rs_stage_stats;
+/* Called after each cycle with the cycles done; non-zero stops the stage (RSMOOTH_CANCELLED). */
+typedef int (*rs_cycle_fn)(void *user, int done, int cycles);
+/* Runs every cycle of `plan` elsewhere (the device: opencl/cl_stage.c), writing the final
+ * positions (the stage's units) to xyz. A runner that cannot take the plan (too large for its
+ * device) returns RSMOOTH_ERROR_OUT_OF_MEMORY having changed nothing: the host runs it then. */
+typedef rsmooth_status (*rs_stage_runner)(void *ctx, const rs_stage_plan *plan, double *xyz,
+                                          rs_cycle_fn cycle_done, void *user, rs_stage_stats *stats,
+                                          rsmooth_error *error);
+
 /* CSR lists: the entries of item i are list[start[i] .. start[i + 1]). Positions in the stage's
  * units (scaled near 1 by a power of two: normal_update.c). */
 struct rs_stage_plan {

@@ -3,7 +3,7 @@
 #ifndef RSMOOTH_CL_INTERNAL_H
 #define RSMOOTH_CL_INTERNAL_H
 
-#include "core/rsmooth_internal.h"
+#include "core/stage_plan.h"
 
 /* ---- cl_device.c / cl_program.c: the OpenCL context object ------------------------------------
  */

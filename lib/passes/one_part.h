@@ -2,7 +2,7 @@
 #ifndef RSMOOTH_ONE_PART_H
 #define RSMOOTH_ONE_PART_H
 
-#include "core/rsmooth_internal.h"
+#include "passes/passes.h"
 
 /* rs_filter_passes's work on a mesh of one part: the stage, the passes, the choice per region,
  * the caller's mask, then the last check of what they wrote (results.c): never a non-finite OK. */

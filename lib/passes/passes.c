@@ -3,7 +3,7 @@
  * data, normals and the grid from the previous positions; the sigmas stay those the input's mean
  * edge length gave, so later passes do not shrink their reach as the mesh smooths. */
 #include "auto/noise_estimate.h"
-#include "core/stage_plan.h"
+#include "passes/passes.h"
 #include "passes/one_part.h"
 #include "passes/region_choice.h"
 #include "stages/normal_update.h"

@@ -3,7 +3,8 @@
 #ifndef RSMOOTH_POINTS_H
 #define RSMOOTH_POINTS_H
 
-#include "core/rsmooth_internal.h"
+#include "passes/passes.h"
+#include "reference/reference.h"
 
 /* One pass's filter on a point cloud's problem (no indices: facet q is point q, its centroid,
  * normal and area kept): the next positions (3 doubles per point, internal units), confidence

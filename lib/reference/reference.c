@@ -2,6 +2,8 @@
  * read beside the paper. Mollification (Sec. 3.2), then robust estimation (Eq. 3). It is the oracle
  * the OpenCL path is tested against and the fallback when no OpenCL device exists. */
 #include "core/spatial.h"
+#include "passes/passes.h"
+#include "reference/reference.h"
 
 #include <float.h>
 #include <math.h>

@@ -2,6 +2,7 @@
  * with the uniform "umbrella" operator on the mesh's edge graph. They need connectivity and many
  * iterations, and they round sharp edges: rsmooth offers them only so its filter can be compared
  * with what people already use. */
+#include "stages/taubin.h"
 #include "core/rsmooth_internal.h"
 
 #include <math.h>

@@ -7,6 +7,7 @@
  * computes its core vertices as the whole run would. This is what streaming (rsmooth_io's
  * rsmooth_stream_smooth) and the MPI driver cut a mesh into. */
 #include "opencl/cl_internal.h"
+#include "reference/reference.h"
 
 #include <float.h>
 #include <math.h>
