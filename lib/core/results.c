@@ -19,9 +19,9 @@ void rs_store_position(rsmooth_scalar scalar, void *out_positions, size_t v, con
     }
 }
 
-void rs_store_unmoved(const rs_problem *problem, rsmooth_scalar scalar, void *out_positions,
-                      float *out_weight, float *out_confidence) {
-    for (size_t v = 0; v < problem->vertex_count; v++) {
+void rs_store_unmoved(const rs_problem *problem, size_t count, rsmooth_scalar scalar,
+                      void *out_positions, float *out_weight, float *out_confidence) {
+    for (size_t v = 0; v < count; v++) {
         rs_store_position(scalar, out_positions, v, problem->xyz + 3 * v, 1 / problem->scale);
         if (out_weight)
             out_weight[v] = 0;

@@ -379,10 +379,10 @@ rsmooth_status rs_check_results(rsmooth_scalar scalar, const void *out_positions
 void rs_store_position(rsmooth_scalar scalar, void *out_positions, size_t v, const double p[3],
                        double unscale);
 
-/* Writes every vertex unmoved, with zero weight and confidence: the result when no facet carries
- * weight (no triangles, or all of zero area). */
-void rs_store_unmoved(const rs_problem *problem, rsmooth_scalar scalar, void *out_positions,
-                      float *out_weight, float *out_confidence);
+/* Writes the first `count` vertices unmoved, with zero weight and confidence: the result when no
+ * facet carries weight (no triangles, or all of zero area). */
+void rs_store_unmoved(const rs_problem *problem, size_t count, rsmooth_scalar scalar,
+                      void *out_positions, float *out_weight, float *out_confidence);
 
 /* Copies `full` into a caller's report as far as its struct_size says it holds (a size some
  * version's struct had, else, a struct never initialised, this version's whole struct), and

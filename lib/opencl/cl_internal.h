@@ -59,12 +59,11 @@ struct rsmooth_context {
     uint64_t memory_budget;  /* caller's or RSMOOTH_MEMORY_BUDGET's limit; 0: the device's */
     unsigned host_threads;   /* threads of the host stages of its calls; 0: every core */
     /* rsmooth_smooth_cl's (cl_store.c): the program storing results into a caller's buffer,
-     * built on its first call (NULL before, and where the device has no fp64), its kernels by
-     * rsmooth_scalar, and the call's sink while it runs (NULL otherwise) */
+     * built on its first call (NULL before, and where the device has no fp64), and its kernels by
+     * rsmooth_scalar */
     cl_program store_program;
     cl_kernel store_kernels[2];
     bool store_tried;
-    struct rs_device_sink *device_sink;
 };
 
 /* Picks the kernel variant and vector width for ctx->device (cl_variant.c): sets ctx->lanes and
@@ -118,6 +117,11 @@ typedef struct rs_result_sink {
     rs_device_sink *device; /* optional */
 } rs_result_sink;
 
+/* rsmooth_smooth_cl's buffer `mem` (named `name` in errors): on ctx's OpenCL context and at least
+ * `bytes` long, those of vertex_count vertices (cl_store.c). */
+rsmooth_status rs_cl_check_buffer(const rsmooth_context *ctx, cl_mem mem, const char *name,
+                                  size_t bytes, size_t vertex_count, rsmooth_error *error);
+
 /* Builds ctx's store program once (cl_store.c); false where it cannot (no fp64): the caller
  * then uploads the host's result. */
 bool rs_cl_store_ready(rsmooth_context *ctx);
@@ -129,13 +133,6 @@ bool rs_cl_store_ready(rsmooth_context *ctx);
 rsmooth_status rs_cl_store_device(rsmooth_context *ctx, rs_device_sink *sink, cl_mem result,
                                   const uint32_t *slot, size_t vertex_count, size_t lanes,
                                   double scale, double h, rsmooth_error *error);
-
-/* rsmooth_smooth's work once ctx's lock is held (api/smooth.c). */
-rsmooth_status rs_smooth_entered(rsmooth_context *ctx, rsmooth_scalar scalar, const void *positions,
-                                 size_t vertex_count, const uint32_t *indices,
-                                 size_t triangle_count, const rsmooth_params *params,
-                                 void *out_positions, float *out_weight, float *out_confidence,
-                                 rsmooth_report *report, rsmooth_error *error);
 
 /* Stage times and work, summed over the runs (tiles) of one call. */
 typedef struct rs_run_stats {

@@ -2,8 +2,8 @@
  * output, optionally only where the previous pass had low confidence. Each pass recomputes facet
  * data, normals and the grid from the previous positions; the sigmas stay those the input's mean
  * edge length gave, so later passes do not shrink their reach as the mesh smooths. */
-#include "auto/noise_estimate.h"
 #include "passes/passes.h"
+#include "auto/noise_estimate.h"
 #include "passes/one_part.h"
 #include "passes/region_choice.h"
 #include "stages/normal_update.h"

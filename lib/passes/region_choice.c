@@ -19,8 +19,8 @@
  * The bounds were fitted by scripts/region_study.py with cross-validation that leaves whole
  * meshes out (docs/accuracy.md); the whole-mesh rule they replace was the same share below 0.52. */
 #include "passes/region_choice.h"
-#include "stages/taubin.h"
 #include "stages/normal_update.h"
+#include "stages/taubin.h"
 
 #include <math.h>
 #include <string.h>

@@ -1,9 +1,9 @@
 /* The reference path: Jones, Durand & Desbrun 2003 in double precision on one thread, written to be
  * read beside the paper. Mollification (Sec. 3.2), then robust estimation (Eq. 3). It is the oracle
  * the OpenCL path is tested against and the fallback when no OpenCL device exists. */
+#include "reference/reference.h"
 #include "core/spatial.h"
 #include "passes/passes.h"
-#include "reference/reference.h"
 
 #include <float.h>
 #include <math.h>
@@ -298,7 +298,7 @@ rsmooth_status rs_reference_solve(const rs_problem *problem, rsmooth_scalar scal
     double t_grid = t_facets, t_mollify = t_facets, t_normals = t_facets;
 
     if (pb.facet_count == 0) { /* nothing carries weight: every vertex stays */
-        rs_store_unmoved(&pb, scalar, out_positions, out_weight, out_confidence);
+        rs_store_unmoved(&pb, pb.vertex_count, scalar, out_positions, out_weight, out_confidence);
         goto done;
     }
 

@@ -6,7 +6,7 @@
  * piece holding its core vertices and every facet within that halo, given the two numbers,
  * computes its core vertices as the whole run would. This is what streaming (rsmooth_io's
  * rsmooth_stream_smooth) and the MPI driver cut a mesh into. */
-#include "opencl/cl_internal.h"
+#include "api/path.h"
 #include "reference/reference.h"
 
 #include <float.h>
@@ -204,30 +204,21 @@ rsmooth_status rsmooth_smooth_piece(rsmooth_context *ctx, const double *position
     if (st != RSMOOTH_OK)
         return st;
     if (ctx) {
-        st = rs_context_enter(ctx, where, error);
+        size_t saved = 0;
+        st = rs_device_enter(ctx, where, &saved, error);
         if (st != RSMOOTH_OK)
             return st;
-        size_t threads_before = rs_set_call_threads(ctx->host_threads);
         st = prepare_piece(&pb, positions, vertex_count, indices, triangle_count, info, params,
                            out_positions, false, error);
-        double t_facets = rs_now_ms();
-        rs_run_stats stats;
-        memset(&stats, 0, sizeof stats);
-        if (st == RSMOOTH_OK && pb.facet_count == 0) {
-            for (size_t v = 0; v < info->core_count; v++)
-                rs_store_position(RSMOOTH_FLOAT64, out_positions, v, pb.xyz + 3 * v, 1 / pb.scale);
-        } else if (st == RSMOOTH_OK && info->core_count > 0) {
-            rs_result_sink sink = {RSMOOTH_FLOAT64,  out_positions, NULL, NULL, NULL,
-                                   info->core_count, NULL};
-            st = rs_cl_filter(ctx, &pb, &sink, &stats, error);
-        }
-        if (st == RSMOOTH_OK && report)
-            rs_cl_report(report, &pb, &stats, ctx->device_name, t_start, t_facets);
+        rs_device_call call = {ctx, where, NULL};
+        rs_result_sink sink = {RSMOOTH_FLOAT64,  out_positions, NULL, NULL, NULL,
+                               info->core_count, NULL};
+        if (st == RSMOOTH_OK && info->core_count > 0)
+            st = rs_device_pass(&call, &pb, &sink, false, NULL, report, t_start, error);
         if (st == RSMOOTH_OK)
             st = rs_check_results(RSMOOTH_FLOAT64, out_positions, NULL, NULL, info->core_count,
                                   "vertex", error, where);
-        rs_set_call_threads(threads_before);
-        rs_context_unlock(ctx);
+        rs_device_leave(ctx, saved);
     } else {
         st = prepare_piece(&pb, positions, vertex_count, indices, triangle_count, info, params,
                            out_positions, true, error);
