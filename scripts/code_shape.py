@@ -13,7 +13,11 @@ Longest functions: every function body in lib/, host/ and kernels/ (a definition
 the first column and ends at a `}` in the first column), longest first, with the number of lines
 from its signature to its closing brace.
 
-Exits 1 when there is a circle or a function over --max-lines (120), else 0. Needs binutils' nm.
+Layers: lib/README.md's table lists lib/'s folders from the top down; a call from a folder to
+one above it in that table is printed as a call upward.
+
+Exits 1 when there is a circle, a call upward or a function over --max-lines (120), else 0.
+Needs binutils' nm. CI runs it as the test code_shape.
 """
 import argparse
 import collections
@@ -88,12 +92,25 @@ def strongly_connected(graph):
     return groups
 
 
+def layers():
+    """lib/'s folders from the top down, as lib/README.md's table lists them."""
+    with open(os.path.join(ROOT, "lib", "README.md"), encoding="utf-8") as f:
+        return re.findall(r"^\| `(\w+)/` \|", f.read(), re.M)
+
+
+def layer_of(src, order):
+    parts = src.split("/")
+    return order.index(parts[1]) if len(parts) > 2 and parts[1] in order else None
+
+
 def circles(build):
+    """(object files, circles, calls upward) of the build's library and programs."""
     objs = objects(build)
     if not objs:
         sys.exit("code_shape: no object files under %s/CMakeFiles: build it first" % build)
     table = {src: symbols(o) for src, o in objs.items()}
-    found = []
+    order = layers()
+    found, upward = [], []
     for side in ("lib/", "host/"):
         files = [s for s in table if s.startswith(side)]
         # lib/ is shared by every program; host/ files may link only some of their neighbours,
@@ -110,13 +127,17 @@ def circles(build):
                     if t != s:
                         graph[s].add(t)
                         why[(s, t)].add(sym)
+        for (a, b), syms in sorted(why.items()):
+            la, lb = layer_of(a, order), layer_of(b, order)
+            if la is not None and lb is not None and lb < la:
+                upward.append("%s -> %s (%s)" % (a, b, ", ".join(sorted(syms)[:3])))
         for group in strongly_connected(graph):
             if len(group) > 1:
                 members = set(group)
                 edges = ["%s -> %s (%s)" % (a, b, ", ".join(sorted(why[(a, b)])[:3]))
                          for a in group for b in sorted(graph[a]) if b in members]
                 found.append((group, edges))
-    return len(table), found
+    return len(table), found, upward
 
 
 DEF_RE = re.compile(r"^(?!static_assert|typedef|struct\s+\w+\s*\{|enum|union|#)"
@@ -153,12 +174,15 @@ def main():
     ap.add_argument("--max-lines", type=int, default=120)
     ap.add_argument("--most", type=int, default=12, help="how many of the longest to list")
     a = ap.parse_args()
-    count, found = circles(a.build)
+    count, found, upward = circles(a.build)
     print("file-level circles among %d object files: %d" % (count, len(found)))
     for group, edges in found:
         print("  circle: " + " <-> ".join(group))
         for e in edges:
             print("    " + e)
+    print("calls upward between lib/'s layers (lib/README.md): %d" % len(upward))
+    for e in upward:
+        print("    " + e)
     srcs = sorted(glob.glob(os.path.join(ROOT, "lib", "**", "*.c"), recursive=True)
                   + glob.glob(os.path.join(ROOT, "host", "*.c"))
                   + glob.glob(os.path.join(ROOT, "kernels", "*.cl")))
@@ -167,7 +191,7 @@ def main():
     print("functions read: %d; over %d lines: %d; the longest:" % (len(funcs), a.max_lines, len(over)))
     for n, path, line, name in funcs[:max(a.most, len(over))]:
         print("  %5d  %s:%d  %s" % (n, path, line, name))
-    return 1 if found or over else 0
+    return 1 if found or upward or over else 0
 
 
 if __name__ == "__main__":
