@@ -74,8 +74,9 @@ static int run(rsmooth_context *ctx, const mesh_in *m, const rsmooth_params *p, 
         unsetenv("RSMOOTH_STAGE_PRECISION");
     rsmooth_error err;
     rsmooth_report_init(report);
-    rsmooth_status st = rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                       m->triangle_count, p, out, NULL, NULL, report, &err);
+    rsmooth_status st = rsmooth_smooth(
+        ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices, m->triangle_count, p, out,
+        &(rsmooth_outputs){.struct_size = sizeof(rsmooth_outputs), .report = report}, &err);
     if (st != RSMOOTH_OK)
         fprintf(stderr, "rsmooth-bench best: %s: %s\n", rsmooth_status_str(st), err.message);
     return st == RSMOOTH_OK ? 0 : 1;
@@ -230,7 +231,10 @@ int bench_best(int argc, char **argv) {
         return code;
     rsmooth_context *ctx = NULL;
     rsmooth_error err;
-    if (rsmooth_context_create(device, &ctx, &err) != RSMOOTH_OK) {
+    if (rsmooth_context_create(
+            &(rsmooth_context_options){.struct_size = sizeof(rsmooth_context_options),
+                                       .device = device},
+            &ctx, &err) != RSMOOTH_OK) {
         fprintf(stderr, "rsmooth-bench best: %s\n", err.message);
         code = 3;
         goto done;
@@ -275,7 +279,9 @@ int bench_best(int argc, char **argv) {
         printf("{\"mesh\":");
         print_string(path ? path : "generated cylinder");
         printf(",\"vertices\":%zu,\"triangles\":%zu,\"device\":", nv, m.triangle_count);
-        print_string(rsmooth_context_device_name(ctx));
+        rsmooth_context_info info = {.struct_size = sizeof info};
+        rsmooth_context_get_info(ctx, &info);
+        print_string(info.device_name);
         printf(",\"repeat\":%d,\"auto\":%s,\"ms_auto_estimate\":%.3f", repeat,
                automatic ? "true" : "false", ms_auto);
         double paper = median(f[PAPER].total, repeat);

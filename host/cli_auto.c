@@ -17,10 +17,9 @@ int cli_choose_params(options *opt, const rsmooth_mesh *mesh, bool points) {
     rsmooth_params chosen = opt->params;
     rsmooth_error err;
     rsmooth_noise_report report;
-    rsmooth_noise_report_init(&report);
-    if (rsmooth_params_auto_report(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
-                                   mesh->triangles, mesh->triangle_count, &chosen, &report,
-                                   &err) != RSMOOTH_OK) {
+    report.struct_size = sizeof report;
+    if (rsmooth_params_auto(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count, mesh->triangles,
+                            mesh->triangle_count, &chosen, &report, &err) != RSMOOTH_OK) {
         fprintf(stderr, "rsmooth: %s: --auto: %s\n", opt->input, err.message);
         return EXIT_USAGE;
     }

@@ -17,14 +17,18 @@ int cli_open_device(const options *opt, cli_progress *bar, rsmooth_context **ctx
     *ctx = NULL;
     *ms_setup = 0;
     if (!reference) {
-        /* the option wins over the environment, as --device over RSMOOTH_DEVICE */
-        if (opt->memory_budget)
-            unsetenv("RSMOOTH_MEMORY_BUDGET");
+        /* the options win over the environment, as --device over RSMOOTH_DEVICE */
+        rsmooth_context_options o = {
+            .struct_size = sizeof o, .device = device, .memory_budget = opt->memory_budget};
         double t = cli_now_ms();
-        st = rsmooth_context_create(device, ctx, &err);
+        st = rsmooth_context_create(&o, ctx, &err);
         *ms_setup = cli_now_ms() - t;
-        if (st == RSMOOTH_OK && opt->memory_budget)
-            rsmooth_context_set_memory_budget(*ctx, opt->memory_budget);
+        rsmooth_context_info info = {.struct_size = sizeof info};
+        if (st == RSMOOTH_OK && rsmooth_context_get_info(*ctx, &info) == RSMOOTH_OK &&
+            *info.program_cache_note && !opt->quiet) { /* the library prints nothing */
+            cli_progress_clear(bar);
+            fprintf(stderr, "rsmooth: warning: %s\n", info.program_cache_note);
+        }
         bool automatic = !device || strcmp(device, "auto") == 0;
         if (st == RSMOOTH_ERROR_NO_DEVICE && automatic) {
             if (!opt->quiet)
@@ -50,4 +54,9 @@ int cli_open_device(const options *opt, cli_progress *bar, rsmooth_context **ctx
         }
     }
     return -1;
+}
+
+const char *cli_device_name(const rsmooth_context *ctx) {
+    rsmooth_context_info info = {.struct_size = sizeof info};
+    return ctx && rsmooth_context_get_info(ctx, &info) == RSMOOTH_OK ? info.device_name : "";
 }

@@ -12,4 +12,7 @@
  * setting, 3 for a device failure, 1 out of memory). *ms_setup: the time it took. */
 int cli_open_device(const options *opt, cli_progress *bar, rsmooth_context **ctx, double *ms_setup);
 
+/* The context's device name ("platform / device"); "" for NULL. */
+const char *cli_device_name(const rsmooth_context *ctx);
+
 #endif

@@ -18,7 +18,8 @@ int cli_list_devices(void) {
          * asking for a context fails at once and says which. */
         rsmooth_context *ctx = NULL;
         rsmooth_error err;
-        if (rsmooth_context_create("auto", &ctx, &err) == RSMOOTH_ERROR_NO_DEVICE)
+        rsmooth_context_options automatic = {.struct_size = sizeof automatic, .device = "auto"};
+        if (rsmooth_context_create(&automatic, &ctx, &err) == RSMOOTH_ERROR_NO_DEVICE)
             printf("%s; --device reference still works\n", err.message);
         else
             printf("no OpenCL device (install an OpenCL driver, e.g. pocl-opencl-icd); "

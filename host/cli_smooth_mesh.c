@@ -41,8 +41,8 @@ static int filter_status(const options *opt, rsmooth_context *ctx, cli_progress 
         return EXIT_OK;
     cli_progress_clear(bar);
     if (st == RSMOOTH_ERROR_OPENCL)
-        fprintf(stderr, "rsmooth: %s: device '%s': %s\n", opt->input,
-                rsmooth_context_device_name(ctx), err->message);
+        fprintf(stderr, "rsmooth: %s: device '%s': %s\n", opt->input, cli_device_name(ctx),
+                err->message);
     else
         fprintf(stderr, "rsmooth: %s: %s\n", opt->input, err->message);
     return st == RSMOOTH_ERROR_OPENCL             ? EXIT_DEVICE
@@ -61,20 +61,16 @@ int cli_smooth_mesh(const options *opt, const rsmooth_mesh *mesh, double *out, f
     int code = cli_open_device(opt, bar, &ctx, &ms_setup);
     if (code >= 0)
         return code;
-    bool reference = ctx == NULL;
     rsmooth_params params = opt->params;
     if (bar->enabled) { /* progress slices the kernel launches: only when a bar can show */
         params.progress = cli_progress_callback;
         params.progress_user = bar;
     }
-    if (reference)
-        st = rsmooth_smooth_reference(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
-                                      mesh->triangles, mesh->triangle_count, &params, out, NULL,
-                                      confidence, report, &err);
-    else
-        st = rsmooth_smooth(ctx, RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
-                            mesh->triangles, mesh->triangle_count, &params, out, NULL, confidence,
-                            report, &err);
+    rsmooth_outputs outputs = {
+        .struct_size = sizeof outputs, .confidence = confidence, .report = report};
+    /* ctx NULL: the reference path */
+    st = rsmooth_smooth(ctx, RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count, mesh->triangles,
+                        mesh->triangle_count, &params, out, &outputs, &err);
     code = filter_status(opt, ctx, bar, st, &err);
     report->ms_setup = ms_setup;
     rsmooth_context_destroy(ctx);
@@ -106,12 +102,15 @@ int cli_check_point_cloud(const options *opt, const rsmooth_mesh *mesh) {
 static rsmooth_status filter_points(rsmooth_context *ctx, const rsmooth_mesh *mesh,
                                     const rsmooth_params *params, double *out, double *out_normals,
                                     float *confidence, rsmooth_report *report, rsmooth_error *err) {
-    if (!ctx)
-        return rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, mesh->positions,
-                                               mesh->vertex_normals, mesh->vertex_count, params,
-                                               out, out_normals, confidence, report, err);
+    rsmooth_outputs outputs = {
+        .struct_size = sizeof outputs, .confidence = confidence, .report = report};
     return rsmooth_smooth_points(ctx, RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_normals,
-                                 mesh->vertex_count, params, out, out_normals, confidence, report,
+                                 mesh->vertex_count, params, out, out_normals, &outputs, err);
+    return rsmooth_smooth_points(ctx, RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_normals,
+                                 mesh->vertex_count, params, out, out_normals,
+                                 &(rsmooth_outputs){.struct_size = sizeof(rsmooth_outputs),
+                                                    .confidence = confidence,
+                                                    .report = report},
                                  err);
 }
 
@@ -129,7 +128,7 @@ int cli_smooth_points(const options *opt, const rsmooth_mesh *mesh, double *out,
                 "rsmooth: note: %s is a point cloud (no faces): filtering its points and "
                 "normals %s%s%s\n",
                 opt->input, ctx ? "on device '" : "on the reference path (CPU)",
-                ctx ? rsmooth_context_device_name(ctx) : "", ctx ? "'" : "");
+                cli_device_name(ctx), ctx ? "'" : "");
     }
     rsmooth_params params = opt->params;
     if (bar->enabled) {

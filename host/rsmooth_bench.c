@@ -389,10 +389,13 @@ static int load_input(const filter_options *opt, bench_input *in) {
 }
 
 /* Creates a context, timed; prints what fails and returns an exit status. */
-static int create_context(const char *device, rsmooth_context **ctx, double *ms) {
+static int create_context(const char *device, uint64_t memory_budget, rsmooth_context **ctx,
+                          double *ms) {
     rsmooth_error err;
+    rsmooth_context_options o = {
+        .struct_size = sizeof o, .device = device, .memory_budget = memory_budget};
     double t0 = now_ms();
-    rsmooth_status st = rsmooth_context_create(device, ctx, &err);
+    rsmooth_status st = rsmooth_context_create(&o, ctx, &err);
     *ms = now_ms() - t0;
     if (st == RSMOOTH_OK)
         return EXIT_OK;
@@ -503,27 +506,34 @@ typedef struct filter_bench {
     bool have_roofline;
 } filter_bench;
 
+/* A context's info. */
+static rsmooth_context_info context_info(const rsmooth_context *ctx) {
+    rsmooth_context_info info = {.struct_size = sizeof info};
+    rsmooth_context_get_info(ctx, &info);
+    return info;
+}
+
 /* The context twice, to time the program build from source and from the cache; the second stays.
  * An exit status. */
 static int build_programs(filter_bench *b) {
-    /* the option wins over the environment, as in the rsmooth command */
-    if (b->opt.memory_budget)
-        unsetenv("RSMOOTH_MEMORY_BUDGET");
     /* The program build twice: from source (unless rsmooth's program cache has it), then from
-     * the binary the first stored (or, with that cache off, from source with PoCL's). */
-    int code = create_context(b->opt.device, &b->ctx, &b->ms_create_first);
+     * the binary the first stored (or, with that cache off, from source with PoCL's). The
+     * option's budget wins over the environment's, as in the rsmooth command. */
+    int code = create_context(b->opt.device, b->opt.memory_budget, &b->ctx, &b->ms_create_first);
     if (code != EXIT_OK)
         return code;
-    b->ms_build_first = rsmooth_context_build_ms(b->ctx);
-    b->cache_first = rsmooth_context_program_cache(b->ctx);
+    rsmooth_context_info info = {.struct_size = sizeof info};
+    rsmooth_context_get_info(b->ctx, &info);
+    b->ms_build_first = info.build_ms;
+    b->cache_first = info.program_cache;
     rsmooth_context_destroy(b->ctx);
     b->ctx = NULL;
-    if ((code = create_context(b->opt.device, &b->ctx, &b->ms_create_cached)) != EXIT_OK)
+    code = create_context(b->opt.device, b->opt.memory_budget, &b->ctx, &b->ms_create_cached);
+    if (code != EXIT_OK)
         return code;
-    b->ms_build_cached = rsmooth_context_build_ms(b->ctx);
-    b->cache_cached = rsmooth_context_program_cache(b->ctx);
-    if (b->opt.memory_budget)
-        rsmooth_context_set_memory_budget(b->ctx, b->opt.memory_budget);
+    rsmooth_context_get_info(b->ctx, &info);
+    b->ms_build_cached = info.build_ms;
+    b->cache_cached = info.program_cache;
     return EXIT_OK;
 }
 
@@ -549,7 +559,8 @@ static int prepare_runs(filter_bench *b) {
     rsmooth_report tiny;
     rsmooth_error tiny_err;
     if (rsmooth_smooth(b->ctx, RSMOOTH_FLOAT32, tiny_xyz, 4, tiny_idx, 2, &b->opt.params, tiny_out,
-                       NULL, NULL, &tiny, &tiny_err) == RSMOOTH_OK)
+                       &(rsmooth_outputs){.struct_size = sizeof(rsmooth_outputs), .report = &tiny},
+                       &tiny_err) == RSMOOTH_OK)
         b->codegen_ms = tiny.ms_total;
     return EXIT_OK;
 }
@@ -565,15 +576,17 @@ static int time_runs(filter_bench *b) {
     /* The first run includes PoCL's one-time code generation for each kernel. */
     memset(&b->report, 0, sizeof b->report);
     rsmooth_error err;
-    rsmooth_status st = rsmooth_smooth(b->ctx, RSMOOTH_FLOAT32, b->in.positions, nv, b->in.indices,
-                                       nt, &opt->params, b->first, NULL, NULL, &b->report, &err);
+    rsmooth_status st = rsmooth_smooth(
+        b->ctx, RSMOOTH_FLOAT32, b->in.positions, nv, b->in.indices, nt, &opt->params, b->first,
+        &(rsmooth_outputs){.struct_size = sizeof(rsmooth_outputs), .report = &b->report}, &err);
     b->first_run_ms = b->report.ms_total;
     b->first_run_peak = (double)peak_rss_kib() * 1024;
     double ms[STAGE_COUNT][99];
     b->identical = true;
     for (int i = 0; i < opt->repeat && st == RSMOOTH_OK; i++) {
-        st = rsmooth_smooth(b->ctx, RSMOOTH_FLOAT32, b->in.positions, nv, b->in.indices, nt,
-                            &opt->params, b->out, NULL, NULL, &b->report, &err);
+        st = rsmooth_smooth(
+            b->ctx, RSMOOTH_FLOAT32, b->in.positions, nv, b->in.indices, nt, &opt->params, b->out,
+            &(rsmooth_outputs){.struct_size = sizeof(rsmooth_outputs), .report = &b->report}, &err);
         double stage[STAGE_COUNT];
         stage_times(&b->report, stage);
         for (int s = 0; s < STAGE_COUNT; s++)
@@ -585,7 +598,7 @@ static int time_runs(filter_bench *b) {
         const char *name = opt->mesh_path ? opt->mesh_path : "generated mesh";
         if (st == RSMOOTH_ERROR_OPENCL)
             fprintf(stderr, "rsmooth-bench: %s: device '%s': %s\n", name,
-                    rsmooth_context_device_name(b->ctx), err.message);
+                    context_info(b->ctx).device_name, err.message);
         else
             fprintf(stderr, "rsmooth-bench: %s: %s\n", name, err.message);
         return st == RSMOOTH_ERROR_OPENCL             ? EXIT_DEVICE
@@ -654,13 +667,11 @@ static void print_setup(const filter_bench *b) {
     printf(",\"radius\":%.6g,\"mollify_radius\":%.6g,\"grid_cell_count\":%zu,\"tiles\":%zu,"
            "\"memory_budget\":%llu,\"device\":",
            report->radius, report->mollify_radius, report->grid_cell_count, report->tiles,
-           (unsigned long long)rsmooth_context_memory_budget(b->ctx));
+           (unsigned long long)context_info(b->ctx).memory_budget);
     cli_print_json_string(report->device);
-    unsigned lanes = 0;
-    size_t group = 0;
-    rsmooth_context_kernel_shape(b->ctx, &lanes, &group);
+    rsmooth_context_info info = context_info(b->ctx);
     printf(",\"kernel_variant\":\"%s\",\"lanes\":%u,\"work_group\":%zu",
-           lanes > 1 ? "block" : "group", lanes, group);
+           info.lanes > 1 ? "block" : "group", info.lanes, info.group);
 }
 
 /* The JSON object's rest: the times, the pairs, the roofline and the memory. */
@@ -850,10 +861,14 @@ static rsmooth_status points_run_one(points_bench *b, int which, rsmooth_report 
     rsmooth_report_init(r);
     double t0 = now_ms();
     rsmooth_status st =
-        which == 0 ? rsmooth_smooth_points(b->ctx, RSMOOTH_FLOAT32, b->xyz, b->normals,
-                                           b->vertex_count, &p, b->out, NULL, NULL, r, &err)
-                   : rsmooth_smooth(b->ctx, RSMOOTH_FLOAT32, b->xyz, b->vertex_count, b->indices,
-                                    b->triangle_count, &p, b->out, NULL, NULL, r, &err);
+        which == 0
+            ? rsmooth_smooth_points(
+                  b->ctx, RSMOOTH_FLOAT32, b->xyz, b->normals, b->vertex_count, &p, b->out, NULL,
+                  &(rsmooth_outputs){.struct_size = sizeof(rsmooth_outputs), .report = r}, &err)
+            : rsmooth_smooth(
+                  b->ctx, RSMOOTH_FLOAT32, b->xyz, b->vertex_count, b->indices, b->triangle_count,
+                  &p, b->out,
+                  &(rsmooth_outputs){.struct_size = sizeof(rsmooth_outputs), .report = r}, &err);
     *ms = now_ms() - t0;
     if (st != RSMOOTH_OK)
         fprintf(stderr, "rsmooth-bench: %s: %s\n",
@@ -865,7 +880,7 @@ static void print_points_figures(const points_bench *b, double med[3], double st
                                  bool identical) {
     printf("{\"mode\":\"points\",\"device\":\"%s\",\"input\":\"%s\",\"points\":%zu,"
            "\"triangles\":%zu,\"sigma_f\":%g,\"sigma_g\":%g,\"repeat\":%d,",
-           rsmooth_context_device_name(b->ctx), b->mesh_path ? b->mesh_path : "cylinder",
+           context_info(b->ctx).device_name, b->mesh_path ? b->mesh_path : "cylinder",
            b->vertex_count, b->triangle_count, b->params.sigma_f, b->params.sigma_g, b->repeat);
     const char *keys[5] = {"points_ms", "mesh_ms", "mesh_bilateral_ms", "points_over_mesh",
                            "points_over_mesh_bilateral"};
@@ -888,7 +903,7 @@ static int bench_points(int argc, char **argv) {
     int code = points_args(argc, argv, &b);
     double ms_context = 0;
     if (code < 0 && (code = points_input(&b)) == EXIT_OK &&
-        (code = create_context(b.device, &b.ctx, &ms_context)) == EXIT_OK) {
+        (code = create_context(b.device, 0, &b.ctx, &ms_context)) == EXIT_OK) {
         double runs[3][100], stage[6][100], med[3], stages[6];
         bool identical = true;
         rsmooth_report r;

@@ -16,7 +16,11 @@ from its signature to its closing brace.
 Layers: lib/README.md's table lists lib/'s folders from the top down; a call from a folder to
 one above it in that table is printed as a call upward.
 
-Exits 1 when there is a circle, a call upward or a function over --max-lines (120), else 0.
+Configuration: the library reads the environment in one file, lib/core/environment.c (its table
+is docs/environment.md); any other lib/ object that calls getenv is printed.
+
+Exits 1 when there is a circle, a call upward, a getenv elsewhere or a function over --max-lines
+(120), else 0.
 Needs binutils' nm. CI runs it as the test code_shape.
 """
 import argparse
@@ -111,6 +115,11 @@ def circles(build):
     table = {src: symbols(o) for src, o in objs.items()}
     order = layers()
     found, upward = [], []
+    readers = sorted(src for src, (_, used) in table.items()
+                     if src.startswith("lib/") and "getenv" in used
+                     and src != "lib/core/environment.c")
+    upward.extend("%s reads the environment (getenv): only lib/core/environment.c may" % src
+                  for src in readers)
     for side in ("lib/", "host/"):
         files = [s for s in table if s.startswith(side)]
         # lib/ is shared by every program; host/ files may link only some of their neighbours,
@@ -180,7 +189,8 @@ def main():
         print("  circle: " + " <-> ".join(group))
         for e in edges:
             print("    " + e)
-    print("calls upward between lib/'s layers (lib/README.md): %d" % len(upward))
+    print("calls upward between lib/'s layers (lib/README.md), and getenv outside "
+          "lib/core/environment.c: %d" % len(upward))
     for e in upward:
         print("    " + e)
     srcs = sorted(glob.glob(os.path.join(ROOT, "lib", "**", "*.c"), recursive=True)

@@ -38,24 +38,23 @@ int main(void) {
         rsmooth_params p;
         rsmooth_params_init(&p);
         p.sigma_f = -1;
-        CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m.xyz, m.vertex_count, m.indices,
-                                              m.triangle_count, &p, out, NULL, NULL, &report, &err),
+        CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, m.xyz, m.vertex_count, m.indices,
+                                    m.triangle_count, &p, out, OUTPUTS(NULL, NULL, &report), &err),
                      RSMOOTH_ERROR_INVALID_ARGUMENT);
         CHECK_EQ_INT(err.struct_size, sizes[i]);
         CHECK(strstr(err.message, "sigma_f") != NULL);
         p.sigma_f = 2;
         p.passes = 1 + i; /* both ways the report is filled: one pass, and the passes' sum */
-        CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m.xyz, m.vertex_count, m.indices,
-                                              m.triangle_count, &p, out, NULL, NULL, &report, &err),
+        CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, m.xyz, m.vertex_count, m.indices,
+                                    m.triangle_count, &p, out, OUTPUTS(NULL, NULL, &report), &err),
                      RSMOOTH_OK);
         CHECK_EQ_INT(err.struct_size, sizes[i]);
         CHECK_EQ_INT(report.struct_size, sizes[i] == sizeof err ? sizeof report : sizes[i]);
         CHECK_EQ_INT(report.vertex_count, m.vertex_count);
         double *normals = malloc(m.vertex_count * 3 * sizeof *normals);
         CHECK(normals && shape_vertex_normals(&m, normals) == 0);
-        CHECK_STATUS(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, m.xyz, normals,
-                                                     m.vertex_count, &p, out, NULL, NULL, &report,
-                                                     &err),
+        CHECK_STATUS(rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, m.xyz, normals, m.vertex_count,
+                                           &p, out, NULL, OUTPUTS(NULL, NULL, &report), &err),
                      RSMOOTH_OK);
         CHECK_EQ_INT(report.struct_size, sizes[i] == sizeof err ? sizeof report : sizes[i]);
         free(normals);

@@ -6,8 +6,8 @@
 #include <stdint.h>
 #include <string.h>
 
-/* The entry points under test, all with rsmooth_smooth_reference's signature. The OpenCL path
- * joins through a wrapper that passes the context main creates, when there is a device. */
+/* The paths under test, through one signature: rsmooth_smooth with ctx NULL (the reference
+ * path), and with the context main creates, when there is a device. */
 typedef rsmooth_status (*smooth_fn)(rsmooth_scalar scalar, const void *positions,
                                     size_t vertex_count, const uint32_t *indices,
                                     size_t triangle_count, const rsmooth_params *params,
@@ -16,20 +16,31 @@ typedef rsmooth_status (*smooth_fn)(rsmooth_scalar scalar, const void *positions
 
 static rsmooth_context *g_context;
 
+static rsmooth_status smooth_reference(rsmooth_scalar scalar, const void *positions,
+                                       size_t vertex_count, const uint32_t *indices,
+                                       size_t triangle_count, const rsmooth_params *params,
+                                       void *out_positions, float *out_weight,
+                                       float *out_confidence, rsmooth_report *report,
+                                       rsmooth_error *error) {
+    return rsmooth_smooth(NULL, scalar, positions, vertex_count, indices, triangle_count, params,
+                          out_positions, OUTPUTS(out_weight, out_confidence, report), error);
+}
+
 static rsmooth_status smooth_opencl(rsmooth_scalar scalar, const void *positions,
                                     size_t vertex_count, const uint32_t *indices,
                                     size_t triangle_count, const rsmooth_params *params,
                                     void *out_positions, float *out_weight, float *out_confidence,
                                     rsmooth_report *report, rsmooth_error *error) {
     return rsmooth_smooth(g_context, scalar, positions, vertex_count, indices, triangle_count,
-                          params, out_positions, out_weight, out_confidence, report, error);
+                          params, out_positions, OUTPUTS(out_weight, out_confidence, report),
+                          error);
 }
 
 static struct {
     const char *name;
     smooth_fn fn;
 } entry_points[2] = {
-    {"rsmooth_smooth_reference", rsmooth_smooth_reference},
+    {"rsmooth_smooth (reference)", smooth_reference},
 };
 static size_t g_entry_points = 1;
 
@@ -247,17 +258,16 @@ static void test_smooth_arguments(void) {
                          (double)bad_colors[i], passes, passes > 1 ? "es" : "");
                 expect_invalid(what, c);
                 rsmooth_error err;
-                CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, pos, vc, idx, tc, &p, g_out,
-                                                      NULL, NULL, NULL, &err),
-                             RSMOOTH_ERROR_INVALID_ARGUMENT);
+                CHECK_STATUS(
+                    rsmooth_smooth(NULL, RSMOOTH_FLOAT64, pos, vc, idx, tc, &p, g_out, NULL, &err),
+                    RSMOOTH_ERROR_INVALID_ARGUMENT);
                 CHECK(strstr(err.message, "vertex 7 ") != NULL); /* names the vertex */
             }
         }
         colors[3 * 7 + 2] = 0.5f;
         p.passes = 1;
         p.sigma_c = INFINITY; /* off: valid */
-        CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, pos, vc, idx, tc, &p, g_out, NULL,
-                                              NULL, NULL, NULL),
+        CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, pos, vc, idx, tc, &p, g_out, NULL, NULL),
                      RSMOOTH_OK);
     }
 
@@ -460,7 +470,7 @@ static void test_mean_edge_length(void) {
 
 int main(void) {
     if (rsmooth_context_create(NULL, &g_context, NULL) == RSMOOTH_OK) {
-        entry_points[g_entry_points].name = "rsmooth_smooth";
+        entry_points[g_entry_points].name = "rsmooth_smooth (device)";
         entry_points[g_entry_points++].fn = smooth_opencl;
     } else {
         printf("no OpenCL device: the reference path alone\n");

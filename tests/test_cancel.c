@@ -43,14 +43,14 @@ typedef rsmooth_status (*run_fn)(rsmooth_context *ctx, const shape_mesh *m, cons
 static rsmooth_status run_reference(rsmooth_context *ctx, const shape_mesh *m,
                                     const rsmooth_params *p, double *out, rsmooth_error *err) {
     (void)ctx;
-    return rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                    m->triangle_count, p, out, NULL, NULL, NULL, err);
+    return rsmooth_smooth(NULL, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                          m->triangle_count, p, out, NULL, err);
 }
 
 static rsmooth_status run_opencl(rsmooth_context *ctx, const shape_mesh *m, const rsmooth_params *p,
                                  double *out, rsmooth_error *err) {
     return rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                          m->triangle_count, p, out, NULL, NULL, NULL, err);
+                          m->triangle_count, p, out, NULL, err);
 }
 
 /* Points: the mesh's vertices with its vertex normals. */
@@ -58,8 +58,8 @@ static const double *point_normals;
 static rsmooth_status run_points(rsmooth_context *ctx, const shape_mesh *m, const rsmooth_params *p,
                                  double *out, rsmooth_error *err) {
     (void)ctx;
-    return rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, m->xyz, point_normals, m->vertex_count,
-                                           p, out, NULL, NULL, NULL, err);
+    return rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, m->xyz, point_normals, m->vertex_count, p,
+                                 out, NULL, NULL, err);
 }
 
 static void check_path(const char *name, run_fn run, rsmooth_context *ctx, const shape_mesh *m,
@@ -132,13 +132,14 @@ int main(void) {
     rsmooth_context *ctx = open_test_context();
     check_path("OpenCL, paper", run_opencl, ctx, &m, &paper);
     check_path("OpenCL, best (stage, 1 pass)", run_opencl, ctx, best_mesh, &best);
-    rsmooth_context_set_memory_budget(ctx, 1u << 20); /* tiles */
+    rsmooth_context_destroy(ctx);
+    ctx = open_test_context_budget(1u << 20); /* tiles */
     rsmooth_report report;
     rsmooth_error err;
     double *out = malloc(3 * m.vertex_count * sizeof *out);
     CHECK(out);
     CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m.xyz, m.vertex_count, m.indices,
-                                m.triangle_count, &paper, out, NULL, NULL, &report, &err),
+                                m.triangle_count, &paper, out, OUTPUTS(NULL, NULL, &report), &err),
                  RSMOOTH_OK);
     CHECK(report.tiles > 1);
     check_path("OpenCL, paper, tiled", run_opencl, ctx, &m, &paper);

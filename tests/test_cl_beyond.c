@@ -58,13 +58,13 @@ static void smooth(rsmooth_context *ctx, const mesh_ref *m, const rsmooth_params
     rsmooth_error err;
     if (ctx)
         CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                    m->triangle_count, params, out->xyz, out->weight,
-                                    out->confidence, &out->report, &err),
+                                    m->triangle_count, params, out->xyz,
+                                    OUTPUTS(out->weight, out->confidence, &out->report), &err),
                      RSMOOTH_OK);
     else
-        CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                              m->triangle_count, params, out->xyz, out->weight,
-                                              out->confidence, &out->report, &err),
+        CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                    m->triangle_count, params, out->xyz,
+                                    OUTPUTS(out->weight, out->confidence, &out->report), &err),
                      RSMOOTH_OK);
 }
 
@@ -94,9 +94,9 @@ static double compare(rsmooth_context *ctx, const char *name, const mesh_ref *m,
     result_alloc(&again, nv);
     smooth(NULL, m, params, &ref);
     smooth(ctx, m, params, &cl);
-    rsmooth_context_set_memory_budget(ctx, budget);
-    smooth(ctx, m, params, &again);
-    rsmooth_context_set_memory_budget(ctx, 0);
+    rsmooth_context *tiled = open_test_context_budget(budget);
+    smooth(tiled, m, params, &again);
+    rsmooth_context_destroy(tiled);
 
     double edge = ref.report.mean_edge_length;
     double dev = max_deviation(cl.xyz, ref.xyz, nv, edge);
@@ -153,10 +153,12 @@ static void compare_searching(rsmooth_context *ctx, const char *name, const mesh
     result_alloc(&again, nv);
     smooth(NULL, m, params, &ref);
     smooth(ctx, m, params, &listed);
-    setenv("RSMOOTH_BILATERAL_LISTS", "0", 1);
-    smooth(ctx, m, params, &searching);
-    smooth(ctx, m, params, &again);
+    setenv("RSMOOTH_BILATERAL_LISTS", "0", 1); /* read when a context is made */
+    rsmooth_context *searcher = open_test_context();
     unsetenv("RSMOOTH_BILATERAL_LISTS");
+    smooth(searcher, m, params, &searching);
+    smooth(searcher, m, params, &again);
+    rsmooth_context_destroy(searcher);
     double edge = ref.report.mean_edge_length;
     double dev = max_deviation(searching.xyz, ref.xyz, nv, edge);
     double apart = max_deviation(searching.xyz, listed.xyz, nv, edge);
@@ -486,12 +488,14 @@ int main(void) {
     result listed, searched;
     result_alloc(&listed, rod.vertex_count);
     result_alloc(&searched, rod.vertex_count);
-    rsmooth_context_set_memory_budget(ctx, roomy);
-    smooth(ctx, &rod_ref, &p, &listed);
-    setenv("RSMOOTH_BILATERAL_LISTS", "0", 1);
-    smooth(ctx, &rod_ref, &p, &searched);
+    rsmooth_context *tiled = open_test_context_budget(roomy);
+    smooth(tiled, &rod_ref, &p, &listed);
+    rsmooth_context_destroy(tiled);
+    setenv("RSMOOTH_BILATERAL_LISTS", "0", 1); /* read when a context is made */
+    tiled = open_test_context_budget(roomy);
     unsetenv("RSMOOTH_BILATERAL_LISTS");
-    rsmooth_context_set_memory_budget(ctx, 0);
+    smooth(tiled, &rod_ref, &p, &searched);
+    rsmooth_context_destroy(tiled);
     printf("  %zu tiles: pairs %llu from lists, %llu searching\n", listed.report.tiles,
            (unsigned long long)listed.report.pairs_mollify,
            (unsigned long long)searched.report.pairs_mollify);

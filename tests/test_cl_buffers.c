@@ -56,7 +56,7 @@ static uint64_t check_same(const fixture *fx, const shape_mesh *m, rsmooth_scala
     CHECK(expected && got);
     rsmooth_error err;
     rsmooth_status st = rsmooth_smooth(fx->ctx, scalar, in, m->vertex_count, m->indices,
-                                       m->triangle_count, p, expected, NULL, NULL, NULL, &err);
+                                       m->triangle_count, p, expected, NULL, &err);
     if (st != RSMOOTH_OK)
         printf("%s: rsmooth_smooth: %s\n", what, err.message);
     CHECK_STATUS(st, RSMOOTH_OK);
@@ -174,7 +174,7 @@ int main(void) {
     fx.queue = clCreateCommandQueue(fx.context, device, 0, &cl_err);
     CHECK(cl_err == CL_SUCCESS);
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_context_create_from_queue(fx.queue, &fx.ctx, &err), RSMOOTH_OK);
+    CHECK_STATUS(rsmooth_context_create_from_queue(fx.queue, NULL, &fx.ctx, &err), RSMOOTH_OK);
     cl_device_fp_config fp64 = 0;
     clGetDeviceInfo(device, CL_DEVICE_DOUBLE_FP_CONFIG, sizeof fp64, &fp64, NULL);
 
@@ -215,9 +215,13 @@ int main(void) {
     shape_mesh big; /* tiles, as test_cl_tiles makes them */
     CHECK(shape_cube(&big, 40, 40.0) == 0);
     CHECK(shape_add_normal_noise(&big, 0.3, 12) == 0);
-    rsmooth_context_set_memory_budget(fx.ctx, (uint64_t)big.triangle_count * 96 / 6);
-    CHECK(check_same(&fx, &big, RSMOOTH_FLOAT32, &p, 0, "tiles (uploaded)") > 0);
-    rsmooth_context_set_memory_budget(fx.ctx, 0);
+    fixture tiled = fx; /* the same queue, a context with a budget */
+    rsmooth_context_options budget = {.struct_size = sizeof budget,
+                                      .memory_budget = (uint64_t)big.triangle_count * 96 / 6};
+    CHECK_STATUS(rsmooth_context_create_from_queue(fx.queue, &budget, &tiled.ctx, &err),
+                 RSMOOTH_OK);
+    CHECK(check_same(&tiled, &big, RSMOOTH_FLOAT32, &p, 0, "tiles (uploaded)") > 0);
+    rsmooth_context_destroy(tiled.ctx);
     shape_free(&big);
 
     check_errors(&fx, &cube);

@@ -21,7 +21,7 @@ static void smooth_cube(rsmooth_context *ctx, const shape_mesh *m, double *out) 
     float *conf = malloc(m->vertex_count * sizeof *conf);
     CHECK(conf);
     CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                m->triangle_count, &p, out, NULL, conf, NULL, &err),
+                                m->triangle_count, &p, out, OUTPUTS(NULL, conf, NULL), &err),
                  RSMOOTH_OK);
     free(conf);
 }
@@ -53,14 +53,14 @@ static void check_progress(rsmooth_context *ctx, const shape_mesh *m, const doub
     p.progress_user = &log;
     rsmooth_error err;
     CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                m->triangle_count, &p, out, NULL, NULL, NULL, &err),
+                                m->triangle_count, &p, out, NULL, &err),
                  RSMOOTH_OK);
     printf("progress (OpenCL): %d reports, last %.3f\n", log.calls, log.last);
     CHECK(log.calls >= 10 && !log.backwards && log.last == 1.0);
     CHECK(memcmp(out, expected, n * sizeof *out) == 0);
     log = (progress_log){0, 0, 0};
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                          m->triangle_count, &p, out, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                m->triangle_count, &p, out, NULL, &err),
                  RSMOOTH_OK);
     printf("progress (reference): %d reports, last %.3f\n", log.calls, log.last);
     CHECK(log.calls >= 3 && !log.backwards && log.last == 1.0);
@@ -86,8 +86,8 @@ static void *share_context(void *arg) {
     for (int call = 0; call < CALLS_PER_THREAD; call++) {
         rsmooth_error err;
         if (rsmooth_smooth(s->ctx, RSMOOTH_FLOAT64, s->mesh->xyz, s->mesh->vertex_count,
-                           s->mesh->indices, s->mesh->triangle_count, NULL, s->out, NULL, NULL,
-                           NULL, &err) != RSMOOTH_OK)
+                           s->mesh->indices, s->mesh->triangle_count, NULL, s->out, NULL,
+                           &err) != RSMOOTH_OK)
             s->failed++;
         else if (memcmp(s->out, s->alone, n * sizeof *s->out) != 0)
             s->wrong++;
@@ -108,7 +108,7 @@ static void check_shared_context(rsmooth_context *ctx) {
         CHECK(alone && out);
         CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, meshes[t].xyz, meshes[t].vertex_count,
                                     meshes[t].indices, meshes[t].triangle_count, NULL, alone, NULL,
-                                    NULL, NULL, NULL),
+                                    NULL),
                      RSMOOTH_OK);
         sharers[t] = (sharer){ctx, &meshes[t], alone, out, 0, 0};
     }
@@ -149,9 +149,8 @@ static void call_back_in(void *user, double fraction) {
     if (r->calls++)
         return;
     rsmooth_error err;
-    r->nested =
-        rsmooth_smooth(r->ctx, RSMOOTH_FLOAT64, r->m->xyz, r->m->vertex_count, r->m->indices,
-                       r->m->triangle_count, NULL, r->scratch, NULL, NULL, NULL, &err);
+    r->nested = rsmooth_smooth(r->ctx, RSMOOTH_FLOAT64, r->m->xyz, r->m->vertex_count,
+                               r->m->indices, r->m->triangle_count, NULL, r->scratch, NULL, &err);
     snprintf(r->message, sizeof r->message, "%s", err.message);
     rsmooth_piece_info info;
     rsmooth_piece_info_init(&info);
@@ -161,11 +160,13 @@ static void call_back_in(void *user, double fraction) {
     /* another context is free: its call runs */
     r->nested_other =
         rsmooth_smooth(r->other, RSMOOTH_FLOAT64, r->m->xyz, r->m->vertex_count, r->m->indices,
-                       r->m->triangle_count, NULL, r->scratch, NULL, NULL, NULL, &err);
-    /* the getters and setters answer from inside the call, and destroy leaves it alone */
-    r->budget = rsmooth_context_memory_budget(r->ctx);
-    rsmooth_context_set_host_threads(r->ctx, rsmooth_context_host_threads(r->ctx));
-    r->threads = rsmooth_context_host_threads(r->ctx);
+                       r->m->triangle_count, NULL, r->scratch, NULL, &err);
+    /* the info answers from inside the call, and destroy leaves it alone */
+    rsmooth_context_info about = {.struct_size = sizeof about};
+    if (rsmooth_context_get_info(r->ctx, &about) == RSMOOTH_OK) {
+        r->budget = about.memory_budget;
+        r->threads = about.host_threads + 1; /* +1: answered */
+    }
     rsmooth_context_destroy(r->ctx);
 }
 
@@ -186,7 +187,7 @@ static void check_reentry(rsmooth_context *ctx, const shape_mesh *m, const doubl
     p.progress_user = &r;
     alarm(120); /* a deadlock fails the test instead of hanging it */
     CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                m->triangle_count, &p, out, NULL, NULL, NULL, &err),
+                                m->triangle_count, &p, out, NULL, &err),
                  RSMOOTH_OK);
     alarm(0);
     printf("a call from its own progress callback: %s (%s); a piece: %s; another context: %s\n",
@@ -202,7 +203,7 @@ static void check_reentry(rsmooth_context *ctx, const shape_mesh *m, const doubl
     CHECK(memcmp(out, expected, n * sizeof *out) == 0); /* the outer call as if alone */
     /* the context still works afterwards */
     CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                m->triangle_count, NULL, out, NULL, NULL, NULL, &err),
+                                m->triangle_count, NULL, out, NULL, &err),
                  RSMOOTH_OK);
     CHECK(memcmp(out, expected, n * sizeof *out) == 0);
     rsmooth_context_destroy(r.other);
@@ -229,7 +230,7 @@ int main(void) {
         double *plain = malloc(n * sizeof *plain);
         CHECK(plain);
         CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count, cube.indices,
-                                    cube.triangle_count, NULL, plain, NULL, NULL, NULL, NULL),
+                                    cube.triangle_count, NULL, plain, NULL, NULL),
                      RSMOOTH_OK);
         check_reentry(ctx, &cube, plain);
         free(plain);
@@ -244,15 +245,22 @@ int main(void) {
         double *one = malloc(nb * sizeof *one), *many = malloc(nb * sizeof *many);
         CHECK(one && many);
         rsmooth_error err;
-        setenv("RSMOOTH_HOST_THREADS", "1", 1);
-        CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, big.xyz, big.vertex_count, big.indices,
-                                    big.triangle_count, NULL, one, NULL, NULL, NULL, &err),
+        setenv("RSMOOTH_HOST_THREADS", "1", 1); /* read when a context is made */
+        rsmooth_context *single = open_test_context();
+        CHECK(context_info(single).host_threads == 1);
+        CHECK_STATUS(rsmooth_smooth(single, RSMOOTH_FLOAT64, big.xyz, big.vertex_count, big.indices,
+                                    big.triangle_count, NULL, one, NULL, &err),
                      RSMOOTH_OK);
-        setenv("RSMOOTH_HOST_THREADS", "5", 1);
-        CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, big.xyz, big.vertex_count, big.indices,
-                                    big.triangle_count, NULL, many, NULL, NULL, NULL, &err),
-                     RSMOOTH_OK);
+        rsmooth_context_destroy(single);
         unsetenv("RSMOOTH_HOST_THREADS");
+        rsmooth_context_options five = {.struct_size = sizeof five, .host_threads = 5};
+        rsmooth_context *several = NULL;
+        CHECK_STATUS(rsmooth_context_create(&five, &several, &err), RSMOOTH_OK);
+        CHECK(context_info(several).host_threads == 5);
+        CHECK_STATUS(rsmooth_smooth(several, RSMOOTH_FLOAT64, big.xyz, big.vertex_count,
+                                    big.indices, big.triangle_count, NULL, many, NULL, &err),
+                     RSMOOTH_OK);
+        rsmooth_context_destroy(several);
         CHECK(memcmp(one, many, nb * sizeof *one) == 0);
         printf("1 and 5 host threads (%zu triangles): bit-identical\n", big.triangle_count);
         free(one);
@@ -268,7 +276,7 @@ int main(void) {
         rsmooth_params p;
         rsmooth_params_init(&p);
         CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, big.xyz, big.vertex_count, big.indices,
-                                    big.triangle_count, &p, plain, NULL, NULL, NULL, NULL),
+                                    big.triangle_count, &p, plain, NULL, NULL),
                      RSMOOTH_OK);
         check_progress(ctx, &big, plain);
         free(plain);
@@ -278,13 +286,14 @@ int main(void) {
     /* Device specs: "cpu" and "0:0" name PoCL's device here; a name that matches nothing fails. */
     rsmooth_error err;
     rsmooth_context *other = NULL;
-    CHECK_STATUS(rsmooth_context_create("0:0", &other, &err), RSMOOTH_OK);
-    printf("device 0:0 is %s\n", rsmooth_context_device_name(other));
+    rsmooth_context_options first = {.struct_size = sizeof first, .device = "0:0"};
+    CHECK_STATUS(rsmooth_context_create(&first, &other, &err), RSMOOTH_OK);
+    printf("device 0:0 is %s\n", context_info(other).device_name);
     rsmooth_device_info devices[8];
     size_t device_count = rsmooth_list_devices(devices, 8);
     CHECK(device_count >= 1);
     CHECK(devices[0].platform_index == 0 && devices[0].device_index == 0);
-    CHECK(strcmp(devices[0].name, rsmooth_context_device_name(other)) == 0);
+    CHECK(strcmp(devices[0].name, context_info(other).device_name) == 0);
     CHECK(devices[0].compute_units >= 1 && devices[0].global_memory > 0);
     /* every device has its version (PoCL's is 65 characters: read whole, then cut to the field;
      * a 63-byte query came back empty) */
@@ -314,10 +323,12 @@ int main(void) {
     smooth_cube(other, &cube, c);
     rsmooth_context_destroy(other);
     other = NULL;
-    CHECK_STATUS(rsmooth_context_create("no such device anywhere", &other, &err),
-                 RSMOOTH_ERROR_NO_DEVICE);
+    rsmooth_context_options nowhere = {.struct_size = sizeof nowhere,
+                                       .device = "no such device anywhere"};
+    CHECK_STATUS(rsmooth_context_create(&nowhere, &other, &err), RSMOOTH_ERROR_NO_DEVICE);
     CHECK(other == NULL && strstr(err.message, "no such device anywhere"));
-    CHECK_STATUS(rsmooth_context_create("99:0", &other, &err), RSMOOTH_ERROR_NO_DEVICE);
+    nowhere.device = "99:0";
+    CHECK_STATUS(rsmooth_context_create(&nowhere, &other, &err), RSMOOTH_ERROR_NO_DEVICE);
     printf("unknown device: %s\n", err.message);
 
     /* A caller's queue: the context derives context and device from it and retains it. The
@@ -335,7 +346,7 @@ int main(void) {
         cl_uint refs_before = 0, refs_during = 0, refs_after = 0;
         clGetCommandQueueInfo(queue, CL_QUEUE_REFERENCE_COUNT, sizeof refs_before, &refs_before,
                               NULL);
-        CHECK_STATUS(rsmooth_context_create_from_queue(queue, &other, &err), RSMOOTH_OK);
+        CHECK_STATUS(rsmooth_context_create_from_queue(queue, NULL, &other, &err), RSMOOTH_OK);
         clGetCommandQueueInfo(queue, CL_QUEUE_REFERENCE_COUNT, sizeof refs_during, &refs_during,
                               NULL);
         CHECK_EQ_INT(refs_during, refs_before + 1);
@@ -353,7 +364,7 @@ int main(void) {
         }
         CHECK_EQ_INT(refs_after, refs_before);
         clReleaseCommandQueue(queue);
-        CHECK_STATUS(rsmooth_context_create_from_queue(NULL, &other, &err),
+        CHECK_STATUS(rsmooth_context_create_from_queue(NULL, NULL, &other, &err),
                      RSMOOTH_ERROR_INVALID_ARGUMENT);
         printf("caller's queue: retained (%u -> %u) and released (%u), same result\n", refs_before,
                refs_during, refs_after);
@@ -367,28 +378,25 @@ int main(void) {
     uint32_t bad = cube.indices[5];
     cube.indices[5] = (uint32_t)cube.vertex_count;
     CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count, cube.indices,
-                                cube.triangle_count, &p, c, NULL, NULL, NULL, &err),
+                                cube.triangle_count, &p, c, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     printf("index out of range: %s\n", err.message);
     cube.indices[5] = bad;
     p.sigma_f = NAN;
     CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count, cube.indices,
-                                cube.triangle_count, &p, c, NULL, NULL, NULL, &err),
+                                cube.triangle_count, &p, c, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     printf("sigma_f NaN: %s\n", err.message);
     rsmooth_params_init(&p);
     double saved = cube.xyz[7];
     cube.xyz[7] = INFINITY;
     CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count, cube.indices,
-                                cube.triangle_count, &p, c, NULL, NULL, NULL, &err),
+                                cube.triangle_count, &p, c, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     printf("infinite coordinate: %s\n", err.message);
     cube.xyz[7] = saved;
-    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count, cube.indices,
-                                cube.triangle_count, &p, c, NULL, NULL, NULL, &err),
-                 RSMOOTH_ERROR_INVALID_ARGUMENT);
     CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count, cube.indices,
-                                cube.triangle_count, &p, cube.xyz, NULL, NULL, NULL, &err),
+                                cube.triangle_count, &p, cube.xyz, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     CHECK(memcmp(b, c, n * sizeof *c) == 0);
     printf("bad arguments: output untouched\n");

@@ -158,13 +158,16 @@ static void whole_filter(rsmooth_context *ctx) {
     rsmooth_params_init(&params);
     params.sigma_f = 4;
     params.sigma_g = 1;
+    (void)ctx;
     for (int device = 0; device < 2; device++) {
-        setenv("RSMOOTH_DEVICE_GRID", device ? "1" : "0", 1);
+        setenv("RSMOOTH_DEVICE_GRID", device ? "1" : "0", 1); /* read when a context is made */
+        rsmooth_context *made = open_test_context();
         rsmooth_error err;
-        CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, mesh.xyz, nv, mesh.indices,
-                                    mesh.triangle_count, &params, out[device], weight[device], NULL,
-                                    NULL, &err),
+        CHECK_STATUS(rsmooth_smooth(made, RSMOOTH_FLOAT64, mesh.xyz, nv, mesh.indices,
+                                    mesh.triangle_count, &params, out[device],
+                                    OUTPUTS(weight[device], NULL, NULL), &err),
                      RSMOOTH_OK);
+        rsmooth_context_destroy(made);
     }
     unsetenv("RSMOOTH_DEVICE_GRID");
     bool equal = memcmp(out[0], out[1], 3 * nv * sizeof(double)) == 0 &&
@@ -178,23 +181,16 @@ static void whole_filter(rsmooth_context *ctx) {
     shape_free(&mesh);
 }
 
-/* A context made while RSMOOTH_DEVICE_GRID says no on a CPU device has no grid kernels: forced
- * later, the device declines (the host sorts) rather than fail. */
-static void without_kernels(void) {
+/* A context reads RSMOOTH_DEVICE_GRID once, at its creation: set afterwards, it changes nothing
+ * (a CPU device's program then has no grid kernels to run). */
+static void read_at_creation(void) {
     unsetenv("RSMOOTH_DEVICE_GRID");
     rsmooth_context *ctx = open_test_context();
     bool made_with = rs_cl_device_grid(ctx); /* a GPU's program holds them anyway */
-    setenv("RSMOOTH_DEVICE_GRID", "1", 1);
-    double p[6] = {0, 0, 0, 0.5, 0.5, 0.5}, lo[3] = {0, 0, 0}, hi[3] = {0.5, 0.5, 0.5};
-    rs_grid grid;
-    rsmooth_error err;
-    bool done = true;
-    CHECK_STATUS(rs_cl_grid_build_columns(ctx, &grid, p, 2, 1.0, 1, lo, hi, &done, &err),
-                 RSMOOTH_OK);
-    printf("forced on a context made without it: %s\n",
-           done ? "sorted on the device" : "declined (host sorts it)");
-    CHECK(done == made_with);
-    rs_grid_free(&grid);
+    setenv("RSMOOTH_DEVICE_GRID", made_with ? "0" : "1", 1);
+    printf("RSMOOTH_DEVICE_GRID set after the creation: %s\n",
+           rs_cl_device_grid(ctx) == made_with ? "no change" : "changed");
+    CHECK(rs_cl_device_grid(ctx) == made_with);
     unsetenv("RSMOOTH_DEVICE_GRID");
     rsmooth_context_destroy(ctx);
 }
@@ -214,7 +210,7 @@ int main(void) {
     point_sets(ctx);
     whole_filter(ctx);
     rsmooth_context_destroy(ctx);
-    without_kernels();
+    read_at_creation();
     printf("device grid == host grid\n");
     return 0;
 }

@@ -20,7 +20,8 @@
 static void check_refused(const char *device) {
     rsmooth_context *ctx = (rsmooth_context *)&ctx; /* not NULL: the call must clear it */
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_context_create(device, &ctx, &err), RSMOOTH_ERROR_NO_DEVICE);
+    rsmooth_context_options options = {.struct_size = sizeof options, .device = device};
+    CHECK_STATUS(rsmooth_context_create(&options, &ctx, &err), RSMOOTH_ERROR_NO_DEVICE);
     CHECK(ctx == NULL);
     CHECK_EQ_INT(err.status, RSMOOTH_ERROR_NO_DEVICE);
     CHECK(strstr(err.message, "loader") != NULL);
@@ -42,9 +43,8 @@ static void check_reference(void) {
     double *out = malloc(3 * cube.vertex_count * sizeof *out);
     CHECK(out);
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count,
-                                          cube.indices, cube.triangle_count, NULL, out, NULL, NULL,
-                                          NULL, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count, cube.indices,
+                                cube.triangle_count, NULL, out, NULL, &err),
                  RSMOOTH_OK);
     for (size_t i = 0; i < 3 * cube.vertex_count; i++)
         CHECK(isfinite(out[i]));
@@ -68,7 +68,8 @@ static int missing_loader(void) {
     rsmooth_context *ctx = NULL;
     /* a caller's queue (never touched: the loader comes first) */
     cl_command_queue queue = (cl_command_queue)(uintptr_t)1;
-    CHECK_STATUS(rsmooth_context_create_from_queue(queue, &ctx, &err), RSMOOTH_ERROR_NO_DEVICE);
+    CHECK_STATUS(rsmooth_context_create_from_queue(queue, NULL, &ctx, &err),
+                 RSMOOTH_ERROR_NO_DEVICE);
     CHECK(ctx == NULL);
     CHECK(strstr(err.message, MISSING) != NULL);
     printf("refused: %s\n", err.message);
@@ -96,11 +97,10 @@ static int real_loader(void) {
     CHECK(out && ref);
     rsmooth_error err;
     CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count, cube.indices,
-                                cube.triangle_count, NULL, out, NULL, NULL, NULL, &err),
+                                cube.triangle_count, NULL, out, NULL, &err),
                  RSMOOTH_OK);
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count,
-                                          cube.indices, cube.triangle_count, NULL, ref, NULL, NULL,
-                                          NULL, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count, cube.indices,
+                                cube.triangle_count, NULL, ref, NULL, &err),
                  RSMOOTH_OK);
     double edge = shape_mean_edge_length(&cube), worst = 0;
     for (size_t i = 0; i < n; i++)

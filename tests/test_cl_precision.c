@@ -19,7 +19,7 @@ static double *smooth(rsmooth_context *ctx, const shape_mesh *m, double *edge) {
     p.sigma_f = 1.5;
     p.sigma_g = 0.7;
     CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                m->triangle_count, &p, out, NULL, NULL, &report, &err),
+                                m->triangle_count, &p, out, OUTPUTS(NULL, NULL, &report), &err),
                  RSMOOTH_OK);
     *edge = report.mean_edge_length;
     return out;
@@ -78,7 +78,7 @@ int main(void) {
     p.sigma_g = 0.7;
     rsmooth_error err;
     CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT32, in32, cube.vertex_count, cube.indices,
-                                cube.triangle_count, &p, out32, NULL, NULL, NULL, &err),
+                                cube.triangle_count, &p, out32, NULL, &err),
                  RSMOOTH_OK);
     double max32 = 0;
     for (size_t i = 0; i < n; i++)

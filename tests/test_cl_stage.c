@@ -62,11 +62,11 @@ static double *run(rsmooth_context *ctx, const mesh_ref *m, const rsmooth_params
     rsmooth_report_init(report);
     if (ctx)
         CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                    m->triangle_count, p, out, NULL, NULL, report, &err),
+                                    m->triangle_count, p, out, OUTPUTS(NULL, NULL, report), &err),
                      RSMOOTH_OK);
     else
-        CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                              m->triangle_count, p, out, NULL, NULL, report, &err),
+        CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                    m->triangle_count, p, out, OUTPUTS(NULL, NULL, report), &err),
                      RSMOOTH_OK);
     return out;
 }
@@ -130,7 +130,8 @@ static mesh_ref ref_of(const shape_mesh *s) {
 
 /* Deviation against the number of cycles (one update each, radius 3), in float32 and in double:
  * neither may drift. */
-static void drift(rsmooth_context *ctx, const char *mesh, const mesh_ref *m, int most) {
+static void drift(rsmooth_context *ctx, rsmooth_context *float_ctx, const char *mesh,
+                  const mesh_ref *m, int most) {
     rsmooth_params p;
     schedule s = {"drift", 1, 1, 1, 3, 0.2};
     printf("%s: deviation against cycles (1 update per cycle), float32 / double:", mesh);
@@ -139,9 +140,7 @@ static void drift(rsmooth_context *ctx, const char *mesh, const mesh_ref *m, int
         stage_params(&p, &s);
         rsmooth_report rr, fr, dr;
         double *ref = run(NULL, m, &p, &rr), *dbl = run(ctx, m, &p, &dr);
-        setenv("RSMOOTH_STAGE_PRECISION", "float", 1);
-        double *flt = run(ctx, m, &p, &fr);
-        unsetenv("RSMOOTH_STAGE_PRECISION");
+        double *flt = run(float_ctx, m, &p, &fr);
         double edge = rr.mean_edge_length;
         double dev_f = max_deviation(flt, ref, m->vertex_count, edge);
         double dev_d = max_deviation(dbl, ref, m->vertex_count, edge);
@@ -193,9 +192,10 @@ static void fallback_and_cancel(rsmooth_context *ctx, const mesh_ref *m) {
     stage_params(&p, &schedules[1]);
     rsmooth_report rr, cr;
     double *ref = run(NULL, m, &p, &rr);
-    rsmooth_context_set_memory_budget(ctx, 4096);
-    double *cl = run(ctx, m, &p, &cr);
-    rsmooth_context_set_memory_budget(ctx, 0);
+    (void)ctx;
+    rsmooth_context *small = open_test_context_budget(4096);
+    double *cl = run(small, m, &p, &cr);
+    rsmooth_context_destroy(small);
     bool same = memcmp(cl, ref, 3 * m->vertex_count * sizeof *cl) == 0;
     printf("budget 4096 bytes: the stage ran on %s (%s), %s the reference\n",
            cr.stage_on_device ? "the device" : "the host", cr.device,
@@ -211,21 +211,28 @@ static void fallback_and_cancel(rsmooth_context *ctx, const mesh_ref *m) {
     CHECK(out);
     rsmooth_error err;
     rsmooth_status st = rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                       m->triangle_count, &p, out, NULL, NULL, NULL, &err);
+                                       m->triangle_count, &p, out, NULL, &err);
     printf("cancel after 2 of 10 cycles: %s after %d reports\n", rsmooth_status_str(st), calls);
     CHECK_STATUS(st, RSMOOTH_ERROR_CANCELLED);
     CHECK(calls == 2);
     free(out);
 }
 
-static rsmooth_context *open_variant(const char *variant) {
+/* A context with the kernel variant `variant`, its stage in `precision` (environment variables:
+ * a context reads them at its creation). */
+static rsmooth_context *open_variant(const char *variant, const char *precision) {
     setenv("RSMOOTH_KERNEL_VARIANT", variant, 1);
+    setenv("RSMOOTH_STAGE_PRECISION", precision, 1);
     rsmooth_context *ctx = open_test_context();
     unsetenv("RSMOOTH_KERNEL_VARIANT");
+    unsetenv("RSMOOTH_STAGE_PRECISION");
     return ctx;
 }
 
-static void benchmark_meshes(rsmooth_context *const variants[2]) {
+/* The float32 stage's contexts, beside the double ones (made in main). */
+static rsmooth_context *float_variants[2];
+
+static void benchmark_meshes(rsmooth_context *const variants[2], rsmooth_context *float_ctx) {
     static const char *const models[] = {"Fandisk0.3", "Twelve0.5Impulsive", "Bunny0.2", "Block0.4",
                                          "SharpSphere0.3"};
     size_t count = test_small() ? 1 : sizeof models / sizeof *models;
@@ -240,7 +247,7 @@ static void benchmark_meshes(rsmooth_context *const variants[2]) {
         compare_schedules(variants, models[i], &m, i > 1);
         if (i == 1 && !test_small()) /* 100 cycles here (1000 on the cube below; the 1000-cycle
                                       * table of every model: rsmooth-bench best --drift) */
-            drift(variants[0], models[i], &m, 100);
+            drift(variants[0], float_ctx, models[i], &m, 100);
         rsmooth_mesh_destroy(mesh);
     }
 }
@@ -249,7 +256,9 @@ int main(void) {
     unsetenv("RSMOOTH_MEMORY_BUDGET");
     setenv("RSMOOTH_STAGE", "device", 1); /* a CPU device's default is the host's stage */
     unsetenv("RSMOOTH_STAGE_PRECISION");
-    rsmooth_context *variants[2] = {open_variant("cpu"), open_variant("gpu")};
+    rsmooth_context *variants[2] = {open_variant("cpu", "double"), open_variant("gpu", "double")};
+    float_variants[0] = open_variant("cpu", "float");
+    float_variants[1] = open_variant("gpu", "float");
     bool small = test_small();
     shape_mesh cube, sphere, plane, soup;
     CHECK(shape_cube(&cube, small ? 8 : 16, 1.0) == 0);
@@ -264,23 +273,23 @@ int main(void) {
     compare_schedules(variants, "noisy cube", &c, false);
     compare_schedules(variants, "noisy sphere", &s, small);
     /* float32, what a device without fp64 runs */
-    setenv("RSMOOTH_STAGE_PRECISION", "float", 1);
-    compare_schedules(variants, "cube, float32", &c, false);
-    compare_schedules(variants, "sphere, float32", &s, true);
-    unsetenv("RSMOOTH_STAGE_PRECISION");
+    compare_schedules(float_variants, "cube, float32", &c, false);
+    compare_schedules(float_variants, "sphere, float32", &s, true);
     compare_schedules(variants, "open plane", &pl, true);
     compare_schedules(variants, "cube soup", &so, true);
     masked(variants, &c);
-    drift(variants[0], "noisy cube", &c, small ? 100 : 1000);
+    drift(variants[0], float_variants[0], "noisy cube", &c, small ? 100 : 1000);
     fallback_and_cancel(variants[0], &c);
-    benchmark_meshes(variants);
+    benchmark_meshes(variants, float_variants[0]);
 
     shape_free(&cube);
     shape_free(&sphere);
     shape_free(&plane);
     shape_free(&soup);
-    rsmooth_context_destroy(variants[0]);
-    rsmooth_context_destroy(variants[1]);
+    for (int i = 0; i < 2; i++) {
+        rsmooth_context_destroy(variants[i]);
+        rsmooth_context_destroy(float_variants[i]);
+    }
     printf("ok\n");
     return 0;
 }

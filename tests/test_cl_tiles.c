@@ -83,24 +83,25 @@ static void check_shape(rsmooth_context *ctx, const char *name, const shape_mesh
     run_alloc(&ref, nv);
     rsmooth_error err;
     rsmooth_params params = *base;
-    rsmooth_context_set_memory_budget(ctx, 0);
     CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, nv, m->indices, nt, &params,
-                                whole.xyz, whole.weight, whole.confidence, &whole.report, &err),
+                                whole.xyz, OUTPUTS(whole.weight, whole.confidence, &whole.report),
+                                &err),
                  RSMOOTH_OK);
     CHECK(whole.report.tiles == 1);
 
     uint64_t budget = (uint64_t)nt * 96 / 6;
-    rsmooth_context_set_memory_budget(ctx, budget);
-    CHECK(rsmooth_context_memory_budget(ctx) == budget);
+    rsmooth_context *budgeted = open_test_context_budget(budget);
+    CHECK(context_info(budgeted).memory_budget == budget);
     progress_log log = {0, 0, 0};
     params.progress = log_progress;
     params.progress_user = &log;
-    CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, nv, m->indices, nt, &params,
-                                tiled.xyz, tiled.weight, tiled.confidence, &tiled.report, &err),
+    CHECK_STATUS(rsmooth_smooth(budgeted, RSMOOTH_FLOAT64, m->xyz, nv, m->indices, nt, &params,
+                                tiled.xyz, OUTPUTS(tiled.weight, tiled.confidence, &tiled.report),
+                                &err),
                  RSMOOTH_OK);
-    rsmooth_context_set_memory_budget(ctx, 0);
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, nv, m->indices, nt, base,
-                                          ref.xyz, ref.weight, ref.confidence, &ref.report, &err),
+    rsmooth_context_destroy(budgeted);
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, m->xyz, nv, m->indices, nt, base, ref.xyz,
+                                OUTPUTS(ref.weight, ref.confidence, &ref.report), &err),
                  RSMOOTH_OK);
     double edge = ref.report.mean_edge_length;
     double vs_whole = max_deviation(&tiled, &whole, nv, edge);
@@ -134,16 +135,17 @@ static void check_too_small(rsmooth_context *ctx, const shape_mesh *m) {
         xyz[i] = (float)m->xyz[i];
         out[i] = -12345.0f;
     }
-    rsmooth_context_set_memory_budget(ctx, 1024);
+    (void)ctx;
+    rsmooth_context *tiny = open_test_context_budget(1024);
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT32, xyz, nv, m->indices, m->triangle_count, NULL,
-                                out, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth(tiny, RSMOOTH_FLOAT32, xyz, nv, m->indices, m->triangle_count, NULL,
+                                out, NULL, &err),
                  RSMOOTH_ERROR_OUT_OF_MEMORY);
     printf("budget 1024 B: %s\n", err.message);
     CHECK(strstr(err.message, "budget") != NULL);
     for (size_t i = 0; i < 3 * nv; i++)
         CHECK(out[i] == -12345.0f);
-    rsmooth_context_set_memory_budget(ctx, 0);
+    rsmooth_context_destroy(tiny);
     free(out);
     free(xyz);
 }
@@ -154,7 +156,7 @@ static void check_environment(void) {
     rsmooth_error err;
     setenv("RSMOOTH_MEMORY_BUDGET", "3M", 1);
     CHECK_STATUS(rsmooth_context_create(NULL, &ctx, &err), RSMOOTH_OK);
-    CHECK(rsmooth_context_memory_budget(ctx) == 3u << 20);
+    CHECK(context_info(ctx).memory_budget == 3u << 20);
     rsmooth_context_destroy(ctx);
     /* junk, and a budget of nothing (as the command refuses --memory-budget 0) */
     static const char *const refused[] = {"lots", "0", "0M", "-5M", "12Q"};
@@ -164,7 +166,28 @@ static void check_environment(void) {
         CHECK(ctx == NULL && strstr(err.message, "RSMOOTH_MEMORY_BUDGET") != NULL);
         printf("RSMOOTH_MEMORY_BUDGET=%s: %s\n", refused[i], err.message);
     }
+    /* the caller's option wins over the environment */
+    setenv("RSMOOTH_MEMORY_BUDGET", "3M", 1);
+    rsmooth_context_options options = {.struct_size = sizeof options, .memory_budget = 5u << 20};
+    CHECK_STATUS(rsmooth_context_create(&options, &ctx, &err), RSMOOTH_OK);
+    CHECK(context_info(ctx).memory_budget == 5u << 20);
+    rsmooth_context_destroy(ctx);
     unsetenv("RSMOOTH_MEMORY_BUDGET");
+    /* every variable with a fixed form is checked when a context is made, and named; before,
+     * RSMOOTH_STAGE_PRECISION=half ran in double without a word */
+    static const char *const wrong[][2] = {{"RSMOOTH_STAGE_PRECISION", "half"},
+                                           {"RSMOOTH_STAGE", "gpu"},
+                                           {"RSMOOTH_LANES", "5"},
+                                           {"RSMOOTH_CELLS_PER_REACH", "9"},
+                                           {"RSMOOTH_DEVICE_GRID", "yes"},
+                                           {"RSMOOTH_HOST_THREADS", "many"}};
+    for (size_t i = 0; i < sizeof wrong / sizeof *wrong; i++) {
+        setenv(wrong[i][0], wrong[i][1], 1);
+        CHECK_STATUS(rsmooth_context_create(NULL, &ctx, &err), RSMOOTH_ERROR_INVALID_ARGUMENT);
+        CHECK(ctx == NULL && strstr(err.message, wrong[i][0]) != NULL);
+        printf("%s=%s: %s\n", wrong[i][0], wrong[i][1], err.message);
+        unsetenv(wrong[i][0]);
+    }
 }
 
 int main(void) {

@@ -10,10 +10,23 @@
 #include <stdlib.h>
 #include <string.h>
 
-static inline rsmooth_context *open_test_context(void) {
+/* ctx's rsmooth_context_info (every field). */
+static inline rsmooth_context_info context_info(const rsmooth_context *ctx) {
+    rsmooth_context_info info = {.struct_size = sizeof info};
+    if (rsmooth_context_get_info(ctx, &info) != RSMOOTH_OK) {
+        fprintf(stderr, "rsmooth_context_get_info failed\n");
+        exit(1);
+    }
+    return info;
+}
+
+/* A context on the default device whose calls may hold `budget` bytes of device memory (0: the
+ * device's own limit), as rsmooth_context_options.memory_budget sets it. */
+static inline rsmooth_context *open_test_context_budget(uint64_t budget) {
     rsmooth_context *ctx = NULL;
     rsmooth_error err;
-    rsmooth_status st = rsmooth_context_create(NULL, &ctx, &err);
+    rsmooth_context_options options = {.struct_size = sizeof options, .memory_budget = budget};
+    rsmooth_status st = rsmooth_context_create(&options, &ctx, &err);
     if (st != RSMOOTH_OK) {
         const char *require = getenv("RSMOOTH_REQUIRE_OPENCL");
         fprintf(stderr, "no OpenCL device: %s: %s\n%s\n", rsmooth_status_str(st), err.message,
@@ -24,9 +37,13 @@ static inline rsmooth_context *open_test_context(void) {
         }
         exit(1);
     }
-    printf("device: %s (program build %.1f ms)\n", rsmooth_context_device_name(ctx),
-           rsmooth_context_build_ms(ctx));
+    rsmooth_context_info info = context_info(ctx);
+    printf("device: %s (program build %.1f ms)\n", info.device_name, info.build_ms);
     return ctx;
+}
+
+static inline rsmooth_context *open_test_context(void) {
+    return open_test_context_budget(0);
 }
 
 /* Path of ../shared/data/benchmark/<model>/<file> beside the source tree, or NULL when absent. */

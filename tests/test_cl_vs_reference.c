@@ -30,11 +30,11 @@ static void compare(rsmooth_context *ctx, const char *name, const double *xyz, s
     CHECK(ref && cl && ref_conf && cl_conf && ref_k && cl_k && dev);
     rsmooth_report rr, rc;
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, xyz, nv, idx, nt, params, ref, ref_k,
-                                          ref_conf, &rr, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, xyz, nv, idx, nt, params, ref,
+                                OUTPUTS(ref_k, ref_conf, &rr), &err),
                  RSMOOTH_OK);
-    CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, xyz, nv, idx, nt, params, cl, cl_k, cl_conf,
-                                &rc, &err),
+    CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, xyz, nv, idx, nt, params, cl,
+                                OUTPUTS(cl_k, cl_conf, &rc), &err),
                  RSMOOTH_OK);
     double edge = rr.mean_edge_length, max_conf = 0, max_k = 0, moved = 0;
     for (size_t v = 0; v < nv; v++) {

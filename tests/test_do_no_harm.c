@@ -51,18 +51,18 @@ static int smooth(rsmooth_context *ctx, const mesh *m, enum mode mode, double *o
     int kind = -1;
     if (mode == AUTO || mode == BEST_AUTO) {
         rsmooth_noise_report noise;
-        rsmooth_noise_report_init(&noise);
-        CHECK_STATUS(rsmooth_params_auto_report(RSMOOTH_FLOAT64, m->xyz, m->vertex_count,
-                                                m->indices, m->triangle_count, &p, &noise, &err),
+        noise.struct_size = sizeof noise;
+        CHECK_STATUS(rsmooth_params_auto(RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                         m->triangle_count, &p, &noise, &err),
                      RSMOOTH_OK);
         kind = noise.kind;
     }
     rsmooth_report_init(report);
     rsmooth_status st =
         ctx ? rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                             m->triangle_count, &p, out, NULL, NULL, report, &err)
-            : rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                       m->triangle_count, &p, out, NULL, NULL, report, &err);
+                             m->triangle_count, &p, out, OUTPUTS(NULL, NULL, report), &err)
+            : rsmooth_smooth(NULL, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                             m->triangle_count, &p, out, OUTPUTS(NULL, NULL, report), &err);
     if (st != RSMOOTH_OK)
         fprintf(stderr, "%s, %s: %s\n", m->name, mode_name[mode], err.message);
     CHECK_STATUS(st, RSMOOTH_OK);
@@ -302,14 +302,14 @@ static void check_points(rsmooth_context *ctx) {
     rsmooth_report report;
     rsmooth_report_init(&report);
     CHECK_STATUS(ctx ? rsmooth_smooth_points(ctx, RSMOOTH_FLOAT64, xyz, normal, n, NULL, out, NULL,
-                                             NULL, &report, &err)
-                     : rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, normal, n, NULL, out,
-                                                       NULL, NULL, &report, &err),
+                                             OUTPUTS(NULL, NULL, &report), &err)
+                     : rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, xyz, normal, n, NULL, out, NULL,
+                                             OUTPUTS(NULL, NULL, &report), &err),
                  RSMOOTH_OK);
     CHECK_STATUS(ctx ? rsmooth_smooth_points(ctx, RSMOOTH_FLOAT64, xyz, normal, n - 1, NULL, alone,
-                                             NULL, NULL, NULL, &err)
-                     : rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, normal, n - 1, NULL,
-                                                       alone, NULL, NULL, NULL, &err),
+                                             NULL, NULL, &err)
+                     : rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, xyz, normal, n - 1, NULL, alone,
+                                             NULL, NULL, &err),
                  RSMOOTH_OK);
     bool same = memcmp(out, alone, 3 * (n - 1) * sizeof *out) == 0;
     printf("  point sphere and a point 1e6 away, %-10s outliers %zu, the far point %s, the "
@@ -344,12 +344,12 @@ static void check_guard(rsmooth_context *ctx) {
         p.guard = guard;
         rsmooth_report report;
         rsmooth_report_init(&report);
-        CHECK_STATUS(ctx ? rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m.xyz, m.vertex_count, m.indices,
-                                          m.triangle_count, &p, out, NULL, NULL, &report, &err)
-                         : rsmooth_smooth_reference(RSMOOTH_FLOAT64, m.xyz, m.vertex_count,
-                                                    m.indices, m.triangle_count, &p, out, NULL,
-                                                    NULL, &report, &err),
-                     RSMOOTH_OK);
+        CHECK_STATUS(
+            ctx ? rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m.xyz, m.vertex_count, m.indices,
+                                 m.triangle_count, &p, out, OUTPUTS(NULL, NULL, &report), &err)
+                : rsmooth_smooth(NULL, RSMOOTH_FLOAT64, m.xyz, m.vertex_count, m.indices,
+                                 m.triangle_count, &p, out, OUTPUTS(NULL, NULL, &report), &err),
+            RSMOOTH_OK);
         turned[guard] = turned_over(&m, out);
         skipped[guard] = report.stage_skipped;
     }

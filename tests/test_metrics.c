@@ -265,9 +265,9 @@ static void test_against_script(void) {
         p.sigma_g = 0.5;
         double *smoothed = malloc(3 * noisy->vertex_count * sizeof *smoothed);
         CHECK(smoothed != NULL);
-        CHECK_STATUS(rsmooth_smooth_reference(
-                         RSMOOTH_FLOAT64, noisy->positions, noisy->vertex_count, noisy->triangles,
-                         noisy->triangle_count, &p, smoothed, NULL, NULL, NULL, &err),
+        CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, noisy->positions, noisy->vertex_count,
+                                    noisy->triangles, noisy->triangle_count, &p, smoothed, NULL,
+                                    &err),
                      RSMOOTH_OK);
         /* The OBJ writer prints coordinates in full precision, so the script reads what we
          * measure. */

@@ -100,10 +100,10 @@ static rsmooth_noise_report read_noise(const shape_mesh *m, const double *xyz) {
     rsmooth_params p;
     rsmooth_params_init(&p);
     rsmooth_noise_report r;
-    rsmooth_noise_report_init(&r);
+    r.struct_size = sizeof r;
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_params_auto_report(RSMOOTH_FLOAT64, xyz, m->vertex_count, m->indices,
-                                            m->triangle_count, &p, &r, &err),
+    CHECK_STATUS(rsmooth_params_auto(RSMOOTH_FLOAT64, xyz, m->vertex_count, m->indices,
+                                     m->triangle_count, &p, &r, &err),
                  RSMOOTH_OK);
     return r;
 }

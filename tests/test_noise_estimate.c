@@ -53,18 +53,19 @@ static double estimate(const double *xyz, size_t nv, const uint32_t *tri, size_t
  * best mode takes its impulsive preset exactly when the noise reads impulsive. */
 static void check_auto(const char *name, const double *xyz, size_t nv, const uint32_t *tri,
                        size_t nt, bool expect_impulsive) {
-    double noise = estimate(xyz, nv, tri, nt), got = -1;
+    double noise = estimate(xyz, nv, tri, nt);
     rsmooth_params paper, best;
     rsmooth_params_init(&paper);
     rsmooth_params_init_best(&best);
-    CHECK_STATUS(rsmooth_params_auto(RSMOOTH_FLOAT64, xyz, nv, tri, nt, &paper, &got, NULL),
+    rsmooth_noise_report read = {.struct_size = sizeof read};
+    CHECK_STATUS(rsmooth_params_auto(RSMOOTH_FLOAT64, xyz, nv, tri, nt, &paper, &read, NULL),
                  RSMOOTH_OK);
-    CHECK(got == noise);
+    CHECK(read.level == noise);
     CHECK_NEAR(paper.sigma_f, 0.6 + 1.6 * noise, 1e-12); /* lib/auto/params_auto.c's paper rule */
     CHECK_NEAR(paper.sigma_g, 4.0 * noise, 1e-12);
     rsmooth_noise_report r;
-    rsmooth_noise_report_init(&r);
-    CHECK_STATUS(rsmooth_params_auto_report(RSMOOTH_FLOAT64, xyz, nv, tri, nt, &best, &r, NULL),
+    r.struct_size = sizeof r;
+    CHECK_STATUS(rsmooth_params_auto(RSMOOTH_FLOAT64, xyz, nv, tri, nt, &best, &r, NULL),
                  RSMOOTH_OK);
     CHECK_EQ_INT(r.kind == RSMOOTH_NOISE_IMPULSIVE, expect_impulsive);
     CHECK_EQ_INT(strcmp(r.preset, "best: impulsive") == 0, expect_impulsive);
@@ -219,7 +220,7 @@ static void random_directions(void) {
         shape_free(&shapes[s]);
 }
 
-/* The kind the estimate reads (rsmooth_params_auto_report): Gaussian noise, along the normals or
+/* The kind the estimate reads (rsmooth_params_auto): Gaussian noise, along the normals or
  * in random directions, at any level from 0.05 to 1 mean edge lengths, is never taken for
  * impulsive; impulsive noise (a share F of the vertices displaced, the rest exact) is, at F 0.05
  * and 0.1 and levels 0.3 to 1. */
@@ -227,10 +228,10 @@ static bool reads_impulsive(const shape_mesh *m, const double *xyz) {
     rsmooth_params p;
     rsmooth_params_init(&p);
     rsmooth_noise_report r;
-    rsmooth_noise_report_init(&r);
+    r.struct_size = sizeof r;
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_params_auto_report(RSMOOTH_FLOAT64, xyz, m->vertex_count, m->indices,
-                                            m->triangle_count, &p, &r, &err),
+    CHECK_STATUS(rsmooth_params_auto(RSMOOTH_FLOAT64, xyz, m->vertex_count, m->indices,
+                                     m->triangle_count, &p, &r, &err),
                  RSMOOTH_OK);
     return r.kind == RSMOOTH_NOISE_IMPULSIVE;
 }

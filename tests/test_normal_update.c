@@ -204,8 +204,8 @@ static void stage(rsmooth_scalar scalar, const void *xyz, const shape_mesh *m, i
     p.move_mask = mask;
     rsmooth_error err;
     rsmooth_error_init(&err);
-    CHECK_STATUS(rsmooth_smooth_reference(scalar, xyz, m->vertex_count, m->indices,
-                                          m->triangle_count, &p, out, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, scalar, xyz, m->vertex_count, m->indices, m->triangle_count,
+                                &p, out, NULL, &err),
                  RSMOOTH_OK);
 }
 
@@ -269,9 +269,8 @@ static void test_restores_cube(void) {
     CHECK(paper && staged && f32 && f32_out);
     rsmooth_params p;
     rsmooth_params_init(&p);
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, noisy.xyz, noisy.vertex_count,
-                                          noisy.indices, noisy.triangle_count, &p, paper, NULL,
-                                          NULL, NULL, NULL),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, noisy.xyz, noisy.vertex_count, noisy.indices,
+                                noisy.triangle_count, &p, paper, NULL, NULL),
                  RSMOOTH_OK);
     stage(RSMOOTH_FLOAT64, noisy.xyz, &noisy, 1, NULL, staged);
     double e_noisy = shape_face_normal_error_deg(&clean, noisy.xyz);
@@ -338,9 +337,8 @@ static void test_parameters_checked(void) {
         p.stage_repeats = bad[i].repeats;
         p.discrepancy_level = bad[i].level;
         p.guided_radius = bad[i].radius;
-        CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count,
-                                              cube.indices, cube.triangle_count, &p, out, NULL,
-                                              NULL, NULL, NULL),
+        CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, cube.xyz, cube.vertex_count,
+                                    cube.indices, cube.triangle_count, &p, out, NULL, NULL),
                      RSMOOTH_ERROR_INVALID_ARGUMENT);
     }
     free(out);
@@ -410,8 +408,8 @@ static void best_on(const shape_mesh *m, double level, double *out, rsmooth_repo
     rsmooth_params_init_best(&p);
     p.discrepancy_level = level;
     rsmooth_report_init(r);
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                          m->triangle_count, &p, out, NULL, NULL, r, NULL),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                m->triangle_count, &p, out, OUTPUTS(NULL, NULL, r), NULL),
                  RSMOOTH_OK);
 }
 
@@ -504,8 +502,8 @@ static void test_region_choice(void) {
     p.discrepancy_level = level;
     p.discrepancy_gain = gain;
     rsmooth_report_init(&r);
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, sphere.xyz, ns, sphere.indices,
-                                          sphere.triangle_count, &p, chosen, NULL, NULL, &r, NULL),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, sphere.xyz, ns, sphere.indices,
+                                sphere.triangle_count, &p, chosen, OUTPUTS(NULL, NULL, &r), NULL),
                  RSMOOTH_OK);
     int g = r.discrepancy_iterations;
     double moved[3];
@@ -600,7 +598,7 @@ static void test_boundary_limit(void) {
     shape_free(&plane);
 }
 
-/* rsmooth_params_auto_report on Gaussian noise: what it read and chose. */
+/* rsmooth_params_auto on Gaussian noise: what it read and chose. */
 static void test_auto_report(void) {
     shape_mesh sphere;
     CHECK(shape_sphere(&sphere, 5, 1.0) == 0);
@@ -608,9 +606,9 @@ static void test_auto_report(void) {
     rsmooth_params p;
     rsmooth_params_init_best(&p);
     rsmooth_noise_report r;
-    rsmooth_noise_report_init(&r);
-    CHECK_STATUS(rsmooth_params_auto_report(RSMOOTH_FLOAT64, sphere.xyz, sphere.vertex_count,
-                                            sphere.indices, sphere.triangle_count, &p, &r, NULL),
+    r.struct_size = sizeof r;
+    CHECK_STATUS(rsmooth_params_auto(RSMOOTH_FLOAT64, sphere.xyz, sphere.vertex_count,
+                                     sphere.indices, sphere.triangle_count, &p, &r, NULL),
                  RSMOOTH_OK);
     printf("auto: level %.3f, kind %d, preset '%s': %s\n", r.level, r.kind, r.preset, r.reason);
     CHECK_EQ_INT(r.kind, RSMOOTH_NOISE_GAUSSIAN);
@@ -621,17 +619,15 @@ static void test_auto_report(void) {
     CHECK(p.vertex_updates > 0);
     rsmooth_params paper;
     rsmooth_params_init(&paper);
-    CHECK_STATUS(rsmooth_params_auto_report(RSMOOTH_FLOAT64, sphere.xyz, sphere.vertex_count,
-                                            sphere.indices, sphere.triangle_count, &paper, &r,
-                                            NULL),
+    CHECK_STATUS(rsmooth_params_auto(RSMOOTH_FLOAT64, sphere.xyz, sphere.vertex_count,
+                                     sphere.indices, sphere.triangle_count, &paper, &r, NULL),
                  RSMOOTH_OK);
     CHECK(strcmp(r.preset, "paper") == 0);
     CHECK_EQ_INT(paper.vertex_updates, 0);
     CHECK(paper.discrepancy_level == 0);
     r.struct_size = 8; /* an uninitialised report is refused */
-    CHECK_STATUS(rsmooth_params_auto_report(RSMOOTH_FLOAT64, sphere.xyz, sphere.vertex_count,
-                                            sphere.indices, sphere.triangle_count, &paper, &r,
-                                            NULL),
+    CHECK_STATUS(rsmooth_params_auto(RSMOOTH_FLOAT64, sphere.xyz, sphere.vertex_count,
+                                     sphere.indices, sphere.triangle_count, &paper, &r, NULL),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     shape_free(&sphere);
 }

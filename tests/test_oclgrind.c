@@ -129,16 +129,17 @@ static rsmooth_context *oclgrind_context(const char *variant) {
                 err.build_log);
         exit(1);
     }
-    unsigned lanes = 0;
-    rsmooth_context_kernel_shape(ctx, &lanes, NULL);
-    CHECK(strstr(rsmooth_context_device_name(ctx), "Oclgrind") != NULL);
+    rsmooth_context_info info = {.struct_size = sizeof info};
+    CHECK_STATUS(rsmooth_context_get_info(ctx, &info), RSMOOTH_OK);
+    unsigned lanes = info.lanes;
+    CHECK(strstr(info.device_name, "Oclgrind") != NULL);
     if (strcmp(variant_kind(variant), "gpu") == 0)
         CHECK_EQ_INT(lanes, 1);
     else if (*variant_lanes(variant))
         CHECK_EQ_INT(lanes, atoi(variant_lanes(variant)));
     else
         CHECK(lanes > 1);
-    CHECK(strcmp(rsmooth_context_program_cache(ctx), "off") == 0); /* built from source */
+    CHECK(strcmp(info.program_cache, "off") == 0); /* built from source */
     return ctx;
 }
 
@@ -187,11 +188,12 @@ static uint64_t run_case(const char *variant, const char *name, const test_mesh 
     rsmooth_report report, cl_report;
     rsmooth_report_init(&cl_report);
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->shape.xyz, nv, m->shape.indices, nt,
-                                          p, ref, NULL, ref_conf, &report, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, m->shape.xyz, nv, m->shape.indices, nt, p,
+                                ref, OUTPUTS(NULL, ref_conf, &report), &err),
                  RSMOOTH_OK);
-    rsmooth_status st = rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->shape.xyz, nv, m->shape.indices, nt,
-                                       p, cl, NULL, confidence ? cl_conf : NULL, &cl_report, &err);
+    rsmooth_status st =
+        rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->shape.xyz, nv, m->shape.indices, nt, p, cl,
+                       OUTPUTS(NULL, confidence ? cl_conf : NULL, &cl_report), &err);
     rsmooth_context_destroy(ctx);
     take_reports(name, log, kept);
     if (st != RSMOOTH_OK)
@@ -330,11 +332,10 @@ static int run_variant(const char *variant, const char *runtime) {
 
     setenv("OCLGRIND_LOG", "/dev/null", 1); /* this context runs nothing */
     rsmooth_context *ctx = oclgrind_context(variant);
-    unsigned lanes = 0;
-    size_t group = 0;
-    rsmooth_context_kernel_shape(ctx, &lanes, &group);
+    rsmooth_context_info info = {.struct_size = sizeof info};
+    CHECK_STATUS(rsmooth_context_get_info(ctx, &info), RSMOOTH_OK);
     printf("case device %s, %u lanes, work-groups of %zu, kernels built from source\n",
-           rsmooth_context_device_name(ctx), lanes, group);
+           info.device_name, info.lanes, info.group);
     fflush(stdout);
     rsmooth_context_destroy(ctx);
     run_cases(variant, &m);

@@ -1,4 +1,4 @@
-/* The host stages' threads: a calling thread's setting (what rsmooth_context_set_host_threads
+/* The host stages' threads: a calling thread's setting (what rsmooth_context_options.host_threads
  * gives a context's calls) caps the chunks and the threads rs_parallel_for starts, is the calling
  * thread's alone, and is restored after; RSMOOTH_HOST_THREADS and the cores are the default. */
 #include "core/rsmooth_internal.h"

@@ -33,11 +33,11 @@ static void run(rsmooth_context *ctx, rsmooth_scalar scalar, const void *in, con
     rsmooth_error err;
     if (ctx)
         CHECK_STATUS(rsmooth_smooth(ctx, scalar, in, m->vertex_count, m->indices, m->triangle_count,
-                                    p, out, NULL, NULL, NULL, &err),
+                                    p, out, NULL, &err),
                      RSMOOTH_OK);
     else
-        CHECK_STATUS(rsmooth_smooth_reference(scalar, in, m->vertex_count, m->indices,
-                                              m->triangle_count, p, out, NULL, NULL, NULL, &err),
+        CHECK_STATUS(rsmooth_smooth(NULL, scalar, in, m->vertex_count, m->indices,
+                                    m->triangle_count, p, out, NULL, &err),
                      RSMOOTH_OK);
 }
 

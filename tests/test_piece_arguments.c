@@ -48,9 +48,9 @@ static void make_case(piece_case *c) {
     rsmooth_report rep;
     rsmooth_report_init(&rep);
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, c->mesh.xyz, v, c->mesh.indices,
-                                          c->mesh.triangle_count, NULL, c->expected, NULL, NULL,
-                                          &rep, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, c->mesh.xyz, v, c->mesh.indices,
+                                c->mesh.triangle_count, NULL, c->expected,
+                                OUTPUTS(NULL, NULL, &rep), &err),
                  RSMOOTH_OK);
     /* the mean area (the reference path's positions do not depend on it): non-zero triangles */
     double sum = 0;

@@ -1,4 +1,4 @@
-/* Point clouds with normals (rsmooth_smooth_points_reference): equal to an independent O(N^2)
+/* Point clouds with normals (rsmooth_smooth_points, ctx NULL): equal to an independent O(N^2)
  * evaluation of the same equations, denoising analytic shapes (a sphere, a cube whose edges stay
  * sharp), and refusing bad input. */
 #include "mesh_shapes.h"
@@ -274,8 +274,9 @@ static void test_oracle(void) {
             bf_points(mesh->xyz, normals[m], n, &p, want, want_n, want_c);
             rsmooth_report report;
             rsmooth_error err;
-            rsmooth_status st = rsmooth_smooth_points_reference(
-                RSMOOTH_FLOAT64, mesh->xyz, normals[m], n, &p, got, got_n, got_c, &report, &err);
+            rsmooth_status st =
+                rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, mesh->xyz, normals[m], n, &p, got,
+                                      got_n, OUTPUTS(NULL, got_c, &report), &err);
             if (st != RSMOOTH_OK)
                 fprintf(stderr, "%s: %s\n", what, err.message);
             CHECK_STATUS(st, RSMOOTH_OK);
@@ -310,8 +311,8 @@ static void test_oracle(void) {
             }
             if (variant == 0 || variant == 3) {
                 bf_points(xyz64, nrm64, n, &p, want, want_n, want_c);
-                CHECK_STATUS(rsmooth_smooth_points_reference(RSMOOTH_FLOAT32, xyz32, nrm32, n, &p,
-                                                             got32, got32_n, NULL, NULL, NULL),
+                CHECK_STATUS(rsmooth_smooth_points(NULL, RSMOOTH_FLOAT32, xyz32, nrm32, n, &p,
+                                                   got32, got32_n, NULL, NULL),
                              RSMOOTH_OK);
                 for (size_t i = 0; i < 3 * n; i++) {
                     CHECK_NEAR(got32[i], want[i], 1e-6 * (fabs(want[i]) + spacing));
@@ -376,8 +377,8 @@ static void test_sphere(void) {
             p.sigma_f = 1.5;
             p.sigma_g = 0.7;
         }
-        CHECK_STATUS(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, sphere.xyz, normals, n, &p,
-                                                     out, NULL, NULL, NULL, NULL),
+        CHECK_STATUS(rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, sphere.xyz, normals, n, &p, out,
+                                           NULL, NULL, NULL),
                      RSMOOTH_OK);
         double before = 0, after = 0;
         for (size_t i = 0; i < n; i++) {
@@ -440,8 +441,8 @@ static void test_cube(void) {
             p.predictor = RSMOOTH_PREDICT_CENTROID;
             p.sigma_g = INFINITY;
         }
-        CHECK_STATUS(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, cube.xyz, normals, n, &p, out,
-                                                     NULL, NULL, NULL, NULL),
+        CHECK_STATUS(rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, cube.xyz, normals, n, &p, out,
+                                           NULL, NULL, NULL),
                      RSMOOTH_OK);
         double face_before = 0, face_after = 0;
         double edge_noise = 0, edge_after = 0, edge_noise_max = 0, edge_after_max = 0;
@@ -491,22 +492,22 @@ static void test_cube(void) {
 static void test_degenerate(void) {
     double one[3] = {1, 2, 3}, n1[3] = {0, 0, 2}, out[12], out_n[12];
     float conf[4] = {-1, -1, -1, -1};
-    CHECK_STATUS(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, one, n1, 1, NULL, out, out_n,
-                                                 conf, NULL, NULL),
+    CHECK_STATUS(rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, one, n1, 1, NULL, out, out_n,
+                                       OUTPUTS(NULL, conf, NULL), NULL),
                  RSMOOTH_OK);
     CHECK(out[0] == 1 && out[1] == 2 && out[2] == 3 && out_n[2] == 1 && conf[0] == 0);
     double same[12] = {1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
     double nn[12] = {0, 0, 1, 0, 1, 0, 1, 0, 0, 0, 0, -1};
-    CHECK_STATUS(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, same, nn, 4, NULL, out, out_n,
-                                                 conf, NULL, NULL),
+    CHECK_STATUS(rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, same, nn, 4, NULL, out, out_n,
+                                       OUTPUTS(NULL, conf, NULL), NULL),
                  RSMOOTH_OK);
     for (int i = 0; i < 12; i++)
         CHECK(out[i] == 1 && out_n[i] == nn[i]);
     /* In place: outputs may be the inputs. */
     double xyz[9] = {0, 0, 0, 1, 0, 0.1, 0, 1, -0.1}, nrm[9] = {0, 0, 1, 0, 0, 1, 0, 0, 1};
-    CHECK_STATUS(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, nrm, 3, NULL, xyz, nrm, NULL,
-                                                 NULL, NULL),
-                 RSMOOTH_OK);
+    CHECK_STATUS(
+        rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, xyz, nrm, 3, NULL, xyz, nrm, NULL, NULL),
+        RSMOOTH_OK);
     for (int i = 0; i < 9; i++)
         CHECK(isfinite(xyz[i]) && isfinite(nrm[i]));
 }
@@ -536,58 +537,58 @@ static void test_bad_input(void) {
             CHECK(out[i_] == -7);                                                                  \
         printf("refused: %s\n", err.message);                                                      \
     } while (0)
-    EXPECT_INVALID(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, NULL, nrm, N, &p, out, NULL,
-                                                   NULL, NULL, &err),
-                   "positions is NULL");
-    EXPECT_INVALID(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, NULL, N, &p, out, NULL,
-                                                   NULL, NULL, &err),
-                   "normals is NULL");
-    EXPECT_INVALID(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, nrm, 0, &p, out, NULL,
-                                                   NULL, NULL, &err),
-                   "empty");
-    EXPECT_INVALID(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, nrm, N, &p, NULL, NULL,
-                                                   NULL, NULL, &err),
-                   "out_positions is NULL");
-    EXPECT_INVALID(rsmooth_smooth_points_reference((rsmooth_scalar)5, xyz, nrm, N, &p, out, NULL,
-                                                   NULL, NULL, &err),
-                   "scalar");
+    EXPECT_INVALID(
+        rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, NULL, nrm, N, &p, out, NULL, NULL, &err),
+        "positions is NULL");
+    EXPECT_INVALID(
+        rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, xyz, NULL, N, &p, out, NULL, NULL, &err),
+        "normals is NULL");
+    EXPECT_INVALID(
+        rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, xyz, nrm, 0, &p, out, NULL, NULL, &err),
+        "empty");
+    EXPECT_INVALID(
+        rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, xyz, nrm, N, &p, NULL, NULL, NULL, &err),
+        "out_positions is NULL");
+    EXPECT_INVALID(
+        rsmooth_smooth_points(NULL, (rsmooth_scalar)5, xyz, nrm, N, &p, out, NULL, NULL, &err),
+        "scalar");
     nrm[3 * 17] = nrm[3 * 17 + 1] = nrm[3 * 17 + 2] = 0;
-    EXPECT_INVALID(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, NULL,
-                                                   NULL, NULL, &err),
-                   "point 17 has a zero-length normal");
+    EXPECT_INVALID(
+        rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, NULL, NULL, &err),
+        "point 17 has a zero-length normal");
     nrm[3 * 17 + 2] = NAN;
-    EXPECT_INVALID(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, NULL,
-                                                   NULL, NULL, &err),
-                   "point 17 has a non-finite normal");
+    EXPECT_INVALID(
+        rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, NULL, NULL, &err),
+        "point 17 has a non-finite normal");
     nrm[3 * 17 + 2] = INFINITY;
-    EXPECT_INVALID(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, NULL,
-                                                   NULL, NULL, &err),
-                   "point 17 has a non-finite normal");
+    EXPECT_INVALID(
+        rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, NULL, NULL, &err),
+        "point 17 has a non-finite normal");
     nrm[3 * 17 + 2] = 1e300; /* huge but finite: fine */
-    CHECK_STATUS(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, NULL, NULL,
-                                                 NULL, &err),
-                 RSMOOTH_OK);
+    CHECK_STATUS(
+        rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, NULL, NULL, &err),
+        RSMOOTH_OK);
     xyz[3 * 23 + 1] = NAN;
-    EXPECT_INVALID(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, NULL,
-                                                   NULL, NULL, &err),
-                   "point 23 has a non-finite coordinate");
+    EXPECT_INVALID(
+        rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, NULL, NULL, &err),
+        "point 23 has a non-finite coordinate");
     xyz[3 * 23 + 1] = 1e200;
-    EXPECT_INVALID(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, NULL,
-                                                   NULL, NULL, &err),
-                   "point 23 has coordinate");
+    EXPECT_INVALID(
+        rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, NULL, NULL, &err),
+        "point 23 has coordinate");
     xyz[3 * 23 + 1] = 0;
-    EXPECT_INVALID(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, out + 3,
-                                                   NULL, NULL, &err),
-                   "overlap");
+    EXPECT_INVALID(
+        rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, out + 3, NULL, &err),
+        "overlap");
     p.sigma_f = -1;
-    EXPECT_INVALID(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, NULL,
-                                                   NULL, NULL, &err),
-                   "sigma_f");
+    EXPECT_INVALID(
+        rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, NULL, NULL, &err),
+        "sigma_f");
     rsmooth_params_init(&p);
     p.passes = 0;
-    EXPECT_INVALID(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, out_n,
-                                                   NULL, NULL, &err),
-                   "passes");
+    EXPECT_INVALID(
+        rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, xyz, nrm, N, &p, out, out_n, NULL, &err),
+        "passes");
     double s;
     CHECK_STATUS(rsmooth_point_spacing(RSMOOTH_FLOAT64, xyz, N, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);

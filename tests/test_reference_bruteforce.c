@@ -357,8 +357,8 @@ static void run_case(const char *name, const double *xyz, size_t vc, const uint3
      * back triangles the filter turns over, is tested in test_do_no_harm */
     rsmooth_params unguarded = *prm;
     unguarded.guard = 0;
-    rsmooth_status s = rsmooth_smooth_reference(RSMOOTH_FLOAT64, xyz, vc, idx, tc, &unguarded, ref,
-                                                rk, rc, &report, &err);
+    rsmooth_status s = rsmooth_smooth(NULL, RSMOOTH_FLOAT64, xyz, vc, idx, tc, &unguarded, ref,
+                                      OUTPUTS(rk, rc, &report), &err);
     if (s != RSMOOTH_OK)
         fprintf(stderr, "%s: %s\n", name, err.message);
     CHECK_STATUS(s, RSMOOTH_OK);
@@ -546,19 +546,19 @@ static void colour_edge_plane(void) {
     double *wide = malloc(3 * nv * sizeof *wide);
     CHECK(plain && narrow && wide);
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m.xyz, nv, m.indices, m.triangle_count,
-                                          &p, plain, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, m.xyz, nv, m.indices, m.triangle_count, &p,
+                                plain, NULL, &err),
                  RSMOOTH_OK);
     p.colors = col;
     p.sigma_c = 0.05;
     run_case("colour-edge plane, centroid, sigma_c 0.05", m.xyz, nv, m.indices, m.triangle_count,
              &p, 0);
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m.xyz, nv, m.indices, m.triangle_count,
-                                          &p, narrow, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, m.xyz, nv, m.indices, m.triangle_count, &p,
+                                narrow, NULL, &err),
                  RSMOOTH_OK);
     p.sigma_c = 1e8;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, m.xyz, nv, m.indices, m.triangle_count,
-                                          &p, wide, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, m.xyz, nv, m.indices, m.triangle_count, &p,
+                                wide, NULL, &err),
                  RSMOOTH_OK);
     /* the edge's vertices away from the plane's border (2 sigma_f = reach of 2.3 units) */
     double plain_dx = 0, narrow_dx = -INFINITY, wide_dev = 0;

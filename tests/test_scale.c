@@ -72,8 +72,8 @@ static void smooth_both(rsmooth_context *ctx, rsmooth_scalar scalar, const void 
     rsmooth_error err;
     rsmooth_report report;
     rsmooth_status st =
-        rsmooth_smooth_reference(scalar, xyz, m->vertex_count, m->indices, m->triangle_count, NULL,
-                                 out_ref, NULL, NULL, &report, &err);
+        rsmooth_smooth(NULL, scalar, xyz, m->vertex_count, m->indices, m->triangle_count, NULL,
+                       out_ref, OUTPUTS(NULL, NULL, &report), &err);
     if (st != RSMOOTH_OK)
         fprintf(stderr, "reference: %s\n", err.message);
     CHECK_STATUS(st, RSMOOTH_OK);
@@ -81,7 +81,7 @@ static void smooth_both(rsmooth_context *ctx, rsmooth_scalar scalar, const void 
     if (!ctx)
         return;
     st = rsmooth_smooth(ctx, scalar, xyz, m->vertex_count, m->indices, m->triangle_count, NULL,
-                        out_cl, NULL, NULL, NULL, &err);
+                        out_cl, NULL, &err);
     if (st != RSMOOTH_OK)
         fprintf(stderr, "opencl: %s\n", err.message);
     CHECK_STATUS(st, RSMOOTH_OK);
@@ -190,18 +190,15 @@ static void test_unrepresentable(rsmooth_context *ctx) {
     p.sigma_g = INFINITY;
     p.mollify = 0;
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, d_xyz, 4, tri, 1, &p, d_out, NULL, NULL,
-                                          NULL, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, d_xyz, 4, tri, 1, &p, d_out, NULL, &err),
                  RSMOOTH_OK);
     printf("lone vertex projected to z = %.4g (float64)\n", d_out[11]);
     CHECK(d_out[11] > FLT_MAX && isfinite(d_out[11]));
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT32, f_xyz, 4, tri, 1, &p, f_out, NULL, NULL,
-                                          NULL, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT32, f_xyz, 4, tri, 1, &p, f_out, NULL, &err),
                  RSMOOTH_ERROR_NUMERICAL);
     printf("float32 reference: %s\n", err.message);
     if (ctx) {
-        CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT32, f_xyz, 4, tri, 1, &p, f_out, NULL, NULL,
-                                    NULL, &err),
+        CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT32, f_xyz, 4, tri, 1, &p, f_out, NULL, &err),
                      RSMOOTH_ERROR_NUMERICAL);
         printf("float32 OpenCL: %s\n", err.message);
     }
@@ -217,21 +214,20 @@ static void test_unrepresentable(rsmooth_context *ctx) {
         for (size_t i = 0; i < 3 * n; i++)
             big[i] = r.noisy.xyz[i] * pow(10, decade);
         rsmooth_status want = decade == 0 ? RSMOOTH_OK : RSMOOTH_ERROR_NUMERICAL;
-        CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, big, n, r.noisy.indices,
-                                              r.noisy.triangle_count, NULL, out, weight, NULL, NULL,
-                                              &err),
+        CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, big, n, r.noisy.indices,
+                                    r.noisy.triangle_count, NULL, out, OUTPUTS(weight, NULL, NULL),
+                                    &err),
                      want);
         if (ctx)
             CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, big, n, r.noisy.indices,
-                                        r.noisy.triangle_count, NULL, out, weight, NULL, NULL,
-                                        &err),
+                                        r.noisy.triangle_count, NULL, out,
+                                        OUTPUTS(weight, NULL, NULL), &err),
                          want);
         if (want != RSMOOTH_OK)
             printf("weights at spacing 1e%d: %s\n", decade, err.message);
         /* and without weights the same call succeeds */
-        CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, big, n, r.noisy.indices,
-                                              r.noisy.triangle_count, NULL, out, NULL, NULL, NULL,
-                                              &err),
+        CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, big, n, r.noisy.indices,
+                                    r.noisy.triangle_count, NULL, out, NULL, &err),
                      RSMOOTH_OK);
     }
     /* Taubin's inflating step pushes a float32 vertex past FLT_MAX. */
@@ -263,19 +259,19 @@ static void test_dynamic_range(void) {
         xyz[i] = m->xyz[i] * 1e-100;
     xyz[3 * n - 3] = xyz[3 * n - 2] = 0;
     xyz[3 * n - 1] = 1e130; /* 1e230 spacings away */
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, xyz, n, m->indices, m->triangle_count,
-                                          NULL, out, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, xyz, n, m->indices, m->triangle_count, NULL,
+                                out, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     printf("stray vertex 1e230 spacings away: %s\n", err.message);
     /* 1e160 spacings away: filtered, and the grid moves exactly as without the stray vertex */
     for (size_t i = 0; i < 3 * m->vertex_count; i++)
         xyz[i] = m->xyz[i] * 1e-10;
     xyz[3 * n - 1] = 1e150;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, xyz, n, m->indices, m->triangle_count,
-                                          NULL, out, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, xyz, n, m->indices, m->triangle_count, NULL,
+                                out, NULL, &err),
                  RSMOOTH_OK);
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, xyz, n - 1, m->indices,
-                                          m->triangle_count, NULL, alone, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, xyz, n - 1, m->indices, m->triangle_count,
+                                NULL, alone, NULL, &err),
                  RSMOOTH_OK);
     double diff = 0;
     for (size_t i = 0; i < 3 * (n - 1); i++)
@@ -303,8 +299,8 @@ static void test_points_and_noise(const roof *r) {
     CHECK_STATUS(rsmooth_estimate_noise(RSMOOTH_FLOAT64, m->xyz, n, m->indices, m->triangle_count,
                                         &noise_one, &err),
                  RSMOOTH_OK);
-    CHECK_STATUS(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, m->xyz, normals, n, NULL, at_one,
-                                                 NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, m->xyz, normals, n, NULL, at_one,
+                                       NULL, NULL, &err),
                  RSMOOTH_OK);
     CHECK_STATUS(rsmooth_point_spacing(RSMOOTH_FLOAT64, m->xyz, n, &spacing_one, &err), RSMOOTH_OK);
     static const int decades[] = {SMALLEST_DECADE, -150, -20, 20, 150 - 2};
@@ -315,8 +311,8 @@ static void test_points_and_noise(const roof *r) {
         CHECK_STATUS(rsmooth_estimate_noise(RSMOOTH_FLOAT64, xyz, n, m->indices, m->triangle_count,
                                             &noise, &err),
                      RSMOOTH_OK);
-        CHECK_STATUS(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, xyz, normals, n, NULL, out,
-                                                     NULL, NULL, NULL, &err),
+        CHECK_STATUS(rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, xyz, normals, n, NULL, out, NULL,
+                                           NULL, &err),
                      RSMOOTH_OK);
         CHECK_STATUS(rsmooth_point_spacing(RSMOOTH_FLOAT64, xyz, n, &spacing, &err), RSMOOTH_OK);
         for (size_t k = 0; k < 3 * n; k++)

@@ -198,10 +198,10 @@ static void test_shape_generators(void) {
 static void smooth(const shape_mesh *m, const rsmooth_params *p, double *out, float *confidence) {
     rsmooth_error err;
     rsmooth_status s =
-        rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                 m->triangle_count, p, out, NULL, confidence, NULL, &err);
+        rsmooth_smooth(NULL, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                       m->triangle_count, p, out, OUTPUTS(NULL, confidence, NULL), &err);
     if (s != RSMOOTH_OK)
-        fprintf(stderr, "rsmooth_smooth_reference: %s\n", err.message);
+        fprintf(stderr, "rsmooth_smooth: %s\n", err.message);
     CHECK_STATUS(s, RSMOOTH_OK);
 }
 
@@ -356,8 +356,8 @@ static void test_unreferenced(void) {
     rsmooth_params p;
     rsmooth_params_init(&p);
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, xyz, vc, plane.indices,
-                                          plane.triangle_count, &p, out, k, conf, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, xyz, vc, plane.indices, plane.triangle_count,
+                                &p, out, OUTPUTS(k, conf, NULL), &err),
                  RSMOOTH_OK);
     const double *f = out + 3 * (vc - 2), *g = out + 3 * (vc - 1);
     printf("unreferenced vertex 0.2 above the plane: -> (%.9g, %.9g, %.9g), confidence %.4f; far "
@@ -375,8 +375,8 @@ static void test_unreferenced(void) {
     float far32[3] = {500.1f, 0.3f, -7.7f};
     memcpy(fin + 3, far32, sizeof far32);
     fin[0] = 0.25f;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT32, fin, 2, NULL, 0, &p, fout, NULL, conf,
-                                          NULL, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT32, fin, 2, NULL, 0, &p, fout,
+                                OUTPUTS(NULL, conf, NULL), &err),
                  RSMOOTH_OK);
     CHECK(memcmp(fin, fout, sizeof fin) == 0);
     CHECK(conf[0] == 0.0f && conf[1] == 0.0f);
@@ -404,8 +404,7 @@ static void test_lone_triangle(void) {
                 p.sigma_f = 0.4;
                 p.sigma_g = 0.06;
             }
-            CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, xyz, 3, tri, 1, &p, out, NULL,
-                                                  NULL, NULL, NULL),
+            CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, xyz, 3, tri, 1, &p, out, NULL, NULL),
                          RSMOOTH_OK);
             double move = 0;
             for (int v = 0; v < 3; v++)

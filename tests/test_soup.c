@@ -16,11 +16,10 @@ static double dist3(const double *a, const double *b) {
 static void smooth64(const shape_mesh *m, const rsmooth_params *p, double *out, float *k,
                      float *conf, rsmooth_report *report) {
     rsmooth_error err;
-    rsmooth_status s =
-        rsmooth_smooth_reference(RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                 m->triangle_count, p, out, k, conf, report, &err);
+    rsmooth_status s = rsmooth_smooth(NULL, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                      m->triangle_count, p, out, OUTPUTS(k, conf, report), &err);
     if (s != RSMOOTH_OK)
-        fprintf(stderr, "rsmooth_smooth_reference: %s\n", err.message);
+        fprintf(stderr, "rsmooth_smooth: %s\n", err.message);
     CHECK_STATUS(s, RSMOOTH_OK);
 }
 
@@ -116,9 +115,9 @@ static void test_float32(const shape_mesh *mesh, const rsmooth_params *p) {
     }
     rsmooth_error err;
     rsmooth_report report;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT32, in32, mesh->vertex_count, mesh->indices,
-                                          mesh->triangle_count, p, out32, k32, conf32, &report,
-                                          &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT32, in32, mesh->vertex_count, mesh->indices,
+                                mesh->triangle_count, p, out32, OUTPUTS(k32, conf32, &report),
+                                &err),
                  RSMOOTH_OK);
     smooth64(mesh, p, out64, NULL, NULL, NULL);
     /* the same float inputs, widened: the float32 call is this, rounded once at the end */
@@ -163,8 +162,8 @@ static void test_extreme_coordinates(void) {
         double out[21];
         float conf[7];
         rsmooth_error err;
-        rsmooth_status s = rsmooth_smooth_reference(RSMOOTH_FLOAT64, xyz, 7, tri, 2, NULL, out,
-                                                    NULL, conf, NULL, &err);
+        rsmooth_status s = rsmooth_smooth(NULL, RSMOOTH_FLOAT64, xyz, 7, tri, 2, NULL, out,
+                                          OUTPUTS(NULL, conf, NULL), &err);
         if (s == RSMOOTH_ERROR_INVALID_ARGUMENT && b > 1e150) { /* documented limit */
             printf("triangles at x = +-%g: refused (\"%s\")\n", b, err.message);
             continue;

@@ -3,7 +3,7 @@
  *     holds: the same positions bit for bit on the OpenCL device (the issue asks 1e-6 mean edge
  *     lengths; pieces see the whole mesh's cells, and the kernels' differences do not depend on
  *     how vertices share blocks);
- *   - the reference path (ctx NULL): the same bits as rsmooth_smooth_reference in memory, and
+ *   - the reference path (ctx NULL): the same bits as rsmooth_smooth(NULL, ...) in memory, and
  *     the same bytes when 3 ranks (threads, synced through a barrier) share the pieces;
  *   - bilateral normals (a wider halo); a float32, big-endian file with colours, a face property
  *     and an element after the faces: the bytes the in-memory writer gives the same positions;
@@ -132,13 +132,13 @@ static double *smooth_in_memory(rsmooth_context *ctx, const char *path,
     rsmooth_report_init(&rep);
     if (ctx)
         CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
-                                    mesh->triangles, mesh->triangle_count, params, out, NULL, NULL,
-                                    &rep, &err),
+                                    mesh->triangles, mesh->triangle_count, params, out,
+                                    OUTPUTS(NULL, NULL, &rep), &err),
                      RSMOOTH_OK);
     else
-        CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
-                                              mesh->triangles, mesh->triangle_count, params, out,
-                                              NULL, NULL, &rep, &err),
+        CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
+                                    mesh->triangles, mesh->triangle_count, params, out,
+                                    OUTPUTS(NULL, NULL, &rep), &err),
                      RSMOOTH_OK);
     *mean_edge = rep.mean_edge_length;
     rsmooth_mesh_destroy(mesh);

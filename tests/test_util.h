@@ -10,6 +10,11 @@
 
 #define TEST_SKIP 77
 
+/* A smoothing call's optional outputs (rsmooth_outputs: weights, confidence, report), for the
+ * tests that give them in one argument. */
+#define OUTPUTS(weight, confidence, report)                                                        \
+    (&(rsmooth_outputs){sizeof(rsmooth_outputs), (weight), (confidence), (report)})
+
 /* Smaller cases of the same checks: tests/CMakeLists.txt sets RSMOOTH_TEST_SMALL=1 for every test
  * of a sanitizer build (RSMOOTH_SANITIZE), where host code runs 5-15 times slower. A test then
  * makes its meshes and repeats smaller, never its assertions fewer or weaker; the plain build runs

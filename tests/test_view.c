@@ -85,14 +85,14 @@ static void check_view_equals_packed(rsmooth_context *ctx, const shape_mesh *m, 
     rsmooth_error err;
     CHECK_STATUS(
         ctx ? rsmooth_smooth(ctx, RSMOOTH_FLOAT32, x.packed, n, m->indices, m->triangle_count, &p,
-                             packed_out, NULL, packed_conf, NULL, &err)
-            : rsmooth_smooth_reference(RSMOOTH_FLOAT32, x.packed, n, m->indices, m->triangle_count,
-                                       &p, packed_out, NULL, packed_conf, NULL, &err),
+                             packed_out, OUTPUTS(NULL, packed_conf, NULL), &err)
+            : rsmooth_smooth(NULL, RSMOOTH_FLOAT32, x.packed, n, m->indices, m->triangle_count, &p,
+                             packed_out, OUTPUTS(NULL, packed_conf, NULL), &err),
         RSMOOTH_OK);
     rsmooth_mesh_view view = view_of(m, &x, int32);
     /* in place: the result goes back into the vertex buffer it came from */
     CHECK_STATUS(rsmooth_smooth_view(ctx, &view, &p, x.buffer, FLOATS_PER_VERTEX * sizeof(float),
-                                     NULL, view_conf, NULL, &err),
+                                     OUTPUTS(NULL, view_conf, NULL), &err),
                  RSMOOTH_OK);
     size_t moved = 0;
     for (size_t v = 0; v < n; v++)
@@ -125,41 +125,42 @@ static void check_view_refusals(const shape_mesh *m) {
 
     rsmooth_mesh_view view = view_of(m, &x, 1);
     x.i32pad[4 * 5 + 1] = -1;
-    CHECK_STATUS(rsmooth_smooth_view(NULL, &view, NULL, out, 0, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_view(NULL, &view, NULL, out, 0, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(err.message, "triangle 5 corner 1: index -1 is negative") != NULL);
     x.i32pad[4 * 5 + 1] = (int32_t)m->indices[3 * 5 + 1];
 
     view = view_of(m, &x, 0);
     x.i64[3 * 9 + 2] = (int64_t)1 << 40; /* would wrap to 0 as uint32 */
-    CHECK_STATUS(rsmooth_smooth_view(NULL, &view, NULL, out, 0, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_view(NULL, &view, NULL, out, 0, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(err.message, "triangle 9 corner 2: index 1099511627776 is beyond") != NULL);
     x.i64[3 * 9 + 2] = m->indices[3 * 9 + 2];
 
     view.position_stride = 8; /* smaller than x, y, z */
-    CHECK_STATUS(rsmooth_smooth_view(NULL, &view, NULL, out, 0, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_view(NULL, &view, NULL, out, 0, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(err.message, "stride") != NULL);
     view = view_of(m, &x, 0);
     view.struct_size = 0;
-    CHECK_STATUS(rsmooth_smooth_view(NULL, &view, NULL, out, 0, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_view(NULL, &view, NULL, out, 0, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     view = view_of(m, &x, 0);
     view.index_type = 7;
-    CHECK_STATUS(rsmooth_smooth_view(NULL, &view, NULL, out, 0, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_view(NULL, &view, NULL, out, 0, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     view = view_of(m, &x, 0);
-    CHECK_STATUS(rsmooth_smooth_view(NULL, &view, NULL, out, 0, (float *)out + 5, NULL, NULL, &err),
-                 RSMOOTH_ERROR_INVALID_ARGUMENT); /* out_weight inside out_positions */
+    CHECK_STATUS(
+        rsmooth_smooth_view(NULL, &view, NULL, out, 0, OUTPUTS((float *)out + 5, NULL, NULL), &err),
+        RSMOOTH_ERROR_INVALID_ARGUMENT); /* out_weight inside out_positions */
     CHECK(strstr(err.message, "overlap") != NULL);
-    CHECK_STATUS(rsmooth_smooth_view(NULL, NULL, NULL, out, 0, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth_view(NULL, NULL, NULL, out, 0, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     rsmooth_params p; /* a mask in the output's memory (the packed call's check) */
     rsmooth_params_init(&p);
     p.move_mask = (const uint8_t *)out;
-    CHECK_STATUS(rsmooth_smooth_reference(RSMOOTH_FLOAT32, x.packed, n, m->indices,
-                                          m->triangle_count, &p, out, NULL, NULL, NULL, &err),
+    CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT32, x.packed, n, m->indices, m->triangle_count,
+                                &p, out, NULL, &err),
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(err.message, "out_positions overlaps params->move_mask") != NULL);
     for (size_t i = 0; i < n * 3 * sizeof(float); i++)
@@ -185,10 +186,9 @@ static void check_mask(rsmooth_context *ctx, const shape_mesh *m, const char *na
     rsmooth_error err;
 #define RUN(params, in, out)                                                                       \
     CHECK_STATUS(ctx ? rsmooth_smooth(ctx, RSMOOTH_FLOAT64, in, n, m->indices, m->triangle_count,  \
-                                      params, out, NULL, NULL, NULL, &err)                         \
-                     : rsmooth_smooth_reference(RSMOOTH_FLOAT64, in, n, m->indices,                \
-                                                m->triangle_count, params, out, NULL, NULL, NULL,  \
-                                                &err),                                             \
+                                      params, out, NULL, &err)                                     \
+                     : rsmooth_smooth(NULL, RSMOOTH_FLOAT64, in, n, m->indices, m->triangle_count, \
+                                      params, out, NULL, &err),                                    \
                  RSMOOTH_OK)
     RUN(&p, m->xyz, full);
     p.move_mask = mask;
@@ -252,9 +252,9 @@ static void check_points_mask(const shape_mesh *m) {
     rsmooth_params_init_best(&p);
     p.move_mask = mask;
     rsmooth_error err;
-    CHECK_STATUS(rsmooth_smooth_points_reference(RSMOOTH_FLOAT64, m->xyz, normals, n, &p, out, NULL,
-                                                 NULL, NULL, &err),
-                 RSMOOTH_OK);
+    CHECK_STATUS(
+        rsmooth_smooth_points(NULL, RSMOOTH_FLOAT64, m->xyz, normals, n, &p, out, NULL, NULL, &err),
+        RSMOOTH_OK);
     size_t moved = 0;
     for (size_t v = 0; v < n; v++) {
         if (!mask[v])
@@ -278,20 +278,22 @@ static void check_host_threads(rsmooth_context *ctx, const shape_mesh *m) {
     rsmooth_params p;
     rsmooth_params_init_best(&p);
     rsmooth_error err;
-    CHECK_EQ_INT(rsmooth_context_host_threads(ctx), 0);
+    CHECK_EQ_INT(context_info(ctx).host_threads, 0);
     CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                m->triangle_count, &p, base, NULL, NULL, NULL, &err),
+                                m->triangle_count, &p, base, NULL, &err),
                  RSMOOTH_OK);
     unsigned counts[] = {1, 3};
     for (int i = 0; i < 2; i++) {
-        rsmooth_context_set_host_threads(ctx, counts[i]);
-        CHECK_EQ_INT(rsmooth_context_host_threads(ctx), counts[i]);
-        CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
-                                    m->triangle_count, &p, other, NULL, NULL, NULL, &err),
+        rsmooth_context_options o = {.struct_size = sizeof o, .host_threads = counts[i]};
+        rsmooth_context *threaded = NULL;
+        CHECK_STATUS(rsmooth_context_create(&o, &threaded, &err), RSMOOTH_OK);
+        CHECK_EQ_INT(context_info(threaded).host_threads, counts[i]);
+        CHECK_STATUS(rsmooth_smooth(threaded, RSMOOTH_FLOAT64, m->xyz, m->vertex_count, m->indices,
+                                    m->triangle_count, &p, other, NULL, &err),
                      RSMOOTH_OK);
         CHECK(memcmp(base, other, bytes) == 0);
+        rsmooth_context_destroy(threaded);
     }
-    rsmooth_context_set_host_threads(ctx, 0);
     printf("host threads 1 and 3: the same bits as every core\n");
     free(base);
     free(other);

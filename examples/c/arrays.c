@@ -51,14 +51,16 @@ int main(void) {
     rsmooth_context *ctx = NULL;
     rsmooth_status st = rsmooth_context_create(NULL, &ctx, &err); /* NULL: RSMOOTH_DEVICE or auto */
     if (st == RSMOOTH_OK) {
-        printf("device: %s\n", rsmooth_context_device_name(ctx));
+        rsmooth_context_info info = {.struct_size = sizeof info};
+        rsmooth_context_get_info(ctx, &info);
+        printf("device: %s\n", info.device_name);
         st = rsmooth_smooth(ctx, RSMOOTH_FLOAT32, xyz, vertex_count, indices, triangle_count,
-                            &params, out, NULL, NULL, NULL, &err);
+                            &params, out, NULL, &err);
         rsmooth_context_destroy(ctx);
     } else if (st == RSMOOTH_ERROR_NO_DEVICE) {
         printf("device: reference path (%s)\n", err.message);
-        st = rsmooth_smooth_reference(RSMOOTH_FLOAT32, xyz, vertex_count, indices, triangle_count,
-                                      &params, out, NULL, NULL, NULL, &err);
+        st = rsmooth_smooth(NULL, RSMOOTH_FLOAT32, xyz, vertex_count, indices, triangle_count,
+                            &params, out, NULL, &err);
     }
     if (st != RSMOOTH_OK) {
         fprintf(stderr, "example_arrays: %s: %s\n", rsmooth_status_str(st), err.message);

@@ -30,13 +30,17 @@ int main(int argc, char **argv) {
     rsmooth_status st = rsmooth_mesh_read_file(argv[1], &mesh, &err);
     if (st == RSMOOTH_OK && strcmp(device, "reference") != 0) {
         what = device;
-        st = rsmooth_context_create(device, &ctx, &err);
+        rsmooth_context_options options = {.struct_size = sizeof options, .device = device};
+        st = rsmooth_context_create(&options, &ctx, &err);
         if (st == RSMOOTH_ERROR_NO_DEVICE)
             code = 77;
     }
     if (st == RSMOOTH_OK) {
+        rsmooth_context_info info = {.struct_size = sizeof info, .device_name = "reference"};
+        if (ctx)
+            rsmooth_context_get_info(ctx, &info);
         printf("%s: %zu vertices, %zu triangles; device %s\n", argv[1], mesh->vertex_count,
-               mesh->triangle_count, ctx ? rsmooth_context_device_name(ctx) : "reference");
+               mesh->triangle_count, info.device_name);
         out = malloc(3 * mesh->vertex_count * sizeof *out);
         if (!out)
             goto done;
@@ -45,11 +49,9 @@ int main(int argc, char **argv) {
         /* The file's positions are doubles whatever it stored (mesh->precision says what). */
         what = argv[1];
         st = ctx ? rsmooth_smooth(ctx, RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
-                                  mesh->triangles, mesh->triangle_count, &params, out, NULL, NULL,
-                                  NULL, &err)
-                 : rsmooth_smooth_reference(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
-                                            mesh->triangles, mesh->triangle_count, &params, out,
-                                            NULL, NULL, NULL, &err);
+                                  mesh->triangles, mesh->triangle_count, &params, out, NULL, &err)
+                 : rsmooth_smooth(NULL, RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
+                                  mesh->triangles, mesh->triangle_count, &params, out, NULL, &err);
     }
     if (st == RSMOOTH_OK) {
         memcpy(mesh->positions, out, 3 * mesh->vertex_count * sizeof *out);

@@ -45,19 +45,18 @@ int main(void) {
     rsmooth_error err;
     rsmooth_error_init(&err);
     rsmooth_context *ctx = NULL;
-    rsmooth_status st = rsmooth_context_create_from_queue(queue, &ctx, &err);
+    rsmooth_status st = rsmooth_context_create_from_queue(queue, NULL, &ctx, &err);
     clReleaseCommandQueue(queue); /* ours: rsmooth holds its own reference until destroyed */
     clReleaseContext(cl_ctx);
     if (st == RSMOOTH_OK) {
-        printf("device: %s (program build %.0f ms)\n", rsmooth_context_device_name(ctx),
-               rsmooth_context_build_ms(ctx));
-        st = rsmooth_smooth(ctx, RSMOOTH_FLOAT64, xyz, 6, indices, 8, NULL, out, NULL, NULL, NULL,
-                            &err);
+        rsmooth_context_info info = {.struct_size = sizeof info};
+        rsmooth_context_get_info(ctx, &info);
+        printf("device: %s (program build %.0f ms)\n", info.device_name, info.build_ms);
+        st = rsmooth_smooth(ctx, RSMOOTH_FLOAT64, xyz, 6, indices, 8, NULL, out, NULL, &err);
     }
     rsmooth_context_destroy(ctx); /* releases the queue and context it retained */
     if (st == RSMOOTH_OK)
-        st = rsmooth_smooth_reference(RSMOOTH_FLOAT64, xyz, 6, indices, 8, NULL, expected, NULL,
-                                      NULL, NULL, &err);
+        st = rsmooth_smooth(NULL, RSMOOTH_FLOAT64, xyz, 6, indices, 8, NULL, expected, NULL, &err);
     if (st != RSMOOTH_OK) {
         fprintf(stderr, "example_own_context: %s: %s\n", rsmooth_status_str(st), err.message);
         return EXIT_FAILURE;

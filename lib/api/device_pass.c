@@ -39,7 +39,7 @@ rsmooth_status rs_device_pass(const rs_device_call *call, const rs_problem *pb,
             return rs_fail(error, st, call->where,
                            "%zu points need %llu bytes on %s, beyond its usable memory or "
                            "the memory budget (point clouds are not cut into tiles; "
-                           "rsmooth_smooth_points_reference takes them)",
+                           "the reference path, ctx NULL, takes them)",
                            pb->vertex_count, (unsigned long long)needed, ctx->device_name);
     } else {
         st = rs_cl_filter(ctx, pb, sink, &stats, error);

@@ -34,10 +34,9 @@ rsmooth_status rs_device_pass(const rs_device_call *call, const rs_problem *pb,
 /* rsmooth_smooth's passes with the context entered, the call's sink given (device_sink may be
  * NULL). */
 rsmooth_status rs_device_smooth(const rs_device_call *call, rsmooth_scalar scalar,
-                                const void *positions, size_t vertex_count,
-                                const uint32_t *indices, size_t triangle_count,
-                                const rsmooth_params *params, void *out_positions,
-                                float *out_weight, float *out_confidence, rsmooth_report *report,
-                                rsmooth_error *error);
+                                const void *positions, size_t vertex_count, const uint32_t *indices,
+                                size_t triangle_count, const rsmooth_params *params,
+                                void *out_positions, float *out_weight, float *out_confidence,
+                                rsmooth_report *report, rsmooth_error *error);
 
 #endif /* RSMOOTH_API_PATH_H */

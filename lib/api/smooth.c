@@ -1,10 +1,10 @@
 /* rsmooth_smooth, the public entry point of the OpenCL path: one call on a context at a time,
  * the caller's host threads, and the passes (passes/passes.c) each run as one device pass
  * (device_pass.c): facet data, then the tiles (opencl/tiles.c) that each run the kernels
- * (opencl/cl_smooth.c). The reference path's entry point is rsmooth_smooth_reference
- * (reference/reference.c). */
+ * (opencl/cl_smooth.c). With ctx NULL, the reference path (reference/reference.c). */
 #include "api/path.h"
 #include "passes/passes.h"
+#include "reference/reference.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -19,9 +19,8 @@ static rsmooth_status cl_pass(void *context, rsmooth_scalar scalar, const void *
     double t_start = rs_now_ms();
     rs_error_clear(error);
     rs_problem pb;
-    rsmooth_status st =
-        rs_problem_prepare(&pb, scalar, positions, vertex_count, indices, triangle_count, params,
-                           out_positions, false, error, call->where);
+    rsmooth_status st = rs_problem_prepare(&pb, scalar, positions, vertex_count, indices,
+                                           triangle_count, params, false, error, call->where);
     if (st != RSMOOTH_OK)
         return st;
     rs_result_sink sink = {scalar, out_positions, out_weight,       out_confidence,
@@ -45,7 +44,8 @@ static rsmooth_status cl_stage(void *context, const rs_stage_plan *plan, double 
 /* Where the normal-update stage's cycles run: on a GPU or other accelerator, the device; on a CPU
  * device, the host's cores (the same cores, in double, and measured faster there: the kernels'
  * gathers do not vectorize, docs/best-mode.md). RSMOOTH_STAGE=device or host chooses. */
-static bool stage_on_device(const rsmooth_context *ctx, const char *asked) {
+static bool stage_on_device(const rsmooth_context *ctx) {
+    const char *asked = ctx->env.value[RS_ENV_STAGE];
     if (asked && *asked)
         return strcmp(asked, "device") == 0;
     cl_device_type type = CL_DEVICE_TYPE_CPU;
@@ -56,17 +56,24 @@ static bool stage_on_device(const rsmooth_context *ctx, const char *asked) {
 
 rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const void *positions,
                               size_t vertex_count, const uint32_t *indices, size_t triangle_count,
-                              const rsmooth_params *params, void *out_positions, float *out_weight,
-                              float *out_confidence, rsmooth_report *report, rsmooth_error *error) {
+                              const rsmooth_params *params, void *out_positions,
+                              const rsmooth_outputs *outputs, rsmooth_error *error) {
     static const char where[] = "rsmooth_smooth";
     rs_error_clear(error);
+    rsmooth_outputs o;
+    rsmooth_status st = rs_read_outputs(outputs, &o, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
+    if (!ctx) /* the reference path */
+        return rs_reference_smooth(scalar, positions, vertex_count, indices, triangle_count, params,
+                                   out_positions, o.weight, o.confidence, o.report, error);
     size_t saved = 0;
-    rsmooth_status st = rs_device_enter(ctx, where, &saved, error);
+    st = rs_device_enter(ctx, where, &saved, error);
     if (st != RSMOOTH_OK)
         return st;
     rs_device_call call = {ctx, where, NULL};
     st = rs_device_smooth(&call, scalar, positions, vertex_count, indices, triangle_count, params,
-                          out_positions, out_weight, out_confidence, report, error);
+                          out_positions, o.weight, o.confidence, o.report, error);
     rs_device_leave(ctx, saved);
     return st;
 }
@@ -76,16 +83,8 @@ rsmooth_status rs_device_smooth(const rs_device_call *call, rsmooth_scalar scala
                                 size_t triangle_count, const rsmooth_params *params,
                                 void *out_positions, float *out_weight, float *out_confidence,
                                 rsmooth_report *report, rsmooth_error *error) {
-    const char *stage_env = getenv("RSMOOTH_STAGE");
-    if (stage_env && *stage_env && strcmp(stage_env, "host") != 0 &&
-        strcmp(stage_env, "device") != 0) {
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, call->where,
-                       "RSMOOTH_STAGE is \"%s\": use device (the normal-update stage on the "
-                       "OpenCL device: the default on GPUs) or host (on the host's cores, in "
-                       "double: the default on CPU devices)",
-                       stage_env);
-    }
-    rs_stage_runner stage = stage_on_device(call->ctx, stage_env) ? cl_stage : NULL;
+    (void)error; /* RSMOOTH_STAGE was checked when the context was made */
+    rs_stage_runner stage = stage_on_device(call->ctx) ? cl_stage : NULL;
     return rs_filter_passes(cl_pass, stage, (void *)call, scalar, positions, vertex_count, indices,
                             triangle_count, params, out_positions, out_weight, out_confidence,
                             report, error, call->where);

@@ -94,14 +94,18 @@ static rsmooth_status check_view(const rsmooth_mesh_view *m, size_t *pstride, si
 
 rsmooth_status rsmooth_smooth_view(rsmooth_context *ctx, const rsmooth_mesh_view *mesh,
                                    const rsmooth_params *params, void *out_positions,
-                                   size_t out_stride, float *out_weight, float *out_confidence,
-                                   rsmooth_report *report, rsmooth_error *error) {
+                                   size_t out_stride, const rsmooth_outputs *outputs,
+                                   rsmooth_error *error) {
     static const char where[] = "rsmooth_smooth_view";
     rs_error_clear(error);
     size_t pstride = 0, istride = 0;
-    rsmooth_status st = check_view(mesh, &pstride, &istride, error, where);
+    rsmooth_outputs o;
+    rsmooth_status st = rs_read_outputs(outputs, &o, error, where);
+    if (st == RSMOOTH_OK)
+        st = check_view(mesh, &pstride, &istride, error, where);
     if (st != RSMOOTH_OK)
         return st;
+    float *out_weight = o.weight, *out_confidence = o.confidence;
     size_t n = mesh->vertex_count;
     size_t record = rs_vertex_bytes(mesh->scalar);
     size_t ostride = out_stride ? out_stride : record;
@@ -134,10 +138,9 @@ rsmooth_status rsmooth_smooth_view(rsmooth_context *ctx, const rsmooth_mesh_view
         memcpy(positions + v * record, (const unsigned char *)mesh->positions + v * pstride,
                record);
     /* the weights and confidences go to copies too: the caller's may share the vertex buffer */
-    st = ctx ? rsmooth_smooth(ctx, mesh->scalar, positions, n, indices, mesh->triangle_count,
-                              params, result, weight, confidence, report, error)
-             : rsmooth_smooth_reference(mesh->scalar, positions, n, indices, mesh->triangle_count,
-                                        params, result, weight, confidence, report, error);
+    rsmooth_outputs packed = {sizeof packed, weight, confidence, o.report};
+    st = rsmooth_smooth(ctx, mesh->scalar, positions, n, indices, mesh->triangle_count, params,
+                        result, &packed, error);
     if (st == RSMOOTH_OK) {
         for (size_t v = 0; v < n; v++)
             memcpy((unsigned char *)out_positions + v * ostride, result + v * record, record);

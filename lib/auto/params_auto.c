@@ -56,7 +56,8 @@ static bool reads_correlated(const rs_noise_details *d) {
     0.5 /* tangential / normal level above which noise reads as random                             \
          * in direction (for the report only) */
 
-void rsmooth_noise_report_init(rsmooth_noise_report *report) {
+/* A report with nothing measured yet. */
+static void noise_report_blank(rsmooth_noise_report *report) {
     if (!report)
         return;
     memset(report, 0, sizeof *report);
@@ -168,10 +169,10 @@ static void choose(rsmooth_params *params, const rs_noise_details *d, char *pres
                  isfinite(b->below) ? b->below : (b - 1)->below, stage);
 }
 
-rsmooth_status rsmooth_params_auto_report(rsmooth_scalar scalar, const void *positions,
-                                          size_t vertex_count, const uint32_t *indices,
-                                          size_t triangle_count, rsmooth_params *params,
-                                          rsmooth_noise_report *report, rsmooth_error *error) {
+rsmooth_status rsmooth_params_auto(rsmooth_scalar scalar, const void *positions,
+                                   size_t vertex_count, const uint32_t *indices,
+                                   size_t triangle_count, rsmooth_params *params,
+                                   rsmooth_noise_report *report, rsmooth_error *error) {
     static const char where[] = "rsmooth_params_auto";
     rs_error_clear(error);
     if (!params)
@@ -180,8 +181,8 @@ rsmooth_status rsmooth_params_auto_report(rsmooth_scalar scalar, const void *pos
                        "rsmooth_params_init_best first");
     if (report && report->struct_size < sizeof *report)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "report.struct_size %zu is not sizeof(rsmooth_noise_report): call "
-                       "rsmooth_noise_report_init first",
+                       "report.struct_size %zu is not sizeof(rsmooth_noise_report): set it "
+                       "first",
                        report->struct_size);
     rsmooth_params checked;
     rsmooth_status st = rs_params_resolve(params, &checked, error, where);
@@ -193,7 +194,7 @@ rsmooth_status rsmooth_params_auto_report(rsmooth_scalar scalar, const void *pos
     if (st != RSMOOTH_OK)
         return st;
     rsmooth_noise_report r;
-    rsmooth_noise_report_init(&r);
+    noise_report_blank(&r);
     choose(&checked, &d, r.preset, sizeof r.preset, r.reason, sizeof r.reason);
     /* only the fields the caller's struct has are written */
     size_t size = params->struct_size;
@@ -215,17 +216,4 @@ rsmooth_status rsmooth_params_auto_report(rsmooth_scalar scalar, const void *pos
         *report = r;
     }
     return RSMOOTH_OK;
-}
-
-rsmooth_status rsmooth_params_auto(rsmooth_scalar scalar, const void *positions,
-                                   size_t vertex_count, const uint32_t *indices,
-                                   size_t triangle_count, rsmooth_params *params, double *out_noise,
-                                   rsmooth_error *error) {
-    rsmooth_noise_report r;
-    rsmooth_noise_report_init(&r);
-    rsmooth_status st = rsmooth_params_auto_report(scalar, positions, vertex_count, indices,
-                                                   triangle_count, params, &r, error);
-    if (st == RSMOOTH_OK && out_noise)
-        *out_noise = r.level;
-    return st;
 }

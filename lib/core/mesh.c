@@ -167,9 +167,20 @@ rsmooth_status rsmooth_mean_edge_length(rsmooth_scalar scalar, const void *posit
     rs_error_clear(error);
     if (!out_length)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_length is NULL");
+    rsmooth_status st = rs_check_mesh_structure(scalar, positions, vertex_count, indices,
+                                                triangle_count, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
+    return rs_mesh_mean_edge(scalar, positions, vertex_count, indices, triangle_count, out_length,
+                             error, where);
+}
+
+rsmooth_status rs_mesh_mean_edge(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
+                                 const uint32_t *indices, size_t triangle_count, double *out_length,
+                                 rsmooth_error *error, const char *where) {
     double magnitude = 0, scale = 1;
-    rsmooth_status st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices,
-                                             triangle_count, &magnitude, error, where);
+    rsmooth_status st =
+        rs_check_coordinates(scalar, positions, vertex_count, "vertex", &magnitude, error, where);
     if (st == RSMOOTH_OK)
         st = rs_mesh_scale(scalar, positions, indices, triangle_count, magnitude, &scale, error,
                            where);
@@ -307,16 +318,6 @@ static void store_facets(void *ctx, size_t begin, size_t end, size_t chunk) {
 
 const char rs_unchecked_output[1];
 
-rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar, const void *positions,
-                                  size_t vertex_count, const uint32_t *indices,
-                                  size_t triangle_count, const rsmooth_params *params,
-                                  const void *out_positions, bool keep_facet_data,
-                                  rsmooth_error *error, const char *where) {
-    return rs_problem_prepare_within(problem, scalar, positions, vertex_count, indices,
-                                     triangle_count, params, out_positions, keep_facet_data, NULL,
-                                     error, where);
-}
-
 /* Whether `scale` is a power of two that keeps coordinates up to `magnitude` below 2^500. */
 static bool usable_scale(double scale, double magnitude) {
     int e = 0;
@@ -324,28 +325,31 @@ static bool usable_scale(double scale, double magnitude) {
            magnitude * scale < ldexp(1.0, 500);
 }
 
-rsmooth_status rs_problem_prepare_within(rs_problem *problem, rsmooth_scalar scalar,
-                                         const void *positions, size_t vertex_count,
-                                         const uint32_t *indices, size_t triangle_count,
-                                         const rsmooth_params *params, const void *out_positions,
-                                         bool keep_facet_data, const rsmooth_piece_info *whole,
-                                         rsmooth_error *error, const char *where) {
+/* rs_problem_prepare and _within: with `checked`, the caller has checked the arrays, outputs and
+ * colours (rs_filter_passes, at the call's entry), and only the coordinates' magnitude is read. */
+static rsmooth_status problem_prepare(rs_problem *problem, rsmooth_scalar scalar,
+                                      const void *positions, size_t vertex_count,
+                                      const uint32_t *indices, size_t triangle_count,
+                                      const rsmooth_params *params, const void *out_positions,
+                                      bool keep_facet_data, const rsmooth_piece_info *whole,
+                                      bool checked, rsmooth_error *error, const char *where) {
     memset(problem, 0, sizeof *problem);
     rsmooth_params p;
     rsmooth_status st = rs_params_resolve(params, &p, error, where);
     if (st != RSMOOTH_OK)
         return st;
     double magnitude = 0;
-    st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count, &magnitude,
-                              error, where);
-    if (st != RSMOOTH_OK)
-        return st;
-    if (out_positions != RS_UNCHECKED_OUTPUT)
+    if (checked)
+        st = rs_check_coordinates(scalar, positions, vertex_count, "vertex", &magnitude, error,
+                                  where);
+    else
+        st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count,
+                                  &magnitude, error, where);
+    if (st == RSMOOTH_OK && !checked && out_positions != RS_UNCHECKED_OUTPUT)
         st = rs_check_outputs(scalar, positions, vertex_count, indices, triangle_count, &p,
                               out_positions, NULL, NULL, error, where);
-    if (st != RSMOOTH_OK)
-        return st;
-    st = rs_check_colors(p.colors, vertex_count, error, where);
+    if (st == RSMOOTH_OK && !checked)
+        st = rs_check_colors(p.colors, vertex_count, error, where);
     if (st != RSMOOTH_OK)
         return st;
     double scale = whole ? whole->scale : 0;
@@ -426,6 +430,24 @@ rsmooth_status rs_problem_prepare_within(rs_problem *problem, rsmooth_scalar sca
                               problem->facet_color + 3 * q);
     }
     return RSMOOTH_OK;
+}
+
+rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar, const void *positions,
+                                  size_t vertex_count, const uint32_t *indices,
+                                  size_t triangle_count, const rsmooth_params *params,
+                                  bool keep_facet_data, rsmooth_error *error, const char *where) {
+    return problem_prepare(problem, scalar, positions, vertex_count, indices, triangle_count,
+                           params, RS_UNCHECKED_OUTPUT, keep_facet_data, NULL, true, error, where);
+}
+
+rsmooth_status rs_problem_prepare_within(rs_problem *problem, rsmooth_scalar scalar,
+                                         const void *positions, size_t vertex_count,
+                                         const uint32_t *indices, size_t triangle_count,
+                                         const rsmooth_params *params, const void *out_positions,
+                                         bool keep_facet_data, const rsmooth_piece_info *whole,
+                                         rsmooth_error *error, const char *where) {
+    return problem_prepare(problem, scalar, positions, vertex_count, indices, triangle_count,
+                           params, out_positions, keep_facet_data, whole, false, error, where);
 }
 
 rsmooth_status rs_problem_apply_params(rs_problem *problem, const rsmooth_params *p, double unit,

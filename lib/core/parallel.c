@@ -10,6 +10,7 @@
  * of its own for that call, as every call did before. A forked child starts with no workers, and
  * the workers are stopped when the library is unloaded. */
 #define _DEFAULT_SOURCE /* sysconf's _SC_NPROCESSORS_ONLN */
+#include "core/environment.h"
 #include "core/rsmooth_internal.h"
 
 #include <pthread.h>
@@ -30,7 +31,7 @@ size_t rs_set_call_threads(size_t threads) {
 size_t rs_host_threads(void) {
     if (call_threads)
         return call_threads > MAX_THREADS ? MAX_THREADS : call_threads;
-    const char *forced = getenv("RSMOOTH_HOST_THREADS");
+    const char *forced = rs_environment_now(RS_ENV_HOST_THREADS);
     long n = forced ? atol(forced) : sysconf(_SC_NPROCESSORS_ONLN);
     return n < 1 ? 1 : n > MAX_THREADS ? MAX_THREADS : (size_t)n;
 }

@@ -146,3 +146,17 @@ void rs_add_part_report(rsmooth_report *sum, const rsmooth_report *part, bool la
         add_work(sum, part);
     }
 }
+
+rsmooth_status rs_read_outputs(const rsmooth_outputs *given, rsmooth_outputs *out,
+                               rsmooth_error *error, const char *where) {
+    memset(out, 0, sizeof *out);
+    if (!given)
+        return RSMOOTH_OK;
+    size_t size = given->struct_size ? given->struct_size : sizeof *out;
+    if (size < sizeof out->struct_size)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "outputs->struct_size is %zu: set it to sizeof(rsmooth_outputs)", size);
+    memcpy(out, given, size < sizeof *out ? size : sizeof *out);
+    out->struct_size = sizeof *out;
+    return RSMOOTH_OK;
+}

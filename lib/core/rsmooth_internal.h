@@ -76,7 +76,8 @@ typedef void (*rs_range_fn)(void *ctx, size_t begin, size_t end, size_t chunk);
 size_t rs_host_threads(void);
 
 /* Sets the host threads of the calling thread's rsmooth calls (0: the default above) and returns
- * the setting it replaces: a context's calls run with its rsmooth_context_set_host_threads. */
+ * the setting it replaces: a context's calls run with its options' host_threads
+ * (api/device_pass.c). */
 size_t rs_set_call_threads(size_t threads);
 
 /* How many chunks rs_parallel_for cuts `count` elements into (at least min_per_chunk each). */
@@ -163,24 +164,26 @@ static inline bool rs_progress(const rs_problem *problem, double fraction) {
 /* RSMOOTH_ERROR_CANCELLED, said so in `error`. */
 rsmooth_status rs_cancelled(rsmooth_error *error, const char *where);
 
-/* Given as out_positions to rs_problem_prepare by a caller that checked its own outputs (a piece
- * writes fewer vertices than it reads). */
+/* Given as out_positions to rs_problem_prepare_within by a caller that checked its own outputs (a
+ * piece writes fewer vertices than it reads). */
 extern const char rs_unchecked_output[1];
 #define RS_UNCHECKED_OUTPUT ((const void *)rs_unchecked_output)
 
-/* Checks every argument of a smoothing call (nothing is written on failure), converts positions to
- * double, finds the facets, computes the mean edge length and area and the absolute parameters,
- * and with keep_facet_data the facets' centroids, normals and areas. */
+/* One pass's problem, for a path's pass function (rs_filter_fn): converts positions to double,
+ * finds the facets, computes the mean edge length and area and the absolute parameters, and with
+ * keep_facet_data the facets' centroids, normals and areas. The arrays, outputs and colours were
+ * checked once, at the call's entry (rs_filter_passes): only the coordinates are read again, for
+ * their magnitude (a pass after the first reads the previous pass's). */
 rsmooth_status rs_problem_prepare(rs_problem *problem, rsmooth_scalar scalar, const void *positions,
                                   size_t vertex_count, const uint32_t *indices,
                                   size_t triangle_count, const rsmooth_params *params,
-                                  const void *out_positions, bool keep_facet_data,
-                                  rsmooth_error *error, const char *where);
+                                  bool keep_facet_data, rsmooth_error *error, const char *where);
 
-/* rs_problem_prepare for a piece of a larger mesh: the whole mesh's figures stand in for the
- * problem's own (its mean edge length and mean area are not computed), and its scale is used
- * unless it is 0 or would put a coordinate beyond 2^500 (then the problem chooses its own, as
- * rs_problem_prepare does; the figures are converted exactly either way). */
+/* rs_problem_prepare for a piece of a larger mesh, an entry point of its own: checks every
+ * argument (nothing is written on failure). The whole mesh's figures stand in for the problem's
+ * own (its mean edge length and mean area are not computed), and its scale is used unless it is 0
+ * or would put a coordinate beyond 2^500 (then the problem chooses its own, as rs_problem_prepare
+ * does; the figures are converted exactly either way). */
 rsmooth_status rs_problem_prepare_within(rs_problem *problem, rsmooth_scalar scalar,
                                          const void *positions, size_t vertex_count,
                                          const uint32_t *indices, size_t triangle_count,
@@ -292,6 +295,12 @@ rsmooth_status rs_check_mesh_structure(rsmooth_scalar scalar, const void *positi
                                        size_t triangle_count, rsmooth_error *error,
                                        const char *where);
 
+/* rsmooth_mean_edge_length of arrays whose structure was checked (the coordinates are read:
+ * their magnitude sets the scale); errors name `where`. */
+rsmooth_status rs_mesh_mean_edge(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
+                                 const uint32_t *indices, size_t triangle_count, double *out_length,
+                                 rsmooth_error *error, const char *where);
+
 /* Mean length of unique undirected edges over `xyz` (double). false on allocation failure. */
 bool rs_mean_edge_length(const double *xyz, size_t vertex_count, const uint32_t *indices,
                          size_t triangle_count, double *out_length);
@@ -388,6 +397,10 @@ void rs_store_unmoved(const rs_problem *problem, size_t count, rsmooth_scalar sc
  * version's struct had, else, a struct never initialised, this version's whole struct), and
  * keeps that struct_size. */
 void rs_give_report(rsmooth_report *report, size_t struct_size, const rsmooth_report *full);
+
+/* The caller's outputs (NULL: none), as much as its struct_size holds, the rest NULL. */
+rsmooth_status rs_read_outputs(const rsmooth_outputs *given, rsmooth_outputs *out,
+                               rsmooth_error *error, const char *where);
 
 /* `from`'s stage times and pairs added to `to`'s, and the larger tile count: what every sum of
  * reports (passes, parts) adds alike. */

@@ -18,7 +18,7 @@
  * filtering of the facet normals instead of mollification, repeated and confidence-driven passes,
  * Tukey / Lorentzian / Huber influence functions, a colour term in the influence weight
  * (rsmooth_params), automatic parameters from the estimated noise (rsmooth_params_auto), and
- * point clouds with normals (rsmooth_smooth_points_reference). rsmooth_params_init_best is the
+ * point clouds with normals (rsmooth_smooth_points). rsmooth_params_init_best is the
  * most accurate preset measured. rsmooth_compare measures a result against its ground truth (the
  * error metrics `rsmooth compare` prints).
  *
@@ -27,16 +27,12 @@
  *     rsmooth_params params;
  *     rsmooth_params_init(&params);             // sigma_f = 2, sigma_g = 0.5 mean edge lengths
  *     params.sigma_f = 1.5;
- *     rsmooth_context *ctx = NULL;
+ *     rsmooth_context *ctx = NULL;   // stays NULL without OpenCL: the reference path
  *     rsmooth_error err;
- *     if (rsmooth_context_create(NULL, &ctx, &err) == RSMOOTH_OK) {   // default device
- *         rsmooth_smooth(ctx, RSMOOTH_FLOAT32, xyz, vertex_count, indices, triangle_count,
- *                        &params, out_xyz, NULL, NULL, NULL, &err);
- *         rsmooth_context_destroy(ctx);
- *     } else {                                   // no OpenCL: the double-precision reference path
- *         rsmooth_smooth_reference(RSMOOTH_FLOAT32, xyz, vertex_count, indices, triangle_count,
- *                                  &params, out_xyz, NULL, NULL, NULL, &err);
- *     }
+ *     rsmooth_context_create(NULL, &ctx, &err);   // NULL: default options
+ *     rsmooth_smooth(ctx, RSMOOTH_FLOAT32, xyz, vertex_count, indices, triangle_count, &params,
+ *                    out_xyz, NULL, &err);        // NULL: no weights, confidence or report
+ *     rsmooth_context_destroy(ctx);
  *
  * Interoperation with a caller's own OpenCL queue lives in rsmooth_cl.h, so this header needs no
  * OpenCL headers.
@@ -56,7 +52,7 @@
 /** @def RSMOOTH_VERSION_PATCH
  * The patch version of this header: fixes within one ABI. */
 #define RSMOOTH_VERSION_MAJOR 0
-#define RSMOOTH_VERSION_MINOR 10
+#define RSMOOTH_VERSION_MINOR 11
 #define RSMOOTH_VERSION_PATCH 0
 
 /** @def RSMOOTH_API
@@ -250,7 +246,7 @@ typedef struct rsmooth_params {
      * applies to the robust estimate (Eq. 3) only; the predictors' normals (mollification or the
      * bilateral filter) ignore colour. The confidence k / sum a f counts the factor in k only,
      * so it drops where neighbouring triangles differ in colour. For point clouds
-     * (rsmooth_smooth_points_reference) a point's own colour is its facet's C_q. @{ */
+     * (rsmooth_smooth_points) a point's own colour is its facet's C_q. @{ */
     const float *colors; /**< NULL (default): off. Else 3 * vertex_count floats, a colour
                           * per vertex (e.g. RGB in [0, 1]; any finite values of
                           * magnitude <= 1e15), in the positions' vertex order. Borrowed:
@@ -347,7 +343,7 @@ RSMOOTH_API rsmooth_status rsmooth_params_init_best(rsmooth_params *params);
 
 /** Mean length of the mesh's unique undirected edges (an edge shared by two triangles counts once),
  * in the mesh's units: the unit of relative sigmas. Writes 0 when there is no edge of non-zero
- * length. Fails like rsmooth_smooth_reference on bad arrays. Thread-safe. */
+ * length. Fails like rsmooth_smooth on bad arrays. Thread-safe. */
 RSMOOTH_API rsmooth_status rsmooth_mean_edge_length(rsmooth_scalar scalar, const void *positions,
                                                     size_t vertex_count, const uint32_t *indices,
                                                     size_t triangle_count, double *out_length,
@@ -375,27 +371,7 @@ RSMOOTH_API rsmooth_status rsmooth_estimate_noise(rsmooth_scalar scalar, const v
                                                   size_t triangle_count, double *out_noise,
                                                   rsmooth_error *error);
 
-/** Automatic parameters: estimates the mesh's noise (rsmooth_estimate_noise) and sets the fields
- * of `params` the rules chosen in docs/experiments.md (section 7; cross-validated, whole meshes
- * left out) give for it. `params` must be initialised first; it picks the rule:
- *   the paper's filter (rsmooth_params_init: normal_filter RSMOOTH_NORMALS_MOLLIFY and no
- *     vertex_updates): sigma_f = 0.6 + 1.6 n, sigma_g = 4 n for noise n in mean edge lengths;
- *   otherwise the best mode (rsmooth_params_init_best's setting): the guided filter's rounds by
- *     noise class (gentle, medium, strong; impulsive noise its own);
- *   either way, on a mesh that reads clean (its roughness is its own shape: see
- *     rsmooth_noise_report.shape_correlation), no pass and no stage (passes 0, vertex_updates 0),
- *     so the smoothing call returns the input as it is (added in 0.11).
- * The estimate reads the mesh's largest part, outliers left out (rsmooth_report.parts).
- * Sigmas are relative (absolute = 0 after the call). Other fields are left as they are. Writes
- * the estimate to *out_noise when not NULL. Fails like rsmooth_estimate_noise, and on invalid
- * params; then `params` is unchanged. Thread-safe. rsmooth_params_auto_report also says what it
- * read and chose. */
-RSMOOTH_API rsmooth_status rsmooth_params_auto(rsmooth_scalar scalar, const void *positions,
-                                               size_t vertex_count, const uint32_t *indices,
-                                               size_t triangle_count, rsmooth_params *params,
-                                               double *out_noise, rsmooth_error *error);
-
-/** The kind of noise rsmooth_params_auto_report found in a mesh (added in 0.6). */
+/** The kind of noise rsmooth_params_auto found in a mesh (added in 0.6). */
 typedef enum rsmooth_noise_kind {
     RSMOOTH_NOISE_NONE = 0,     /**< nothing to remove: nothing measurable (too few vertices,
                                  * no edge), or roughness that reads as the mesh's own shape (a
@@ -405,10 +381,9 @@ typedef enum rsmooth_noise_kind {
     RSMOOTH_NOISE_IMPULSIVE = 2 /**< a share of the vertices thrown, the others (nearly) exact */
 } rsmooth_noise_kind;
 
-/** What rsmooth_params_auto_report read from a mesh and chose (added in 0.6): initialise it with
- * rsmooth_noise_report_init. */
+/** What rsmooth_params_auto read from a mesh and chose (added in 0.6): set struct_size first. */
 typedef struct rsmooth_noise_report {
-    size_t struct_size;        /**< sizeof(rsmooth_noise_report): rsmooth_noise_report_init */
+    size_t struct_size;        /**< sizeof(rsmooth_noise_report), set by the caller */
     double level;              /**< rsmooth_estimate_noise's figure: the standard deviation of the
                                 * displacement along the surface normal, in mean edge lengths of
                                 * the clean mesh (impulsive: of the displaced vertices) */
@@ -443,16 +418,26 @@ typedef struct rsmooth_noise_report {
                                 * (Added in 0.11) */
 } rsmooth_noise_report;
 
-/** Sets struct_size and clears the rest. */
-RSMOOTH_API void rsmooth_noise_report_init(rsmooth_noise_report *report);
-
-/** rsmooth_params_auto, also saying what it read and chose in *report (when not NULL; initialise
- * it with rsmooth_noise_report_init). (Added in 0.6.) */
-RSMOOTH_API rsmooth_status rsmooth_params_auto_report(rsmooth_scalar scalar, const void *positions,
-                                                      size_t vertex_count, const uint32_t *indices,
-                                                      size_t triangle_count, rsmooth_params *params,
-                                                      rsmooth_noise_report *report,
-                                                      rsmooth_error *error);
+/** Automatic parameters: estimates the mesh's noise (rsmooth_estimate_noise) and sets the fields
+ * of `params` the rules chosen in docs/experiments.md (section 7; cross-validated, whole meshes
+ * left out) give for it. `params` must be initialised first; it picks the rule:
+ *   the paper's filter (rsmooth_params_init: normal_filter RSMOOTH_NORMALS_MOLLIFY and no
+ *     vertex_updates): sigma_f = 0.6 + 1.6 n, sigma_g = 4 n for noise n in mean edge lengths;
+ *   otherwise the best mode (rsmooth_params_init_best's setting): the guided filter's rounds by
+ *     noise class (gentle, medium, strong; impulsive noise its own);
+ *   either way, on a mesh that reads clean (its roughness is its own shape: see
+ *     rsmooth_noise_report.shape_correlation), no pass and no stage (passes 0, vertex_updates 0),
+ *     so the smoothing call returns the input as it is (added in 0.11).
+ * The estimate reads the mesh's largest part, outliers left out (rsmooth_report.parts).
+ * Sigmas are relative (absolute = 0 after the call). Other fields are left as they are.
+ * `report` (optional, NULL: none) says what it read and chose: set its struct_size first,
+ * `rsmooth_noise_report r = {.struct_size = sizeof r};` (its level is the estimate). Fails like
+ * rsmooth_estimate_noise, and on invalid params; then `params` is unchanged. Thread-safe.
+ * (`report` in 0.11: before, `double *out_noise`, and rsmooth_params_auto_report) */
+RSMOOTH_API rsmooth_status rsmooth_params_auto(rsmooth_scalar scalar, const void *positions,
+                                               size_t vertex_count, const uint32_t *indices,
+                                               size_t triangle_count, rsmooth_params *params,
+                                               rsmooth_noise_report *report, rsmooth_error *error);
 
 /** Figures of one filter run, filled when a non-NULL pointer is passed. Times in milliseconds;
  * stages a path does not have are 0. */
@@ -582,35 +567,61 @@ RSMOOTH_API rsmooth_status rsmooth_compare(rsmooth_scalar scalar, const void *re
 /* Layer 1: arrays in, arrays out */
 /* ---------------------------------------------------------------------------------------------- */
 
-/** The filter in double precision on one CPU thread: the oracle of the OpenCL path and the fallback
- * when no OpenCL device exists.
+/** Owns (or shares) an OpenCL context, device, queue and the built program (Layer 2 below). */
+typedef struct rsmooth_context rsmooth_context;
+
+/** The optional per-vertex outputs and the report of a smoothing call (rsmooth_smooth,
+ * rsmooth_smooth_points, rsmooth_smooth_view). Zero-initialise it and set struct_size, e.g.
+ * `rsmooth_outputs out = {.struct_size = sizeof out, .confidence = conf};`; a call given NULL
+ * writes none of them. (Added in 0.11: the three trailing arguments of 0.10's calls) */
+typedef struct rsmooth_outputs {
+    size_t struct_size; /**< sizeof(rsmooth_outputs); 0 reads as the 0.11 size */
+    /** vertex_count floats receiving k(p) = sum a f g (area units; a k beyond FLT_MAX, e.g. on a
+     * mesh with edges of 1e20, is RSMOOTH_ERROR_NUMERICAL, one below float's range rounds to 0:
+     * the confidence is the scale-free measure). Not for point clouds (must be NULL there). */
+    float *weight;
+    /** vertex_count floats receiving k(p) / sum a f, in [0, 1]; 0 where no facet is within reach
+     * (such vertices keep their position). */
+    float *confidence;
+    /** Figures of the run; set its struct_size (rsmooth_report_init). */
+    rsmooth_report *report;
+} rsmooth_outputs;
+
+/** The filter: on the context's OpenCL device, or with ctx NULL on the reference path, in double
+ * precision on the host (the oracle of the device path and the fallback when no OpenCL device
+ * exists).
  *
- * scalar         type of `positions` and `out_positions`.
- * positions      3 * vertex_count floats or doubles (x, y, z per vertex), finite, magnitude
- *                <= 1e150. Borrowed. Any scale works alike, from edges of 1e-300 (float32:
- *                1e-36) to coordinates of 1e150: both paths work in units of a power of two
- *                near the mesh's typical edge, which is exact. A mesh whose largest coordinate
- *                lies more than 1e225 typical edges from the origin is refused.
- * vertex_count   >= 1 and < 2^32.
- * indices        3 * triangle_count vertex indices, each < vertex_count. May be NULL only when
- *                triangle_count is 0 (then nothing moves). Any soup is fine: duplicated,
- * unreferenced or disconnected vertices, non-manifold edges, zero-area triangles. params NULL means
- * defaults (rsmooth_params_init). out_positions  3 * vertex_count values of `scalar`, in the
- * input's vertex order. Must not overlap `positions`. out_weight     optional (NULL): vertex_count
- * floats receiving k(p) = sum a f g (area units; a k beyond FLT_MAX, e.g. on a mesh with edges of
- * 1e20, is RSMOOTH_ERROR_NUMERICAL, one below float's range rounds to 0: the confidence is the
- * scale-free measure). out_confidence optional (NULL): vertex_count floats receiving k(p) / sum a
- * f, in [0, 1]; 0 where no facet is within reach (such vertices keep their position). report
- * optional (NULL): figures of the run. error          optional (NULL): detail on failure.
+ * - ctx: a context (rsmooth_context_create), or NULL for the reference path.
+ * - scalar: the type of `positions` and `out_positions`.
+ * - positions: 3 * vertex_count floats or doubles (x, y, z per vertex), finite, magnitude
+ *   <= 1e150. Borrowed. Any scale works alike, from edges of 1e-300 (float32: 1e-36) to
+ *   coordinates of 1e150: both paths work in units of a power of two near the mesh's typical
+ *   edge, which is exact. A mesh whose largest coordinate lies more than 1e225 typical edges from
+ *   the origin is refused.
+ * - vertex_count: >= 1 and < 2^32.
+ * - indices: 3 * triangle_count vertex indices, each < vertex_count. May be NULL only when
+ *   triangle_count is 0 (then nothing moves). Any soup is fine: duplicated, unreferenced or
+ *   disconnected vertices, non-manifold edges, zero-area triangles.
+ * - params: NULL means defaults (rsmooth_params_init).
+ * - out_positions: 3 * vertex_count values of `scalar`, in the input's vertex order. Must not
+ *   overlap `positions`.
+ * - outputs: optional (NULL): weights, confidence, report (rsmooth_outputs).
+ * - error: optional (NULL): detail on failure.
  *
  * Returns RSMOOTH_OK, RSMOOTH_ERROR_INVALID_ARGUMENT (then no output is written),
  * RSMOOTH_ERROR_OUT_OF_MEMORY or RSMOOTH_ERROR_NUMERICAL (a float32 result beyond FLT_MAX, a
- * weight beyond float's range; outputs undefined). RSMOOTH_OK guarantees every output is finite.
- * Thread-safe (no shared state). */
-RSMOOTH_API rsmooth_status rsmooth_smooth_reference(
-    rsmooth_scalar scalar, const void *positions, size_t vertex_count, const uint32_t *indices,
-    size_t triangle_count, const rsmooth_params *params, void *out_positions, float *out_weight,
-    float *out_confidence, rsmooth_report *report, rsmooth_error *error);
+ * weight beyond float's range; outputs undefined), and on a device RSMOOTH_ERROR_OPENCL (outputs
+ * undefined) when the device fails. RSMOOTH_OK guarantees every output is finite. The device
+ * computes in float32 in cell-local coordinates (meshes far from the origin lose nothing); its
+ * result agrees with the reference path's to about 1e-4 mean edge lengths, and two runs on the
+ * same device are bit-identical. Thread-safe: the reference path has no shared state; a context's
+ * calls run one at a time. (ctx NULL and `outputs` in 0.11: before, rsmooth_smooth_reference and
+ * three trailing arguments) */
+RSMOOTH_API rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar,
+                                          const void *positions, size_t vertex_count,
+                                          const uint32_t *indices, size_t triangle_count,
+                                          const rsmooth_params *params, void *out_positions,
+                                          const rsmooth_outputs *outputs, rsmooth_error *error);
 
 /** The isotropic baselines people already use, for comparison only: `iterations` rounds of
  * p += lambda * U(p), each followed, when mu != 0, by p += mu * U(p) (Taubin's lambda|mu smoothing,
@@ -618,7 +629,7 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_reference(
  * shrinks the mesh. U(p) is the uniform umbrella operator: the mean of p's edge neighbours minus p.
  * Unlike the filter above these need connectivity (vertices without an edge stay) and round sharp
  * edges. lambda in (0, 1], mu in [-1, 0]. Same arrays and argument errors as
- * rsmooth_smooth_reference (RSMOOTH_ERROR_NUMERICAL when a float32 result leaves float's range);
+ * rsmooth_smooth (RSMOOTH_ERROR_NUMERICAL when a float32 result leaves float's range);
  * double precision, one thread, thread-safe. */
 RSMOOTH_API rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const void *positions,
                                                  size_t vertex_count, const uint32_t *indices,
@@ -626,7 +637,8 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const vo
                                                  unsigned iterations, void *out_positions,
                                                  rsmooth_error *error);
 
-/** Point clouds with normals (beyond the paper; added in 0.4). A point set has no triangles, so
+/** Point clouds with normals (beyond the paper; added in 0.4), on a context's device or (ctx
+ * NULL) the reference path. A point set has no triangles, so
  * each point p_i is its own facet: its centroid is p_i, its plane the tangent plane through p_i
  * with normal n_i, and its area a_i = (sqrt(3) / 2) s_i^2, where s_i is p_i's mean distance to its
  * 6 nearest other points (the area per point of a regular triangular lattice of spacing s_i), so
@@ -653,24 +665,33 @@ RSMOOTH_API rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const vo
  * out_positions   3 * point_count values: the filtered points, in input order.
  * out_normals     optional (NULL): 3 * point_count values receiving the unit normals the last pass
  *                 predicted with (the filtered normals; the input's, normalised, with mollify 0).
- * out_confidence  optional (NULL): point_count floats, k(p) / sum a f in [0, 1].
- * report          optional (NULL): triangle_count 0, facet_count the points of non-zero area,
- *                 mean_edge_length the point spacing; ms_mollify the normal filter.
+ * outputs         optional (NULL): confidence (point_count floats, k(p) / sum a f in [0, 1]) and
+ *                 report (triangle_count 0, facet_count the points of non-zero area,
+ *                 mean_edge_length the point spacing; ms_mollify the normal filter); its weight
+ *                 must be NULL.
  * Every input is read before any output is written: outputs may be the input arrays themselves,
  * but must not overlap each other.
  *
  * Returns RSMOOTH_OK, RSMOOTH_ERROR_INVALID_ARGUMENT (naming the point of a non-finite or zero
  * normal; no output written), RSMOOTH_ERROR_OUT_OF_MEMORY or RSMOOTH_ERROR_NUMERICAL (outputs
- * undefined). Double
- * precision, thread-safe. rsmooth_smooth_points (below) runs the same filter on a device. */
-RSMOOTH_API rsmooth_status rsmooth_smooth_points_reference(
-    rsmooth_scalar scalar, const void *positions, const void *normals, size_t point_count,
-    const rsmooth_params *params, void *out_positions, void *out_normals, float *out_confidence,
-    rsmooth_report *report, rsmooth_error *error);
+ * undefined). With ctx NULL: the reference path, in double precision, thread-safe. On a
+ * context's device each pass is one device run with the points as facets (the same grid,
+ * bilateral rounds and robust kernels as rsmooth_smooth; spacings and areas on the host); the
+ * result agrees with the reference path to about 1e-4 point spacings, two runs on the same device
+ * are bit-identical. Point clouds are not cut into tiles: one that does not fit the device (or the
+ * context's memory budget) returns RSMOOTH_ERROR_OUT_OF_MEMORY; RSMOOTH_ERROR_OPENCL (outputs
+ * undefined) when the device fails. (ctx NULL and `outputs` in 0.11: before,
+ * rsmooth_smooth_points_reference and two trailing arguments) */
+RSMOOTH_API rsmooth_status rsmooth_smooth_points(rsmooth_context *ctx, rsmooth_scalar scalar,
+                                                 const void *positions, const void *normals,
+                                                 size_t point_count, const rsmooth_params *params,
+                                                 void *out_positions, void *out_normals,
+                                                 const rsmooth_outputs *outputs,
+                                                 rsmooth_error *error);
 
 /** The point spacing of a point set, as above: the mean over the points of each one's mean distance
  * to its 6 nearest others (fewer when there are fewer points; 0 for one point). Fails like
- * rsmooth_smooth_points_reference on bad positions. Thread-safe. */
+ * rsmooth_smooth_points on bad positions. Thread-safe. */
 RSMOOTH_API rsmooth_status rsmooth_point_spacing(rsmooth_scalar scalar, const void *positions,
                                                  size_t point_count, double *out_spacing,
                                                  rsmooth_error *error);
@@ -679,31 +700,52 @@ RSMOOTH_API rsmooth_status rsmooth_point_spacing(rsmooth_scalar scalar, const vo
 /* Layer 2: an OpenCL context object */
 /* ---------------------------------------------------------------------------------------------- */
 
-/** Owns (or shares) an OpenCL context, device, queue and the built program. */
-typedef struct rsmooth_context rsmooth_context;
+/** How a context is made (rsmooth_context_create). Zero-initialise it and set struct_size, e.g.
+ * `rsmooth_context_options o = {.struct_size = sizeof o};`, then the fields wanted: a zero field
+ * takes its environment variable when set, else the default. The environment is read once, at the
+ * creation (every variable is in docs/environment.md); the context's calls use what it read then.
+ * (Added in 0.11) */
+typedef struct rsmooth_context_options {
+    size_t struct_size; /**< sizeof(rsmooth_context_options); 0 reads as the 0.11 size */
+    /** The device: NULL takes RSMOOTH_DEVICE, else "auto"; "auto" the first GPU of any platform,
+     * else the first CPU device, else the first device; "gpu"/"cpu" the first device of that
+     * type; "P:D" device D of platform P (0-based, in clGetPlatformIDs/clGetDeviceIDs order);
+     * other text the first device whose "platform device" name contains it (case-insensitive). */
+    const char *device;
+    /** Device memory one filter call may hold, bytes: 0 takes RSMOOTH_MEMORY_BUDGET (e.g.
+     * "256M"), else most of the device's memory. A mesh that needs more, or a buffer larger than
+     * the device's largest allocation, is cut into spatial tiles, each run with the facets within
+     * reach of its vertices: results are an untiled run's bit for bit (the grid's cells count
+     * from a lattice fixed in space; a mesh spanning more than about a million cells along an
+     * axis, where the whole mesh's cells widen, excepted). rsmooth_report.tiles says how many
+     * ran. */
+    uint64_t memory_budget;
+    /** Threads of the host stages of the context's calls (facet data, grid, packing, results, the
+     * normal-update stage on CPU devices): 0 takes RSMOOTH_HOST_THREADS, else every online core;
+     * at most 64 run. A host application with its own thread pool sets 1, or its share. The
+     * result does not depend on it (bit for bit). */
+    unsigned host_threads;
+} rsmooth_context_options;
 
-/** Creates a context on the device named by `device`:
- *   NULL        use the RSMOOTH_DEVICE environment variable if set, else "auto";
- *   "auto"      first GPU of any platform, else first CPU device, else the first device;
- *   "gpu"/"cpu" first device of that type;
- *   "P:D"       device D of platform P (0-based, in clGetPlatformIDs/clGetDeviceIDs order);
- *   other text  first device whose "platform device" name contains it (case-insensitive).
- * The program is built here (PoCL caches binaries on disk in POCL_CACHE_DIR). Developers may set
- * RSMOOTH_KERNEL_DIR to load kernels/ *.cl from a directory instead of the embedded copies, and
+/** Creates a context: `options` may be NULL (every field zero: the environment, else the
+ * defaults). The program is built here (PoCL caches binaries on disk in POCL_CACHE_DIR; rsmooth
+ * keeps its own cache, rsmooth_context_info.program_cache). Developers may set RSMOOTH_KERNEL_DIR
+ * to load kernels/ *.cl from a directory instead of the embedded copies, and
  * RSMOOTH_BUILD_OPTIONS to append OpenCL build options.
  * The OpenCL loader is opened on the first call that needs it (the library does not link it):
  * RSMOOTH_OPENCL_LIBRARY names its file when set and non-empty, else libOpenCL.so.1 (OpenCL.dll,
  * the OpenCL framework); where it cannot be opened, this returns RSMOOTH_ERROR_NO_DEVICE saying
  * so and rsmooth_list_devices 0, while the reference path works.
  * Returns RSMOOTH_ERROR_NO_DEVICE, RSMOOTH_ERROR_KERNEL_BUILD, RSMOOTH_ERROR_OPENCL, ... with *ctx
- * set to NULL on failure. Thread-safe. A context may be shared by threads: its calls are
- * serialised (each holds the context while it runs), so threads sharing one wait for each other;
- * give each thread its own context to filter concurrently. A call on a context from a progress
- * callback of a call still running on it would wait for itself: it returns
- * RSMOOTH_ERROR_INVALID_ARGUMENT at once instead. RSMOOTH_MEMORY_BUDGET set but not a
- * positive byte count is RSMOOTH_ERROR_INVALID_ARGUMENT naming it. */
-RSMOOTH_API rsmooth_status rsmooth_context_create(const char *device, rsmooth_context **ctx,
-                                                  rsmooth_error *error);
+ * set to NULL on failure. An environment variable of rsmooth's set to a value it does not take
+ * (RSMOOTH_STAGE=gpu, RSMOOTH_MEMORY_BUDGET=lots) is RSMOOTH_ERROR_INVALID_ARGUMENT naming it.
+ * Thread-safe. A context may be shared by threads: its calls are serialised (each holds the
+ * context while it runs), so threads sharing one wait for each other; give each thread its own
+ * context to filter concurrently. A call on a context from a progress callback of a call still
+ * running on it would wait for itself: it returns RSMOOTH_ERROR_INVALID_ARGUMENT at once
+ * instead. (`options` in 0.11: before, the device name alone) */
+RSMOOTH_API rsmooth_status rsmooth_context_create(const rsmooth_context_options *options,
+                                                  rsmooth_context **ctx, rsmooth_error *error);
 
 /** One OpenCL device as rsmooth_list_devices reports it. */
 typedef struct rsmooth_device_info {
@@ -739,84 +781,46 @@ RSMOOTH_API size_t rsmooth_device_version(int platform_index, int device_index, 
  * still running on ctx, does nothing (the call would go on with freed objects). */
 RSMOOTH_API void rsmooth_context_destroy(rsmooth_context *ctx);
 
-/** "Platform name / device name" of the context's device; valid while ctx lives. */
-RSMOOTH_API const char *rsmooth_context_device_name(const rsmooth_context *ctx);
+/** What a context is and how it was made: rsmooth_context_get_info fills it. Set struct_size first,
+ * e.g. `rsmooth_context_info info = {.struct_size = sizeof info};`: only that many bytes are
+ * written.
+ * (Added in 0.11: the getters of 0.10 in one struct) */
+typedef struct rsmooth_context_info {
+    size_t struct_size;      /**< sizeof(rsmooth_context_info) */
+    const char *device_name; /**< "platform name / device name"; valid while the context lives */
+    double build_ms;         /**< milliseconds its creation spent building the OpenCL program */
+    /** Where the program came from: "hit" (built from the binary in rsmooth's program cache),
+     * "miss" (built from source, its binary then stored), "refused" (built from source: the
+     * cache folder or file could have been written by another user, program_cache_note says
+     * which and why) or "off" (no cache: RSMOOTH_CACHE_DIR is empty or "off", or neither
+     * XDG_CACHE_HOME nor HOME is set). The cache is the folder RSMOOTH_CACHE_DIR, else
+     * $XDG_CACHE_HOME/rsmooth, else $HOME/.cache/rsmooth, created (mode 0700) when first written;
+     * one file per device, driver, program source and build options. A program binary is native
+     * code, so a file is used only when it, its folder and every folder between the home folder
+     * and it (or RSMOOTH_CACHE_DIR itself) belong to the effective user and are writable by
+     * nobody else. A file that is damaged (its BLAKE2b digest is checked), another key's, not a
+     * regular file or fails to build is a miss and is replaced; a folder that cannot be written
+     * only means a build from source each time. Static text. */
+    const char *program_cache;
+    /** Why the cache was refused, a sentence for the user (the library prints nothing); "" when
+     * it was not. Valid while the context lives. */
+    const char *program_cache_note;
+    /** How the kernels spread the work on the device: `lanes` vertices per work-item (the block
+     * variant, CPU devices: the device's preferred float vector width, 4, 8 or 16) or 1 (the
+     * group variant, GPUs: one vertex per work-item, the work-group's candidate facets staged
+     * through local memory), and `group` work-items per work-group. RSMOOTH_KERNEL_VARIANT=cpu|gpu
+     * and RSMOOTH_LANES=4|8|16 override the choice; every variant computes the same sums. */
+    unsigned lanes;
+    size_t group;
+    uint64_t memory_budget; /**< bytes one filter call may hold on the device */
+    unsigned host_threads;  /**< the host threads its calls use (0: every online core) */
+} rsmooth_context_info;
 
-/** Milliseconds the context's creation spent building the OpenCL program. */
-RSMOOTH_API double rsmooth_context_build_ms(const rsmooth_context *ctx);
-
-/** Where the context's program came from: "hit" (built from the binary in rsmooth's program cache),
- * "miss" (built from source, its binary then stored), "refused" (built from source: the cache
- * folder or file could have been written by another user, see below) or "off" (no cache:
- * RSMOOTH_CACHE_DIR is empty or "off", or neither XDG_CACHE_HOME nor HOME is set). The cache is the
- * folder RSMOOTH_CACHE_DIR, else $XDG_CACHE_HOME/rsmooth, else $HOME/.cache/rsmooth, created (mode
- * 0700) when first written; one file per device, driver, program source and build options. A
- * program binary is native code, so a file is used only when it, its folder and every folder
- * between the home folder and it (or RSMOOTH_CACHE_DIR itself) belong to the effective user and
- * are writable by nobody else; otherwise the first such context of the process says why on stderr
- * and builds from source. A file that is damaged (its BLAKE2b digest is checked), another key's,
- * not a regular file or fails to build is a miss and is replaced; a folder that cannot be written
- * only means a build from source each time. Static text; "" for NULL. (Added in 0.8; "refused"
- * in 0.9) */
-RSMOOTH_API const char *rsmooth_context_program_cache(const rsmooth_context *ctx);
-
-/** How the context's kernels spread the work on its device: *lanes vertices per work-item (the
- * block variant, CPU devices: the device's preferred float vector width, 4, 8 or 16) or 1 (the
- * group variant, GPUs: one vertex per work-item, the work-group's candidate facets staged through
- * local memory), and *group work-items per work-group. RSMOOTH_KERNEL_VARIANT=cpu|gpu and
- * RSMOOTH_LANES=4|8|16 (read at creation) override the choice; every variant computes the same
- * sums (tests compare each with the reference path). Either pointer may be NULL. (Added in 0.8) */
-RSMOOTH_API void rsmooth_context_kernel_shape(const rsmooth_context *ctx, unsigned *lanes,
-                                              size_t *group);
-
-/** Limits the device memory one filter call holds to `bytes` (0: most of the device's memory, the
- * default; the environment variable RSMOOTH_MEMORY_BUDGET, e.g. "256M", sets it at creation).
- * Thread-safe: waits for a running call on the context.
- * A mesh that needs more, or a buffer larger than the device's largest allocation, is cut into
- * spatial tiles, each run with the facets within reach of its vertices: results are an untiled
- * run's bit for bit (the grid's cells count from a lattice fixed in space, and no float the
- * kernels compute depends on which vertices share a block; a mesh spanning more than about a
- * million cells along an axis, where the whole mesh's cells widen, excepted). rsmooth_report.tiles
- * says how many ran. */
-RSMOOTH_API void rsmooth_context_set_memory_budget(rsmooth_context *ctx, uint64_t bytes);
-
-/** The bytes one filter call may hold on the device now: the budget, else the device's share. */
-RSMOOTH_API uint64_t rsmooth_context_memory_budget(const rsmooth_context *ctx);
-
-/** Threads the host stages of the context's calls use (facet data, grid, packing, results): 0 (the
- * default) means every online core, or RSMOOTH_HOST_THREADS when set; at most 64 run. A host
- * application with its own thread pool sets 1, or its share. The result does not depend on it (bit
- * for bit). Thread-safe: waits for a running call on the context. (Added in 0.5) */
-RSMOOTH_API void rsmooth_context_set_host_threads(rsmooth_context *ctx, unsigned threads);
-/** The threads set by rsmooth_context_set_host_threads (0: every online core, or
- * RSMOOTH_HOST_THREADS). (Added in 0.5) */
-RSMOOTH_API unsigned rsmooth_context_host_threads(const rsmooth_context *ctx);
-
-/** The filter on the context's device, float32 arithmetic in cell-local coordinates (so meshes far
- * from the origin lose nothing). Same arguments, outputs and argument errors as
- * rsmooth_smooth_reference; the result agrees with it to about 1e-4 mean edge lengths, and two
- * runs on the same device are bit-identical. Also returns RSMOOTH_ERROR_OPENCL (outputs undefined)
- * when the device fails, e.g. runs out of memory. */
-RSMOOTH_API rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar,
-                                          const void *positions, size_t vertex_count,
-                                          const uint32_t *indices, size_t triangle_count,
-                                          const rsmooth_params *params, void *out_positions,
-                                          float *out_weight, float *out_confidence,
-                                          rsmooth_report *report, rsmooth_error *error);
-
-/** Point clouds with normals on the context's device: rsmooth_smooth_points_reference's filter,
- * arguments, outputs and errors, each pass one device run with the points as facets (the same
- * grid, bilateral rounds and robust kernels as rsmooth_smooth; spacings and areas on the host).
- * The result agrees with the reference path to about 1e-4 point spacings; two runs on the same
- * device are bit-identical. Point clouds are not cut into tiles: one that does not fit the device
- * (or the context's memory budget) returns RSMOOTH_ERROR_OUT_OF_MEMORY. Also returns
- * RSMOOTH_ERROR_OPENCL (outputs undefined) when the device fails. (Added in 0.11) */
-RSMOOTH_API rsmooth_status rsmooth_smooth_points(rsmooth_context *ctx, rsmooth_scalar scalar,
-                                                 const void *positions, const void *normals,
-                                                 size_t point_count, const rsmooth_params *params,
-                                                 void *out_positions, void *out_normals,
-                                                 float *out_confidence, rsmooth_report *report,
-                                                 rsmooth_error *error);
+/** Fills `info` (its struct_size bytes) about ctx. RSMOOTH_ERROR_INVALID_ARGUMENT for a NULL ctx
+ * or info, or a struct_size below that of 0.11's first fields. Thread-safe: waits for a running
+ * call on the context, or reads at once from that call's progress callback. (Added in 0.11) */
+RSMOOTH_API rsmooth_status rsmooth_context_get_info(const rsmooth_context *ctx,
+                                                    rsmooth_context_info *info);
 
 /* ---------------------------------------------------------------------------------------------- */
 /* Meshes as host applications hold them: strided vertices, any index type */
@@ -853,15 +857,14 @@ RSMOOTH_API rsmooth_status rsmooth_mesh_view_init(rsmooth_mesh_view *view);
  * is read whole (into packed arrays; the packed calls above avoid that copy) before any output is
  * written, so out_positions may be the view's own vertex buffer: vertex v's result goes to the
  * three scalars at byte v * out_stride of out_positions (0: packed), the bytes between them
- * untouched. out_weight and out_confidence are packed floats, as for rsmooth_smooth. Indices are
- * checked first: a negative one, or one >= vertex_count, is RSMOOTH_ERROR_INVALID_ARGUMENT naming
- * the triangle and corner, with nothing written; so are outputs that overlap each other. Otherwise
- * the same arguments, results (bit for bit those of the packed call on the same values), errors and
- * thread-safety as rsmooth_smooth and rsmooth_smooth_reference. (Added in 0.5) */
+ * untouched. The outputs' weight and confidence are packed floats, as for rsmooth_smooth. Indices
+ * are checked first: a negative one, or one >= vertex_count, is RSMOOTH_ERROR_INVALID_ARGUMENT
+ * naming the triangle and corner, with nothing written; so are outputs that overlap each other.
+ * Otherwise the same arguments, results (bit for bit those of the packed call on the same values),
+ * errors and thread-safety as rsmooth_smooth. (Added in 0.5; `outputs` in 0.11) */
 RSMOOTH_API rsmooth_status rsmooth_smooth_view(rsmooth_context *ctx, const rsmooth_mesh_view *mesh,
                                                const rsmooth_params *params, void *out_positions,
-                                               size_t out_stride, float *out_weight,
-                                               float *out_confidence, rsmooth_report *report,
+                                               size_t out_stride, const rsmooth_outputs *outputs,
                                                rsmooth_error *error);
 
 /* ---------------------------------------------------------------------------------------------- */
@@ -906,7 +909,7 @@ RSMOOTH_API rsmooth_status rsmooth_piece_halo(const rsmooth_params *params, doub
  * rsmooth_piece_halo of them (more do no harm). Positions are double, packed; out_positions
  * receives 3 * core_count values. The whole mesh's mean edge length, mean facet area and scale
  * stand in for the piece's own, so results are the whole run's bit for bit, on a device (as tiles
- * are, see rsmooth_context_set_memory_budget) and on the reference path (ctx NULL). Params as
+ * are, see rsmooth_context_options.memory_budget) and on the reference path (ctx NULL). Params as
  * rsmooth_piece_halo accepts them. Errors as rsmooth_smooth, and RSMOOTH_ERROR_INVALID_ARGUMENT
  * naming the field of `info` outside its range (see rsmooth_piece_info); nothing written on
  * failure. Thread-safety as rsmooth_smooth. (Added in 0.7) */

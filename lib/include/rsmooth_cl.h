@@ -3,7 +3,7 @@
  * when the host application already has an OpenCL context and queue.
  *
  *     rsmooth_context *ctx;
- *     rsmooth_context_create_from_queue(my_queue, &ctx, &err);  // retains my_queue
+ *     rsmooth_context_create_from_queue(my_queue, NULL, &ctx, &err);  // retains my_queue
  *     rsmooth_smooth(ctx, ...);                                  // runs on my_queue, then finishes
  * it rsmooth_context_destroy(ctx);                              // releases what it retained
  *
@@ -29,11 +29,13 @@ extern "C" {
 /** Creates a context that runs on the caller's queue; its OpenCL context and device are derived
  * from the queue. The queue (and its context) are retained here and released by
  * rsmooth_context_destroy; the caller keeps its own reference and must not release the queue early.
- * The program is built for the queue's device. Fails like rsmooth_context_create
- * (RSMOOTH_ERROR_INVALID_ARGUMENT for a NULL or invalid queue). The context's calls are serialised
- * among themselves; work the caller enqueues on the same queue from other threads meanwhile is the
- * caller's to order. */
+ * The program is built for the queue's device. `options` as rsmooth_context_create's (its device
+ * is ignored: the queue's is used; NULL: the defaults). Fails like rsmooth_context_create
+ * (RSMOOTH_ERROR_INVALID_ARGUMENT for a NULL or invalid queue). (`options` in 0.11) The context's
+ * calls are serialised among themselves; work the caller enqueues on the same queue from other
+ * threads meanwhile is the caller's to order. */
 RSMOOTH_API rsmooth_status rsmooth_context_create_from_queue(cl_command_queue queue,
+                                                             const rsmooth_context_options *options,
                                                              rsmooth_context **ctx,
                                                              rsmooth_error *error);
 

@@ -26,8 +26,8 @@
  *     rsmooth_error err;
  *     if (rsmooth_mesh_read_file("scan.ply", &mesh, &err) != RSMOOTH_OK)
  *         fprintf(stderr, "scan.ply: %s (line %lld)\n", err.message, (long long)err.line);
- *     ... rsmooth_smooth_reference(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
- *                                  mesh->triangles, mesh->triangle_count, ...);
+ *     ... rsmooth_smooth(ctx, RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
+ *                        mesh->triangles, mesh->triangle_count, ...);
  *     rsmooth_mesh_destroy(mesh);
  */
 #ifndef RSMOOTH_IO_H

@@ -1,6 +1,7 @@
 /* Putting an output file in place (see output_file.h). */
 #define _GNU_SOURCE /* O_TMPFILE, linkat, renameat2 and RENAME_NOREPLACE (Linux) */
 #include "io/output_file.h"
+#include "core/environment.h"
 #include "io/temporary_guard.h"
 
 #include <errno.h>
@@ -143,7 +144,7 @@ static void fill_random_name(rs_output *o) {
  * file system has none, or no /proc to link it by. */
 static int open_unnamed(rs_output *o) {
 #ifdef O_TMPFILE
-    const char *named = getenv("RSMOOTH_NAMED_TEMPORARY");
+    const char *named = rs_environment_now(RS_ENV_NAMED_TEMPORARY);
     if (named && strcmp(named, "1") == 0)
         return -1;
     char dir[RS_OUTPUT_PATH_MAX];

@@ -250,9 +250,8 @@ static cl_int run_bilateral_lists(rsmooth_context *ctx, const rs_problem *pb, co
                                   const cl_mem *buf, cl_mem *normals, uint64_t *pairs,
                                   bool *listed) {
     *listed = false;
-    const char *env = getenv("RSMOOTH_BILATERAL_LISTS");
     /* building them costs about what a searching round does: one round is cheaper without */
-    if ((env && !strcmp(env, "0")) || pb->normal_iterations < 2)
+    if (rs_environment_is(&ctx->env, RS_ENV_BILATERAL_LISTS, "0") || pb->normal_iterations < 2)
         return CL_SUCCESS;
     bilateral_lists l;
     memset(&l, 0, sizeof l);

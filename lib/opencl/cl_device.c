@@ -234,8 +234,10 @@ bool rs_parse_bytes(const char *text, uint64_t *bytes) {
     return true;
 }
 
-/* Reads the device's memory limits and the RSMOOTH_MEMORY_BUDGET override. */
-static rsmooth_status read_memory_limits(rsmooth_context *ctx, rsmooth_error *error) {
+/* Reads the device's memory limits and the budget: the caller's (`given`, unless 0), else
+ * RSMOOTH_MEMORY_BUDGET's. */
+static rsmooth_status read_memory_limits(rsmooth_context *ctx, uint64_t given,
+                                         rsmooth_error *error) {
     cl_ulong global = device_ulong(ctx->device, CL_DEVICE_GLOBAL_MEM_SIZE, 0);
     cl_ulong max_alloc = device_ulong(ctx->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, 0);
     ctx->global_memory = global ? global : (uint64_t)1 << 30;
@@ -245,7 +247,8 @@ static rsmooth_status read_memory_limits(rsmooth_context *ctx, rsmooth_error *er
                         NULL) != CL_SUCCESS)
         unified = CL_FALSE;
     ctx->host_unified = unified == CL_TRUE;
-    const char *budget = getenv("RSMOOTH_MEMORY_BUDGET");
+    /* the caller's budget wins: the variable is then not read at all, as if unset */
+    const char *budget = given ? NULL : ctx->env.value[RS_ENV_MEMORY_BUDGET];
     if (budget && *budget && !rs_parse_bytes(budget, &ctx->memory_budget))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_context_create",
                        "RSMOOTH_MEMORY_BUDGET='%s' is not a byte count (examples: 268435456, "
@@ -256,6 +259,8 @@ static rsmooth_status read_memory_limits(rsmooth_context *ctx, rsmooth_error *er
                        "RSMOOTH_MEMORY_BUDGET='%s' leaves no memory: unset it for the device's "
                        "own limit",
                        budget);
+    if (given)
+        ctx->memory_budget = given;
     return RSMOOTH_OK;
 }
 
@@ -270,54 +275,6 @@ cl_mem_flags rs_cl_input_flags(const rsmooth_context *ctx) {
      * checker such as Oclgrind's uninitialised-value check sees CL_MEM_USE_HOST_PTR buffers as
      * never written (error 1 in tests/test_oclgrind.c). */
     return ctx->host_unified ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR;
-}
-
-void rsmooth_context_set_memory_budget(rsmooth_context *ctx, uint64_t bytes) {
-    if (!ctx)
-        return;
-    bool mine = rs_context_held_here(ctx); /* from a callback of a call on ctx */
-    if (!mine)
-        rs_context_lock(ctx);
-    ctx->memory_budget = bytes;
-    if (!mine)
-        rs_context_unlock(ctx);
-}
-
-void rsmooth_context_set_host_threads(rsmooth_context *ctx, unsigned threads) {
-    if (!ctx)
-        return;
-    bool mine = rs_context_held_here(ctx); /* from a callback of a call on ctx */
-    if (!mine)
-        rs_context_lock(ctx);
-    ctx->host_threads = threads;
-    if (!mine)
-        rs_context_unlock(ctx);
-}
-
-unsigned rsmooth_context_host_threads(const rsmooth_context *ctx) {
-    if (!ctx)
-        return 0;
-    rsmooth_context *shared = (rsmooth_context *)ctx; /* the lock is the one mutable part */
-    bool mine = rs_context_held_here(ctx);            /* from a callback of a call on ctx */
-    if (!mine)
-        rs_context_lock(shared);
-    unsigned threads = ctx->host_threads;
-    if (!mine)
-        rs_context_unlock(shared);
-    return threads;
-}
-
-uint64_t rsmooth_context_memory_budget(const rsmooth_context *ctx) {
-    if (!ctx)
-        return 0;
-    rsmooth_context *shared = (rsmooth_context *)ctx; /* the lock is the one mutable part */
-    bool mine = rs_context_held_here(ctx);            /* from a callback of a call on ctx */
-    if (!mine)
-        rs_context_lock(shared);
-    uint64_t bytes = rs_cl_usable_memory(ctx);
-    if (!mine)
-        rs_context_unlock(shared);
-    return bytes;
 }
 
 void rs_context_lock(rsmooth_context *ctx) {
@@ -355,18 +312,60 @@ static rsmooth_context *new_context(void) {
     return ctx;
 }
 
-rsmooth_status rsmooth_context_create(const char *device, rsmooth_context **out,
+/* The caller's options, as much of them as its struct_size holds (0: all of 0.11's), the rest
+ * zero; false when struct_size is smaller than the first field's end. */
+static bool read_options(const rsmooth_context_options *given, rsmooth_context_options *out) {
+    memset(out, 0, sizeof *out);
+    if (!given)
+        return true;
+    size_t size = given->struct_size ? given->struct_size : sizeof *out;
+    if (size < sizeof out->struct_size)
+        return false;
+    memcpy(out, given, size < sizeof *out ? size : sizeof *out);
+    return true;
+}
+
+/* The context's copy of the environment, then the caller's options over it: its host threads
+ * (its memory budget after read_memory_limits, which reads the device's). */
+static void set_environment(rsmooth_context *ctx, const rs_environment *env,
+                            const rsmooth_context_options *options) {
+    ctx->env = *env;
+    for (int i = 0; i < RS_ENV_COUNT; i++) /* into the context's own copy of the text */
+        if (env->value[i])
+            ctx->env.value[i] = ctx->env.text + (env->value[i] - env->text);
+    ctx->host_threads = options->host_threads
+                            ? options->host_threads
+                            : (unsigned)rs_environment_integer(env, RS_ENV_HOST_THREADS, 1, 64, 0);
+}
+
+/* The context's environment and options, read and checked: the start of both creations. */
+static rsmooth_status begin_creation(const rsmooth_context_options *options,
+                                     rsmooth_context_options *opts, rs_environment *env,
+                                     rsmooth_error *error, const char *where) {
+    if (!read_options(options, opts))
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "options->struct_size is %zu: set it to sizeof(rsmooth_context_options)",
+                       options->struct_size);
+    rs_environment_read(env);
+    return rs_environment_check(env, error, where);
+}
+
+rsmooth_status rsmooth_context_create(const rsmooth_context_options *options, rsmooth_context **out,
                                       rsmooth_error *error) {
     static const char where[] = "rsmooth_context_create";
     rs_error_clear(error);
     if (!out)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "ctx is NULL");
     *out = NULL;
-    if (!device)
-        device = getenv("RSMOOTH_DEVICE");
+    rsmooth_context_options opts;
+    rs_environment env;
+    rsmooth_status st = begin_creation(options, &opts, &env, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
+    const char *device = opts.device ? opts.device : env.value[RS_ENV_DEVICE];
     if (!device)
         device = "auto";
-    rsmooth_status st = rs_cl_load(where, error);
+    st = rs_cl_load(where, error);
     if (st != RSMOOTH_OK)
         return st;
     candidate chosen;
@@ -376,6 +375,7 @@ rsmooth_status rsmooth_context_create(const char *device, rsmooth_context **out,
     rsmooth_context *ctx = new_context();
     if (!ctx)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the context");
+    set_environment(ctx, &env, &opts);
     ctx->device = chosen.device;
     snprintf(ctx->device_name, sizeof ctx->device_name, "%s", chosen.name);
     st = rs_cl_choose_variant(ctx, error);
@@ -394,7 +394,7 @@ rsmooth_status rsmooth_context_create(const char *device, rsmooth_context **out,
         st = rs_cl_fail(error, err, "clCreateCommandQueue", chosen.name);
         goto fail;
     }
-    st = read_memory_limits(ctx, error);
+    st = read_memory_limits(ctx, opts.memory_budget, error);
     if (st == RSMOOTH_OK)
         st = rs_cl_build_program(ctx, error);
     if (st != RSMOOTH_OK)
@@ -406,8 +406,9 @@ fail:
     return st;
 }
 
-rsmooth_status rsmooth_context_create_from_queue(cl_command_queue queue, rsmooth_context **out,
-                                                 rsmooth_error *error) {
+rsmooth_status rsmooth_context_create_from_queue(cl_command_queue queue,
+                                                 const rsmooth_context_options *options,
+                                                 rsmooth_context **out, rsmooth_error *error) {
     static const char where[] = "rsmooth_context_create_from_queue";
     rs_error_clear(error);
     if (!out)
@@ -415,8 +416,13 @@ rsmooth_status rsmooth_context_create_from_queue(cl_command_queue queue, rsmooth
     *out = NULL;
     if (!queue)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "queue is NULL");
+    rsmooth_context_options opts;
+    rs_environment env;
+    rsmooth_status st = begin_creation(options, &opts, &env, error, where);
+    if (st != RSMOOTH_OK)
+        return st;
     /* the caller's queue came from a loader it linked: the same library, opened once more */
-    rsmooth_status st = rs_cl_load(where, error);
+    st = rs_cl_load(where, error);
     if (st != RSMOOTH_OK)
         return st;
     cl_context context = NULL;
@@ -434,6 +440,7 @@ rsmooth_status rsmooth_context_create_from_queue(cl_command_queue queue, rsmooth
     rsmooth_context *ctx = new_context();
     if (!ctx)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the context");
+    set_environment(ctx, &env, &opts);
     clRetainCommandQueue(queue);
     clRetainContext(context);
     ctx->queue = queue;
@@ -447,7 +454,7 @@ rsmooth_status rsmooth_context_create_from_queue(cl_command_queue queue, rsmooth
     snprintf(ctx->device_name, sizeof ctx->device_name, "%s / %s", platform_name, device_name);
     st = rs_cl_choose_variant(ctx, error);
     if (st == RSMOOTH_OK)
-        st = read_memory_limits(ctx, error);
+        st = read_memory_limits(ctx, opts.memory_budget, error);
     if (st == RSMOOTH_OK)
         st = rs_cl_build_program(ctx, error);
     if (st != RSMOOTH_OK) {
@@ -480,14 +487,34 @@ void rsmooth_context_destroy(rsmooth_context *ctx) {
     rs_free(ctx);
 }
 
-const char *rsmooth_context_device_name(const rsmooth_context *ctx) {
-    return ctx ? ctx->device_name : "";
-}
-
-double rsmooth_context_build_ms(const rsmooth_context *ctx) {
-    return ctx ? ctx->build_ms : 0;
-}
-
 cl_command_queue rsmooth_context_queue(const rsmooth_context *ctx) {
     return ctx ? ctx->queue : NULL;
+}
+
+rsmooth_status rsmooth_context_get_info(const rsmooth_context *ctx, rsmooth_context_info *info) {
+    static const char where[] = "rsmooth_context_get_info";
+    if (!ctx || !info)
+        return rs_fail(NULL, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "%s is NULL",
+                       ctx ? "info" : "ctx");
+    size_t size = info->struct_size;
+    if (size < offsetof(rsmooth_context_info, program_cache_note))
+        return RSMOOTH_ERROR_INVALID_ARGUMENT; /* set struct_size */
+    rsmooth_context_info full = {.struct_size = sizeof full};
+    rsmooth_context *shared = (rsmooth_context *)ctx; /* the lock is the one mutable part */
+    bool mine = rs_context_held_here(ctx);            /* from a callback of a call on ctx */
+    if (!mine)
+        rs_context_lock(shared);
+    full.device_name = ctx->device_name;
+    full.build_ms = ctx->build_ms;
+    full.program_cache = rs_program_cache_name(ctx->program_cache);
+    full.program_cache_note = ctx->program_cache_note;
+    full.lanes = ctx->lanes;
+    full.group = ctx->local_size;
+    full.memory_budget = rs_cl_usable_memory(ctx);
+    full.host_threads = ctx->host_threads;
+    if (!mine)
+        rs_context_unlock(shared);
+    memcpy(info, &full, size < sizeof full ? size : sizeof full);
+    info->struct_size = size;
+    return RSMOOTH_OK;
 }

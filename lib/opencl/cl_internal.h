@@ -3,6 +3,7 @@
 #ifndef RSMOOTH_CL_INTERNAL_H
 #define RSMOOTH_CL_INTERNAL_H
 
+#include "core/environment.h"
 #include "core/stage_plan.h"
 
 /* ---- cl_device.c / cl_program.c: the OpenCL context object ------------------------------------
@@ -38,6 +39,7 @@ enum {
 };
 
 struct rsmooth_context {
+    rs_environment env;   /* the environment as it was at the creation: every call reads this */
     pthread_mutex_t lock; /* serialises the calls of threads sharing the context */
     pthread_t owner;      /* the thread holding `lock`, while `busy` */
     _Atomic int busy;
@@ -48,16 +50,17 @@ struct rsmooth_context {
     cl_kernel kernels[RS_KERNEL_COUNT];
     char device_name[256];
     double build_ms;
-    int program_cache;       /* RS_PROGRAM_CACHE_: whether the program came from rsmooth's cache */
-    size_t local_size;       /* work-group size used for every kernel */
-    unsigned lanes;          /* vertices per block: the kernels' vector width (RS_LANES, see
-                              * cl_variant.c); 1 is the GPU variant, one vertex per work-item */
-    uint64_t global_memory;  /* CL_DEVICE_GLOBAL_MEM_SIZE */
-    uint64_t max_allocation; /* CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest one buffer may be */
-    bool host_unified;       /* CL_DEVICE_HOST_UNIFIED_MEMORY: the device reads host arrays in
-                              * place (rs_cl_input_flags) */
-    uint64_t memory_budget;  /* caller's or RSMOOTH_MEMORY_BUDGET's limit; 0: the device's */
-    unsigned host_threads;   /* threads of the host stages of its calls; 0: every core */
+    int program_cache; /* RS_PROGRAM_CACHE_: whether the program came from rsmooth's cache */
+    char program_cache_note[1024]; /* why the cache was refused, else "" */
+    size_t local_size;             /* work-group size used for every kernel */
+    unsigned lanes;                /* vertices per block: the kernels' vector width (RS_LANES, see
+                                    * cl_variant.c); 1 is the GPU variant, one vertex per work-item */
+    uint64_t global_memory;        /* CL_DEVICE_GLOBAL_MEM_SIZE */
+    uint64_t max_allocation;       /* CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest one buffer may be */
+    bool host_unified;             /* CL_DEVICE_HOST_UNIFIED_MEMORY: the device reads host arrays in
+                                    * place (rs_cl_input_flags) */
+    uint64_t memory_budget;        /* caller's or RSMOOTH_MEMORY_BUDGET's limit; 0: the device's */
+    unsigned host_threads;         /* threads of the host stages of its calls; 0: every core */
     /* rsmooth_smooth_cl's (cl_store.c): the program storing results into a caller's buffer,
      * built on its first call (NULL before, and where the device has no fp64), and its kernels by
      * rsmooth_scalar */
@@ -215,9 +218,14 @@ enum {
 typedef struct rs_program_cache {
     char top[4096], below[1024], name[48];
     uint64_t key[2], key_bytes, key_fields;
-    bool enabled; /* a folder and key are known */
-    bool refused; /* the folder or file was refused as another user's (said on stderr) */
+    bool enabled;    /* a folder and key are known */
+    bool refused;    /* the folder or file was refused as another user's: `note` says why */
+    char note[1024]; /* ... for the context's program_cache_note */
 } rs_program_cache;
+
+/* "hit", "miss", "refused" or "off": a context's program_cache state (RS_PROGRAM_CACHE_) as
+ * rsmooth_context_info names it. */
+const char *rs_program_cache_name(int state);
 
 /* Keys the program of the `count` sources (OpenCL's strings and lengths, as passed to
  * clCreateProgramWithSource) and build `options` for ctx's device, its driver and platform.

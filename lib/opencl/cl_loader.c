@@ -2,6 +2,7 @@
 #define _POSIX_C_SOURCE 200809L
 #define RS_CL_LOADER_KEEP_NAMES
 #include "opencl/cl_loader.h"
+#include "core/environment.h"
 #include "opencl/cl_loader_elf.h"
 
 #include <pthread.h>
@@ -86,7 +87,7 @@ static any_function find_function(void *library, const char *name) {
 }
 
 static void load(void) {
-    const char *env = getenv("RSMOOTH_OPENCL_LIBRARY");
+    const char *env = rs_environment_now(RS_ENV_OPENCL_LIBRARY);
     bool named = env && *env;
     const char *path = named ? env : DEFAULT_LOADER;
     char why[200];

@@ -129,7 +129,7 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
      * program stays without its kernels, whose loading would lengthen every setup */
     const bool grid = rs_cl_device_grid(ctx);
     rsmooth_status st = RSMOOTH_OK;
-    const char *dir = getenv("RSMOOTH_KERNEL_DIR");
+    const char *dir = ctx->env.value[RS_ENV_KERNEL_DIR];
     if (dir && *dir) {
         for (int i = 0; i < KERNEL_FILES; i++) {
             if (!grid && strcmp(names[i], "grid.cl") == 0)
@@ -165,7 +165,7 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
     double t0 = rs_now_ms();
     cl_int err = CL_SUCCESS;
     char options[1024];
-    const char *extra = getenv("RSMOOTH_BUILD_OPTIONS");
+    const char *extra = ctx->env.value[RS_ENV_BUILD_OPTIONS];
     snprintf(options, sizeof options, "%s %s", default_options, extra ? extra : "");
     /* rsmooth's binary cache (cl_program_cache.c), keyed by exactly the sources and options the
      * build from source below takes */
@@ -177,8 +177,10 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
         ctx->program_cache = RS_PROGRAM_CACHE_HIT;
         goto kernels;
     }
-    if (cache.refused)
+    if (cache.refused) {
         ctx->program_cache = RS_PROGRAM_CACHE_REFUSED;
+        snprintf(ctx->program_cache_note, sizeof ctx->program_cache_note, "%s", cache.note);
+    }
     ctx->program = clCreateProgramWithSource(ctx->context, count, sources, sizes, &err);
     if (err != CL_SUCCESS) {
         st = rs_cl_fail(error, err, "clCreateProgramWithSource", ctx->device_name);

@@ -6,7 +6,8 @@
  * A program binary is native code the OpenCL runtime loads and runs, so a cache file is trusted
  * only as far as its folder is: a file is used only when it, its folder and every folder between
  * the user's home and it (or the folder RSMOOTH_CACHE_DIR names, alone) belong to the effective
- * user and are writable by nobody else. Anything else is refused, said once per process on stderr,
+ * user and are writable by nobody else. Anything else is refused (the reason is the context's
+ * program_cache_note: the library prints nothing),
  * and the program built from source. Folders are walked by descriptor with O_NOFOLLOW below the
  * starting folder, and each checked with fstat on what was opened, so no link or rename between
  * check and use can swap in another file. The file is opened O_NOFOLLOW | O_NONBLOCK (a FIFO or
@@ -131,8 +132,8 @@ static void hash_info(hash2 *h, cl_platform_id platform, cl_device_id device, cl
  * RSMOOTH_CACHE_DIR (empty or "off": no cache) alone; else $XDG_CACHE_HOME/rsmooth, from the home
  * folder when it lies below it; else $HOME/.cache/rsmooth from $HOME. false when there is none, or
  * its path does not fit. */
-static bool cache_location(rs_program_cache *cache) {
-    const char *env = getenv("RSMOOTH_CACHE_DIR"), *home = getenv("HOME");
+static bool cache_location(rs_program_cache *cache, const rs_environment *environment) {
+    const char *env = environment->value[RS_ENV_CACHE_DIR], *home = environment->value[RS_ENV_HOME];
     int n, m = 0;
     size_t home_length = home ? strlen(home) : 0;
     while (home_length > 1 && home[home_length - 1] == '/')
@@ -141,7 +142,8 @@ static bool cache_location(rs_program_cache *cache) {
         if (!*env || strcmp(env, "off") == 0)
             return false;
         n = snprintf(cache->top, sizeof cache->top, "%s", env);
-    } else if ((env = getenv("XDG_CACHE_HOME")) && env[0] == '/') { /* relative: ignored (spec) */
+    } else if ((env = environment->value[RS_ENV_XDG_CACHE_HOME]) &&
+               env[0] == '/') { /* relative: ignored (spec) */
         if (home && home[0] == '/' && home_length > 1 && strncmp(env, home, home_length) == 0 &&
             env[home_length] == '/') {
             n = snprintf(cache->top, sizeof cache->top, "%.*s", (int)home_length, home);
@@ -168,25 +170,26 @@ static const char *untrusted(const struct stat *st) {
     return NULL;
 }
 
-/* The first refusal is said on stderr; later ones (other contexts, other threads) are not. */
-static atomic_flag refusal_said = ATOMIC_FLAG_INIT;
-
-static void say_refusal(const char *what, const char *why, const struct stat *st) {
-    if (atomic_flag_test_and_set(&refusal_said))
-        return;
-    fprintf(stderr,
-            "rsmooth: not using the program cache: %s %s (owner uid %ld, mode %04o; you are uid "
-            "%ld): the OpenCL program is built from source instead. Use a folder of your own "
-            "(RSMOOTH_CACHE_DIR) or turn the cache off (RSMOOTH_CACHE_DIR=off)\n",
-            what, why, (long)st->st_uid, (unsigned)(st->st_mode & 07777), (long)geteuid());
+/* Says why `what` was refused into note[size] (NULL: nowhere), for the context's
+ * program_cache_note. */
+static void say_refusal(char *note, size_t size, const char *what, const char *why,
+                        const struct stat *st) {
+    if (note)
+        snprintf(note, size,
+                 "not using the program cache: %.300s %s (owner uid %ld, mode %04o; you are uid "
+                 "%ld): the OpenCL program is built from source instead. Use a folder of your own "
+                 "(RSMOOTH_CACHE_DIR) or turn the cache off (RSMOOTH_CACHE_DIR=off)",
+                 what, why, (long)st->st_uid, (unsigned)(st->st_mode & 07777), (long)geteuid());
 }
 
 enum { WALK_OK, WALK_MISSING, WALK_REFUSED, WALK_FAILED };
 
 /* Opens the cache folder by descriptor into *dir_fd: `top` following links, then each folder of
  * `below` with O_NOFOLLOW, creating missing ones (0700) when `create`; each checked to be the
- * user's own where the rules above ask it. WALK_REFUSED has been said on stderr. */
-static int open_cache_dir(const rs_program_cache *cache, bool create, int *dir_fd) {
+ * user's own where the rules above ask it. WALK_REFUSED has been said in note[size] (NULL: not
+ * said). */
+static int open_cache_dir(const rs_program_cache *cache, bool create, int *dir_fd, char *note,
+                          size_t size) {
     *dir_fd = -1;
     struct stat st;
     if (create && !cache->below[0] && stat(cache->top, &st) != 0 && errno == ENOENT) {
@@ -209,7 +212,7 @@ static int open_cache_dir(const rs_program_cache *cache, bool create, int *dir_f
     if (!cache->below[0]) { /* the named folder itself must be the user's */
         const char *why = fstat(fd, &st) == 0 ? untrusted(&st) : "cannot be examined";
         if (why) {
-            say_refusal(cache->top, why, &st);
+            say_refusal(note, size, cache->top, why, &st);
             close(fd);
             return WALK_REFUSED;
         }
@@ -237,7 +240,7 @@ static int open_cache_dir(const rs_program_cache *cache, bool create, int *dir_f
         fd = sub;
         const char *why = fstat(fd, &st) == 0 ? untrusted(&st) : "cannot be examined";
         if (why) {
-            say_refusal(path, why, &st);
+            say_refusal(note, size, path, why, &st);
             close(fd);
             return WALK_REFUSED;
         }
@@ -249,7 +252,7 @@ static int open_cache_dir(const rs_program_cache *cache, bool create, int *dir_f
 bool rs_program_cache_open(rs_program_cache *cache, const rsmooth_context *ctx, cl_uint count,
                            const char *const *sources, const size_t *sizes, const char *options) {
     memset(cache, 0, sizeof *cache);
-    if (!cache_location(cache))
+    if (!cache_location(cache, &ctx->env))
         return false;
     hash2 h;
     hash_init(&h);
@@ -308,9 +311,9 @@ static void digest_of(const unsigned char *header, const unsigned char *binary, 
 
 /* The binary of a valid file for the key (to rs_free), or NULL; *refused when the file (or its
  * folder) was refused as untrusted rather than missing or invalid. */
-static unsigned char *read_binary(const rs_program_cache *cache, size_t *size, bool *refused) {
+static unsigned char *read_binary(rs_program_cache *cache, size_t *size, bool *refused) {
     int dir_fd;
-    int walk = open_cache_dir(cache, false, &dir_fd);
+    int walk = open_cache_dir(cache, false, &dir_fd, cache->note, sizeof cache->note);
     *refused = walk == WALK_REFUSED;
     if (walk != WALK_OK)
         return NULL;
@@ -328,7 +331,7 @@ static unsigned char *read_binary(const rs_program_cache *cache, size_t *size, b
         char what[sizeof cache->top + sizeof cache->below + sizeof cache->name + 2];
         snprintf(what, sizeof what, "%s%s%s/%s", cache->top, cache->below[0] ? "/" : "",
                  cache->below, cache->name);
-        say_refusal(what, why, &st);
+        say_refusal(cache->note, sizeof cache->note, what, why, &st);
         *refused = true;
         goto fail;
     }
@@ -438,7 +441,7 @@ void rs_program_cache_store(const rs_program_cache *cache, const rsmooth_context
     if (!binary)
         return;
     int dir_fd = -1;
-    if (open_cache_dir(cache, true, &dir_fd) == WALK_OK) {
+    if (open_cache_dir(cache, true, &dir_fd, NULL, 0) == WALK_OK) {
         unsigned char header[HEADER_BYTES];
         header_words(cache, size, header);
         digest_of(header, binary, size, header + HEADER_WORDS * 8);
@@ -457,11 +460,9 @@ void rs_program_cache_store(const rs_program_cache *cache, const rsmooth_context
     rs_free(binary);
 }
 
-const char *rsmooth_context_program_cache(const rsmooth_context *ctx) {
-    if (!ctx)
-        return "";
-    return ctx->program_cache == RS_PROGRAM_CACHE_HIT       ? "hit"
-           : ctx->program_cache == RS_PROGRAM_CACHE_MISS    ? "miss"
-           : ctx->program_cache == RS_PROGRAM_CACHE_REFUSED ? "refused"
-                                                            : "off";
+const char *rs_program_cache_name(int state) {
+    return state == RS_PROGRAM_CACHE_HIT       ? "hit"
+           : state == RS_PROGRAM_CACHE_MISS    ? "miss"
+           : state == RS_PROGRAM_CACHE_REFUSED ? "refused"
+                                               : "off";
 }

@@ -313,10 +313,10 @@ static rsmooth_status pack(const rs_problem *pb, const rs_grid *grid, double **c
  * facets out of reach), large ones hold more vertices per block; measured on PoCL's CPU device
  * (rsmooth-bench filter), cells about two mean edges wide did best. RSMOOTH_CELLS_PER_REACH
  * overrides it, for such measurements. */
-static int cells_per_reach(const rs_problem *pb) {
-    const char *forced = getenv("RSMOOTH_CELLS_PER_REACH");
-    if (forced && atoi(forced) >= 1 && atoi(forced) <= 8)
-        return atoi(forced);
+static int cells_per_reach(const rsmooth_context *ctx, const rs_problem *pb) {
+    long forced = rs_environment_integer(&ctx->env, RS_ENV_CELLS_PER_REACH, 1, 8, 0);
+    if (forced)
+        return (int)forced;
     double cells = floor(pb->radius / (2 * pb->mean_edge_length));
     return cells < 1 || !isfinite(cells) ? 1 : cells > 3 ? 3 : (int)cells;
 }
@@ -377,7 +377,7 @@ static rsmooth_status build_grid(rsmooth_context *ctx, const rs_problem *pb, rs_
         }
     /* on the device where it sorts faster (rs_cl_device_grid), else (or where it declines the
      * grid) on the host: the same grid either way */
-    int split = cells_per_reach(pb);
+    int split = cells_per_reach(ctx, pb);
     bool done = false;
     rsmooth_status st = RSMOOTH_OK;
     if (rs_cl_device_grid(ctx))

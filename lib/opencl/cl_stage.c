@@ -327,18 +327,11 @@ static rsmooth_status read_back(stage_run *r, int d, double *xyz, rs_stage_stats
 }
 
 /* Double where the device has it, unless RSMOOTH_STAGE_PRECISION=float asks for float (the drift
- * measurements); false, with the error said, for any other value. */
+ * measurements; its value was checked when the context was made). */
 static bool choose_precision(stage_run *r, rsmooth_error *error) {
-    const char *asked = getenv("RSMOOTH_STAGE_PRECISION");
-    if (asked && *asked && strcmp(asked, "float") != 0 && strcmp(asked, "double") != 0) {
-        rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                "RSMOOTH_STAGE_PRECISION is \"%s\": use double (the default where the device "
-                "has it) or float",
-                asked);
-        return false;
-    }
+    (void)error;
     bool has_double = r->ctx->kernels[RS_KERNEL_STAGE_DOUBLE] != NULL;
-    r->dbl = has_double && !(asked && strcmp(asked, "float") == 0);
+    r->dbl = has_double && !rs_environment_is(&r->ctx->env, RS_ENV_STAGE_PRECISION, "float");
     r->real = r->dbl ? sizeof(double) : sizeof(float);
     r->kernels = r->ctx->kernels + (r->dbl ? RS_KERNEL_STAGE_DOUBLE : RS_KERNEL_STAGE_FLOAT);
     return true;

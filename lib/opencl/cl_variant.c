@@ -40,7 +40,7 @@ rsmooth_status rs_cl_choose_variant(rsmooth_context *ctx, rsmooth_error *error) 
     if (clGetDeviceInfo(ctx->device, CL_DEVICE_TYPE, sizeof type, &type, NULL) != CL_SUCCESS)
         type = CL_DEVICE_TYPE_CPU;
     bool group_variant = (type & CL_DEVICE_TYPE_GPU) != 0;
-    const char *variant = getenv("RSMOOTH_KERNEL_VARIANT");
+    const char *variant = ctx->env.value[RS_ENV_KERNEL_VARIANT];
     if (variant && *variant) {
         if (strcmp(variant, "gpu") != 0 && strcmp(variant, "cpu") != 0)
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
@@ -59,7 +59,7 @@ rsmooth_status rs_cl_choose_variant(rsmooth_context *ctx, rsmooth_error *error) 
                         &preferred, NULL) != CL_SUCCESS)
         preferred = 8;
     ctx->lanes = preferred >= 16 ? 16 : preferred >= 8 ? 8 : 4;
-    const char *lanes = getenv("RSMOOTH_LANES");
+    const char *lanes = ctx->env.value[RS_ENV_LANES];
     if (lanes && *lanes) {
         if (strcmp(lanes, "4") != 0 && strcmp(lanes, "8") != 0 && strcmp(lanes, "16") != 0)
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
@@ -73,13 +73,6 @@ rsmooth_status rs_cl_choose_variant(rsmooth_context *ctx, rsmooth_error *error) 
     return RSMOOTH_OK;
 }
 
-void rsmooth_context_kernel_shape(const rsmooth_context *ctx, unsigned *lanes, size_t *group) {
-    if (lanes)
-        *lanes = ctx ? ctx->lanes : 0;
-    if (group)
-        *group = ctx ? ctx->local_size : 0;
-}
-
 /* Whether the grid is sorted on the device too (cl_grid.c): a choice of what a device runs, as
  * the variant is, and made here so that the program (cl_program.c) and the runs agree. */
 static bool has_fp64(const rsmooth_context *ctx) {
@@ -90,7 +83,7 @@ static bool has_fp64(const rsmooth_context *ctx) {
 }
 
 bool rs_cl_device_grid(const rsmooth_context *ctx) {
-    const char *forced = getenv("RSMOOTH_DEVICE_GRID");
+    const char *forced = ctx->env.value[RS_ENV_DEVICE_GRID];
     bool want;
     if (forced && (strcmp(forced, "0") == 0 || strcmp(forced, "1") == 0)) {
         want = forced[0] == '1';

@@ -79,12 +79,9 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
                                     rsmooth_report *report, rsmooth_error *error, const char *where,
                                     const rs_stage_place *stage, rs_stage_stats *stage_stats) {
     double t_start = rs_now_ms();
-    rsmooth_status st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices,
-                                             triangle_count, NULL, error, where);
-    double unit = 0;
-    if (st == RSMOOTH_OK)
-        st = rsmooth_mean_edge_length(scalar, positions, vertex_count, indices, triangle_count,
-                                      &unit, error);
+    double unit = 0; /* (the arrays were checked at the call's entry: rs_filter_passes) */
+    rsmooth_status st = rs_mesh_mean_edge(scalar, positions, vertex_count, indices, triangle_count,
+                                          &unit, error, where);
     if (st != RSMOOTH_OK)
         return st;
     rsmooth_params p = *resolved;
@@ -205,11 +202,8 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
     rs_error_clear(error);
     rsmooth_params p;
     rsmooth_status st = rs_params_resolve(params, &p, error, where);
-    *resolved = p; /* the caller's mask and guard act at the end */
-    if (st == RSMOOTH_OK)
-        st = rs_check_outputs(scalar, positions, vertex_count, indices, triangle_count, &p,
-                              out_positions, out_weight, out_confidence, error, where);
-    if (st != RSMOOTH_OK)
+    *resolved = p;        /* the caller's mask and guard act at the end */
+    if (st != RSMOOTH_OK) /* (arrays and outputs checked at the call's entry: rs_filter_passes) */
         return st;
     if (p.vertex_updates > 0)
         return staged_passes(one_pass, ctx, scalar, positions, vertex_count, indices,
@@ -221,14 +215,10 @@ static rsmooth_status filter_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
     if (p.passes == 1) /* the paper's single pass, exactly as it was */
         return one_pass(ctx, scalar, positions, vertex_count, indices, triangle_count, params,
                         out_positions, out_weight, out_confidence, report, error);
-    if ((st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices, triangle_count, NULL,
-                                   error, where)) != RSMOOTH_OK)
-        return st; /* (the outputs were checked above) */
-
-    /* Fix the sigmas in mesh units once, from the input. */
+    /* Fix the sigmas in mesh units once, from the input (checked at the call's entry). */
     double unit = 0;
-    if ((st = rsmooth_mean_edge_length(scalar, positions, vertex_count, indices, triangle_count,
-                                       &unit, error)) != RSMOOTH_OK)
+    if ((st = rs_mesh_mean_edge(scalar, positions, vertex_count, indices, triangle_count, &unit,
+                                error, where)) != RSMOOTH_OK)
         return st;
     if (!p.absolute) {
         if (!(unit > 0)) /* no edge: nothing moves, one pass says so */

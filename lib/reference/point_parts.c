@@ -247,12 +247,12 @@ static rsmooth_status reference_pass(void *ctx, const rs_problem *pb, double *ou
                               report, t_start, error, where);
 }
 
-rsmooth_status rsmooth_smooth_points_reference(rsmooth_scalar scalar, const void *positions,
-                                               const void *normals, size_t point_count,
-                                               const rsmooth_params *params, void *out_positions,
-                                               void *out_normals, float *out_confidence,
-                                               rsmooth_report *report, rsmooth_error *error) {
-    return rs_smooth_points_with(reference_pass, NULL, "rsmooth_smooth_points_reference", scalar,
-                                 positions, normals, point_count, params, out_positions,
-                                 out_normals, out_confidence, report, error);
+rsmooth_status rs_reference_smooth_points(rsmooth_scalar scalar, const void *positions,
+                                          const void *normals, size_t point_count,
+                                          const rsmooth_params *params, void *out_positions,
+                                          void *out_normals, float *out_confidence,
+                                          rsmooth_report *report, rsmooth_error *error) {
+    return rs_smooth_points_with(reference_pass, NULL, "rsmooth_smooth_points", scalar, positions,
+                                 normals, point_count, params, out_positions, out_normals,
+                                 out_confidence, report, error);
 }

@@ -15,7 +15,7 @@ typedef rsmooth_status (*rs_points_solve_fn)(void *ctx, const rs_problem *pb, do
                                              rsmooth_report *report, double t_start,
                                              rsmooth_error *error, const char *where);
 
-/* rsmooth_smooth_points_reference's whole call (checks, spacings, passes, outputs) with `solve`
+/* rsmooth_smooth_points's whole call (checks, spacings, passes, outputs) with `solve`
  * (given `solve_ctx`) filtering each pass; errors name `where`. Part by part (point_parts.c):
  * points whose spacings differ by more than about 8 times, with none between, are filtered apart,
  * and parts of fewer than RS_MIN_PART_POINTS points are held as outliers. */

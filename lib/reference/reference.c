@@ -395,14 +395,13 @@ static rsmooth_status reference_pass(void *unused, rsmooth_scalar scalar, const 
                                      size_t triangle_count, const rsmooth_params *params,
                                      void *out_positions, float *out_weight, float *out_confidence,
                                      rsmooth_report *report, rsmooth_error *error) {
-    static const char where[] = "rsmooth_smooth_reference";
+    static const char where[] = "rsmooth_smooth";
     (void)unused;
     double t_start = rs_now_ms();
     rs_error_clear(error);
     rs_problem pb;
-    rsmooth_status st =
-        rs_problem_prepare(&pb, scalar, positions, vertex_count, indices, triangle_count, params,
-                           out_positions, true, error, where);
+    rsmooth_status st = rs_problem_prepare(&pb, scalar, positions, vertex_count, indices,
+                                           triangle_count, params, true, error, where);
     if (st != RSMOOTH_OK)
         return st;
     st = rs_reference_solve(&pb, scalar, out_positions, out_weight, out_confidence, NULL, report,
@@ -411,13 +410,12 @@ static rsmooth_status reference_pass(void *unused, rsmooth_scalar scalar, const 
     return st;
 }
 
-rsmooth_status rsmooth_smooth_reference(rsmooth_scalar scalar, const void *positions,
-                                        size_t vertex_count, const uint32_t *indices,
-                                        size_t triangle_count, const rsmooth_params *params,
-                                        void *out_positions, float *out_weight,
-                                        float *out_confidence, rsmooth_report *report,
-                                        rsmooth_error *error) {
+rsmooth_status rs_reference_smooth(rsmooth_scalar scalar, const void *positions,
+                                   size_t vertex_count, const uint32_t *indices,
+                                   size_t triangle_count, const rsmooth_params *params,
+                                   void *out_positions, float *out_weight, float *out_confidence,
+                                   rsmooth_report *report, rsmooth_error *error) {
     return rs_filter_passes(reference_pass, NULL, NULL, scalar, positions, vertex_count, indices,
                             triangle_count, params, out_positions, out_weight, out_confidence,
-                            report, error, "rsmooth_smooth_reference");
+                            report, error, "rsmooth_smooth");
 }

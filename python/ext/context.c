@@ -45,7 +45,8 @@ PyObject *ext_context_create(PyObject *self, PyObject *args) {
     rsmooth_context *ctx = NULL;
     rsmooth_error err;
     rsmooth_status st;
-    Py_BEGIN_ALLOW_THREADS st = rsmooth_context_create(device, &ctx, &err);
+    rsmooth_context_options options = {.struct_size = sizeof options, .device = device};
+    Py_BEGIN_ALLOW_THREADS st = rsmooth_context_create(&options, &ctx, &err);
     Py_END_ALLOW_THREADS return capsule_for(st, ctx, &err);
 }
 
@@ -77,7 +78,7 @@ PyObject *ext_context_from_queue(PyObject *self, PyObject *args) {
     rsmooth_error err;
     rsmooth_status st;
     Py_BEGIN_ALLOW_THREADS st =
-        rsmooth_context_create_from_queue((cl_command_queue)queue, &ctx, &err);
+        rsmooth_context_create_from_queue((cl_command_queue)queue, NULL, &ctx, &err);
     Py_END_ALLOW_THREADS return capsule_for(st, ctx, &err);
 }
 
@@ -138,11 +139,10 @@ PyObject *ext_context_info(PyObject *self, PyObject *args) {
         return NULL;
     /* the budget is read under the context's lock, which a call on another thread may hold
      * until its progress callable has had the GIL */
-    uint64_t budget;
-    Py_BEGIN_ALLOW_THREADS budget = rsmooth_context_memory_budget(ctx);
-    Py_END_ALLOW_THREADS return Py_BuildValue("(sdK)", rsmooth_context_device_name(ctx),
-                                              rsmooth_context_build_ms(ctx),
-                                              (unsigned long long)budget);
+    rsmooth_context_info info = {.struct_size = sizeof info};
+    Py_BEGIN_ALLOW_THREADS rsmooth_context_get_info(ctx, &info);
+    Py_END_ALLOW_THREADS return Py_BuildValue("(sdK)", info.device_name, info.build_ms,
+                                              (unsigned long long)info.memory_budget);
 }
 
 /* _devices() -> list of dicts, one per OpenCL device ([] without OpenCL). */

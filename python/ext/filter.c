@@ -132,11 +132,17 @@ PyObject *ext_smooth(PyObject *self, PyObject *args, PyObject *kwargs) {
     rsmooth_status st;
     ext_start_call(&call, progress, &p, ctx != NULL);
     if (ctx)
-        st = rsmooth_smooth(ctx, v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows, &p,
-                            out.data, NULL, conf.data, &rep, &err);
+        st = rsmooth_smooth(
+            ctx, v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows, &p, out.data,
+            &(rsmooth_outputs){
+                .struct_size = sizeof(rsmooth_outputs), .confidence = conf.data, .report = &rep},
+            &err);
     else
-        st = rsmooth_smooth_reference(v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows, &p,
-                                      out.data, NULL, conf.data, &rep, &err);
+        st = rsmooth_smooth(
+            NULL, v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows, &p, out.data,
+            &(rsmooth_outputs){
+                .struct_size = sizeof(rsmooth_outputs), .confidence = conf.data, .report = &rep},
+            &err);
     result = ext_finish_call(&call, st, &rep, &err);
     if (result) {
         ext_array_publish(&out);
@@ -192,8 +198,11 @@ PyObject *ext_smooth_points(PyObject *self, PyObject *args, PyObject *kwargs) {
     rsmooth_report_init(&rep); /* its struct_size says which fields this caller has */
     rsmooth_error err;
     ext_start_call(&call, progress, &p, 0);
-    rsmooth_status st = rsmooth_smooth_points_reference(
-        v.scalar, v.data, n.data, (size_t)v.rows, &p, out.data, out_n.data, conf.data, &rep, &err);
+    rsmooth_status st = rsmooth_smooth_points(
+        NULL, v.scalar, v.data, n.data, (size_t)v.rows, &p, out.data, out_n.data,
+        &(rsmooth_outputs){
+            .struct_size = sizeof(rsmooth_outputs), .confidence = conf.data, .report = &rep},
+        &err);
     result = ext_finish_call(&call, st, &rep, &err);
     if (result) {
         ext_array_publish(&out);

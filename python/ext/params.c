@@ -237,7 +237,7 @@ static PyObject *noise_report_to_dict(const rsmooth_noise_report *r) {
                          (Py_ssize_t)r->outliers);
 }
 
-/* _params_auto(vertices, faces, params) -> (params, report): rsmooth_params_auto_report's rule
+/* _params_auto(vertices, faces, params) -> (params, report): rsmooth_params_auto's rule
  * for the mesh, starting from `params` (whose normal_filter and vertex_updates pick the rule),
  * and what it read and chose (noise_report_to_dict). */
 PyObject *ext_params_auto(PyObject *self, PyObject *args) {
@@ -258,11 +258,11 @@ PyObject *ext_params_auto(PyObject *self, PyObject *args) {
     if (ext_params_from_dict(pobj, v.rows, &p, &held) == 0 && ext_array_own(&v, 0) == 0 &&
         ext_array_own(&f, 0) == 0) {
         rsmooth_noise_report report;
-        rsmooth_noise_report_init(&report);
+        report.struct_size = sizeof report;
         rsmooth_error err;
         rsmooth_status st;
-        Py_BEGIN_ALLOW_THREADS st = rsmooth_params_auto_report(
-            v.scalar, v.data, (size_t)v.rows, f.data, (size_t)f.rows, &p, &report, &err);
+        Py_BEGIN_ALLOW_THREADS st = rsmooth_params_auto(v.scalar, v.data, (size_t)v.rows, f.data,
+                                                        (size_t)f.rows, &p, &report, &err);
         Py_END_ALLOW_THREADS if (st != RSMOOTH_OK) {
             ext_raise(st, &err);
         }

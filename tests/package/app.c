@@ -9,8 +9,8 @@ int main(void) {
     const uint32_t idx[] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
     float out[12];
     rsmooth_error err;
-    rsmooth_status st = rsmooth_smooth_reference(RSMOOTH_FLOAT32, xyz, 4, idx, 4, NULL, out, NULL,
-                                                 NULL, NULL, &err);
+    rsmooth_status st =
+        rsmooth_smooth(NULL, RSMOOTH_FLOAT32, xyz, 4, idx, 4, NULL, out, NULL, &err);
     int major, minor, patch;
     rsmooth_version(&major, &minor, &patch);
     printf("app: header %d.%d.%d, library %d.%d.%d: %s\n", RSMOOTH_VERSION_MAJOR,

@@ -35,10 +35,9 @@ int main(void) {
     float out[12];
     rsmooth_error err;
     rsmooth_context *ctx = NULL;
-    rsmooth_status st = rsmooth_context_create_from_queue(queue, &ctx, &err);
+    rsmooth_status st = rsmooth_context_create_from_queue(queue, NULL, &ctx, &err);
     if (st == RSMOOTH_OK) {
-        st =
-            rsmooth_smooth(ctx, RSMOOTH_FLOAT32, xyz, 4, idx, 4, NULL, out, NULL, NULL, NULL, &err);
+        st = rsmooth_smooth(ctx, RSMOOTH_FLOAT32, xyz, 4, idx, 4, NULL, out, NULL, &err);
         rsmooth_context_destroy(ctx);
     }
     clReleaseCommandQueue(queue);

@@ -19,9 +19,8 @@ int main(void) {
         return 1;
     }
     double *out = malloc(3 * mesh->vertex_count * sizeof *out);
-    st = out ? rsmooth_smooth_reference(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
-                                        mesh->triangles, mesh->triangle_count, NULL, out, NULL,
-                                        NULL, NULL, &err)
+    st = out ? rsmooth_smooth(NULL, RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
+                              mesh->triangles, mesh->triangle_count, NULL, out, NULL, &err)
              : RSMOOTH_ERROR_OUT_OF_MEMORY;
     if (st == RSMOOTH_OK) {
         memcpy(mesh->positions, out, 3 * mesh->vertex_count * sizeof *out);
