@@ -85,16 +85,16 @@ fuzz:
 	  -DRSMOOTH_BUILD_FUZZERS=ON -DRSMOOTH_INSTALL=OFF -DRSMOOTH_BUILD_TESTS=OFF \
 	  -DRSMOOTH_BUILD_TOOLS=OFF -DRSMOOTH_WERROR=$(WERROR)
 	cmake --build $(FUZZ_BUILD) -j $(JOBS)
-	rm -rf $(FUZZ_BUILD)/corpus $(FUZZ_BUILD)/work
+	rm -rf $(FUZZ_BUILD)/corpus $(FUZZ_BUILD)/grown
 	mkdir -p $(FUZZ_BUILD)/artifacts
 	$(FUZZ_BUILD)/fuzz/make_seed_corpus $(FUZZ_BUILD)/corpus
 	failed=""; for f in $(FUZZERS); do \
-	  mkdir -p $(FUZZ_BUILD)/work/$$f && cp $(FUZZ_BUILD)/corpus/$$f/* $(FUZZ_BUILD)/work/$$f/ \
+	  mkdir -p $(FUZZ_BUILD)/grown/$$f && cp $(FUZZ_BUILD)/corpus/$$f/* $(FUZZ_BUILD)/grown/$$f/ \
 	    || exit 1; \
 	  echo "fuzz_$$f: $(FUZZ_SECONDS) s"; \
 	  $(FUZZ_BUILD)/fuzz/fuzz_$$f -max_total_time=$(FUZZ_SECONDS) -rss_limit_mb=2048 \
 	    -max_len=65536 -print_final_stats=1 -artifact_prefix=$(FUZZ_BUILD)/artifacts/$$f- \
-	    $(FUZZ_BUILD)/work/$$f || failed="$$failed fuzz_$$f"; \
+	    $(FUZZ_BUILD)/grown/$$f || failed="$$failed fuzz_$$f"; \
 	done; \
 	if [ -n "$$failed" ]; then echo "fuzzing failed:$$failed (inputs in $(FUZZ_BUILD)/artifacts)"; \
 	  exit 1; fi

@@ -2,7 +2,8 @@
 """Regenerates every table and picture of docs/experiments.md (and the pictures in docs/img/ that
 README.md shows), from the benchmark and clean meshes (--data; by default ../shared/data beside the
 checkout, not in the repository), by running the rsmooth command (filter, `noise`, `compare` and
-`render`). It writes docs/experiments.md, docs/img/ and docs/results/*.json, never README.md.
+`render`). It writes docs/experiments.md and docs/img/, never README.md, and its figures as JSON into
+out/experiments/ (beyond.json, benchmark.json, fig5a.json, meshmetrics_agreement.json).
 
 usage: scripts/experiments.py [--rsmooth build/rsmooth] [--data ../shared/data] [--jobs 2]
                               [--fresh] [--no-meshmetrics]
@@ -632,7 +633,6 @@ def main():
         os.makedirs(os.path.join(work, sub), exist_ok=True)
     img = os.path.join(ROOT, "docs", "img")
     os.makedirs(img, exist_ok=True)
-    os.makedirs(os.path.join(ROOT, "docs", "results"), exist_ok=True)
 
     runner = Runner(os.path.abspath(args.rsmooth), work, args.fresh)
     listing = runner.run(["--list-devices"]).splitlines()
@@ -657,14 +657,14 @@ def main():
     t["beyond"] = experiments_beyond.tables(beyond, MODELS, fmt)
     t["pointcloud"] = pointcloud
     t["held_out"] = experiments_beyond.held_out_table(held_out, fmt)
-    with open(os.path.join(ROOT, "docs", "results", "beyond.json"), "w") as fh:
+    with open(os.path.join(work, "beyond.json"), "w") as fh:
         json.dump({"models": beyond, "held_out": held_out}, fh, indent=1)
-    with open(os.path.join(ROOT, "docs", "results", "benchmark.json"), "w") as fh:
+    with open(os.path.join(work, "benchmark.json"), "w") as fh:
         json.dump({m: {k: v for k, v in r.items()} for m, r in rows.items()}, fh, indent=1)
-    with open(os.path.join(ROOT, "docs", "results", "fig5a.json"), "w") as fh:
+    with open(os.path.join(work, "fig5a.json"), "w") as fh:
         json.dump({"data": fig5_data, "rule": rule}, fh, indent=1)
     if agreement:
-        with open(os.path.join(ROOT, "docs", "results", "meshmetrics_agreement.json"), "w") as fh:
+        with open(os.path.join(work, "meshmetrics_agreement.json"), "w") as fh:
             json.dump(agreement, fh, indent=1)
     write_docs(t, pics)
     shutil.rmtree(os.path.join(work, "tmp"), ignore_errors=True)

@@ -74,7 +74,7 @@ extract() {
 
 ran=0 skipped=0 blocks=0 files=0 block_dir=
 cd "$source_dir" || exit 1
-docs=(README.md docs/*.md)
+docs=(README.md docs/*.md docs/maintainers/*.md)
 cd "$work" || exit 1
 for doc in "${docs[@]}"; do
   files=$((files + 1))
