@@ -516,7 +516,7 @@ yellow to red its lowest: most were discounted as outliers), ground truth. On Fa
 is low along the sharp edges and steps, where the triangles of the other side predict far-away
 positions and are discounted, and high inside the flat and smoothly curved faces. On the Bunny,
 whose σ_g is wide, it is high almost everywhere; it drops on the thin rims of the ears, where the
-other side of the sheet is within reach, and at single vertices the noise threw farthest.
+other side of the sheet is within reach (near enough to weigh on a vertex), and at single vertices the noise threw farthest.
 
 ## What the tables say
 
@@ -540,14 +540,15 @@ other side of the sheet is within reach, and at single vertices the noise threw 
 
 This section measures the best mode as version 0.5 shipped it. It is no longer what `--best` runs:
 the present mode adds the normal update stage (guided normal filtering and vertex updates) before
-one robust pass, with rules cross-validated on meshes left out
+one robust pass, with rules cross-validated on meshes left out (each mesh's figures come from
+rules fitted without it)
 ([best-mode.md](best-mode.md), [accuracy.md](accuracy.md)). The figures below are kept for
 comparison.
 
 Version 0.5's `--best` replaced the paper's mollification by a bilateral filter on
 the facet normals (Zheng et al. 2011: area × Gaussian of centroid distance × Gaussian of normal
 difference, repeated) and runs the robust projection several times, each pass from the previous
-result. A coordinate descent over {steps} (three rounds at most), from the best of three starting
+result. Anchors here are the figures of other denoisers to compare against. A coordinate descent over {steps} (three rounds at most), from the best of three starting
 points (the preset; gentler normals, σ_n 0.6, 3 rounds, 2 passes; stronger, σ_g 0.15, σ_n 0.3,
 10 rounds, 6 passes, Huber), tuned it per model twice: on the larger of the two ratios E_v / best
 anchor E_v and θ / best anchor θ (to beat both anchors on both measures), then
