@@ -4,8 +4,8 @@
 # is installed into a fresh virtual environment of every CPython here its tags accept (abi3: 3.11
 # and later, pyenv's and /usr/bin's; cpXY: that version; a Python not here is said and skipped),
 # with numpy, pytest, trimesh, meshio and tqdm from PyPI (in the first also Open3D, PyVista, PyOpenCL
-# and mypy, where their wheels exist: their tests skip in the others). The pytest suite tests/python/ runs from a copy outside the checkout (with scripts/, which
-# one test imports), so only the installed package can be imported, against the command built in
+# and mypy, where their wheels exist: their tests skip in the others). The pytest suite tests/python/ runs from a copy outside the checkout,
+# so only the installed package can be imported, against the command built in
 # BUILD (the C oracle). The sdist is built and installed by pip into one more venv (the system's C
 # compiler, WERROR) and used from /. A table gives each wheel, Python and the tests passed, skipped
 # and failed; any failed test, unusable wheel or failed install fails the script.
@@ -19,9 +19,8 @@ build=$(cd "${2:-build}" && pwd)
 werror=${3:-OFF}
 work=$build-python
 rm -rf "$work"
-mkdir -p "$work/tree/tests" "$work/tree/scripts"
+mkdir -p "$work/tree/tests"
 cp -r tests/python "$work/tree/tests/python"
-cp scripts/*.py "$work/tree/scripts/"
 export RSMOOTH_CLI="$build/rsmooth" RSMOOTH_REQUIRE_CLI=1 POCL_CACHE_DIR="$build/pocl-cache"
 export PIP_DISABLE_PIP_VERSION_CHECK=1
 t0=$SECONDS

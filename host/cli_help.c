@@ -78,7 +78,7 @@ const char cli_usage_text[] =
     "  --vertex-updates N    the normal update stage, before the passes: guided normal filtering\n"
     "                        (Zhang et al. 2015) of the facet normals, then Sun et al. 2007's\n"
     "                        vertex update, N iterations (0..1000) moving the vertices to agree\n"
-    "                        with the filtered normals. In --best (10, repeated 5 times).\n"
+    "                        with the filtered normals. In --best: 10 per cycle, 10 cycles.\n"
     "                        Default 0: off\n"
     "  --guided-sigma-s X    guided filter: spatial width, in mean edge lengths (default 2)\n"
     "  --guided-radius R     guided filter: neighbourhood, in mean distances between the\n"

@@ -2,7 +2,8 @@
 """Regenerates every table and picture of docs/experiments.md (and the pictures in docs/img/ that
 README.md shows), from the benchmark and clean meshes (--data; by default ../shared/data beside the
 checkout, not in the repository), by running the rsmooth command (filter, `noise`, `compare` and
-`render`). It writes docs/experiments.md, docs/img/ and docs/results/*.json, never README.md.
+`render`). It writes docs/experiments.md and docs/img/, never README.md, and its figures as JSON into
+out/experiments/ (beyond.json, benchmark.json, fig5a.json, meshmetrics_agreement.json).
 
 usage: scripts/experiments.py [--rsmooth build/rsmooth] [--data ../shared/data] [--jobs 2]
                               [--fresh] [--no-meshmetrics]
@@ -515,7 +516,7 @@ yellow to red its lowest: most were discounted as outliers), ground truth. On Fa
 is low along the sharp edges and steps, where the triangles of the other side predict far-away
 positions and are discounted, and high inside the flat and smoothly curved faces. On the Bunny,
 whose σ_g is wide, it is high almost everywhere; it drops on the thin rims of the ears, where the
-other side of the sheet is within reach, and at single vertices the noise threw farthest.
+other side of the sheet is within reach (near enough to weigh on a vertex), and at single vertices the noise threw farthest.
 
 ## What the tables say
 
@@ -539,14 +540,15 @@ other side of the sheet is within reach, and at single vertices the noise threw 
 
 This section measures the best mode as version 0.5 shipped it. It is no longer what `--best` runs:
 the present mode adds the normal update stage (guided normal filtering and vertex updates) before
-one robust pass, with rules cross-validated on meshes left out
+one robust pass, with rules cross-validated on meshes left out (each mesh's figures come from
+rules fitted without it)
 ([best-mode.md](best-mode.md), [accuracy.md](accuracy.md)). The figures below are kept for
 comparison.
 
 Version 0.5's `--best` replaced the paper's mollification by a bilateral filter on
 the facet normals (Zheng et al. 2011: area × Gaussian of centroid distance × Gaussian of normal
 difference, repeated) and runs the robust projection several times, each pass from the previous
-result. A coordinate descent over {steps} (three rounds at most), from the best of three starting
+result. Anchors here are the figures of other denoisers to compare against. A coordinate descent over {steps} (three rounds at most), from the best of three starting
 points (the preset; gentler normals, σ_n 0.6, 3 rounds, 2 passes; stronger, σ_g 0.15, σ_n 0.3,
 10 rounds, 6 passes, Huber), tuned it per model twice: on the larger of the two ratios E_v / best
 anchor E_v and θ / best anchor θ (to beat both anchors on both measures), then
@@ -632,7 +634,6 @@ def main():
         os.makedirs(os.path.join(work, sub), exist_ok=True)
     img = os.path.join(ROOT, "docs", "img")
     os.makedirs(img, exist_ok=True)
-    os.makedirs(os.path.join(ROOT, "docs", "results"), exist_ok=True)
 
     runner = Runner(os.path.abspath(args.rsmooth), work, args.fresh)
     listing = runner.run(["--list-devices"]).splitlines()
@@ -657,14 +658,14 @@ def main():
     t["beyond"] = experiments_beyond.tables(beyond, MODELS, fmt)
     t["pointcloud"] = pointcloud
     t["held_out"] = experiments_beyond.held_out_table(held_out, fmt)
-    with open(os.path.join(ROOT, "docs", "results", "beyond.json"), "w") as fh:
+    with open(os.path.join(work, "beyond.json"), "w") as fh:
         json.dump({"models": beyond, "held_out": held_out}, fh, indent=1)
-    with open(os.path.join(ROOT, "docs", "results", "benchmark.json"), "w") as fh:
+    with open(os.path.join(work, "benchmark.json"), "w") as fh:
         json.dump({m: {k: v for k, v in r.items()} for m, r in rows.items()}, fh, indent=1)
-    with open(os.path.join(ROOT, "docs", "results", "fig5a.json"), "w") as fh:
+    with open(os.path.join(work, "fig5a.json"), "w") as fh:
         json.dump({"data": fig5_data, "rule": rule}, fh, indent=1)
     if agreement:
-        with open(os.path.join(ROOT, "docs", "results", "meshmetrics_agreement.json"), "w") as fh:
+        with open(os.path.join(work, "meshmetrics_agreement.json"), "w") as fh:
             json.dump(agreement, fh, indent=1)
     write_docs(t, pics)
     shutil.rmtree(os.path.join(work, "tmp"), ignore_errors=True)

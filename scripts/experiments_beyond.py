@@ -1,6 +1,6 @@
-"""Experiment 6 of scripts/experiments.py: rsmooth beyond the paper (issue 6). The best mode
+"""Experiment 6 of scripts/experiments.py: rsmooth beyond the paper. The best mode
 (bilateral normals, several passes, a choice of influence function) tuned per model against the
-ground truth, compared with the anchors of the issue (tuned Open3D Taubin and MeshLab TwoStep
+ground truth, compared with the anchors (tuned Open3D Taubin and MeshLab TwoStep
 smoothing), the preset `--best`, `--best --auto` (no tuning: sigmas from the estimated noise), the
 influence functions and confidence-driven passes, and the time of the best mode against the
 paper's filter on the same device."""
@@ -8,9 +8,9 @@ import os
 import statistics
 import sys
 
-# The anchors, as issue 6 gives them (E_v, theta): best results of Open3D's Taubin smoothing and
-# of MeshLab's TwoStep smoothing tuned per model, on the same files. They were measured outside
-# this project (neither tool is a Debian package here); the numbers are the issue's.
+# The anchors, as the request for this work gave them (E_v, theta): best results of Open3D's
+# Taubin smoothing and of MeshLab's TwoStep smoothing tuned per model, on the same files. They were measured outside
+# this project (neither tool is a Debian package here); the numbers are that request's.
 ANCHORS = {
     "Open3D Taubin": {"Fandisk0.3": (1.69, 10.0), "Block0.4": (2.27, 11.7),
                       "Bunny0.2": (0.486, 5.7), "SharpSphere0.3": (1.67, 10.6),

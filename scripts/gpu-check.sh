@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The first-GPU check (issue 26): one script that, on a bare Linux machine with an NVIDIA GPU and
+# The first-GPU check: one script that, on a bare Linux machine with an NVIDIA GPU and
 # its driver, CMake and a C compiler, and no package registry, builds rsmooth from this tree (or
 # uses a carried build), provides the OpenCL ICD loader if the machine lacks one, lists the
 # devices, runs the tests cl_vs_reference and cl_beyond with the GPU kernel variant, and times
@@ -13,7 +13,7 @@
 #       the benchmark meshes' Noisy.obj from ../shared. Copy or carry .gpu-check with the tree.
 #   scripts/gpu-check.sh [--device nvidia|pocl|SPEC] [--out DIR] [--build DIR] [--skip-build]
 #                        [--budget S] [--cap-16m S] [--bunny FILE] [--jobs N]
-#       the check (docs/gpu.md says what it writes). Exit 0 when every step passed, 1 when one
+#       the check (docs/maintainers/gpu.md says what it writes). Exit 0 when every step passed, 1 when one
 #       failed or ran out of time (the summary names it), 2 on bad usage or set-up.
 set -u -o pipefail
 

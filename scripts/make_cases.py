@@ -1,5 +1,6 @@
-"""The calibration and evaluation cases of issue 15, generated from ../shared/data into a folder
-outside the project (the data is never copied into it), with a manifest every experiment reads.
+"""The calibration and evaluation cases of the accuracy study (docs/accuracy.md), generated from
+../shared/data into a folder outside the project (the data is never copied into it), with a
+manifest every experiment reads.
 
 Cases:
   - the six noisy/truth pairs of ../shared/data/benchmark and ../shared/data/train;
@@ -11,8 +12,8 @@ Every case names its `group`: the underlying model. Fandisk0.3 and clean/fandisk
 Bunny0.2 and clean/stanford-bunny another, so cross-validation that leaves a group out leaves the
 whole mesh out, never a noisier copy of a mesh the rule was fitted on.
 
-    python3 scripts/make_cases.py --rsmooth build/rsmooth --out /work/cases
-writes /work/cases/manifest.json and the noisy files. Seeds are fixed: the same files every run."""
+    python3 scripts/make_cases.py --rsmooth build/rsmooth --out ../cases
+writes ../cases/manifest.json and the noisy files. Seeds are fixed: the same files every run."""
 import argparse
 import json
 import os

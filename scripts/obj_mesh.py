@@ -1,6 +1,5 @@
 """OBJ vertices and triangles for the experiment scripts (numpy arrays): the one reader and writer
-scripts/anchors_classic.py, scripts/anchors_normal_filtering.py and scripts/discrepancy_study.py
-share. Vertex order is kept; polygons are fanned; `f` indices may be negative (relative)."""
+scripts/do_no_harm.py uses. Vertex order is kept; polygons are fanned; `f` indices may be negative (relative)."""
 import numpy as np
 
 

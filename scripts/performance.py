@@ -41,7 +41,7 @@ RUN_FILES = {"cold": "program-build-cold", "s1M": "scaling-1M", "s4M": "scaling-
 HEADLINE_FILES = {"bunny": "bunny0.2-2-0.5", "g200k": "generated-200k-4-1",
                   "best_bunny": "best-bunny0.2", "best_auto_bunny": "best-auto-bunny0.2",
                   "best_200k": "best-200k", "points_200k": "points-200k"}
-# Issue 26's targets on this machine class (PoCL's CPU device): (key, what, target, at most?)
+# The speed targets set for this machine class (PoCL's CPU device): (key, what, target, at most?)
 TARGETS = [("g200k", "paper filter, 200k triangles at σ 4/1", 70, True),
            ("bunny", "paper filter, Bunny0.2 at σ 2/0.5", 18, True),
            ("setup", "command setup, warm caches (Fandisk0.3)", 35, True),
@@ -53,6 +53,16 @@ TARGETS = [("g200k", "paper filter, 200k triangles at σ 4/1", 70, True),
            ("points", "200k-point cloud on the device, × the mesh filter", 2, True)]
 
 
+def beside(result):
+    """The result with the data's paths written as from the checkout (../shared/data/...), not as
+    this machine's absolute paths."""
+    parent = os.path.dirname(ROOT) + os.sep
+    for key in ("mesh", "command"):
+        if isinstance(result.get(key), str):
+            result[key] = result[key].replace(parent, ".." + os.sep)
+    return result
+
+
 def bench(build, name, args, env=None):
     cmd = [os.path.join(build, "rsmooth-bench"), "filter"] + args
     print("running:", " ".join(cmd), file=sys.stderr)
@@ -60,6 +70,7 @@ def bench(build, name, args, env=None):
     out = subprocess.run(cmd, check=True, capture_output=True, text=True, env=run_env).stdout
     result = json.loads(out)
     result["command"] = "rsmooth-bench filter " + " ".join(args)
+    beside(result)
     with open(os.path.join(OUT, name + ".json"), "w") as f:
         json.dump(result, f, indent=1)
     return result
@@ -105,6 +116,7 @@ def best_bench(build, name, args, mode="best"):
     out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
     result = json.loads(out)
     result["command"] = f"rsmooth-bench {mode} " + " ".join(args)
+    beside(result)
     with open(os.path.join(OUT, name + ".json"), "w") as f:
         json.dump(result, f, indent=1)
     return result
@@ -275,7 +287,7 @@ def section(before, after, runs, label, machine_text):
               f"{g.get('lanes', 8)} vertices per work-item, work-groups of "
               f"{g.get('work_group', 64)} (chosen per device; see [method.md](method.md)).", ""]
     lines += [standing(before, after, label), ""]
-    lines += ["Against issue 26's targets (PoCL's CPU device; `--best` ratios are filter times, "
+    lines += ["Against the project's speed targets (PoCL's CPU device; `--best` ratios are filter times, "
               "the device-stage and 200k ones `rsmooth-bench best`'s whole calls):", ""]
     lines += targets_table(before, after) + [""]
     if "best_bunny" in after:

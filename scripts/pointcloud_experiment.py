@@ -1,9 +1,9 @@
 #!/usr/bin/python3
-"""Point clouds with normals (issue 6, capability 5): how much the point-cloud filter removes of
+"""Point clouds with normals: how much the point-cloud filter removes of
 the noise of a point cloud sampled from each benchmark model's clean surface.
 
 usage: scripts/pointcloud_experiment.py [--rsmooth build/rsmooth] [--data ../shared/data]
-                                        [--out out/pointcloud] [--json docs/results/pointcloud.json]
+                                        [--out out/pointcloud] [--json out/pointcloud/pointcloud.json]
 
 For each ../shared/data/benchmark/<M>/Original.obj (skipped when missing):
   1. the cloud: the Original's vertices, moved along their area-weighted vertex normals by
@@ -151,7 +151,7 @@ def main():
     ap.add_argument("--rsmooth", default=os.path.join(ROOT, "build", "rsmooth"))
     ap.add_argument("--data", default=os.path.join(ROOT, "..", "shared", "data"))
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "pointcloud"))
-    ap.add_argument("--json", default=os.path.join(ROOT, "docs", "results", "pointcloud.json"))
+    ap.add_argument("--json", default=os.path.join(ROOT, "out", "pointcloud", "pointcloud.json"))
     args = ap.parse_args()
     global mm
     sys.path.insert(0, os.path.join(args.data, "..", "tools"))

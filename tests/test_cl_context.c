@@ -130,7 +130,7 @@ static void check_shared_context(rsmooth_context *ctx) {
     CHECK_EQ_INT(wrong, 0);
 }
 
-/* A progress callback that calls back into the context its call runs on (issue 23): every entry
+/* A progress callback that calls back into the context its call runs on: every entry
  * point must answer at once instead of waiting for the lock its own call holds. */
 typedef struct reentry {
     rsmooth_context *ctx, *other;

@@ -3,7 +3,7 @@
  * wrong magic, empty, a folder in the file's place) are misses that get rewritten; folders that
  * cannot be made or written, and "off", build from source and leave nothing; the default folders;
  * and processes and threads starting together on an empty folder all succeed and leave one whole
- * file and no temporaries. Then trust (issue 23, item 1): a binary built from modified kernels,
+ * file and no temporaries. Then trust: a binary built from modified kernels,
  * planted under the genuine key with a valid digest, is refused in a folder another user owns or
  * can write, and in the home chain, said in the context's program_cache_note, and the results are
  * the genuine program's; a FIFO, a link or a file of another user at the key's name is never opened
@@ -228,7 +228,7 @@ static void remove_tree(const char *path) {
     }
 }
 
-/* ---- trust (issue 23, item 1) ------------------------------------------------------------------
+/* ---- trust -------------------------------------------------------------------------------------
  */
 
 static unsigned char *read_whole(const char *path, size_t *size) {

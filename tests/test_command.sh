@@ -498,7 +498,7 @@ grep -q "leave it out" err.txt || fail "--memory-budget 0 does not say how to ge
 RSMOOTH_MEMORY_BUDGET=lots expect 0 "$rsmooth" small.ply -o budget.ply -q --memory-budget 256M
 [ -e x.ply ] && fail "a refused memory budget wrote its output"
 
-# Every scale alike (issue 12): a tetrahedron reaching 1e39 and a noisy grid at 1e-20 and 1e120
+# Every scale alike: a tetrahedron reaching 1e39 and a noisy grid at 1e-20 and 1e120
 # come out finite on both paths, moved, and the same on both; vertices only, no faces and no
 # normals, is refused naming the end of the file.
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1e39\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n' > tall.obj

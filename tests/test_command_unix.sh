@@ -146,7 +146,7 @@ expect 2 "$rsmooth" noisy.ply -o x.obj --mask farmask.txt $ref
 grep -q "farmask.txt:1: vertex 99999999 is beyond" err.txt || fail "far --mask: $(cat err.txt)"
 expect 2 "$rsmooth" noisy.ply -o x.obj --mask mask.txt --method taubin
 [ -e x.obj ] && fail "an output written after a bad --mask"
-# Masks that are not text (issue 23, item 14): a device is refused at once instead of read
+# Masks that are not text: a device is refused at once instead of read
 # forever, a NUL byte is an error at its line and column instead of cutting the line, an endless
 # pipe stops at the size bound; a pipe of indices works as the file does.
 expect_within 20 2 "$rsmooth" noisy.ply -o x.obj --mask /dev/zero $ref

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Every command shown in README.md and docs/*.md runs. The convention, for whoever writes docs:
+# Every command shown in README.md, docs/*.md and docs/maintainers/*.md runs. The convention, for
+# whoever writes docs:
 #   - every line of a ```sh block is a command (a line ending in \ continues on the next; blank
 #     lines and lines starting with # are not commands);
 #   - the commands of a block run in order, with bash, in a fresh folder holding the inputs the
@@ -74,7 +75,7 @@ extract() {
 
 ran=0 skipped=0 blocks=0 files=0 block_dir=
 cd "$source_dir" || exit 1
-docs=(README.md docs/*.md)
+docs=(README.md docs/*.md docs/maintainers/*.md)
 cd "$work" || exit 1
 for doc in "${docs[@]}"; do
   files=$((files + 1))

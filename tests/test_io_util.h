@@ -102,7 +102,7 @@ static inline void check_face(const rsmooth_mesh *m, size_t f, const uint32_t *e
         CHECK_EQ_INT(m->face_indices[m->face_offsets[f] + i], expected[i]);
 }
 
-/* ---- what every reader and writer owes (issue 12): shared by the format tests */
+/* ---- what every reader and writer owes: shared by the format tests */
 
 /* Reads `size` bytes of `data` from an exact-size copy (ASan sees any over-read) as `format`. */
 static inline rsmooth_status read_exact_copy(const void *data, size_t size, rsmooth_format format,
@@ -313,13 +313,13 @@ static inline rsmooth_mesh *write_checked(const rsmooth_mesh *m, rsmooth_format 
     return back;
 }
 
-/* Float32 at the mesh's own scale (issue 12's campaign: a tetrahedron at 1e-150 written as binary
- * STL came out as four vertices at 0 0 0 with exit 0; at 1e-45..1e-43 the float32 subnormals moved
- * vertices by up to 0.8 edge lengths). A writer whose file stores float32 (binary STL) refuses such
- * a mesh, naming the vertex and what holds it; the others write it exactly, float32 meshes too
- * (their float mode falls back to the doubles). A normal-sized mesh with a stray subnormal
- * coordinate is no such mesh: float32's error there is far below its precision at the mesh's
- * scale. */
+/* Float32 at the mesh's own scale (the hostile-input campaign: a tetrahedron at 1e-150 written as
+ * binary STL came out as four vertices at 0 0 0 with exit 0; at 1e-45..1e-43 the float32 subnormals
+ * moved vertices by up to 0.8 edge lengths). A writer whose file stores float32 (binary STL)
+ * refuses such a mesh, naming the vertex and what holds it; the others write it exactly, float32
+ * meshes too (their float mode falls back to the doubles). A normal-sized mesh with a stray
+ * subnormal coordinate is no such mesh: float32's error there is far below its precision at the
+ * mesh's scale. */
 static inline void check_float32_scale(rsmooth_format format) {
     const bool float_file = format == RSMOOTH_FORMAT_STL_BINARY;
     const double scales[] = {1e-150, 1e-300, 1e-45, 1e-44, 1e-43, 1e-40};

@@ -73,7 +73,7 @@ if [ -n "$loader" ]; then
   cmp -s out.txt default.txt || fail "RSMOOTH_OPENCL_LIBRARY=$loader lists other devices"
 fi
 
-# Named files that must never reach dlopen (issue 23, item 13): a truncated copy of the loader
+# Named files that must never reach dlopen: a truncated copy of the loader
 # (dlopen maps segments past the file's end: SIGBUS), copies ending in zeros or with zeroed code
 # (SIGSEGV inside dlopen or the constructors), a FIFO (blocks forever), a device, a folder, a text
 # file. Each refused before dlopen, naming the file and why, within seconds.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# rsmooth-mpi refuses ranks that were not given the same job (issue 23, item 6): two ranks
+# rsmooth-mpi refuses ranks that were not given the same job: two ranks
 # started with different --max-memory (different pieces: 12,800 of 50,625 vertices were left
 # unsmoothed), a different input file, different parameters, a different output: each exits 2,
 # names rank 1 and what differs, and writes nothing. A different --device per rank (MPMD) is

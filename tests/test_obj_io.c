@@ -714,7 +714,7 @@ static void test_faithful(void) {
     rsmooth_mesh_destroy(m);
 }
 
-/* ---- issue 12: writers refuse what cannot be read back; byte-order marks; located errors */
+/* ---- writers refuse what cannot be read back; byte-order marks; located errors */
 
 static void test_write_refusals_and_extremes(void) {
     check_writer_refuses_unreadable(RSMOOTH_FORMAT_OBJ);

@@ -486,9 +486,9 @@ static void test_write_refusals_and_extremes(void) {
     rsmooth_mesh_destroy(m);
 }
 
-/* A line holds exactly the values its variant declares (issue 12's campaign: '0 1 0 7' read as
- * 0 1 0 and written back with its ' 7'; a stray CR running two COFF lines together): refused at the
- * first value too many, or at the line when too few; face colours are a colormap index or r g b
+/* A line holds exactly the values its variant declares (the hostile-input campaign: '0 1 0 7' read
+ * as 0 1 0 and written back with its ' 7'; a stray CR running two COFF lines together): refused at
+ * the first value too many, or at the line when too few; face colours are a colormap index or r g b
  * [a]; nothing but comments after the declared faces. */
 static void test_values_per_line(void) {
     const rsmooth_status P = RSMOOTH_ERROR_PARSE;

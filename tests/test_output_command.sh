@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# One way of writing an output file for all three writers (issue 23, items 2, 3, 5, 7, 15): the
+# One way of writing an output file for all three writers: the
 # in-memory command, the streamed command (--max-memory) and rsmooth-mpi on 2 ranks, each checked
 # the same way: a replaced file keeps its mode, owner and group (also --in-place); the hard-link
 # warning; -o LINK --force writes through the link; a FIFO or device is never replaced; output

@@ -1,4 +1,4 @@
-/* The piece and stream C API refuse what would return garbage (issue 23, items 8 and 9):
+/* The piece and stream C API refuse what would return garbage:
  *   - rsmooth_smooth_piece checks every field of rsmooth_piece_info, a scale the whole-mesh path
  *     cannot choose (2^-1030) or one that is not the whole mesh's (2^300, 2^-300 on a mesh of
  *     0.1 edges) among them, and returns INVALID_ARGUMENT naming it with nothing written; the

@@ -568,7 +568,7 @@ static void test_corruption(void) {
     bytes_free(&goods[1]);
 }
 
-/* ---- issue 12: writers refuse what cannot be read back; byte-order marks; located errors;
+/* ---- writers refuse what cannot be read back; byte-order marks; located errors;
  * values the declared types cannot hold */
 
 /* Expects a parse error (any format family, read by AUTO) at `line` holding `needle`. */

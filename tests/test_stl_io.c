@@ -531,7 +531,7 @@ static void test_indexed(void) {
     rsmooth_mesh_destroy(m);
 }
 
-/* ---- issue 12 */
+/* ---- what the hostile-input campaign found */
 
 static void test_write_refusals_and_extremes(void) {
     check_writer_refuses_unreadable(RSMOOTH_FORMAT_STL_ASCII);
@@ -558,8 +558,8 @@ static void test_write_refusals_and_extremes(void) {
                  RSMOOTH_ERROR_INVALID_ARGUMENT);
     CHECK(access(path, F_OK) != 0);
     rsmooth_mesh_destroy(m);
-    /* issue 12's reproducer: the OBJ tetrahedron at 1e-150, written as binary STL, was four
-     * vertices at 0 0 0 with exit 0 */
+    /* the hostile-input campaign's reproducer: the OBJ tetrahedron at 1e-150, written as binary
+     * STL, was four vertices at 0 0 0 with exit 0 */
     const char *tiny = "v 0 0 0\nv 1e-150 0 0\nv 0 1e-150 0\nv 0 0 1e-150\n"
                        "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
     m = parse_ok(tiny, strlen(tiny), RSMOOTH_FORMAT_AUTO);

@@ -1,6 +1,6 @@
 /* Streaming (rsmooth_stream_smooth) against the in-memory filter, the oracle:
  *   - a noisy cylinder of 400k triangles under a memory cap far below what the in-memory run
- *     holds: the same positions bit for bit on the OpenCL device (the issue asks 1e-6 mean edge
+ *     holds: the same positions bit for bit on the OpenCL device (the requirement is 1e-6 mean edge
  *     lengths; pieces see the whole mesh's cells, and the kernels' differences do not depend on
  *     how vertices share blocks);
  *   - the reference path (ctx NULL): the same bits as rsmooth_smooth(NULL, ...) in memory, and

@@ -103,7 +103,7 @@ if [ -n "$mpi" ]; then
   ls ./*partial* >/dev/null 2>&1 && fail "a partial output was left behind"
 fi
 
-# ---- Issue 23, items 4 and 15: the streamed file is the in-memory command's, byte for byte, and
+# ---- The streamed file is the in-memory command's, byte for byte, and
 # what the in-memory writer refuses is refused with its status and message, nothing written.
 # header_end FILE: bytes up to and with the 'end_header' line
 header_end() { echo $(($(grep -a -b -m1 '^end_header' "$1" | cut -d: -f1) + 11)); }

@@ -1,4 +1,4 @@
-/* The streaming call's output (rsmooth_stream_smooth, issue 23, items 2, 5, 7 and 15): it writes
+/* The streaming call's output (rsmooth_stream_smooth): it writes
  * its file as the command writes its own. On the reference path (no device needed), a small mesh
  * written to a plain new file is the oracle; then with options->replace: a FIFO, a folder, a link
  * to nothing and (as root) a device node are refused and left as they were; a link to a file is

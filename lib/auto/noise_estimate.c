@@ -57,8 +57,8 @@
  *    regular mesh passes the first test). The level and the share displaced then come from a
  *    two-normal mixture fitted by EM to the least-squares residuals (impulsive_mixture).
  * Apart from IMPULSIVE_SHARE no constant was fitted in 5-8 (TRIM 5, MIX_SCREEN 2, ROBUST_CUT 2.5,
- * OUTLIER_Z 6, IMPULSIVE_TANGENTIAL 0.5 chosen, not fitted); scripts/noise_accuracy.py measures the
- * table (docs/results/noise_accuracy.json).
+ * OUTLIER_Z 6, IMPULSIVE_TANGENTIAL 0.5 chosen, not fitted); the noise_accuracy study measured the
+ * table (docs/accuracy.md; the study: docs/maintainers/studies.md).
  *
  * Exact duplicate positions are welded first (a triangle soup's corners), so a vertex's copies are
  * not its neighbours. Up to MAX_SAMPLES vertices are used, at a fixed stride; each sample depends
@@ -726,7 +726,7 @@ static double robust_sigma(const double *residual, const double *variance, size_
  * along the normals or in random directions, moves the neighbours as much as the sample: its
  * studentised residual exceeds OUTLIER_Z for at most 0.5% of the samples (creases and corners
  * included: their refit keeps one side and the sample sits on it). IMPULSIVE_SHARE was fitted on
- * docs/results/noise_accuracy.json with cross-validation leaving each of its 13 meshes out (the
+ * the noise_accuracy study's rows with cross-validation leaving each of its 13 meshes out (the
  * geometric mean of the largest Gaussian share and the smallest impulsive one above it, fitted on
  * the other 12: 0.0055-0.0063; no Gaussian case of the left-out mesh read impulsive), and rounded.
  */

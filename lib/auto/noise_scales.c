@@ -303,11 +303,11 @@ rsmooth_status rs_noise_scales(const double *xyz, const double *normal, size_t c
 }
 
 /* The inference's constants. GAIN, GROWTH, FLOOR_SHARE and EXCESS_SHARE were fitted by
- * scripts/noise_scales_fit.py (a grid search, log error) on beetle-alt and rocker-arm (clean
+ * the noise_scales_fit study (a grid search, log error) on beetle-alt and rocker-arm (clean
  * meshes of ../shared/data/clean: clean, and with generated noise along normals, in random
  * directions, band-limited L = 1, stripes W = 3; sigma 0.3 to 1) and the raw scan bun000 (truth:
  * its rms distance to the Stanford reconstruction), and checked on the other meshes of
- * scripts/noise_accuracy.py, bun045 among them (docs/accuracy.md, "Correlated noise").
+ * the noise_accuracy study, bun045 among them (docs/accuracy.md, "Correlated noise").
  * WHITE_SHARE was chosen; HALF_TO_LENGTH is beetle-alt's L = 1. */
 #define GAIN 10.5 /* correlated variance per unit of excess growth at RADII[1] */
 #define GROWTH                                                                                     \

@@ -1,6 +1,6 @@
 /* Automatic parameters: the widths (and, for the best mode, its whole setting) picked from the
  * input's estimated noise, by rules chosen on noisy meshes with a ground truth with
- * cross-validation that leaves whole meshes out (scripts/calibrate.py; the figures of meshes the
+ * cross-validation that leaves whole meshes out (the calibrate study; the figures of meshes the
  * rules never saw are in docs/experiments.md, section 7). */
 #include "auto/noise_estimate.h"
 #include "core/rsmooth_internal.h"
@@ -10,7 +10,7 @@
 #include <stdio.h>
 #include <string.h>
 
-/* The paper's filter: sigma_f = A + B n, sigma_g = C n for noise n (scripts/calibrate.py fit,
+/* The paper's filter: sigma_f = A + B n, sigma_g = C n for noise n (the calibrate study's fit,
  * the lattice rule with the lowest mean ratio to each case's best sigmas). */
 #define PAPER_SIGMA_F_AT_0 0.6
 #define PAPER_SIGMA_F_PER_NOISE 1.6
@@ -20,7 +20,7 @@
  * facet normals, one guided round and some vertex updates; spatial width 1 mean edge length),
  * then robust passes with bilateral normals, by noise class; then the choice per region
  * (rsmooth_params.discrepancy_level) at the estimated noise. The classes' bounds were fixed in
- * advance; each class's setting is the one scripts/calibrate_stage.py chose on all 30
+ * advance; each class's setting is the one the calibrate_stage study chose on all 30
  * calibration cases (the figures of cases left out of the fit: docs/accuracy.md). */
 typedef struct best_preset {
     const char *name;
@@ -44,7 +44,7 @@ static const best_preset IMPULSIVE_PRESET = {"best: impulsive", INFINITY, 10, 10
  * iteration adds less than CORRELATED_GAIN mean edge lengths to the move (rsmooth_params
  * .discrepancy_gain): on the two raw Stanford scans the truth-tuned iteration count (18 of a
  * grid 1..90, both) is where that gain falls to 0.0030 on either scan, so fitting on one and
- * applying to the other gives 19 iterations (scripts/scans.py). */
+ * applying to the other gives 19 iterations (the scans study). */
 #define CORRELATED_SHARE 1.5
 #define CORRELATED_GAIN 0.003
 

@@ -201,7 +201,7 @@ static bool add_triangle(rs_ply_reader *r, uint32_t a, uint32_t b, uint32_t c, d
 
 /* The triangles of the block of cells (x, y) to (x + 1, y + 1). Its corners in cycle order,
  * (x, y), (x + 1, y), (x + 1, y + 1), (x, y + 1) (x the column, y the row), wind every triangle
- * the same way: towards the scanner in the Stanford scans (scripts/scans.py: 99.96% of the
+ * the same way: towards the scanner in the Stanford scans (the scans study: 99.96% of the
  * triangles of bun000 and bun045 face the way of the reconstruction's nearest triangle; the other
  * cycle gave 0.04%). */
 static bool block_triangles(rs_ply_reader *r, uint64_t x, uint64_t y, double limit) {

@@ -16,7 +16,7 @@
  *      lengths, from the input: neither smoother has the other side to lean on there, and a
  *      boundary pulled inwards opens holes between scans.
  *
- * The bounds were fitted by scripts/region_study.py with cross-validation that leaves whole
+ * The bounds were fitted by the region study with cross-validation that leaves whole
  * meshes out (docs/accuracy.md); the whole-mesh rule they replace was the same share below 0.52. */
 #include "passes/region_choice.h"
 #include "stages/normal_update.h"

@@ -18,7 +18,7 @@
  * filter put it, so holes do not open); then halfway back toward the input (where none is turned
  * over), and after HALVINGS such rounds to the input exactly, with two rings of vertices around.
  * Host code, double precision, one thread, in index order: the same bytes on every run and for both
- * paths. scripts/region_study.py carries an independent numpy copy (its --check compares).
+ * paths. tests/python/region_blend.py carries an independent numpy copy (a test compares).
  * (Snapping a triangle's corners and the ring of vertices around them to the input makes its
  * neighbourhood the input's, where it did not face against it: each snapping round snaps some
  * vertex anew, so the rounds end.) */

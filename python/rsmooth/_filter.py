@@ -167,8 +167,8 @@ def smooth(
     vertex_updates : the normal update stage, before the passes: guided normal filtering
         (Zhang et al. 2015) of the facet normals, then Sun et al. 2007's vertex update, this
         many iterations ([0, 1000]) moving the vertices to agree with the filtered normals.
-        Default 0 (off; ``best``: 10, the stage repeated 5 times). Runs on the CPU's cores in
-        double precision.
+        Default 0 (off; ``best``: 10 per cycle, 10 cycles of 1 guided round). Runs on the CPU's
+        cores in double precision.
     guided_sigma_s, guided_sigma_n, guided_rounds : the guided filter's spatial width (mean edge
         lengths, default 2), width on guidance-normal differences ((0, 2], default 0.2) and
         rounds per cycle ([1, 100], default 20).

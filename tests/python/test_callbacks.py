@@ -1,5 +1,5 @@
 """Python code that runs during a call (the progress callable, a signal handler, other threads)
-cannot hurt it (issue 23 items 10 and 11): the call works on its own copies of the arrays, so
+cannot hurt it: the call works on its own copies of the arrays, so
 rewriting, resizing or freeing the caller's arrays leaves its result as it was, on every path; a
 call that would wait for an OpenCL context the running call holds raises RuntimeError instead of
 hanging; Ctrl-C from a progress callable cancels cleanly. Each runs in a child interpreter, so a

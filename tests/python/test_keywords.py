@@ -1,4 +1,4 @@
-"""Every numeric keyword is checked by name before the library runs (issue 23 item 12): whole
+"""Every numeric keyword is checked by name before the library runs: whole
 numbers in the command's ranges (the command is the oracle: it accepts and refuses the same
 values), ValueError naming the keyword and its range outside them, however far (beyond a C
 long too: nothing wraps); TypeError naming the keyword for a bool, a float or a string where a
@@ -75,7 +75,8 @@ def test_counts_refuse_what_would_wrap_or_truncate(tiny, key, flag, low, high, b
 
 
 def test_iterations_as_reported(tiny):
-    """The issue's cases: 2**32 returned the input unchanged (wrapped to 0), -1 ran 4.3e9 steps."""
+    """What the hostile-input campaign found: 2**32 returned the input unchanged (wrapped to 0),
+    -1 ran 4.3e9 steps."""
     v, f = tiny
     with pytest.raises(ValueError, match=r"iterations must be in \[0, 1000000\] \(got 4294967296\)"):
         rsmooth.smooth(v, f, method="taubin", iterations=2**32)

@@ -90,11 +90,11 @@ def discrepancy_iterations(v, f, level):
 
 
 def test_region_choice_against_numpy():
-    """The library's choice per region equals scripts/region_study.py's independent numpy blend
+    """The library's choice per region equals region_blend.py's independent numpy blend
     at the library's bounds, on one mesh of a box (flat faces and creases: the filter's result)
     and a ball (curved at triangle scale: Taubin's), and each part goes its own way."""
-    sys.path.insert(0, str(ROOT / "scripts"))
-    from region_study import LIBRARY, blend
+    sys.path.insert(0, str(ROOT / "tests" / "python"))
+    from region_blend import LIBRARY, blend
 
     bv, bf = box(10)
     gv, gf = ball(8)

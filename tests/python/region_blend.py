@@ -1,43 +1,19 @@
-"""The choice per region (lib/passes/region_choice.c): its bounds fitted with cross-validation that
-leaves whole meshes out, from an independent numpy implementation of the blend.
+"""An independent numpy copy of the best mode's choice per region (lib/passes/region_choice.c) and
+of the fold guard (lib/stages/fold_guard.c), written from their descriptions, for
+test_normal_update.py to compare the library against.
 
-    python3 scripts/region_study.py --cases /work/cases/manifest.json \
-        --stage docs/results/calibration_stage.json --out docs/results/region_study.json
-
-For every case: F, the best mode's result with the stage setting the case's fold chose
-(calibration_stage.json, from scripts/calibrate_stage.py fit; no --auto, so no blend), and T,
-Taubin's smoothing of the input with the iterations the command's --auto reports (the discrepancy
-principle at the estimated noise). Then, for each candidate (low, high, spread): per vertex, the
-share of the pairs of facets sharing an edge at it whose normals in F lie within 2 degrees,
-spread over `spread` rings, the weight w = clamp((share - low) / (high - low)), the result
-w F + (1 - w) T, boundary vertices limited to the noise level in their edge lengths from the
-input; E_v and theta by `rsmooth compare`. The bounds are chosen per left-out group on the other
-groups (lowest mean ratio of E_v to each case's best candidate); the figures reported for a case
-come from bounds that never saw that mesh.
-
-`--check` compares the library's own blend (`--best --auto` with the fold's stage) with this
-script's at the library's bounds: the largest vertex difference, in mean edge lengths."""
-import argparse
+blend(x_in, F, T, faces, level, low, high, rounds): per vertex, the share of the pairs of facets
+sharing an edge at it whose normals in F (the filter's result) lie within 2 degrees, spread over
+`rounds` rings, the weight w = clamp((share - low) / (high - low)), the result w F + (1 - w) T
+(T: Taubin's smoothing of the input), boundary vertices limited to the noise level in their edge
+lengths from the input, then the fold guard. (The bounds were fitted with cross-validation that
+leaves whole meshes out; docs/maintainers/studies.md says where that study is kept.)"""
 import itertools
-import json
-import os
-import re
-import statistics
-import subprocess
-import sys
-import tempfile
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from obj_mesh import read_obj, write_obj  # noqa: E402
-
-LOWS = [0.1, 0.2, 0.3, 0.4]
-WIDTHS = [0.3, 0.4, 0.6]
-SPREADS = [3, 6]
 LIBRARY = (0.2, 0.8, 6)  # region_choice.c's SHARE_LOW, SHARE_HIGH, SHARE_SPREAD
 FLAT_ANGLE = np.radians(2.0)
-
 
 def weld(x):
     """Each vertex's representative: the lowest-numbered vertex at exactly its position."""
@@ -245,105 +221,3 @@ def blend(x_in, f_xyz, t_xyz, faces, level, low, high, rounds, parts=None):
     out[clamp] = x_in[clamp] + d[clamp] * (limit[clamp] / move[clamp])[:, None]
     return fold_guard(x_in, out, faces), float(w.mean())
 
-
-def run(rsmooth, args):
-    p = subprocess.run([rsmooth] + args, capture_output=True, text=True)
-    if p.returncode:
-        sys.exit("region_study.py: %s: %s" % (" ".join(args), p.stderr))
-    return p
-
-
-def compare(rsmooth, path, truth):
-    return json.loads(run(rsmooth, ["compare", path, truth, "--json"]).stdout)
-
-
-def case_inputs(rsmooth, case, stage, tmp):
-    """F, T, the level and the input, each as a vertex array, and the faces."""
-    f_path, t_path = os.path.join(tmp, "f.obj"), os.path.join(tmp, "t.obj")
-    stage = [o for o in stage if o != "--auto"]  # F: the stage and its pass, no choice
-    # (nor the fold guard, which the library runs after the choice, as blend() does)
-    run(rsmooth, [case["noisy"], "-o", f_path, "-f", "-q", "--no-guard"] + stage)
-    p = run(rsmooth, [case["noisy"], "-o", os.path.join(tmp, "a.obj"), "-f", "--json", "--auto"]
-            + stage)
-    report = json.loads(p.stdout.strip().splitlines()[-1])
-    level = float(re.search(r"noise estimate ([0-9.eE+-]+)", p.stderr).group(1))
-    if "impulsive" in p.stderr:
-        level = report.get("discrepancy_level", level)
-    iterations = report.get("region_choice", {}).get("taubin_iterations", 0)
-    run(rsmooth, [case["noisy"], "-o", t_path, "-f", "-q", "--method", "taubin", "--iterations",
-                  str(max(iterations, 1))])
-    x_in, faces = read_obj(case["noisy"])
-    return (x_in, read_obj(f_path)[0], read_obj(t_path)[0] if iterations else read_obj(f_path)[0],
-            faces, report.get("discrepancy_level", level), iterations)
-
-
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--cases", required=True)
-    ap.add_argument("--stage", default="docs/results/calibration_stage.json")
-    ap.add_argument("--rsmooth", default="build/rsmooth")
-    ap.add_argument("--out", default="docs/results/region_study.json")
-    ap.add_argument("--only", default="")
-    ap.add_argument("--check", action="store_true")
-    args = ap.parse_args()
-    cases = json.load(open(args.cases))["cases"]
-    if args.only:
-        cases = [c for c in cases if c["name"] in args.only.split(",")]
-    fold = {r["case"]: r["setting"].split() for r in json.load(open(args.stage))["rows"]}
-    grid = [(lo, lo + w, s) for lo in LOWS for w in WIDTHS for s in SPREADS]
-    table = {}
-    with tempfile.TemporaryDirectory() as tmp:
-        for case in cases:
-            x_in, f_xyz, t_xyz, faces, level, iterations = case_inputs(
-                args.rsmooth, case, fold[case["name"]], tmp)
-            parts = vertex_shares(f_xyz, faces)
-            row = {"level": level, "taubin_iterations": iterations,
-                   "filter": compare(args.rsmooth, os.path.join(tmp, "f.obj"), case["truth"]),
-                   "taubin": compare(args.rsmooth, os.path.join(tmp, "t.obj"), case["truth"])}
-            if args.check:
-                mine, _ = blend(x_in, f_xyz, t_xyz, faces, level, *LIBRARY, parts=parts)
-                lib = read_obj(os.path.join(tmp, "a.obj"))[0]
-                unit = np.mean(np.linalg.norm(x_in[faces[:, 0]] - x_in[faces[:, 1]], axis=1))
-                row["check_max_gap"] = float(np.abs(mine - lib).max() / unit)
-                print("%s: library vs numpy blend: %.3g mean edge lengths" % (
-                    case["name"], row["check_max_gap"]), flush=True)
-            for lo, hi, s in ([] if args.check else grid):
-                out, mean_w = blend(x_in, f_xyz, t_xyz, faces, level, lo, hi, s, parts=parts)
-                path = os.path.join(tmp, "b.obj")
-                write_obj(path, out, faces)
-                m = compare(args.rsmooth, path, case["truth"])
-                row["%g %g %d" % (lo, hi, s)] = {"ev": m["ev"], "theta": m["theta"],
-                                                 "filter_share": mean_w}
-            table[case["name"]] = row
-            if not args.check:
-                print("%-22s filter %.3f taubin %.3f best blend %.3f" % (
-                    case["name"], row["filter"]["ev"], row["taubin"]["ev"],
-                    min(row["%g %g %d" % g]["ev"] for g in grid)), flush=True)
-    if args.check:
-        return
-    keys = ["%g %g %d" % g for g in grid]
-
-    def ratio(c, k):
-        return table[c][k]["ev"] / min(table[c][q]["ev"] for q in keys)
-
-    groups = sorted({c["group"] for c in cases})
-    rows = []
-    for g in groups:
-        train = [c["name"] for c in cases if c["group"] != g]
-        k = min(keys, key=lambda q: statistics.mean(ratio(c, q) for c in train))
-        for c in (c["name"] for c in cases if c["group"] == g):
-            rows.append({"case": c, "bounds": k, "ev": table[c][k]["ev"],
-                         "theta": table[c][k]["theta"], "filter_ev": table[c]["filter"]["ev"],
-                         "taubin_ev": table[c]["taubin"]["ev"]})
-    chosen_all = min(keys, key=lambda q: statistics.mean(ratio(c["name"], q) for c in cases))
-    with open(args.out, "w") as f:
-        json.dump({"grid": {"low": LOWS, "width": WIDTHS, "spread": SPREADS},
-                   "chosen_all": chosen_all, "rows": rows, "table": table}, f, indent=1)
-    for r in rows:
-        print("%-22s bounds %-12s E_v %.3f (filter %.3f, taubin %.3f)" % (
-            r["case"], r["bounds"], r["ev"], r["filter_ev"], r["taubin_ev"]))
-    print("bounds fitted on all groups (low high spread):", chosen_all)
-
-
-if __name__ == "__main__":
-    main()
