@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # scripts/skipped-checks.sh, which make check runs after ctest: a test that passed with some checks
-# skipped (its data absent) is counted and named, with its lines; other tests, and a test's own
-# count of commands it was told to skip ("skipped (marked)"), are not.
+# skipped (its data absent) is counted and named, with its lines; other tests, a test's own count
+# of commands it was told to skip ("skipped (marked)"), and a whole test ctest skipped, are not.
 set -uo pipefail
 script=$1
 . "$(dirname "$0")/command_util.sh"
@@ -35,14 +35,24 @@ Output:
 clean meshes: /nowhere/data/clean absent, skipped
 <end of output>
 Test Passed.
+4/4 Testing: cl_grid
+4/4 Test: cl_grid
+Output:
+----------------------------------------------------------
+skipping (set RSMOOTH_REQUIRE_OPENCL=1 to make this a failure)
+<end of output>
+Test time =   0.01 sec
+----------------------------------------------------------
+Test Skipped.
 End testing: Dec 07 06:19 UTC
 LOG
 expect 0 "$script" LastTest.log
-head -1 out.txt | grep -qx "2 tests passed with checks skipped (their data absent):" ||
+head -1 out.txt | grep -qx "2 tests passed with checks skipped (data or a capability absent):" ||
   fail "no count of 2: $(cat out.txt)"
 grep -qx "  metrics" out.txt && grep -qx "  do_no_harm" out.txt || fail "tests not named: $(cat out.txt)"
 [ "$(grep -c 'absent, skipped' out.txt)" -eq 3 ] || fail "not the 3 lines: $(cat out.txt)"
 grep -q docs_commands out.txt && fail "counted a test's marked skips: $(cat out.txt)"
+grep -q cl_grid out.txt && fail "counted a test ctest skipped whole: $(cat out.txt)"
 
 # nothing skipped: nothing printed
 sed -i '/absent, skipped/d' LastTest.log

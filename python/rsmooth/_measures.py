@@ -55,7 +55,11 @@ def auto_params(vertices: Any, faces: Any, *, best: bool = False) -> Dict[str, A
 
 def mean_edge_length(vertices: Any, faces: Any) -> float:
     """Mean length of the mesh's unique undirected edges, in its units: the unit of relative
-    sigmas."""
+    sigmas. The same figure as the command's ``--json`` ``mean_edge_length`` and ``rsmooth compare
+    --json``'s ``mean_edge`` for the same vertices and faces. An STL file holds every triangle's
+    own corners: the command reads them as they are (each triangle's edges its own), while
+    ``trimesh.load`` merges equal vertices by default, so an open mesh's figure can differ
+    between the two (``trimesh.load(path, process=False)`` reads it as the command does)."""
     v = _vertices(vertices)
     return _rsmooth._mean_edge_length(v, _faces(faces, v.shape[0]))
 
