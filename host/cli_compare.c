@@ -40,8 +40,10 @@ static const char compare_usage[] =
     "\n"
     "Options:\n"
     "  --json      print one JSON object with the keys theta, ev, rms_v, hausdorff, mean_edge,\n"
-    "              bbox_diag, vertices and faces (triangles), in the units above; a figure\n"
-    "              that does not exist (no face with area) is null\n"
+    "              bbox_diag (in the units above; a figure that does not exist, no face with\n"
+    "              area, is null), theta_count (the triangles theta averages), vertices and\n"
+    "              triangles (faces fanned into triangles): the keys of Python's\n"
+    "              rsmooth.compare. \"faces\", the triangles' old key, is kept until 0.12\n"
     "  -h, --help  print this help\n"
     "\n"
     "The figures agree with ../shared/tools/meshmetrics.py, except that ev there tries only the\n"
@@ -142,7 +144,9 @@ int cli_compare_main(int argc, char **argv) {
         print_json_number("hausdorff", m.hausdorff, false);
         print_json_number("mean_edge", m.mean_edge, false);
         print_json_number("bbox_diag", m.bbox_diag, false);
-        printf("\"vertices\": %zu, \"faces\": %zu}\n", m.vertex_count, m.triangle_count);
+        /* the keys rsmooth.compare returns; "faces" (the triangles) goes in 0.12 */
+        printf("\"theta_count\": %zu, \"vertices\": %zu, \"triangles\": %zu, \"faces\": %zu}\n",
+               m.theta_count, m.vertex_count, m.triangle_count, m.triangle_count);
     } else {
         printf("theta      %.6g degrees\n"
                "ev         %.6g thousandths of the bounding-box diagonal\n"

@@ -51,8 +51,18 @@ static int short_option(cli_getopt_state *s, const char **value) {
         o++;
     snprintf(s->spelled, sizeof s->spelled, "-%c", letter);
     if (!o->name) {
+        /* "-sigma-f": a long name with one dash, its first letter no option */
+        const char *eq = strchr(s->word, '=');
+        size_t length = eq ? (size_t)(eq - s->word) : strlen(s->word);
+        const char *near = s->cluster == s->word + 1 && length > 1
+                               ? nearest_name(s->table, s->word, length)
+                               : NULL;
         s->cluster = NULL;
-        cli_usage_error(s->command, "unknown option '-%c'", letter);
+        if (near)
+            cli_usage_error(s->command, "unknown option '-%.*s' (did you mean --%s?)",
+                            (int)(length < 60 ? length : 60), s->word, near);
+        else
+            cli_usage_error(s->command, "unknown option '-%c'", letter);
         return CLI_GETOPT_ERROR;
     }
     if (!o->takes_value) {
@@ -77,6 +87,17 @@ int cli_getopt(cli_getopt_state *s, const char **value) {
         return CLI_GETOPT_OPERAND;
     }
     if (a[1] != '-') { /* -o FILE, -oFILE, -fq */
+        /* a long name after one dash ("-force", "-output x") is that typo, not -f -o rce */
+        const char *eq = strchr(a + 1, '=');
+        size_t length = eq ? (size_t)(eq - (a + 1)) : strlen(a + 1);
+        for (const cli_option *o = s->table; o->name && length > 1; o++)
+            if (strlen(o->name) == length && !strncmp(o->name, a + 1, length)) {
+                snprintf(s->spelled, sizeof s->spelled, "--%s", o->name);
+                cli_usage_error(s->command, "unknown option '-%s' (did you mean --%s?)", o->name,
+                                o->name);
+                return CLI_GETOPT_ERROR;
+            }
+        s->word = a + 1;
         s->cluster = a + 1;
         return short_option(s, value);
     }

@@ -4,7 +4,9 @@
  * Accepted: "--name value" and "--name=value" for every option that takes a value; "-o FILE" and
  * "-oFILE"; short flags grouped ("-fq"); options before, between and after the operands; "--"
  * ends the options (everything after it is an operand, even "-x"); a lone "-" is an operand
- * (standard input or output). A value may begin with '-' ("--mu -0.45").
+ * (standard input or output). A value may begin with '-' ("--mu -0.45"). A long name after one
+ * dash ("-force", "-sigma-f") is refused with the two-dash spelling suggested, not read as a group
+ * of letters ("-f -o rce").
  *
  * Why not getopt_long: it accepts abbreviations ("--forc"), so an option added later can make a
  * user's script ambiguous; it prints its own messages (not naming the command the way the rest of
@@ -32,6 +34,7 @@ typedef struct cli_getopt_state {
     const cli_option *table;
     int next;            /* the next argv index to look at */
     const char *cluster; /* the rest of a group of short flags ("-fq"), or NULL */
+    const char *word;    /* the whole group, after its '-' ("fq"): a long name with one dash? */
     bool operands_only;  /* after "--" */
     char spelled[64];    /* the option as to name it in messages: "--sigma-f", "-o" */
 } cli_getopt_state;

@@ -24,6 +24,7 @@ void cli_progress_init(cli_progress *bar, bool quiet, bool force) {
     bar->show_after_ms = force ? 0 : SHOW_AFTER_MS;
     bar->redraw_ms = terminal ? REDRAW_MS : LINE_MS;
     bar->drawn = false;
+    bar->shown = false;
     bar->start_ms = cli_now_ms();
     bar->last_draw_ms = 0;
     bar->stage_from = 0;
@@ -38,13 +39,10 @@ void cli_progress_stage(cli_progress *bar, const char *stage, double from, doubl
     cli_progress_update(bar, 0);
 }
 
-void cli_progress_update(cli_progress *bar, double fraction) {
-    if (!bar->enabled)
-        return;
-    double now = cli_now_ms();
-    if (now - bar->start_ms < bar->show_after_ms || now - bar->last_draw_ms < bar->redraw_ms)
-        return;
+/* Draws the bar at `fraction` of the current stage, `now`. */
+static void draw(cli_progress *bar, double fraction, double now) {
     bar->last_draw_ms = now;
+    bar->shown = true;
     double whole = bar->stage_from + (bar->stage_to - bar->stage_from) * fraction;
     int filled = (int)(whole * WIDTH + 0.5);
     char cells[WIDTH + 1];
@@ -56,6 +54,29 @@ void cli_progress_update(cli_progress *bar, double fraction) {
             bar->lines ? "\n" : "");
     fflush(stderr);
     bar->drawn = !bar->lines; /* a whole line needs no clearing */
+}
+
+void cli_progress_update(cli_progress *bar, double fraction) {
+    if (!bar->enabled)
+        return;
+    double now = cli_now_ms();
+    if (now - bar->start_ms < bar->show_after_ms || now - bar->last_draw_ms < bar->redraw_ms)
+        return;
+    draw(bar, fraction, now);
+}
+
+void cli_progress_done(cli_progress *bar) {
+    if (!bar->enabled || !(bar->shown || bar->show_after_ms == 0))
+        return;
+    bar->stage = "done";
+    bar->stage_from = 1;
+    bar->stage_to = 1;
+    draw(bar, 1, cli_now_ms());
+    if (bar->drawn && bar->show_after_ms == 0) { /* --progress on a terminal: the line stays */
+        fputc('\n', stderr);
+        fflush(stderr);
+        bar->drawn = false;
+    }
 }
 
 void cli_progress_callback(void *user, double fraction) {

@@ -11,6 +11,7 @@ typedef struct cli_progress {
     bool lines;   /* forced where stderr is no terminal: whole lines, no carriage returns */
     double show_after_ms, redraw_ms;
     bool drawn;      /* something is on the line, to be cleared */
+    bool shown;      /* the bar was drawn at least once */
     double start_ms; /* when the work began */
     double last_draw_ms;
     double stage_from, stage_to; /* the current stage's share of the whole bar */
@@ -28,6 +29,11 @@ void cli_progress_update(cli_progress *bar, double fraction);
 
 /* rsmooth_progress_fn adapter: `user` is a cli_progress. */
 void cli_progress_callback(void *user, double fraction);
+
+/* The work is done: the bar at 100% ("done"), drawn however soon after the last drawing, where it
+ * was shown or is forced (--progress), so that a quick run's bar does not end at its first state.
+ * --progress on a terminal leaves that line; otherwise cli_progress_clear clears it as before. */
+void cli_progress_done(cli_progress *bar);
 
 /* Clears the bar's line (before printing anything else, and at the end). */
 void cli_progress_clear(cli_progress *bar);

@@ -89,7 +89,15 @@ void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read,
     cli_print_json_string(opt->input);
     printf(",\"output\":");
     cli_print_json_string(opt->output);
-    printf(",\"method\":\"%s\"", cli_method_names[opt->method]);
+    /* what ran: --auto's blend per region is the filter and Taubin's smoothing; --auto on a mesh
+     * that reads clean ran nothing */
+    const char *ran = cli_method_names[opt->method];
+    if (r->discrepancy_iterations > 0)
+        ran = "robust+taubin";
+    else if (!cli_method_uses_edges(opt->method) && opt->params.passes == 0 &&
+             opt->params.vertex_updates == 0)
+        ran = "none";
+    printf(",\"method\":\"%s\"", ran);
     if (r->discrepancy_iterations > 0) /* --auto's choice per region: blended with Taubin's */
         printf(",\"region_choice\":{\"taubin_iterations\":%d,\"lambda\":0.5,\"mu\":-0.53,"
                "\"filter_share\":%.4f}",
@@ -131,7 +139,9 @@ void cli_print_json(const rsmooth_report *r, const options *opt, double ms_read,
             printf(",\"noise_correlated\":%.9g,\"noise_correlation_length\":%.9g",
                    opt->noise_correlated, opt->noise_correlation_length);
     }
-    printf(",\"vertices\":%zu,\"triangles\":%zu,\"facets\":%zu,\"mean_edge_length\":%.9g,"
+    /* mean_edge_length to the last bit: the figure rsmooth compare's mean_edge and Python's
+     * rsmooth.mean_edge_length give for the same file */
+    printf(",\"vertices\":%zu,\"triangles\":%zu,\"facets\":%zu,\"mean_edge_length\":%.17g,"
            "\"sigma_f\":%.9g,",
            r->vertex_count, r->triangle_count, r->facet_count, r->mean_edge_length, r->sigma_f);
     if (isinf(r->sigma_g))

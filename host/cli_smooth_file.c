@@ -171,6 +171,8 @@ static int write_results(file_job *job) {
     mesh->positions = input_positions;
     mesh->vertex_normals = input_normals;
     job->ms_write = cli_now_ms() - t1;
+    if (code == EXIT_OK)
+        cli_progress_done(&job->bar);
     cli_progress_clear(&job->bar);
     return code;
 }

@@ -133,6 +133,8 @@ int cli_stream_file(const options *opt, const char *path) {
     rsmooth_stream_report_init(&rep);
     rsmooth_error err;
     rsmooth_status st = rsmooth_stream_smooth(ctx, path, opt->output, &params, &so, &rep, &err);
+    if (st == RSMOOTH_OK)
+        cli_progress_done(&bar);
     cli_progress_clear(&bar);
     rsmooth_context_destroy(ctx);
     if (st != RSMOOTH_OK) {

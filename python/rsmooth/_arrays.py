@@ -9,15 +9,19 @@ import numpy as np
 
 
 def _vertices(array: Any, name: str = "vertices") -> np.ndarray:
-    """(n, 3) float32 or float64, C-contiguous (a copy only when the input is not)."""
+    """(n, 3) float32 or float64, C-contiguous (a copy only when the input is not). Any real
+    floating dtype is taken: float16 is worked on as float32, one wider than float64 (numpy's
+    longdouble) as float64; _result gives the result back in the caller's dtype."""
     a = np.asarray(array)
     if a.dtype not in (np.float32, np.float64):
-        if a.dtype.kind in "iub" or a.dtype == np.float16:
+        if a.dtype.kind in "iub":
             raise TypeError(
-                f"{name}: dtype {a.dtype} is not float32 or float64 "
+                f"{name}: dtype {a.dtype} is not a floating-point dtype "
                 f"(convert first, e.g. {name}.astype(np.float64))"
             )
-        raise TypeError(f"{name}: expected a float32 or float64 array, got dtype {a.dtype}")
+        if a.dtype.kind != "f":
+            raise TypeError(f"{name}: expected a real floating-point array, got dtype {a.dtype}")
+        a = a.astype(np.float32 if a.dtype.itemsize < 4 else np.float64)
     if a.ndim != 2 or a.shape[1] != 3:
         raise ValueError(f"{name}: expected shape (n, 3), got {a.shape}")
     if a.shape[0] == 0:
@@ -25,6 +29,15 @@ def _vertices(array: Any, name: str = "vertices") -> np.ndarray:
     if a.shape[0] >= 2**32:
         raise ValueError(f"{name}: {a.shape[0]} vertices; at most 2**32 - 1")
     return np.ascontiguousarray(a)
+
+
+def _result(out: np.ndarray, given: Any) -> np.ndarray:
+    """`out` in the dtype of the caller's `given` array where that is another floating dtype
+    (float16, longdouble): the dtype in is the dtype out."""
+    dtype = getattr(given, "dtype", None)
+    if dtype is not None and np.dtype(dtype).kind == "f" and np.dtype(dtype) != out.dtype:
+        return out.astype(dtype)
+    return out
 
 
 def _faces(array: Any, vertex_count: int, name: str = "faces") -> np.ndarray:

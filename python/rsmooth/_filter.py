@@ -12,10 +12,17 @@ from typing import TYPE_CHECKING, Any, Optional, Tuple, overload
 import numpy as np
 
 from . import _rsmooth
-from ._arrays import _colors, _faces, _mask, _vertices
+from ._arrays import _colors, _faces, _mask, _result, _vertices
 from ._context import Context, _check_device
-from ._meshes import MeshInput, is_mesh_object, read
-from ._options import _METHODS, Progress, _numpy_bool, _params, _progress_callable
+from ._meshes import MeshInput, is_mesh_object, read, scene_error
+from ._options import (
+    _METHODS,
+    Progress,
+    _filter_params,
+    _numpy_bool,
+    _params,
+    _progress_callable,
+)
 from ._rsmooth import DeviceError
 from ._typing import PointOptions, SmoothOptions
 
@@ -128,7 +135,9 @@ def smooth(
 
     Parameters
     ----------
-    vertices : (n, 3) float32 or float64 array-like, any strides or order; or a mesh object, with
+    vertices : (n, 3) array-like of a real floating dtype, any strides or order (float32 and
+        float64 are filtered as they are, float16 in float32 and longdouble in float64; the
+        result has the input's dtype; integer dtypes raise TypeError); or a mesh object, with
         no ``faces``: a ``trimesh.Trimesh``, ``open3d.geometry.TriangleMesh``, triangulated
         ``pyvista.PolyData`` or ``meshio.Mesh`` (its triangle cells), for which a new object of
         the same type comes back with every other attribute kept (normals recomputed where the
@@ -264,6 +273,9 @@ def smooth(
 
 def _mesh_input(first: Any, second: Any, points: bool) -> Optional[MeshInput]:
     """The arrays of a mesh object passed alone; None for arrays (which need their second)."""
+    scene = scene_error(first, points)
+    if scene is not None:
+        raise TypeError(scene)
     if is_mesh_object(first):
         if second is not None:
             what = "normals" if points else "faces"
@@ -329,14 +341,9 @@ def _smooth(
                 raise ValueError(f"mu must be in [-1, 0) for method 'taubin' (got {m!r})")
         # lam, mu and iterations go as given: the extension checks their types and ranges
         _rsmooth._taubin(v, f, out, lam, mu if method == "taubin" else 0.0, iterations)
-        return out.reshape(shape_in)
-    if method == "gaussian":  # the isotropic baseline: centroids, no influence weight
-        overrides.update(predictor="centroid", sigma_g=float("inf"), mollify=False)
-    params, _ = _params(v, f, best=best, auto=auto, overrides=overrides)
-    if colors is not None:
-        params["colors"] = _colors(colors, v.shape[0])
-    if mask is not None:
-        params["move_mask"] = _mask(mask, v.shape[0])
+        return _result(out, vertices).reshape(shape_in)
+    params = _filter_params(v, f, v.shape[0], best=best, auto=auto, colors=colors, mask=mask,
+                            method=method, overrides=overrides)
     conf = np.empty(v.shape[0], dtype=np.float32) if confidence else None
     call, bar = _progress_callable(progress)
     try:
@@ -348,7 +355,7 @@ def _smooth(
             bar.close()
     if context is not None:
         context.last_report = report
-    out = out.reshape(shape_in)
+    out = _result(out, vertices).reshape(shape_in)
     return (out, conf) if confidence else out
 
 
@@ -404,10 +411,11 @@ def smooth_points(
     """The filter on a point cloud with normals: each point is its own facet, its plane the
     tangent plane through it, its area from the spacing of its 6 nearest neighbours.
 
-    ``points`` and ``normals``: (n, 3), float32 or float64 (normals of any non-zero length,
-    consistently oriented). Sigmas are in point spacings (:func:`point_spacing`) unless
-    ``absolute``. With ``mollify`` (default) the normals are smoothed by the bilateral normal
-    filter first. Runs on the CPU reference path (double precision).
+    ``points`` and ``normals``: (n, 3), of a real floating dtype as :func:`smooth`'s vertices
+    (normals of any non-zero length, consistently oriented). Sigmas are in point spacings
+    (:func:`point_spacing`) unless ``absolute``. With ``mollify`` (default) the normals are
+    smoothed by the bilateral normal filter first. Runs on the CPU reference path (double
+    precision).
 
     ``points`` may instead be a point cloud object with normals, and no ``normals`` given: an
     ``open3d.geometry.PointCloud`` or a ``pyvista.PolyData`` of vertices with
@@ -459,5 +467,8 @@ def smooth_points(
     finally:
         if bar is not None:
             bar.close()
+    out = _result(out, points)
+    if out_n is not None:
+        out_n = _result(out_n, points)
     result = (out,) + ((out_n,) if return_normals else ()) + ((conf,) if confidence else ())
     return result if len(result) > 1 else out

@@ -28,10 +28,12 @@ def auto_params(vertices: Any, faces: Any, *, best: bool = False) -> Dict[str, A
     ``kind`` ("gaussian": every vertex displaced, "impulsive": a share of them thrown and the
     others nearly exact, "none": nothing to remove, either nothing measurable or roughness that
     reads as the mesh's own shape, and then the setting leaves every vertex where it is),
-    ``impulsive_fraction`` (the share
-    displaced: 1 unless impulsive), ``tangential_level`` (the displacement along one tangent
-    direction, same unit; NaN when not measured), ``mean_edge_length`` (the clean mesh's, as
-    estimated, in the mesh's units), ``preset`` (the setting chosen, e.g. "paper" or
+    ``impulsive_fraction`` (the share displaced: 1 unless impulsive), ``tangential_level`` (the
+    displacement along one tangent direction, same unit; NaN when not measured),
+    ``mean_edge_length`` (the mesh's as given, in its units: :func:`mean_edge_length`'s figure,
+    the command's ``--json`` ``mean_edge_length`` and :func:`compare`'s ``mean_edge``),
+    ``clean_mean_edge_length`` (the clean mesh's, as estimated: the unit of ``level``; until 0.11
+    this figure was ``mean_edge_length``), ``preset`` (the setting chosen, e.g. "paper" or
     "best: mid"), ``reason`` (why, in words), ``correlated_level`` (the rms along the normal
     including the noise's spatially correlated part, as real range scans have: ``level`` when the
     noise reads uncorrelated), ``correlation_length`` (mean edge lengths; 0: uncorrelated),
@@ -43,13 +45,21 @@ def auto_params(vertices: Any, faces: Any, *, best: bool = False) -> Dict[str, A
     f = _faces(faces, v.shape[0])
     params, report = _params(v, f, best=best, auto=True, overrides={})
     assert report is not None
+    # the library's figure is the clean mesh's, as estimated; under the name every other measure
+    # uses for the mesh as given, it read as a third "mean edge length" of the same file
+    report["clean_mean_edge_length"] = report["mean_edge_length"]
+    report["mean_edge_length"] = _rsmooth._mean_edge_length(v, f)
     report["params"] = _keywords(params)
     return report
 
 
 def mean_edge_length(vertices: Any, faces: Any) -> float:
     """Mean length of the mesh's unique undirected edges, in its units: the unit of relative
-    sigmas."""
+    sigmas. The same figure as the command's ``--json`` ``mean_edge_length`` and ``rsmooth compare
+    --json``'s ``mean_edge`` for the same vertices and faces. An STL file holds every triangle's
+    own corners: the command reads them as they are (each triangle's edges its own), while
+    ``trimesh.load`` merges equal vertices by default, so an open mesh's figure can differ
+    between the two (``trimesh.load(path, process=False)`` reads it as the command does)."""
     v = _vertices(vertices)
     return _rsmooth._mean_edge_length(v, _faces(faces, v.shape[0]))
 
@@ -67,10 +77,15 @@ def compare(result: Any, truth: Any, faces: Any) -> Dict[str, float]:
     (Sun et al.'s area-weighted vertex-to-surface distance E_v, in thousandths of the truth's
     bounding-box diagonal), ``rms_v`` (RMS distance between corresponding vertices, in the
     truth's mean edge lengths), ``hausdorff`` (symmetric, sampled at the vertices, thousandths
-    of the diagonal), and ``theta_count``, ``mean_edge``, ``bbox_diag``, ``vertex_count``,
-    ``triangle_count``. Distances to surfaces are exact."""
+    of the diagonal), and ``theta_count``, ``mean_edge``, ``bbox_diag``, ``vertices``,
+    ``triangles``: the keys of ``rsmooth compare --json``. Distances to surfaces are exact.
+    ``vertex_count`` and ``triangle_count``, the old names of ``vertices`` and ``triangles``, are
+    kept until 0.12."""
     r = _vertices(result, "result")
     t = _vertices(truth, "truth")
     if t.shape != r.shape:
         raise ValueError(f"truth: shape {t.shape} for a result of shape {r.shape}")
-    return _rsmooth._compare(r, t.astype(r.dtype, copy=False), _faces(faces, r.shape[0]))
+    figures = _rsmooth._compare(r, t.astype(r.dtype, copy=False), _faces(faces, r.shape[0]))
+    figures["vertices"] = figures["vertex_count"]  # the command's keys (compare --json)
+    figures["triangles"] = figures["triangle_count"]
+    return figures

@@ -9,6 +9,7 @@ from typing import Any, Callable, Dict, Optional, Tuple, Union
 import numpy as np
 
 from . import _rsmooth
+from ._arrays import _colors, _mask
 
 _NORMAL_FILTERS = {"mollify": 0, "bilateral": 1}
 _INFLUENCES = {"gaussian": 0, "tukey": 1, "lorentzian": 2, "huber": 3}
@@ -62,6 +63,49 @@ def _params(
         params, report = _rsmooth._params_auto(vertices, faces, rule)
     params.update(given)
     return params, report
+
+
+def _filter_params(
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    vertex_count: int,
+    *,
+    best: bool,
+    auto: bool,
+    colors: Any,
+    mask: Any,
+    method: str,
+    overrides: Dict[str, Any],
+) -> Dict[str, Any]:
+    """The library's parameters of one filter call, the same for rsmooth.smooth and
+    Context.smooth on numpy or PyOpenCL arrays: the method's setting ("robust" or "gaussian"),
+    the preset, the noise rule, the keywords, the colours and the mask, all checked before any
+    work. `vertices`: the positions on the host (only read with `auto`, and for the check that
+    the normal update stage has edges: an empty array where they are not on the host)."""
+    if method not in ("robust", "gaussian"):
+        raise ValueError(f"method: expected one of {', '.join(_METHODS)}, got {method!r}")
+    if method == "gaussian":  # the isotropic baseline: centroids, no influence weight
+        overrides = dict(overrides, predictor="centroid", sigma_g=float("inf"), mollify=False)
+    params, _ = _params(vertices, faces, best=best, auto=auto, overrides=overrides)
+    updates: Any = params.get("vertex_updates")  # (any type here: the extension checks it)
+    whole = isinstance(updates, (int, np.integer)) and not isinstance(updates, bool)
+    if whole and updates > 0 and not params["absolute"] and (
+        faces.shape[0] == 0
+        or (len(vertices) == vertex_count and _rsmooth._mean_edge_length(vertices, faces) == 0)
+    ):
+        # the library would go on to the pass with a relative sigma_f of 0 mean edge lengths
+        # and blame sigma_f; the reason is the mesh's
+        raise ValueError(
+            "faces: " + ("none given" if faces.shape[0] == 0 else "no edge of non-zero length")
+            + ": the normal update stage (best=True or vertex_updates) needs triangles, and the "
+            "mesh's mean edge length, the unit of relative sigmas, is 0 (points with normals: "
+            "rsmooth.smooth_points)"
+        )
+    if colors is not None:
+        params["colors"] = _colors(colors, vertex_count)
+    if mask is not None:
+        params["move_mask"] = _mask(mask, vertex_count)
+    return params
 
 
 def _keywords(params: Dict[str, Any]) -> Dict[str, Any]:

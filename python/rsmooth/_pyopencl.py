@@ -10,8 +10,8 @@ from typing import TYPE_CHECKING, Any, Optional
 import numpy as np
 
 from . import _rsmooth
-from ._arrays import _colors, _faces, _mask
-from ._options import _params, _progress_callable
+from ._arrays import _faces
+from ._options import _filter_params, _progress_callable
 
 if TYPE_CHECKING:  # pragma: no cover
     from ._context import Context
@@ -112,15 +112,13 @@ def smooth_array(
     vertices.finish()
     if vertices.queue is not None and vertices.queue is not queue:
         vertices.queue.finish()
-    if method == "gaussian":
-        overrides.update(predictor="centroid", sigma_g=float("inf"), mollify=False)
     # `auto` reads the noise from the positions: one more read to the host, for it alone
     host = vertices.get(queue) if auto else np.empty((0, 3), dtype=dtype)
-    params, _ = _params(host, f, best=best, auto=auto, overrides=overrides)
-    if colors is not None:
-        params["colors"] = _colors(colors.get() if _is_device_array(colors) else colors, n)
-    if mask is not None:
-        params["move_mask"] = _mask(mask.get() if _is_device_array(mask) else mask, n)
+    params = _filter_params(
+        host, f, n, best=best, auto=auto, method=method, overrides=overrides,
+        colors=colors.get() if _is_device_array(colors) else colors,
+        mask=mask.get() if _is_device_array(mask) else mask,
+    )
     import pyopencl.array as cl_array  # the caller passed an array: pyopencl is there
 
     out: Any = cl_array.empty(queue, (n, 3), dtype)  # (its base_data a buffer: made here)

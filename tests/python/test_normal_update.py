@@ -202,7 +202,8 @@ def test_auto_params_reads_gaussian_noise():
     # noise in every direction: the tangential part about the normal one
     assert 0.15 < paper["tangential_level"] < 0.45, paper
     edge = rsmooth.mean_edge_length(truth, f)
-    assert paper["mean_edge_length"] == pytest.approx(edge, rel=0.1)
+    assert paper["clean_mean_edge_length"] == pytest.approx(edge, rel=0.1)
+    assert paper["mean_edge_length"] == rsmooth.mean_edge_length(v, f)  # the mesh's as given
     assert paper["preset"] == "paper"
     assert "Gaussian" in paper["reason"] and "sigma_f" in paper["reason"]
     assert paper["params"]["sigma_f"] == pytest.approx(0.6 + 1.6 * paper["level"])
