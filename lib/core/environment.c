@@ -27,8 +27,8 @@ static const rs_environment_entry table[RS_ENV_COUNT] = {
     [RS_ENV_CACHE_DIR] = {"RSMOOTH_CACHE_DIR",
                           "the folder of the compiled-program cache; empty or off: no cache",
                           "$XDG_CACHE_HOME/rsmooth, else $HOME/.cache/rsmooth", NULL},
-    [RS_ENV_XDG_CACHE_HOME] = {"XDG_CACHE_HOME", "where the program cache goes by default",
-                               "unset", NULL},
+    [RS_ENV_XDG_CACHE_HOME] = {"XDG_CACHE_HOME", "where the program cache goes by default", "unset",
+                               NULL},
     [RS_ENV_HOME] = {"HOME", "where the program cache goes when XDG_CACHE_HOME is unset", "unset",
                      NULL},
     [RS_ENV_STAGE] = {"RSMOOTH_STAGE",
@@ -106,7 +106,7 @@ static bool read_integer(const char *text, long *out) {
 }
 
 long rs_environment_integer(const rs_environment *env, rs_env name, long low, long high,
-                           long fallback) {
+                            long fallback) {
     long v = 0;
     const char *text = env->value[name];
     return text && read_integer(text, &v) && v >= low && v <= high ? v : fallback;
@@ -133,8 +133,8 @@ rsmooth_status rs_environment_check(const rs_environment *env, rsmooth_error *er
             continue;
         const char *dots = strstr(accepted, "..");
         long low = 0, high = 0, n = 0;
-        bool ok = dots ? read_integer(v, &n) && (low = atol(accepted), high = atol(dots + 2),
-                                                 n >= low && n <= high)
+        bool ok = dots ? read_integer(v, &n) &&
+                             (low = atol(accepted), high = atol(dots + 2), n >= low && n <= high)
                        : one_of(v, accepted);
         if (!ok)
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,

@@ -11,23 +11,23 @@
 #include <stddef.h>
 
 typedef enum rs_env {
-    RS_ENV_DEVICE,           /* the device of a context created without one */
-    RS_ENV_MEMORY_BUDGET,    /* a context's device memory budget, a byte count */
-    RS_ENV_HOST_THREADS,     /* threads of the host stages */
-    RS_ENV_CACHE_DIR,        /* the program cache's folder; "" or "off": none */
-    RS_ENV_XDG_CACHE_HOME,   /* ... else $XDG_CACHE_HOME/rsmooth */
-    RS_ENV_HOME,             /* ... else $HOME/.cache/rsmooth */
-    RS_ENV_STAGE,            /* where the normal-update stage runs: host or device */
-    RS_ENV_STAGE_PRECISION,  /* the device stage's type: double or float */
-    RS_ENV_KERNEL_VARIANT,   /* cpu or gpu kernels */
-    RS_ENV_LANES,            /* vertices per block of the cpu kernels: 4, 8 or 16 */
-    RS_ENV_DEVICE_GRID,      /* 1: sort the grid on the device; 0: on the host */
-    RS_ENV_BILATERAL_LISTS,  /* 0: the bilateral rounds search the grid every round */
-    RS_ENV_CELLS_PER_REACH,  /* grid cells per reach, 1 to 8 */
-    RS_ENV_KERNEL_DIR,       /* kernels/ *.cl read from this folder instead of the embedded ones */
-    RS_ENV_BUILD_OPTIONS,    /* appended to the OpenCL build options */
-    RS_ENV_OPENCL_LIBRARY,   /* the OpenCL loader's file */
-    RS_ENV_NAMED_TEMPORARY,  /* 1: output files go through a named temporary */
+    RS_ENV_DEVICE,          /* the device of a context created without one */
+    RS_ENV_MEMORY_BUDGET,   /* a context's device memory budget, a byte count */
+    RS_ENV_HOST_THREADS,    /* threads of the host stages */
+    RS_ENV_CACHE_DIR,       /* the program cache's folder; "" or "off": none */
+    RS_ENV_XDG_CACHE_HOME,  /* ... else $XDG_CACHE_HOME/rsmooth */
+    RS_ENV_HOME,            /* ... else $HOME/.cache/rsmooth */
+    RS_ENV_STAGE,           /* where the normal-update stage runs: host or device */
+    RS_ENV_STAGE_PRECISION, /* the device stage's type: double or float */
+    RS_ENV_KERNEL_VARIANT,  /* cpu or gpu kernels */
+    RS_ENV_LANES,           /* vertices per block of the cpu kernels: 4, 8 or 16 */
+    RS_ENV_DEVICE_GRID,     /* 1: sort the grid on the device; 0: on the host */
+    RS_ENV_BILATERAL_LISTS, /* 0: the bilateral rounds search the grid every round */
+    RS_ENV_CELLS_PER_REACH, /* grid cells per reach, 1 to 8 */
+    RS_ENV_KERNEL_DIR,      /* kernels/ *.cl read from this folder instead of the embedded ones */
+    RS_ENV_BUILD_OPTIONS,   /* appended to the OpenCL build options */
+    RS_ENV_OPENCL_LIBRARY,  /* the OpenCL loader's file */
+    RS_ENV_NAMED_TEMPORARY, /* 1: output files go through a named temporary */
     RS_ENV_COUNT
 } rs_env;
 
@@ -55,7 +55,7 @@ bool rs_environment_is(const rs_environment *env, rs_env name, const char *word)
 
 /* The variable as an integer in [low, high], else `fallback` (unset, or not such a number). */
 long rs_environment_integer(const rs_environment *env, rs_env name, long low, long high,
-                           long fallback);
+                            long fallback);
 
 /* The table itself, for the docs test: name, meaning and default of entry i < RS_ENV_COUNT. */
 typedef struct rs_environment_entry {
