@@ -272,7 +272,9 @@ typedef struct rsmooth_params {
      * weight compares the mean normals of each facet's most consistent nearby patch, so creases
      * survive heavy noise), guided_rounds times, and then the vertices are moved to agree with
      * those normals by Sun et al. 2007's iterative update, vertex_updates times. The passes then
-     * start from the updated positions. Runs on the host's cores, in double precision. @{ */
+     * start from the updated positions. The filter and the update repeat stage_repeats cycles.
+     * Runs on the device on GPUs and on the host's cores, in double, on CPU devices and on the
+     * reference path (RSMOOTH_STAGE chooses: docs/environment.md). @{ */
     int vertex_updates;       /**< 0 (default): no stage. [1, 1000]: update iterations */
     double guided_sigma_s;    /**< spatial width of the guided filter's Gaussian, in mean edge
                                * lengths (absolute = 0) or mesh units (absolute = 1), > 0; its

@@ -674,6 +674,26 @@ static rsmooth_status run_robust(cl_run *r) {
 
 /* The results mapped (not copied: a CPU device hands over its own memory), scattered to the
  * caller's vertices in the caller's type, and the run's figures added to *stats. */
+/* Adds one run's stage times (up to t_end), cells and tile to `stats`; with `pairs`, the facet
+ * pairs its blocks counted (on the host: the device store brings none back). */
+static void add_run_stats(const cl_run *r, rs_run_stats *stats, double t_end, bool pairs) {
+    stats->ms_grid += r->t_grid - r->t_start;
+    stats->ms_upload += r->t_upload - r->t_grid;
+    stats->ms_mollify += r->t_mollify - r->t_upload;
+    stats->ms_normals += r->t_normals - r->t_mollify;
+    stats->ms_robust += r->t_robust - r->t_normals;
+    stats->ms_download += t_end - r->t_robust;
+    const rs_problem *pb = r->pb;
+    bool paper_mollify = pb->mollify && !pb->bilateral;
+    for (size_t b = 0; pairs && b < r->pk.block_count; b++) {
+        stats->pairs_mollify += paper_mollify ? (uint64_t)r->pairs[2 * b] * r->ctx->lanes : 0;
+        stats->pairs_robust += (uint64_t)r->pairs[2 * b + 1] * r->ctx->lanes;
+    }
+    stats->pairs_mollify += r->bilateral_pairs;
+    stats->cells += r->grid.cell_count;
+    stats->tiles++;
+}
+
 static rsmooth_status collect_results(cl_run *r, rs_run_stats *stats) {
     rsmooth_context *ctx = r->ctx;
     const rs_problem *pb = r->pb;
@@ -686,18 +706,9 @@ static rsmooth_status collect_results(cl_run *r, rs_run_stats *stats) {
         rsmooth_status st =
             rs_cl_store_device(ctx, sink->device, r->buf[BUF_BLOCK_RESULT], r->pk.slot, nv,
                                ctx->lanes, pb->scale, r->grid.cell_size, r->error);
-        if (st != RSMOOTH_OK)
-            return st;
-        stats->ms_grid += r->t_grid - r->t_start;
-        stats->ms_upload += r->t_upload - r->t_grid;
-        stats->ms_mollify += r->t_mollify - r->t_upload;
-        stats->ms_normals += r->t_normals - r->t_mollify;
-        stats->ms_robust += r->t_robust - r->t_normals;
-        stats->ms_download += rs_now_ms() - r->t_robust;
-        stats->pairs_mollify += r->bilateral_pairs;
-        stats->cells += r->grid.cell_count;
-        stats->tiles++;
-        return RSMOOTH_OK;
+        if (st == RSMOOTH_OK)
+            add_run_stats(r, stats, rs_now_ms(), false);
+        return st;
     }
     cl_int err = CL_SUCCESS;
     r->result = clEnqueueMapBuffer(ctx->queue, r->buf[BUF_BLOCK_RESULT], CL_TRUE, CL_MAP_READ, 0,
@@ -721,21 +732,7 @@ static rsmooth_status collect_results(cl_run *r, rs_run_stats *stats) {
     result_job rj = {pb, r->sink, &r->pk, r->result, r->extra, r->grid.cell_size};
     rs_parallel_for(r->sink->core_count < nv ? r->sink->core_count : nv, PARALLEL_GRAIN,
                     store_results, &rj);
-    double t_end = rs_now_ms();
-    stats->ms_grid += r->t_grid - r->t_start;
-    stats->ms_upload += r->t_upload - r->t_grid;
-    stats->ms_mollify += r->t_mollify - r->t_upload;
-    stats->ms_normals += r->t_normals - r->t_mollify;
-    stats->ms_robust += r->t_robust - r->t_normals;
-    stats->ms_download += t_end - r->t_robust;
-    bool paper_mollify = pb->mollify && !pb->bilateral;
-    for (size_t b = 0; b < nb; b++) {
-        stats->pairs_mollify += paper_mollify ? (uint64_t)r->pairs[2 * b] * ctx->lanes : 0;
-        stats->pairs_robust += (uint64_t)r->pairs[2 * b + 1] * ctx->lanes;
-    }
-    stats->pairs_mollify += r->bilateral_pairs;
-    stats->cells += r->grid.cell_count;
-    stats->tiles++;
+    add_run_stats(r, stats, rs_now_ms(), true);
     return RSMOOTH_OK;
 }
 

@@ -21,7 +21,7 @@ def estimate_noise(vertices: Any, faces: Any) -> float:
 
 def auto_params(vertices: Any, faces: Any, *, best: bool = False) -> Dict[str, Any]:
     """What ``rsmooth.smooth(vertices, faces, auto=True, best=best)`` reads from the mesh and
-    chooses (the library's rsmooth_params_auto_report).
+    chooses (the library's rsmooth_params_auto with its report).
 
     Returns a dict: ``level`` (the noise's standard deviation along the surface normal, in mean
     edge lengths of the clean mesh; for impulsive noise that of the displaced vertices),
