@@ -37,6 +37,7 @@ typedef enum variant {
     NO_COLS,      /* no num_cols line */
     TEXT_ROWS,    /* num_rows not a number */
     WITH_FACES,   /* a face element as well */
+    TWO_GRIDS,    /* a second range_grid element, the same cells again */
     VARIANT_COUNT
 } variant;
 
@@ -48,11 +49,12 @@ static const char *const expected_message[VARIANT_COUNT] = {
     "range grid of 300 cells, but num_cols x num_rows is 20 x 14",
     "range grid without an 'obj_info num_cols' line",
     "'obj_info num_rows 1five' is not one 'obj_info num_rows N' line",
-    "range grid together with a face element"};
+    "range grid together with a face element",
+    "a second 'range_grid' element"};
 
 static const char *const variant_name[VARIANT_COUNT] = {"good",      "two_indices", "out_of_range",
                                                         "twice",     "wrong_count", "no_cols",
-                                                        "text_rows", "with_faces"};
+                                                        "text_rows", "with_faces",  "two_grids"};
 
 /* Vertex ids: the samples in reverse cell order (the vertex order need not follow the grid). */
 static int sample_count(void) {
@@ -97,7 +99,8 @@ static bytes grid_file(rsmooth_format format, variant v, double step) {
     put_text(&b, line);
     snprintf(line, sizeof line, "element range_grid %d\nproperty list uchar int vertex_indices\n",
              COLS * ROWS);
-    put_text(&b, line);
+    for (int g = 0; g < (v == TWO_GRIDS ? 2 : 1); g++)
+        put_text(&b, line);
     if (v == WITH_FACES)
         put_text(&b, "element face 1\nproperty list uchar int vertex_indices\n");
     put_text(&b, "end_header\n");
@@ -114,8 +117,9 @@ static bytes grid_file(rsmooth_format format, variant v, double step) {
                     for (int a = 0; a < 3; a++)
                         put_f32(&b, (float)p[a]);
             }
-    for (int k = 0; k < COLS * ROWS; k++) {
-        int id = vertex_of(k % COLS, k / COLS), extra = -1;
+    for (int k = 0; k < (v == TWO_GRIDS ? 2 : 1) * COLS * ROWS; k++) {
+        int cell = k % (COLS * ROWS); /* a second grid: the same cells again */
+        int id = vertex_of(cell % COLS, cell / COLS), extra = -1;
         if (k == 21 && v == TWO_INDICES)
             extra = 0;
         if (k == 21 && v == OUT_OF_RANGE)
@@ -296,7 +300,7 @@ static void check_written_back(void) {
 
 /* The header lines of grid_file's output, so that an ascii cell's line can be told. */
 static int header_lines(variant v) {
-    return 14 - (v == NO_COLS) + 2 * (v == WITH_FACES);
+    return 14 - (v == NO_COLS) + 2 * (v == WITH_FACES || v == TWO_GRIDS);
 }
 
 static void check_malformed(void) {
@@ -320,6 +324,8 @@ static void check_malformed(void) {
                 CHECK_EQ_INT(err.line, header_lines((variant)v) + sample_count() + 21 + 1);
             if (formats[f] != RSMOOTH_FORMAT_PLY_ASCII && (v == TWO_INDICES || v == OUT_OF_RANGE))
                 CHECK(err.byte_offset > 0);
+            if (v == TWO_GRIDS) /* the second 'element range_grid' line: 2 before end_header */
+                CHECK_EQ_INT(err.line, header_lines(TWO_GRIDS) - 2);
             bytes_free(&b);
         }
 }
