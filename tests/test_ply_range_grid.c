@@ -298,6 +298,57 @@ static void check_written_back(void) {
     rsmooth_mesh_destroy(m);
 }
 
+/* `b` without the header line `line` (which it holds once). */
+static void drop_line(bytes *b, const char *line) {
+    size_t n = strlen(line), at = 0;
+    while (at + n <= b->size && memcmp(b->data + at, line, n) != 0)
+        at++;
+    CHECK(at + n <= b->size);
+    memmove(b->data + at, b->data + at + n, b->size - at - n);
+    b->size -= n;
+}
+
+/* Written, read back and written again: the same bytes, each encoding written in ascii and
+ * binary, from a grid with the scanner's obj_info lines and from one whose obj_info lines all
+ * describe the grid (num_cols, num_rows, is_mesh: all dropped on reading, which leaves a header
+ * with nothing of the input's own). */
+static void check_rewrite_stable(void) {
+    const rsmooth_format formats[3] = {RSMOOTH_FORMAT_PLY_ASCII, RSMOOTH_FORMAT_PLY_BINARY,
+                                       RSMOOTH_FORMAT_PLY_BINARY_BE};
+    const rsmooth_format out[2] = {RSMOOTH_FORMAT_PLY_ASCII, RSMOOTH_FORMAT_PLY_BINARY};
+    for (int only_grid = 0; only_grid < 2; only_grid++)
+        for (int f = 0; f < 3; f++)
+            for (int o = 0; o < 2; o++) {
+                bytes b = grid_file(formats[f], GOOD, 40);
+                if (only_grid) {
+                    drop_line(&b, "obj_info is_cyberware_data 1\n");
+                    drop_line(&b, "obj_info echo_lgincr 0.000500\n");
+                }
+                rsmooth_mesh *m = NULL, *back = NULL;
+                rsmooth_error err;
+                CHECK_STATUS(
+                    rsmooth_mesh_read_memory(b.data, b.size, RSMOOTH_FORMAT_AUTO, &m, &err),
+                    RSMOOTH_OK);
+                size_t size1, size2;
+                char *first = mesh_to_memory(m, out[o], &size1);
+                CHECK_STATUS(
+                    rsmooth_mesh_read_memory(first, size1, RSMOOTH_FORMAT_AUTO, &back, &err),
+                    RSMOOTH_OK);
+                char *second = mesh_to_memory(back, out[o], &size2);
+                if (size1 != size2 || memcmp(first, second, size1) != 0) {
+                    fprintf(stderr, "%s grid, encoding %d written as %d: %zu bytes, then %zu\n",
+                            only_grid ? "obj_info-only" : "scanner's", (int)formats[f], (int)out[o],
+                            size1, size2);
+                    CHECK(0);
+                }
+                free(first);
+                free(second);
+                rsmooth_mesh_destroy(back);
+                rsmooth_mesh_destroy(m);
+                bytes_free(&b);
+            }
+}
+
 /* The header lines of grid_file's output, so that an ascii cell's line can be told. */
 static int header_lines(variant v) {
     return 14 - (v == NO_COLS) + 2 * (v == WITH_FACES || v == TWO_GRIDS);
@@ -417,6 +468,7 @@ int main(int argc, char **argv) {
     check_good(RSMOOTH_FORMAT_PLY_BINARY_BE);
     check_encodings_agree();
     check_written_back();
+    check_rewrite_stable();
     check_malformed();
     check_bunny_scan();
     printf("ply_range_grid: all checks passed\n");
