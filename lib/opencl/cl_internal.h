@@ -122,6 +122,15 @@ typedef struct rs_result_sink {
  * then uploads the host's result. */
 bool rs_cl_store_ready(rsmooth_context *ctx);
 
+/* rsmooth_smooth_cl's buffers, once each is known valid, of ctx's context and `bytes` long
+ * (cl_buffer_check.c): RSMOOTH_ERROR_INVALID_ARGUMENT, naming the argument, where either is no
+ * buffer (an image), `positions` is write-only or `out_positions` read-only (its own flags or its
+ * buffer's), or the two are different objects whose `bytes` used share memory (sub-buffers of
+ * one buffer, a sub-buffer and its buffer, buffers over one host memory); the same object for
+ * both (in place) is allowed. */
+rsmooth_status rs_cl_check_buffer_pair(cl_mem positions, cl_mem out_positions, size_t bytes,
+                                       rsmooth_error *error);
+
 /* Writes a whole run's positions into sink->output on the device (cl_store.c): vertex v's are
  * (input_v * scale + result_v * h) / scale in double, as store_results computes them on the
  * host, result_v the robust pass's displacement at slot[v] (`lanes` per block); sets
