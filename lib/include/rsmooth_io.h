@@ -166,10 +166,17 @@ RSMOOTH_API rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, F
 RSMOOTH_API rsmooth_status rsmooth_mesh_check_writable(const rsmooth_mesh *mesh,
                                                        rsmooth_format format, rsmooth_error *error);
 
-/** Writes `mesh` to `path` (created or truncated). AUTO picks the format from the extension: .obj,
+/** Writes `mesh` to `path`, whole or not at all. AUTO picks the format from the extension: .obj,
  * .ply (binary little-endian), .off, .stl (binary). A mesh refused as by rsmooth_mesh_write_stream
- * creates no file. Callers that must never leave a partial file write to a temporary path and
- * rename it (the rsmooth command does). */
+ * creates no file. The file is written beside `path` (beside the file a symbolic link leads to)
+ * and takes the name only when complete, replacing an existing regular file atomically and
+ * keeping its permission bits, owner and group: a write that fails (RSMOOTH_ERROR_IO, the path
+ * named; or the writer's own status) leaves whatever was at `path` untouched and no temporary
+ * behind. Never replaces a directory, device, FIFO or socket, nor writes through a link to
+ * nothing (RSMOOTH_ERROR_IO). On success error->message is empty, or a warning to pass on (the
+ * file had other hard links, which keep the old content; its owner could not be kept). While a
+ * named temporary exists (where the file system has no unnamed ones), a SIGINT, SIGTERM or SIGHUP
+ * removes it first, then takes its previous action. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_write_file(const rsmooth_mesh *mesh, const char *path,
                                                    rsmooth_format format, rsmooth_error *error);
 
