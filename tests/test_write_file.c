@@ -3,12 +3,15 @@
  * limit, RLIMIT_FSIZE, below the mesh's size: every write past it fails with EFBIG) leaves the
  * old file's bytes and mode as they were and nothing else in its folder, with the unnamed
  * temporary and the named one (RSMOOTH_NAMED_TEMPORARY=1); a write that succeeds gives the bytes
- * rsmooth_mesh_write_stream writes and keeps the old file's mode. */
+ * rsmooth_mesh_write_stream writes and keeps the old file's mode. rsmooth_file_write, the same
+ * with the caller's content: its checks alone, a refused existing name, a failing writer, a
+ * new file, and the warning for a file with another hard link. */
 #define _GNU_SOURCE /* open_memstream, mkdtemp */
 #include "rsmooth_io.h"
 #include "test_util.h"
 
 #include <dirent.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <stdbool.h>
 #include <stdlib.h>
@@ -147,7 +150,61 @@ static void check_write_replaces(const rsmooth_mesh *m, const char *dir, bool na
            named ? "named" : "unnamed", size);
 }
 
+/* rsmooth_file_write's content: `user` as text, or a failure after part of it. */
+static int write_text(FILE *stream, void *user, char *message, size_t size) {
+    const char *text = user;
+    if (fputs(text, stream) < 0)
+        return -1;
+    if (!strcmp(text, "half")) {
+        snprintf(message, size, "gave up half-way");
+        return -1;
+    }
+    return 0;
+}
+
+static void check_file_write(const char *dir) {
+    char path[4200], link[4200];
+    snprintf(path, sizeof path, "%s/note.txt", dir);
+    snprintf(link, sizeof link, "%s/other-name.txt", dir);
+    rsmooth_error err;
+    /* the checks alone: a new name may be written, and nothing is */
+    CHECK_STATUS(rsmooth_file_write(path, 0, "use --force", NULL, NULL, &err), RSMOOTH_OK);
+    CHECK(access(path, F_OK) != 0);
+    CHECK_STATUS(rsmooth_file_write(dir, 1, NULL, NULL, NULL, &err), RSMOOTH_ERROR_IO);
+    CHECK(strstr(err.message, "is a directory") != NULL);
+    CHECK_STATUS(rsmooth_file_write(NULL, 1, NULL, NULL, NULL, &err),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    /* a new file */
+    CHECK_STATUS(rsmooth_file_write(path, 0, "use --force", write_text, "first\n", &err),
+                 RSMOOTH_OK);
+    check_file(path, "first\n", 6, 0644); /* 0666 less main's umask */
+    /* an existing name without replace: refused with the caller's hint, whether checked alone
+     * or written */
+    CHECK_STATUS(rsmooth_file_write(path, 0, "use --force", NULL, NULL, &err), RSMOOTH_ERROR_IO);
+    CHECK(strstr(err.message, "already exists (use --force to replace it)") != NULL);
+    CHECK_STATUS(rsmooth_file_write(path, 0, NULL, write_text, "second\n", &err), RSMOOTH_ERROR_IO);
+    CHECK(strstr(err.message, "already exists (set replace to replace it)") != NULL);
+    /* a writer that fails: its message, the file as it was, no temporary */
+    CHECK_STATUS(rsmooth_file_write(path, 1, NULL, write_text, "half", &err), RSMOOTH_ERROR_IO);
+    printf("a failing writer: %s\n", err.message);
+    CHECK(strstr(err.message, path) == err.message);
+    CHECK(strstr(err.message, "cannot write: gave up half-way") != NULL);
+    check_file(path, "first\n", 6, 0644);
+    check_alone(dir, "note.txt");
+    /* replaced while another hard link holds the old content: a warning on success */
+    CHECK(chmod(path, 0600) == 0);
+    CHECK(linkat(AT_FDCWD, path, AT_FDCWD, link, 0) == 0);
+    CHECK_STATUS(rsmooth_file_write(path, 1, NULL, write_text, "second\n", &err), RSMOOTH_OK);
+    printf("another hard link: warning '%s'\n", err.message);
+    CHECK(strstr(err.message, "the file has 2 hard links") != NULL);
+    check_file(path, "second\n", 7, 0600);
+    check_file(link, "first\n", 6, 0600);
+    CHECK(remove(link) == 0);
+    CHECK(remove(path) == 0);
+}
+
 int main(void) {
+    umask(022);
     signal(SIGXFSZ, SIG_IGN); /* a write past RLIMIT_FSIZE fails with EFBIG instead */
     char dir[] = "/tmp/rsmooth_test_write_file_XXXXXX";
     CHECK(mkdtemp(dir) != NULL);
@@ -159,6 +216,7 @@ int main(void) {
     char path[4200];
     snprintf(path, sizeof path, "%s/out.obj", dir);
     CHECK(remove(path) == 0);
+    check_file_write(dir);
     CHECK(rmdir(dir) == 0);
     rsmooth_mesh_destroy(m);
     printf("write_file: all checks passed\n");

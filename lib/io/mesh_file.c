@@ -273,3 +273,29 @@ rsmooth_status rsmooth_mesh_write_file(const rsmooth_mesh *mesh, const char *pat
     mesh_content c = {mesh, format};
     return write_whole(path, true, "", write_mesh_content, &c, where, error);
 }
+
+typedef struct caller_content {
+    rsmooth_file_writer write;
+    void *user;
+} caller_content;
+
+static rsmooth_status write_caller_content(FILE *stream, void *user, rsmooth_error *error) {
+    const caller_content *c = user;
+    char message[sizeof error->message] = "";
+    if (c->write(stream, c->user, message, sizeof message) == 0)
+        return RSMOOTH_OK;
+    message[sizeof message - 1] = '\0';
+    return rs_fail(error, RSMOOTH_ERROR_IO, "rsmooth_file_write", "%s",
+                   message[0] ? message : "the content's writer failed");
+}
+
+rsmooth_status rsmooth_file_write(const char *path, int replace, const char *hint,
+                                  rsmooth_file_writer write, void *user, rsmooth_error *error) {
+    static const char where[] = "rsmooth_file_write";
+    rs_error_clear(error);
+    if (!path)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "path is NULL");
+    caller_content c = {write, user};
+    return write_whole(path, replace != 0, hint ? hint : "set replace",
+                       write ? write_caller_content : NULL, &c, where, error);
+}
