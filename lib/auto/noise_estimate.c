@@ -887,6 +887,27 @@ static void summarise(const sample_job *job, size_t valid, double unit, double s
     }
 }
 
+typedef struct rs_noise_stats {
+    double noise;   /* rsmooth_estimate_noise's estimate, mean edge lengths */
+    bool impulsive; /* the residuals' tail beyond 4 robust sigmas is far heavier than a
+                     * Gaussian's: a few vertices thrown far */
+} rs_noise_stats;
+
+/* rsmooth_estimate_noise with the tail statistic; errors name `caller`. */
+static rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positions,
+                                              size_t vertex_count, const uint32_t *indices,
+                                              size_t triangle_count, rs_noise_stats *out,
+                                              rsmooth_error *error, const char *caller) {
+    rs_noise_details details;
+    rsmooth_status st = rs_estimate_noise_details(scalar, positions, vertex_count, indices,
+                                                  triangle_count, &details, error, caller);
+    if (st == RSMOOTH_OK) {
+        out->noise = details.level;
+        out->impulsive = details.impulsive;
+    }
+    return st;
+}
+
 rsmooth_status rsmooth_estimate_noise(rsmooth_scalar scalar, const void *positions,
                                       size_t vertex_count, const uint32_t *indices,
                                       size_t triangle_count, double *out_noise,
@@ -899,20 +920,6 @@ rsmooth_status rsmooth_estimate_noise(rsmooth_scalar scalar, const void *positio
                                                 triangle_count, &stats, error, where);
     if (st == RSMOOTH_OK)
         *out_noise = stats.noise;
-    return st;
-}
-
-rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positions,
-                                       size_t vertex_count, const uint32_t *indices,
-                                       size_t triangle_count, rs_noise_stats *out,
-                                       rsmooth_error *error, const char *caller) {
-    rs_noise_details details;
-    rsmooth_status st = rs_estimate_noise_details(scalar, positions, vertex_count, indices,
-                                                  triangle_count, &details, error, caller);
-    if (st == RSMOOTH_OK) {
-        out->noise = details.level;
-        out->impulsive = details.impulsive;
-    }
     return st;
 }
 

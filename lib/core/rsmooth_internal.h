@@ -403,18 +403,6 @@ void rs_report_unscale(rsmooth_report *report, double unscale);
 
 /* ---- noise_estimate.c / params_auto.c: automatic parameters -------------------------------- */
 
-typedef struct rs_noise_stats {
-    double noise;   /* rsmooth_estimate_noise's estimate, mean edge lengths */
-    bool impulsive; /* the residuals' tail beyond 4 robust sigmas is far heavier than a
-                     * Gaussian's: a few vertices thrown far */
-} rs_noise_stats;
-
-/* rsmooth_estimate_noise with the tail statistic; errors name `caller`. */
-rsmooth_status rs_estimate_noise_stats(rsmooth_scalar scalar, const void *positions,
-                                       size_t vertex_count, const uint32_t *indices,
-                                       size_t triangle_count, rs_noise_stats *out,
-                                       rsmooth_error *error, const char *caller);
-
 /* ---- taubin.c ---------------------------------------------------------------------------------
  */
 

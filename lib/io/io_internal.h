@@ -126,12 +126,6 @@ bool rs_io_float32_misfit_find(const double *xyz, size_t vertex_count, const uin
  * as the double it is. */
 bool rs_io_float32_holds(const rsmooth_mesh *mesh);
 
-/* Every refusal of the writer of `format`, run before its first byte (rsmooth_mesh_check_writable
- * and rsmooth_mesh_write_stream): rs_io_mesh_check, rs_io_mesh_check_values, then the format's
- * own check. AUTO or an unknown value is INVALID_ARGUMENT, big-endian PLY UNSUPPORTED. */
-rsmooth_status rs_io_check_writable(const rsmooth_mesh *mesh, rsmooth_format format,
-                                    const char *where, rsmooth_error *error);
-
 /* Each format's own refusals (before its writer runs; the mesh already passed rs_io_mesh_check and
  * rs_io_mesh_check_values): what its file cannot hold (STL: no triangles, binary STL's float32;
  * PLY: the input's declared types), and the normals it would write. */

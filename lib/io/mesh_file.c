@@ -108,8 +108,11 @@ rsmooth_status rsmooth_mesh_read_stream(FILE *stream, const char *name, rsmooth_
     return status;
 }
 
-rsmooth_status rs_io_check_writable(const rsmooth_mesh *mesh, rsmooth_format format,
-                                    const char *where, rsmooth_error *error) {
+/* Every refusal of the writer of `format`, run before its first byte (rsmooth_mesh_check_writable
+ * and rsmooth_mesh_write_stream): rs_io_mesh_check, rs_io_mesh_check_values, then the format's
+ * own check. AUTO or an unknown value is INVALID_ARGUMENT, big-endian PLY UNSUPPORTED. */
+static rsmooth_status rs_io_check_writable(const rsmooth_mesh *mesh, rsmooth_format format,
+                                           const char *where, rsmooth_error *error) {
     rsmooth_status status = rs_io_mesh_check(mesh, where, error);
     if (status == RSMOOTH_OK)
         status = rs_io_mesh_check_values(mesh, where, error);

@@ -71,12 +71,9 @@ struct rsmooth_context {
  * ctx->local_size. RSMOOTH_KERNEL_VARIANT (cpu, gpu) and RSMOOTH_LANES (4, 8, 16) override it. */
 rsmooth_status rs_cl_choose_variant(rsmooth_context *ctx, rsmooth_error *error);
 
-/* A context's calls hold its lock while they use it: threads sharing one run one at a time. */
-void rs_context_lock(rsmooth_context *ctx);
+/* Releases ctx's lock, which a context's calls hold while they use it (cl_device.c): threads
+ * sharing one run one at a time. */
 void rs_context_unlock(rsmooth_context *ctx);
-/* Whether the calling thread holds ctx's lock: it is inside a call on ctx, in one of the call's
- * callbacks (progress, progress_cancel). */
-bool rs_context_held_here(const rsmooth_context *ctx);
 /* Takes the lock for a filter call, or refuses (RSMOOTH_ERROR_INVALID_ARGUMENT) a call made from
  * a callback of a call on the same context, which would wait for itself for ever. */
 rsmooth_status rs_context_enter(rsmooth_context *ctx, const char *where, rsmooth_error *error);
