@@ -5,7 +5,7 @@
  * temporary and the named one (RSMOOTH_NAMED_TEMPORARY=1); a write that succeeds gives the bytes
  * rsmooth_mesh_write_stream writes and keeps the old file's mode. rsmooth_file_write, the same
  * with the caller's content: its checks alone, a refused existing name, a failing writer, a
- * new file, and the warning for a file with another hard link. */
+ * new file (its mode the umask's), and the warning for a file with another hard link. */
 #define _GNU_SOURCE /* open_memstream, mkdtemp */
 #include "rsmooth_io.h"
 #include "test_util.h"
@@ -200,6 +200,14 @@ static void check_file_write(const char *dir) {
     check_file(path, "second\n", 7, 0600);
     check_file(link, "first\n", 6, 0600);
     CHECK(remove(link) == 0);
+    CHECK(remove(path) == 0);
+    /* a new file's mode: the umask's, which is left as it was (a named temporary is made 0600) */
+    umask(027);
+    CHECK(setenv("RSMOOTH_NAMED_TEMPORARY", "1", 1) == 0);
+    CHECK_STATUS(rsmooth_file_write(path, 0, NULL, write_text, "third\n", &err), RSMOOTH_OK);
+    CHECK(unsetenv("RSMOOTH_NAMED_TEMPORARY") == 0);
+    CHECK_EQ_INT(umask(022), 027);
+    check_file(path, "third\n", 6, 0640);
     CHECK(remove(path) == 0);
 }
 
