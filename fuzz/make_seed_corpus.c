@@ -253,8 +253,28 @@ static void ply_common_seed(corpus *c, const char *name, bool big_endian) {
     bytes_free(&b);
 }
 
+/* Scanners' range grids (lib/io/ply_range_grid.c): 3 x 2 cells, one empty, read as three
+ * triangles; with the scanner's obj_info lines, and with only those that describe the grid. */
+static void ply_range_grid_seeds(corpus *c) {
+    static const char *const info[2] = {"obj_info is_cyberware_data 1\n", ""};
+    static const char *const name[2] = {"range_grid.ply", "range_grid_plain.ply"};
+    for (int k = 0; k < 2; k++) {
+        bytes b = {0};
+        put_text(&b, "ply\nformat ascii 1.0\n");
+        put_text(&b, info[k]);
+        put_text(&b, "obj_info num_cols 3\nobj_info num_rows 2\n");
+        put_text(&b, k == 0 ? "obj_info echo_lgincr 0.000500\n" : "");
+        put_text(&b, "element vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+                     "element range_grid 6\nproperty list uchar int vertex_indices\nend_header\n"
+                     "0 0 0\n1 0 0.1\n2 0 0\n0 1 0\n1 1 0.05\n1 0\n1 1\n1 2\n1 3\n1 4\n0\n");
+        emit(c, "ply", name[k], &b);
+        bytes_free(&b);
+    }
+}
+
 static void ply_seeds(corpus *c) {
     ply_ascii_seeds(c);
+    ply_range_grid_seeds(c);
     ply_binary_seed(c, "binary_le_float.ply", false, false);
     ply_binary_seed(c, "binary_le_double.ply", false, true);
     ply_binary_seed(c, "binary_be_float.ply", true, false);

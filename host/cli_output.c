@@ -1,23 +1,22 @@
 /* The rsmooth command's output files (see cli_output.h): the library's one way of putting an
- * output in place (lib/io/output_file.c), with the command's messages and exit statuses. */
+ * output in place (rsmooth_file_write), with the command's messages and exit statuses. */
 #define _POSIX_C_SOURCE 200809L
 #include "cli_output.h"
 #include "cli_files.h"
-#include "io/output_file.h"
+#include "rsmooth_io.h"
 
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <unistd.h>
 
 /* How the command asks for replacing, in the refusals. */
 #define REPLACE_HINT "use --force"
 
 int cli_check_output_path(const char *path, bool replace) {
-    rs_output o;
     rsmooth_error err;
-    if (rs_output_resolve(&o, path, replace, REPLACE_HINT, "rsmooth", &err) == RSMOOTH_OK)
+    rsmooth_error_init(&err);
+    if (rsmooth_file_write(path, replace, REPLACE_HINT, NULL, NULL, &err) == RSMOOTH_OK)
         return -1;
     fprintf(stderr, "rsmooth: %s\n", err.message);
     return EXIT_USAGE;
@@ -75,44 +74,17 @@ bool cli_same_file(const char *a, const char *b) {
 }
 
 int cli_write_atomically(const char *path, bool replace, bool quiet, cli_writer write, void *user) {
-    rs_output o;
+    int code = cli_check_output_path(path, replace); /* a refused path is the user's: 2 */
+    if (code >= 0)
+        return code;
     rsmooth_error err;
-    if (rs_output_resolve(&o, path, replace, REPLACE_HINT, "rsmooth", &err) != RSMOOTH_OK) {
+    rsmooth_error_init(&err);
+    if (rsmooth_file_write(path, replace, REPLACE_HINT, write, user, &err) != RSMOOTH_OK) {
         fprintf(stderr, "rsmooth: %s\n", err.message);
-        return EXIT_USAGE;
-    }
-    if (rs_output_create(&o, "rsmooth", &err) != RSMOOTH_OK) {
-        fprintf(stderr, "rsmooth: %s\n", err.message);
-        rs_output_discard(&o);
-        return EXIT_OTHER;
-    }
-    if (o.notes[0] && !quiet)
-        fprintf(stderr, "rsmooth: %s: warning: %s\n", path, o.notes);
-    /* the writer gets a stream of its own over a copy of the descriptor, closed (and so flushed
-     * and checked) before the content is put in place */
-    char message[256] = "";
-    int copy = dup(o.fd);
-    FILE *f = copy >= 0 ? fdopen(copy, "wb") : NULL;
-    bool ok = f != NULL;
-    if (!ok) {
-        snprintf(message, sizeof message, "%s", strerror(errno));
-        if (copy >= 0)
-            close(copy);
-    }
-    if (ok)
-        ok = write(f, user, message, sizeof message) == 0;
-    if (f && fclose(f) != 0 && ok) {
-        snprintf(message, sizeof message, "%s", strerror(errno));
-        ok = false;
-    }
-    if (!ok) {
-        fprintf(stderr, "rsmooth: %s: cannot write: %s\n", path, message);
-        rs_output_discard(&o);
-        return EXIT_OTHER;
-    }
-    if (rs_output_publish(&o, replace, "rsmooth", &err) != RSMOOTH_OK) {
-        fprintf(stderr, "rsmooth: %s\n", err.message);
+        /* another run took the name meanwhile: as if it had been there */
         return strstr(err.message, "already exists") ? EXIT_USAGE : EXIT_OTHER;
     }
+    if (err.message[0] && !quiet)
+        fprintf(stderr, "rsmooth: %s: warning: %s\n", path, err.message);
     return EXIT_OK;
 }

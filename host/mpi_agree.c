@@ -1,11 +1,12 @@
-/* Digests of a rank's job, compared across ranks (see mpi_agree.h). */
+/* What a rank was given, compared across ranks (see mpi_agree.h): each part's bytes, rank 0's
+ * broadcast to every rank and compared in full (about 130 KiB in all, once per run). */
 #define _POSIX_C_SOURCE 200809L
 #include "mpi_agree.h"
 #include "cli_files.h"
-#include "core/blake2b.h"
 
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <mpi.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -19,25 +20,44 @@ static const char *const part_names[PARTS] = {
     "the input file (its size, time or content)", "the parameters (or the rsmooth version)",
     "--max-memory", "the output (-o, --force, --in-place)"};
 
-#define DIGEST 32
 #define HEAD_BYTES (64 * 1024)
 #define SAMPLES 16
 #define SAMPLE_BYTES 4096
 
-/* A value into the digest, its size first, so no two sequences of values hash the same bytes. */
-static void add(rs_blake2b *s, const void *data, size_t size) {
-    uint64_t n = size;
-    rs_blake2b_update(s, &n, sizeof n);
-    rs_blake2b_update(s, data, size);
+/* One part's bytes. */
+typedef struct part {
+    unsigned char *data;
+    size_t size, capacity;
+} part;
+
+static void append(part *p, const void *data, size_t size) {
+    if (size > p->capacity - p->size) {
+        size_t capacity = 2 * (p->size + size) + 256;
+        unsigned char *grown = realloc(p->data, capacity);
+        if (!grown)
+            MPI_Abort(MPI_COMM_WORLD, EXIT_OTHER);
+        p->data = grown;
+        p->capacity = capacity;
+    }
+    if (size > 0)
+        memcpy(p->data + p->size, data, size);
+    p->size += size;
 }
 
-static void add_text(rs_blake2b *s, const char *text) {
+/* A value into a part, its size first, so no two sequences of values give the same bytes. */
+static void add(part *s, const void *data, size_t size) {
+    uint64_t n = size;
+    append(s, &n, sizeof n);
+    append(s, data, size);
+}
+
+static void add_text(part *s, const char *text) {
     add(s, text ? text : "", text ? strlen(text) + 1 : 0); /* NULL differs from "" */
 }
 
 /* The input's fingerprint: what stat says and bytes from its head and throughout. A file that
  * cannot be read digests its error, so it differs from one that can. */
-static void add_input(rs_blake2b *s, const char *path) {
+static void add_input(part *s, const char *path) {
     int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     struct stat st;
     if (fd < 0 || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
@@ -65,11 +85,8 @@ static void add_input(rs_blake2b *s, const char *path) {
     close(fd);
 }
 
-static void digest_parts(const options *opt, unsigned char d[PARTS][DIGEST]) {
-    rs_blake2b s[PARTS];
-    for (int p = 0; p < PARTS; p++)
-        rs_blake2b_init(&s[p], DIGEST);
-    add_input(&s[PART_INPUT], opt->input);
+static void fingerprint_parts(const options *opt, part d[PARTS]) {
+    add_input(&d[PART_INPUT], opt->input);
     /* the parameters as bytes (rsmooth_params_init zeroes the struct, padding included), the
      * per-process pointers cleared */
     rsmooth_params params;
@@ -79,25 +96,36 @@ static void digest_parts(const options *opt, unsigned char d[PARTS][DIGEST]) {
     params.progress_cancel = NULL;
     params.colors = NULL;
     params.move_mask = NULL;
-    add(&s[PART_PARAMETERS], &params, sizeof params);
-    add_text(&s[PART_PARAMETERS], rsmooth_version(NULL, NULL, NULL));
-    add(&s[PART_CAP], &opt->max_memory, sizeof opt->max_memory);
-    add_text(&s[PART_OUTPUT], opt->output);
+    add(&d[PART_PARAMETERS], &params, sizeof params);
+    add_text(&d[PART_PARAMETERS], rsmooth_version(NULL, NULL, NULL));
+    add(&d[PART_CAP], &opt->max_memory, sizeof opt->max_memory);
+    add_text(&d[PART_OUTPUT], opt->output);
     const int flags[3] = {opt->force, opt->in_place, (int)opt->format};
-    add(&s[PART_OUTPUT], flags, sizeof flags);
-    for (int p = 0; p < PARTS; p++)
-        rs_blake2b_final(&s[p], d[p]);
+    add(&d[PART_OUTPUT], flags, sizeof flags);
 }
 
 int mpi_agree(const options *opt, int rank, int ranks) {
-    unsigned char mine[PARTS][DIGEST], first[PARTS][DIGEST];
-    digest_parts(opt, mine);
-    memcpy(first, mine, sizeof first);
-    MPI_Bcast(first, (int)sizeof first, MPI_BYTE, 0, MPI_COMM_WORLD);
-    int differs = 0; /* a bit per part */
+    part mine[PARTS];
+    memset(mine, 0, sizeof mine);
+    fingerprint_parts(opt, mine);
+    uint64_t sizes[PARTS];
     for (int p = 0; p < PARTS; p++)
-        if (memcmp(mine[p], first[p], DIGEST) != 0)
+        sizes[p] = mine[p].size;
+    MPI_Bcast(sizes, PARTS, MPI_UINT64_T, 0, MPI_COMM_WORLD);
+    int differs = 0; /* a bit per part */
+    for (int p = 0; p < PARTS; p++) {
+        if (sizes[p] > INT_MAX)
+            MPI_Abort(MPI_COMM_WORLD, EXIT_OTHER); /* never: a part is some 130 KiB at most */
+        unsigned char *first = rank == 0 ? mine[p].data : malloc(sizes[p] ? sizes[p] : 1);
+        if (!first)
+            MPI_Abort(MPI_COMM_WORLD, EXIT_OTHER);
+        MPI_Bcast(first, (int)sizes[p], MPI_BYTE, 0, MPI_COMM_WORLD);
+        if (sizes[p] != mine[p].size || memcmp(first, mine[p].data, mine[p].size) != 0)
             differs |= 1 << p;
+        if (rank != 0)
+            free(first);
+        free(mine[p].data);
+    }
     int *all = malloc((size_t)ranks * sizeof *all);
     if (!all)
         MPI_Abort(MPI_COMM_WORLD, EXIT_OTHER);

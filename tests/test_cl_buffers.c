@@ -3,8 +3,8 @@
  * in place too, on the path that writes it on the device (one whole run without the fold guard:
  * the report's pair counts are 0) and on the paths that upload the host's (the guard, a move
  * mask, tiles); bad
- * buffers (NULL, too small, another OpenCL context) are refused by name and leave the output
- * untouched. */
+ * buffers (NULL, too small, another OpenCL context, an image, a read-only output, a write-only
+ * input, two objects over shared memory) are refused by name and leave the output untouched. */
 #include "mesh_shapes.h"
 #include "rsmooth_cl.h"
 #include "test_cl_util.h"
@@ -162,6 +162,159 @@ static void check_errors(const fixture *fx, const shape_mesh *m) {
     free(got);
 }
 
+/* A sub-buffer of `parent`: `bytes` from `origin`, with `flags` (0: the parent's). */
+static cl_mem sub_buffer(cl_mem parent, cl_mem_flags flags, size_t origin, size_t bytes) {
+    cl_buffer_region region = {origin, bytes};
+    cl_int err = CL_SUCCESS;
+    cl_mem mem = clCreateSubBuffer(parent, flags, CL_BUFFER_CREATE_TYPE_REGION, &region, &err);
+    CHECK(err == CL_SUCCESS && mem);
+    return mem;
+}
+
+/* rsmooth_smooth_cl(in, out) on the cube's float32 positions is refused with a message that
+ * holds `wanted`; `out_marker` (out's `bytes` when they can be read back, else NULL) unchanged. */
+static void check_refused(const fixture *fx, const shape_mesh *m, cl_mem in, cl_mem out,
+                          const void *out_marker, const char *wanted, const char *what) {
+    size_t bytes = 3 * m->vertex_count * sizeof(float);
+    rsmooth_params p;
+    rsmooth_params_init(&p);
+    p.guard = 0; /* the result written on the device, where overlap changes it */
+    rsmooth_error err;
+    rsmooth_status st = rsmooth_smooth_cl(fx->ctx, RSMOOTH_FLOAT32, in, m->vertex_count, m->indices,
+                                          m->triangle_count, &p, out, NULL, &err);
+    printf("%s: %s: %s\n", what, rsmooth_status_str(st), st ? err.message : "accepted");
+    CHECK_STATUS(st, RSMOOTH_ERROR_INVALID_ARGUMENT);
+    if (!strstr(err.message, wanted)) {
+        printf("%s: the message lacks '%s'\n", what, wanted);
+        CHECK(0);
+    }
+    if (out_marker) {
+        void *got = malloc(bytes);
+        CHECK(got);
+        read_back(fx, out, bytes, got);
+        CHECK(memcmp(got, out_marker, bytes) == 0);
+        free(got);
+    }
+}
+
+/* The memory objects rsmooth_smooth_cl must refuse besides NULL, small and foreign ones: images,
+ * an input kernels may not read, an output they may not write, and two objects over shared
+ * memory (sub-buffers of one buffer, a sub-buffer and its buffer, buffers over one host memory),
+ * where the device would read inputs other work-items had already overwritten. Sub-buffers of one
+ * buffer that do not meet are taken, and give rsmooth_smooth's bits. */
+static void check_memory_objects(const fixture *fx, const shape_mesh *m) {
+    size_t n = m->vertex_count, bytes = 3 * n * sizeof(float);
+    float *in = positions_as(m, RSMOOTH_FLOAT32);
+    float *marker = malloc(bytes);
+    CHECK(marker);
+    memset(marker, 0x5a, bytes);
+    cl_mem din = buffer_with(fx, bytes, in), dout = buffer_with(fx, bytes, marker);
+    cl_device_id device = NULL;
+    CHECK(clGetCommandQueueInfo(fx->queue, CL_QUEUE_DEVICE, sizeof device, &device, NULL) ==
+          CL_SUCCESS);
+    cl_int err = CL_SUCCESS;
+
+    /* an image holding enough bytes, as either argument */
+    cl_bool images = CL_FALSE;
+    size_t max_width = 0, texels = (3 * n + 3) / 4; /* RGBA float: 4 coordinates a texel */
+    clGetDeviceInfo(device, CL_DEVICE_IMAGE_SUPPORT, sizeof images, &images, NULL);
+    clGetDeviceInfo(device, CL_DEVICE_IMAGE2D_MAX_WIDTH, sizeof max_width, &max_width, NULL);
+    if (images && texels <= max_width) {
+        cl_image_format format = {CL_RGBA, CL_FLOAT};
+        cl_image_desc desc = {
+            .image_type = CL_MEM_OBJECT_IMAGE2D, .image_width = texels, .image_height = 1};
+        cl_mem image = clCreateImage(fx->context, CL_MEM_READ_WRITE, &format, &desc, NULL, &err);
+        CHECK(err == CL_SUCCESS && image);
+        check_refused(fx, m, image, dout, marker, "positions is not a buffer", "image in");
+        check_refused(fx, m, din, image, NULL, "out_positions is not a buffer", "image out");
+        clReleaseMemObject(image);
+    } else
+        printf("no images on this device: the image checks skipped\n");
+
+    /* access flags: the input's and the output's own, and a sub-buffer's inherited ones */
+    cl_mem read_only =
+        clCreateBuffer(fx->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, marker, &err);
+    CHECK(err == CL_SUCCESS);
+    check_refused(fx, m, din, read_only, marker, "out_positions is read-only", "read-only out");
+    cl_mem inherits = sub_buffer(read_only, 0, 0, bytes);
+    check_refused(fx, m, din, inherits, marker, "out_positions is read-only",
+                  "a sub-buffer of a read-only buffer out");
+    cl_mem write_only =
+        clCreateBuffer(fx->context, CL_MEM_WRITE_ONLY | CL_MEM_COPY_HOST_PTR, bytes, in, &err);
+    CHECK(err == CL_SUCCESS);
+    check_refused(fx, m, write_only, dout, marker, "positions is write-only", "write-only in");
+
+    /* sub-buffers of one buffer: the output `align` bytes (the least a sub-buffer may start at)
+     * after the input, so that they share all but `align` bytes; then apart */
+    cl_uint align_bits = 0;
+    CHECK(clGetDeviceInfo(device, CL_DEVICE_MEM_BASE_ADDR_ALIGN, sizeof align_bits, &align_bits,
+                          NULL) == CL_SUCCESS);
+    size_t align = align_bits / 8, apart = (bytes + align - 1) / align * align;
+    CHECK(align > 0 && align < bytes);
+    cl_mem parent = buffer_with(fx, apart + bytes, NULL);
+    CHECK(clEnqueueWriteBuffer(fx->queue, parent, CL_TRUE, 0, bytes, in, 0, NULL, NULL) ==
+          CL_SUCCESS);
+    CHECK(clEnqueueWriteBuffer(fx->queue, parent, CL_TRUE, align, bytes, marker, 0, NULL, NULL) ==
+          CL_SUCCESS); /* the input's bytes from `align` on are now the marker's */
+    float *shifted = malloc(bytes);
+    CHECK(shifted);
+    read_back(fx, parent, bytes, shifted); /* the input as the parent now holds it */
+    cl_mem first = sub_buffer(parent, 0, 0, bytes), later = sub_buffer(parent, 0, align, bytes);
+    check_refused(fx, m, first, later, marker, "positions and out_positions overlap",
+                  "sub-buffers sharing memory");
+    check_refused(fx, m, later, first, shifted, "positions and out_positions overlap",
+                  "sub-buffers sharing memory, the other way");
+    check_refused(fx, m, later, parent, shifted, "positions and out_positions overlap",
+                  "a sub-buffer into its buffer");
+    cl_mem same = sub_buffer(parent, 0, 0, bytes);
+    check_refused(fx, m, first, same, shifted, "positions and out_positions overlap",
+                  "two sub-buffers over the same bytes");
+
+    /* apart in one buffer: taken, rsmooth_smooth's bits */
+    CHECK(clEnqueueWriteBuffer(fx->queue, parent, CL_TRUE, 0, bytes, in, 0, NULL, NULL) ==
+          CL_SUCCESS);
+    cl_mem beyond = sub_buffer(parent, 0, apart, bytes);
+    rsmooth_params p;
+    rsmooth_params_init(&p);
+    p.guard = 0;
+    rsmooth_error e;
+    float *expected = malloc(bytes), *got = malloc(bytes);
+    CHECK(expected && got);
+    CHECK_STATUS(rsmooth_smooth(fx->ctx, RSMOOTH_FLOAT32, in, n, m->indices, m->triangle_count, &p,
+                                expected, NULL, &e),
+                 RSMOOTH_OK);
+    CHECK_STATUS(rsmooth_smooth_cl(fx->ctx, RSMOOTH_FLOAT32, first, n, m->indices,
+                                   m->triangle_count, &p, beyond, NULL, &e),
+                 RSMOOTH_OK);
+    read_back(fx, beyond, bytes, got);
+    CHECK(memcmp(got, expected, bytes) == 0);
+    printf("sub-buffers of one buffer, apart: taken, bit-identical\n");
+
+    /* two buffers over one host memory, `align` bytes apart */
+    char *host = malloc(apart + bytes);
+    CHECK(host);
+    memcpy(host, in, bytes);
+    cl_mem over_host =
+        clCreateBuffer(fx->context, CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR, bytes, host, &err);
+    CHECK(err == CL_SUCCESS);
+    cl_mem over_host_later = clCreateBuffer(fx->context, CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR,
+                                            bytes, host + align, &err);
+    CHECK(err == CL_SUCCESS);
+    check_refused(fx, m, over_host, over_host_later, NULL, "positions and out_positions overlap",
+                  "buffers over one host memory");
+
+    cl_mem all[] = {over_host_later, over_host,  beyond,   same,      first, later,
+                    parent,          write_only, inherits, read_only, din,   dout};
+    for (size_t k = 0; k < sizeof all / sizeof all[0]; k++)
+        clReleaseMemObject(all[k]);
+    free(host);
+    free(expected);
+    free(got);
+    free(shifted);
+    free(marker);
+    free(in);
+}
+
 int main(void) {
     rsmooth_context *base = open_test_context();
     fixture fx;
@@ -225,6 +378,7 @@ int main(void) {
     shape_free(&big);
 
     check_errors(&fx, &cube);
+    check_memory_objects(&fx, &cube);
 
     shape_free(&cube);
     rsmooth_context_destroy(fx.ctx);

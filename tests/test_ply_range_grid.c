@@ -37,6 +37,7 @@ typedef enum variant {
     NO_COLS,      /* no num_cols line */
     TEXT_ROWS,    /* num_rows not a number */
     WITH_FACES,   /* a face element as well */
+    TWO_GRIDS,    /* a second range_grid element, the same cells again */
     VARIANT_COUNT
 } variant;
 
@@ -48,11 +49,12 @@ static const char *const expected_message[VARIANT_COUNT] = {
     "range grid of 300 cells, but num_cols x num_rows is 20 x 14",
     "range grid without an 'obj_info num_cols' line",
     "'obj_info num_rows 1five' is not one 'obj_info num_rows N' line",
-    "range grid together with a face element"};
+    "range grid together with a face element",
+    "a second 'range_grid' element"};
 
 static const char *const variant_name[VARIANT_COUNT] = {"good",      "two_indices", "out_of_range",
                                                         "twice",     "wrong_count", "no_cols",
-                                                        "text_rows", "with_faces"};
+                                                        "text_rows", "with_faces",  "two_grids"};
 
 /* Vertex ids: the samples in reverse cell order (the vertex order need not follow the grid). */
 static int sample_count(void) {
@@ -97,7 +99,8 @@ static bytes grid_file(rsmooth_format format, variant v, double step) {
     put_text(&b, line);
     snprintf(line, sizeof line, "element range_grid %d\nproperty list uchar int vertex_indices\n",
              COLS * ROWS);
-    put_text(&b, line);
+    for (int g = 0; g < (v == TWO_GRIDS ? 2 : 1); g++)
+        put_text(&b, line);
     if (v == WITH_FACES)
         put_text(&b, "element face 1\nproperty list uchar int vertex_indices\n");
     put_text(&b, "end_header\n");
@@ -114,8 +117,9 @@ static bytes grid_file(rsmooth_format format, variant v, double step) {
                     for (int a = 0; a < 3; a++)
                         put_f32(&b, (float)p[a]);
             }
-    for (int k = 0; k < COLS * ROWS; k++) {
-        int id = vertex_of(k % COLS, k / COLS), extra = -1;
+    for (int k = 0; k < (v == TWO_GRIDS ? 2 : 1) * COLS * ROWS; k++) {
+        int cell = k % (COLS * ROWS); /* a second grid: the same cells again */
+        int id = vertex_of(cell % COLS, cell / COLS), extra = -1;
         if (k == 21 && v == TWO_INDICES)
             extra = 0;
         if (k == 21 && v == OUT_OF_RANGE)
@@ -294,9 +298,60 @@ static void check_written_back(void) {
     rsmooth_mesh_destroy(m);
 }
 
+/* `b` without the header line `line` (which it holds once). */
+static void drop_line(bytes *b, const char *line) {
+    size_t n = strlen(line), at = 0;
+    while (at + n <= b->size && memcmp(b->data + at, line, n) != 0)
+        at++;
+    CHECK(at + n <= b->size);
+    memmove(b->data + at, b->data + at + n, b->size - at - n);
+    b->size -= n;
+}
+
+/* Written, read back and written again: the same bytes, each encoding written in ascii and
+ * binary, from a grid with the scanner's obj_info lines and from one whose obj_info lines all
+ * describe the grid (num_cols, num_rows, is_mesh: all dropped on reading, which leaves a header
+ * with nothing of the input's own). */
+static void check_rewrite_stable(void) {
+    const rsmooth_format formats[3] = {RSMOOTH_FORMAT_PLY_ASCII, RSMOOTH_FORMAT_PLY_BINARY,
+                                       RSMOOTH_FORMAT_PLY_BINARY_BE};
+    const rsmooth_format out[2] = {RSMOOTH_FORMAT_PLY_ASCII, RSMOOTH_FORMAT_PLY_BINARY};
+    for (int only_grid = 0; only_grid < 2; only_grid++)
+        for (int f = 0; f < 3; f++)
+            for (int o = 0; o < 2; o++) {
+                bytes b = grid_file(formats[f], GOOD, 40);
+                if (only_grid) {
+                    drop_line(&b, "obj_info is_cyberware_data 1\n");
+                    drop_line(&b, "obj_info echo_lgincr 0.000500\n");
+                }
+                rsmooth_mesh *m = NULL, *back = NULL;
+                rsmooth_error err;
+                CHECK_STATUS(
+                    rsmooth_mesh_read_memory(b.data, b.size, RSMOOTH_FORMAT_AUTO, &m, &err),
+                    RSMOOTH_OK);
+                size_t size1, size2;
+                char *first = mesh_to_memory(m, out[o], &size1);
+                CHECK_STATUS(
+                    rsmooth_mesh_read_memory(first, size1, RSMOOTH_FORMAT_AUTO, &back, &err),
+                    RSMOOTH_OK);
+                char *second = mesh_to_memory(back, out[o], &size2);
+                if (size1 != size2 || memcmp(first, second, size1) != 0) {
+                    fprintf(stderr, "%s grid, encoding %d written as %d: %zu bytes, then %zu\n",
+                            only_grid ? "obj_info-only" : "scanner's", (int)formats[f], (int)out[o],
+                            size1, size2);
+                    CHECK(0);
+                }
+                free(first);
+                free(second);
+                rsmooth_mesh_destroy(back);
+                rsmooth_mesh_destroy(m);
+                bytes_free(&b);
+            }
+}
+
 /* The header lines of grid_file's output, so that an ascii cell's line can be told. */
 static int header_lines(variant v) {
-    return 14 - (v == NO_COLS) + 2 * (v == WITH_FACES);
+    return 14 - (v == NO_COLS) + 2 * (v == WITH_FACES || v == TWO_GRIDS);
 }
 
 static void check_malformed(void) {
@@ -320,6 +375,8 @@ static void check_malformed(void) {
                 CHECK_EQ_INT(err.line, header_lines((variant)v) + sample_count() + 21 + 1);
             if (formats[f] != RSMOOTH_FORMAT_PLY_ASCII && (v == TWO_INDICES || v == OUT_OF_RANGE))
                 CHECK(err.byte_offset > 0);
+            if (v == TWO_GRIDS) /* the second 'element range_grid' line: 2 before end_header */
+                CHECK_EQ_INT(err.line, header_lines(TWO_GRIDS) - 2);
             bytes_free(&b);
         }
 }
@@ -411,6 +468,7 @@ int main(int argc, char **argv) {
     check_good(RSMOOTH_FORMAT_PLY_BINARY_BE);
     check_encodings_agree();
     check_written_back();
+    check_rewrite_stable();
     check_malformed();
     check_bunny_scan();
     printf("ply_range_grid: all checks passed\n");

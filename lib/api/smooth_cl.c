@@ -57,6 +57,8 @@ rsmooth_status rsmooth_smooth_cl(rsmooth_context *ctx, rsmooth_scalar scalar, cl
     st = rs_cl_check_buffer(ctx, positions, "positions", bytes, vertex_count, error);
     if (st == RSMOOTH_OK)
         st = rs_cl_check_buffer(ctx, out_positions, "out_positions", bytes, vertex_count, error);
+    if (st == RSMOOTH_OK) /* buffers, readable, writable, the same or apart */
+        st = rs_cl_check_buffer_pair(positions, out_positions, bytes, error);
     void *host_in = NULL, *host_out = NULL;
     if (st == RSMOOTH_OK) {
         /* the host's output stays zero where the device takes the result: the final check of

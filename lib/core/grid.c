@@ -29,7 +29,8 @@ void rs_grid_cell_of(const rs_grid *grid, const double p[3], int32_t cell[3]) {
     }
 }
 
-void rs_grid_facet_cell(const rs_grid *grid, const double p[3], int32_t cell[3]) {
+/* The cell the grid filed a point it was built over in (rs_grid_cell_of, within the grid). */
+static void rs_grid_facet_cell(const rs_grid *grid, const double p[3], int32_t cell[3]) {
     rs_grid_cell_of(grid, p, cell);
     for (int k = 0; k < 3; k++) /* rounding can put the far edge one cell out */
         cell[k] = cell[k] < 0 ? 0 : cell[k] >= grid->dims[k] ? grid->dims[k] - 1 : cell[k];

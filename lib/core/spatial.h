@@ -61,9 +61,6 @@ bool rs_grid_index_columns(rs_grid *grid);
  * than `split` cells away from every facet, so clamping never loses a neighbour. */
 void rs_grid_cell_of(const rs_grid *grid, const double p[3], int32_t cell[3]);
 
-/* The cell the grid filed a point it was built over in (rs_grid_cell_of, within the grid). */
-void rs_grid_facet_cell(const rs_grid *grid, const double p[3], int32_t cell[3]);
-
 /* Index of the occupied cell at (x, y, z), or -1 (a grid from rs_grid_build). */
 int32_t rs_grid_find(const rs_grid *grid, int32_t x, int32_t y, int32_t z);
 

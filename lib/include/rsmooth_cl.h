@@ -41,7 +41,11 @@ RSMOOTH_API rsmooth_status rsmooth_context_create_from_queue(cl_command_queue qu
 
 /** rsmooth_smooth on positions held in OpenCL buffers of the context's OpenCL context: `positions`
  * holds vertex_count x 3 `scalar`s, packed (x, y, z per vertex, from offset 0), and the result
- * goes to `out_positions` in the same layout (it may be `positions` itself). Indices stay on the
+ * goes to `out_positions` in the same layout. `out_positions` may be `positions` itself (the
+ * same cl_mem: smoothed in place), while two different objects must not share the bytes the
+ * call uses: overlapping sub-buffers of one buffer, a sub-buffer and its buffer, or buffers over
+ * the same host memory (CL_MEM_USE_HOST_PTR) are refused, since a kernel would read inputs it
+ * had overwritten (OpenCL leaves such use undefined). Indices stay on the
  * host. The call enqueues its work on the context's queue after what the caller enqueued there
  * (an in-order queue; on another queue of the same context, finish that first), and finishes
  * the queue before it returns: the output is then ready. The input is read to the host once (the
@@ -53,8 +57,10 @@ RSMOOTH_API rsmooth_status rsmooth_context_create_from_queue(cl_command_queue qu
  * arithmetic the host uses, so the bits equal rsmooth_smooth's; nothing of the output travels
  * through the host, and the report's pair counts are 0. Otherwise the result is computed on the
  * host as rsmooth_smooth computes it and written into out_positions. Fails like rsmooth_smooth,
- * and with RSMOOTH_ERROR_INVALID_ARGUMENT when a buffer is NULL, not a buffer, of another OpenCL
- * context, or smaller than vertex_count x 3 scalars (the message names it); out_positions is then
+ * and with RSMOOTH_ERROR_INVALID_ARGUMENT when a buffer is NULL, not a buffer (an image), of
+ * another OpenCL context, or smaller than vertex_count x 3 scalars, when `positions` is
+ * CL_MEM_WRITE_ONLY or `out_positions` CL_MEM_READ_ONLY (a sub-buffer's own or its buffer's),
+ * or when the two share memory as above (the message names it); out_positions is then
  * untouched. No weight or confidence output: call rsmooth_smooth for those. (Added in 0.11) */
 RSMOOTH_API rsmooth_status rsmooth_smooth_cl(rsmooth_context *ctx, rsmooth_scalar scalar,
                                              cl_mem positions, size_t vertex_count,

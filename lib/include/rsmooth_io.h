@@ -166,12 +166,42 @@ RSMOOTH_API rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, F
 RSMOOTH_API rsmooth_status rsmooth_mesh_check_writable(const rsmooth_mesh *mesh,
                                                        rsmooth_format format, rsmooth_error *error);
 
-/** Writes `mesh` to `path` (created or truncated). AUTO picks the format from the extension: .obj,
+/** Writes `mesh` to `path`, whole or not at all. AUTO picks the format from the extension: .obj,
  * .ply (binary little-endian), .off, .stl (binary). A mesh refused as by rsmooth_mesh_write_stream
- * creates no file. Callers that must never leave a partial file write to a temporary path and
- * rename it (the rsmooth command does). */
+ * creates no file. The file is written beside `path` (beside the file a symbolic link leads to)
+ * and takes the name only when complete, replacing an existing regular file atomically and
+ * keeping its permission bits, owner and group: a write that fails (RSMOOTH_ERROR_IO, the path
+ * named; or the writer's own status) leaves whatever was at `path` untouched and no temporary
+ * behind. Never replaces a directory, device, FIFO or socket, nor writes through a link to
+ * nothing (RSMOOTH_ERROR_IO). On success error->message is empty, or a warning to pass on (the
+ * file had other hard links, which keep the old content; its owner could not be kept). While a
+ * named temporary exists (where the file system has no unnamed ones), a SIGINT, SIGTERM or SIGHUP
+ * removes it first, then takes its previous action. */
 RSMOOTH_API rsmooth_status rsmooth_mesh_write_file(const rsmooth_mesh *mesh, const char *path,
                                                    rsmooth_format format, rsmooth_error *error);
+
+/** Writes a file's content for rsmooth_file_write into `stream`: returns 0, or -1 with what went
+ * wrong in `message` (a buffer of `size` bytes). (Added in 0.11) */
+typedef int (*rsmooth_file_writer)(FILE *stream, void *user, char *message, size_t size);
+
+/** Writes `path` whole or not at all, as rsmooth_mesh_write_file writes a mesh, with content of
+ * the caller's (the rsmooth command's meshes and pictures): `write(stream, user, ...)` fills a new
+ * file beside `path` (beside the file a symbolic link leads to), which takes the name only when
+ * `write` returned 0 and the stream was flushed and closed without error; anything that fails
+ * removes it and leaves whatever was at `path` untouched. Without `replace` an existing name is
+ * refused, and so is a file another program creates at the name meanwhile; with it an existing
+ * regular file (or the one a link leads to) is replaced atomically and keeps its permission
+ * bits, owner and group. Directories, devices, FIFOs, sockets and links to nothing are never
+ * written. `hint` says how a caller's user asks for replacing, in the refusal of an existing
+ * name ("PATH: already exists (HINT to replace it)"; NULL: "set replace"). With `write` NULL
+ * only checks that `path` may be written, and writes nothing. RSMOOTH_ERROR_IO with a message
+ * that starts with the path when `path` may not be written or the writing fails ("PATH: cannot
+ * write: " and `write`'s message); RSMOOTH_ERROR_INVALID_ARGUMENT for a NULL path. On success
+ * error->message is empty, or a warning to pass on (the file had other hard links, which keep
+ * the old content; its owner could not be kept). (Added in 0.11) */
+RSMOOTH_API rsmooth_status rsmooth_file_write(const char *path, int replace, const char *hint,
+                                              rsmooth_file_writer write, void *user,
+                                              rsmooth_error *error);
 
 /** The format a path's extension names (case-insensitive .obj, .ply (binary), .off, .stl (binary)),
  * or AUTO if none. */

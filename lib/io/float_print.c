@@ -106,7 +106,13 @@ static rs_io_decimal to_decimal(uint64_t c, int q, bool closer_below) {
     return strip_zeros(vb < mid || (vb == mid && (s & 1) == 0) ? s : t, k);
 }
 
-rs_io_decimal rs_io_shortest_double(double v) {
+/* The decimal with the fewest significant digits that lies in the rounding interval of |v| (so
+ * that strtod / strtof, rounding to nearest even, read it back as |v|), the closest to |v| among
+ * them (ties to an even last digit). These are the digits of the smallest precision p for which
+ * "%.{p}g" reads back as v, except at some powers of two, whose interval reaches twice as far up
+ * as down: there "%.{p}g" may round down out of it where a decimal one digit shorter above v is
+ * in it. v finite and nonzero. */
+static rs_io_decimal rs_io_shortest_double(double v) {
     uint64_t bits;
     memcpy(&bits, &v, sizeof bits);
     const uint64_t fraction = bits & (((uint64_t)1 << 52) - 1);
@@ -116,7 +122,7 @@ rs_io_decimal rs_io_shortest_double(double v) {
     return to_decimal(fraction | (uint64_t)1 << 52, biased - 1075, fraction == 0 && biased > 1);
 }
 
-rs_io_decimal rs_io_shortest_float(float v) {
+static rs_io_decimal rs_io_shortest_float(float v) {
     uint32_t bits;
     memcpy(&bits, &v, sizeof bits);
     const uint32_t fraction = bits & ((1u << 23) - 1);

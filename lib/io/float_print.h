@@ -16,15 +16,6 @@ typedef struct rs_io_decimal {
     int exponent;
 } rs_io_decimal;
 
-/* The decimal with the fewest significant digits that lies in the rounding interval of |v| (so
- * that strtod / strtof, rounding to nearest even, read it back as |v|), the closest to |v| among
- * them (ties to an even last digit). These are the digits of the smallest precision p for which
- * "%.{p}g" reads back as v, except at some powers of two, whose interval reaches twice as far up
- * as down: there "%.{p}g" may round down out of it where a decimal one digit shorter above v is
- * in it. v finite and nonzero. */
-rs_io_decimal rs_io_shortest_double(double v);
-rs_io_decimal rs_io_shortest_float(float v);
-
 /* Writes v (no terminating NUL) and returns the number of bytes, at most RS_IO_PRINT_MAX: the
  * shortest digits above, laid out as "%.{P}g" lays out its digits, P = 15 when they are at most
  * 15 and 17 otherwise (floats: 6 and 9): plain decimal, or d.ddde+XX from P digits up or below

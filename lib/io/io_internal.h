@@ -6,7 +6,7 @@
  *   *_read.c        the readers (ply_read.c over ply_header.c, ply_ascii.c / ply_binary.c, then
  *                   ply_element.c)
  *   *_write.c       the writers and their own checks (over text_out.c, float_print.c and
- *                   mesh_normals.c)
+ *                   mesh_normals.c; OBJ's and OFF's through text_mesh_write.c, which calls those)
  *   mesh_data.c     the mesh record (create, destroy, adopt) and the conversion-loss report
  *   mesh_check.c    the well-formedness and value checks every writer makes
  *   *_extras.c      each format's extras record: its release and what a conversion drops
@@ -126,12 +126,6 @@ bool rs_io_float32_misfit_find(const double *xyz, size_t vertex_count, const uin
  * as the double it is. */
 bool rs_io_float32_holds(const rsmooth_mesh *mesh);
 
-/* Every refusal of the writer of `format`, run before its first byte (rsmooth_mesh_check_writable
- * and rsmooth_mesh_write_stream): rs_io_mesh_check, rs_io_mesh_check_values, then the format's
- * own check. AUTO or an unknown value is INVALID_ARGUMENT, big-endian PLY UNSUPPORTED. */
-rsmooth_status rs_io_check_writable(const rsmooth_mesh *mesh, rsmooth_format format,
-                                    const char *where, rsmooth_error *error);
-
 /* Each format's own refusals (before its writer runs; the mesh already passed rs_io_mesh_check and
  * rs_io_mesh_check_values): what its file cannot hold (STL: no triangles, binary STL's float32;
  * PLY: the input's declared types), and the normals it would write. */
@@ -207,19 +201,34 @@ bool rs_io_keeps_bom(const rsmooth_mesh *mesh, rsmooth_format format);
  * after their checks, before their first byte. */
 bool rs_io_put_bom(const rsmooth_mesh *mesh, rsmooth_format format, FILE *stream);
 
+/* ---- text_mesh_write.c: what the text mesh writers (OBJ, OFF) share */
+
 /* The body of a text mesh file (OBJ, OFF): writes `mesh` through `out`, with `extras` the format's
- * record of what the file was read with (NULL: none) and `normals` per-vertex normals (or NULL). */
+ * record of what the file was read with (NULL: rsmooth's own layout) and `normals` per-vertex
+ * normals (or NULL). */
 struct rs_io_text_out;
 typedef void (*rs_io_text_body)(const rsmooth_mesh *mesh, const void *extras, const double *normals,
                                 bool as_float, struct rs_io_text_out *out);
 
-/* Writes a text mesh file to `stream`: its byte-order mark (rs_io_put_bom), then `body` through a
- * buffered text writer, then flushes the stream. RSMOOTH_ERROR_IO ("writing NAME: reason") when
- * any write fails. */
+/* Writes a text mesh file to `stream`: the vertex normals computed first when `want_normals`
+ * (rs_io_vertex_normals: its errors), its byte-order mark (rs_io_put_bom), then `faithful` with
+ * `extras` where they describe the mesh (not NULL), else `generic`, through a buffered text
+ * writer; then flushes the stream. `as_float` for the bodies: rs_io_float32_holds(mesh).
+ * RSMOOTH_ERROR_IO ("writing NAME: reason") when any write fails. */
 rsmooth_status rs_io_text_write_mesh(const rsmooth_mesh *mesh, FILE *stream, rsmooth_format format,
-                                     const char *name, rs_io_text_body body, const void *extras,
-                                     const double *normals, const char *where,
-                                     rsmooth_error *error);
+                                     const char *name, rs_io_text_body faithful,
+                                     rs_io_text_body generic, const void *extras, bool want_normals,
+                                     const char *where, rsmooth_error *error);
+
+/* v so that it reads back as the same value (the same float when `as_float`), in its shortest
+ * decimal (float_print.h: "%.15g"'s text when that is shortest, so unchanged coordinates keep
+ * their short form). A value beyond float range is written as the double it is. */
+void rs_io_text_coordinate(struct rs_io_text_out *out, double v, bool as_float);
+
+/* " n", a vertex normal's component: a point cloud's own normals (`exact`: its data) as
+ * rs_io_text_coordinate writes them, so that they read back exactly; recomputed ones to 9 digits
+ * (ample for a unit vector; "%.9g"). */
+void rs_io_text_normal(struct rs_io_text_out *out, double n, bool exact, bool as_float);
 
 /* Each frees its record (accepts NULL). */
 void rs_io_ply_extras_free(rs_ply_extras *extras);

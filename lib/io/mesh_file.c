@@ -1,11 +1,13 @@
 /* Public entry points of the mesh file library: whole-file and stream reads (parsed by
- * mesh_detect.c), stream and file writes. */
+ * mesh_detect.c), stream and file writes (files put in place whole, through output_file.h). */
 #define _POSIX_C_SOURCE 200809L
 #include "io/io_internal.h"
+#include "io/output_file.h"
 
 #include <errno.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 /* Reads the whole stream; regular files in one allocation of their size, others by doubling. */
 static rsmooth_status read_all(FILE *file, const char *path, size_t size_hint, char **out_data,
@@ -106,8 +108,11 @@ rsmooth_status rsmooth_mesh_read_stream(FILE *stream, const char *name, rsmooth_
     return status;
 }
 
-rsmooth_status rs_io_check_writable(const rsmooth_mesh *mesh, rsmooth_format format,
-                                    const char *where, rsmooth_error *error) {
+/* Every refusal of the writer of `format`, run before its first byte (rsmooth_mesh_check_writable
+ * and rsmooth_mesh_write_stream): rs_io_mesh_check, rs_io_mesh_check_values, then the format's
+ * own check. AUTO or an unknown value is INVALID_ARGUMENT, big-endian PLY UNSUPPORTED. */
+static rsmooth_status rs_io_check_writable(const rsmooth_mesh *mesh, rsmooth_format format,
+                                           const char *where, rsmooth_error *error) {
     rsmooth_status status = rs_io_mesh_check(mesh, where, error);
     if (status == RSMOOTH_OK)
         status = rs_io_mesh_check_values(mesh, where, error);
@@ -178,6 +183,80 @@ rsmooth_status rsmooth_mesh_write_stream(const rsmooth_mesh *mesh, FILE *stream,
     return write_checked(mesh, stream, format, error);
 }
 
+/* What a file written whole gets as content: written into `stream`, a status and `error` as a
+ * writer gives them. */
+typedef rsmooth_status (*content_writer)(FILE *stream, void *user, rsmooth_error *error);
+
+/* A successful write's notes (output_file.h) in error->message, cut to fit. */
+static void put_notes(rsmooth_error *error, const char *notes) {
+    if (!error)
+        return;
+    size_t n = strnlen(notes, sizeof error->message - 1);
+    memcpy(error->message, notes, n);
+    error->message[n] = '\0';
+}
+
+/* Writes `path` whole or not at all (output_file.h): `content` goes into a new file beside it,
+ * which takes the name only when written, flushed and closed without error; anything that fails
+ * removes it and leaves whatever was at `path` as it was. Without `write` only the checks of
+ * `path`. A failure of `write` keeps its status (RSMOOTH_ERROR_IO with the path named); on
+ * success error->message holds output_file.h's notes, or nothing. */
+static rsmooth_status write_whole(const char *path, bool replace, const char *hint,
+                                  content_writer write, void *user, const char *where,
+                                  rsmooth_error *error) {
+    rs_output o;
+    rsmooth_status status = rs_output_resolve(&o, path, replace, hint, where, error);
+    if (status == RSMOOTH_OK && write)
+        status = rs_output_create(&o, where, error);
+    if (status != RSMOOTH_OK || !write) {
+        rs_output_discard(&o);
+        if (status == RSMOOTH_OK)
+            put_notes(error, o.notes);
+        return status;
+    }
+    /* a stream of its own over a copy of the descriptor, closed (flushed and checked) before
+     * the content is put in place */
+    int copy = dup(o.fd);
+    FILE *stream = copy >= 0 ? fdopen(copy, "wb") : NULL;
+    if (!stream) {
+        status =
+            rs_fail(error, RSMOOTH_ERROR_IO, where, "%s: cannot write: %s", path, strerror(errno));
+        if (copy >= 0)
+            close(copy);
+    }
+    if (stream)
+        status = write(stream, user, error);
+    if (status == RSMOOTH_ERROR_IO) {
+        char detail[sizeof error->message]; /* rs_fail clears `error` before formatting */
+        snprintf(detail, sizeof detail, "%s", error ? error->message : "write failed");
+        status = rs_fail(error, RSMOOTH_ERROR_IO, where, "%s: cannot write: %s", path, detail);
+    }
+    errno = 0;
+    if (stream && fclose(stream) != 0 && status == RSMOOTH_OK)
+        status = rs_fail(error, RSMOOTH_ERROR_IO, where, "%s: cannot write: %s", path,
+                         errno ? strerror(errno) : "close failed");
+    if (status != RSMOOTH_OK) {
+        rs_output_discard(&o);
+        return status;
+    }
+    char notes[sizeof o.notes];
+    memcpy(notes, o.notes, sizeof notes);
+    status = rs_output_publish(&o, replace, where, error);
+    if (status == RSMOOTH_OK)
+        put_notes(error, notes);
+    return status;
+}
+
+typedef struct mesh_content {
+    const rsmooth_mesh *mesh;
+    rsmooth_format format;
+} mesh_content;
+
+static rsmooth_status write_mesh_content(FILE *stream, void *user, rsmooth_error *error) {
+    const mesh_content *c = user;
+    return write_checked(c->mesh, stream, c->format, error);
+}
+
 rsmooth_status rsmooth_mesh_write_file(const rsmooth_mesh *mesh, const char *path,
                                        rsmooth_format format, rsmooth_error *error) {
     static const char where[] = "rsmooth_mesh_write_file";
@@ -190,30 +269,36 @@ rsmooth_status rsmooth_mesh_write_file(const rsmooth_mesh *mesh, const char *pat
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                            "cannot tell the format of '%s' (use .obj, .ply, .off or .stl)", path);
     }
-    /* Every refusal before creating the file, so a refused mesh leaves no file behind. */
+    /* Every refusal before anything is created, so a refused mesh leaves no file behind. */
     rsmooth_status status = rs_io_check_writable(mesh, format, where, error);
     if (status != RSMOOTH_OK)
         return status;
-    struct stat before;
-    bool existed = stat(path, &before) == 0;
-    FILE *file = fopen(path, "wb");
-    if (!file)
-        return rs_fail(error, RSMOOTH_ERROR_IO, where, "cannot create '%s': %s", path,
-                       strerror(errno));
-    status = write_checked(mesh, file, format, error);
-    errno = 0;
-    bool closed = fclose(file) == 0;
-    if (status == RSMOOTH_ERROR_INVALID_ARGUMENT && !existed)
-        remove(path); /* the writer refused before its first byte: leave no empty file */
-    if (status == RSMOOTH_ERROR_IO) {
-        char detail[sizeof error->message]; /* rs_fail clears `error` before formatting */
-        snprintf(detail, sizeof detail, "%s", error ? error->message : "write failed");
-        return rs_fail(error, RSMOOTH_ERROR_IO, where, "writing '%s': %s", path, detail);
-    }
-    if (status != RSMOOTH_OK)
-        return status;
-    if (!closed)
-        return rs_fail(error, RSMOOTH_ERROR_IO, where, "writing '%s': %s", path,
-                       errno ? strerror(errno) : "close failed");
-    return RSMOOTH_OK;
+    mesh_content c = {mesh, format};
+    return write_whole(path, true, "", write_mesh_content, &c, where, error);
+}
+
+typedef struct caller_content {
+    rsmooth_file_writer write;
+    void *user;
+} caller_content;
+
+static rsmooth_status write_caller_content(FILE *stream, void *user, rsmooth_error *error) {
+    const caller_content *c = user;
+    char message[sizeof error->message] = "";
+    if (c->write(stream, c->user, message, sizeof message) == 0)
+        return RSMOOTH_OK;
+    message[sizeof message - 1] = '\0';
+    return rs_fail(error, RSMOOTH_ERROR_IO, "rsmooth_file_write", "%s",
+                   message[0] ? message : "the content's writer failed");
+}
+
+rsmooth_status rsmooth_file_write(const char *path, int replace, const char *hint,
+                                  rsmooth_file_writer write, void *user, rsmooth_error *error) {
+    static const char where[] = "rsmooth_file_write";
+    rs_error_clear(error);
+    if (!path)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "path is NULL");
+    caller_content c = {write, user};
+    return write_whole(path, replace != 0, hint ? hint : "set replace",
+                       write ? write_caller_content : NULL, &c, where, error);
 }

@@ -2,21 +2,14 @@
 #include "io/obj_format.h"
 #include "io/text_out.h"
 
-#include <errno.h>
-#include <math.h>
 #include <string.h>
 
 static const char where[] = "rsmooth_mesh_write_stream";
 
-/* Writes " v" so that it reads back as the same value (the same float when `as_float`), in its
- * shortest decimal (float_print.h: "%.15g"'s text when that is shortest, so unchanged
- * coordinates keep their short form). A value beyond float range is written as the double it is. */
+/* " v", read back as the same value (rs_io_text_coordinate). */
 static void put_coord(rs_io_text_out *out, double v, bool as_float) {
     rs_io_text_char(out, ' ');
-    if (as_float && isfinite((float)v))
-        rs_io_text_float(out, (float)v);
-    else
-        rs_io_text_double(out, v);
+    rs_io_text_coordinate(out, v, as_float);
 }
 
 /* `as_float`: a float32 mesh that float32 holds at its scale (rs_io_float32_holds). */
@@ -28,22 +21,16 @@ static void put_position(rs_io_text_out *out, const rsmooth_mesh *mesh, size_t v
     put_coord(out, p[2], as_float);
 }
 
-/* vertex_count vn lines, each ended by `eol`: recomputed normals to 9 digits (ample for a unit
- * vector; "%.9g"), a point cloud's own normals (its data) so that they read back exactly. */
+/* vertex_count vn lines, each ended by `eol` (rs_io_text_normal: recomputed normals to 9 digits,
+ * a point cloud's own exactly). */
 static void put_normals(rs_io_text_out *out, const rsmooth_mesh *mesh, const double *normals,
                         const char *eol, size_t eol_len, bool as_float) {
     bool exact = rs_io_normals_are_data(mesh);
     for (size_t i = 0; out->ok && i < mesh->vertex_count; i++) {
         const double *n = normals + 3 * i;
         rs_io_text_bytes(out, "vn", 2);
-        for (int c = 0; c < 3; c++) {
-            if (exact) {
-                put_coord(out, n[c], as_float);
-            } else {
-                rs_io_text_char(out, ' ');
-                rs_io_text_g9(out, n[c]);
-            }
-        }
+        for (int c = 0; c < 3; c++)
+            rs_io_text_normal(out, n[c], exact, as_float);
         rs_io_text_bytes(out, eol, eol_len);
     }
 }
@@ -149,8 +136,9 @@ static void write_text(const rsmooth_mesh *mesh, const rs_obj_extras *x, const d
 }
 
 /* Writes the file the mesh was read from, run by run. */
-static void write_faithful(const rsmooth_mesh *mesh, const rs_obj_extras *x, const double *normals,
+static void write_faithful(const rsmooth_mesh *mesh, const void *extras, const double *normals,
                            bool as_float, rs_io_text_out *out) {
+    const rs_obj_extras *x = extras;
     faithful_cursor at = {0, 0, false, as_float};
     const char *eol = x->crlf ? "\r\n" : "\n";
     size_t eol_len = x->crlf ? 2 : 1;
@@ -173,8 +161,9 @@ static void write_faithful(const rsmooth_mesh *mesh, const rs_obj_extras *x, con
     }
 }
 
-static void write_generic(const rsmooth_mesh *mesh, const double *normals, bool as_float,
-                          rs_io_text_out *out) {
+static void write_generic(const rsmooth_mesh *mesh, const void *no_extras, const double *normals,
+                          bool as_float, rs_io_text_out *out) {
+    (void)no_extras;
     rs_io_text_printf(out, "# written by rsmooth\n# %zu vertices, %zu faces\n", mesh->vertex_count,
                       mesh->face_count);
     char colors[256][16]; /* " %.4g" of each channel value / 255, formatted once */
@@ -219,26 +208,8 @@ rsmooth_status rs_io_obj_check(const rsmooth_mesh *mesh, rsmooth_error *error) {
                                                       : RSMOOTH_OK;
 }
 
-/* The file's text: as it was read (faithful) or rsmooth's own layout. */
-static void write_body(const rsmooth_mesh *mesh, const void *extras, const double *normals,
-                       bool as_float, rs_io_text_out *out) {
-    if (extras)
-        write_faithful(mesh, extras, normals, as_float, out);
-    else
-        write_generic(mesh, normals, as_float, out);
-}
-
 rsmooth_status rs_io_obj_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_error *error) {
     const rs_obj_extras *x = faithful_extras(mesh);
-    bool want_normals = wants_normals(mesh, x);
-    double *normals = NULL;
-    if (want_normals) {
-        rsmooth_status status = rs_io_vertex_normals(mesh, &normals, where, error);
-        if (status != RSMOOTH_OK)
-            return status;
-    }
-    rsmooth_status status = rs_io_text_write_mesh(mesh, stream, RSMOOTH_FORMAT_OBJ, "OBJ",
-                                                  write_body, x, normals, where, error);
-    rs_free(normals);
-    return status;
+    return rs_io_text_write_mesh(mesh, stream, RSMOOTH_FORMAT_OBJ, "OBJ", write_faithful,
+                                 write_generic, x, wants_normals(mesh, x), where, error);
 }

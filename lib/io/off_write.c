@@ -2,22 +2,15 @@
 #include "io/off_format.h"
 #include "io/text_out.h"
 
-#include <errno.h>
-#include <math.h>
 #include <string.h>
 
 static const char where[] = "rsmooth_mesh_write_stream";
 
-/* Writes `sep` and v so that v reads back as the same value (the same float when `as_float`), in
- * its shortest decimal (float_print.h: "%.15g"'s text when that is shortest, so unchanged
- * coordinates keep their short form). */
+/* `sep` and v, read back as the same value (rs_io_text_coordinate). */
 static void put_coord(rs_io_text_out *out, bool sep, double v, bool as_float) {
     if (sep)
         rs_io_text_char(out, ' ');
-    if (as_float && isfinite((float)v)) /* else the double it is: text holds either */
-        rs_io_text_float(out, (float)v);
-    else
-        rs_io_text_double(out, v);
+    rs_io_text_coordinate(out, v, as_float);
 }
 
 /* " text" for element i of `texts`, nothing when it is empty. */
@@ -55,23 +48,17 @@ static void put_vertex(rs_io_text_out *out, const rsmooth_mesh *mesh, size_t v,
     put_coord(out, true, p[1], as_float);
     put_coord(out, true, p[2], as_float);
     if (normals) { /* recomputed: 9 digits ("%.9g"); a point cloud's own (its data): exact */
-        const double *n = normals + 3 * v;
         bool exact = rs_io_normals_are_data(mesh);
-        for (int c = 0; c < 3; c++) {
-            if (exact) {
-                put_coord(out, true, n[c], as_float);
-            } else {
-                rs_io_text_char(out, ' ');
-                rs_io_text_g9(out, n[c]);
-            }
-        }
+        for (int c = 0; c < 3; c++)
+            rs_io_text_normal(out, normals[3 * v + (size_t)c], exact, as_float);
     }
 }
 
 /* The file the mesh was read from: its keyword, edge count and the text after each vertex's
  * position and each face's indices. */
-static void write_faithful(const rsmooth_mesh *mesh, const rs_off_extras *x, const double *normals,
+static void write_faithful(const rsmooth_mesh *mesh, const void *extras, const double *normals,
                            bool as_float, rs_io_text_out *out) {
+    const rs_off_extras *x = extras;
     rs_io_text_printf(out, "%s\n%zu %zu %llu\n", x->keyword, mesh->vertex_count, mesh->face_count,
                       (unsigned long long)x->edge_count);
     for (size_t v = 0; out->ok && v < mesh->vertex_count; v++) {
@@ -83,8 +70,9 @@ static void write_faithful(const rsmooth_mesh *mesh, const rs_off_extras *x, con
 }
 
 /* OFF, COFF, NOFF or CNOFF from the mesh's own fields. */
-static void write_generic(const rsmooth_mesh *mesh, const double *normals, bool as_float,
-                          rs_io_text_out *out) {
+static void write_generic(const rsmooth_mesh *mesh, const void *no_extras, const double *normals,
+                          bool as_float, rs_io_text_out *out) {
+    (void)no_extras;
     const uint8_t *colors = mesh->vertex_colors;
     rs_io_text_printf(out, "%s%sOFF\n%zu %zu 0\n", colors ? "C" : "", normals ? "N" : "",
                       mesh->vertex_count, mesh->face_count);
@@ -122,26 +110,8 @@ rsmooth_status rs_io_off_check(const rsmooth_mesh *mesh, rsmooth_error *error) {
                                                       : RSMOOTH_OK;
 }
 
-/* The file's text: as it was read (faithful) or rsmooth's own layout. */
-static void write_body(const rsmooth_mesh *mesh, const void *extras, const double *normals,
-                       bool as_float, rs_io_text_out *out) {
-    if (extras)
-        write_faithful(mesh, extras, normals, as_float, out);
-    else
-        write_generic(mesh, normals, as_float, out);
-}
-
 rsmooth_status rs_io_off_write(const rsmooth_mesh *mesh, FILE *stream, rsmooth_error *error) {
     const rs_off_extras *x = faithful_extras(mesh);
-    bool want_normals = wants_normals(mesh, x);
-    double *normals = NULL;
-    if (want_normals) {
-        rsmooth_status status = rs_io_vertex_normals(mesh, &normals, where, error);
-        if (status != RSMOOTH_OK)
-            return status;
-    }
-    rsmooth_status status = rs_io_text_write_mesh(mesh, stream, RSMOOTH_FORMAT_OFF, "OFF",
-                                                  write_body, x, normals, where, error);
-    rs_free(normals);
-    return status;
+    return rs_io_text_write_mesh(mesh, stream, RSMOOTH_FORMAT_OFF, "OFF", write_faithful,
+                                 write_generic, x, wants_normals(mesh, x), where, error);
 }

@@ -166,8 +166,21 @@ static int open_unnamed(rs_output *o) {
 #endif
 }
 
-/* The permissions a new file gets from the umask. */
+/* The permissions a new file gets from the umask, read without changing it where Linux shows it
+ * (/proc/self/status, "Umask:", since 4.7): umask() reads it only by setting it, and meanwhile
+ * files that other threads of the process create get mode 0666. Elsewhere umask(), set back. */
 static mode_t new_file_mode(void) {
+    FILE *f = fopen("/proc/self/status", "re");
+    if (f) {
+        char line[256];
+        unsigned mask = 0;
+        bool found = false;
+        while (!found && fgets(line, sizeof line, f))
+            found = sscanf(line, "Umask: %o", &mask) == 1;
+        fclose(f);
+        if (found)
+            return 0666 & ~(mode_t)mask;
+    }
     mode_t mask = umask(0);
     umask(mask);
     return 0666 & ~mask;

@@ -173,6 +173,10 @@ struct rs_ply_extras {
     /* The faces were triangulated from a range grid of grid_cols x grid_rows cells holding
      * grid_samples samples (ply_range_grid.c); all 0 otherwise. */
     uint64_t grid_cols, grid_rows, grid_samples;
+    /* Kept only for the grid's size above: the layout is the generic writer's (rs_ply_is_plain,
+     * once the grid is faces and its obj_info lines are gone), so the mesh is written as a plain
+     * file is, and what is written reads back as a plain file and is written the same again. */
+    bool plain;
 };
 
 /* ---- ply_write.c: what the streamed writer (lib/stream) shares with rs_io_ply_write, so that a

@@ -361,6 +361,7 @@ bool rs_ply_is_plain(const rs_ply_reader *r) {
 
 rsmooth_status rs_ply_find_elements(rs_ply_reader *r, rsmooth_error *error) {
     rs_ply_extras *x = r->x;
+    const rs_ply_element *grid = NULL;
     for (size_t ei = 0; ei < x->element_count; ei++) {
         rs_ply_element *e = &x->elements[ei];
         bool vertex = !strcmp(e->name, "vertex");
@@ -368,6 +369,16 @@ rsmooth_status rs_ply_find_elements(rs_ply_reader *r, rsmooth_error *error) {
         if ((vertex && r->vertex_element) || (face && r->face_element))
             return rs_fail_parse(error, e->header_line, -1, where, "a second '%s' element",
                                  vertex ? "vertex" : "face");
+        /* one range grid is the surface (ply_range_grid.c); a second would be kept as data and
+         * written beside the faces made from the first, a file no reader takes back */
+        if (!strcmp(e->name, "range_grid")) {
+            if (grid)
+                return rs_fail_parse(error, e->header_line, -1, where,
+                                     "a second 'range_grid' element (the first is on line %lld): "
+                                     "a scan is one grid",
+                                     (long long)grid->header_line);
+            grid = e;
+        }
         if (vertex) {
             r->vertex_element = e;
             x->vertex_element = ei;

@@ -196,7 +196,10 @@ rsmooth_status rs_io_ply_read(const char *data, size_t size, rsmooth_mesh **mesh
     rsmooth_format format = r.encoding == RS_PLY_ASCII       ? RSMOOTH_FORMAT_PLY_ASCII
                             : r.encoding == RS_PLY_BINARY_LE ? RSMOOTH_FORMAT_PLY_BINARY
                                                              : RSMOOTH_FORMAT_PLY_BINARY_BE;
-    bool plain = rs_ply_is_plain(&r) && !r.grid_element; /* extras say it was a grid */
+    bool plain = rs_ply_is_plain(&r);
+    r.x->plain = plain;
+    if (r.grid_element) /* the extras say it was a grid */
+        plain = false;
     rsmooth_mesh *m = NULL;
     status = rs_io_mesh_adopt(r.positions, r.vertex_count, r.precision, r.face_offsets,
                               r.face_count, indices, format, &m, error);

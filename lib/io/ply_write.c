@@ -626,10 +626,11 @@ static rsmooth_status write_faithful(const rsmooth_mesh *mesh, const rs_ply_extr
     return ok ? RSMOOTH_OK : io_failure(error);
 }
 
-/* The PLY record of the mesh, while it describes it (the same vertex and face counts). */
+/* The PLY record of the mesh, while it describes it (the same vertex and face counts) with a
+ * layout of its own (not plain: a plain one is written as the generic path writes it). */
 static const rs_ply_extras *faithful_extras(const rsmooth_mesh *mesh) {
     const rs_ply_extras *x = mesh->extras ? mesh->extras->ply : NULL;
-    if (x && x->vertex_element < x->element_count &&
+    if (x && !x->plain && x->vertex_element < x->element_count &&
         x->elements[x->vertex_element].count == mesh->vertex_count &&
         (x->face_element < x->element_count ? x->elements[x->face_element].count == mesh->face_count
                                             : mesh->face_count == 0))

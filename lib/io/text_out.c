@@ -67,21 +67,3 @@ void rs_io_text_printf(rs_io_text_out *out, const char *format, ...) {
     va_end(again);
     va_end(args);
 }
-
-rsmooth_status rs_io_text_write_mesh(const rsmooth_mesh *mesh, FILE *stream, rsmooth_format format,
-                                     const char *name, rs_io_text_body body, const void *extras,
-                                     const double *normals, const char *where,
-                                     rsmooth_error *error) {
-    rs_io_text_out out;
-    rs_io_text_open(&out, stream);
-    errno = 0;
-    bool ok = rs_io_put_bom(mesh, format, stream);
-    if (ok)
-        body(mesh, extras, normals, rs_io_float32_holds(mesh), &out);
-    ok = rs_io_text_close(&out) && ok;
-    ok = ok && fflush(stream) == 0 && !ferror(stream);
-    if (!ok)
-        return rs_fail(error, RSMOOTH_ERROR_IO, where, "writing %s: %s", name,
-                       errno ? strerror(errno) : "stream error");
-    return RSMOOTH_OK;
-}

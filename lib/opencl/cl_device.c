@@ -277,20 +277,24 @@ cl_mem_flags rs_cl_input_flags(const rsmooth_context *ctx) {
     return ctx->host_unified ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR;
 }
 
-void rs_context_lock(rsmooth_context *ctx) {
+/* A context's calls hold its lock while they use it: threads sharing one run one at a time
+ * (rs_context_unlock releases it). */
+static void rs_context_lock(rsmooth_context *ctx) {
     pthread_mutex_lock(&ctx->lock);
     ctx->owner = pthread_self();
     atomic_store(&ctx->busy, 1);
 }
 
+/* Whether the calling thread holds ctx's lock: it is inside a call on ctx, in one of the call's
+ * callbacks (progress, progress_cancel). */
+static bool rs_context_held_here(const rsmooth_context *ctx) {
+    /* only the holder sets `owner` to itself, so another thread's holding never reads as ours */
+    return atomic_load(&ctx->busy) && pthread_equal(ctx->owner, pthread_self());
+}
+
 void rs_context_unlock(rsmooth_context *ctx) {
     atomic_store(&ctx->busy, 0);
     pthread_mutex_unlock(&ctx->lock);
-}
-
-bool rs_context_held_here(const rsmooth_context *ctx) {
-    /* only the holder sets `owner` to itself, so another thread's holding never reads as ours */
-    return atomic_load(&ctx->busy) && pthread_equal(ctx->owner, pthread_self());
 }
 
 rsmooth_status rs_context_enter(rsmooth_context *ctx, const char *where, rsmooth_error *error) {

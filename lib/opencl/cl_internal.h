@@ -73,12 +73,9 @@ struct rsmooth_context {
  * ctx->local_size. RSMOOTH_KERNEL_VARIANT (cpu, gpu) and RSMOOTH_LANES (4, 8, 16) override it. */
 rsmooth_status rs_cl_choose_variant(rsmooth_context *ctx, rsmooth_error *error);
 
-/* A context's calls hold its lock while they use it: threads sharing one run one at a time. */
-void rs_context_lock(rsmooth_context *ctx);
+/* Releases ctx's lock, which a context's calls hold while they use it (cl_device.c): threads
+ * sharing one run one at a time. */
 void rs_context_unlock(rsmooth_context *ctx);
-/* Whether the calling thread holds ctx's lock: it is inside a call on ctx, in one of the call's
- * callbacks (progress, progress_cancel). */
-bool rs_context_held_here(const rsmooth_context *ctx);
 /* Takes the lock for a filter call, or refuses (RSMOOTH_ERROR_INVALID_ARGUMENT) a call made from
  * a callback of a call on the same context, which would wait for itself for ever. */
 rsmooth_status rs_context_enter(rsmooth_context *ctx, const char *where, rsmooth_error *error);
@@ -128,6 +125,15 @@ rsmooth_status rs_cl_check_buffer(const rsmooth_context *ctx, cl_mem mem, const 
 /* Builds ctx's store program once (cl_store.c); false where it cannot (no fp64): the caller
  * then uploads the host's result. */
 bool rs_cl_store_ready(rsmooth_context *ctx);
+
+/* rsmooth_smooth_cl's buffers, once each is known valid, of ctx's context and `bytes` long
+ * (cl_buffer_check.c): RSMOOTH_ERROR_INVALID_ARGUMENT, naming the argument, where either is no
+ * buffer (an image), `positions` is write-only or `out_positions` read-only (its own flags or its
+ * buffer's), or the two are different objects whose `bytes` used share memory (sub-buffers of
+ * one buffer, a sub-buffer and its buffer, buffers over one host memory); the same object for
+ * both (in place) is allowed. */
+rsmooth_status rs_cl_check_buffer_pair(cl_mem positions, cl_mem out_positions, size_t bytes,
+                                       rsmooth_error *error);
 
 /* Writes a whole run's positions into sink->output on the device (cl_store.c): vertex v's are
  * (input_v * scale + result_v * h) / scale in double, as store_results computes them on the
