@@ -19,8 +19,11 @@ one above it in that table is printed as a call upward.
 Configuration: the library reads the environment in one file, lib/core/environment.c (its table
 is docs/environment.md); any other lib/ object that calls getenv is printed.
 
-Exits 1 when there is a circle, a call upward, a getenv elsewhere or a function over --max-lines
-(120), else 0.
+Public functions: each function rsmooth.h and rsmooth_cl.h declare is defined in lib/api/, and each
+of rsmooth_io.h's in lib/io/ or lib/stream/ (the file library's layers); any other is printed.
+
+Exits 1 when there is a circle, a call upward, a getenv elsewhere, a public function defined
+outside its layer or a function over --max-lines (120), else 0.
 Needs binutils' nm. CI runs it as the test code_shape.
 """
 import argparse
@@ -115,6 +118,15 @@ def circles(build):
     table = {src: symbols(o) for src, o in objs.items()}
     order = layers()
     found, upward = [], []
+    for header, homes in (("rsmooth.h", ("lib/api/",)), ("rsmooth_cl.h", ("lib/api/",)),
+                          ("rsmooth_io.h", ("lib/io/", "lib/stream/"))):
+        with open(os.path.join(ROOT, "lib", "include", header), encoding="utf-8") as f:
+            names = set(re.findall(r"RSMOOTH_API[^;(]*?\b(rsmooth_\w+)\s*\(", f.read()))
+        for src, (defined, _) in sorted(table.items()):
+            for name in sorted(names & defined):
+                if src.startswith("lib/") and not src.startswith(homes):
+                    upward.append("%s defines %s (%s): its home is %s" % (src, name, header,
+                                                                          " or ".join(homes)))
     readers = sorted(src for src, (_, used) in table.items()
                      if src.startswith("lib/") and "getenv" in used
                      and src != "lib/core/environment.c")
@@ -189,8 +201,8 @@ def main():
         print("  circle: " + " <-> ".join(group))
         for e in edges:
             print("    " + e)
-    print("calls upward between lib/'s layers (lib/README.md), and getenv outside "
-          "lib/core/environment.c: %d" % len(upward))
+    print("calls upward between lib/'s layers (lib/README.md), getenv outside "
+          "lib/core/environment.c, public functions outside their layer: %d" % len(upward))
     for e in upward:
         print("    " + e)
     srcs = sorted(glob.glob(os.path.join(ROOT, "lib", "**", "*.c"), recursive=True)

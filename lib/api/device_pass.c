@@ -1,5 +1,5 @@
 /* The device path's one run over a prepared problem: the sequence a mesh's pass (smooth.c), a
- * point cloud's pass (points.c) and a streamed piece (stream/piece.c) share, and the entry and
+ * point cloud's pass (points.c) and a piece of a larger mesh (piece.c) share, and the entry and
  * exit of every call on a context. */
 #include "api/path.h"
 

@@ -887,10 +887,9 @@ static void summarise(const sample_job *job, size_t valid, double unit, double s
     }
 }
 
-rsmooth_status rsmooth_estimate_noise(rsmooth_scalar scalar, const void *positions,
-                                      size_t vertex_count, const uint32_t *indices,
-                                      size_t triangle_count, double *out_noise,
-                                      rsmooth_error *error) {
+rsmooth_status rs_estimate_noise(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
+                                 const uint32_t *indices, size_t triangle_count, double *out_noise,
+                                 rsmooth_error *error) {
     rs_error_clear(error);
     if (!out_noise)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_noise is NULL");

@@ -77,4 +77,15 @@ rsmooth_status rs_estimate_noise_details(rsmooth_scalar scalar, const void *posi
  * the mesh's own shape (a clean mesh, however coarse). */
 bool rs_noise_reads_clean(const rs_noise_details *d);
 
+/* The public functions' bodies, for api/'s definitions of them (lib/api/): */
+/* rsmooth_params_auto */
+rsmooth_status rs_params_auto(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
+                              const uint32_t *indices, size_t triangle_count,
+                              rsmooth_params *params, rsmooth_noise_report *report,
+                              rsmooth_error *error);
+/* rsmooth_estimate_noise */
+rsmooth_status rs_estimate_noise(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
+                                 const uint32_t *indices, size_t triangle_count, double *out_noise,
+                                 rsmooth_error *error);
+
 #endif

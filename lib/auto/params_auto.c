@@ -138,7 +138,7 @@ static void choose(rsmooth_params *params, const rs_noise_details *d, char *pres
         for (b = GAUSSIAN_PRESETS; !(n < b->below); b++)
             ;
     rsmooth_params best;
-    rsmooth_params_init_best(&best);
+    rs_params_init_best(&best);
     params->sigma_f = best.sigma_f;
     params->sigma_g = best.sigma_g;
     params->normal_filter = best.normal_filter;
@@ -169,10 +169,10 @@ static void choose(rsmooth_params *params, const rs_noise_details *d, char *pres
                  isfinite(b->below) ? b->below : (b - 1)->below, stage);
 }
 
-rsmooth_status rsmooth_params_auto(rsmooth_scalar scalar, const void *positions,
-                                   size_t vertex_count, const uint32_t *indices,
-                                   size_t triangle_count, rsmooth_params *params,
-                                   rsmooth_noise_report *report, rsmooth_error *error) {
+rsmooth_status rs_params_auto(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
+                              const uint32_t *indices, size_t triangle_count,
+                              rsmooth_params *params, rsmooth_noise_report *report,
+                              rsmooth_error *error) {
     static const char where[] = "rsmooth_params_auto";
     rs_error_clear(error);
     if (!params)

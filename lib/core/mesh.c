@@ -159,7 +159,7 @@ bool rs_mean_edge_length_below(const double *xyz, size_t vertex_count, const uin
     return true;
 }
 
-rsmooth_status rsmooth_mean_edge_length(rsmooth_scalar scalar, const void *positions,
+rsmooth_status rs_mesh_mean_edge_length(rsmooth_scalar scalar, const void *positions,
                                         size_t vertex_count, const uint32_t *indices,
                                         size_t triangle_count, double *out_length,
                                         rsmooth_error *error) {

@@ -7,7 +7,7 @@
 /* The size of the first published rsmooth_params: callers built against it stay valid. */
 #define PARAMS_V0_SIZE (offsetof(rsmooth_params, mollify) + sizeof(int))
 
-rsmooth_status rsmooth_params_init(rsmooth_params *params) {
+rsmooth_status rs_params_init(rsmooth_params *params) {
     if (!params)
         return RSMOOTH_ERROR_INVALID_ARGUMENT;
     memset(params, 0, sizeof *params);
@@ -43,8 +43,8 @@ rsmooth_status rsmooth_params_init(rsmooth_params *params) {
     return RSMOOTH_OK;
 }
 
-rsmooth_status rsmooth_params_init_best(rsmooth_params *params) {
-    if (rsmooth_params_init(params) != RSMOOTH_OK)
+rsmooth_status rs_params_init_best(rsmooth_params *params) {
+    if (rs_params_init(params) != RSMOOTH_OK)
         return RSMOOTH_ERROR_INVALID_ARGUMENT;
     params->sigma_f = 0.8;
     params->sigma_g = 0.3;
@@ -66,7 +66,7 @@ rsmooth_status rsmooth_params_init_best(rsmooth_params *params) {
 
 rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *out,
                                  rsmooth_error *error, const char *where) {
-    rsmooth_params_init(out);
+    rs_params_init(out);
     if (params) {
         if (params->struct_size < PARAMS_V0_SIZE)
             return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,

@@ -69,7 +69,7 @@ rsmooth_status rs_check_results(rsmooth_scalar scalar, const void *out_positions
     return RSMOOTH_OK;
 }
 
-void rsmooth_report_init(rsmooth_report *report) {
+void rs_report_init(rsmooth_report *report) {
     if (!report)
         return;
     memset(report, 0, sizeof *report);

@@ -416,4 +416,21 @@ void rs_report_problem(rsmooth_report *report, const rs_problem *problem, size_t
 /* Multiplies a report's lengths by `unscale`: internal units to the caller's. */
 void rs_report_unscale(rsmooth_report *report, double unscale);
 
+/* The public functions' bodies, for api/'s definitions of them (lib/api/): */
+/* rsmooth_status_str */
+const char *rs_status_str(rsmooth_status status);
+/* rsmooth_error_init */
+void rs_error_init(rsmooth_error *error);
+/* rsmooth_params_init_best */
+rsmooth_status rs_params_init_best(rsmooth_params *params);
+/* rsmooth_params_init */
+rsmooth_status rs_params_init(rsmooth_params *params);
+/* rsmooth_report_init */
+void rs_report_init(rsmooth_report *report);
+/* rsmooth_mean_edge_length */
+rsmooth_status rs_mesh_mean_edge_length(rsmooth_scalar scalar, const void *positions,
+                                        size_t vertex_count, const uint32_t *indices,
+                                        size_t triangle_count, double *out_length,
+                                        rsmooth_error *error);
+
 #endif /* RSMOOTH_INTERNAL_H */

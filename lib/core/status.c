@@ -5,7 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
-const char *rsmooth_status_str(rsmooth_status status) {
+const char *rs_status_str(rsmooth_status status) {
     switch (status) {
     case RSMOOTH_OK:
         return "success";
@@ -33,7 +33,7 @@ const char *rsmooth_status_str(rsmooth_status status) {
     return "unknown status";
 }
 
-void rsmooth_error_init(rsmooth_error *error) {
+void rs_error_init(rsmooth_error *error) {
     if (!error)
         return;
     memset(error, 0, sizeof *error);

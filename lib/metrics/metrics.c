@@ -11,6 +11,7 @@
  * digit, while squared distances and cross products (edge lengths to the fourth power) neither
  * overflow nor underflow at any scale the library accepts. mean_edge and bbox_diag are divided by
  * it again. */
+#include "metrics/metrics.h"
 #include "core/rsmooth_internal.h"
 #include "metrics/surface_index.h"
 
@@ -175,10 +176,9 @@ done:
     return ok;
 }
 
-rsmooth_status rsmooth_compare(rsmooth_scalar scalar, const void *result_positions,
-                               const void *truth_positions, size_t vertex_count,
-                               const uint32_t *indices, size_t triangle_count, rsmooth_metrics *out,
-                               rsmooth_error *error) {
+rsmooth_status rs_compare(rsmooth_scalar scalar, const void *result_positions,
+                          const void *truth_positions, size_t vertex_count, const uint32_t *indices,
+                          size_t triangle_count, rsmooth_metrics *out, rsmooth_error *error) {
     rs_error_clear(error);
     if (!out)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out is NULL");

@@ -97,14 +97,14 @@ static int list_devices(candidate *out, int capacity) {
     return n;
 }
 
-void rsmooth_device_info_init(rsmooth_device_info *info) {
+void rs_cl_device_info_init(rsmooth_device_info *info) {
     if (!info)
         return;
     memset(info, 0, sizeof *info);
     info->struct_size = sizeof *info;
 }
 
-size_t rsmooth_device_version(int platform_index, int device_index, char *out, size_t size) {
+size_t rs_cl_device_version(int platform_index, int device_index, char *out, size_t size) {
     char none[1];
     if (!out || size == 0) { /* only the length asked */
         out = none;
@@ -121,7 +121,7 @@ size_t rsmooth_device_version(int platform_index, int device_index, char *out, s
     return 0;
 }
 
-size_t rsmooth_list_devices(rsmooth_device_info *devices, size_t capacity) {
+size_t rs_cl_list_devices(rsmooth_device_info *devices, size_t capacity) {
     if (rs_cl_load("rsmooth_list_devices", NULL) != RSMOOTH_OK)
         return 0; /* no loader: no platform either */
     candidate all[MAX_DEVICES];
@@ -354,8 +354,8 @@ static rsmooth_status begin_creation(const rsmooth_context_options *options,
     return rs_environment_check(env, error, where);
 }
 
-rsmooth_status rsmooth_context_create(const rsmooth_context_options *options, rsmooth_context **out,
-                                      rsmooth_error *error) {
+rsmooth_status rs_cl_context_create(const rsmooth_context_options *options, rsmooth_context **out,
+                                    rsmooth_error *error) {
     static const char where[] = "rsmooth_context_create";
     rs_error_clear(error);
     if (!out)
@@ -406,13 +406,13 @@ rsmooth_status rsmooth_context_create(const rsmooth_context_options *options, rs
     *out = ctx;
     return RSMOOTH_OK;
 fail:
-    rsmooth_context_destroy(ctx);
+    rs_cl_context_destroy(ctx);
     return st;
 }
 
-rsmooth_status rsmooth_context_create_from_queue(cl_command_queue queue,
-                                                 const rsmooth_context_options *options,
-                                                 rsmooth_context **out, rsmooth_error *error) {
+rsmooth_status rs_cl_context_create_from_queue(cl_command_queue queue,
+                                               const rsmooth_context_options *options,
+                                               rsmooth_context **out, rsmooth_error *error) {
     static const char where[] = "rsmooth_context_create_from_queue";
     rs_error_clear(error);
     if (!out)
@@ -462,14 +462,14 @@ rsmooth_status rsmooth_context_create_from_queue(cl_command_queue queue,
     if (st == RSMOOTH_OK)
         st = rs_cl_build_program(ctx, error);
     if (st != RSMOOTH_OK) {
-        rsmooth_context_destroy(ctx);
+        rs_cl_context_destroy(ctx);
         return st;
     }
     *out = ctx;
     return RSMOOTH_OK;
 }
 
-void rsmooth_context_destroy(rsmooth_context *ctx) {
+void rs_cl_context_destroy(rsmooth_context *ctx) {
     /* from a callback of a call still running on it: the call would go on with freed objects */
     if (!ctx || rs_context_held_here(ctx))
         return;
@@ -491,11 +491,11 @@ void rsmooth_context_destroy(rsmooth_context *ctx) {
     rs_free(ctx);
 }
 
-cl_command_queue rsmooth_context_queue(const rsmooth_context *ctx) {
+cl_command_queue rs_cl_context_queue(const rsmooth_context *ctx) {
     return ctx ? ctx->queue : NULL;
 }
 
-rsmooth_status rsmooth_context_get_info(const rsmooth_context *ctx, rsmooth_context_info *info) {
+rsmooth_status rs_cl_context_get_info(const rsmooth_context *ctx, rsmooth_context_info *info) {
     static const char where[] = "rsmooth_context_get_info";
     if (!ctx || !info)
         return rs_fail(NULL, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "%s is NULL",

@@ -261,4 +261,25 @@ rsmooth_status rs_cl_fail(rsmooth_error *error, cl_int code, const char *call, c
 /* Symbolic name of an OpenCL error code, e.g. "CL_OUT_OF_RESOURCES". */
 const char *rs_cl_error_name(cl_int code);
 
+/* The public functions' bodies, for api/'s definitions of them (lib/api/): */
+/* rsmooth_context_create */
+rsmooth_status rs_cl_context_create(const rsmooth_context_options *options, rsmooth_context **out,
+                                    rsmooth_error *error);
+/* rsmooth_context_create_from_queue */
+rsmooth_status rs_cl_context_create_from_queue(cl_command_queue queue,
+                                               const rsmooth_context_options *options,
+                                               rsmooth_context **out, rsmooth_error *error);
+/* rsmooth_context_destroy */
+void rs_cl_context_destroy(rsmooth_context *ctx);
+/* rsmooth_context_get_info */
+rsmooth_status rs_cl_context_get_info(const rsmooth_context *ctx, rsmooth_context_info *info);
+/* rsmooth_context_queue */
+cl_command_queue rs_cl_context_queue(const rsmooth_context *ctx);
+/* rsmooth_list_devices */
+size_t rs_cl_list_devices(rsmooth_device_info *devices, size_t capacity);
+/* rsmooth_device_info_init */
+void rs_cl_device_info_init(rsmooth_device_info *info);
+/* rsmooth_device_version */
+size_t rs_cl_device_version(int platform_index, int device_index, char *out, size_t size);
+
 #endif /* RSMOOTH_CL_INTERNAL_H */

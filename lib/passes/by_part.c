@@ -147,7 +147,7 @@ static rsmooth_status filter_parts(rs_filter_fn one_pass, rs_stage_runner stage,
         if (parts->vertices[part] == 0)
             continue; /* outliers alone, or nothing the caller lets move */
         progress.pass = (int)part;
-        rsmooth_report_init(&one);
+        rs_report_init(&one);
         rsmooth_status st = filter_part(one_pass, stage, ctx, scalar, parts, part, positions,
                                         vertex_count, indices, triangle_count, resolved, &progress,
                                         whole, report ? &one : NULL, error, where);
@@ -159,7 +159,7 @@ static rsmooth_status filter_parts(rs_filter_fn one_pass, rs_stage_runner stage,
         ++*smoothed;
     }
     if (report && first) /* nothing to smooth: the whole mesh's counts */
-        rsmooth_report_init(report);
+        rs_report_init(report);
     return RSMOOTH_OK;
 }
 
@@ -203,7 +203,7 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, rs_stage_runner stage, vo
     if (st != RSMOOTH_OK)
         return st;
     rsmooth_report full; /* filled whole, then as much as the caller's struct holds */
-    rsmooth_report_init(&full);
+    rs_report_init(&full);
     rsmooth_report *r = report ? &full : NULL;
     rs_parts parts;
     st = rs_parts_find(&parts, scalar, positions, vertex_count, indices, triangle_count, error,

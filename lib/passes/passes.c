@@ -58,7 +58,7 @@ static void no_pass(float *out_weight, float *out_confidence, size_t vertex_coun
             out_confidence[v] = 1;
     }
     if (report) {
-        rsmooth_report_init(report);
+        rs_report_init(report);
         report->vertex_count = vertex_count;
         report->triangle_count = triangle_count;
     }

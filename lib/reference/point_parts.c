@@ -143,7 +143,7 @@ static rsmooth_status filter_parts(rs_points_solve_fn solve, void *solve_ctx, co
             sub.progress_user = &progress;
         }
         rsmooth_report one;
-        rsmooth_report_init(&one);
+        rs_report_init(&one);
         rsmooth_status st = rs_smooth_points_one_part(
             solve, solve_ctx, where, scalar, q.positions, q.normals, q.n, NULL, &sub,
             q.out_positions, q.out_normals, q.confidence, report ? &one : NULL, error);
@@ -197,7 +197,7 @@ rsmooth_status rs_smooth_points_with(rs_points_solve_fn solve, void *solve_ctx, 
     for (size_t i = 0; size && i < point_count; i++)
         outliers += part[i] == RS_NO_PART || size[part[i]] < RS_MIN_PART_POINTS;
     rsmooth_report full;
-    rsmooth_report_init(&full);
+    rs_report_init(&full);
     rsmooth_report *r = report ? &full : NULL;
     if (st == RSMOOTH_OK && (!checked || (parts <= 1 && outliers == 0))) {
         st = rs_smooth_points_one_part(solve, solve_ctx, where, scalar, positions, normals,

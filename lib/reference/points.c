@@ -98,9 +98,8 @@ const char *rs_point_unit_normal(rsmooth_scalar scalar, const void *normals, siz
     return NULL;
 }
 
-rsmooth_status rsmooth_point_spacing(rsmooth_scalar scalar, const void *positions,
-                                     size_t point_count, double *out_spacing,
-                                     rsmooth_error *error) {
+rsmooth_status rs_point_spacing(rsmooth_scalar scalar, const void *positions, size_t point_count,
+                                double *out_spacing, rsmooth_error *error) {
     static const char caller[] = "rsmooth_point_spacing";
     rs_error_clear(error);
     if (!out_spacing)

@@ -52,4 +52,9 @@ const char *rs_point_unit_normal(rsmooth_scalar scalar, const void *normals, siz
                                  double out[3]);
 double rs_point_spacings(const rs_kdtree *tree, double *spacing);
 
+/* The public functions' bodies, for api/'s definitions of them (lib/api/): */
+/* rsmooth_point_spacing */
+rsmooth_status rs_point_spacing(rsmooth_scalar scalar, const void *positions, size_t point_count,
+                                double *out_spacing, rsmooth_error *error);
+
 #endif /* RSMOOTH_POINTS_H */

@@ -77,11 +77,10 @@ static void umbrella_step(const adjacency *adj, size_t vertex_count, double fact
     }
 }
 
-rsmooth_status rsmooth_smooth_taubin(rsmooth_scalar scalar, const void *positions,
-                                     size_t vertex_count, const uint32_t *indices,
-                                     size_t triangle_count, double lambda, double mu,
-                                     unsigned iterations, void *out_positions,
-                                     rsmooth_error *error) {
+rsmooth_status rs_smooth_taubin(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
+                                const uint32_t *indices, size_t triangle_count, double lambda,
+                                double mu, unsigned iterations, void *out_positions,
+                                rsmooth_error *error) {
     static const char where[] = "rsmooth_smooth_taubin";
     rs_error_clear(error);
     rsmooth_status st = rs_check_mesh_arrays(scalar, positions, vertex_count, indices,

@@ -3,6 +3,8 @@
 #ifndef RSMOOTH_TAUBIN_H
 #define RSMOOTH_TAUBIN_H
 
+#include "rsmooth.h"
+
 #include <stddef.h>
 #include <stdint.h>
 
@@ -13,5 +15,12 @@
 int rs_taubin_until(double *xyz, size_t vertex_count, const uint32_t *indices,
                     size_t triangle_count, double lambda, double mu, double target_move,
                     double min_gain, int max_iterations);
+
+/* The public functions' bodies, for api/'s definitions of them (lib/api/): */
+/* rsmooth_smooth_taubin */
+rsmooth_status rs_smooth_taubin(rsmooth_scalar scalar, const void *positions, size_t vertex_count,
+                                const uint32_t *indices, size_t triangle_count, double lambda,
+                                double mu, unsigned iterations, void *out_positions,
+                                rsmooth_error *error);
 
 #endif /* RSMOOTH_TAUBIN_H */
