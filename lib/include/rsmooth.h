@@ -813,7 +813,7 @@ typedef struct rsmooth_context_info {
      * through local memory), and `group` work-items per work-group. RSMOOTH_KERNEL_VARIANT=cpu|gpu
      * and RSMOOTH_LANES=4|8|16 override the choice; every variant computes the same sums. */
     unsigned lanes;
-    size_t group;
+    size_t group;           /**< work-items per work-group (see lanes) */
     uint64_t memory_budget; /**< bytes one filter call may hold on the device */
     unsigned host_threads;  /**< the host threads its calls use (0: every online core) */
 } rsmooth_context_info;
