@@ -209,7 +209,10 @@ static rsmooth_status pick_device(const char *spec, candidate *chosen, rsmooth_e
     return rs_fail(error, RSMOOTH_ERROR_NO_DEVICE, where, "no OpenCL device found");
 }
 
-bool rs_parse_bytes(const char *text, uint64_t *bytes) {
+/* Reads a byte count such as "256M", "1.5G", "4096" (suffixes K, M, G, T: powers of 1024), as
+ * RSMOOTH_MEMORY_BUDGET holds it; false when `text` is not one. (The command parses its
+ * --memory-budget with its own copy, host/cli_args.c: host/ calls only the public API.) */
+static bool parse_bytes(const char *text, uint64_t *bytes) {
     char *end = NULL;
     double value = strtod(text, &end);
     if (end == text || !(value >= 0))
@@ -249,7 +252,7 @@ static rsmooth_status read_memory_limits(rsmooth_context *ctx, uint64_t given,
     ctx->host_unified = unified == CL_TRUE;
     /* the caller's budget wins: the variable is then not read at all, as if unset */
     const char *budget = given ? NULL : ctx->env.value[RS_ENV_MEMORY_BUDGET];
-    if (budget && *budget && !rs_parse_bytes(budget, &ctx->memory_budget))
+    if (budget && *budget && !parse_bytes(budget, &ctx->memory_budget))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, "rsmooth_context_create",
                        "RSMOOTH_MEMORY_BUDGET='%s' is not a byte count (examples: 268435456, "
                        "256M, 1.5G; unset it for the device's own limit)",

@@ -88,9 +88,6 @@ uint64_t rs_cl_usable_memory(const rsmooth_context *ctx);
  * (CL_MEM_COPY_HOST_PTR) on one that does not, which would copy them at its first use anyway. */
 cl_mem_flags rs_cl_input_flags(const rsmooth_context *ctx);
 
-/* Reads a byte count such as "256M", "1.5G", "4096" (suffixes K, M, G, T: powers of 1024).
- * false when `text` is not one. */
-bool rs_parse_bytes(const char *text, uint64_t *bytes);
 
 /* ---- cl_smooth.c / tiles.c: the OpenCL path ------------------------------------------------- */
 
