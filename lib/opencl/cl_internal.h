@@ -88,7 +88,6 @@ uint64_t rs_cl_usable_memory(const rsmooth_context *ctx);
  * (CL_MEM_COPY_HOST_PTR) on one that does not, which would copy them at its first use anyway. */
 cl_mem_flags rs_cl_input_flags(const rsmooth_context *ctx);
 
-
 /* ---- cl_smooth.c / tiles.c: the OpenCL path ------------------------------------------------- */
 
 /* rsmooth_smooth_cl's destination on the device: a run that solves every vertex in one piece
