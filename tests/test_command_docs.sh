@@ -77,7 +77,9 @@ if [ -x "$demo_shape" ]; then
   [ -n "$cycles" ] && [ -n "$rounds" ] && [ -n "$updates" ] || fail "--best --json: $report"
   round_word=rounds
   [ "$rounds" = 1 ] && round_word=round
-  "$rsmooth" --help | grep -qF "In --best: $updates per cycle, $cycles cycles." ||
+  # the help read whole first: grep -q stops reading at its match, and the command would then
+  # die of SIGPIPE (pipefail), as it does under the sanitizers
+  grep -qF "In --best: $updates per cycle, $cycles cycles." <<<"$("$rsmooth" --help)" ||
     fail "rsmooth --help does not say --best's $updates updates per cycle, $cycles cycles"
   for page in host/rsmooth.1 docs/python.md python/README.md; do
     has "$page" "$cycles cycles, each fresh facet normals, $rounds guided $round_word and $updates"
@@ -100,7 +102,7 @@ top=${top%]}
 [ -n "$top" ] || fail "--stage-repeats 0 gave no range"
 has docs/python.md "\`stage_repeats\` 1–$top"
 has python/README.md "\`stage_repeats\` 1 to $top"
-"$rsmooth" --help | grep -qF -- "--stage-repeats K     the stage's cycles (1..$top," ||
+grep -qF -- "--stage-repeats K     the stage's cycles (1..$top," <<<"$("$rsmooth" --help)" ||
   fail "rsmooth --help gives another range for --stage-repeats than [1, $top]"
 grep -qF "cycles (1 to $top," "$src/host/rsmooth.1" || fail "rsmooth.1: --stage-repeats not 1 to $top"
 
