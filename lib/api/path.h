@@ -7,6 +7,7 @@
 #define RSMOOTH_API_PATH_H
 
 #include "opencl/cl_internal.h"
+#include "passes/passes.h"
 
 /* One call on the device path, passed down to each of its passes (in place of state set aside in
  * the context while the call runs). */
@@ -31,12 +32,26 @@ rsmooth_status rs_device_pass(const rs_device_call *call, const rs_problem *pb,
                               const rs_result_sink *sink, bool points, double *out_normals,
                               rsmooth_report *report, double t_start, rsmooth_error *error);
 
-/* rsmooth_smooth's passes with the context entered, the call's sink given (device_sink may be
- * NULL). */
-rsmooth_status rs_device_smooth(const rs_device_call *call, rsmooth_scalar scalar,
-                                const void *positions, size_t vertex_count, const uint32_t *indices,
-                                size_t triangle_count, const rsmooth_params *params,
-                                void *out_positions, float *out_weight, float *out_confidence,
-                                rsmooth_report *report, rsmooth_error *error);
+/* A path, as a mesh call runs it: one pass of its filter (rs_filter_passes repeats it, part by
+ * part) and the runner of the normal-update stage's cycles (NULL: the host's), both given
+ * `context`. The reference path is {rs_reference_pass, NULL, NULL} (reference/); the device's is
+ * rs_device_path's. */
+typedef struct rs_path {
+    rs_filter_fn pass;
+    rs_stage_runner stage;
+    void *context;
+} rs_path;
+
+/* The device path of a call entered on its context: its pass (smooth.c's), and the stage on the
+ * device where RSMOOTH_STAGE or the device's type puts it there. */
+rs_path rs_device_path(const rs_device_call *call);
+
+/* A mesh call's whole work on `path` (the arrays checked once at its start, rs_filter_passes);
+ * errors name `where`. */
+rsmooth_status rs_path_smooth(const rs_path *path, rsmooth_scalar scalar, const void *positions,
+                              size_t vertex_count, const uint32_t *indices, size_t triangle_count,
+                              const rsmooth_params *params, void *out_positions, float *out_weight,
+                              float *out_confidence, rsmooth_report *report, rsmooth_error *error,
+                              const char *where);
 
 #endif /* RSMOOTH_API_PATH_H */

@@ -31,10 +31,10 @@ rsmooth_status rsmooth_smooth_points(rsmooth_context *ctx, rsmooth_scalar scalar
                      "outputs->weight: point clouds give no weight (set it to NULL)");
     if (st != RSMOOTH_OK)
         return st;
-    if (!ctx) /* the reference path */
-        return rs_reference_smooth_points(scalar, positions, normals, point_count, params,
-                                          out_positions, out_normals, o.confidence, o.report,
-                                          error);
+    if (!ctx) /* the reference path: its pass, on the host */
+        return rs_smooth_points_with(rs_reference_points_pass, NULL, where, scalar, positions,
+                                     normals, point_count, params, out_positions, out_normals,
+                                     o.confidence, o.report, error);
     size_t saved = 0;
     st = rs_device_enter(ctx, where, &saved, error);
     if (st != RSMOOTH_OK)

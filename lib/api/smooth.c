@@ -54,6 +54,21 @@ static bool stage_on_device(const rsmooth_context *ctx) {
     return (type & CL_DEVICE_TYPE_CPU) == 0;
 }
 
+rs_path rs_device_path(const rs_device_call *call) {
+    rs_path path = {cl_pass, stage_on_device(call->ctx) ? cl_stage : NULL, (void *)call};
+    return path;
+}
+
+rsmooth_status rs_path_smooth(const rs_path *path, rsmooth_scalar scalar, const void *positions,
+                              size_t vertex_count, const uint32_t *indices, size_t triangle_count,
+                              const rsmooth_params *params, void *out_positions, float *out_weight,
+                              float *out_confidence, rsmooth_report *report, rsmooth_error *error,
+                              const char *where) {
+    return rs_filter_passes(path->pass, path->stage, path->context, scalar, positions, vertex_count,
+                            indices, triangle_count, params, out_positions, out_weight,
+                            out_confidence, report, error, where);
+}
+
 rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const void *positions,
                               size_t vertex_count, const uint32_t *indices, size_t triangle_count,
                               const rsmooth_params *params, void *out_positions,
@@ -64,28 +79,20 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     rsmooth_status st = rs_read_outputs(outputs, &o, error, where);
     if (st != RSMOOTH_OK)
         return st;
-    if (!ctx) /* the reference path */
-        return rs_reference_smooth(scalar, positions, vertex_count, indices, triangle_count, params,
-                                   out_positions, o.weight, o.confidence, o.report, error);
+    if (!ctx) { /* the reference path */
+        rs_path reference = {rs_reference_pass, NULL, NULL};
+        return rs_path_smooth(&reference, scalar, positions, vertex_count, indices, triangle_count,
+                              params, out_positions, o.weight, o.confidence, o.report, error,
+                              where);
+    }
     size_t saved = 0;
     st = rs_device_enter(ctx, where, &saved, error);
     if (st != RSMOOTH_OK)
         return st;
     rs_device_call call = {ctx, where, NULL};
-    st = rs_device_smooth(&call, scalar, positions, vertex_count, indices, triangle_count, params,
-                          out_positions, o.weight, o.confidence, o.report, error);
+    rs_path device = rs_device_path(&call);
+    st = rs_path_smooth(&device, scalar, positions, vertex_count, indices, triangle_count, params,
+                        out_positions, o.weight, o.confidence, o.report, error, where);
     rs_device_leave(ctx, saved);
     return st;
-}
-
-rsmooth_status rs_device_smooth(const rs_device_call *call, rsmooth_scalar scalar,
-                                const void *positions, size_t vertex_count, const uint32_t *indices,
-                                size_t triangle_count, const rsmooth_params *params,
-                                void *out_positions, float *out_weight, float *out_confidence,
-                                rsmooth_report *report, rsmooth_error *error) {
-    (void)error; /* RSMOOTH_STAGE was checked when the context was made */
-    rs_stage_runner stage = stage_on_device(call->ctx) ? cl_stage : NULL;
-    return rs_filter_passes(cl_pass, stage, (void *)call, scalar, positions, vertex_count, indices,
-                            triangle_count, params, out_positions, out_weight, out_confidence,
-                            report, error, call->where);
 }

@@ -85,8 +85,9 @@ rsmooth_status rsmooth_smooth_cl(rsmooth_context *ctx, rsmooth_scalar scalar, cl
             sink.kernel = ctx->store_kernels[scalar];
             call.device_sink = &sink;
         }
-        st = rs_device_smooth(&call, scalar, host_in, vertex_count, indices, triangle_count, params,
-                              host_out, NULL, NULL, report, error);
+        rs_path device = rs_device_path(&call);
+        st = rs_path_smooth(&device, scalar, host_in, vertex_count, indices, triangle_count, params,
+                            host_out, NULL, NULL, report, error, where);
     }
     if (st == RSMOOTH_OK && sink.written && sink.bad)
         st = rs_fail(error, RSMOOTH_ERROR_NUMERICAL, where,

@@ -21,7 +21,8 @@ int rs_report_pass_progress(void *user, double fraction);
  * counts, sigmas and device from the last pass, the facet count from the first. */
 void rs_add_pass_report(rsmooth_report *sum, const rsmooth_report *pass);
 
-/* One pass of a filter path, with rs_reference_smooth's arguments; `ctx` is the path's own. */
+/* One pass of a path's filter (rs_reference_pass, api/smooth.c's device pass); `ctx` is the path's
+ * own. */
 typedef rsmooth_status (*rs_filter_fn)(void *ctx, rsmooth_scalar scalar, const void *positions,
                                        size_t vertex_count, const uint32_t *indices,
                                        size_t triangle_count, const rsmooth_params *params,

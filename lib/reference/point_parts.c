@@ -237,22 +237,11 @@ rsmooth_status rs_smooth_points_with(rs_points_solve_fn solve, void *solve_ctx, 
     return st;
 }
 
-/* The reference path's pass: rs_reference_solve in double on the host. */
-static rsmooth_status reference_pass(void *ctx, const rs_problem *pb, double *out_next,
-                                     float *out_confidence, double *out_normals,
-                                     rsmooth_report *report, double t_start, rsmooth_error *error,
-                                     const char *where) {
+rsmooth_status rs_reference_points_pass(void *ctx, const rs_problem *pb, double *out_next,
+                                        float *out_confidence, double *out_normals,
+                                        rsmooth_report *report, double t_start,
+                                        rsmooth_error *error, const char *where) {
     (void)ctx;
     return rs_reference_solve(pb, RSMOOTH_FLOAT64, out_next, NULL, out_confidence, out_normals,
                               report, t_start, error, where);
-}
-
-rsmooth_status rs_reference_smooth_points(rsmooth_scalar scalar, const void *positions,
-                                          const void *normals, size_t point_count,
-                                          const rsmooth_params *params, void *out_positions,
-                                          void *out_normals, float *out_confidence,
-                                          rsmooth_report *report, rsmooth_error *error) {
-    return rs_smooth_points_with(reference_pass, NULL, "rsmooth_smooth_points", scalar, positions,
-                                 normals, point_count, params, out_positions, out_normals,
-                                 out_confidence, report, error);
 }

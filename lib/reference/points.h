@@ -15,6 +15,13 @@ typedef rsmooth_status (*rs_points_solve_fn)(void *ctx, const rs_problem *pb, do
                                              rsmooth_report *report, double t_start,
                                              rsmooth_error *error, const char *where);
 
+/* The reference path's pass on a point cloud (an rs_points_solve_fn): rs_reference_solve in
+ * double on the host (point_parts.c). */
+rsmooth_status rs_reference_points_pass(void *ctx, const rs_problem *pb, double *out_next,
+                                        float *out_confidence, double *out_normals,
+                                        rsmooth_report *report, double t_start,
+                                        rsmooth_error *error, const char *where);
+
 /* rsmooth_smooth_points's whole call (checks, spacings, passes, outputs) with `solve`
  * (given `solve_ctx`) filtering each pass; errors name `where`. Part by part (point_parts.c):
  * points whose spacings differ by more than about 8 times, with none between, are filtered apart,

@@ -389,12 +389,11 @@ cleanup:
     return st;
 }
 
-/* One pass of the filter (rs_filter_passes repeats it). */
-static rsmooth_status reference_pass(void *unused, rsmooth_scalar scalar, const void *positions,
-                                     size_t vertex_count, const uint32_t *indices,
-                                     size_t triangle_count, const rsmooth_params *params,
-                                     void *out_positions, float *out_weight, float *out_confidence,
-                                     rsmooth_report *report, rsmooth_error *error) {
+rsmooth_status rs_reference_pass(void *unused, rsmooth_scalar scalar, const void *positions,
+                                 size_t vertex_count, const uint32_t *indices,
+                                 size_t triangle_count, const rsmooth_params *params,
+                                 void *out_positions, float *out_weight, float *out_confidence,
+                                 rsmooth_report *report, rsmooth_error *error) {
     static const char where[] = "rsmooth_smooth";
     (void)unused;
     double t_start = rs_now_ms();
@@ -408,14 +407,4 @@ static rsmooth_status reference_pass(void *unused, rsmooth_scalar scalar, const 
                             t_start, error, where);
     rs_problem_free(&pb);
     return st;
-}
-
-rsmooth_status rs_reference_smooth(rsmooth_scalar scalar, const void *positions,
-                                   size_t vertex_count, const uint32_t *indices,
-                                   size_t triangle_count, const rsmooth_params *params,
-                                   void *out_positions, float *out_weight, float *out_confidence,
-                                   rsmooth_report *report, rsmooth_error *error) {
-    return rs_filter_passes(reference_pass, NULL, NULL, scalar, positions, vertex_count, indices,
-                            triangle_count, params, out_positions, out_weight, out_confidence,
-                            report, error, "rsmooth_smooth");
 }

@@ -13,19 +13,13 @@ rsmooth_status rs_reference_solve(const rs_problem *problem, rsmooth_scalar scal
                                   double *out_normals, rsmooth_report *report, double t_start,
                                   rsmooth_error *error, const char *where);
 
-/* rsmooth_smooth with ctx NULL: the reference path's passes (rs_filter_passes) on the caller's
- * arrays. */
-rsmooth_status rs_reference_smooth(rsmooth_scalar scalar, const void *positions,
-                                   size_t vertex_count, const uint32_t *indices,
-                                   size_t triangle_count, const rsmooth_params *params,
-                                   void *out_positions, float *out_weight, float *out_confidence,
-                                   rsmooth_report *report, rsmooth_error *error);
-
-/* rsmooth_smooth_points with ctx NULL: point clouds on the reference path (point_parts.c). */
-rsmooth_status rs_reference_smooth_points(rsmooth_scalar scalar, const void *positions,
-                                          const void *normals, size_t point_count,
-                                          const rsmooth_params *params, void *out_positions,
-                                          void *out_normals, float *out_confidence,
-                                          rsmooth_report *report, rsmooth_error *error);
+/* The reference path's pass of the filter (an rs_filter_fn, passes/passes.h): the problem
+ * prepared, then rs_reference_solve in double on the host. `unused` is the path's context (it has
+ * none). */
+rsmooth_status rs_reference_pass(void *unused, rsmooth_scalar scalar, const void *positions,
+                                 size_t vertex_count, const uint32_t *indices,
+                                 size_t triangle_count, const rsmooth_params *params,
+                                 void *out_positions, float *out_weight, float *out_confidence,
+                                 rsmooth_report *report, rsmooth_error *error);
 
 #endif /* RSMOOTH_REFERENCE_H */
