@@ -147,16 +147,26 @@ void rs_add_part_report(rsmooth_report *sum, const rsmooth_report *part, bool la
     }
 }
 
+bool rs_read_sized(const void *given, void *out, size_t full) {
+    memset(out, 0, full);
+    if (!given)
+        return true;
+    size_t size = 0; /* the caller's struct_size: the first field of every such struct */
+    memcpy(&size, given, sizeof size);
+    if (size == 0)
+        size = full;
+    if (size < sizeof size)
+        return false;
+    memcpy(out, given, size < full ? size : full);
+    memcpy(out, &full, sizeof full); /* the copy is whole */
+    return true;
+}
+
 rsmooth_status rs_read_outputs(const rsmooth_outputs *given, rsmooth_outputs *out,
                                rsmooth_error *error, const char *where) {
-    memset(out, 0, sizeof *out);
-    if (!given)
-        return RSMOOTH_OK;
-    size_t size = given->struct_size ? given->struct_size : sizeof *out;
-    if (size < sizeof out->struct_size)
+    if (!rs_read_sized(given, out, sizeof *out))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "outputs->struct_size is %zu: set it to sizeof(rsmooth_outputs)", size);
-    memcpy(out, given, size < sizeof *out ? size : sizeof *out);
-    out->struct_size = sizeof *out;
+                       "outputs->struct_size is %zu: set it to sizeof(rsmooth_outputs)",
+                       given->struct_size);
     return RSMOOTH_OK;
 }

@@ -398,6 +398,12 @@ void rs_store_unmoved(const rs_problem *problem, size_t count, rsmooth_scalar sc
  * keeps that struct_size. */
 void rs_give_report(rsmooth_report *report, size_t struct_size, const rsmooth_report *full);
 
+/* A caller's struct that starts with its struct_size (options, outputs): as much of it as that
+ * size holds (0 reads as `full`), the rest zero, into out[full], whose struct_size becomes
+ * `full`; `given` NULL: all zero. false, with *out all zero, for a struct_size too small to hold
+ * itself. */
+bool rs_read_sized(const void *given, void *out, size_t full);
+
 /* The caller's outputs (NULL: none), as much as its struct_size holds, the rest NULL. */
 rsmooth_status rs_read_outputs(const rsmooth_outputs *given, rsmooth_outputs *out,
                                rsmooth_error *error, const char *where);

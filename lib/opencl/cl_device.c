@@ -319,19 +319,6 @@ static rsmooth_context *new_context(void) {
     return ctx;
 }
 
-/* The caller's options, as much of them as its struct_size holds (0: all of 0.11's), the rest
- * zero; false when struct_size is smaller than the first field's end. */
-static bool read_options(const rsmooth_context_options *given, rsmooth_context_options *out) {
-    memset(out, 0, sizeof *out);
-    if (!given)
-        return true;
-    size_t size = given->struct_size ? given->struct_size : sizeof *out;
-    if (size < sizeof out->struct_size)
-        return false;
-    memcpy(out, given, size < sizeof *out ? size : sizeof *out);
-    return true;
-}
-
 /* The context's copy of the environment, then the caller's options over it: its host threads
  * (its memory budget after read_memory_limits, which reads the device's). */
 static void set_environment(rsmooth_context *ctx, const rs_environment *env,
@@ -349,7 +336,7 @@ static void set_environment(rsmooth_context *ctx, const rs_environment *env,
 static rsmooth_status begin_creation(const rsmooth_context_options *options,
                                      rsmooth_context_options *opts, rs_environment *env,
                                      rsmooth_error *error, const char *where) {
-    if (!read_options(options, opts))
+    if (!rs_read_sized(options, opts, sizeof *opts))
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "options->struct_size is %zu: set it to sizeof(rsmooth_context_options)",
                        options->struct_size);

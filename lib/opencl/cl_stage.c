@@ -328,13 +328,11 @@ static rsmooth_status read_back(stage_run *r, int d, double *xyz, rs_stage_stats
 
 /* Double where the device has it, unless RSMOOTH_STAGE_PRECISION=float asks for float (the drift
  * measurements; its value was checked when the context was made). */
-static bool choose_precision(stage_run *r, rsmooth_error *error) {
-    (void)error;
+static void choose_precision(stage_run *r) {
     bool has_double = r->ctx->kernels[RS_KERNEL_STAGE_DOUBLE] != NULL;
     r->dbl = has_double && !rs_environment_is(&r->ctx->env, RS_ENV_STAGE_PRECISION, "float");
     r->real = r->dbl ? sizeof(double) : sizeof(float);
     r->kernels = r->ctx->kernels + (r->dbl ? RS_KERNEL_STAGE_DOUBLE : RS_KERNEL_STAGE_FLOAT);
-    return true;
 }
 
 rsmooth_status rs_cl_stage_run(void *context, const rs_stage_plan *plan, double *xyz,
@@ -345,8 +343,7 @@ rsmooth_status rs_cl_stage_run(void *context, const rs_stage_plan *plan, double 
     r.ctx = context;
     r.plan = plan;
     double t0 = rs_now_ms();
-    if (!choose_precision(&r, error))
-        return RSMOOTH_ERROR_INVALID_ARGUMENT;
+    choose_precision(&r);
     stats->float_bits = r.dbl ? 64 : 32;
     rsmooth_status st = pack_plan(&r) ? RSMOOTH_OK
                                       : rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where,
