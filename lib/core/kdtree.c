@@ -148,21 +148,35 @@ void rs_kdtree_free(rs_kdtree *tree) {
     memset(tree, 0, sizeof *tree);
 }
 
-/* The k best so far, nearest first: dist2[0 .. found). */
+/* The k best so far, nearest first: dist2[0 .. found), and their points in id when asked for. */
 typedef struct knn_state {
     const double *p;
     uint32_t skip;
     size_t k, found;
     double *dist2;
+    uint32_t *id; /* NULL: distances only */
 } knn_state;
 
-static void knn_offer(knn_state *s, double d2) {
-    if (s->found == s->k && !(d2 < s->dist2[s->k - 1]))
+/* Whether (d2, q) comes before entry i: nearer first, then (with ids) the lower id, so points at
+ * equal distances are listed the same way whatever order the tree visits them in. */
+static bool knn_before(const knn_state *s, double d2, uint32_t q, size_t i) {
+    if (d2 != s->dist2[i])
+        return d2 < s->dist2[i];
+    return s->id && q < s->id[i];
+}
+
+static void knn_offer(knn_state *s, double d2, uint32_t q) {
+    if (s->found == s->k && !knn_before(s, d2, q, s->k - 1))
         return;
     size_t i = s->found < s->k ? s->found++ : s->k - 1;
-    for (; i > 0 && s->dist2[i - 1] > d2; i--) /* insertion: k is small */
+    for (; i > 0 && knn_before(s, d2, q, i - 1); i--) { /* insertion: k is small */
         s->dist2[i] = s->dist2[i - 1];
+        if (s->id)
+            s->id[i] = s->id[i - 1];
+    }
     s->dist2[i] = d2;
+    if (s->id)
+        s->id[i] = q;
 }
 
 static void knn_node(const rs_kdtree *tree, knn_state *s, size_t node, size_t lo, size_t hi) {
@@ -173,7 +187,7 @@ static void knn_node(const rs_kdtree *tree, knn_state *s, size_t node, size_t lo
                 continue;
             double d[3];
             rs_sub3(tree->xyz + 3 * (size_t)q, s->p, d);
-            knn_offer(s, rs_dot3(d, d));
+            knn_offer(s, rs_dot3(d, d), q);
         }
         return;
     }
@@ -186,7 +200,7 @@ static void knn_node(const rs_kdtree *tree, knn_state *s, size_t node, size_t lo
         knn_node(tree, s, 2 * node + 1, lo, mid);
     else
         knn_node(tree, s, 2 * node + 2, mid, hi);
-    if (s->found < s->k || diff * diff < s->dist2[s->k - 1]) {
+    if (s->found < s->k || diff * diff <= s->dist2[s->k - 1]) { /* <=: a tie may win on its id */
         if (left_first)
             knn_node(tree, s, 2 * node + 2, mid, hi);
         else
@@ -196,7 +210,12 @@ static void knn_node(const rs_kdtree *tree, knn_state *s, size_t node, size_t lo
 
 size_t rs_kdtree_nearest(const rs_kdtree *tree, const double p[3], uint32_t skip, size_t k,
                          double *dist2) {
-    knn_state s = {p, skip, k, 0, dist2};
+    return rs_kdtree_nearest_ids(tree, p, skip, k, dist2, NULL);
+}
+
+size_t rs_kdtree_nearest_ids(const rs_kdtree *tree, const double p[3], uint32_t skip, size_t k,
+                             double *dist2, uint32_t *ids) {
+    knn_state s = {p, skip, k, 0, dist2, ids};
     if (k > 0 && tree->count > 0)
         knn_node(tree, &s, 0, 0, tree->count);
     return s.found;

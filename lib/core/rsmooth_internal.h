@@ -322,6 +322,11 @@ static inline void rs_cross3(const double a[3], const double b[3], double out[3]
     out[1] = a[2] * b[0] - a[0] * b[2];
     out[2] = a[0] * b[1] - a[1] * b[0];
 }
+static inline void rs_scale3(double v[3], double s) {
+    v[0] *= s;
+    v[1] *= s;
+    v[2] *= s;
+}
 
 /* A mollified facet is degenerate, and its input normal is used instead, when the sine of its
  * corner angle falls below RS_DEGENERATE_SINE or its area shrank below RS_DEGENERATE_AREA_RATIO of

@@ -95,5 +95,9 @@ void rs_kdtree_free(rs_kdtree *tree);
  * on a built tree. */
 size_t rs_kdtree_nearest(const rs_kdtree *tree, const double p[3], uint32_t skip, size_t k,
                          double *dist2);
+/* The same with the points' indices into ids[0 ..) (ids may be NULL); points at equal distances
+ * come in increasing index, so the list does not depend on the tree's layout. */
+size_t rs_kdtree_nearest_ids(const rs_kdtree *tree, const double p[3], uint32_t skip, size_t k,
+                             double *dist2, uint32_t *ids);
 
 #endif /* RSMOOTH_SPATIAL_H */
