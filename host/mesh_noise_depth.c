@@ -137,6 +137,8 @@ int mesh_add_depth_noise(double *xyz, size_t vertex_count, const uint32_t *trian
     for (size_t i = 0; i < 3 * triangle_count; i++)
         if (triangles[i] >= vertex_count)
             return -1;
+    if (camera)
+        memset(camera, 0, sizeof *camera); /* an empty mesh has no camera */
     if (vertex_count == 0)
         return 0;
 

@@ -54,9 +54,10 @@ typedef struct mesh_depth_noise_camera {
  * distance from the camera to the depth step; a vertex no triangle uses has no normal and is taken
  * as facing the camera. `triangles` (3 * triangle_count indices) give the normals and the mean
  * edge length (the unit). Vertex order and faces are the caller's and never change. `camera`
- * (may be NULL) receives the camera. A mesh without a non-zero edge has no unit: nothing moves.
- * Returns 0, or -1 on bad options (a value out of its range or not finite, a zero view), bad
- * arrays (NULL, an index out of range) or out of memory; xyz is then unchanged. */
+ * (may be NULL) receives the camera (zeros for an empty mesh). A mesh without a non-zero edge has
+ * no unit: nothing moves. Returns 0, or -1 on bad options (a value out of its range or not finite,
+ * a zero view), bad arrays (NULL, an index out of range) or out of memory; xyz is then unchanged.
+ */
 int mesh_add_depth_noise(double *xyz, size_t vertex_count, const uint32_t *triangles,
                          size_t triangle_count, const mesh_depth_noise_options *options,
                          mesh_depth_noise_camera *camera);
