@@ -1,9 +1,11 @@
-/* `rsmooth noise`: corrupts a mesh with reproducible Gaussian or impulsive noise (experiments). */
+/* `rsmooth noise`: corrupts a mesh with reproducible Gaussian, impulsive, correlated or
+ * depth-sensor noise (experiments, training data). */
 #include "cli_args.h"
 #include "cli_commands.h"
 #include "cli_files.h"
 #include "cli_getopt.h"
 #include "mesh_noise.h"
+#include "mesh_noise_depth.h"
 #include "rsmooth_io.h"
 
 #include <ctype.h>
@@ -22,6 +24,12 @@
 #define MAX_SIGMA 1e6
 /* The largest coordinate magnitude rsmooth reads (rsmooth.h): the output must stay readable. */
 #define MAX_COORDINATE 1e150
+/* --depth-sensor's defaults: a step of half the noise, the cosine below which a vertex grazes,
+ * ridges a quarter of the noise every 4 edges */
+#define DEFAULT_QUANTUM_OF_SIGMA 0.5
+#define DEFAULT_GRAZING 0.15
+#define DEFAULT_RIDGES 0.25
+#define DEFAULT_RIDGE_PERIOD 4.0
 
 static const char noise_usage_text[] =
     "usage: rsmooth noise INPUT OUTPUT --sigma S [options]\n"
@@ -59,6 +67,34 @@ static const char noise_usage_text[] =
     "                   grooves along u's normal planes, continuous), the whole scaled so the\n"
     "                   root mean square displacement over the vertices is exactly --sigma.\n"
     "                   W > 0 (at most 1e6); not with --correlation.\n"
+    "  --depth-sensor   depth-camera noise, Kinect-like structured light or time of flight, for\n"
+    "                   training data that looks like real scans. A camera looks at INPUT's\n"
+    "                   bounding-box centre from 3 bounding-box diagonals away, along --view or\n"
+    "                   a direction drawn from the seed. Each vertex moves along the ray from\n"
+    "                   the camera to it (not along its normal) by a Gaussian of standard\n"
+    "                   deviation --sigma x (z / z_mean)^2, z its distance from the camera and\n"
+    "                   z_mean the mean over the vertices (depth error grows with the square of\n"
+    "                   depth), plus scan-line ridges; its depth is then rounded to --quantum\n"
+    "                   steps. Where a sensor sees the surface edge-on or from behind it returns\n"
+    "                   no depth; here no vertex or face is removed (training pairs need the\n"
+    "                   clean mesh's vertices and faces, one for one), so such holes are strong\n"
+    "                   noise instead: the Gaussian is divided by max(c, --grazing), c the\n"
+    "                   cosine between the vertex normal and the direction to the camera. Not\n"
+    "                   with --direction, --impulsive, --correlation or --stripes.\n"
+    "  --view X,Y,Z     with --depth-sensor: the camera's direction from the bounding-box centre,\n"
+    "                   three numbers not all zero (default: drawn from the seed)\n"
+    "  --quantum Q      with --depth-sensor: the depth step at the mean depth in mean edge\n"
+    "                   lengths, growing as (z / z_mean)^2 like the noise; in [0, 1e6], 0 off\n"
+    "                   (default 0.5 x --sigma)\n"
+    "  --grazing C      with --depth-sensor: the cosine below which a vertex grazes and gets\n"
+    "                   1 / C times the noise (a vertex seen from behind too); in [0.01, 1]\n"
+    "                   (default 0.15)\n"
+    "  --ridges A       with --depth-sensor: scan-line ridges, A sigma (z / z_mean)^2\n"
+    "                   sin(2 pi x / P + phase) added to the depth, x along the image's\n"
+    "                   horizontal axis (the phase from the seed); A a fraction of --sigma\n"
+    "                   in [0, 10], 0 off (default 0.25)\n"
+    "  --ridge-period P with --depth-sensor: the ridges' period P in mean edge lengths at the\n"
+    "                   mean depth; in (0, 1e6] (default 4)\n"
     "  --seed N         seed of the random generator, an integer in [0, 2^64) (default 1).\n"
     "                   The same INPUT, options and seed give the same OUTPUT, byte for\n"
     "                   byte; a vertex moved by --impulsive moves exactly as without it.\n"
@@ -73,6 +109,7 @@ static const char noise_usage_text[] =
     "  rsmooth noise fandisk.obj fandisk-0.3.obj --sigma 0.3 --seed 7\n"
     "  rsmooth noise part.ply part-impulsive.ply --sigma 0.5 --impulsive 0.1\n"
     "  rsmooth noise bunny.obj bunny-scan.obj --sigma 0.15 --correlation 2\n"
+    "  rsmooth noise chair.ply chair-kinect.ply --sigma 0.2 --depth-sensor --view 0,1,2\n"
     "\n"
     "Exit status: 0 success, 2 bad usage, a bad input file or an OUTPUT that may not be\n"
     "written, 1 other.\n";
@@ -81,6 +118,10 @@ typedef struct noise_args {
     const char *input, *output;
     mesh_noise_options noise;
     bool have_sigma, impulsive, ascii, force, quiet;
+    /* --depth-sensor; its options; which of them were given (to refuse them without it) */
+    bool depth, have_direction, have_quantum;
+    mesh_depth_noise_options depth_noise;
+    char depth_option[sizeof((cli_getopt_state *)0)->spelled];
 } noise_args;
 
 /* Decimal digits only: strtoull would take "-1" as 2^64 - 1, and a seed must be typed exactly. */
@@ -100,23 +141,131 @@ static bool parse_seed(const char *text, uint64_t *out) {
     return true;
 }
 
+/* "X,Y,Z": three finite numbers, not all zero, divided by the largest magnitude so that even
+ * "1e-200,0,0" has a length the noise can normalise. */
+static bool parse_view(const char *text, double view[3]) {
+    char buffer[256];
+    if (strlen(text) >= sizeof buffer)
+        return false;
+    strcpy(buffer, text);
+    char *part = buffer;
+    double largest = 0;
+    for (int k = 0; k < 3; k++) {
+        char *comma = strchr(part, ',');
+        if ((k < 2) != (comma != NULL))
+            return false;
+        if (comma)
+            *comma = '\0';
+        if (!cli_parse_number(part, &view[k]) || !isfinite(view[k]))
+            return false;
+        largest = fmax(largest, fabs(view[k]));
+        part = comma ? comma + 1 : part;
+    }
+    for (int k = 0; largest > 0 && k < 3; k++)
+        view[k] /= largest;
+    return largest > 0;
+}
+
+enum {
+    N_HELP = 1,
+    N_SIGMA,
+    N_IMPULSIVE,
+    N_DIRECTION,
+    N_SEED,
+    N_ASCII,
+    N_FORCE,
+    N_QUIET,
+    N_CORRELATION,
+    N_STRIPES,
+    N_DEPTH,
+    N_VIEW,
+    N_QUANTUM,
+    N_GRAZING,
+    N_RIDGES,
+    N_RIDGE_PERIOD
+};
+
+/* --view, --quantum, --grazing, --ridges, --ridge-period: -1 when taken, else the exit status. */
+static int parse_depth_option(int id, const char *spelled, const char *value, noise_args *a) {
+    mesh_depth_noise_options *d = &a->depth_noise;
+    if (!a->depth_option[0])
+        snprintf(a->depth_option, sizeof a->depth_option, "%s", spelled);
+    if (id == N_VIEW) {
+        if (!parse_view(value, d->view))
+            return cli_usage_error("noise",
+                                   "--view must be three finite numbers X,Y,Z, not all zero "
+                                   "(got '%s')",
+                                   value);
+        d->have_view = true;
+        return -1;
+    }
+    /* each option's range: the quantum and the period in mean edge lengths, like --sigma */
+    static const struct {
+        int id;
+        double least, most;
+        bool least_open;
+    } ranges[] = {{N_QUANTUM, 0, MAX_SIGMA, false},
+                  {N_GRAZING, 0.01, 1, false},
+                  {N_RIDGES, 0, 10, false},
+                  {N_RIDGE_PERIOD, 0, MAX_SIGMA, true}};
+    for (size_t i = 0; i < sizeof ranges / sizeof ranges[0]; i++) {
+        if (ranges[i].id != id)
+            continue;
+        double x;
+        if (!cli_parse_number(value, &x) ||
+            !(ranges[i].least_open ? x > ranges[i].least : x >= ranges[i].least) ||
+            !(x <= ranges[i].most))
+            return cli_usage_error("noise", "%s must be in %c%g, %g] (got '%s')", spelled,
+                                   ranges[i].least_open ? '(' : '[', ranges[i].least,
+                                   ranges[i].most, value);
+        if (id == N_QUANTUM)
+            d->quantum = x, a->have_quantum = true;
+        else if (id == N_GRAZING)
+            d->grazing = x;
+        else if (id == N_RIDGES)
+            d->ridge_amplitude = x;
+        else
+            d->ridge_period = x;
+    }
+    return -1;
+}
+
+/* Options that exclude each other, and what --depth-sensor's defaults become once --sigma is
+ * known. Returns -1 when the command should go on, else the exit status. */
+static int settle_noise_args(noise_args *a) {
+    if (a->noise.correlation > 0 && a->noise.stripes > 0)
+        return cli_usage_error("noise", "--correlation and --stripes exclude each other");
+    if (!a->depth && a->depth_option[0])
+        return cli_usage_error("noise", "%s is an option of --depth-sensor (give both)",
+                               a->depth_option);
+    if (a->depth) {
+        /* the depth model chooses its own direction (the ray) and moves every vertex */
+        const char *other = a->have_direction          ? "--direction"
+                            : a->impulsive             ? "--impulsive"
+                            : a->noise.correlation > 0 ? "--correlation"
+                            : a->noise.stripes > 0     ? "--stripes"
+                                                       : NULL;
+        if (other)
+            return cli_usage_error("noise", "--depth-sensor and %s exclude each other", other);
+    }
+    if (!a->have_sigma)
+        return cli_usage_error("noise",
+                               "--sigma is required (in mean edge lengths, e.g. --sigma 0.3)");
+    a->depth_noise.sigma = a->noise.sigma;
+    a->depth_noise.seed = a->noise.seed;
+    if (!a->have_quantum)
+        a->depth_noise.quantum = DEFAULT_QUANTUM_OF_SIGMA * a->noise.sigma;
+    return -1;
+}
+
 /* Returns -1 when the command should go on, else the exit status. */
 static int parse_noise_args(int argc, char **argv, noise_args *a) {
     memset(a, 0, sizeof *a);
     a->noise.direction = MESH_NOISE_NORMAL;
     a->noise.seed = DEFAULT_SEED;
-    enum {
-        N_HELP = 1,
-        N_SIGMA,
-        N_IMPULSIVE,
-        N_DIRECTION,
-        N_SEED,
-        N_ASCII,
-        N_FORCE,
-        N_QUIET,
-        N_CORRELATION,
-        N_STRIPES
-    };
+    a->depth_noise.grazing = DEFAULT_GRAZING;
+    a->depth_noise.ridge_amplitude = DEFAULT_RIDGES;
+    a->depth_noise.ridge_period = DEFAULT_RIDGE_PERIOD;
     static const cli_option table[] = {{"help", 'h', false, N_HELP},
                                        {"sigma", 0, true, N_SIGMA},
                                        {"impulsive", 0, true, N_IMPULSIVE},
@@ -127,11 +276,17 @@ static int parse_noise_args(int argc, char **argv, noise_args *a) {
                                        {"quiet", 'q', false, N_QUIET},
                                        {"correlation", 0, true, N_CORRELATION},
                                        {"stripes", 0, true, N_STRIPES},
+                                       {"depth-sensor", 0, false, N_DEPTH},
+                                       {"view", 0, true, N_VIEW},
+                                       {"quantum", 0, true, N_QUANTUM},
+                                       {"grazing", 0, true, N_GRAZING},
+                                       {"ridges", 0, true, N_RIDGES},
+                                       {"ridge-period", 0, true, N_RIDGE_PERIOD},
                                        {NULL, 0, false, 0}};
     cli_getopt_state s;
     cli_getopt_init(&s, argc, argv, "noise", table);
     const char *value;
-    int id;
+    int id, code;
     while ((id = cli_getopt(&s, &value)) != CLI_GETOPT_END) {
         double x;
         if (id == CLI_GETOPT_ERROR) {
@@ -173,7 +328,13 @@ static int parse_noise_args(int argc, char **argv, noise_args *a) {
                 a->noise.correlation = x;
             else
                 a->noise.stripes = x;
+        } else if (id >= N_VIEW && id <= N_RIDGE_PERIOD) {
+            if ((code = parse_depth_option(id, s.spelled, value, a)) >= 0)
+                return code;
+        } else if (id == N_DEPTH) {
+            a->depth = true;
         } else if (id == N_DIRECTION) {
+            a->have_direction = true;
             if (!strcmp(value, "normal"))
                 a->noise.direction = MESH_NOISE_NORMAL;
             else if (!strcmp(value, "random"))
@@ -202,12 +363,7 @@ static int parse_noise_args(int argc, char **argv, noise_args *a) {
         return cli_usage_error("noise", "no input file");
     if (!a->output)
         return cli_usage_error("noise", "no output file");
-    if (a->noise.correlation > 0 && a->noise.stripes > 0)
-        return cli_usage_error("noise", "--correlation and --stripes exclude each other");
-    if (!a->have_sigma)
-        return cli_usage_error("noise",
-                               "--sigma is required (in mean edge lengths, e.g. --sigma 0.3)");
-    return -1;
+    return settle_noise_args(a);
 }
 
 /* The noisy mesh must be one rsmooth reads back: every coordinate finite and within
@@ -225,6 +381,21 @@ static int check_coordinates(const noise_args *a, const rsmooth_mesh *mesh) {
         return EXIT_USAGE;
     }
     return EXIT_OK;
+}
+
+/* What --depth-sensor did, with the camera it placed (so a drawn view can be given back). */
+static void print_depth_summary(const noise_args *a, size_t nv, double edge,
+                                const mesh_depth_noise_camera *camera) {
+    const mesh_depth_noise_options *d = &a->depth_noise;
+    fprintf(
+        stderr,
+        "rsmooth noise: %s: %zu vertices; depth sensor at (%.6g, %.6g, %.6g), view %.6g,%.6g,"
+        "%.6g from the bounding-box centre; sigma %.6g mean edge lengths = %.6g mesh units at "
+        "the mean depth, along the rays; quantum %.6g, ridges %.6g x sigma every %.6g mean edge "
+        "lengths; grazing below cosine %.6g; seed %" PRIu64 "; wrote %s\n",
+        a->input, nv, camera->position[0], camera->position[1], camera->position[2],
+        camera->view[0], camera->view[1], camera->view[2], d->sigma, d->sigma * edge, d->quantum,
+        d->ridge_amplitude, d->ridge_period, d->grazing, d->seed, a->output);
 }
 
 int cli_noise_main(int argc, char **argv) {
@@ -252,13 +423,18 @@ int cli_noise_main(int argc, char **argv) {
         fprintf(stderr, "rsmooth noise: %s: out of memory\n", a.input);
         goto cleanup;
     }
-    if (!(edge > 0) && a.noise.sigma > 0) {
+    if (!(edge > 0) && (a.noise.sigma > 0 || (a.depth && a.depth_noise.quantum > 0))) {
         fprintf(stderr, "rsmooth noise: %s: no edge of non-zero length, so no unit for --sigma\n",
                 a.input);
         code = EXIT_USAGE;
         goto cleanup;
     }
-    if (mesh_add_noise(mesh->positions, nv, mesh->triangles, mesh->triangle_count, &a.noise) != 0) {
+    mesh_depth_noise_camera camera;
+    int failed = a.depth ? mesh_add_depth_noise(mesh->positions, nv, mesh->triangles,
+                                                mesh->triangle_count, &a.depth_noise, &camera)
+                         : mesh_add_noise(mesh->positions, nv, mesh->triangles,
+                                          mesh->triangle_count, &a.noise);
+    if (failed) { /* the options were checked: only memory is left to fail */
         fprintf(stderr, "rsmooth noise: %s: out of memory\n", a.input);
         goto cleanup;
     }
@@ -275,7 +451,9 @@ int cli_noise_main(int argc, char **argv) {
     if ((code = cli_write_mesh(mesh, a.output, format, a.force, a.quiet)) != EXIT_OK)
         goto cleanup;
 
-    if (!a.quiet) {
+    if (!a.quiet && a.depth)
+        print_depth_summary(&a, nv, edge, &camera);
+    else if (!a.quiet) {
         size_t moved =
             a.noise.sigma > 0 ? mesh_noise_moved_count(nv, a.noise.impulsive_fraction) : 0;
         char impulsive[128] = "";

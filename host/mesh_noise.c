@@ -64,7 +64,7 @@ size_t mesh_noise_moved_count(size_t vertex_count, double impulsive_fraction) {
  * so squares and cross products neither overflow nor underflow at any scale (at 1e-300 they
  * would vanish); the scaling is exact, so at ordinary scales every result has the same bits.
  * NULL when out of memory. */
-static double *scaled_copy(const double *xyz, size_t vertex_count, double *unit) {
+double *mesh_noise_scaled_copy(const double *xyz, size_t vertex_count, double *unit) {
     double largest = 0;
     for (size_t i = 0; i < 3 * vertex_count; i++)
         largest = fmax(largest, fabs(xyz[i]));
@@ -88,7 +88,7 @@ static double scaled_mean_edge_length(const double *scaled, double unit, size_t 
 double mesh_noise_mean_edge_length(const double *xyz, size_t vertex_count,
                                    const uint32_t *triangles, size_t triangle_count) {
     double unit = 1;
-    double *scaled = scaled_copy(xyz, vertex_count, &unit);
+    double *scaled = mesh_noise_scaled_copy(xyz, vertex_count, &unit);
     if (!scaled)
         return NAN;
     double edge = scaled_mean_edge_length(scaled, unit, vertex_count, triangles, triangle_count);
@@ -127,9 +127,9 @@ int mesh_add_noise(double *xyz, size_t vertex_count, const uint32_t *triangles,
     if (vertex_count == 0 || options->sigma == 0)
         return 0; /* adding 0 could still turn -0.0 into +0.0: leave the bits alone */
 
-    /* edge lengths and normals from the scaled copy (see scaled_copy) */
+    /* edge lengths and normals from the scaled copy (see mesh_noise_scaled_copy) */
     double unit = 1;
-    double *scaled = scaled_copy(xyz, vertex_count, &unit);
+    double *scaled = mesh_noise_scaled_copy(xyz, vertex_count, &unit);
     if (!scaled)
         return -1;
     double edge = scaled_mean_edge_length(scaled, unit, vertex_count, triangles, triangle_count);

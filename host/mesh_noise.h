@@ -59,4 +59,9 @@ size_t mesh_noise_moved_count(size_t vertex_count, double impulsive_fraction);
 double mesh_noise_mean_edge_length(const double *xyz, size_t vertex_count,
                                    const uint32_t *triangles, size_t triangle_count);
 
+/* A copy of the positions (3 * vertex_count doubles) times a power of two, *unit, that brings the
+ * largest coordinate near 1, so squares and cross products neither overflow nor underflow at any
+ * scale; the scaling is exact. The caller frees it; NULL when out of memory. */
+double *mesh_noise_scaled_copy(const double *xyz, size_t vertex_count, double *unit);
+
 #endif
