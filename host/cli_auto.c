@@ -53,6 +53,10 @@ int cli_choose_params(options *opt, const rsmooth_mesh *mesh, bool points) {
         chosen.guided_radius = given->guided_radius;
     if (opt->given & (GIVEN_SIGMA_F | GIVEN_SIGMA_G))
         chosen.absolute = given->absolute;
+    /* what the stage follows is the command line's, whatever strength the rule chose */
+    chosen.stage_normals = given->stage_normals;
+    chosen.model = given->model;
+    chosen.model_size = given->model_size;
     opt->params = chosen;
     opt->noise = report.level;
     opt->noise_correlated = report.correlated_level;

@@ -4,6 +4,7 @@
 #include "cli_files.h"
 #include "cli_getopt.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -54,6 +55,8 @@ enum {
     OPT_TMPDIR,
     OPT_PROGRESS,
     OPT_GUIDED_RADIUS,
+    OPT_STAGE,
+    OPT_MODEL,
     OPT_NO_GUARD
 };
 
@@ -90,6 +93,8 @@ static const cli_option table[] = {{"help", 'h', false, OPT_HELP},
                                    {"guided-rounds", 0, true, OPT_GUIDED_ROUNDS},
                                    {"stage-repeats", 0, true, OPT_STAGE_REPEATS},
                                    {"guided-radius", 0, true, OPT_GUIDED_RADIUS},
+                                   {"stage", 0, true, OPT_STAGE},
+                                   {"model", 0, true, OPT_MODEL},
                                    {"auto", 0, false, OPT_AUTO},
                                    {"best", 0, false, OPT_BEST},
                                    {"absolute", 0, false, OPT_ABSOLUTE},
@@ -118,6 +123,15 @@ static int find_name(const char *value, const char *const *names, int count) {
 /* The options that name one of a few choices: --format, --method, --normals, --influence. */
 static int apply_choice(options *opt, int id, const char *value) {
     switch (id) {
+    case OPT_STAGE: {
+        static const char *const names[] = {"guided", "learned"};
+        int k = find_name(value, names, 2);
+        if (k < 0)
+            return cli_usage_error(NULL, "--stage: '%s' is not guided or learned", value);
+        opt->params.stage_normals =
+            k ? RSMOOTH_STAGE_NORMALS_LEARNED : RSMOOTH_STAGE_NORMALS_GUIDED;
+        break;
+    }
     case OPT_FORMAT: {
         static const char *const names[] = {"obj", "ply", "off", "stl"};
         static const rsmooth_format formats[] = {RSMOOTH_FORMAT_OBJ, RSMOOTH_FORMAT_PLY_BINARY,
@@ -256,6 +270,31 @@ static int apply_number(options *opt, int id, const char *name, const char *valu
     return -1;
 }
 
+/* --model FILE: the whole file in memory (the library checks that it is a model, and says what
+ * is wrong with it). -1, or the usage exit status (printed). */
+static int load_model(options *opt, const char *path) {
+    FILE *f = fopen(path, "rb");
+    long size = -1;
+    if (f && fseek(f, 0, SEEK_END) == 0)
+        size = ftell(f);
+    if (!f || size < 0 || fseek(f, 0, SEEK_SET) != 0) {
+        int e = errno;
+        if (f)
+            fclose(f);
+        return cli_usage_error(NULL, "--model: cannot read %s: %s", path, strerror(e));
+    }
+    free(opt->model);
+    opt->model = malloc(size ? (size_t)size : 1);
+    size_t got = opt->model ? fread(opt->model, 1, (size_t)size, f) : 0;
+    fclose(f);
+    if (got != (size_t)size)
+        return cli_usage_error(NULL, "--model: cannot read %s whole", path);
+    opt->model_path = path;
+    opt->params.model = opt->model;
+    opt->params.model_size = (size_t)size;
+    return -1;
+}
+
 /* Sets what option `id` (spelled `name`, e.g. "--sigma-f") with `value` asks for. -1, or the exit
  * status (--help, --version, or a bad value). */
 static int apply(options *opt, int id, const char *name, const char *value) {
@@ -305,6 +344,8 @@ static int apply(options *opt, int id, const char *name, const char *value) {
                                    "(examples: 512M, 2G)",
                                    value);
         break;
+    case OPT_MODEL:
+        return load_model(opt, value);
     case OPT_TMPDIR:
         if (!*value)
             return cli_usage_error(NULL, "--tmpdir: an empty folder name");
@@ -357,6 +398,8 @@ static int apply(options *opt, int id, const char *name, const char *value) {
 void cli_options_free(options *opt) {
     free(opt->inputs);
     opt->inputs = NULL;
+    free(opt->model);
+    opt->model = NULL;
 }
 
 int cli_options_parse(int argc, char **argv, options *opt) {

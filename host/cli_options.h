@@ -61,6 +61,8 @@ typedef struct options {
     uint64_t memory_budget; /* 0: the library's default */
     uint64_t max_memory;    /* --max-memory: stream the file under this cap (0: in memory) */
     const char *tmpdir;     /* --tmpdir: the streaming path's temporary files */
+    const char *model_path; /* --model: the learned model's file (read whole into model) */
+    void *model;
     bool colors;            /* --sigma-c: the input's vertex colours in the weight */
     bool sigma_g_given, umbrella_given; /* for consistency checks against --method */
     bool ascii, json, force, quiet, in_place, stats, list_devices, best;

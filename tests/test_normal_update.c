@@ -354,8 +354,12 @@ static void test_cycles_against_brute_force(void) {
     CHECK(shape_add_normal_noise(&cube, 0.4, 5) == 0);
     size_t nv = cube.vertex_count, n = 3 * nv;
     double edge = shape_mean_edge_length(&cube);
-    rs_stage_setting setting = {0.7 * edge, 0.3, 3.0,
-                                2,          3,   4}; /* s, t, radius, rounds, k, cycles */
+    rs_stage_setting setting = {.sigma_s = 0.7 * edge,
+                                .sigma_n = 0.3,
+                                .radius = 3.0,
+                                .rounds = 2,
+                                .updates = 3,
+                                .cycles = 4};
     double *lib = malloc(n * sizeof(double)), *brute = malloc(n * sizeof(double));
     CHECK(lib && brute);
     memcpy(lib, cube.xyz, n * sizeof(double));

@@ -52,7 +52,8 @@ def noise_args(kind, rng, mean_edge_free=True):
         return ["--sigma", f"{rng.uniform(0.1, 0.4):.3f}", "--stripes",
                 f"{rng.uniform(2.0, 6.0):.2f}"]
     if kind == "depth":
-        return ["--sigma", f"{rng.uniform(0.1, 0.5):.3f}", "--depth-sensor"]
+        return ["--sigma", f"{rng.uniform(0.05, 0.3):.3f}", "--depth-sensor", "--grazing",
+                f"{rng.uniform(0.3, 0.6):.2f}"]
     raise ValueError(kind)
 
 
@@ -152,10 +153,26 @@ def noisy_mesh(build, cache, case):
     return out
 
 
-def features(build, mesh, truth, surface=False, model=None, stages=0, predict=False):
+def staged_mesh(build, cache, case, noisy):
+    """The hand-fitted stage's result on the noisy mesh (rsmooth --best --auto --passes 0): the
+    learned normals refine what it leaves."""
+    out = os.path.join(cache, "staged", case["name"] + ".ply")
+    if not os.path.exists(out):
+        os.makedirs(os.path.dirname(out), exist_ok=True)
+        tmp = out + ".tmp.ply"
+        subprocess.run([os.path.join(build, "rsmooth"), noisy, "-o", tmp, "--best", "--auto",
+                        "--passes", "0", "--device", "reference", "-q", "-f"], check=True)
+        os.replace(tmp, out)
+    return out
+
+
+def features(build, mesh, truth, surface=False, model=None, stages=0, predict=False,
+             noise_from=None):
     """The tool's arrays for one mesh, as a dict."""
     with tempfile.TemporaryDirectory() as tmp:
         cmd = [os.path.join(build, "rsmooth-train-features"), mesh, tmp]
+        if noise_from:
+            cmd += ["--noise-from", noise_from]
         if truth:
             cmd += ["--truth-surface" if surface else "--truth", truth]
         if model and stages:
@@ -177,16 +194,17 @@ def sample(case, arrays, rng):
     want = SAMPLES_CLEAN if case["class"] == "clean" else SAMPLES_PER_CASE
     if n <= want:
         return np.arange(n)
-    weight = 1.0 + 8.0 * np.minimum(arrays["sharp"][:, 0] / 0.3, 1.0)
+    weight = 1.0 + 4.0 * np.minimum(arrays["sharp"][:, 0] / 0.3, 1.0)
     return np.sort(rng.choice(n, size=want, replace=False, p=weight / weight.sum()))
 
 
 def one_case(job):
     build, cache, case, model, stage = job
-    mesh = noisy_mesh(build, cache, case)
+    noisy = noisy_mesh(build, cache, case)
+    mesh = staged_mesh(build, cache, case, noisy)
     truth = scan_truth(cache, case["name"]) if case["class"] == "scan" else case["clean"]
     arrays = features(build, mesh, truth, surface=case["class"] == "scan",
-                      model=model, stages=stage - 1)
+                      model=model, stages=stage - 1, noise_from=noisy)
     rng = np.random.default_rng(int(hashlib.sha256(case["name"].encode()).hexdigest()[:8], 16))
     keep = sample(case, arrays, rng)
     x = arrays["descriptor"][keep]

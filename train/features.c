@@ -7,7 +7,8 @@
  *
  * With --model, the first S stages run first and the descriptors are those the next stage reads;
  * --predict also writes every stage's output normals (the library's reference path, double).
- * --truth names the clean mesh (the same triangles): each facet's target is its clean normal;
+ * --noise-from takes the noise level from another mesh (the noisy input, when MESH is the result
+ * of the stage before the learned one). --truth names the clean mesh (the same triangles): each facet's target is its clean normal;
  * --truth-surface a surface to measure against (a range scan's reconstruction): each facet's
  * target is the normal of the surface's triangle nearest its centroid. Both also write how sharp
  * the truth is around each facet (1 - the least cosine between its target and its 8 nearest
@@ -160,6 +161,7 @@ static rsmooth_status read_model(const char *path, rs_learned_model *model, rsmo
 
 int main(int argc, char **argv) {
     const char *mesh_path = NULL, *dir = NULL, *model_path = NULL, *truth_path = NULL;
+    const char *noise_from = NULL;
     bool truth_surface = false;
     int stages = 0;
     bool predict = false;
@@ -172,7 +174,9 @@ int main(int argc, char **argv) {
                  i + 1 < argc) {
             truth_surface = !strcmp(argv[i], "--truth-surface");
             truth_path = argv[++i];
-        } else if (!strcmp(argv[i], "--predict"))
+        } else if (!strcmp(argv[i], "--noise-from") && i + 1 < argc)
+            noise_from = argv[++i];
+        else if (!strcmp(argv[i], "--predict"))
             predict = true;
         else if (!mesh_path)
             mesh_path = argv[i];
@@ -200,9 +204,14 @@ int main(int argc, char **argv) {
         !rs_mean_edge_length(mesh->positions, mesh->vertex_count, mesh->triangles,
                              mesh->triangle_count, &mean_edge))
         return fail(mesh_path, "out of memory");
-    if (rsmooth_estimate_noise(RSMOOTH_FLOAT64, mesh->positions, mesh->vertex_count,
-                               mesh->triangles, mesh->triangle_count, &noise, &err) != RSMOOTH_OK)
-        return fail(mesh_path, err.message);
+    rsmooth_mesh *noisy = mesh;
+    if (noise_from && rsmooth_mesh_read_file(noise_from, &noisy, &err) != RSMOOTH_OK)
+        return fail(noise_from, err.message);
+    if (rsmooth_estimate_noise(RSMOOTH_FLOAT64, noisy->positions, noisy->vertex_count,
+                               noisy->triangles, noisy->triangle_count, &noise, &err) != RSMOOTH_OK)
+        return fail(noise_from ? noise_from : mesh_path, err.message);
+    if (noisy != mesh)
+        rsmooth_mesh_destroy(noisy);
     rs_learned_patches patches;
     if (!rs_learned_patches_build(&patches, facets.centroid, facets.count))
         return fail(mesh_path, "out of memory");
@@ -211,7 +220,7 @@ int main(int argc, char **argv) {
     size_t n = facets.count;
     double *normals = malloc((n ? n : 1) * 3 * sizeof(double));
     memcpy(normals, facets.normal, n * 3 * sizeof(double));
-    if (stages > 0 && !rs_learned_normals(&model, stages, &in, normals))
+    if (stages > 0 && !rs_learned_normals(&model, stages, &in, NULL, normals))
         return fail(mesh_path, "out of memory");
     in.normal = normals;
     float *nf = to_float(normals, 3 * n);
@@ -222,7 +231,7 @@ int main(int argc, char **argv) {
                            mesh->triangle_count);
     if (!rc && predict) {
         in.normal = facets.normal;
-        rs_learned_normals(&model, (int)model.stage_count, &in, normals);
+        rs_learned_normals(&model, (int)model.stage_count, &in, NULL, normals);
         rc = write_npy(dir, "predicted", "<f8", normals, n, 3, 8);
     }
     printf("%s: %zu facets, mean edge %.9g, noise %.4f mean edges\n", mesh_path, n, mean_edge,

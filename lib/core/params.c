@@ -40,6 +40,9 @@ rsmooth_status rs_params_init(rsmooth_params *params) {
     params->guided_radius = 2.0;
     params->discrepancy_gain = 0.0;
     params->guard = 1;
+    params->stage_normals = RSMOOTH_STAGE_NORMALS_GUIDED;
+    params->model = NULL;
+    params->model_size = 0;
     return RSMOOTH_OK;
 }
 
@@ -96,6 +99,15 @@ rsmooth_status rs_params_resolve(const rsmooth_params *params, rsmooth_params *o
     if (out->guard != 0 && out->guard != 1)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "guard must be 0 or 1 (got %d)", out->guard);
+    if (out->stage_normals != RSMOOTH_STAGE_NORMALS_GUIDED &&
+        out->stage_normals != RSMOOTH_STAGE_NORMALS_LEARNED)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "stage_normals must be RSMOOTH_STAGE_NORMALS_GUIDED (0) or _LEARNED (1) "
+                       "(got %d)",
+                       out->stage_normals);
+    if (out->model && out->model_size == 0)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "model is set but model_size is 0");
     if (out->mollify != 0 && out->mollify != 1)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "mollify must be 0 or 1 (got %d)", out->mollify);

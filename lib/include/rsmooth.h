@@ -330,7 +330,26 @@ typedef struct rsmooth_params {
                 * exactly as set (the paper's own, for comparisons). Parts and
                 * outliers (rsmooth_report.parts) are kept apart either way.
                 * (Added in 0.11) */
+    /** @name Learned normals
+     * What the normal update stage's cycles follow (added in 0.12; docs/model.md): the guided
+     * filter's own guidance, or the facet normals a small network trained on noisy copies of
+     * clean meshes predicts from each facet's patch (computed once on the input). @{ */
+    int stage_normals;      /**< an rsmooth_stage_normals. Default RSMOOTH_STAGE_NORMALS_GUIDED */
+    const void *model;      /**< NULL (default): the model built into the library. Else the
+                             * bytes of a model file (docs/model.md, "The file"; borrowed, read
+                             * during the call only): a file that is not a model, is truncated,
+                             * damaged or of another descriptor layout is an
+                             * RSMOOTH_ERROR_PARSE saying which */
+    size_t model_size;      /**< the model's size in bytes */
+    /** @} */
 } rsmooth_params;
+
+/** What the normal update stage's cycles follow (rsmooth_params.stage_normals). */
+typedef enum rsmooth_stage_normals {
+    RSMOOTH_STAGE_NORMALS_GUIDED = 0, /**< guided normal filtering (Zhang et al. 2015) */
+    RSMOOTH_STAGE_NORMALS_LEARNED = 1 /**< the learned model's normals, computed once on the
+                                       * input, as the vertex update's targets */
+} rsmooth_stage_normals;
 
 /** Fills `params` with the defaults above. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if params is
  * NULL. */

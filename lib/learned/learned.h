@@ -90,10 +90,22 @@ void rs_learned_network(const rs_learned_stage *stage, const double *descriptor,
 void rs_learned_normal_from_residual(const double frame[3][3], const double own[3],
                                      const double residual[3], double normal[3]);
 
-/* Every stage of `model` on every facet, on the host in double on every core: normals
- * (3 per facet) start as the facets' own and end as the last stage's. `stages` stages only (at
- * most the model's). false when out of memory (normals then unchanged). */
+/* Runs one stage's network elsewhere (the device: opencl/cl_learned.c) on `count` descriptors
+ * (RS_LEARNED_INPUTS floats each, row after row), writing 3 residuals per descriptor. Any status
+ * but RSMOOTH_OK has the host run that chunk, in double (the runner's refusal is no error). */
+typedef rsmooth_status (*rs_network_runner)(void *ctx, const rs_learned_stage *stage,
+                                            const float *descriptors, size_t count,
+                                            float *residuals);
+typedef struct rs_network_place {
+    rs_network_runner runner; /* NULL: the host */
+    void *ctx;
+} rs_network_place;
+
+/* Every stage of `model` on every facet: normals (3 per facet) start as the facets' own and end
+ * as the last stage's; `stages` stages only (at most the model's). The descriptors are made on
+ * the host's cores in double; the networks run there too, in double, or at `place` (may be
+ * NULL) in float, a chunk of facets at a time. false when out of memory (normals unchanged). */
 bool rs_learned_normals(const rs_learned_model *model, int stages, const rs_learned_input *in,
-                        double *normals);
+                        const rs_network_place *place, double *normals);
 
 #endif /* RSMOOTH_LEARNED_H */

@@ -1,44 +1,99 @@
-/* The cascade on the host: every stage of the model on every facet, each stage reading the one
- * before's normals over the input's geometry, in double on every core. */
+/* The cascade: every stage of the model on every facet, each stage reading the one before's
+ * normals over the input's geometry. Descriptors are made on the host's cores in double; each
+ * stage's network runs there too, or on the device a chunk of facets at a time (the chunk bounds
+ * the descriptors' memory: 1 KB per facet). */
 #include "learned/learned.h"
 
 #include <string.h>
 
-typedef struct stage_job {
+/* Facets per chunk: 16 MB of float descriptors. */
+#define CHUNK 16384
+
+typedef struct chunk_job {
     const rs_learned_stage *stage;
     const rs_learned_input *in; /* in->normal: the stage's input normals */
-    double *out;                /* 3 per facet */
-} stage_job;
+    size_t first;
+    double *frames;     /* 9 per facet of the chunk */
+    float *descriptors; /* RS_LEARNED_INPUTS per facet of the chunk; NULL: the host's network */
+    double *out;        /* 3 per facet of the mesh */
+} chunk_job;
 
-static void run_stage(void *ctx, size_t begin, size_t end, size_t chunk) {
+/* Descriptors of facets first + [begin, end): for the device (float), or straight through the
+ * host's network in double. */
+static void describe_range(void *ctx, size_t begin, size_t end, size_t chunk) {
     (void)chunk;
-    stage_job *job = ctx;
+    chunk_job *job = ctx;
     double descriptor[RS_LEARNED_INPUTS], frame[3][3], residual[3];
-    for (size_t f = begin; f < end; f++) {
+    for (size_t i = begin; i < end; i++) {
+        size_t f = job->first + i;
         rs_learned_descriptor(job->in, f, descriptor, frame);
+        if (job->descriptors) {
+            for (int k = 0; k < RS_LEARNED_INPUTS; k++)
+                job->descriptors[i * RS_LEARNED_INPUTS + k] = (float)descriptor[k];
+            memcpy(job->frames + 9 * i, frame, sizeof frame);
+            continue;
+        }
         rs_learned_network(job->stage, descriptor, residual);
         /* the facet's own normal in the frame is its patch's first entry */
         rs_learned_normal_from_residual(frame, descriptor, residual, job->out + 3 * f);
     }
 }
 
-bool rs_learned_normals(const rs_learned_model *model, int stages, const rs_learned_input *in,
-                        double *normals) {
-    size_t n = in->facet_count;
-    double *current = rs_alloc_array(n ? 3 * n : 1, sizeof(double));
-    if (!current)
-        return false;
-    memcpy(current, in->normal, 3 * n * sizeof(double));
-    rs_learned_input step = *in;
-    if (stages > (int)model->stage_count)
-        stages = (int)model->stage_count;
-    for (int s = 0; s < stages; s++) {
-        step.normal = current;
-        stage_job job = {&model->stage[s], &step, normals};
-        rs_parallel_for(n, 64, run_stage, &job);
-        memcpy(current, normals, 3 * n * sizeof(double));
+/* One chunk of one stage: true when it is done (the device's residuals, or the host's). */
+static void run_chunk(chunk_job *job, size_t count, const rs_network_place *place,
+                      float *residuals) {
+    if (job->descriptors) {
+        rs_parallel_for(count, 64, describe_range, job);
+        if (place->runner(place->ctx, job->stage, job->descriptors, count, residuals) ==
+            RSMOOTH_OK) {
+            for (size_t i = 0; i < count; i++) {
+                double own[3], r[3], frame[3][3];
+                memcpy(frame, job->frames + 9 * i, sizeof frame);
+                for (int k = 0; k < 3; k++) {
+                    own[k] = job->descriptors[i * RS_LEARNED_INPUTS + k];
+                    r[k] = residuals[3 * i + k];
+                }
+                /* own from the frame in double, not the float copy: as the host computes it */
+                for (int k = 0; k < 3; k++)
+                    own[k] = rs_dot3(frame[k], job->in->normal + 3 * (job->first + i));
+                rs_learned_normal_from_residual(frame, own, r, job->out + 3 * (job->first + i));
+            }
+            return;
+        }
     }
-    memcpy(normals, current, 3 * n * sizeof(double));
+    chunk_job host = *job;
+    host.descriptors = NULL;
+    rs_parallel_for(count, 64, describe_range, &host);
+}
+
+bool rs_learned_normals(const rs_learned_model *model, int stages, const rs_learned_input *in,
+                        const rs_network_place *place, double *normals) {
+    size_t n = in->facet_count;
+    bool device = place && place->runner;
+    size_t chunk = n < CHUNK ? (n ? n : 1) : CHUNK;
+    double *current = rs_alloc_array(n ? 3 * n : 1, sizeof(double));
+    double *frames = device ? rs_alloc_array(chunk, 9 * sizeof(double)) : NULL;
+    float *descriptors = device ? rs_alloc_array(chunk, RS_LEARNED_INPUTS * sizeof(float)) : NULL;
+    float *residuals = device ? rs_alloc_array(chunk, 3 * sizeof(float)) : NULL;
+    bool ok = current && (!device || (frames && descriptors && residuals));
+    if (ok) {
+        memcpy(current, in->normal, 3 * n * sizeof(double));
+        rs_learned_input step = *in;
+        step.normal = current;
+        if (stages > (int)model->stage_count)
+            stages = (int)model->stage_count;
+        for (int s = 0; s < stages; s++) {
+            for (size_t first = 0; first < n; first += chunk) {
+                chunk_job job = {&model->stage[s], &step, first, frames, descriptors, normals};
+                run_chunk(&job, n - first < chunk ? n - first : chunk, place, residuals);
+            }
+            memcpy(current, normals, 3 * n * sizeof(double));
+        }
+        memcpy(normals, current, 3 * n * sizeof(double));
+    }
     rs_free(current);
-    return true;
+    rs_free(frames);
+    rs_free(descriptors);
+    rs_free(residuals);
+    return ok;
 }

@@ -3,6 +3,8 @@
  * data, normals and the grid from the previous positions; the sigmas stay those the input's mean
  * edge length gave, so later passes do not shrink their reach as the mesh smooths. */
 #include "passes/passes.h"
+
+#include "learned/learned.h"
 #include "auto/noise_estimate.h"
 #include "passes/one_part.h"
 #include "passes/region_choice.h"
@@ -103,23 +105,38 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
     int halves = p.passes > 0 ? 2 : 1;
     rs_pass_progress pp = {p.progress, p.progress_cancel, p.progress_user, 0, halves};
     bool reports = pp.progress || pp.cancel;
-    rs_stage_setting setting = {p.guided_sigma_s, p.guided_sigma_n, p.guided_radius,
-                                p.guided_rounds,  p.vertex_updates, p.stage_repeats};
+    rs_stage_setting setting = {.sigma_s = p.guided_sigma_s,
+                                .sigma_n = p.guided_sigma_n,
+                                .radius = p.guided_radius,
+                                .rounds = p.guided_rounds,
+                                .updates = p.vertex_updates,
+                                .cycles = p.stage_repeats};
     /* do no harm: no stage where the noise estimate finds nothing to remove (a caller that gives
      * the noise level, as rsmooth_params_auto does where it found noise, has measured it) */
-    bool clean = false;
-    if (p.guard && unit > 0 && !(p.discrepancy_level > 0)) {
-        rs_noise_details noise;
+    bool clean = false, learned = p.stage_normals == RSMOOTH_STAGE_NORMALS_LEARNED;
+    rs_noise_details noise = {0};
+    if (unit > 0 && ((p.guard && !(p.discrepancy_level > 0)) || learned)) {
         st = rs_estimate_noise_details(scalar, positions, vertex_count, indices, triangle_count,
                                        &noise, error, where);
-        clean = st == RSMOOTH_OK && rs_noise_reads_clean(&noise);
+        clean = st == RSMOOTH_OK && p.guard && !(p.discrepancy_level > 0) &&
+                rs_noise_reads_clean(&noise);
         if (stage_stats)
             stage_stats->skipped = clean;
+    }
+    rs_learned_model model = {0};
+    if (st == RSMOOTH_OK && learned && unit > 0 && !clean) {
+        st = p.model ? rs_learned_model_read(p.model, p.model_size, &model, error, "params.model")
+                     : rs_learned_model_builtin(&model, error);
+        setting.learned = &model;
+        setting.noise_level = noise.level; /* the descriptor's: as train/ measures it */
+        setting.mean_edge = unit;
+        setting.network = stage ? &stage->network : NULL;
     }
     if (st == RSMOOTH_OK && unit > 0 && !clean) /* no edge: nothing to filter */
         st = rs_normal_update_stage(staged, vertex_count, indices, triangle_count, &setting,
                                     p.move_mask, stage, reports ? report_cycle : NULL, &pp,
                                     stage_stats, error, where);
+    rs_learned_model_free(&model);
     double t_stage = rs_now_ms();
     if (st == RSMOOTH_OK && p.passes == 0) { /* the stage alone */
         for (size_t v = 0; v < vertex_count; v++)
@@ -325,7 +342,7 @@ rsmooth_status rs_filter_one_part(rs_filter_fn one_pass, rs_stage_runner stage, 
                                   rsmooth_error *error, const char *where) {
     size_t caller_size = report ? report->struct_size : 0; /* the report's fillers reset it */
     rsmooth_params p;
-    rs_stage_place place = {stage, ctx};
+    rs_stage_place place = {stage, ctx, {NULL, NULL}};
     rs_stage_stats stage_stats;
     memset(&stage_stats, 0, sizeof stage_stats);
     rsmooth_status st = filter_passes(

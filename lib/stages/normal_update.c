@@ -4,6 +4,8 @@
  */
 #include "stages/normal_update.h"
 
+#include "learned/learned.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -55,6 +57,41 @@ static rsmooth_status run_elsewhere(const rs_stage_place *place, double *xyz, si
     rsmooth_status st = place->runner(place->ctx, &plan, xyz, cycle_done, user, stats, error);
     rs_free(facet_vertex);
     return st;
+}
+
+/* The model's normals of the input's facets (positions in the stage's units, `scale` from the
+ * caller's), 3 per facet; NULL when out of memory. */
+static double *learned_normals(const rs_stage_setting *setting, const rs_facets *facets,
+                               double scale) {
+    double *out = rs_alloc_array(facets->count ? facets->count : 1, 3 * sizeof(double));
+    rs_learned_patches patches;
+    if (!out || !rs_learned_patches_build(&patches, facets->centroid, facets->count)) {
+        rs_free(out);
+        return NULL;
+    }
+    rs_learned_input in = {facets->count, facets->centroid,      facets->area,
+                           facets->normal, &patches,             setting->mean_edge * scale,
+                           setting->noise_level};
+    bool ok = rs_learned_normals(setting->learned, (int)setting->learned->stage_count, &in,
+                                 setting->network, out);
+    rs_learned_patches_free(&patches);
+    if (!ok) {
+        rs_free(out);
+        return NULL;
+    }
+    return out;
+}
+
+/* The learned normals of what the cycles left, then the vertex update toward them. */
+static bool refine_after(const rs_stage_setting *setting, double *xyz, size_t vertex_count,
+                         const uint32_t *indices, rs_facets *facets, const rs_adjacency *adj,
+                         double scale, const uint8_t *move_mask) {
+    rs_facets_update(facets, xyz, indices);
+    double *learned = learned_normals(setting, facets, scale);
+    bool ok = learned && rs_vertex_update(xyz, vertex_count, indices, facets, adj, learned,
+                                          setting->updates, move_mask);
+    rs_free(learned);
+    return ok;
 }
 
 rsmooth_status rs_normal_update_stage(double *xyz, size_t vertex_count, const uint32_t *indices,
@@ -113,6 +150,8 @@ rsmooth_status rs_normal_update_stage(double *xyz, size_t vertex_count, const ui
         stats->cycles = c + 1;
         cancelled = ok && cycle_done && cycle_done(user, c + 1, setting->cycles) != 0;
     }
+    if (ok && !cancelled && setting->learned && facets.count > 0) /* (after any runner too) */
+        ok = refine_after(setting, xyz, vertex_count, indices, &facets, &adj, scale, move_mask);
     if (!done) {
         stats->ms_cycles = rs_now_ms() - t_cycles;
         stats->float_bits = 64;

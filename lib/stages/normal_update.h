@@ -6,6 +6,7 @@
 #define RSMOOTH_NORMAL_UPDATE_H
 
 #include "core/stage_plan.h"
+#include "learned/learned.h"
 
 /* The triangles of non-zero area of a mesh, with their geometry. */
 typedef struct rs_facets {
@@ -74,6 +75,13 @@ bool rs_vertex_update(double *xyz, size_t vertex_count, const uint32_t *indices,
 typedef struct rs_stage_setting {
     double sigma_s, sigma_n, radius;
     int rounds, updates, cycles;
+    /* NULL, or the learned normals' model (learned/learned.h): after the cycles, the model's
+     * normals of their result are the targets of `updates` more vertex updates (the model is
+     * trained on what the guided cycles leave: docs/model.md). noise_level (the input's, in
+     * mean edge lengths) and mean_edge (mesh units) feed its descriptors. */
+    const rs_learned_model *learned;
+    double noise_level, mean_edge;
+    const rs_network_place *network; /* where its networks run (NULL: the host) */
 } rs_stage_setting;
 
 /* Where the stage's cycles run: `runner` with `ctx` (the device), or the host when runner is
@@ -81,6 +89,7 @@ typedef struct rs_stage_setting {
 typedef struct rs_stage_place {
     rs_stage_runner runner;
     void *ctx;
+    rs_network_place network; /* where the learned model's networks run ({NULL}: the host) */
 } rs_stage_place;
 
 /* The whole stage on `xyz` (double, in place). Vertices whose move_mask byte is 0 stay. `place`
