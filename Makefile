@@ -14,7 +14,7 @@ WHEELS ?= $(wildcard $(DIST)/rsmooth-*-manylinux*.whl)
 ADDON_VERSION := $(shell sed -n 's/^\#define RSMOOTH_VERSION_[A-Z]* //p' lib/include/rsmooth.h | paste -sd.)
 ADDON_ZIP ?= $(DIST)/rsmooth_blender-$(ADDON_VERSION).zip
 
-.PHONY: all deps configure build demo experiments check wheels wheels-check python-check sanitize fuzz \
+.PHONY: all deps configure build demo experiments check train train-env wheels wheels-check python-check sanitize fuzz \
         docs install clean blender-addon blender-check format format-check
 
 all: build
@@ -49,6 +49,19 @@ demo: build
 experiments: build
 	@.ci/install-deps.sh experiments
 	POCL_CACHE_DIR=$(abspath $(BUILD))/pocl-cache python3 scripts/experiments.py
+
+# The learned normals' model from ../shared/data (train/README.md; about an hour on 2 cores,
+# resumable): out/train/model.rsnn and its left-out figures. It does not replace the shipped
+# models/learned-normals.rsnn.
+train: build
+	train/run.sh $(BUILD) out/train
+
+# The part of the training environment the test learned_training needs (JAX and numpy, pinned as
+# in train/requirements.txt), in $(BUILD)/train-venv.
+train-env:
+	@.ci/install-deps.sh python
+	@test -x $(BUILD)/train-venv/bin/python || python3 -m venv $(BUILD)/train-venv
+	$(BUILD)/train-venv/bin/pip install -q $$(grep -E '^(numpy|jax|jaxlib|ml_dtypes|opt_einsum)==' train/requirements.txt)
 
 # ctest -j $(JOBS): tests that use both cores themselves ask for them (tests/CMakeLists.txt).
 # Then how many tests passed with checks skipped because their data is absent (the benchmark

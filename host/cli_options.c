@@ -289,6 +289,13 @@ static int load_model(options *opt, const char *path) {
     fclose(f);
     if (got != (size_t)size)
         return cli_usage_error(NULL, "--model: cannot read %s whole", path);
+    rsmooth_error err;
+    if (rsmooth_model_check(opt->model, (size_t)size, NULL, &err) != RSMOOTH_OK) {
+        const char *why = err.message;
+        if (!strncmp(why, "the model: ", 11))
+            why += 11;
+        return cli_usage_error(NULL, "--model %s: %s", path, why);
+    }
     opt->model_path = path;
     opt->params.model = opt->model;
     opt->params.model_size = (size_t)size;

@@ -32,6 +32,11 @@ static int check_params(options *opt) {
     if ((opt->given & GIVEN_PASSES) && p->passes == 0 && p->vertex_updates == 0)
         return cli_usage_error(NULL, "--passes 0 runs the normal update stage alone: give "
                                      "--vertex-updates (or --best) too");
+    if (p->stage_normals == RSMOOTH_STAGE_NORMALS_LEARNED && p->vertex_updates == 0 && !opt->best)
+        return cli_usage_error(NULL, "--stage learned runs in the normal update stage: give "
+                                     "--best (or --vertex-updates) too");
+    if (opt->model_path && p->stage_normals != RSMOOTH_STAGE_NORMALS_LEARNED)
+        return cli_usage_error(NULL, "--model is the learned stage's: give --stage learned too");
     return -1;
 }
 

@@ -139,6 +139,28 @@ def file_digest(path):
         return hashlib.sha256(f.read()).hexdigest()
 
 
+def portable(path):
+    """A source's name without the machine's folders: data/... for ../shared/data, cad/NAME for
+    a generated part (its recipe is in the shape generator's manifest, by seed)."""
+    if path.startswith(SHARED + os.sep):
+        return "data/" + os.path.relpath(path, SHARED)
+    return "cad/" + os.path.basename(path)
+
+
+def write_manifest(path, all_cases):
+    """What the training data is made of (every case's source, class, fold and noise options,
+    every source's SHA-256, the sampling), one line of JSON: its digest goes into the model."""
+    cases = [dict(c, clean=portable(c["clean"])) for c in all_cases]
+    sources = sorted({c["clean"] for c in all_cases})
+    manifest = {"cases": cases, "sources": {portable(p): file_digest(p) for p in sources},
+                "samples_per_case": SAMPLES_PER_CASE, "samples_clean": SAMPLES_CLEAN,
+                "descriptor_layout": 1}
+    with open(path + ".tmp", "w") as f:
+        json.dump(manifest, f, sort_keys=True, separators=(",", ":"))
+        f.write("\n")
+    os.replace(path + ".tmp", path)
+
+
 def noisy_mesh(build, cache, case):
     """The case's noisy mesh, made once (rsmooth noise) and kept in CACHE/meshes."""
     if not case["noise"]:
@@ -221,6 +243,8 @@ def main():
     ap.add_argument("--cad")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--classes", default=",".join(NOISE_CLASSES))
+    ap.add_argument("--name", help="the output's name (default stage{S}): a stage after the "
+                    "first is made per fold, from that fold's model")
     args = ap.parse_args()
     if not os.path.isdir(SHARED):
         sys.exit(f"dataset.py: the training data folder {SHARED} is missing: the training reads "
@@ -228,12 +252,7 @@ def main():
     os.makedirs(args.cache, exist_ok=True)
     all_cases = cases(args.cad, args.classes.split(","))
     if args.stage == 1:
-        sources = sorted({c["clean"] for c in all_cases})
-        manifest = {"cases": all_cases,
-                    "sources": {os.path.relpath(p, SHARED): file_digest(p) for p in sources},
-                    "samples_per_case": SAMPLES_PER_CASE, "samples_clean": SAMPLES_CLEAN}
-        with open(os.path.join(args.cache, "manifest.json"), "w") as f:
-            json.dump(manifest, f, indent=1, sort_keys=True)
+        write_manifest(os.path.join(args.cache, "manifest.json"), all_cases)
     jobs = [(args.build, args.cache, c, args.model, args.stage) for c in all_cases]
     xs, ys, sharp, case_of = [], [], [], []
     with Pool(args.jobs) as pool:
@@ -241,7 +260,7 @@ def main():
             xs.append(x), ys.append(y), sharp.append(s), case_of.append(np.full(n, i, np.int32))
             if (i + 1) % 25 == 0 or i + 1 == len(jobs):
                 print(f"[{i + 1}/{len(jobs)}] cases", flush=True)
-    out = os.path.join(args.cache, f"stage{args.stage}.npz")
+    out = os.path.join(args.cache, f"{args.name or f'stage{args.stage}'}.npz")
     np.savez(out + ".tmp.npz", x=np.concatenate(xs), y=np.concatenate(ys),
              sharp=np.concatenate(sharp), case=np.concatenate(case_of))
     os.replace(out + ".tmp.npz", out)

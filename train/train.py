@@ -21,7 +21,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-HIDDEN = (192, 192, 96)
+HIDDEN = (176, 176, 96)
 BATCH = 512
 NEIGHBOURS, PER, FILTERED = 32, 7, 4
 
@@ -99,7 +99,10 @@ def fold_layers(params, mean, std):
 
 
 def load(cache, stage, leave_out):
-    data = np.load(os.path.join(cache, f"stage{stage}.npz"))
+    """The stage's data: stage{S}.npz, or for a stage after the first the fold's own
+    (stage{S}-fold{F}.npz: made from the fold's model of the stage before)."""
+    own = os.path.join(cache, f"stage{stage}-fold{'all' if leave_out is None else leave_out}.npz")
+    data = np.load(own if stage > 1 else os.path.join(cache, f"stage{stage}.npz"))
     cases = json.load(open(os.path.join(cache, "manifest.json")))["cases"]
     fold = np.array([c["fold"] for c in cases])[data["case"]]
     kind = np.array([c["class"] for c in cases])[data["case"]]
@@ -121,7 +124,8 @@ def train(args):
     axis = mirror_signs()
     ckpt = os.path.join(args.out, tag + ".ckpt.npz")
     rng = np.random.default_rng(args.seed)
-    params = init(jax.random.PRNGKey(args.seed), (x.shape[1], *HIDDEN, 3))
+    hidden = tuple(int(h) for h in args.hidden.split(",")) if args.hidden else HIDDEN
+    params = init(jax.random.PRNGKey(args.seed), (x.shape[1], *hidden, 3))
     m = jax.tree_util.tree_map(jnp.zeros_like, params)
     v = jax.tree_util.tree_map(jnp.zeros_like, params)
     history, start, t = [], 0, 0
@@ -180,6 +184,7 @@ def main():
     ap.add_argument("--epochs", type=int, default=12)
     ap.add_argument("--lr", type=float, default=2e-3)
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--hidden", help="the hidden layers' widths (default: 176,176,96)")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     train(args)

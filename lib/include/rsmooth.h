@@ -374,6 +374,25 @@ RSMOOTH_API rsmooth_status rsmooth_mean_edge_length(rsmooth_scalar scalar, const
 /* Noise estimate */
 /* ---------------------------------------------------------------------------------------------- */
 
+/** What a learned model file holds (rsmooth_model_check; added in 0.12). */
+typedef struct rsmooth_model_info {
+    size_t struct_size;           /**< sizeof(rsmooth_model_info), set by the caller */
+    int stages;                   /**< cascade stages */
+    size_t parameters;            /**< weights and biases, every stage */
+    unsigned format_version;      /**< the file's format version */
+    unsigned layout;              /**< the descriptor layout it was trained on */
+    unsigned char manifest[32];   /**< BLAKE2b-256 of the training data's manifest (train/) */
+} rsmooth_model_info;
+
+/** Checks that `bytes` (`size` of them) are a learned model this library can run
+ * (rsmooth_params.model), filling `info` (may be NULL) when they are. RSMOOTH_ERROR_PARSE with a
+ * message saying what is wrong (not a model, another format version or descriptor layout, cut
+ * short, a checksum that does not match); RSMOOTH_ERROR_INVALID_ARGUMENT for NULL bytes or an
+ * info whose struct_size is too small. NULL bytes with size 0 check the model built into the
+ * library. Thread-safe. */
+RSMOOTH_API rsmooth_status rsmooth_model_check(const void *bytes, size_t size,
+                                               rsmooth_model_info *info, rsmooth_error *error);
+
 /** Estimates the mesh's noise: the standard deviation of its vertices' displacement along the
  * surface normal, in mean edge lengths of the mesh as given (the unit of relative sigmas, as
  * rsmooth_mean_edge_length computes it), from the geometry alone. Each vertex (at most 6000, at a

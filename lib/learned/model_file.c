@@ -118,9 +118,9 @@ rsmooth_status rs_learned_model_read(const void *bytes, size_t size, rs_learned_
     const unsigned char *b = bytes;
     if (!b || size < MAGIC_SIZE || memcmp(b, MAGIC, MAGIC_SIZE) != 0)
         return rs_fail(error, RSMOOTH_ERROR_PARSE, where,
-                       "%s is not an rsmooth model (it does not start with RSNN)", name);
+                       "%s: not an rsmooth model (it does not start with RSNN)", name);
     if (size < HEADER_SIZE + DIGEST_SIZE)
-        return rs_fail(error, RSMOOTH_ERROR_PARSE, where, "%s is truncated (%zu bytes)", name,
+        return rs_fail(error, RSMOOTH_ERROR_PARSE, where, "%s: truncated (%zu bytes)", name,
                        size);
     reader r = {b + MAGIC_SIZE, b + size};
     uint32_t version = 0, layout = 0, neighbours = 0, inputs = 0, stages = 0;
@@ -130,12 +130,12 @@ rsmooth_status rs_learned_model_read(const void *bytes, size_t size, rs_learned_
     read_u32(&r, &inputs);
     if (version != FORMAT_VERSION)
         return rs_fail(error, RSMOOTH_ERROR_PARSE, where,
-                       "%s has format version %u; this rsmooth reads version %d", name, version,
+                       "%s: format version %u; this rsmooth reads version %d", name, version,
                        FORMAT_VERSION);
     if (layout != RS_LEARNED_LAYOUT || neighbours != RS_LEARNED_NEIGHBOURS ||
         inputs != RS_LEARNED_INPUTS)
         return rs_fail(error, RSMOOTH_ERROR_PARSE, where,
-                       "%s was trained on descriptor layout %u (%u neighbours, %u inputs); this "
+                       "%s: trained on descriptor layout %u (%u neighbours, %u inputs); this "
                        "rsmooth computes layout %d (%d neighbours, %d inputs)",
                        name, layout, neighbours, inputs, RS_LEARNED_LAYOUT, RS_LEARNED_NEIGHBOURS,
                        RS_LEARNED_INPUTS);
@@ -143,7 +143,7 @@ rsmooth_status rs_learned_model_read(const void *bytes, size_t size, rs_learned_
     r.at += 32;
     read_u32(&r, &stages);
     if (stages < 1 || stages > MAX_STAGES)
-        return rs_fail(error, RSMOOTH_ERROR_PARSE, where, "%s has %u stages (1..%d expected)",
+        return rs_fail(error, RSMOOTH_ERROR_PARSE, where, "%s: %u stages (1..%d expected)",
                        name, stages, MAX_STAGES);
     size_t parameters, layers;
     const char *problem = scan_layers(r, stages, inputs, &parameters, &layers);

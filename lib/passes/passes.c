@@ -115,7 +115,11 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
      * the noise level, as rsmooth_params_auto does where it found noise, has measured it) */
     bool clean = false, learned = p.stage_normals == RSMOOTH_STAGE_NORMALS_LEARNED;
     rs_noise_details noise = {0};
-    if (unit > 0 && ((p.guard && !(p.discrepancy_level > 0)) || learned)) {
+    rs_learned_model model = {0}; /* read first: a bad model is an error on any mesh */
+    if (learned)
+        st = p.model ? rs_learned_model_read(p.model, p.model_size, &model, error, "params.model")
+                     : rs_learned_model_builtin(&model, error);
+    if (st == RSMOOTH_OK && unit > 0 && ((p.guard && !(p.discrepancy_level > 0)) || learned)) {
         st = rs_estimate_noise_details(scalar, positions, vertex_count, indices, triangle_count,
                                        &noise, error, where);
         clean = st == RSMOOTH_OK && p.guard && !(p.discrepancy_level > 0) &&
@@ -123,10 +127,7 @@ static rsmooth_status staged_passes(rs_filter_fn one_pass, void *ctx, rsmooth_sc
         if (stage_stats)
             stage_stats->skipped = clean;
     }
-    rs_learned_model model = {0};
     if (st == RSMOOTH_OK && learned && unit > 0 && !clean) {
-        st = p.model ? rs_learned_model_read(p.model, p.model_size, &model, error, "params.model")
-                     : rs_learned_model_builtin(&model, error);
         setting.learned = &model;
         setting.noise_level = noise.level; /* the descriptor's: as train/ measures it */
         setting.mean_edge = unit;

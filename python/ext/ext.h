@@ -117,6 +117,7 @@ int ext_real_arg(PyObject *value, const char *name, double *out);
  * while the call runs. */
 typedef struct ext_param_arrays {
     ext_array colors, mask;
+    PyObject *model; /* the learned model's bytes (a reference held for the call) */
 } ext_param_arrays;
 
 /* Fills `p` from a dict holding rsmooth_params' fields by name (every key must be one; missing

@@ -14,6 +14,7 @@ PyObject *ext_raise(rsmooth_status status, const rsmooth_error *error) {
     const char *message = error && error->message[0] ? error->message : rsmooth_status_str(status);
     switch (status) {
     case RSMOOTH_ERROR_INVALID_ARGUMENT:
+    case RSMOOTH_ERROR_PARSE: /* bytes handed in (a model=) that are not what they should be */
         PyErr_SetString(PyExc_ValueError, message);
         break;
     case RSMOOTH_ERROR_OUT_OF_MEMORY:

@@ -49,6 +49,7 @@ static const field fields[] = {
     DOUBLE_FIELD(guided_radius),
     DOUBLE_FIELD(discrepancy_gain),
     INT_FIELD(guard, 0, 1),
+    INT_FIELD(stage_normals, RSMOOTH_STAGE_NORMALS_GUIDED, RSMOOTH_STAGE_NORMALS_LEARNED),
 };
 #define FIELD_COUNT (sizeof fields / sizeof fields[0])
 
@@ -159,6 +160,18 @@ int ext_params_from_dict(PyObject *dict, Py_ssize_t vertex_count, rsmooth_params
                 return -1;
             continue;
         }
+        if (strcmp(name, "model") == 0) { /* bytes: immutable, so a reference is enough */
+            if (!PyBytes_Check(value)) {
+                PyErr_Format(PyExc_TypeError, "model: expected bytes (got %R)", value);
+                return -1;
+            }
+            Py_XDECREF(held->model);
+            Py_INCREF(value);
+            held->model = value;
+            p->model = PyBytes_AS_STRING(value);
+            p->model_size = (size_t)PyBytes_GET_SIZE(value);
+            continue;
+        }
         if (strcmp(name, "move_mask") == 0) {
             p->move_mask = hold(value, name, EXT_UINT8, 0, vertex_count, &held->mask);
             if (PyErr_Occurred())
@@ -181,6 +194,8 @@ int ext_params_from_dict(PyObject *dict, Py_ssize_t vertex_count, rsmooth_params
 void ext_param_arrays_release(ext_param_arrays *held) {
     ext_array_release(&held->colors);
     ext_array_release(&held->mask);
+    Py_XDECREF(held->model);
+    held->model = NULL;
 }
 
 PyObject *ext_params_to_dict(const rsmooth_params *p) {

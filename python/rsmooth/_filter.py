@@ -117,6 +117,8 @@ def smooth(
     guided_rounds: Optional[int] = None,
     stage_repeats: Optional[int] = None,
     guided_radius: Optional[float] = None,
+    stage: Optional[str] = None,
+    model: Any = None,
     discrepancy_level: Optional[float] = None,
     discrepancy_gain: Optional[float] = None,
     guard: Optional[bool] = None,
@@ -185,6 +187,12 @@ def smooth(
         of triangles sharing an edge ([1, 8], default 2).
     stage_repeats : the stage's cycles ([1, 1000], default 1): each reads fresh facet normals
         from the current positions, runs the guided rounds, then the vertex updates.
+    stage : what the stage's vertex updates follow: "guided" (default) or "learned": after the
+        guided cycles, a small network trained on noisy copies of clean meshes predicts each
+        triangle's normal from its 32 nearest, and the vertices take ``vertex_updates`` more
+        updates toward them (docs/model.md). Needs the stage (``best`` or ``vertex_updates``).
+    model : the learned stage's model: a path or the bytes of a file train/ wrote (default: the
+        one built into the library); a bad one raises ValueError saying what is wrong.
     discrepancy_level : 0 (default): off. A noise level, in mean edge lengths (``auto`` with
         ``best`` sets the estimate): a choice per region. Each vertex's result blends the
         filter's with Taubin smoothing of the input run until the vertices moved (RMS) that far,
@@ -243,7 +251,8 @@ def smooth(
         pass_confidence=pass_confidence, vertex_updates=vertex_updates,
         guided_sigma_s=guided_sigma_s, guided_sigma_n=guided_sigma_n,
         guided_rounds=guided_rounds, stage_repeats=stage_repeats, guided_radius=guided_radius,
-        discrepancy_level=discrepancy_level, discrepancy_gain=discrepancy_gain, guard=guard,
+        stage=stage, model=model, discrepancy_level=discrepancy_level,
+        discrepancy_gain=discrepancy_gain, guard=guard,
         predictor=predictor, mollify_cutoff=mollify_cutoff, colors=colors, sigma_c=sigma_c,
         mask=mask, method=method, iterations=iterations, lam=lam, mu=mu, progress=progress,
     )

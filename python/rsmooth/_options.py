@@ -3,6 +3,7 @@ a tqdm bar. The defaults come from the library itself (rsmooth_params_init and _
 
 from __future__ import annotations
 
+import os
 import warnings
 from typing import Any, Callable, Dict, Optional, Tuple, Union
 
@@ -14,6 +15,20 @@ from ._arrays import _colors, _mask
 _NORMAL_FILTERS = {"mollify": 0, "bilateral": 1}
 _INFLUENCES = {"gaussian": 0, "tukey": 1, "lorentzian": 2, "huber": 3}
 _PREDICTORS = {"projection": 0, "centroid": 1}
+_STAGES = {"guided": 0, "learned": 1}
+
+
+def _model_bytes(model: Any) -> bytes:
+    """model=: a model file's bytes, or its path (read whole here; the library checks it)."""
+    if isinstance(model, (bytes, bytearray, memoryview)):
+        return bytes(model)
+    try:
+        with open(os.fspath(model), "rb") as f:
+            return f.read()
+    except TypeError:
+        raise TypeError(f"model: expected a path or bytes, got {model!r}") from None
+    except OSError as e:
+        raise ValueError(f"model: cannot read {os.fspath(model)}: {e.strerror}") from None
 _METHODS = ("robust", "gaussian", "laplacian", "taubin")
 
 Progress = Union[bool, Callable[[float], Any], None]
@@ -44,6 +59,10 @@ def _params(
     Also the rule's noise report when `auto` (else None)."""
     params = _rsmooth._default_params(bool(best))
     given = {k: _numpy_bool(v) for k, v in overrides.items() if v is not None}
+    if "stage" in given:
+        given["stage_normals"] = _choice(given.pop("stage"), _STAGES, "stage")
+    if "model" in given:
+        given["model"] = _model_bytes(given["model"])
     for key, table in (
         ("normal_filter", _NORMAL_FILTERS),
         ("influence", _INFLUENCES),
@@ -111,6 +130,10 @@ def _filter_params(
 def _keywords(params: Dict[str, Any]) -> Dict[str, Any]:
     """The library's parameters as rsmooth.smooth's keywords (choices by name, flags as bools)."""
     out = dict(params)
+    if "stage" in given:
+        given["stage_normals"] = _choice(given.pop("stage"), _STAGES, "stage")
+    if "model" in given:
+        given["model"] = _model_bytes(given["model"])
     for key, table in (
         ("normal_filter", _NORMAL_FILTERS),
         ("influence", _INFLUENCES),

@@ -44,6 +44,8 @@ class SmoothOptions(PointOptions, total=False):
     guided_rounds: Optional[int]
     stage_repeats: Optional[int]
     guided_radius: Optional[float]
+    stage: Optional[str]
+    model: Any
     discrepancy_level: Optional[float]
     discrepancy_gain: Optional[float]
     guard: Optional[bool]
