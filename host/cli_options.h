@@ -63,7 +63,7 @@ typedef struct options {
     const char *tmpdir;     /* --tmpdir: the streaming path's temporary files */
     const char *model_path; /* --model: the learned model's file (read whole into model) */
     void *model;
-    bool colors;            /* --sigma-c: the input's vertex colours in the weight */
+    bool colors;                        /* --sigma-c: the input's vertex colours in the weight */
     bool sigma_g_given, umbrella_given; /* for consistency checks against --method */
     bool ascii, json, force, quiet, in_place, stats, list_devices, best;
     bool progress;           /* --progress: the bar even where stderr is no terminal */

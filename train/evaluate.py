@@ -27,6 +27,10 @@ import dataset  # noqa: E402
 
 METRICS = os.path.join(dataset.SHARED, "..", "tools", "meshmetrics.py")
 GCN_LEVELS = (0.1, 0.2, 0.3)
+# GCN-Denoiser's noise model on these shapes (the ones its published cases resemble: CAD parts,
+# and a few scanned ones), to keep the evaluation within the training's hour
+GCN_SHAPES = ("fandisk", "block", "stanford-bunny", "twelve", "trimstar", "sharpsphere",
+              "rocker-arm", "armadillo", "lion", "screwdriver")
 
 
 def eval_cases(cad_dir, folds, cad_per_fold):
@@ -53,7 +57,7 @@ def eval_cases(cad_dir, folds, cad_per_fold):
                 seen.append(case["group"])
         case = dict(case, truth=case["clean"], name=case["name"] + "-eval")
         out.append(case)
-        if case["class"] == "gaussian":
+        if case["class"] == "gaussian" and case["group"] in GCN_SHAPES:
             for level in GCN_LEVELS:
                 for kind, args in (("gcn-gaussian", ["--sigma", str(level)]),
                                    ("gcn-impulsive", ["--sigma", str(level), "--impulsive",
@@ -116,7 +120,7 @@ def main():
     ap.add_argument("--models", required=True)
     ap.add_argument("--cad")
     ap.add_argument("--folds", default="0,1,2,3")
-    ap.add_argument("--cad-per-fold", type=int, default=4)
+    ap.add_argument("--cad-per-fold", type=int, default=3)
     ap.add_argument("--jobs", type=int, default=2)
     args = ap.parse_args()
     folds = [int(f) for f in args.folds.split(",")]

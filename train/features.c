@@ -8,7 +8,8 @@
  * With --model, the first S stages run first and the descriptors are those the next stage reads;
  * --predict also writes every stage's output normals (the library's reference path, double).
  * --noise-from takes the noise level from another mesh (the noisy input, when MESH is the result
- * of the stage before the learned one). --truth names the clean mesh (the same triangles): each facet's target is its clean normal;
+ * of the stage before the learned one). --truth names the clean mesh (the same triangles): each
+ * facet's target is its clean normal;
  * --truth-surface a surface to measure against (a range scan's reconstruction): each facet's
  * target is the normal of the surface's triangle nearest its centroid. Both also write how sharp
  * the truth is around each facet (1 - the least cosine between its target and its 8 nearest
@@ -39,8 +40,8 @@ static int write_npy(const char *dir, const char *name, const char *descr, const
     char path[4096], header[256];
     snprintf(path, sizeof path, "%s/%s.npy", dir, name);
     int n = snprintf(header, sizeof header,
-                     "{'descr': '%s', 'fortran_order': False, 'shape': (%zu, %zu), }", descr,
-                     count, cols);
+                     "{'descr': '%s', 'fortran_order': False, 'shape': (%zu, %zu), }", descr, count,
+                     cols);
     int total = 10 + n + 1, pad = (64 - total % 64) % 64;
     FILE *f = fopen(path, "wb");
     if (!f)
@@ -112,11 +113,10 @@ static int write_targets(const char *dir, const char *path, bool surface, const 
     float *target = malloc((n ? n : 1) * 3 * sizeof(float));
     float *sharp = malloc((n ? n : 1) * sizeof(float));
     double *t = malloc((n ? n : 1) * 3 * sizeof(double));
-    rs_surface_index *index = surface ? rs_surface_index_build(truth->positions,
-                                                               truth->vertex_count,
-                                                               truth->triangles,
-                                                               truth->triangle_count)
-                                      : NULL;
+    rs_surface_index *index = surface
+                                  ? rs_surface_index_build(truth->positions, truth->vertex_count,
+                                                           truth->triangles, truth->triangle_count)
+                                  : NULL;
     if (!target || !sharp || !t || (surface && !index))
         return fail(path, "out of memory");
     for (size_t f = 0; f < n; f++) {
@@ -132,7 +132,8 @@ static int write_targets(const char *dir, const char *path, bool surface, const 
     for (size_t f = 0; f < n; f++) {
         double least = 1.0;
         for (int k = 1; k <= 8; k++) {
-            double c = rs_dot3(t + 3 * f, t + 3 * (size_t)patches->neighbour[f * RS_LEARNED_NEIGHBOURS + k]);
+            double c = rs_dot3(t + 3 * f,
+                               t + 3 * (size_t)patches->neighbour[f * RS_LEARNED_NEIGHBOURS + k]);
             least = c < least ? c : least;
         }
         sharp[f] = (float)(1.0 - least);
@@ -195,8 +196,8 @@ int main(int argc, char **argv) {
         return fail(mesh_path, err.message);
     rs_learned_model model = {0};
     if ((model_path || predict) &&
-        (model_path ? read_model(model_path, &model, &err) : rs_learned_model_builtin(&model, &err)) !=
-            RSMOOTH_OK)
+        (model_path ? read_model(model_path, &model, &err)
+                    : rs_learned_model_builtin(&model, &err)) != RSMOOTH_OK)
         return fail(model_path ? model_path : "built-in model", err.message);
     rs_facets facets;
     double mean_edge = 0, noise = 0;
@@ -227,8 +228,7 @@ int main(int argc, char **argv) {
     int rc = write_descriptors(dir, &in) || write_npy(dir, "normal", "<f4", nf, n, 3, 4) ||
              write_npy(dir, "triangle", "<u4", facets.triangle, n, 1, 4);
     if (!rc && truth_path)
-        rc = write_targets(dir, truth_path, truth_surface, &facets, &patches,
-                           mesh->triangle_count);
+        rc = write_targets(dir, truth_path, truth_surface, &facets, &patches, mesh->triangle_count);
     if (!rc && predict) {
         in.normal = facets.normal;
         rs_learned_normals(&model, (int)model.stage_count, &in, NULL, normals);

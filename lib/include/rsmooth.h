@@ -331,24 +331,26 @@ typedef struct rsmooth_params {
                 * outliers (rsmooth_report.parts) are kept apart either way.
                 * (Added in 0.11) */
     /** @name Learned normals
-     * What the normal update stage's cycles follow (added in 0.12; docs/model.md): the guided
-     * filter's own guidance, or the facet normals a small network trained on noisy copies of
-     * clean meshes predicts from each facet's patch (computed once on the input). @{ */
-    int stage_normals;      /**< an rsmooth_stage_normals. Default RSMOOTH_STAGE_NORMALS_GUIDED */
-    const void *model;      /**< NULL (default): the model built into the library. Else the
-                             * bytes of a model file (docs/model.md, "The file"; borrowed, read
-                             * during the call only): a file that is not a model, is truncated,
-                             * damaged or of another descriptor layout is an
-                             * RSMOOTH_ERROR_PARSE saying which */
-    size_t model_size;      /**< the model's size in bytes */
+     * What the normal update stage's vertex updates follow (added in 0.11; docs/model.md): the
+     * guided filter's normals, or after the guided cycles the facet normals a small network
+     * (trained on what those cycles leave of noisy copies of clean meshes) predicts from each
+     * facet's 32 nearest facets, as the targets of vertex_updates more updates. Without the
+     * stage (vertex_updates 0) there is nothing to follow and the field has no effect. @{ */
+    int stage_normals; /**< an rsmooth_stage_normals. Default RSMOOTH_STAGE_NORMALS_GUIDED */
+    const void *model; /**< NULL (default): the model built into the library. Else the
+                        * bytes of a model file (docs/model.md, "The file"; borrowed, read
+                        * during the call only): a file that is not a model, is truncated,
+                        * damaged or of another descriptor layout is an
+                        * RSMOOTH_ERROR_PARSE saying which */
+    size_t model_size; /**< the model's size in bytes */
     /** @} */
 } rsmooth_params;
 
 /** What the normal update stage's cycles follow (rsmooth_params.stage_normals). */
 typedef enum rsmooth_stage_normals {
     RSMOOTH_STAGE_NORMALS_GUIDED = 0, /**< guided normal filtering (Zhang et al. 2015) */
-    RSMOOTH_STAGE_NORMALS_LEARNED = 1 /**< the learned model's normals, computed once on the
-                                       * input, as the vertex update's targets */
+    RSMOOTH_STAGE_NORMALS_LEARNED = 1 /**< then the learned model's normals of the result, as
+                                       * the targets of more vertex updates */
 } rsmooth_stage_normals;
 
 /** Fills `params` with the defaults above. Returns RSMOOTH_ERROR_INVALID_ARGUMENT if params is
@@ -374,14 +376,14 @@ RSMOOTH_API rsmooth_status rsmooth_mean_edge_length(rsmooth_scalar scalar, const
 /* Noise estimate */
 /* ---------------------------------------------------------------------------------------------- */
 
-/** What a learned model file holds (rsmooth_model_check; added in 0.12). */
+/** What a learned model file holds (rsmooth_model_check; added in 0.11). */
 typedef struct rsmooth_model_info {
-    size_t struct_size;           /**< sizeof(rsmooth_model_info), set by the caller */
-    int stages;                   /**< cascade stages */
-    size_t parameters;            /**< weights and biases, every stage */
-    unsigned format_version;      /**< the file's format version */
-    unsigned layout;              /**< the descriptor layout it was trained on */
-    unsigned char manifest[32];   /**< BLAKE2b-256 of the training data's manifest (train/) */
+    size_t struct_size;         /**< sizeof(rsmooth_model_info), set by the caller */
+    int stages;                 /**< cascade stages */
+    size_t parameters;          /**< weights and biases, every stage */
+    unsigned format_version;    /**< the file's format version */
+    unsigned layout;            /**< the descriptor layout it was trained on */
+    unsigned char manifest[32]; /**< BLAKE2b-256 of the training data's manifest (train/) */
 } rsmooth_model_info;
 
 /** Checks that `bytes` (`size` of them) are a learned model this library can run

@@ -26,9 +26,8 @@ static void find_patches(void *ctx, size_t begin, size_t end, size_t chunk) {
     for (size_t f = begin; f < end; f++) {
         uint32_t *row = job->patches->neighbour + f * RS_LEARNED_NEIGHBOURS;
         row[0] = (uint32_t)f;
-        size_t found =
-            rs_kdtree_nearest_ids(job->tree, job->centroid + 3 * f, (uint32_t)f, job->k, dist2,
-                                  row + 1);
+        size_t found = rs_kdtree_nearest_ids(job->tree, job->centroid + 3 * f, (uint32_t)f, job->k,
+                                             dist2, row + 1);
         for (size_t k = 1 + found; k < RS_LEARNED_NEIGHBOURS; k++)
             row[k] = (uint32_t)f; /* a mesh of few facets: the facet itself fills the patch */
     }
@@ -37,8 +36,8 @@ static void find_patches(void *ctx, size_t begin, size_t end, size_t chunk) {
 bool rs_learned_patches_build(rs_learned_patches *patches, const double *centroid,
                               size_t facet_count) {
     memset(patches, 0, sizeof *patches);
-    patches->neighbour = rs_alloc_array(facet_count ? facet_count : 1,
-                                        RS_LEARNED_NEIGHBOURS * sizeof(uint32_t));
+    patches->neighbour =
+        rs_alloc_array(facet_count ? facet_count : 1, RS_LEARNED_NEIGHBOURS * sizeof(uint32_t));
     rs_kdtree tree;
     if (!patches->neighbour || !rs_kdtree_build(&tree, centroid, facet_count)) {
         rs_free(patches->neighbour);
@@ -110,8 +109,8 @@ static void filtered_normals(const rs_learned_input *in, const uint32_t *row, co
     double e2 = in->mean_edge * in->mean_edge;
     for (int w = 0; w < RS_LEARNED_FILTERED; w++) {
         double ss = 1.0 / (2.0 * filter_width[w][0] * filter_width[w][0] * e2);
-        double sn = filter_width[w][1] > 0 ? 1.0 / (2.0 * filter_width[w][1] * filter_width[w][1])
-                                           : 0.0;
+        double sn =
+            filter_width[w][1] > 0 ? 1.0 / (2.0 * filter_width[w][1] * filter_width[w][1]) : 0.0;
         double sum[3] = {0, 0, 0};
         for (int k = 0; k < RS_LEARNED_NEIGHBOURS; k++) {
             const double *n = in->normal + 3 * (size_t)row[k];

@@ -85,6 +85,12 @@ void rs_learned_descriptor(const rs_learned_input *in, size_t f, double *descrip
 /* One stage's network on one descriptor: the residual (3 numbers), in double. */
 void rs_learned_network(const rs_learned_stage *stage, const double *descriptor, double out[3]);
 
+/* The same on `count` descriptors at once, their numbers interleaved: a holds input i of facet f
+ * at a[i * count + f] (RS_LEARNED_INPUTS * count doubles; at least as many as the widest layer
+ * times count); b is scratch of the widest layer times count. The residuals end in a (3 * count:
+ * a[k * count + f]), equal bit for bit to rs_learned_network's. */
+void rs_learned_network_batch(const rs_learned_stage *stage, size_t count, double *a, double *b);
+
 /* The predicted normal from the facet's own normal in the frame and the residual: unit, back in
  * mesh coordinates. */
 void rs_learned_normal_from_residual(const double frame[3][3], const double own[3],

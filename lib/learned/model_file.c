@@ -34,8 +34,8 @@ static bool read_floats(reader *r, float *out, size_t count) {
     if ((size_t)(r->end - r->at) / 4 < count)
         return false;
     for (size_t i = 0; i < count; i++) {
-        uint32_t bits = (uint32_t)r->at[0] | (uint32_t)r->at[1] << 8 |
-                        (uint32_t)r->at[2] << 16 | (uint32_t)r->at[3] << 24;
+        uint32_t bits = (uint32_t)r->at[0] | (uint32_t)r->at[1] << 8 | (uint32_t)r->at[2] << 16 |
+                        (uint32_t)r->at[3] << 24;
         memcpy(out + i, &bits, 4);
         r->at += 4;
     }
@@ -120,8 +120,7 @@ rsmooth_status rs_learned_model_read(const void *bytes, size_t size, rs_learned_
         return rs_fail(error, RSMOOTH_ERROR_PARSE, where,
                        "%s: not an rsmooth model (it does not start with RSNN)", name);
     if (size < HEADER_SIZE + DIGEST_SIZE)
-        return rs_fail(error, RSMOOTH_ERROR_PARSE, where, "%s: truncated (%zu bytes)", name,
-                       size);
+        return rs_fail(error, RSMOOTH_ERROR_PARSE, where, "%s: truncated (%zu bytes)", name, size);
     reader r = {b + MAGIC_SIZE, b + size};
     uint32_t version = 0, layout = 0, neighbours = 0, inputs = 0, stages = 0;
     read_u32(&r, &version);
@@ -143,8 +142,8 @@ rsmooth_status rs_learned_model_read(const void *bytes, size_t size, rs_learned_
     r.at += 32;
     read_u32(&r, &stages);
     if (stages < 1 || stages > MAX_STAGES)
-        return rs_fail(error, RSMOOTH_ERROR_PARSE, where, "%s: %u stages (1..%d expected)",
-                       name, stages, MAX_STAGES);
+        return rs_fail(error, RSMOOTH_ERROR_PARSE, where, "%s: %u stages (1..%d expected)", name,
+                       stages, MAX_STAGES);
     size_t parameters, layers;
     const char *problem = scan_layers(r, stages, inputs, &parameters, &layers);
     if (problem)

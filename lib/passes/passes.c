@@ -4,8 +4,8 @@
  * edge length gave, so later passes do not shrink their reach as the mesh smooths. */
 #include "passes/passes.h"
 
-#include "learned/learned.h"
 #include "auto/noise_estimate.h"
+#include "learned/learned.h"
 #include "passes/one_part.h"
 #include "passes/region_choice.h"
 #include "stages/normal_update.h"

@@ -69,8 +69,8 @@ static double *learned_normals(const rs_stage_setting *setting, const rs_facets 
         rs_free(out);
         return NULL;
     }
-    rs_learned_input in = {facets->count, facets->centroid,      facets->area,
-                           facets->normal, &patches,             setting->mean_edge * scale,
+    rs_learned_input in = {facets->count,       facets->centroid, facets->area,
+                           facets->normal,      &patches,         setting->mean_edge * scale,
                            setting->noise_level};
     bool ok = rs_learned_normals(setting->learned, (int)setting->learned->stage_count, &in,
                                  setting->network, out);
