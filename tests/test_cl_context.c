@@ -411,8 +411,8 @@ int main(void) {
     rsmooth_context_destroy(other);
     char broken_dir[] = "/tmp/rsmooth-broken-kernels-XXXXXX";
     CHECK(mkdtemp(broken_dir) != NULL);
-    static const char *const names[] = {"common.cl",   "mollify.cl", "bilateral.cl",
-                                        "estimate.cl", "stage.cl",   "grid.cl"};
+    static const char *const names[] = {"common.cl", "mollify.cl", "bilateral.cl", "estimate.cl",
+                                        "stage.cl",  "grid.cl",    "learned.cl"};
     const int files = (int)(sizeof names / sizeof *names);
     for (int i = 0; i < files; i++) {
         char path[256];

@@ -250,8 +250,8 @@ static void write_whole(const char *path, const void *data, size_t size, mode_t 
 /* A copy of the kernels in `dir` whose fast_exp2 takes a quarter of its argument: Gaussians twice
  * as wide, so every vertex moves differently. What an attacker's binary would compute. */
 static void modified_kernels(const char *dir) {
-    static const char *const names[] = {"common.cl",   "mollify.cl", "bilateral.cl",
-                                        "estimate.cl", "stage.cl",   "grid.cl"};
+    static const char *const names[] = {"common.cl", "mollify.cl", "bilateral.cl", "estimate.cl",
+                                        "stage.cl",  "grid.cl",    "learned.cl"};
     static const char anchor[] = "inline lanef fast_exp2(lanef x) {";
     CHECK(mkdir(dir, 0700) == 0);
     for (int i = 0; i < (int)(sizeof names / sizeof *names); i++) {

@@ -5,8 +5,9 @@
  * variant (lib/opencl/cl_variant.c: vertex blocks 4 and 16 wide, and the GPU's work-groups) runs in
  * a child process of its own, on a small noisy cylinder: the paper's filter, the bilateral normal
  * filter from lists and searching, every influence function, both predictors, the underflow rescue
- * with and without colour. Each case must agree with the double-precision reference path, Oclgrind
- * must report nothing (OCLGRIND_LOG), and every __kernel in kernels/ must have run (Oclgrind's
+ * with and without colour, the normal-update stage, the learned normals' networks. Each case must
+ * agree with the double-precision reference path, Oclgrind must report nothing (OCLGRIND_LOG),
+ * and every __kernel in kernels/ must have run (Oclgrind's
  * OCLGRIND_INST_COUNTS names each kernel it ran). Skipped (77) where Oclgrind's runtime library
  * is not installed (Debian's oclgrind package; RSMOOTH_TEST_OCLGRIND names another one), unless
  * RSMOOTH_REQUIRE_OPENCL=1.
@@ -291,6 +292,10 @@ static void run_cases(const char *variant, const test_mesh *m) {
     run_case(variant, "normal-update stage, float", m, &p, true);
     unsetenv("RSMOOTH_STAGE_PRECISION");
     unsetenv("RSMOOTH_STAGE");
+    /* the learned stage: its networks on the device (learned.cl, the built-in model), the
+     * cycles on the host */
+    p.stage_normals = RSMOOTH_STAGE_NORMALS_LEARNED;
+    run_case(variant, "learned normals (networks on the device)", m, &p, true);
 }
 
 /* The child's work for one variant: its output goes to the parent's file. Fails when a case
@@ -369,8 +374,8 @@ static size_t collect_names(const char *text, const char *marker, char end, char
 
 /* Every __kernel the sources define. */
 static size_t source_kernels(char names[][64]) {
-    static const char *const files[] = {"common.cl",   "mollify.cl", "bilateral.cl",
-                                        "estimate.cl", "stage.cl",   "grid.cl"};
+    static const char *const files[] = {"common.cl", "mollify.cl", "bilateral.cl", "estimate.cl",
+                                        "stage.cl",  "grid.cl",    "learned.cl"};
     size_t count = 0;
     for (size_t i = 0; i < sizeof files / sizeof *files; i++) {
         char path[4096];

@@ -33,17 +33,18 @@ rsmooth_status rs_device_pass(const rs_device_call *call, const rs_problem *pb,
                               rsmooth_report *report, double t_start, rsmooth_error *error);
 
 /* A path, as a mesh call runs it: one pass of its filter (rs_filter_passes repeats it, part by
- * part) and the runner of the normal-update stage's cycles (NULL: the host's), both given
- * `context`. The reference path is {rs_reference_pass, NULL, NULL} (reference/); the device's is
- * rs_device_path's. */
+ * part), the runner of the normal-update stage's cycles and that of the learned normals'
+ * networks (NULL: the host's), all given `context`. The reference path is {rs_reference_pass,
+ * NULL, NULL, NULL} (reference/); the device's is rs_device_path's. */
 typedef struct rs_path {
     rs_filter_fn pass;
     rs_stage_runner stage;
+    rs_network_runner network;
     void *context;
 } rs_path;
 
-/* The device path of a call entered on its context: its pass (smooth.c's), and the stage on the
- * device where RSMOOTH_STAGE or the device's type puts it there. */
+/* The device path of a call entered on its context: its pass (smooth.c's), the stage on the
+ * device where RSMOOTH_STAGE or the device's type puts it there, the networks on the device. */
 rs_path rs_device_path(const rs_device_call *call);
 
 /* A mesh call's whole work on `path` (the arrays checked once at its start, rs_filter_passes);

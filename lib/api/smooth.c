@@ -41,6 +41,13 @@ static rsmooth_status cl_stage(void *context, const rs_stage_plan *plan, double 
     return rs_cl_stage_run(call->ctx, plan, xyz, cycle_done, user, stats, error);
 }
 
+/* A learned stage's network on the call's device: an rs_network_runner over the call record. */
+static rsmooth_status cl_network(void *context, const rs_learned_stage *stage,
+                                 const float *descriptors, size_t count, float *residuals) {
+    const rs_device_call *call = context;
+    return rs_cl_learned_run(call->ctx, stage, descriptors, count, residuals);
+}
+
 /* Where the normal-update stage's cycles run: on a GPU or other accelerator, the device; on a CPU
  * device, the host's cores (the same cores, in double, and measured faster there: the kernels'
  * gathers do not vectorize, docs/best-mode.md). RSMOOTH_STAGE=device or host chooses. */
@@ -55,7 +62,8 @@ static bool stage_on_device(const rsmooth_context *ctx) {
 }
 
 rs_path rs_device_path(const rs_device_call *call) {
-    rs_path path = {cl_pass, stage_on_device(call->ctx) ? cl_stage : NULL, (void *)call};
+    rs_path path = {cl_pass, stage_on_device(call->ctx) ? cl_stage : NULL, cl_network,
+                    (void *)call};
     return path;
 }
 
@@ -64,9 +72,9 @@ rsmooth_status rs_path_smooth(const rs_path *path, rsmooth_scalar scalar, const 
                               const rsmooth_params *params, void *out_positions, float *out_weight,
                               float *out_confidence, rsmooth_report *report, rsmooth_error *error,
                               const char *where) {
-    return rs_filter_passes(path->pass, path->stage, path->context, scalar, positions, vertex_count,
-                            indices, triangle_count, params, out_positions, out_weight,
-                            out_confidence, report, error, where);
+    return rs_filter_passes(path->pass, path->stage, path->network, path->context, scalar,
+                            positions, vertex_count, indices, triangle_count, params, out_positions,
+                            out_weight, out_confidence, report, error, where);
 }
 
 rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const void *positions,
@@ -80,7 +88,7 @@ rsmooth_status rsmooth_smooth(rsmooth_context *ctx, rsmooth_scalar scalar, const
     if (st != RSMOOTH_OK)
         return st;
     if (!ctx) { /* the reference path */
-        rs_path reference = {rs_reference_pass, NULL, NULL};
+        rs_path reference = {rs_reference_pass, NULL, NULL, NULL};
         return rs_path_smooth(&reference, scalar, positions, vertex_count, indices, triangle_count,
                               params, out_positions, o.weight, o.confidence, o.report, error,
                               where);

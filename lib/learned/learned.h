@@ -21,6 +21,10 @@
 #define RS_LEARNED_INPUTS                                                                          \
     (RS_LEARNED_NEIGHBOURS * RS_LEARNED_PER_NEIGHBOUR + 3 * RS_LEARNED_FILTERED + 3 + 1)
 
+/* The widest layer the model format allows (model_file.c checks it; network.c and the device's
+ * kernels size their activations by it). */
+#define RS_LEARNED_MAX_WIDTH 1024
+
 /* One dense layer: out = activation(weight . in + bias), weight row-major (out rows of in). */
 typedef struct rs_learned_layer {
     uint32_t in, out;

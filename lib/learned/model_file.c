@@ -14,7 +14,6 @@
 /* Bounds well above any model this format is for; they keep a hostile file's sizes small. */
 #define MAX_STAGES 8
 #define MAX_LAYERS 16
-#define MAX_WIDTH 1024
 #define MAX_PARAMETERS (1u << 22)
 
 typedef struct reader {
@@ -60,7 +59,7 @@ static const char *scan_layers(reader r, uint32_t stages, uint32_t inputs, size_
                 return "truncated in a layer's header";
             if (in != width)
                 return "a layer's input count is not the previous layer's output count";
-            if (out < 1 || out > MAX_WIDTH || activation > 1)
+            if (out < 1 || out > RS_LEARNED_MAX_WIDTH || activation > 1)
                 return "a layer's width outside 1..1024 or an unknown activation";
             if (l + 1 == count && (out != 3 || activation != 0))
                 return "a stage's last layer does not give 3 numbers without activation";

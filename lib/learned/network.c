@@ -5,11 +5,8 @@
 #include <math.h>
 #include <string.h>
 
-/* The widest layer this format allows (model_file.c checks it). */
-#define MAX_WIDTH 1024
-
 void rs_learned_network(const rs_learned_stage *stage, const double *descriptor, double out[3]) {
-    double a[MAX_WIDTH], b[MAX_WIDTH];
+    double a[RS_LEARNED_MAX_WIDTH], b[RS_LEARNED_MAX_WIDTH];
     const double *in = descriptor;
     for (uint32_t l = 0; l < stage->layer_count; l++) {
         const rs_learned_layer *layer = &stage->layer[l];

@@ -32,6 +32,7 @@ enum {
     RS_KERNEL_NORMALS,
     RS_KERNEL_BILATERAL,
     RS_KERNEL_ROBUST,
+    RS_KERNEL_LEARNED,     /* learned.cl's stage network, in the context's variant */
     RS_KERNEL_STAGE_FLOAT, /* RS_STAGE_KERNELS of them, float */
     RS_KERNEL_STAGE_DOUBLE = RS_KERNEL_STAGE_FLOAT + RS_STAGE_KERNELS, /* double: NULL where the
                                                                         * device has no fp64 */
@@ -201,6 +202,18 @@ void rs_cl_report(rsmooth_report *report, const rs_problem *pb, const rs_run_sta
 rsmooth_status rs_cl_stage_run(void *ctx, const rs_stage_plan *plan, double *xyz,
                                rs_cycle_fn cycle_done, void *user, rs_stage_stats *stats,
                                rsmooth_error *error);
+
+/* Facets per work-group in learned.cl's GPU variant (compiled into the program). */
+#define RS_LEARNED_TILE 8
+
+struct rs_learned_stage;
+/* One learned stage's network on `count` descriptors on ctx's device, in float (cl_learned.c):
+ * an rs_network_runner (learned/learned.h). RSMOOTH_OK with every residual written, else a
+ * status (RSMOOTH_ERROR_OUT_OF_MEMORY: a chunk or model the device cannot hold;
+ * RSMOOTH_ERROR_OPENCL) and nothing to use: the host then runs the chunk. Called inside a call
+ * that holds ctx's lock. */
+rsmooth_status rs_cl_learned_run(void *ctx, const struct rs_learned_stage *stage,
+                                 const float *descriptors, size_t count, float *residuals);
 
 /* Builds the program from the embedded kernels (or RSMOOTH_KERNEL_DIR) and creates the kernels. */
 rsmooth_status rs_cl_build_program(rsmooth_context *ctx, rsmooth_error *error);

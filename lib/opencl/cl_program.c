@@ -2,6 +2,7 @@
  * per phase. Kernels are embedded at build time; RSMOOTH_KERNEL_DIR loads them from a directory
  * instead. */
 #define _POSIX_C_SOURCE 200809L
+#include "learned/learned.h"
 #include "opencl/cl_grid.h"
 #include "opencl/cl_internal.h"
 
@@ -11,14 +12,14 @@
 #include <string.h>
 
 extern const unsigned char rs_kernel_common[], rs_kernel_mollify[], rs_kernel_bilateral[],
-    rs_kernel_estimate[], rs_kernel_stage[];
+    rs_kernel_estimate[], rs_kernel_learned[], rs_kernel_stage[];
 extern const size_t rs_kernel_common_size, rs_kernel_mollify_size, rs_kernel_bilateral_size,
-    rs_kernel_estimate_size, rs_kernel_stage_size;
+    rs_kernel_estimate_size, rs_kernel_learned_size, rs_kernel_stage_size;
 extern const unsigned char rs_kernel_grid[];
 extern const size_t rs_kernel_grid_size;
 
 /* The kernel files in the order they are compiled, after the prelude and the device's shape. */
-#define KERNEL_FILES 6
+#define KERNEL_FILES 7
 /* The most strings compiled: the prelude, the device's shape, the files, and stage.cl's second
  * copy with the definitions before each copy and the end of the double one's #if. */
 #define SOURCES (KERNEL_FILES + 6)
@@ -84,6 +85,7 @@ static rsmooth_status create_kernels(rsmooth_context *ctx, rsmooth_error *error)
         [RS_KERNEL_NORMALS] = "mollified_facet_normal",
         [RS_KERNEL_BILATERAL] = "bilateral_cell_normals",
         [RS_KERNEL_ROBUST] = "robust_block",
+        [RS_KERNEL_LEARNED] = "learned_stage",
         [RS_KERNEL_STAGE_FLOAT + RS_STAGE_FACETS] = "stage_facets_f",
         [RS_KERNEL_STAGE_FLOAT + RS_STAGE_PATCH] = "stage_patch_f",
         [RS_KERNEL_STAGE_FLOAT + RS_STAGE_GUIDANCE] = "stage_guidance_f",
@@ -107,11 +109,15 @@ static rsmooth_status create_kernels(rsmooth_context *ctx, rsmooth_error *error)
 
 static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *error) {
     static const char *const names[KERNEL_FILES] = {"common.cl",   "mollify.cl", "bilateral.cl",
-                                                    "estimate.cl", "grid.cl",    "stage.cl"};
-    /* the variant this device runs (cl_variant.c): its vector width and work-group size */
-    char shape[96];
-    snprintf(shape, sizeof shape, "#define RS_LANES %u\n#define RS_GROUP %zu\n", ctx->lanes,
-             ctx->local_size);
+                                                    "estimate.cl", "grid.cl",    "learned.cl",
+                                                    "stage.cl"};
+    /* the variant this device runs (cl_variant.c): its vector width and work-group size; the
+     * learned networks' tile (cl_learned.c launches by it) and widest layer */
+    char shape[192];
+    snprintf(shape, sizeof shape,
+             "#define RS_LANES %u\n#define RS_GROUP %zu\n#define RS_LEARNED_TILE %d\n"
+             "#define RS_LEARNED_MAX_WIDTH %d\n",
+             ctx->lanes, ctx->local_size, RS_LEARNED_TILE, RS_LEARNED_MAX_WIDTH);
     const char *sources[SOURCES] = {prelude,
                                     shape,
                                     (const char *)rs_kernel_common,
@@ -119,11 +125,13 @@ static rsmooth_status build_program_once(rsmooth_context *ctx, rsmooth_error *er
                                     (const char *)rs_kernel_bilateral,
                                     (const char *)rs_kernel_estimate,
                                     (const char *)rs_kernel_grid,
+                                    (const char *)rs_kernel_learned,
                                     (const char *)rs_kernel_stage};
     size_t sizes[SOURCES] = {sizeof prelude - 1,       strlen(shape),
                              rs_kernel_common_size,    rs_kernel_mollify_size,
                              rs_kernel_bilateral_size, rs_kernel_estimate_size,
-                             rs_kernel_grid_size,      rs_kernel_stage_size};
+                             rs_kernel_grid_size,      rs_kernel_learned_size,
+                             rs_kernel_stage_size};
     char *loaded[KERNEL_FILES] = {NULL};
     /* grid.cl only where the grid is sorted on the device (rs_cl_device_grid): a CPU device's
      * program stays without its kernels, whose loading would lengthen every setup */

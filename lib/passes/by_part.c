@@ -60,13 +60,13 @@ static void in_unit(rsmooth_params *p, double unit, double own) {
 }
 
 /* One part through the passes, its results scattered into `whole`. */
-static rsmooth_status filter_part(rs_filter_fn one_pass, rs_stage_runner stage, void *ctx,
-                                  rsmooth_scalar scalar, const rs_parts *parts, uint32_t part,
-                                  const void *positions, size_t vertex_count,
-                                  const uint32_t *indices, size_t triangle_count,
-                                  const rsmooth_params *resolved, rs_pass_progress *progress,
-                                  whole_outputs *whole, rsmooth_report *report,
-                                  rsmooth_error *error, const char *where) {
+static rsmooth_status filter_part(rs_filter_fn one_pass, rs_stage_runner stage,
+                                  rs_network_runner network, void *ctx, rsmooth_scalar scalar,
+                                  const rs_parts *parts, uint32_t part, const void *positions,
+                                  size_t vertex_count, const uint32_t *indices,
+                                  size_t triangle_count, const rsmooth_params *resolved,
+                                  rs_pass_progress *progress, whole_outputs *whole,
+                                  rsmooth_report *report, rsmooth_error *error, const char *where) {
     rs_submesh sub;
     if (!rs_submesh_make(&sub, parts, part, scalar, positions, vertex_count, indices,
                          triangle_count, resolved->move_mask))
@@ -100,7 +100,7 @@ static rsmooth_status filter_part(rs_filter_fn one_pass, rs_stage_runner stage, 
     if (st != RSMOOTH_OK)
         goto done;
     in_unit(&p, unit, own);
-    st = rs_filter_one_part(one_pass, stage, ctx, scalar, sub.positions, n, sub.indices,
+    st = rs_filter_one_part(one_pass, stage, network, ctx, scalar, sub.positions, n, sub.indices,
                             sub.triangle_count, &p, out, weight, confidence, report, error, where);
     if (st != RSMOOTH_OK)
         goto done;
@@ -125,13 +125,13 @@ done:
 }
 
 /* Every part in turn into `whole` (the input where no part moves a vertex). */
-static rsmooth_status filter_parts(rs_filter_fn one_pass, rs_stage_runner stage, void *ctx,
-                                   rsmooth_scalar scalar, const rs_parts *parts,
-                                   const void *positions, size_t vertex_count,
-                                   const uint32_t *indices, size_t triangle_count,
-                                   const rsmooth_params *resolved, whole_outputs *whole,
-                                   rsmooth_report *report, size_t *smoothed, rsmooth_error *error,
-                                   const char *where) {
+static rsmooth_status filter_parts(rs_filter_fn one_pass, rs_stage_runner stage,
+                                   rs_network_runner network, void *ctx, rsmooth_scalar scalar,
+                                   const rs_parts *parts, const void *positions,
+                                   size_t vertex_count, const uint32_t *indices,
+                                   size_t triangle_count, const rsmooth_params *resolved,
+                                   whole_outputs *whole, rsmooth_report *report, size_t *smoothed,
+                                   rsmooth_error *error, const char *where) {
     memcpy(whole->positions, positions, vertex_count * rs_vertex_bytes(scalar));
     if (whole->weight)
         memset(whole->weight, 0, vertex_count * sizeof *whole->weight);
@@ -148,9 +148,9 @@ static rsmooth_status filter_parts(rs_filter_fn one_pass, rs_stage_runner stage,
             continue; /* outliers alone, or nothing the caller lets move */
         progress.pass = (int)part;
         rs_report_init(&one);
-        rsmooth_status st = filter_part(one_pass, stage, ctx, scalar, parts, part, positions,
-                                        vertex_count, indices, triangle_count, resolved, &progress,
-                                        whole, report ? &one : NULL, error, where);
+        rsmooth_status st = filter_part(one_pass, stage, network, ctx, scalar, parts, part,
+                                        positions, vertex_count, indices, triangle_count, resolved,
+                                        &progress, whole, report ? &one : NULL, error, where);
         if (st != RSMOOTH_OK)
             return st;
         if (report)
@@ -182,12 +182,12 @@ static long guard_folds(rsmooth_scalar scalar, const void *positions, void *out_
     return moved;
 }
 
-rsmooth_status rs_filter_passes(rs_filter_fn one_pass, rs_stage_runner stage, void *ctx,
-                                rsmooth_scalar scalar, const void *positions, size_t vertex_count,
-                                const uint32_t *indices, size_t triangle_count,
-                                const rsmooth_params *params, void *out_positions,
-                                float *out_weight, float *out_confidence, rsmooth_report *report,
-                                rsmooth_error *error, const char *where) {
+rsmooth_status rs_filter_passes(rs_filter_fn one_pass, rs_stage_runner stage,
+                                rs_network_runner network, void *ctx, rsmooth_scalar scalar,
+                                const void *positions, size_t vertex_count, const uint32_t *indices,
+                                size_t triangle_count, const rsmooth_params *params,
+                                void *out_positions, float *out_weight, float *out_confidence,
+                                rsmooth_report *report, rsmooth_error *error, const char *where) {
     rs_error_clear(error);
     double t_start = rs_now_ms();
     rsmooth_params p;
@@ -210,9 +210,9 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, rs_stage_runner stage, vo
                        where);
     size_t smoothed = parts.count;
     if (st == RSMOOTH_OK && parts.whole) {
-        st = rs_filter_one_part(one_pass, stage, ctx, scalar, positions, vertex_count, indices,
-                                triangle_count, params, out_positions, out_weight, out_confidence,
-                                r, error, where);
+        st = rs_filter_one_part(one_pass, stage, network, ctx, scalar, positions, vertex_count,
+                                indices, triangle_count, params, out_positions, out_weight,
+                                out_confidence, r, error, where);
     } else if (st == RSMOOTH_OK) {
         size_t record = rs_vertex_bytes(scalar);
         whole_outputs whole = {rs_alloc_array(vertex_count, record),
@@ -222,8 +222,9 @@ rsmooth_status rs_filter_passes(rs_filter_fn one_pass, rs_stage_runner stage, vo
             (out_confidence && !whole.confidence))
             st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the parts");
         else
-            st = filter_parts(one_pass, stage, ctx, scalar, &parts, positions, vertex_count,
-                              indices, triangle_count, &p, &whole, r, &smoothed, error, where);
+            st =
+                filter_parts(one_pass, stage, network, ctx, scalar, &parts, positions, vertex_count,
+                             indices, triangle_count, &p, &whole, r, &smoothed, error, where);
         if (st == RSMOOTH_OK) {
             memcpy(out_positions, whole.positions, vertex_count * record);
             if (out_weight)

@@ -6,8 +6,9 @@
 
 /* rs_filter_passes's work on a mesh of one part: the stage, the passes, the choice per region,
  * the caller's mask, then the last check of what they wrote (results.c): never a non-finite OK. */
-rsmooth_status rs_filter_one_part(rs_filter_fn one_pass, rs_stage_runner stage, void *ctx,
-                                  rsmooth_scalar scalar, const void *positions, size_t vertex_count,
+rsmooth_status rs_filter_one_part(rs_filter_fn one_pass, rs_stage_runner stage,
+                                  rs_network_runner network, void *ctx, rsmooth_scalar scalar,
+                                  const void *positions, size_t vertex_count,
                                   const uint32_t *indices, size_t triangle_count,
                                   const rsmooth_params *params, void *out_positions,
                                   float *out_weight, float *out_confidence, rsmooth_report *report,

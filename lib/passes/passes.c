@@ -335,15 +335,16 @@ static void report_stage(rsmooth_report *report, const rs_stage_stats *stats) {
     report->stage_skipped = stats->skipped;
 }
 
-rsmooth_status rs_filter_one_part(rs_filter_fn one_pass, rs_stage_runner stage, void *ctx,
-                                  rsmooth_scalar scalar, const void *positions, size_t vertex_count,
+rsmooth_status rs_filter_one_part(rs_filter_fn one_pass, rs_stage_runner stage,
+                                  rs_network_runner network, void *ctx, rsmooth_scalar scalar,
+                                  const void *positions, size_t vertex_count,
                                   const uint32_t *indices, size_t triangle_count,
                                   const rsmooth_params *params, void *out_positions,
                                   float *out_weight, float *out_confidence, rsmooth_report *report,
                                   rsmooth_error *error, const char *where) {
     size_t caller_size = report ? report->struct_size : 0; /* the report's fillers reset it */
     rsmooth_params p;
-    rs_stage_place place = {stage, ctx, {NULL, NULL}};
+    rs_stage_place place = {stage, ctx, {network, network ? ctx : NULL}};
     rs_stage_stats stage_stats;
     memset(&stage_stats, 0, sizeof stage_stats);
     rsmooth_status st = filter_passes(

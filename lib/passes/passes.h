@@ -5,6 +5,7 @@
 #define RSMOOTH_PASSES_H
 
 #include "core/stage_plan.h"
+#include "learned/learned.h"
 
 /* The caller's progress callback seen through pass `pass` of `count` (rs_report_pass_progress
  * is the callback to give the pass, with this as its user pointer). */
@@ -33,12 +34,13 @@ typedef rsmooth_status (*rs_filter_fn)(void *ctx, rsmooth_scalar scalar, const v
 /* Runs `one_pass` params->passes times (once, unchanged, when passes is 1), each pass from the
  * previous pass's positions with the sigmas of the input, honouring pass_confidence; the
  * normal-update stage before them, if params ask for it, through `stage` (NULL: on the host),
- * both with `ctx`. The caller's outputs are written only when every pass succeeded. */
-rsmooth_status rs_filter_passes(rs_filter_fn one_pass, rs_stage_runner stage, void *ctx,
-                                rsmooth_scalar scalar, const void *positions, size_t vertex_count,
-                                const uint32_t *indices, size_t triangle_count,
-                                const rsmooth_params *params, void *out_positions,
-                                float *out_weight, float *out_confidence, rsmooth_report *report,
-                                rsmooth_error *error, const char *where);
+ * its learned networks through `network` (NULL: on the host), all with `ctx`. The caller's
+ * outputs are written only when every pass succeeded. */
+rsmooth_status rs_filter_passes(rs_filter_fn one_pass, rs_stage_runner stage,
+                                rs_network_runner network, void *ctx, rsmooth_scalar scalar,
+                                const void *positions, size_t vertex_count, const uint32_t *indices,
+                                size_t triangle_count, const rsmooth_params *params,
+                                void *out_positions, float *out_weight, float *out_confidence,
+                                rsmooth_report *report, rsmooth_error *error, const char *where);
 
 #endif /* RSMOOTH_PASSES_H */
