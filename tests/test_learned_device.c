@@ -8,12 +8,12 @@
  * leaves the host to run its chunks: the same bytes as the host alone, whatever the runner wrote
  * into the residuals before failing, and a runner that fails on one chunk only still agrees. */
 #define _POSIX_C_SOURCE 200809L
-#include "core/blake2b.h"
 #include "learned/learned.h"
 #include "mesh_shapes.h"
 #include "opencl/cl_internal.h"
 #include "stages/normal_update.h"
 #include "test_cl_util.h"
+#include "test_model.h"
 
 #include <math.h>
 #include <string.h>
@@ -21,86 +21,6 @@
 /* More facets than learned_normals.c's chunk of 16384. */
 #define TRIANGLES 17000
 #define TOLERANCE 1e-5
-
-/* ---- a model's bytes (docs/model.md, "The file") --------------------------------------------- */
-
-typedef struct bytes {
-    unsigned char *at;
-    size_t size, capacity;
-} bytes;
-
-static void put(bytes *b, const void *data, size_t size) {
-    if (b->size + size > b->capacity) {
-        b->capacity = 2 * (b->size + size);
-        b->at = realloc(b->at, b->capacity);
-        CHECK(b->at);
-    }
-    memcpy(b->at + b->size, data, size);
-    b->size += size;
-}
-
-static void put_u32(bytes *b, uint32_t v) {
-    unsigned char le[4] = {(unsigned char)v, (unsigned char)(v >> 8), (unsigned char)(v >> 16),
-                           (unsigned char)(v >> 24)};
-    put(b, le, 4);
-}
-
-static void put_f32(bytes *b, float f) {
-    uint32_t bits;
-    memcpy(&bits, &f, 4);
-    put_u32(b, bits);
-}
-
-/* Uniform in [-1, 1) from a splitmix64 state. */
-static double uniform(uint64_t *state) {
-    uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    z ^= z >> 31;
-    return (double)(z >> 11) / 9007199254740992.0 * 2 - 1;
-}
-
-/* `stages` stages of layers RS_LEARNED_INPUTS -> hidden[0] -> ... -> 3, rectifiers between,
- * weights uniform within He's scale (each layer's outputs about as large as its inputs), the
- * last layer's a tenth of it. */
-static bytes random_model(int stages, const uint32_t *hidden, int hidden_count, uint64_t seed) {
-    bytes b = {NULL, 0, 0};
-    put(&b, "RSNN\r\n\x1a\n", 8);
-    put_u32(&b, 1); /* format version */
-    put_u32(&b, RS_LEARNED_LAYOUT);
-    put_u32(&b, RS_LEARNED_NEIGHBOURS);
-    put_u32(&b, RS_LEARNED_INPUTS);
-    unsigned char manifest[32] = {0};
-    put(&b, manifest, sizeof manifest);
-    put_u32(&b, (uint32_t)stages);
-    for (int s = 0; s < stages; s++) {
-        put_u32(&b, (uint32_t)hidden_count + 1);
-        uint32_t in = RS_LEARNED_INPUTS;
-        for (int l = 0; l <= hidden_count; l++) {
-            bool last = l == hidden_count;
-            uint32_t out = last ? 3 : hidden[l];
-            put_u32(&b, in);
-            put_u32(&b, out);
-            put_u32(&b, last ? 0 : 1);
-            /* the last layer's residuals about a tenth of the unit normal, as a trained model's
-             * corrections are: not a normal that the residual nearly cancels, whose direction
-             * float rounding would turn as far as it likes */
-            double scale = sqrt(6.0 / in) * (last ? 0.1 : 1.0);
-            for (size_t k = 0; k < (size_t)in * out; k++)
-                put_f32(&b, (float)(scale * uniform(&seed)));
-            for (uint32_t k = 0; k < out; k++)
-                put_f32(&b, (float)(0.1 * uniform(&seed)));
-            in = out;
-        }
-    }
-    unsigned char digest[32];
-    rs_blake2b h;
-    rs_blake2b_init(&h, 32);
-    rs_blake2b_update(&h, b.at, b.size);
-    rs_blake2b_final(&h, digest);
-    put(&b, digest, sizeof digest);
-    return b;
-}
 
 /* ---- runners ------------------------------------------------------------------------------- */
 
@@ -209,12 +129,16 @@ static void compare(const char *name, const rs_learned_model *model, const scene
     free(device);
 }
 
+_Static_assert(MODEL_INPUTS == RS_LEARNED_INPUTS && MODEL_NEIGHBOURS == RS_LEARNED_NEIGHBOURS &&
+                   MODEL_LAYOUT == RS_LEARNED_LAYOUT,
+               "test_model.h's descriptor layout");
+
 int main(void) {
     scene s;
     make_scene(&s);
     CHECK(s.facets.count > 16384 && s.facets.count < 2 * 16384);
     static const uint32_t hidden[] = {192, 192, 96};
-    bytes encoded = random_model(2, hidden, 3, 42);
+    model_bytes encoded = random_model(2, hidden, 3, 42);
     rs_learned_model random_weights, builtin;
     rsmooth_error err;
     CHECK_STATUS(rs_learned_model_read(encoded.at, encoded.size, &random_weights, &err, "test"),

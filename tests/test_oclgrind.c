@@ -55,6 +55,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "mesh_shapes.h"
 #include "rsmooth.h"
+#include "test_model.h"
 #include "test_util.h"
 
 #include <errno.h>
@@ -292,10 +293,15 @@ static void run_cases(const char *variant, const test_mesh *m) {
     run_case(variant, "normal-update stage, float", m, &p, true);
     unsetenv("RSMOOTH_STAGE_PRECISION");
     unsetenv("RSMOOTH_STAGE");
-    /* the learned stage: its networks on the device (learned.cl, the built-in model), the
-     * cycles on the host */
+    /* the learned stage: its networks on the device (learned.cl), the cycles on the host; a
+     * small random model (the built-in one's weights may be all 0) */
+    static const uint32_t hidden[] = {16, 8};
+    model_bytes model = random_model(2, hidden, 2, 5);
     p.stage_normals = RSMOOTH_STAGE_NORMALS_LEARNED;
+    p.model = model.at;
+    p.model_size = model.size;
     run_case(variant, "learned normals (networks on the device)", m, &p, true);
+    free(model.at);
 }
 
 /* The child's work for one variant: its output goes to the parent's file. Fails when a case
