@@ -71,6 +71,52 @@ __kernel void learned_stage(uint count, uint layers, __global const uint4 *shape
 
 #else
 
+/* One output from its 8 lanes of partial sums over row[0, from) and the row's tail: the bias,
+ * the lanes summed pairwise, then the tail in order, and the rectifier where asked. The lanes go
+ * through a private array: Oclgrind's uninitialised-value check crashes on the shuffles of .lo
+ * and .hi (tests/test_oclgrind.c, its error 3). */
+inline float finish(float8 acc8, __global const float *row, const float *in, uint from, uint n,
+                    float bias, uint rectify) {
+    float lane[8];
+    vstore8(acc8, 0, lane);
+    float sum = bias + (((lane[0] + lane[1]) + (lane[2] + lane[3])) +
+                        ((lane[4] + lane[5]) + (lane[6] + lane[7])));
+    for (uint i = from; i < n; i++)
+        sum = mad(row[i], in[i], sum);
+    return rectify == 1 ? fmax(sum, 0.0f) : sum;
+}
+
+/* One layer from `in` to `out`: 4 outputs at a time, each 8 inputs loaded once for the 4 rows
+ * (every output sums as it would alone), then the outputs left over one at a time. */
+inline void dense(uint4 s, __global const float *w, const float *in, float *out) {
+    __global const float *bias = w + (size_t)s.x * s.y;
+    uint o = 0;
+    for (; o + 4 <= s.y; o += 4) {
+        __global const float *r = w + (size_t)o * s.x;
+        float8 a0 = (float8)(0.0f), a1 = a0, a2 = a0, a3 = a0;
+        uint i = 0;
+        for (; i + 8 <= s.x; i += 8) {
+            float8 x = vload8(0, in + i);
+            a0 = mad(vload8(0, r + i), x, a0);
+            a1 = mad(vload8(0, r + s.x + i), x, a1);
+            a2 = mad(vload8(0, r + 2 * s.x + i), x, a2);
+            a3 = mad(vload8(0, r + 3 * s.x + i), x, a3);
+        }
+        out[o] = finish(a0, r, in, i, s.x, bias[o], s.z);
+        out[o + 1] = finish(a1, r + s.x, in, i, s.x, bias[o + 1], s.z);
+        out[o + 2] = finish(a2, r + 2 * s.x, in, i, s.x, bias[o + 2], s.z);
+        out[o + 3] = finish(a3, r + 3 * s.x, in, i, s.x, bias[o + 3], s.z);
+    }
+    for (; o < s.y; o++) {
+        __global const float *r = w + (size_t)o * s.x;
+        float8 a0 = (float8)(0.0f);
+        uint i = 0;
+        for (; i + 8 <= s.x; i += 8)
+            a0 = mad(vload8(0, r + i), vload8(0, in + i), a0);
+        out[o] = finish(a0, r, in, i, s.x, bias[o], s.z);
+    }
+}
+
 __kernel void learned_stage(uint count, uint layers, __global const uint4 *shape,
                             __global const float *weight, __global const float *descriptors,
                             __global float *residuals, __local float *scratch, uint width) {
@@ -85,25 +131,7 @@ __kernel void learned_stage(uint count, uint layers, __global const uint4 *shape
     for (uint i = 0; i < inputs; i++)
         a[i] = descriptors[f * inputs + i];
     for (uint l = 0; l < layers; l++) {
-        uint4 s = shape[l];
-        __global const float *w = weight + s.w, *bias = w + (size_t)s.x * s.y;
-        for (uint o = 0; o < s.y; o++) {
-            __global const float *row = w + (size_t)o * s.x;
-            /* 8 partial sums: the row's dot product in the vector unit */
-            float8 acc8 = (float8)(0.0f);
-            uint i = 0;
-            for (; i + 8 <= s.x; i += 8)
-                acc8 = mad(vload8(0, row + i), vload8(0, in + i), acc8);
-            /* the lanes summed through a private array: Oclgrind's uninitialised-value check
-             * crashes on the shuffles of .lo and .hi (tests/test_oclgrind.c, its error 3) */
-            float lane[8];
-            vstore8(acc8, 0, lane);
-            float sum = bias[o] + (((lane[0] + lane[1]) + (lane[2] + lane[3])) +
-                                   ((lane[4] + lane[5]) + (lane[6] + lane[7])));
-            for (; i < s.x; i++)
-                sum = mad(row[i], in[i], sum);
-            out[o] = s.z == 1 ? fmax(sum, 0.0f) : sum;
-        }
+        dense(shape[l], weight + shape[l].w, in, out);
         float *next = in;
         in = out;
         out = next;
