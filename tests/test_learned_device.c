@@ -18,8 +18,9 @@
 #include <math.h>
 #include <string.h>
 
-/* More facets than learned_normals.c's chunk of 16384. */
-#define TRIANGLES 17000
+/* More facets than learned_normals.c's chunk of 16384 (17250), the rest not a whole number of
+ * the GPU variant's tiles nor of work-groups. */
+#define TRIANGLES 17250
 #define TOLERANCE 1e-5
 
 /* ---- runners ------------------------------------------------------------------------------- */
@@ -137,6 +138,7 @@ int main(void) {
     scene s;
     make_scene(&s);
     CHECK(s.facets.count > 16384 && s.facets.count < 2 * 16384);
+    CHECK(s.facets.count % RS_LEARNED_TILE != 0 && s.facets.count % 64 != 0);
     static const uint32_t hidden[] = {192, 192, 96};
     model_bytes encoded = random_model(2, hidden, 3, 42);
     rs_learned_model random_weights, builtin;
