@@ -22,7 +22,8 @@ static const char usage[] =
     "  pass) against the paper filter at its defaults on the same device, the stage on the host\n"
     "  (double) and on the device (double where it has fp64, and float32): medians of R runs of\n"
     "  each, in turn, with the stage's parts (lists, upload, cycles, download), its bytes moved\n"
-    "  and how far the device's result is from the host's (JSON)\n"
+    "  and how far the device's result is from the host's, and the best mode with the learned\n"
+    "  stage (--stage learned: its networks on the device) (JSON)\n"
     "  MESH            any mesh file rsmooth reads; default: a generated closed cylinder\n"
     "  --triangles N   generated mesh: about N triangles, noise 0.2 (default 200000)\n"
     "  --device D      as rsmooth --device (default: RSMOOTH_DEVICE, else auto)\n"
@@ -56,9 +57,9 @@ typedef struct mesh_in {
 } mesh_in;
 
 /* The modes timed, in the order each round runs them. */
-enum { PAPER, BEST_HOST, BEST_DEVICE, BEST_FLOAT, MODES };
+enum { PAPER, BEST_HOST, BEST_DEVICE, BEST_FLOAT, BEST_LEARNED, MODES };
 static const char *const mode_names[MODES] = {"paper", "best_stage_host", "best_stage_device",
-                                              "best_stage_device_float32"};
+                                              "best_stage_device_float32", "best_learned"};
 
 typedef struct figures {
     double total[99], stage[99], lists[99], upload[99], cycles[99], download[99];
@@ -253,7 +254,9 @@ int bench_best(int argc, char **argv) {
         }
         ms_auto = now_ms() - t0;
     }
-    params[BEST_DEVICE] = params[BEST_FLOAT] = params[BEST_HOST];
+    params[BEST_DEVICE] = params[BEST_FLOAT] = params[BEST_LEARNED] = params[BEST_HOST];
+    /* the learned stage (docs/model.md): its networks on the device, its descriptors on the host */
+    params[BEST_LEARNED].stage_normals = RSMOOTH_STAGE_NORMALS_LEARNED;
     size_t nv = m.vertex_count;
     double *out[MODES];
     figures *f = calloc(MODES, sizeof *f);

@@ -165,11 +165,15 @@ int ext_params_from_dict(PyObject *dict, Py_ssize_t vertex_count, rsmooth_params
                 PyErr_Format(PyExc_TypeError, "model: expected bytes (got %R)", value);
                 return -1;
             }
+            char *bytes;
+            Py_ssize_t size;
+            if (PyBytes_AsStringAndSize(value, &bytes, &size) != 0) /* (the limited API's) */
+                return -1;
             Py_XDECREF(held->model);
             Py_INCREF(value);
             held->model = value;
-            p->model = PyBytes_AS_STRING(value);
-            p->model_size = (size_t)PyBytes_GET_SIZE(value);
+            p->model = bytes;
+            p->model_size = (size_t)size;
             continue;
         }
         if (strcmp(name, "move_mask") == 0) {

@@ -27,7 +27,8 @@ def test_learned_stage_helps_and_differs(cube):
     truth, v, f = cube
     out, guided = learned(v, f), rsmooth.smooth(v, f, device="reference", best=True)
     assert out.shape == v.shape and np.all(np.isfinite(out))
-    assert not np.array_equal(out, guided)  # the model's normals moved the vertices further
+    # the model's normals moved the vertices further than rounding would
+    assert np.abs(out - guided).max() > 1e-3 * rsmooth.mean_edge_length(v, f)
     before, after = rsmooth.compare(v, truth, f), rsmooth.compare(out, truth, f)
     assert after["theta"] < 0.5 * before["theta"], (before, after)
 
