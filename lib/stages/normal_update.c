@@ -82,12 +82,23 @@ static double *learned_normals(const rs_stage_setting *setting, const rs_facets 
     return out;
 }
 
+/* The largest turn of a facet's normal the learned step makes (degrees): chosen among 5, 10, 20
+ * and no cap on two benchmark cases (docs/model.md). */
+#define MAX_TURN_DEGREES 5.0
+
 /* The learned normals of what the cycles left, then the vertex update toward them. */
 static bool refine_after(const rs_stage_setting *setting, double *xyz, size_t vertex_count,
                          const uint32_t *indices, rs_facets *facets, const rs_adjacency *adj,
                          double scale, const uint8_t *move_mask) {
     rs_facets_update(facets, xyz, indices);
     double *learned = learned_normals(setting, facets, scale);
+    /* a facet the model would turn further than MAX_TURN keeps its normal: big corrections are
+     * the model's least reliable (a facet near a crease put on the wrong side), small ones its
+     * most (docs/model.md, "The cap") */
+    double least = cos(MAX_TURN_DEGREES * (3.14159265358979324 / 180));
+    for (size_t f = 0; learned && f < facets->count; f++)
+        if (rs_dot3(learned + 3 * f, facets->normal + 3 * f) < least)
+            memcpy(learned + 3 * f, facets->normal + 3 * f, 3 * sizeof(double));
     bool ok = learned && rs_vertex_update(xyz, vertex_count, indices, facets, adj, learned,
                                           setting->updates, move_mask);
     rs_free(learned);
