@@ -130,10 +130,9 @@ def _filter_params(
 def _keywords(params: Dict[str, Any]) -> Dict[str, Any]:
     """The library's parameters as rsmooth.smooth's keywords (choices by name, flags as bools)."""
     out = dict(params)
-    if "stage" in given:
-        given["stage_normals"] = _choice(given.pop("stage"), _STAGES, "stage")
-    if "model" in given:
-        given["model"] = _model_bytes(given["model"])
+    if "stage_normals" in out:
+        value = out.pop("stage_normals")
+        out["stage"] = next(name for name, v in _STAGES.items() if v == value)
     for key, table in (
         ("normal_filter", _NORMAL_FILTERS),
         ("influence", _INFLUENCES),
