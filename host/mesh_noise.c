@@ -108,6 +108,18 @@ static void choose_vertices(unsigned char *chosen, size_t n, size_t k, uint64_t 
     }
 }
 
+bool mesh_noise_arrays_valid(const double *xyz, size_t vertex_count, const uint32_t *triangles,
+                             size_t triangle_count) {
+    if ((vertex_count && !xyz) || (triangle_count && !triangles) ||
+        vertex_count > SIZE_MAX / (3 * sizeof(double)) ||
+        triangle_count > SIZE_MAX / (3 * sizeof(uint32_t)))
+        return false;
+    for (size_t i = 0; i < 3 * triangle_count; i++)
+        if (triangles[i] >= vertex_count)
+            return false;
+    return true;
+}
+
 int mesh_add_noise(double *xyz, size_t vertex_count, const uint32_t *triangles,
                    size_t triangle_count, const mesh_noise_options *options) {
     if (!options || !(options->sigma >= 0) || !isfinite(options->sigma) ||
@@ -117,13 +129,8 @@ int mesh_add_noise(double *xyz, size_t vertex_count, const uint32_t *triangles,
         !(options->stripes >= 0) || !isfinite(options->stripes) ||
         (options->correlation > 0 && options->stripes > 0))
         return -1;
-    if ((vertex_count && !xyz) || (triangle_count && !triangles) ||
-        vertex_count > SIZE_MAX / (3 * sizeof(double)) ||
-        triangle_count > SIZE_MAX / (3 * sizeof(uint32_t)))
+    if (!mesh_noise_arrays_valid(xyz, vertex_count, triangles, triangle_count))
         return -1;
-    for (size_t i = 0; i < 3 * triangle_count; i++)
-        if (triangles[i] >= vertex_count)
-            return -1;
     if (vertex_count == 0 || options->sigma == 0)
         return 0; /* adding 0 could still turn -0.0 into +0.0: leave the bits alone */
 

@@ -5,6 +5,7 @@
 
 #include "mesh_noise_correlated.h"
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -58,6 +59,11 @@ size_t mesh_noise_moved_count(size_t vertex_count, double impulsive_fraction);
  * when out of memory). Indices must be in range. */
 double mesh_noise_mean_edge_length(const double *xyz, size_t vertex_count,
                                    const uint32_t *triangles, size_t triangle_count);
+
+/* The arrays every noise model checks: present where counted, sizes that fit, every index below
+ * vertex_count. */
+bool mesh_noise_arrays_valid(const double *xyz, size_t vertex_count, const uint32_t *triangles,
+                             size_t triangle_count);
 
 /* A copy of the positions (3 * vertex_count doubles) times a power of two, *unit, that brings the
  * largest coordinate near 1, so squares and cross products neither overflow nor underflow at any

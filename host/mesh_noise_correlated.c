@@ -11,16 +11,10 @@
 #define STRIPE_STREAM 0x8EBC6AF09C88C6E3ull
 #define PI 3.14159265358979323846
 
-static uint64_t mix64(uint64_t z) {
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
 /* Uniform in [0, 1) from 53 random bits. */
 static double uniform01(uint64_t *state) {
     *state += 0x9E3779B97F4A7C15ull;
-    return (double)(mix64(*state) >> 11) * 0x1.0p-53;
+    return (double)(mesh_noise_mix64(*state) >> 11) * 0x1.0p-53;
 }
 
 /* A uniform grid of cubes of side `cell`: the vertices sorted by cell. */
@@ -145,7 +139,7 @@ int mesh_band_limited_field(const double *xyz, size_t vertex_count, double lengt
 
 int mesh_stripe_field(const double *xyz, size_t vertex_count, double width, uint64_t seed,
                       double *out) {
-    uint64_t state = mix64(seed ^ STRIPE_STREAM);
+    uint64_t state = mesh_noise_mix64(seed ^ STRIPE_STREAM);
     double u[3], len;
     do { /* an isotropic direction */
         for (int k = 0; k < 3; k++)
@@ -155,14 +149,14 @@ int mesh_stripe_field(const double *xyz, size_t vertex_count, double width, uint
     for (int k = 0; k < 3; k++)
         u[k] /= len;
     double phase = uniform01(&state);
-    uint64_t amplitude_base = mix64(state);
+    uint64_t amplitude_base = mesh_noise_mix64(state);
     double ss = 0;
     for (size_t v = 0; v < vertex_count; v++) {
         const double *p = xyz + 3 * v;
         double t = (p[0] * u[0] + p[1] * u[1] + p[2] * u[2]) / width + phase;
         double slab = floor(t), f = t - slab;
         /* the slab's amplitude from a stream of its own: the same for every vertex in it */
-        uint64_t slab_state = mix64(amplitude_base ^ (uint64_t)(int64_t)slab);
+        uint64_t slab_state = mesh_noise_mix64(amplitude_base ^ (uint64_t)(int64_t)slab);
         out[v] = shape_gaussian(&slab_state) * sin(PI * f);
         ss += out[v] * out[v];
     }

@@ -6,6 +6,13 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/* splitmix64's finaliser: the noise models' streams for their directions and phases. */
+static inline uint64_t mesh_noise_mix64(uint64_t z) {
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
 /* Band-limited noise: out[v] = sum_u w(|p_u - p_v|) g_u / sqrt(sum_u w^2), over the vertices u
  * within 3 `length` (Euclidean, no geodesics) of v, w(d) = exp(-d^2 / (2 length^2)), g the
  * seed's i.i.d. standard Gaussians (g_v the v-th Gaussian of `seed`, as for plain noise). Each

@@ -15,12 +15,6 @@
 #define VIEW_STREAM 0x2D358DCCAA6C78A5ull
 #define PI 3.14159265358979323846
 
-static uint64_t mix64(uint64_t z) {
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
 static double dot3(const double a[3], const double b[3]) {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
@@ -55,7 +49,7 @@ typedef struct depth_camera {
 
 static void place_camera(const double *xyz, size_t n, const mesh_depth_noise_options *o,
                          depth_camera *cam) {
-    uint64_t state = mix64(o->seed ^ VIEW_STREAM);
+    uint64_t state = mesh_noise_mix64(o->seed ^ VIEW_STREAM);
     if (o->have_view) {
         memcpy(cam->view, o->view, sizeof cam->view);
         normalise(cam->view);
@@ -65,7 +59,7 @@ static void place_camera(const double *xyz, size_t n, const mesh_depth_noise_opt
                 cam->view[k] = shape_gaussian(&state);
         } while (!normalise(cam->view));
     }
-    cam->phase = 2 * PI * (double)(mix64(state + 1) >> 11) * 0x1.0p-53;
+    cam->phase = 2 * PI * (double)(mesh_noise_mix64(state + 1) >> 11) * 0x1.0p-53;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t v = 0; v < n; v++)
         for (int k = 0; k < 3; k++) {
@@ -130,13 +124,9 @@ static double noisy_depth(const mesh_depth_noise_options *o, const depth_camera 
 int mesh_add_depth_noise(double *xyz, size_t vertex_count, const uint32_t *triangles,
                          size_t triangle_count, const mesh_depth_noise_options *options,
                          mesh_depth_noise_camera *camera) {
-    if (!options_valid(options) || (vertex_count && !xyz) || (triangle_count && !triangles) ||
-        vertex_count > SIZE_MAX / (3 * sizeof(double)) ||
-        triangle_count > SIZE_MAX / (3 * sizeof(uint32_t)))
+    if (!options_valid(options) ||
+        !mesh_noise_arrays_valid(xyz, vertex_count, triangles, triangle_count))
         return -1;
-    for (size_t i = 0; i < 3 * triangle_count; i++)
-        if (triangles[i] >= vertex_count)
-            return -1;
     if (camera)
         memset(camera, 0, sizeof *camera); /* an empty mesh has no camera */
     if (vertex_count == 0)

@@ -5,66 +5,39 @@
 #include "core/blake2b.h"
 #include "learned/learned.h"
 #include "rsmooth.h"
+#include "test_model.h"
 #include "test_util.h"
 
 #include <stdint.h>
 #include <string.h>
 
-typedef struct buffer {
-    unsigned char *data;
-    size_t size;
-} buffer;
-
-static void put(buffer *b, const void *p, size_t n) {
-    b->data = realloc(b->data, b->size + n);
-    CHECK(b->data);
-    memcpy(b->data + b->size, p, n);
-    b->size += n;
-}
-
-static void put_u32(buffer *b, uint32_t v) {
-    unsigned char le[4] = {(unsigned char)v, (unsigned char)(v >> 8), (unsigned char)(v >> 16),
-                           (unsigned char)(v >> 24)};
-    put(b, le, 4);
-}
-
-static void seal(buffer *b) {
-    unsigned char digest[32];
-    rs_blake2b s;
-    rs_blake2b_init(&s, 32);
-    rs_blake2b_update(&s, b->data, b->size);
-    rs_blake2b_final(&s, digest);
-    put(b, digest, 32);
-}
-
 /* A model of `stages` stages of (inputs -> hidden relu -> 3), weights from a fixed sequence;
  * `last_out` the last layer's width (3 for a good model). Not sealed. */
-static buffer make_model(uint32_t version, uint32_t layout, int stages, uint32_t hidden,
-                         uint32_t last_out) {
-    buffer b = {NULL, 0};
-    put(&b, "RSNN\r\n\x1a\n", 8);
-    put_u32(&b, version);
-    put_u32(&b, layout);
-    put_u32(&b, RS_LEARNED_NEIGHBOURS);
-    put_u32(&b, RS_LEARNED_INPUTS);
+static model_bytes make_model(uint32_t version, uint32_t layout, int stages, uint32_t hidden,
+                              uint32_t last_out) {
+    model_bytes b = {NULL, 0, 0};
+    model_put(&b, "RSNN\r\n\x1a\n", 8);
+    model_put_u32(&b, version);
+    model_put_u32(&b, layout);
+    model_put_u32(&b, RS_LEARNED_NEIGHBOURS);
+    model_put_u32(&b, RS_LEARNED_INPUTS);
     unsigned char manifest[32];
     for (int i = 0; i < 32; i++)
         manifest[i] = (unsigned char)(7 * i + 1);
-    put(&b, manifest, 32);
-    put_u32(&b, (uint32_t)stages);
+    model_put(&b, manifest, 32);
+    model_put_u32(&b, (uint32_t)stages);
     uint32_t seed = 12345;
     for (int s = 0; s < stages; s++) {
-        put_u32(&b, 2);
+        model_put_u32(&b, 2);
         uint32_t widths[3] = {RS_LEARNED_INPUTS, hidden, last_out};
         for (int l = 0; l < 2; l++) {
-            put_u32(&b, widths[l]);
-            put_u32(&b, widths[l + 1]);
-            put_u32(&b, l == 0 ? 1 : 0);
+            model_put_u32(&b, widths[l]);
+            model_put_u32(&b, widths[l + 1]);
+            model_put_u32(&b, l == 0 ? 1 : 0);
             size_t n = (size_t)widths[l] * widths[l + 1] + widths[l + 1];
             for (size_t i = 0; i < n; i++) {
                 seed = seed * 1664525u + 1013904223u;
-                float w = ((float)(seed >> 8) / 16777216.0f - 0.5f) * 0.2f;
-                put(&b, &w, 4); /* the test machines are little-endian, as the format */
+                model_put_f32(&b, ((float)(seed >> 8) / 16777216.0f - 0.5f) * 0.2f);
             }
         }
     }
@@ -72,10 +45,10 @@ static buffer make_model(uint32_t version, uint32_t layout, int stages, uint32_t
 }
 
 /* The file is refused, and the message holds `what`. */
-static void refused(const buffer *b, size_t size, const char *what) {
+static void refused(const model_bytes *b, size_t size, const char *what) {
     rsmooth_error err;
     rs_learned_model m;
-    rsmooth_status st = rs_learned_model_read(b->data, size, &m, &err, "test.rsnn");
+    rsmooth_status st = rs_learned_model_read(b->at, size, &m, &err, "test.rsnn");
     if (st != RSMOOTH_ERROR_PARSE || !strstr(err.message, what) ||
         !strstr(err.message, "test.rsnn")) {
         fprintf(stderr, "expected a refusal with '%s' for %zu bytes, got status %d: %s\n", what,
@@ -131,11 +104,11 @@ static void check_builtin_manifest(void) {
 }
 
 int main(void) {
-    buffer good = make_model(1, RS_LEARNED_LAYOUT, 2, 24, 3);
-    seal(&good);
+    model_bytes good = make_model(1, RS_LEARNED_LAYOUT, 2, 24, 3);
+    model_seal(&good);
     rs_learned_model m;
     rsmooth_error err;
-    CHECK(rs_learned_model_read(good.data, good.size, &m, &err, "good") == RSMOOTH_OK);
+    CHECK(rs_learned_model_read(good.at, good.size, &m, &err, "good") == RSMOOTH_OK);
     size_t per_stage = RS_LEARNED_INPUTS * 24 + 24 + 24 * 3 + 3;
     CHECK_EQ_INT(m.stage_count, 2);
     CHECK_EQ_INT(m.parameters, 2 * per_stage);
@@ -143,41 +116,40 @@ int main(void) {
     check_network(&m);
     rs_learned_model_free(&m);
     rsmooth_model_info info = {.struct_size = sizeof info};
-    CHECK(rsmooth_model_check(good.data, good.size, &info, &err) == RSMOOTH_OK);
+    CHECK(rsmooth_model_check(good.at, good.size, &info, &err) == RSMOOTH_OK);
     CHECK_EQ_INT(info.stages, 2);
     CHECK_EQ_INT(info.parameters, 2 * per_stage);
     CHECK_EQ_INT(info.manifest[1], 8);
 
-    buffer bad = make_model(1, RS_LEARNED_LAYOUT, 2, 24, 3);
-    seal(&bad);
-    bad.data[0] = 'X';
+    model_bytes bad = make_model(1, RS_LEARNED_LAYOUT, 2, 24, 3);
+    model_seal(&bad);
+    bad.at[0] = 'X';
     refused(&bad, bad.size, "not an rsmooth model");
     for (size_t cut = 9; cut < good.size; cut += good.size / 7)
         refused(&good, cut, "truncated");
     refused(&good, good.size - 1, "truncated");
-    buffer v2 = make_model(2, RS_LEARNED_LAYOUT, 1, 8, 3);
-    seal(&v2);
+    model_bytes v2 = make_model(2, RS_LEARNED_LAYOUT, 1, 8, 3);
+    model_seal(&v2);
     refused(&v2, v2.size, "format version 2");
-    buffer l2 = make_model(1, RS_LEARNED_LAYOUT + 1, 1, 8, 3);
-    seal(&l2);
+    model_bytes l2 = make_model(1, RS_LEARNED_LAYOUT + 1, 1, 8, 3);
+    model_seal(&l2);
     refused(&l2, l2.size, "descriptor layout");
-    buffer wide = make_model(1, RS_LEARNED_LAYOUT, 1, 8, 4);
-    seal(&wide);
+    model_bytes wide = make_model(1, RS_LEARNED_LAYOUT, 1, 8, 4);
+    model_seal(&wide);
     refused(&wide, wide.size, "does not give 3 numbers");
-    buffer flipped = make_model(1, RS_LEARNED_LAYOUT, 2, 24, 3);
-    seal(&flipped);
-    flipped.data[200] ^= 0x10;
+    model_bytes flipped = make_model(1, RS_LEARNED_LAYOUT, 2, 24, 3);
+    model_seal(&flipped);
+    flipped.at[200] ^= 0x10;
     refused(&flipped, flipped.size, "checksum does not match");
-    buffer longer = make_model(1, RS_LEARNED_LAYOUT, 1, 8, 3);
-    seal(&longer);
-    put(&longer, "x", 1);
+    model_bytes longer = make_model(1, RS_LEARNED_LAYOUT, 1, 8, 3);
+    model_seal(&longer);
+    model_put(&longer, "x", 1);
     refused(&longer, longer.size, "bytes after its checksum");
     rsmooth_model_info small = {.struct_size = 4};
-    CHECK(rsmooth_model_check(good.data, good.size, &small, &err) ==
-          RSMOOTH_ERROR_INVALID_ARGUMENT);
+    CHECK(rsmooth_model_check(good.at, good.size, &small, &err) == RSMOOTH_ERROR_INVALID_ARGUMENT);
     check_builtin_manifest();
-    free(good.data), free(bad.data), free(v2.data), free(l2.data), free(wide.data);
-    free(flipped.data), free(longer.data);
+    free(good.at), free(bad.at), free(v2.at), free(l2.at), free(wide.at);
+    free(flipped.at), free(longer.at);
     printf("learned model file: all checks passed\n");
     return 0;
 }

@@ -45,6 +45,16 @@ static inline void model_put_f32(model_bytes *b, float f) {
     model_put_u32(b, bits);
 }
 
+/* Appends the BLAKE2b-256 of every byte so far: the file's last 32 bytes. */
+static inline void model_seal(model_bytes *b) {
+    unsigned char digest[32];
+    rs_blake2b h;
+    rs_blake2b_init(&h, 32);
+    rs_blake2b_update(&h, b->at, b->size);
+    rs_blake2b_final(&h, digest);
+    model_put(b, digest, sizeof digest);
+}
+
 /* Uniform in [-1, 1) from a splitmix64 state. */
 static inline double model_uniform(uint64_t *state) {
     uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
@@ -88,12 +98,7 @@ static inline model_bytes random_model(int stages, const uint32_t *hidden, int h
             in = out;
         }
     }
-    unsigned char digest[32];
-    rs_blake2b h;
-    rs_blake2b_init(&h, 32);
-    rs_blake2b_update(&h, b.at, b.size);
-    rs_blake2b_final(&h, digest);
-    model_put(&b, digest, sizeof digest);
+    model_seal(&b);
     return b;
 }
 

@@ -36,7 +36,7 @@ PINNED_FOLDS = {"fandisk": 0, "block": 0, "stanford-bunny": 1, "twelve": 1, "tri
                 "sharpsphere": 2}
 
 
-def noise_args(kind, rng, mean_edge_free=True):
+def noise_args(kind, rng):
     """rsmooth noise's options for one case of a noise class."""
     if kind == "gaussian":
         return ["--sigma", f"{rng.uniform(0.05, 0.8):.3f}"]

@@ -79,7 +79,7 @@ static void describe_range(void *ctx, size_t begin, size_t end, size_t chunk) {
     }
 }
 
-/* One chunk of one stage: true when it is done (the device's residuals, or the host's). */
+/* One chunk of one stage: the device's residuals, or (no runner, or it refused) the host's. */
 static void run_chunk(chunk_job *job, size_t count, const rs_network_place *place,
                       float *residuals) {
     if (job->descriptors) {
@@ -89,13 +89,11 @@ static void run_chunk(chunk_job *job, size_t count, const rs_network_place *plac
             for (size_t i = 0; i < count; i++) {
                 double own[3], r[3], frame[3][3];
                 memcpy(frame, job->frames + 9 * i, sizeof frame);
+                /* own from the frame in double, not the float copy: as the host computes it */
                 for (int k = 0; k < 3; k++) {
-                    own[k] = job->descriptors[i * RS_LEARNED_INPUTS + k];
+                    own[k] = rs_dot3(frame[k], job->in->normal + 3 * (job->first + i));
                     r[k] = residuals[3 * i + k];
                 }
-                /* own from the frame in double, not the float copy: as the host computes it */
-                for (int k = 0; k < 3; k++)
-                    own[k] = rs_dot3(frame[k], job->in->normal + 3 * (job->first + i));
                 rs_learned_normal_from_residual(frame, own, r, job->out + 3 * (job->first + i));
             }
             return;
