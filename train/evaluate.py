@@ -1,16 +1,22 @@
 """The learned stage against the hand-fitted one on shapes each fold's model never saw.
 
-    python train/evaluate.py BUILD CACHE OUT --models DIR [--folds 0,1,2,3] [--quick]
+    python train/evaluate.py BUILD CACHE OUT --models DIR [--folds 0,1,2,3] [--cases A,B]
 
 For each fold F, DIR/model-fold{F}.rsnn (trained without fold F's shapes) runs as
 `rsmooth --best --auto --stage learned --model ...` and the hand-fitted stage as
 `rsmooth --best --auto` on the fold's cases: the benchmark pairs of its shapes, fresh noisy
 copies of its shapes (every noise class, seeds the training never used), GCN-Denoiser's noise
 model (Gaussian along vertex normals of 0.1, 0.2, 0.3 and 0.6 mean edges; impulsive with 0.1,
-0.2, 0.3 as both the fraction moved and the size) on its shapes, and the raw scans (against the
-reconstruction). Errors by ../shared/tools/meshmetrics.py (independent of rsmooth): theta (mean
-face-normal angle, degrees) and ev (vertex-to-surface, thousandths of the diagonal). Writes
-OUT/evaluation.json and prints the tables docs/model.md quotes.
+0.2, 0.3 as both the fraction moved and the size) on its shapes, and the raw scans of its
+shapes (against the reconstruction, with Taubin smoothing tuned against it as the anchor). Errors
+by ../shared/tools/meshmetrics.py (independent of rsmooth): theta (mean face-normal angle,
+degrees) and ev (vertex-to-surface, thousandths of the diagonal); a scan's theta is against the
+reconstruction triangle nearest each centroid.
+
+Each case also says where the learned step's limit lies, facet by facet: the mean normal error of
+what the guided cycles leave (the model's input), of the model's normals of it, and of those
+normals capped as the stage caps them (rsmooth-train-features --predict, the library's own path).
+Writes OUT/evaluation.json and prints the tables docs/model.md quotes.
 """
 import argparse
 import hashlib
@@ -27,6 +33,15 @@ import dataset  # noqa: E402
 
 METRICS = os.path.join(dataset.SHARED, "..", "tools", "meshmetrics.py")
 GCN_LEVELS = (0.1, 0.2, 0.3, 0.6)
+# lib/stages/normal_update.c's MAX_TURN_DEGREES: a facet the model turns further keeps its normal
+MAX_TURN_DEGREES = 5.0
+# a facet counts as at a crease when its true normal and one of its 8 nearest facets' differ by
+# more than about 25 degrees (features.c's sharpness, 1 - the least cosine, above 0.1)
+SHARP = 0.1
+TAUBIN_GRID = (1, 2, 3, 5, 8, 12, 18, 27, 40, 60, 90)
+
+sys.path.insert(0, os.path.dirname(METRICS))
+import meshmetrics  # noqa: E402  (the independent measure)
 # GCN-Denoiser's noise model on these shapes (the ones its published cases resemble: CAD parts,
 # and a few scanned ones), to keep the evaluation within the training's hour
 GCN_SHAPES = ("fandisk", "block", "stanford-bunny", "twelve", "trimstar", "sharpsphere",
@@ -47,7 +62,10 @@ def eval_cases(cad_dir, folds, cad_per_fold):
                             "truth": os.path.join(dataset.SHARED, base, d, "Original.obj")})
     cad_seen = {}
     for case in dataset.cases(cad_dir, dataset.NOISE_CLASSES, seed=1001):
-        if case["fold"] not in folds or case["class"] == "scan" or "Original" in case["clean"]:
+        if case["fold"] not in folds or "Original" in case["clean"]:
+            continue
+        if case["class"] == "scan":
+            out.append(dict(case, truth=None))
             continue
         if case["group"].startswith("cad-"):
             seen = cad_seen.setdefault(case["fold"], [])
@@ -79,18 +97,98 @@ def measure(result, truth):
     return float(fields["theta"]), float(fields["ev"])
 
 
+def measure_scan(result, surface):
+    """theta against the nearest reconstruction triangle, ev of the vertices to its surface."""
+    v, f = meshmetrics.read_mesh(result)
+    tv, tf = meshmetrics.read_mesh(surface)
+    n, area = meshmetrics.face_normals(v, f)
+    tn, _ = meshmetrics.face_normals(tv, tf)
+    va = np.zeros(len(v))
+    for j in range(3):
+        np.add.at(va, f[:, j], area)
+    used = va > 0
+    d = meshmetrics.dist_to_surface(v[used], tv, tf)
+    # the diagonal of the reconstruction's box in its own frame (a box turned with the scan's
+    # frame is another box), as docs/accuracy.md measured the scans
+    rv, _ = meshmetrics.read_mesh(os.path.join(dataset.SHARED, "scans", "stanford-bunny",
+                                               "bun_zipper.ply"))
+    diag = float(np.linalg.norm(rv.max(0) - rv.min(0)))
+    ev = float(np.sqrt((va[used] * d ** 2).sum() / va[used].sum())) / diag * 1e3
+    from scipy.spatial import cKDTree
+    _, nearest = cKDTree(tv[tf].mean(1)).query(v[f].mean(1))
+    cos = np.clip((n * tn[nearest]).sum(1), -1, 1)
+    return float(np.degrees(np.arccos(cos[np.isfinite(cos)])).mean()), ev
+
+
+def smooth(build, noisy, path, args):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    subprocess.run([os.path.join(build, "rsmooth"), noisy, "-o", path, "-q", "-f"] + args,
+                   check=True)
+
+
+def facet_normals(build, cache, out, case, noisy, model, surface):
+    """Mean normal error (degrees), over all facets and over those at creases, of what the guided
+    cycles leave, of the model's normals of it, and of those normals capped."""
+    staged = dataset.staged_mesh(build, cache, case, noisy)
+    folder = os.path.join(out, "results", case["name"] + "-facets")
+    os.makedirs(folder, exist_ok=True)
+    truth = ["--truth-surface", surface] if case["class"] == "scan" else ["--truth", case["truth"]]
+    subprocess.run([os.path.join(build, "rsmooth-train-features"), staged, folder, "--model",
+                    model, "--stages", "0", "--predict", "--noise-from", noisy] + truth,
+                   check=True, stdout=subprocess.DEVNULL)
+    read = {k: np.load(os.path.join(folder, k + ".npy")).astype(np.float64)
+            for k in ("normal", "predicted", "target", "sharp")}
+    for k in read:
+        os.remove(os.path.join(folder, k + ".npy"))
+    for k in ("descriptor", "frame", "triangle"):
+        os.remove(os.path.join(folder, k + ".npy"))
+    os.rmdir(folder)
+
+    def angle(a, b):
+        cos = (a * b).sum(1) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
+        return np.degrees(np.arccos(np.clip(cos, -1, 1)))
+    staged_err = angle(read["normal"], read["target"])
+    learned_err = angle(read["predicted"], read["target"])
+    turned = angle(read["predicted"], read["normal"])
+    capped_err = np.where(turned > MAX_TURN_DEGREES, staged_err, learned_err)
+    sharp = read["sharp"].ravel() > SHARP
+    row = {"staged": float(staged_err.mean()), "learned": float(learned_err.mean()),
+           "capped": float(capped_err.mean()), "crease_share": float(sharp.mean())}
+    if sharp.any():
+        row["crease"] = [float(staged_err[sharp].mean()), float(learned_err[sharp].mean())]
+    return row
+
+
 def run_case(job):
     build, cache, out, case, model = job
     noisy = case.get("noisy") or dataset.noisy_mesh(build, cache, case)
+    scan = case["class"] == "scan"
+    surface = dataset.scan_truth(cache, case["name"]) if scan else None
+    score = (lambda p: measure_scan(p, surface)) if scan else (lambda p: measure(p, case["truth"]))
     result = {"name": case["name"], "fold": case["fold"], "class": case["class"]}
     for label, extra in (("hand", []), ("learned", ["--stage", "learned", "--model", model])):
         path = os.path.join(out, "results", f"{case['name']}-{label}.ply")
-        os.makedirs(os.path.dirname(path), exist_ok=True)
-        subprocess.run([os.path.join(build, "rsmooth"), noisy, "-o", path, "--best", "--auto",
-                        "-q", "-f"] + extra, check=True)
-        result[label] = measure(path, case["truth"])
+        smooth(build, noisy, path, ["--best", "--auto"] + extra)
+        result[label] = score(path)
         os.remove(path)
-    result["input"] = measure(noisy, case["truth"])
+    if scan:  # (the raw range grid as triangles: a filter that moves nothing writes them)
+        path = os.path.join(out, "results", f"{case['name']}-raw.ply")
+        smooth(build, noisy, path, ["--method", "laplacian", "--iterations", "0"])
+        result["input"] = score(path)
+        os.remove(path)
+    else:
+        result["input"] = score(noisy)
+    if scan:  # the standing anchor: Taubin smoothing tuned against the reconstruction
+        grid = {}
+        for n in TAUBIN_GRID:
+            path = os.path.join(out, "results", f"{case['name']}-taubin.ply")
+            smooth(build, noisy, path, ["--method", "taubin", "--iterations", str(n)])
+            grid[n] = score(path)
+            os.remove(path)
+        best = min(grid, key=lambda n: grid[n][1])
+        result["taubin"] = {"iterations": best, "theta": grid[best][0], "ev": grid[best][1],
+                            "at_grid_edge": best in (TAUBIN_GRID[0], TAUBIN_GRID[-1])}
+    result["normals"] = facet_normals(build, cache, out, case, noisy, model, surface)
     return result
 
 
@@ -111,6 +209,10 @@ def summary(results):
                       "theta_hand": float(np.mean([r["hand"][0] for r in rs])),
                       "ev_learned": float(np.mean([r["learned"][1] for r in rs])),
                       "ev_hand": float(np.mean([r["hand"][1] for r in rs]))}
+        facets = [r["normals"] for r in rs if "normals" in r]
+        if facets:
+            table[key]["normals"] = {k: float(np.mean([x[k] for x in facets]))
+                                     for k in ("staged", "learned", "capped")}
     return table
 
 
@@ -124,13 +226,36 @@ def markdown(results, table):
                      f"{row['theta_learned']:.2f} | {row['ev_hand']:.3f} -> "
                      f"{row['ev_learned']:.3f} | {row['theta_ratio']:.3f} / "
                      f"{row['ev_ratio']:.3f} | {row['theta_wins']} / {row['ev_wins']} |")
-    lines += ["", "| case | fold | input theta / ev | guided | learned |",
-              "| --- | --- | --- | --- | --- |"]
+    lines += ["", "Facet by facet (the model's input, its normals, capped), mean normal error in "
+              "degrees:", "", "| noise class | after the guided cycles | the model's normals | "
+              "capped as the stage caps them |", "| --- | --- | --- | --- |"]
+    for key, row in table.items():
+        if "normals" in row:
+            n = row["normals"]
+            lines.append(f"| {key} | {n['staged']:.2f} | {n['learned']:.2f} | {n['capped']:.2f} |")
+    scans = [r for r in results if "taubin" in r]
+    if scans:
+        lines += ["", "| scan | raw theta / ev | guided | learned | Taubin tuned on the truth |",
+                  "| --- | --- | --- | --- | --- |"]
+        for r in scans:
+            t = r["taubin"]
+            lines.append(f"| {r['name']} | {r['input'][0]:.2f} / {r['input'][1]:.3f} "
+                         f"| {r['hand'][0]:.2f} / {r['hand'][1]:.3f} "
+                         f"| {r['learned'][0]:.2f} / {r['learned'][1]:.3f} "
+                         f"| {t['theta']:.2f} / {t['ev']:.3f} (N = {t['iterations']}) |")
+    lines += ["", "| case | fold | input theta / ev | guided | learned | facets: guided cycles"
+              " -> model -> capped |", "| --- | --- | --- | --- | --- | --- |"]
     for r in sorted(results, key=lambda r: (r["fold"], r["name"])):
         lines.append(f"| {r['name']} | {r['fold']} | {r['input'][0]:.2f} / {r['input'][1]:.3f} "
                      f"| {r['hand'][0]:.2f} / {r['hand'][1]:.3f} "
-                     f"| {r['learned'][0]:.2f} / {r['learned'][1]:.3f} |")
+                     f"| {r['learned'][0]:.2f} / {r['learned'][1]:.3f} "
+                     f"| {facets_cell(r)} |")
     return "\n".join(lines) + "\n"
+
+
+def facets_cell(r):
+    n = r.get("normals")
+    return f"{n['staged']:.2f} -> {n['learned']:.2f} -> {n['capped']:.2f}" if n else ""
 
 
 def main():
@@ -143,9 +268,12 @@ def main():
     ap.add_argument("--folds", default="0,1,2,3")
     ap.add_argument("--cad-per-fold", type=int, default=3)
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--cases", help="only these cases (names, comma-separated)")
     args = ap.parse_args()
     folds = [int(f) for f in args.folds.split(",")]
     cases = eval_cases(args.cad, folds, args.cad_per_fold)
+    if args.cases:
+        cases = [c for c in cases if c["name"] in args.cases.split(",")]
     jobs = [(args.build, args.cache, args.out, c,
              os.path.join(args.models, f"model-fold{c['fold']}.rsnn")) for c in cases]
     results = []
