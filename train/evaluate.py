@@ -222,10 +222,11 @@ def markdown(results, table):
              "| median ratio theta / ev (learned / guided) | learned at or below guided, theta "
              "/ ev |", "| --- | --- | --- | --- | --- | --- |"]
     for key, row in table.items():
+        ratio = " / ".join("-" if row[k] is None else f"{row[k]:.3f}"  # (all zero: clean)
+                           for k in ("theta_ratio", "ev_ratio"))
         lines.append(f"| {key} | {row['cases']} | {row['theta_hand']:.2f} -> "
                      f"{row['theta_learned']:.2f} | {row['ev_hand']:.3f} -> "
-                     f"{row['ev_learned']:.3f} | {row['theta_ratio']:.3f} / "
-                     f"{row['ev_ratio']:.3f} | {row['theta_wins']} / {row['ev_wins']} |")
+                     f"{row['ev_learned']:.3f} | {ratio} | {row['theta_wins']} / {row['ev_wins']} |")
     lines += ["", "Facet by facet (the model's input, its normals, capped), mean normal error in "
               "degrees:", "", "| noise class | after the guided cycles | the model's normals | "
               "capped as the stage caps them |", "| --- | --- | --- | --- |"]

@@ -1,6 +1,7 @@
-"""The model card's two plots, as SVG (no plotting library): the training loss by epoch of each
-stage and fold, and the left-out normal error (theta) by noise class, learned against the
-hand-fitted stage (evaluate.py's figures).
+"""The model card's plots, as SVG (no plotting library): the training loss by epoch of each stage
+and fold; the left-out normal error (theta) by noise class, learned against the hand-fitted
+stage; and the left-out facets' normal error by noise class, of what the guided cycles leave, of
+the model's normals and of those capped (evaluate.py's figures).
 
     python train/plots.py OUT docs/img
 """
@@ -51,18 +52,18 @@ def loss_plot(models):
     return svg(w, h, "\n".join(body) + "\n")
 
 
-def class_plot(evaluation):
-    table = json.load(open(evaluation))["by_class"]
-    keys = list(table)
-    w, h, left, top, ph = 80 + 70 * len(keys), 300, 40, 30, 210
-    top_value = max(max(table[k]["theta_hand"], table[k]["theta_learned"]) for k in keys)
-    body = ['<text x="10" y="14">left-out mean theta (degrees) by noise class: grey the '
-            'hand-fitted stage, blue the learned</text>']
+def bars(table, series, title):
+    """Grouped bars per noise class: series is [(label, value of a row, colour)]."""
+    keys = [k for k in table if all(get(table[k]) is not None for _, get, _ in series)]
+    step = 24 * len(series) + 26
+    w, h, left, top, ph = 80 + step * len(keys), 300, 40, 30, 210
+    top_value = max(get(table[k]) for k in keys for _, get, _ in series) or 1
+    legend = ", ".join(f"{NAMES[colour]} {label}" for label, _, colour in series)
+    body = [f'<text x="10" y="14">{title}: {legend}</text>']
     for i, k in enumerate(keys):
-        x = left + 70 * i
-        for j, (key, colour) in enumerate((("theta_hand", "#999"), ("theta_learned",
-                                                                     "#1f77b4"))):
-            v = table[k][key]
+        x = left + step * i
+        for j, (_, get, colour) in enumerate(series):
+            v = get(table[k])
             bh = ph * v / top_value
             body.append(f'<rect x="{x + 22 * j}" y="{top + ph - bh:.1f}" width="20" '
                         f'height="{bh:.1f}" fill="{colour}"/>')
@@ -70,6 +71,27 @@ def class_plot(evaluation):
                         f'{v:.1f}</text>')
         body.append(f'<text x="{x}" y="{top + ph + 14}" font-size="10">{k}</text>')
     return svg(w, h, "\n".join(body) + "\n")
+
+
+NAMES = {"#999": "grey", "#1f77b4": "blue", "#ff7f0e": "orange"}
+
+
+def class_plot(evaluation):
+    table = json.load(open(evaluation))["by_class"]
+    return bars(table, [("the hand-fitted stage", lambda r: r["theta_hand"], "#999"),
+                        ("the learned", lambda r: r["theta_learned"], "#1f77b4")],
+                "left-out mean theta (degrees) by noise class")
+
+
+def facet_plot(evaluation):
+    """Facet by facet: what the guided cycles leave, the model's normals, those capped."""
+    table = json.load(open(evaluation))["by_class"]
+    return bars(table, [("after the guided cycles", lambda r: r.get("normals", {}).get("staged"),
+                         "#999"),
+                        ("the model's normals", lambda r: r.get("normals", {}).get("learned"),
+                         "#1f77b4"),
+                        ("capped", lambda r: r.get("normals", {}).get("capped"), "#ff7f0e")],
+                "left-out mean facet normal error (degrees) by noise class")
 
 
 def main():
@@ -82,6 +104,8 @@ def main():
     if os.path.exists(evaluation):
         with open(os.path.join(img, "model-left-out.svg"), "w") as f:
             f.write(class_plot(evaluation))
+        with open(os.path.join(img, "model-facets.svg"), "w") as f:
+            f.write(facet_plot(evaluation))
 
 
 if __name__ == "__main__":
