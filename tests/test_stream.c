@@ -272,6 +272,27 @@ int main(void) {
     CHECK(rep.mean_edge_length == edge); /* summed in the same order: the same bits */
     CHECK(dev == 0);
     free(expected);
+    /* The mesh's figures are made on every core (stream_stats.c): 1 and 5 host threads cut the
+     * work differently and must give the same bytes. */
+    size_t capped_size;
+    unsigned char *capped = slurp(path_in_dir("capped.ply"), &capped_size);
+    for (int t = 0; t < 2; t++) {
+        setenv("RSMOOTH_HOST_THREADS", t ? "5" : "1", 1);
+        rsmooth_stream_report threads_rep;
+        CHECK_STATUS(stream(ctx, big, path_in_dir("threads.ply"), cap, NULL, &threads_rep, &err),
+                     RSMOOTH_OK);
+        size_t size;
+        unsigned char *bytes = slurp(path_in_dir("threads.ply"), &size);
+        printf("%s host thread(s): mean edge %.17g, output %s\n", t ? "5" : "1",
+               threads_rep.mean_edge_length,
+               size == capped_size && !memcmp(bytes, capped, size) ? "the same bytes" : "DIFFERS");
+        CHECK(threads_rep.mean_edge_length == edge);
+        CHECK(size == capped_size && memcmp(bytes, capped, size) == 0);
+        free(bytes);
+        remove(path_in_dir("threads.ply"));
+    }
+    unsetenv("RSMOOTH_HOST_THREADS");
+    free(capped);
 
     /* 2. Bilateral normals widen the halo. */
     rsmooth_params bilateral;

@@ -71,7 +71,11 @@ const unsigned char *rs_stream_read(rs_stream_reader *r, size_t n) {
 }
 
 bool rs_stream_triangles_open(rs_stream_reader *r, int fd, uint64_t triangle_count) {
-    return rs_stream_reader_open(r, fd, "triangles", 0, triangle_count * 12, 1u << 20);
+    return rs_stream_triangles_open_range(r, fd, 0, triangle_count);
+}
+
+bool rs_stream_triangles_open_range(rs_stream_reader *r, int fd, uint64_t first, uint64_t end) {
+    return rs_stream_reader_open(r, fd, "triangles", first * 12, end * 12, 1u << 20);
 }
 
 int rs_stream_temporary(const char *dir) {

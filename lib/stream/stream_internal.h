@@ -43,6 +43,9 @@ static inline uint64_t rs_stream_reader_offset(const rs_stream_reader *r) {
 
 /* The temporary triangle file (3 uint32 vertex ids per triangle), read front to back. */
 bool rs_stream_triangles_open(rs_stream_reader *r, int fd, uint64_t triangle_count);
+/* Triangles [first, end) only: readers of one file at different places may run at once (each
+ * reads with pread at its own offset). */
+bool rs_stream_triangles_open_range(rs_stream_reader *r, int fd, uint64_t first, uint64_t end);
 /* The next triangle's ids into tri; false at the end or on a read error. */
 static inline bool rs_stream_next_triangle(rs_stream_reader *r, uint32_t tri[3]) {
     const unsigned char *rec = rs_stream_read(r, 3 * sizeof(uint32_t));

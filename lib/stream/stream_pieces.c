@@ -185,42 +185,82 @@ static size_t pieces_near(const cell_grid *g, const box *boxes, const double c[3
     return n;
 }
 
-/* One pass over the triangles: counts each piece's facets (writer NULL), or writes this rank's
- * pieces' facet records. */
-static rsmooth_status facet_pass(const rs_stream_positions *pos, int fd, uint64_t triangles,
-                                 const cell_grid *g, const box *boxes, rs_piece *pieces,
-                                 double scale, double halo, int rank, rs_region_writer *writer,
-                                 rsmooth_error *error) {
+/* The triangles of a facet pass, cut into `chunks` runs that run on every core. Both passes cut
+ * them the same way, so that the writing pass knows from the counting pass where each run's
+ * records of each piece go: after the earlier runs' records, as one pass in order would put
+ * them. */
+typedef struct facet_pass_job {
+    const rs_stream_positions *pos;
+    int fd;
+    uint64_t triangles;
+    size_t chunks;
+    const cell_grid *g;
+    const box *boxes;
+    const rs_piece *pieces;
+    size_t piece_count;
+    double scale, halo;
+    int rank;
+    uint64_t *counts;          /* chunks x pieces: each run's facets of each piece */
+    rs_region_writer *writers; /* per run (the writing pass), or NULL (the counting pass) */
+    bool *unread, *unwritten;  /* per run */
+} facet_pass_job;
+
+static void facet_run(facet_pass_job *job, size_t c) {
+    uint64_t first = job->triangles * c / job->chunks;
+    uint64_t last = job->triangles * (c + 1) / job->chunks;
     rs_stream_reader r;
-    if (!rs_stream_triangles_open(&r, fd, triangles))
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
+    if (!rs_stream_triangles_open_range(&r, job->fd, first, last)) {
+        job->unread[c] = true;
+        return;
+    }
     enum { MAX_NEAR = 512 };
     int32_t near[MAX_NEAR];
-    for (uint64_t t = 0; t < triangles; t++) {
+    uint64_t *counts = job->counts + c * job->piece_count;
+    for (uint64_t t = first; t < last && !job->unwritten[c]; t++) {
         uint32_t tri[3];
         if (!rs_stream_next_triangle(&r, tri)) {
-            rs_stream_reader_close(&r);
-            return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                           "cannot read the temporary triangle file");
+            job->unread[c] = true;
+            break;
         }
-        double corners[9], c[3], area;
-        if (!rs_stream_facet(pos, tri, scale, corners, c, &area))
+        double corners[9], centroid[3], area;
+        if (!rs_stream_facet(job->pos, tri, job->scale, corners, centroid, &area))
             continue; /* zero-area triangles weigh nothing anywhere */
         for (int k = 0; k < 3; k++)
-            c[k] /= scale; /* exact: a power of two */
-        size_t n = pieces_near(g, boxes, c, halo, near, MAX_NEAR);
+            centroid[k] /= job->scale; /* exact: a power of two */
+        size_t n = pieces_near(job->g, job->boxes, centroid, job->halo, near, MAX_NEAR);
         for (size_t i = 0; i < n; i++) {
-            rs_piece *p = &pieces[near[i]];
-            if (!writer) {
-                p->facet_count++;
-            } else if (p->rank == rank && !rs_region_append(writer, (size_t)near[i], tri)) {
-                rs_stream_reader_close(&r);
-                return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                               "cannot write a temporary file (disk full?)");
-            }
+            if (!job->writers)
+                counts[near[i]]++;
+            else if (job->pieces[near[i]].rank == job->rank &&
+                     !rs_region_append(job->writers + c, (size_t)near[i], tri))
+                job->unwritten[c] = true;
         }
     }
     rs_stream_reader_close(&r);
+}
+
+static void facet_runs(void *ctx, size_t begin, size_t end, size_t chunk) {
+    (void)chunk;
+    for (size_t c = begin; c < end; c++)
+        facet_run(ctx, c);
+}
+
+/* One pass over the triangles: counts each run's facets of each piece (writers NULL), or writes
+ * this rank's pieces' facet records. */
+static rsmooth_status facet_pass(facet_pass_job *job, rs_region_writer *writers,
+                                 rsmooth_error *error) {
+    job->writers = writers;
+    memset(job->unread, 0, job->chunks * sizeof *job->unread);
+    memset(job->unwritten, 0, job->chunks * sizeof *job->unwritten);
+    rs_parallel_for(job->chunks, 1, facet_runs, job);
+    for (size_t c = 0; c < job->chunks; c++) {
+        if (job->unread[c])
+            return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                           "cannot read the temporary triangle file");
+        if (job->unwritten[c])
+            return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                           "cannot write a temporary file (disk full?)");
+    }
     return RSMOOTH_OK;
 }
 
@@ -269,9 +309,10 @@ rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int 
     out->vertex_fd = out->facet_fd = -1;
     cell_grid g;
     cutter ct = {&g, piece_vertices ? piece_vertices : 1, NULL, NULL, 0, 0};
-    rs_region_writer vw, fw;
+    rs_region_writer vw, *writers = NULL;
     memset(&vw, 0, sizeof vw);
-    memset(&fw, 0, sizeof fw);
+    facet_pass_job job;
+    memset(&job, 0, sizeof job);
     uint64_t *starts = NULL;
     rsmooth_status st = RSMOOTH_OK;
     size_t max_cells = buffer_memory / 8 < MAX_CELLS ? buffer_memory / 8 : MAX_CELLS;
@@ -288,10 +329,23 @@ rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int 
     }
     /* a little beyond the halo: a facet exactly at it must not round out (as tiles.c) */
     double reach = halo * (1 + 1e-6);
-    st = facet_pass(positions, triangles_fd, triangle_count, &g, ct.boxes, ct.pieces, stats->scale,
-                    reach, rank, NULL, error);
+    size_t chunks = rs_parallel_chunks((size_t)triangle_count, 65536);
+    job = (facet_pass_job){positions, triangles_fd, triangle_count, chunks, &g, ct.boxes,
+                           ct.pieces, ct.count, stats->scale, reach, rank,
+                           rs_calloc_array(chunks * (ct.count ? ct.count : 1), sizeof(uint64_t)),
+                           NULL, rs_alloc_array(chunks, sizeof(bool)),
+                           rs_alloc_array(chunks, sizeof(bool))};
+    writers = rs_calloc_array(chunks, sizeof *writers);
+    if (!job.counts || !job.unread || !job.unwritten || !writers) {
+        st = no_memory(error);
+        goto done;
+    }
+    st = facet_pass(&job, NULL, error);
     if (st != RSMOOTH_OK)
         goto done;
+    for (size_t c = 0; c < chunks; c++)
+        for (size_t i = 0; i < ct.count; i++)
+            ct.pieces[i].facet_count += job.counts[c * ct.count + i];
     if (!share(ct.pieces, ct.count, ranks < 1 ? 1 : ranks)) {
         st = no_memory(error);
         goto done;
@@ -339,21 +393,31 @@ rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int 
                      "cannot write a temporary file in %s (disk full?)", dir);
         goto done;
     }
-    for (size_t i = 0; i < ct.count; i++)
+    for (size_t i = 0; i < ct.count; i++) /* each run's records after the earlier runs' */
         starts[i] = ct.pieces[i].facet_start;
-    if (!rs_region_writer_init(&fw, out->facet_fd, ct.count, 12, starts, buffer_memory)) {
-        st = no_memory(error);
-        goto done;
+    for (size_t c = 0; c < chunks; c++) {
+        if (!rs_region_writer_init(writers + c, out->facet_fd, ct.count, 12, starts,
+                                   buffer_memory / chunks)) {
+            st = no_memory(error);
+            goto done;
+        }
+        for (size_t i = 0; i < ct.count; i++)
+            starts[i] += job.counts[c * ct.count + i];
     }
-    st = facet_pass(positions, triangles_fd, triangle_count, &g, ct.boxes, ct.pieces, stats->scale,
-                    reach, rank, &fw, error);
-    if (st == RSMOOTH_OK && !rs_region_writer_finish(&fw))
-        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                     "cannot write a temporary file in %s (disk full?)", dir);
+    st = facet_pass(&job, writers, error);
+    for (size_t c = 0; st == RSMOOTH_OK && c < chunks; c++)
+        if (!rs_region_writer_finish(writers + c))
+            st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                         "cannot write a temporary file in %s (disk full?)", dir);
 
 done:
     rs_region_writer_free(&vw);
-    rs_region_writer_free(&fw);
+    for (size_t c = 0; writers && c < job.chunks; c++)
+        rs_region_writer_free(writers + c);
+    rs_free(writers);
+    rs_free(job.counts);
+    rs_free(job.unread);
+    rs_free(job.unwritten);
     rs_free(starts);
     rs_free(g.count);
     rs_free(g.piece);

@@ -297,50 +297,106 @@ void rs_stream_ply_close(rs_stream_ply *ply) {
     memset(ply, 0, sizeof *ply);
 }
 
+/* One chunk of rows of rs_stream_ply_read_vertices, on every core. */
+typedef struct vertex_chunk {
+    rs_stream_extent extent;
+    uint64_t bad;    /* the first vertex with a coordinate out of range, or UINT64_MAX */
+    double bad_value;
+    bool unread, no_memory;
+} vertex_chunk;
+
+typedef struct vertex_job {
+    const rs_stream_ply *ply;
+    void *xyz;
+    vertex_chunk *chunk;
+} vertex_job;
+
+static void read_rows(void *ctx, size_t begin, size_t end, size_t chunk_index) {
+    const vertex_job *job = ctx;
+    const rs_stream_ply *ply = job->ply;
+    vertex_chunk *chunk = job->chunk + chunk_index;
+    chunk->bad = UINT64_MAX;
+    for (int k = 0; k < 3; k++) {
+        chunk->extent.lo[k] = INFINITY;
+        chunk->extent.hi[k] = -INFINITY;
+    }
+    rs_stream_reader r;
+    if (!rs_stream_reader_open(&r, ply->fd, ply->path,
+                               ply->vertex_start + (uint64_t)begin * ply->vertex_stride,
+                               ply->vertex_start + (uint64_t)end * ply->vertex_stride,
+                               READ_BUFFER)) {
+        chunk->no_memory = true;
+        return;
+    }
+    bool f32 = ply->xyz_type == RS_PLY_FLOAT32;
+    rs_stream_extent *extent = &chunk->extent;
+    for (uint64_t i = begin; i < end && chunk->bad == UINT64_MAX; i++) {
+        const unsigned char *row = rs_stream_read(&r, ply->vertex_stride);
+        if (!row) {
+            chunk->unread = true;
+            break;
+        }
+        for (int k = 0; k < 3; k++) {
+            double c = value_at(row + ply->xyz_offset[k], ply->xyz_type, ply->swap);
+            if (!rs_io_coordinate_ok(c)) {
+                chunk->bad = i;
+                chunk->bad_value = c;
+                break;
+            }
+            extent->magnitude = fmax(extent->magnitude, fabs(c));
+            extent->lo[k] = fmin(extent->lo[k], c);
+            extent->hi[k] = fmax(extent->hi[k], c);
+            if (f32)
+                ((float *)job->xyz)[3 * i + (uint64_t)k] = (float)c;
+            else
+                ((double *)job->xyz)[3 * i + (uint64_t)k] = c;
+        }
+    }
+    rs_stream_reader_close(&r);
+}
+
 rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz, rs_stream_extent *extent,
                                            rsmooth_error *error) {
     uint64_t end = ply->vertex_start + ply->vertex_count * ply->vertex_stride;
     if (end > ply->size)
         return rs_fail_parse(error, -1, (int64_t)ply->size, RS_STREAM_WHERE,
                              "%s: the file ends inside the vertex block", ply->path);
-    rs_stream_reader r;
-    if (!rs_stream_reader_open(&r, ply->fd, ply->path, ply->vertex_start, end, READ_BUFFER))
+    /* rows on every core, each chunk from its own place in the file; the extent's minima and
+     * maxima and the first bad vertex do not depend on how the rows were cut */
+    size_t rows = (size_t)ply->vertex_count, chunks = rs_parallel_chunks(rows, 65536);
+    vertex_chunk *chunk = rs_calloc_array(chunks, sizeof *chunk);
+    if (!chunk)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
-    bool f32 = ply->xyz_type == RS_PLY_FLOAT32;
+    vertex_job job = {ply, xyz, chunk};
+    rs_parallel_for(rows, 65536, read_rows, &job);
     for (int k = 0; k < 3; k++) {
         extent->lo[k] = INFINITY;
         extent->hi[k] = -INFINITY;
     }
     extent->magnitude = 0;
-    for (uint64_t i = 0; i < ply->vertex_count; i++) {
-        const unsigned char *row = rs_stream_read(&r, ply->vertex_stride);
-        if (!row) {
-            rs_stream_reader_close(&r);
-            return io_fail(ply->path, "cannot read the vertices", error);
-        }
+    rsmooth_status st = RSMOOTH_OK;
+    for (size_t c = 0; c < chunks && st == RSMOOTH_OK; c++) { /* in file order: the first error */
+        if (chunk[c].no_memory)
+            st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
+        else if (chunk[c].bad != UINT64_MAX)
+            st = rs_fail_parse(error, -1,
+                               (int64_t)(ply->vertex_start + chunk[c].bad * ply->vertex_stride),
+                               RS_STREAM_WHERE,
+                               "%s: vertex %llu has coordinate %g (finite values up to 1e150 "
+                               "are supported)",
+                               ply->path, (unsigned long long)chunk[c].bad, chunk[c].bad_value);
+        else if (chunk[c].unread)
+            st = io_fail(ply->path, "cannot read the vertices", error);
         for (int k = 0; k < 3; k++) {
-            double c = value_at(row + ply->xyz_offset[k], ply->xyz_type, ply->swap);
-            if (!rs_io_coordinate_ok(c)) {
-                rs_stream_reader_close(&r);
-                return rs_fail_parse(error, -1,
-                                     (int64_t)(ply->vertex_start + i * ply->vertex_stride),
-                                     RS_STREAM_WHERE,
-                                     "%s: vertex %llu has coordinate %g (finite values up to "
-                                     "1e150 are supported)",
-                                     ply->path, (unsigned long long)i, c);
-            }
-            extent->magnitude = fmax(extent->magnitude, fabs(c));
-            extent->lo[k] = fmin(extent->lo[k], c);
-            extent->hi[k] = fmax(extent->hi[k], c);
-            if (f32)
-                ((float *)xyz)[3 * i + (uint64_t)k] = (float)c;
-            else
-                ((double *)xyz)[3 * i + (uint64_t)k] = c;
+            extent->lo[k] = fmin(extent->lo[k], chunk[c].extent.lo[k]);
+            extent->hi[k] = fmax(extent->hi[k], chunk[c].extent.hi[k]);
         }
+        extent->magnitude = fmax(extent->magnitude, chunk[c].extent.magnitude);
     }
-    rs_stream_reader_close(&r);
-    ply->magnitude = extent->magnitude;
-    return RSMOOTH_OK;
+    rs_free(chunk);
+    if (st == RSMOOTH_OK)
+        ply->magnitude = extent->magnitude;
+    return st;
 }
 
 /* The in-memory reader's last check: after the elements the header declares, blanks only (a

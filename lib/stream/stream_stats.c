@@ -7,7 +7,9 @@
  *   - the mean area: facets summed per block of 8192 triangles, the blocks' sums in order.
  *
  * Both sum at the in-memory path's own power-of-two scale (scale.c, from the same sampled
- * triangles), so even where squares under- or overflow at other scales the figures agree. */
+ * triangles), so even where squares under- or overflow at other scales the figures agree. The
+ * lengths and the blocks' sums are made on every core (rs_parallel_for); only the final sums run
+ * in one thread, in that order, so the bits do not depend on the number of threads. */
 #include "core/parts.h"
 #include "stream/stream_internal.h"
 
@@ -35,12 +37,57 @@ static rsmooth_status read_fail(rsmooth_error *error) {
                    "cannot read the temporary triangle file");
 }
 
+/* The vertices whose edges edge_lengths measures: each lower vertex's bucket of upper ends. */
+typedef struct edge_job {
+    const rs_stream_positions *pos;
+    double scale;
+    uint32_t lo;         /* the first lower vertex */
+    const size_t *start; /* bucket i: upper[start[i], start[i + 1]) */
+    uint32_t *upper;
+    double *length; /* per upper end: its edge's length, or -1 for an edge seen before */
+} edge_job;
+
+/* Buckets [begin, end), on every core: each sorted when large (mesh.c's rule), its repeated
+ * edges marked, the others measured. */
+static void edge_lengths(void *ctx, size_t begin, size_t end, size_t chunk) {
+    (void)chunk;
+    const edge_job *job = ctx;
+    for (size_t i = begin; i < end; i++) {
+        uint32_t *bucket = job->upper + job->start[i];
+        double *length = job->length + job->start[i];
+        size_t n = job->start[i + 1] - job->start[i];
+        if (n > EDGE_SCAN_LIMIT)
+            qsort(bucket, n, sizeof *bucket, compare_u32);
+        double p[3];
+        if (n > 0)
+            scaled_position(job->pos, job->lo + (uint32_t)i, job->scale, p);
+        for (size_t j = 0; j < n; j++) {
+            bool seen = false;
+            if (n > EDGE_SCAN_LIMIT)
+                seen = j > 0 && bucket[j] == bucket[j - 1];
+            else
+                for (size_t k = 0; k < j && !seen; k++)
+                    seen = bucket[k] == bucket[j];
+            length[j] = -1;
+            if (seen)
+                continue;
+            double q[3], d[3];
+            scaled_position(job->pos, bucket[j], job->scale, q);
+            for (int k = 0; k < 3; k++)
+                d[k] = p[k] - q[k];
+            length[j] = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        }
+    }
+}
+
 /* Sum and count of the unique edges whose lower vertex lies in [lo, hi); `capacity` upper ends
- * fit in `upper`. *fits is false (nothing summed) when the range has more edges than that. */
+ * fit in `upper` and their lengths in `length`. *fits is false (nothing summed) when the range
+ * has more edges than that. The lengths are measured on every core and summed here in the
+ * in-memory path's order. */
 static rsmooth_status edge_range(const rs_stream_positions *pos, int fd, uint64_t triangles,
                                  double scale, uint32_t lo, uint32_t hi, size_t *start,
-                                 uint32_t *upper, size_t capacity, double *sum, uint64_t *unique,
-                                 bool *fits, rsmooth_error *error) {
+                                 uint32_t *upper, double *length, size_t capacity, double *sum,
+                                 uint64_t *unique, bool *fits, rsmooth_error *error) {
     size_t span = (size_t)(hi - lo);
     for (int fill = 0; fill < 2; fill++) { /* count, then place */
         if (fill == 0)
@@ -78,31 +125,13 @@ static rsmooth_status edge_range(const rs_stream_positions *pos, int fd, uint64_
     for (size_t v = span; v > 0; v--) /* the fill moved each start to the next's */
         start[v] = start[v - 1];
     start[0] = 0;
-    for (size_t i = 0; i < span; i++) {
-        uint32_t *bucket = upper + start[i];
-        size_t n = start[i + 1] - start[i];
-        if (n > EDGE_SCAN_LIMIT)
-            qsort(bucket, n, sizeof *bucket, compare_u32);
-        double p[3];
-        if (n > 0)
-            scaled_position(pos, lo + (uint32_t)i, scale, p);
-        for (size_t j = 0; j < n; j++) {
-            bool seen = false;
-            if (n > EDGE_SCAN_LIMIT)
-                seen = j > 0 && bucket[j] == bucket[j - 1];
-            else
-                for (size_t k = 0; k < j && !seen; k++)
-                    seen = bucket[k] == bucket[j];
-            if (seen)
-                continue;
-            double q[3], d[3];
-            scaled_position(pos, bucket[j], scale, q);
-            for (int k = 0; k < 3; k++)
-                d[k] = p[k] - q[k];
-            *sum += sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    edge_job job = {pos, scale, lo, start, upper, length};
+    rs_parallel_for(span, 4096, edge_lengths, &job);
+    for (size_t e = 0; e < start[span]; e++) /* in order: the in-memory path's bits */
+        if (!(length[e] < 0)) {
+            *sum += length[e];
             (*unique)++;
         }
-    }
     *fits = true;
     return RSMOOTH_OK;
 }
@@ -112,7 +141,7 @@ static rsmooth_status mean_edge_length(const rs_stream_positions *pos, int fd, u
                                        rsmooth_error *error) {
     uint64_t v_count = pos->count;
     /* a first guess at the run of vertices that fits: each holds about 3 T / V upper ends */
-    double per_vertex = 8 + 4 * (v_count ? 3.0 * (double)triangles / (double)v_count : 0) * 1.25;
+    double per_vertex = 8 + 12 * (v_count ? 3.0 * (double)triangles / (double)v_count : 0) * 1.25;
     uint64_t span = (uint64_t)((double)memory / per_vertex);
     if (span < 1024)
         span = 1024;
@@ -124,22 +153,26 @@ static rsmooth_status mean_edge_length(const rs_stream_positions *pos, int fd, u
         uint64_t hi = lo + span < v_count ? lo + span : v_count;
         size_t *start = rs_alloc_array((size_t)(hi - lo) + 1, sizeof *start);
         uint64_t used = 8 * (hi - lo + 1);
-        size_t capacity = memory > used ? (size_t)((memory - used) / 4) : 0;
+        /* an upper end (4 bytes) and its length (8) per edge */
+        size_t capacity = memory > used ? (size_t)((memory - used) / 12) : 0;
         if (capacity > 3 * triangles)
             capacity = (size_t)(3 * triangles);
         uint32_t *upper = rs_alloc_array(capacity ? capacity : 1, sizeof *upper);
-        if (!start || !upper) {
+        double *length = rs_alloc_array(capacity ? capacity : 1, sizeof *length);
+        if (!start || !upper || !length) {
             rs_free(start);
             rs_free(upper);
+            rs_free(length);
             return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
                            "no memory for the edges of %llu vertices",
                            (unsigned long long)(hi - lo));
         }
         bool fits = false;
         rsmooth_status st = edge_range(pos, fd, triangles, scale, (uint32_t)lo, (uint32_t)hi, start,
-                                       upper, capacity, &sum, &unique, &fits, error);
+                                       upper, length, capacity, &sum, &unique, &fits, error);
         rs_free(start);
         rs_free(upper);
+        rs_free(length);
         if (st != RSMOOTH_OK)
             return st;
         if (!fits && hi - lo <= 1)
@@ -156,51 +189,110 @@ static rsmooth_status mean_edge_length(const rs_stream_positions *pos, int fd, u
     return RSMOOTH_OK;
 }
 
-/* Facet count, mean area and reach, in blocks as mesh.c sums them. */
-static rsmooth_status facet_figures(const rs_stream_positions *pos, int fd, uint64_t triangles,
-                                    double scale, rs_stream_stats *stats, rsmooth_error *error) {
+/* What one chunk of blocks (facet_figures, on every core) finds besides its blocks' sums. */
+typedef struct facet_chunk {
+    uint64_t facets;
+    double reach, longest;
+    size_t *histogram; /* RS_PART_BIN_COUNT: the parts test's scales (core/parts.h) */
+    bool unread;       /* a read error */
+    bool no_memory;
+} facet_chunk;
+
+typedef struct facet_job {
+    const rs_stream_positions *pos;
+    int fd;
+    uint64_t triangles;
+    double scale;
+    double *block_sum; /* per block of GEOMETRY_BLOCK triangles: its facets' areas, in order */
+    facet_chunk *chunk;
+} facet_job;
+
+/* Blocks [begin, end): each block's area summed in triangle order, as mesh.c sums it. */
+static void facet_blocks(void *ctx, size_t begin, size_t end, size_t chunk_index) {
+    facet_job *job = ctx;
+    facet_chunk *chunk = job->chunk + chunk_index;
+    const rs_stream_positions *pos = job->pos;
+    uint64_t first = (uint64_t)begin * GEOMETRY_BLOCK, last = (uint64_t)end * GEOMETRY_BLOCK;
+    if (last > job->triangles)
+        last = job->triangles;
     rs_stream_reader r;
-    if (!rs_stream_triangles_open(&r, fd, triangles))
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
-    double area_sum = 0, block_sum = 0, reach = 0, longest = 0;
-    uint64_t facets = 0;
-    size_t *histogram = rs_calloc_array(RS_PART_BIN_COUNT, sizeof *histogram);
-    if (!histogram) {
-        rs_stream_reader_close(&r);
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "scale histogram");
+    chunk->histogram = rs_calloc_array(RS_PART_BIN_COUNT, sizeof *chunk->histogram);
+    if (!chunk->histogram || !rs_stream_triangles_open_range(&r, job->fd, first, last)) {
+        chunk->no_memory = true;
+        return;
     }
     rsmooth_scalar scalar = pos->f32 ? RSMOOTH_FLOAT32 : RSMOOTH_FLOAT64;
-    for (uint64_t t = 0; t < triangles; t++) {
-        uint32_t tri[3];
-        if (!rs_stream_next_triangle(&r, tri)) {
-            rs_stream_reader_close(&r);
-            rs_free(histogram);
-            return read_fail(error);
-        }
-        double hi = 0; /* the parts test (core/parts.h), in the caller's units as in memory */
-        int16_t bin = rs_scale_bin(rs_triangle_scale(scalar, pos->xyz, tri, &hi));
-        if (bin != RS_NO_BIN) {
-            histogram[bin - RS_PART_BIN_MIN]++;
-            longest = fmax(longest, hi);
-        }
-        double p[9], centroid[3], area = 0;
-        if (rs_stream_facet(pos, tri, scale, p, centroid, &area)) {
-            facets++;
-            block_sum += area;
-            for (int c = 0; c < 3; c++) {
-                double d[3];
-                rs_sub3(p + 3 * c, centroid, d);
-                reach = fmax(reach, sqrt(rs_dot3(d, d)));
+    for (size_t b = begin; b < end && !chunk->unread; b++) {
+        double block_sum = 0;
+        uint64_t block_end = (uint64_t)(b + 1) * GEOMETRY_BLOCK;
+        for (uint64_t t = (uint64_t)b * GEOMETRY_BLOCK; t < block_end && t < last; t++) {
+            uint32_t tri[3];
+            if (!rs_stream_next_triangle(&r, tri)) {
+                chunk->unread = true;
+                break;
+            }
+            double hi = 0; /* the parts test, in the caller's units as in memory */
+            int16_t bin = rs_scale_bin(rs_triangle_scale(scalar, pos->xyz, tri, &hi));
+            if (bin != RS_NO_BIN) {
+                chunk->histogram[bin - RS_PART_BIN_MIN]++;
+                chunk->longest = fmax(chunk->longest, hi);
+            }
+            double p[9], centroid[3], area = 0;
+            if (rs_stream_facet(pos, tri, job->scale, p, centroid, &area)) {
+                chunk->facets++;
+                block_sum += area;
+                for (int c = 0; c < 3; c++) {
+                    double d[3];
+                    rs_sub3(p + 3 * c, centroid, d);
+                    chunk->reach = fmax(chunk->reach, sqrt(rs_dot3(d, d)));
+                }
             }
         }
-        if ((t + 1) % GEOMETRY_BLOCK == 0 || t + 1 == triangles) {
-            area_sum += block_sum;
-            block_sum = 0;
-        }
+        job->block_sum[b] = block_sum;
     }
     rs_stream_reader_close(&r);
-    stats->whole = rs_scales_whole(histogram, longest);
+}
+
+/* Facet count, mean area and reach, in blocks as mesh.c sums them: the blocks on every core,
+ * then their sums in block order, so the bits do not depend on the number of threads. */
+static rsmooth_status facet_figures(const rs_stream_positions *pos, int fd, uint64_t triangles,
+                                    double scale, rs_stream_stats *stats, rsmooth_error *error) {
+    size_t blocks = (size_t)((triangles + GEOMETRY_BLOCK - 1) / GEOMETRY_BLOCK);
+    size_t chunks = rs_parallel_chunks(blocks, 4);
+    facet_job job = {pos, fd, triangles, scale,
+                     rs_alloc_array(blocks ? blocks : 1, sizeof(double)),
+                     rs_calloc_array(chunks ? chunks : 1, sizeof(facet_chunk))};
+    size_t *histogram = rs_calloc_array(RS_PART_BIN_COUNT, sizeof *histogram);
+    bool ok = job.block_sum && job.chunk && histogram;
+    if (ok)
+        rs_parallel_for(blocks, 4, facet_blocks, &job);
+    double area_sum = 0, reach = 0, longest = 0;
+    uint64_t facets = 0;
+    bool failed = false;
+    for (size_t c = 0; ok && c < chunks; c++) {
+        facet_chunk *chunk = job.chunk + c;
+        failed |= chunk->unread;
+        ok &= !chunk->no_memory;
+        facets += chunk->facets;
+        reach = fmax(reach, chunk->reach);
+        longest = fmax(longest, chunk->longest);
+        for (size_t b = 0; chunk->histogram && b < RS_PART_BIN_COUNT; b++)
+            histogram[b] += chunk->histogram[b];
+    }
+    for (size_t b = 0; ok && !failed && b < blocks; b++)
+        area_sum += job.block_sum[b];
+    if (ok && !failed)
+        stats->whole = rs_scales_whole(histogram, longest);
+    for (size_t c = 0; job.chunk && c < chunks; c++)
+        rs_free(job.chunk[c].histogram);
+    rs_free(job.chunk);
+    rs_free(job.block_sum);
     rs_free(histogram);
+    if (!ok)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
+                       "no memory for the facets' figures");
+    if (failed)
+        return read_fail(error);
     stats->facet_count = facets;
     stats->scaled_mean_area = facets ? area_sum / (double)facets : 0;
     stats->mean_area = stats->scaled_mean_area / scale / scale;
