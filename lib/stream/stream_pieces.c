@@ -330,10 +330,20 @@ rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int 
     /* a little beyond the halo: a facet exactly at it must not round out (as tiles.c) */
     double reach = halo * (1 + 1e-6);
     size_t chunks = rs_parallel_chunks((size_t)triangle_count, 65536);
-    job = (facet_pass_job){positions, triangles_fd, triangle_count, chunks, &g, ct.boxes,
-                           ct.pieces, ct.count, stats->scale, reach, rank,
+    job = (facet_pass_job){positions,
+                           triangles_fd,
+                           triangle_count,
+                           chunks,
+                           &g,
+                           ct.boxes,
+                           ct.pieces,
+                           ct.count,
+                           stats->scale,
+                           reach,
+                           rank,
                            rs_calloc_array(chunks * (ct.count ? ct.count : 1), sizeof(uint64_t)),
-                           NULL, rs_alloc_array(chunks, sizeof(bool)),
+                           NULL,
+                           rs_alloc_array(chunks, sizeof(bool)),
                            rs_alloc_array(chunks, sizeof(bool))};
     writers = rs_calloc_array(chunks, sizeof *writers);
     if (!job.counts || !job.unread || !job.unwritten || !writers) {

@@ -300,7 +300,7 @@ void rs_stream_ply_close(rs_stream_ply *ply) {
 /* One chunk of rows of rs_stream_ply_read_vertices, on every core. */
 typedef struct vertex_chunk {
     rs_stream_extent extent;
-    uint64_t bad;    /* the first vertex with a coordinate out of range, or UINT64_MAX */
+    uint64_t bad; /* the first vertex with a coordinate out of range, or UINT64_MAX */
     double bad_value;
     bool unread, no_memory;
 } vertex_chunk;
@@ -321,10 +321,9 @@ static void read_rows(void *ctx, size_t begin, size_t end, size_t chunk_index) {
         chunk->extent.hi[k] = -INFINITY;
     }
     rs_stream_reader r;
-    if (!rs_stream_reader_open(&r, ply->fd, ply->path,
-                               ply->vertex_start + (uint64_t)begin * ply->vertex_stride,
-                               ply->vertex_start + (uint64_t)end * ply->vertex_stride,
-                               READ_BUFFER)) {
+    if (!rs_stream_reader_open(
+            &r, ply->fd, ply->path, ply->vertex_start + (uint64_t)begin * ply->vertex_stride,
+            ply->vertex_start + (uint64_t)end * ply->vertex_stride, READ_BUFFER)) {
         chunk->no_memory = true;
         return;
     }

@@ -259,7 +259,10 @@ static rsmooth_status facet_figures(const rs_stream_positions *pos, int fd, uint
                                     double scale, rs_stream_stats *stats, rsmooth_error *error) {
     size_t blocks = (size_t)((triangles + GEOMETRY_BLOCK - 1) / GEOMETRY_BLOCK);
     size_t chunks = rs_parallel_chunks(blocks, 4);
-    facet_job job = {pos, fd, triangles, scale,
+    facet_job job = {pos,
+                     fd,
+                     triangles,
+                     scale,
                      rs_alloc_array(blocks ? blocks : 1, sizeof(double)),
                      rs_calloc_array(chunks ? chunks : 1, sizeof(facet_chunk))};
     size_t *histogram = rs_calloc_array(RS_PART_BIN_COUNT, sizeof *histogram);
