@@ -22,7 +22,8 @@ static const rs_environment_entry table[RS_ENV_COUNT] = {
                               "most of the device's memory", NULL},
     [RS_ENV_HOST_THREADS] = {"RSMOOTH_HOST_THREADS",
                              "threads of the host's stages (grid, facet data, noise estimate, "
-                             "the normal-update stage on CPU devices)",
+                             "the normal-update stage on CPU devices; streaming's reading, "
+                             "figures and cutting)",
                              "every online core", "1..64"},
     [RS_ENV_CACHE_DIR] = {"RSMOOTH_CACHE_DIR",
                           "the folder of the compiled-program cache; empty or off: no cache",

@@ -300,6 +300,85 @@ static rsmooth_status no_memory(rsmooth_error *error) {
     return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "no memory for pieces");
 }
 
+static rsmooth_status unwritten(const char *dir, rsmooth_error *error) {
+    return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                   "cannot write a temporary file in %s (disk full?)", dir);
+}
+
+static void facet_job_free(facet_pass_job *job) {
+    rs_free(job->counts);
+    rs_free(job->unread);
+    rs_free(job->unwritten);
+}
+
+/* Each piece's facet count (the counting pass), with the runs' counts kept in job. */
+static rsmooth_status count_facets(facet_pass_job *job, rs_piece *pieces, size_t count,
+                                   rsmooth_error *error) {
+    job->chunks = rs_parallel_chunks((size_t)job->triangles, 65536);
+    job->counts = rs_calloc_array(job->chunks * (count ? count : 1), sizeof(uint64_t));
+    job->unread = rs_alloc_array(job->chunks, sizeof(bool));
+    job->unwritten = rs_alloc_array(job->chunks, sizeof(bool));
+    if (!job->counts || !job->unread || !job->unwritten)
+        return no_memory(error);
+    rsmooth_status st = facet_pass(job, NULL, error);
+    for (size_t c = 0; st == RSMOOTH_OK && c < job->chunks; c++)
+        for (size_t i = 0; i < count; i++)
+            pieces[i].facet_count += job->counts[c * count + i];
+    return st;
+}
+
+/* This rank's pieces' vertex lists, in vertex order. */
+static rsmooth_status write_vertex_lists(const rs_stream_positions *positions, const cell_grid *g,
+                                         const rs_piece *pieces, size_t count, int rank, int fd,
+                                         size_t buffer_memory, const char *dir,
+                                         rsmooth_error *error) {
+    uint64_t *starts = rs_alloc_array(count ? count : 1, sizeof *starts);
+    if (!starts)
+        return no_memory(error);
+    for (size_t i = 0; i < count; i++)
+        starts[i] = pieces[i].vertex_start;
+    rs_region_writer w;
+    bool ok = rs_region_writer_init(&w, fd, count, 4, starts, buffer_memory);
+    rs_free(starts);
+    if (!ok)
+        return no_memory(error);
+    for (uint64_t v = 0; ok && v < positions->count; v++) {
+        int32_t id = g->piece[vertex_cell(g, positions, v)];
+        uint32_t v32 = (uint32_t)v;
+        ok = pieces[id].rank != rank || rs_region_append(&w, (size_t)id, &v32);
+    }
+    ok = rs_region_writer_finish(&w) && ok; /* (finish frees the writer) */
+    return ok ? RSMOOTH_OK : unwritten(dir, error);
+}
+
+/* This rank's pieces' facet lists: each run of triangles through its own writer, its records
+ * after the earlier runs' (count_facets' counts), so the lists are in triangle order. */
+static rsmooth_status write_facet_lists(facet_pass_job *job, int fd, size_t buffer_memory,
+                                        const char *dir, rsmooth_error *error) {
+    size_t count = job->piece_count;
+    uint64_t *starts = rs_alloc_array(count ? count : 1, sizeof *starts);
+    rs_region_writer *writers = rs_calloc_array(job->chunks, sizeof *writers);
+    rsmooth_status st = starts && writers ? RSMOOTH_OK : no_memory(error);
+    for (size_t i = 0; st == RSMOOTH_OK && i < count; i++)
+        starts[i] = job->pieces[i].facet_start;
+    for (size_t c = 0; st == RSMOOTH_OK && c < job->chunks; c++) {
+        if (!rs_region_writer_init(writers + c, fd, count, 12, starts, buffer_memory / job->chunks))
+            st = no_memory(error);
+        for (size_t i = 0; st == RSMOOTH_OK && i < count; i++)
+            starts[i] += job->counts[c * count + i];
+    }
+    if (st == RSMOOTH_OK)
+        st = facet_pass(job, writers, error);
+    for (size_t c = 0; st == RSMOOTH_OK && c < job->chunks; c++)
+        if (!rs_region_writer_finish(writers + c))
+            st = unwritten(dir, error);
+    for (size_t c = 0; writers && c < job->chunks; c++)
+        rs_region_writer_free(writers + c);
+    rs_free(writers);
+    rs_free(starts);
+    return st;
+}
+
 rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int triangles_fd,
                                       uint64_t triangle_count, const rs_stream_stats *stats,
                                       double halo, uint64_t piece_vertices, size_t buffer_memory,
@@ -309,11 +388,8 @@ rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int 
     out->vertex_fd = out->facet_fd = -1;
     cell_grid g;
     cutter ct = {&g, piece_vertices ? piece_vertices : 1, NULL, NULL, 0, 0};
-    rs_region_writer vw, *writers = NULL;
-    memset(&vw, 0, sizeof vw);
     facet_pass_job job;
     memset(&job, 0, sizeof job);
-    uint64_t *starts = NULL;
     rsmooth_status st = RSMOOTH_OK;
     size_t max_cells = buffer_memory / 8 < MAX_CELLS ? buffer_memory / 8 : MAX_CELLS;
     if (!grid_init(&g, stats, halo, max_cells < 1 ? 1 : max_cells)) {
@@ -327,46 +403,27 @@ rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int 
         st = no_memory(error);
         goto done;
     }
-    /* a little beyond the halo: a facet exactly at it must not round out (as tiles.c) */
-    double reach = halo * (1 + 1e-6);
-    size_t chunks = rs_parallel_chunks((size_t)triangle_count, 65536);
-    job = (facet_pass_job){positions,
-                           triangles_fd,
-                           triangle_count,
-                           chunks,
-                           &g,
-                           ct.boxes,
-                           ct.pieces,
-                           ct.count,
-                           stats->scale,
-                           reach,
-                           rank,
-                           rs_calloc_array(chunks * (ct.count ? ct.count : 1), sizeof(uint64_t)),
-                           NULL,
-                           rs_alloc_array(chunks, sizeof(bool)),
-                           rs_alloc_array(chunks, sizeof(bool))};
-    writers = rs_calloc_array(chunks, sizeof *writers);
-    if (!job.counts || !job.unread || !job.unwritten || !writers) {
-        st = no_memory(error);
-        goto done;
-    }
-    st = facet_pass(&job, NULL, error);
+    job = (facet_pass_job){.pos = positions,
+                           .fd = triangles_fd,
+                           .triangles = triangle_count,
+                           .g = &g,
+                           .boxes = ct.boxes,
+                           .pieces = ct.pieces,
+                           .piece_count = ct.count,
+                           .scale = stats->scale,
+                           /* a little beyond the halo: a facet exactly at it must not round out
+                            * (as tiles.c) */
+                           .halo = halo * (1 + 1e-6),
+                           .rank = rank};
+    st = count_facets(&job, ct.pieces, ct.count, error);
     if (st != RSMOOTH_OK)
         goto done;
-    for (size_t c = 0; c < chunks; c++)
-        for (size_t i = 0; i < ct.count; i++)
-            ct.pieces[i].facet_count += job.counts[c * ct.count + i];
     if (!share(ct.pieces, ct.count, ranks < 1 ? 1 : ranks)) {
         st = no_memory(error);
         goto done;
     }
-    starts = rs_alloc_array(ct.count ? ct.count : 1, sizeof *starts);
     out->vertex_fd = rs_stream_temporary(dir);
     out->facet_fd = rs_stream_temporary(dir);
-    if (!starts) {
-        st = no_memory(error);
-        goto done;
-    }
     if (out->vertex_fd < 0 || out->facet_fd < 0) {
         st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
                      "cannot create a temporary file in %s", dir);
@@ -383,52 +440,13 @@ rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int 
         }
     }
     out->temporary_bytes = 4 * vertices + 12 * facets;
-    for (size_t i = 0; i < ct.count; i++)
-        starts[i] = ct.pieces[i].vertex_start;
-    if (!rs_region_writer_init(&vw, out->vertex_fd, ct.count, 4, starts, buffer_memory)) {
-        st = no_memory(error);
-        goto done;
-    }
-    for (uint64_t v = 0; v < positions->count; v++) {
-        int32_t id = g.piece[vertex_cell(&g, positions, v)];
-        uint32_t v32 = (uint32_t)v;
-        if (ct.pieces[id].rank == rank && !rs_region_append(&vw, (size_t)id, &v32)) {
-            st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                         "cannot write a temporary file in %s (disk full?)", dir);
-            goto done;
-        }
-    }
-    if (!rs_region_writer_finish(&vw)) {
-        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                     "cannot write a temporary file in %s (disk full?)", dir);
-        goto done;
-    }
-    for (size_t i = 0; i < ct.count; i++) /* each run's records after the earlier runs' */
-        starts[i] = ct.pieces[i].facet_start;
-    for (size_t c = 0; c < chunks; c++) {
-        if (!rs_region_writer_init(writers + c, out->facet_fd, ct.count, 12, starts,
-                                   buffer_memory / chunks)) {
-            st = no_memory(error);
-            goto done;
-        }
-        for (size_t i = 0; i < ct.count; i++)
-            starts[i] += job.counts[c * ct.count + i];
-    }
-    st = facet_pass(&job, writers, error);
-    for (size_t c = 0; st == RSMOOTH_OK && c < chunks; c++)
-        if (!rs_region_writer_finish(writers + c))
-            st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                         "cannot write a temporary file in %s (disk full?)", dir);
+    st = write_vertex_lists(positions, &g, ct.pieces, ct.count, rank, out->vertex_fd, buffer_memory,
+                            dir, error);
+    if (st == RSMOOTH_OK)
+        st = write_facet_lists(&job, out->facet_fd, buffer_memory, dir, error);
 
 done:
-    rs_region_writer_free(&vw);
-    for (size_t c = 0; writers && c < job.chunks; c++)
-        rs_region_writer_free(writers + c);
-    rs_free(writers);
-    rs_free(job.counts);
-    rs_free(job.unread);
-    rs_free(job.unwritten);
-    rs_free(starts);
+    facet_job_free(&job);
     rs_free(g.count);
     rs_free(g.piece);
     rs_free(ct.boxes);
