@@ -19,14 +19,17 @@ normals capped as the stage caps them (rsmooth-train-features --predict, the lib
 Writes OUT/evaluation.json and prints the tables docs/model.md quotes.
 """
 import argparse
+import functools
 import hashlib
 import json
 import os
+import shutil
 import subprocess
 import sys
 from multiprocessing import Pool
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import dataset  # noqa: E402
@@ -97,25 +100,30 @@ def measure(result, truth):
     return float(fields["theta"]), float(fields["ev"])
 
 
+@functools.lru_cache(maxsize=None)
+def scan_surface(surface):
+    """A reconstruction read once per process: vertices, triangles, normals, centroid tree, and
+    the diagonal of its box in its own frame (a box turned with the scan's frame is another box),
+    as docs/accuracy.md measured the scans."""
+    tv, tf = meshmetrics.read_mesh(surface)
+    tn, _ = meshmetrics.face_normals(tv, tf)
+    rv, _ = meshmetrics.read_mesh(os.path.join(dataset.SHARED, "scans", "stanford-bunny",
+                                               "bun_zipper.ply"))
+    return tv, tf, tn, cKDTree(tv[tf].mean(1)), float(np.linalg.norm(rv.max(0) - rv.min(0)))
+
+
 def measure_scan(result, surface):
     """theta against the nearest reconstruction triangle, ev of the vertices to its surface."""
+    tv, tf, tn, tree, diag = scan_surface(surface)
     v, f = meshmetrics.read_mesh(result)
-    tv, tf = meshmetrics.read_mesh(surface)
     n, area = meshmetrics.face_normals(v, f)
-    tn, _ = meshmetrics.face_normals(tv, tf)
     va = np.zeros(len(v))
     for j in range(3):
         np.add.at(va, f[:, j], area)
     used = va > 0
     d = meshmetrics.dist_to_surface(v[used], tv, tf)
-    # the diagonal of the reconstruction's box in its own frame (a box turned with the scan's
-    # frame is another box), as docs/accuracy.md measured the scans
-    rv, _ = meshmetrics.read_mesh(os.path.join(dataset.SHARED, "scans", "stanford-bunny",
-                                               "bun_zipper.ply"))
-    diag = float(np.linalg.norm(rv.max(0) - rv.min(0)))
     ev = float(np.sqrt((va[used] * d ** 2).sum() / va[used].sum())) / diag * 1e3
-    from scipy.spatial import cKDTree
-    _, nearest = cKDTree(tv[tf].mean(1)).query(v[f].mean(1))
+    _, nearest = tree.query(v[f].mean(1))
     cos = np.clip((n * tn[nearest]).sum(1), -1, 1)
     return float(np.degrees(np.arccos(cos[np.isfinite(cos)])).mean()), ev
 
@@ -138,11 +146,7 @@ def facet_normals(build, cache, out, case, noisy, model, surface):
                    check=True, stdout=subprocess.DEVNULL)
     read = {k: np.load(os.path.join(folder, k + ".npy")).astype(np.float64)
             for k in ("normal", "predicted", "target", "sharp")}
-    for k in read:
-        os.remove(os.path.join(folder, k + ".npy"))
-    for k in ("descriptor", "frame", "triangle"):
-        os.remove(os.path.join(folder, k + ".npy"))
-    os.rmdir(folder)
+    shutil.rmtree(folder)
 
     def angle(a, b):
         cos = (a * b).sum(1) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))

@@ -1,5 +1,6 @@
 /* Argument checks and per-facet data (centroid c_q, area a_q, unit normal n_q) shared by both
  * paths. */
+#include "core/edge_bucket.h"
 #include "core/rsmooth_internal.h"
 
 #include <math.h>
@@ -85,14 +86,6 @@ rsmooth_status rs_check_colors(const float *colors, size_t vertex_count, rsmooth
     return RSMOOTH_OK;
 }
 
-static int compare_u32(const void *a, const void *b) {
-    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
-    return (x > y) - (x < y);
-}
-
-/* Buckets of more edges than this are sorted to find duplicates; smaller ones are scanned. */
-#define EDGE_SCAN_LIMIT 32
-
 bool rs_mean_edge_length(const double *xyz, size_t vertex_count, const uint32_t *indices,
                          size_t triangle_count, double *out_length) {
     return rs_mean_edge_length_below(xyz, vertex_count, indices, triangle_count, INFINITY,
@@ -133,16 +126,9 @@ bool rs_mean_edge_length_below(const double *xyz, size_t vertex_count, const uin
     for (size_t v = 0; v < vertex_count; v++) {
         uint32_t *bucket = upper + start[v];
         size_t n = start[v + 1] - start[v];
-        if (n > EDGE_SCAN_LIMIT)
-            qsort(bucket, n, sizeof *bucket, compare_u32);
+        rs_edge_bucket_order(bucket, n);
         for (size_t i = 0; i < n; i++) {
-            bool seen = false;
-            if (n > EDGE_SCAN_LIMIT)
-                seen = i > 0 && bucket[i] == bucket[i - 1];
-            else
-                for (size_t j = 0; j < i && !seen; j++)
-                    seen = bucket[j] == bucket[i];
-            if (seen)
+            if (rs_edge_repeats(bucket, n, i))
                 continue;
             double d[3];
             rs_sub3(xyz + 3 * v, xyz + 3 * (size_t)bucket[i], d);

@@ -10,6 +10,7 @@
  * triangles), so even where squares under- or overflow at other scales the figures agree. The
  * lengths and the blocks' sums are made on every core (rs_parallel_for); only the final sums run
  * in one thread, in that order, so the bits do not depend on the number of threads. */
+#include "core/edge_bucket.h"
 #include "core/parts.h"
 #include "stream/stream_internal.h"
 
@@ -17,14 +18,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* mesh.c's constants: the block of the area sums, the bucket size from which edges are sorted */
+/* mesh.c's block of the area sums */
 #define GEOMETRY_BLOCK 8192
-#define EDGE_SCAN_LIMIT 32
-
-static int compare_u32(const void *a, const void *b) {
-    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
-    return (x > y) - (x < y);
-}
 
 static void scaled_position(const rs_stream_positions *p, uint32_t v, double scale, double out[3]) {
     rs_stream_position(p, v, out);
@@ -56,20 +51,13 @@ static void edge_lengths(void *ctx, size_t begin, size_t end, size_t chunk) {
         uint32_t *bucket = job->upper + job->start[i];
         double *length = job->length + job->start[i];
         size_t n = job->start[i + 1] - job->start[i];
-        if (n > EDGE_SCAN_LIMIT)
-            qsort(bucket, n, sizeof *bucket, compare_u32);
+        rs_edge_bucket_order(bucket, n);
         double p[3];
         if (n > 0)
             scaled_position(job->pos, job->lo + (uint32_t)i, job->scale, p);
         for (size_t j = 0; j < n; j++) {
-            bool seen = false;
-            if (n > EDGE_SCAN_LIMIT)
-                seen = j > 0 && bucket[j] == bucket[j - 1];
-            else
-                for (size_t k = 0; k < j && !seen; k++)
-                    seen = bucket[k] == bucket[j];
             length[j] = -1;
-            if (seen)
+            if (rs_edge_repeats(bucket, n, j))
                 continue;
             double q[3], d[3];
             scaled_position(job->pos, bucket[j], job->scale, q);
