@@ -92,9 +92,11 @@ void cli_stream_print_json(const rsmooth_stream_report *r, const options *opt, i
            (unsigned long long)r->triangle_count, (unsigned long long)r->facet_count,
            r->mean_edge_length, r->halo);
     printf(",\"pieces\":%zu,\"pieces_here\":%zu,\"piece_facets_max\":%llu,"
-           "\"facets_filtered\":%llu,\"temporary_bytes\":%llu,\"device\":",
+           "\"facets_filtered\":%llu,\"temporary_bytes\":%llu,\"position_runs\":%llu,"
+           "\"device\":",
            r->pieces, r->pieces_here, (unsigned long long)r->piece_facets_max,
-           (unsigned long long)r->facets_filtered, (unsigned long long)r->temporary_bytes);
+           (unsigned long long)r->facets_filtered, (unsigned long long)r->temporary_bytes,
+           (unsigned long long)r->position_runs);
     cli_print_json_string(r->device);
     printf(",\"ms\":{\"read\":%.3f,\"statistics\":%.3f,\"cut\":%.3f,\"copy\":%.3f,"
            "\"assemble\":%.3f,\"filter\":%.3f,\"write\":%.3f,\"total\":%.3f}}\n",

@@ -2,10 +2,12 @@
 # The "Large meshes" benchmark (README): generated terrains of 4M, 16M and 100M triangles
 # (rsmooth-big-mesh, binary PLY, float), each filtered in memory where it fits and under
 # --max-memory, with the peak resident memory (GNU time), the wall time, the temporary disk the
-# streaming run reports, and the capped result against the in-memory one; rsmooth-mpi on 1 and 2
-# ranks at 16M. Figures, not assertions: run it on a quiet machine.
+# streaming run reports, how often it read the positions, and the capped result against the
+# in-memory one; at 16M also a cap below the positions (MPI_CAP) and rsmooth-mpi on 1, 2 and 4
+# ranks under it. Figures, not assertions: run it on a quiet machine.
 #
-# usage: scripts/large_meshes.sh BUILD WORKDIR [MAX_TRIANGLES_IN_MEMORY ["TRIANGLES:CAP ..."]]
+# usage: scripts/large_meshes.sh BUILD WORKDIR [MAX_TRIANGLES_IN_MEMORY ["TRIANGLES:CAP ..."]
+#        [MPI_CAP]]
 #   BUILD    the build folder (rsmooth, rsmooth-big-mesh, rsmooth-mpi)
 #   WORKDIR  where the meshes go (about 5 GB free for 100M triangles, 10 GB with the outputs)
 set -euo pipefail
@@ -13,6 +15,7 @@ build=$(cd "$1" && pwd)
 work=$2
 in_memory_max=${3:-16000000}
 sizes=${4:-"4000000:256M 16000000:512M 100000000:2G"}
+mpi_cap=${5:-64M}
 here=$(cd "$(dirname "$0")" && pwd)
 mkdir -p "$work"
 cd "$work"
@@ -26,11 +29,25 @@ run() {
   echo "$wall $((kb / 1024))"
 }
 
-echo "| triangles | run | wall s | peak RSS MB | pieces | temporary MB | vs in memory |"
-echo "| --- | --- | --- | --- | --- | --- | --- |"
+# capped NAME CAP: one streamed run of $mesh ($n triangles) and its table line
+capped() {
+  read -r wall rss < <(run "$1" "$build/rsmooth" "$mesh" -o "$1.ply" --force --max-memory "$2" --json)
+  pieces=$(grep -o '"pieces":[0-9]*' "$1.out" | head -1 | cut -d: -f2)
+  runs=$(grep -o '"position_runs":[0-9]*' "$1.out" | cut -d: -f2)
+  temp=$(grep -o '"temporary_bytes":[0-9]*' "$1.out" | cut -d: -f2)
+  versus=""
+  if [ -n "$edge" ]; then
+    versus=$(python3 "$here/compare_ply_positions.py" "$1.ply" mem$n.ply "$edge")
+  fi
+  echo "| $n | --max-memory $2 | $wall | $rss | $pieces | $runs | $((temp >> 20)) | $versus |"
+  grep "streamed" "$1.err" | sed 's/^/    /' >&2
+}
+
+echo "| triangles | run | wall s | peak RSS MB | pieces | position runs | temporary MB | vs in memory |"
+echo "| --- | --- | --- | --- | --- | --- | --- | --- |"
 "$build/rsmooth-big-mesh" tiny.ply --triangles 1000 --force 2>/dev/null
 read -r wall rss < <(run tiny "$build/rsmooth" tiny.ply -o tiny_out.ply --force --max-memory 64M)
-echo "| 1000 | --max-memory 64M (the runtime's own memory) | $wall | $rss | | | |"
+echo "| 1000 | --max-memory 64M (the runtime's own memory) | $wall | $rss | | | | |"
 for spec in $sizes; do
   n=${spec%%:*}
   cap=${spec##*:}
@@ -40,25 +57,19 @@ for spec in $sizes; do
   if [ "$n" -le "$in_memory_max" ]; then
     read -r wall rss < <(run mem$n "$build/rsmooth" "$mesh" -o mem$n.ply --force)
     edge=$(sed -n 's/.*mean edge \([0-9.e+-]*\);.*/\1/p' mem$n.err)
-    echo "| $n | in memory | $wall | $rss | | | |"
+    echo "| $n | in memory | $wall | $rss | | | | |"
   fi
-  read -r wall rss < <(run cap$n "$build/rsmooth" "$mesh" -o cap$n.ply --force --max-memory "$cap" --json)
-  pieces=$(grep -o '"pieces":[0-9]*' cap$n.out | head -1 | cut -d: -f2)
-  temp=$(grep -o '"temporary_bytes":[0-9]*' cap$n.out | cut -d: -f2)
-  versus=""
-  if [ -n "$edge" ]; then
-    versus=$(python3 "$here/compare_ply_positions.py" cap$n.ply mem$n.ply "$edge")
-  fi
-  echo "| $n | --max-memory $cap | $wall | $rss | $pieces | $((temp >> 20)) | $versus |"
-  if [ "$n" -eq 16000000 ] && [ -x "$build/rsmooth-mpi" ]; then
-    for ranks in 1 2; do
+  capped cap$n "$cap"
+  if [ "$n" -eq 16000000 ]; then
+    capped low$n "$mpi_cap" # below the positions (96 MB at 16M)
+    for ranks in 1 2 4; do
+      [ -x "$build/rsmooth-mpi" ] || break
       read -r wall rss < <(run mpi$ranks "$(command -v mpirun)" -n $ranks --oversubscribe \
-        "$build/rsmooth-mpi" "$mesh" -o mpi$ranks.ply --force --max-memory "$cap")
+        "$build/rsmooth-mpi" "$mesh" -o mpi$ranks.ply --force --max-memory "$mpi_cap")
       same=$(cmp -s mpi$ranks.ply cap$n.ply && echo "the --max-memory bytes" || echo "DIFFERS")
-      echo "| $n | rsmooth-mpi -n $ranks --max-memory $cap (peak of one rank) | $wall | $rss | | | $same |"
-      grep "rank" mpi$ranks.err | sed 's/^/    /' >&2
+      echo "| $n | rsmooth-mpi -n $ranks --max-memory $mpi_cap (peak of one rank) | $wall | $rss | | | | $same |"
+      grep "rank\|statistics" mpi$ranks.err | sed 's/^/    /' >&2
     done
   fi
-  rm -f mem$n.ply mpi1.ply mpi2.ply
-  grep "streamed" cap$n.err | sed 's/^/    /' >&2
+  rm -f mem$n.ply mpi1.ply mpi2.ply mpi4.ply low$n.ply
 done

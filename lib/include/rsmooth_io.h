@@ -304,6 +304,10 @@ typedef struct rsmooth_stream_report {
      * keep the old content, an owner or group that could not be kept (only root can give a file
      * away). "" when nothing. (Added in 0.9) */
     char notes[400];
+    /** How many times runs of vertex positions were read from the input: 1 when they were held
+     * whole, more when the cap holds only a run of them at a time (each pass that needs them
+     * reads every run again). (Added in 0.11) */
+    uint64_t position_runs;
 } rsmooth_stream_report;
 
 /** Zeroes `report` and sets its struct_size. Accepts NULL. */
@@ -334,11 +338,13 @@ RSMOOTH_API void rsmooth_stream_report_init(rsmooth_stream_report *report);
  *
  * What streams: binary PLY (either byte order) with float or double x, y, z, faces of any size
  * (fanned into triangles as the reader does), up to 2^32 - 1 vertices and any number of faces.
- * Memory: the vertex positions stay in memory (12 bytes per vertex for float files, 24 for
- * double), the rest scales with the cap. Refused with RSMOOTH_ERROR_UNSUPPORTED and a message:
- * other formats, vertex normals in the file (the in-memory path recomputes them), params that need
- * the whole mesh (see rsmooth_piece_halo). RSMOOTH_ERROR_OUT_OF_MEMORY names the cap needed when
- * max_memory cannot hold the positions and one piece. Progress and cancellation through params'
+ * Memory: nothing grows with the mesh. The vertex positions are held whole when they fit in half
+ * of the cap, else read a run at a time (report->position_runs); the triangles carry their
+ * corners' positions on disk (about 48 bytes a triangle for float files, 84 for double, besides
+ * the pieces' lists). Refused with RSMOOTH_ERROR_UNSUPPORTED and a message: other formats, vertex
+ * normals in the file (the in-memory path recomputes them), params that need the whole mesh (see
+ * rsmooth_piece_halo). RSMOOTH_ERROR_OUT_OF_MEMORY names the cap needed when max_memory cannot
+ * hold the buffers and one piece (about 10 MB). Progress and cancellation through params'
  * callbacks. */
 RSMOOTH_API rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input,
                                                  const char *output, const rsmooth_params *params,

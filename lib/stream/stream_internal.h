@@ -1,10 +1,12 @@
 /* Streaming a mesh larger than memory (not installed): the parts of rsmooth_stream_smooth.
  *
- *   stream_files.c   temporary files, buffered sequential reads and positioned writes
- *   stream_ply.c     a binary PLY's layout, its vertex block and its faces as triangles
- *   stream_stats.c   the whole mesh's figures, summed as the in-memory path sums them
- *   stream_pieces.c  spatial pieces: a grid of counts cut into boxes, and their files
- *   stream_smooth.c  the pipeline (rsmooth_stream_smooth)
+ *   stream_files.c     temporary files, buffered sequential reads and positioned writes
+ *   stream_ply.c       a binary PLY's layout, its vertex block and its faces as triangles
+ *   stream_vertices.c  the positions: held whole when they fit, else read a run at a time
+ *   stream_corners.c   the triangles joined with their corners' positions (corner records)
+ *   stream_stats.c     the whole mesh's figures, summed as the in-memory path sums them
+ *   stream_pieces.c    spatial pieces: a grid of counts cut into boxes, and their files
+ *   stream_smooth.c    the pipeline (rsmooth_stream_smooth)
  */
 #ifndef RSMOOTH_STREAM_INTERNAL_H
 #define RSMOOTH_STREAM_INTERNAL_H
@@ -122,11 +124,6 @@ typedef struct rs_stream_extent {
     double magnitude;
 } rs_stream_extent;
 
-/* Reads every vertex's x, y, z into `xyz` (3 per vertex, floats when xyz_type is FLOAT32, else
- * doubles), checking each, and measures their extent on the way. */
-rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz, rs_stream_extent *extent,
-                                           rsmooth_error *error);
-
 /* Reads the faces, fans each into triangles as the in-memory reader does, and writes their
  * vertex indices (3 uint32 each) to `triangles_fd`; *triangle_count receives how many. */
 rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_fd,
@@ -144,35 +141,118 @@ rsmooth_status rs_stream_ply_check_positions(const rs_stream_ply *ply, const uin
 bool rs_stream_ply_write_positions(const rs_stream_ply *ply, int out_fd, const uint32_t *ids,
                                    size_t n, const double *xyz);
 
-/* ---- stream_stats.c ------------------------------------------------------------------------ */
+/* Reads vertex rows [first, first + count) into `xyz` (3 per vertex from xyz[0], floats when
+ * xyz_type is FLOAT32, else doubles), checking each, and measures their extent on the way. */
+rsmooth_status rs_stream_ply_read_range(rs_stream_ply *ply, uint64_t first, uint64_t count,
+                                        void *xyz, rs_stream_extent *extent, rsmooth_error *error);
 
-/* The vertex positions held in memory, in the file's type. */
-typedef struct rs_stream_positions {
-    const void *xyz;
+/* ---- stream_vertices.c --------------------------------------------------------------------- */
+
+/* The vertex positions, in the file's type: all held when they fit in the memory given, else
+ * read from the input a run of vertices at a time, by each pass that needs them. No array of the
+ * whole mesh's positions is needed: what holds them afterwards is the corner records. */
+typedef struct rs_stream_vertices {
+    rs_stream_ply *ply;
     bool f32;
     uint64_t count;
-} rs_stream_positions;
+    uint64_t run;           /* vertices per run: count when they are all held */
+    void *xyz;              /* vertices [first, first + loaded) */
+    uint64_t first, loaded; /* which run xyz holds */
+    uint64_t runs_read;     /* runs read from the file, for the report */
+} rs_stream_vertices;
 
-static inline void rs_stream_position(const rs_stream_positions *p, uint64_t v, double out[3]) {
+/* Reads every vertex once, checking each and measuring their extent, holding `memory` bytes of
+ * positions at most (all of them when they fit). */
+rsmooth_status rs_stream_vertices_open(rs_stream_vertices *v, rs_stream_ply *ply, uint64_t memory,
+                                       rs_stream_extent *extent, rsmooth_error *error);
+/* Makes xyz hold the run that starts at vertex `first` (a multiple of run), reading it unless it
+ * is held already. */
+rsmooth_status rs_stream_vertices_load(rs_stream_vertices *v, uint64_t first, rsmooth_error *error);
+/* Frees the run held (a later load allocates it again). */
+void rs_stream_vertices_release(rs_stream_vertices *v);
+
+/* Vertex `id`'s position (one of the loaded run's). */
+static inline void rs_stream_vertex(const rs_stream_vertices *v, uint64_t id, double out[3]) {
+    uint64_t i = 3 * (id - v->first);
     for (int k = 0; k < 3; k++)
-        out[k] = p->f32 ? (double)((const float *)p->xyz)[3 * v + (uint64_t)k]
-                        : ((const double *)p->xyz)[3 * v + (uint64_t)k];
+        out[k] = v->f32 ? (double)((const float *)v->xyz)[i + (uint64_t)k]
+                        : ((const double *)v->xyz)[i + (uint64_t)k];
 }
 
-/* rs_triangle_geometry of triangle `tri` with its corners times `scale` (internal units):
- * whether it is a facet, and then its centroid (scaled) and area. */
-static inline bool rs_stream_facet(const rs_stream_positions *p, const uint32_t tri[3],
-                                   double scale, double corners[9], double centroid[3],
-                                   double *area) {
+/* ---- stream_corners.c ---------------------------------------------------------------------- */
+
+/* The triangles as corner records on disk: a triangle's three vertex ids (uint32), then its
+ * corners' x y z in the file's type. Every later pass reads its positions from them (or from
+ * the pieces' lists, made of the same records), so no pass needs the whole mesh's positions. */
+typedef struct rs_stream_corners {
+    int fd;
+    int ids_fd; /* the same triangles' ids alone, while kept (else -1): for passes that count */
+    bool f32;
+    size_t record; /* bytes per triangle */
+    uint64_t count;
+} rs_stream_corners;
+
+static inline size_t rs_stream_corner_record(bool f32) {
+    return 3 * sizeof(uint32_t) + 9 * (f32 ? sizeof(float) : sizeof(double));
+}
+
+/* Writes the corner records of the `triangles` in `ids_fd` (3 uint32 each) to out->fd, reading
+ * the positions a run of vertices at a time: one pass over the triangles per run. */
+rsmooth_status rs_stream_corners_write(rs_stream_vertices *v, int ids_fd, uint64_t triangles,
+                                       rs_stream_corners *out, rsmooth_error *error);
+
+/* Records [first, end) front to back; readers of one file at different places may run at once
+ * (each reads with pread at its own offset). */
+bool rs_stream_corners_open_range(rs_stream_reader *r, const rs_stream_corners *c, uint64_t first,
+                                  uint64_t end);
+
+/* The next record, or NULL at the end or on a read error. */
+static inline const unsigned char *rs_stream_next_record(rs_stream_reader *r,
+                                                         const rs_stream_corners *c) {
+    return rs_stream_read(r, c->record);
+}
+
+static inline void rs_stream_record_ids(const unsigned char *rec, uint32_t tri[3]) {
+    memcpy(tri, rec, 3 * sizeof(uint32_t));
+}
+
+/* Corner c's (0-2) position in a record. */
+static inline void rs_stream_record_corner(bool f32, const unsigned char *rec, int c,
+                                           double out[3]) {
+    const unsigned char *at = rec + 3 * sizeof(uint32_t);
+    for (int k = 0; k < 3; k++) {
+        if (f32) {
+            float x;
+            memcpy(&x, at + sizeof x * (size_t)(3 * c + k), sizeof x);
+            out[k] = (double)x;
+        } else
+            memcpy(out + k, at + sizeof(double) * (size_t)(3 * c + k), sizeof(double));
+    }
+}
+
+/* A record's corners in the file's type, as an xyz array of three vertices (for the functions
+ * of core/ that read positions through vertex ids 0, 1, 2). */
+static inline const void *rs_stream_record_xyz(bool f32, const unsigned char *rec,
+                                               double aligned[9]) {
+    memcpy(aligned, rec + 3 * sizeof(uint32_t), 9 * (f32 ? sizeof(float) : sizeof(double)));
+    return aligned;
+}
+
+/* rs_triangle_geometry of a record's triangle with its corners times `scale` (internal units):
+ * whether it is a facet, and then its corners and centroid (scaled) and area. */
+static inline bool rs_stream_facet(bool f32, const unsigned char *rec, double scale,
+                                   double corners[9], double centroid[3], double *area) {
     static const uint32_t local[3] = {0, 1, 2};
     double normal[3];
     for (int c = 0; c < 3; c++) {
-        rs_stream_position(p, tri[c], corners + 3 * c);
+        rs_stream_record_corner(f32, rec, c, corners + 3 * c);
         for (int k = 0; k < 3; k++)
             corners[3 * c + k] *= scale;
     }
     return rs_triangle_geometry(corners, local, centroid, normal, area);
 }
+
+/* ---- stream_stats.c ------------------------------------------------------------------------ */
 
 typedef struct rs_stream_stats {
     double scale;            /* power of two the sums run at (exact; see stream_stats.c) */
@@ -187,34 +267,36 @@ typedef struct rs_stream_stats {
     bool whole;          /* one part, no edge out of line (core/parts.h): what streams */
 } rs_stream_stats;
 
-/* The figures of the mesh whose triangles are in `triangles_fd`, with at most `memory` bytes of
- * working memory for the unique edges. */
-rsmooth_status rs_stream_statistics(const rs_stream_positions *positions, int triangles_fd,
-                                    uint64_t triangle_count, const rs_stream_extent *extent,
-                                    uint64_t memory, rs_stream_stats *stats, rsmooth_error *error);
+/* The figures of the mesh of `vertex_count` vertices whose triangles are `corners`, with at most
+ * `memory` bytes of working memory for the unique edges. */
+rsmooth_status rs_stream_statistics(const rs_stream_corners *corners, uint64_t vertex_count,
+                                    const rs_stream_extent *extent, uint64_t memory,
+                                    rs_stream_stats *stats, rsmooth_error *error);
 
 /* ---- stream_pieces.c ----------------------------------------------------------------------- */
 
 typedef struct rs_piece {
     uint64_t vertex_start, vertex_count; /* in the vertex list file, records */
-    uint64_t facet_start, facet_count;   /* in the facet list file, records (3 uint32) */
+    uint64_t facet_start, facet_count;   /* in the facet list file, corner records */
     int rank;                            /* who filters it */
 } rs_piece;
 
 typedef struct rs_stream_pieces {
     rs_piece *pieces;
     size_t count;
-    int vertex_fd, facet_fd; /* the lists (facets only of this rank's pieces) */
+    int vertex_fd, facet_fd; /* the lists (only of this rank's pieces) */
+    size_t vertex_record;    /* a vertex's id (uint32), then its x y z in the file's type */
     uint64_t temporary_bytes;
 } rs_stream_pieces;
 
 /* Cuts the mesh into pieces of at most about `piece_vertices` core vertices, shares them among
- * `ranks` by their facet counts, and writes each piece's core vertex ids and (for this `rank`'s
- * pieces) its facets within `halo` to temporary files in `dir`. */
-rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int triangles_fd,
-                                      uint64_t triangle_count, const rs_stream_stats *stats,
-                                      double halo, uint64_t piece_vertices, size_t buffer_memory,
-                                      int rank, int ranks, const char *dir, rs_stream_pieces *out,
+ * `ranks` by their facet counts, and writes (for this `rank`'s pieces) each piece's core
+ * vertices and its facets within `halo` (corner records) to temporary files in `dir`. */
+rsmooth_status rs_stream_pieces_build(rs_stream_vertices *vertices,
+                                      const rs_stream_corners *corners,
+                                      const rs_stream_stats *stats, double halo,
+                                      uint64_t piece_vertices, size_t buffer_memory, int rank,
+                                      int ranks, const char *dir, rs_stream_pieces *out,
                                       rsmooth_error *error);
 void rs_stream_pieces_free(rs_stream_pieces *pieces);
 

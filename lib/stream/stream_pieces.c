@@ -38,11 +38,11 @@ static void cell_of(const cell_grid *g, const double p[3], int32_t c[3]) {
         c[k] = cell_coordinate(g, p[k], k);
 }
 
-/* The cell index of vertex v. */
-static size_t vertex_cell(const cell_grid *g, const rs_stream_positions *positions, uint64_t v) {
+/* The cell index of vertex v (of the loaded run). */
+static size_t vertex_cell(const cell_grid *g, const rs_stream_vertices *vertices, uint64_t v) {
     double p[3];
     int32_t c[3];
-    rs_stream_position(positions, v, p);
+    rs_stream_vertex(vertices, v, p);
     cell_of(g, p, c);
     return cell_index(g, c);
 }
@@ -190,9 +190,7 @@ static size_t pieces_near(const cell_grid *g, const box *boxes, const double c[3
  * records of each piece go: after the earlier runs' records, as one pass in order would put
  * them. */
 typedef struct facet_pass_job {
-    const rs_stream_positions *pos;
-    int fd;
-    uint64_t triangles;
+    const rs_stream_corners *corners;
     size_t chunks;
     const cell_grid *g;
     const box *boxes;
@@ -206,10 +204,11 @@ typedef struct facet_pass_job {
 } facet_pass_job;
 
 static void facet_run(facet_pass_job *job, size_t c) {
-    uint64_t first = job->triangles * c / job->chunks;
-    uint64_t last = job->triangles * (c + 1) / job->chunks;
+    const rs_stream_corners *corners = job->corners;
+    uint64_t first = corners->count * c / job->chunks;
+    uint64_t last = corners->count * (c + 1) / job->chunks;
     rs_stream_reader r;
-    if (!rs_stream_triangles_open_range(&r, job->fd, first, last)) {
+    if (!rs_stream_corners_open_range(&r, corners, first, last)) {
         job->unread[c] = true;
         return;
     }
@@ -217,13 +216,13 @@ static void facet_run(facet_pass_job *job, size_t c) {
     int32_t near[MAX_NEAR];
     uint64_t *counts = job->counts + c * job->piece_count;
     for (uint64_t t = first; t < last && !job->unwritten[c]; t++) {
-        uint32_t tri[3];
-        if (!rs_stream_next_triangle(&r, tri)) {
+        const unsigned char *rec = rs_stream_next_record(&r, corners);
+        if (!rec) {
             job->unread[c] = true;
             break;
         }
-        double corners[9], centroid[3], area;
-        if (!rs_stream_facet(job->pos, tri, job->scale, corners, centroid, &area))
+        double p[9], centroid[3], area;
+        if (!rs_stream_facet(corners->f32, rec, job->scale, p, centroid, &area))
             continue; /* zero-area triangles weigh nothing anywhere */
         for (int k = 0; k < 3; k++)
             centroid[k] /= job->scale; /* exact: a power of two */
@@ -232,7 +231,7 @@ static void facet_run(facet_pass_job *job, size_t c) {
             if (!job->writers)
                 counts[near[i]]++;
             else if (job->pieces[near[i]].rank == job->rank &&
-                     !rs_region_append(job->writers + c, (size_t)near[i], tri))
+                     !rs_region_append(job->writers + c, (size_t)near[i], rec))
                 job->unwritten[c] = true;
         }
     }
@@ -256,7 +255,7 @@ static rsmooth_status facet_pass(facet_pass_job *job, rs_region_writer *writers,
     for (size_t c = 0; c < job->chunks; c++) {
         if (job->unread[c])
             return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                           "cannot read the temporary triangle file");
+                           "cannot read the temporary corner file");
         if (job->unwritten[c])
             return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
                            "cannot write a temporary file (disk full?)");
@@ -314,7 +313,7 @@ static void facet_job_free(facet_pass_job *job) {
 /* Each piece's facet count (the counting pass), with the runs' counts kept in job. */
 static rsmooth_status count_facets(facet_pass_job *job, rs_piece *pieces, size_t count,
                                    rsmooth_error *error) {
-    job->chunks = rs_parallel_chunks((size_t)job->triangles, 65536);
+    job->chunks = rs_parallel_chunks((size_t)job->corners->count, 65536);
     job->counts = rs_calloc_array(job->chunks * (count ? count : 1), sizeof(uint64_t));
     job->unread = rs_alloc_array(job->chunks, sizeof(bool));
     job->unwritten = rs_alloc_array(job->chunks, sizeof(bool));
@@ -327,27 +326,56 @@ static rsmooth_status count_facets(facet_pass_job *job, rs_piece *pieces, size_t
     return st;
 }
 
-/* This rank's pieces' vertex lists, in vertex order. */
-static rsmooth_status write_vertex_lists(const rs_stream_positions *positions, const cell_grid *g,
-                                         const rs_piece *pieces, size_t count, int rank, int fd,
-                                         size_t buffer_memory, const char *dir,
-                                         rsmooth_error *error) {
+/* The grid's vertex counts, a run of vertices at a time. */
+static rsmooth_status count_vertices(rs_stream_vertices *vertices, cell_grid *g,
+                                     rsmooth_error *error) {
+    for (uint64_t first = 0; first < vertices->count; first += vertices->run) {
+        rsmooth_status st = rs_stream_vertices_load(vertices, first, error);
+        if (st != RSMOOTH_OK)
+            return st;
+        for (uint64_t v = first; v < first + vertices->loaded; v++)
+            g->count[vertex_cell(g, vertices, v)]++;
+    }
+    return RSMOOTH_OK;
+}
+
+/* This rank's pieces' vertex lists, in vertex order: each vertex's id, then its position. */
+static rsmooth_status write_vertex_lists(rs_stream_vertices *vertices, const cell_grid *g,
+                                         const rs_piece *pieces, size_t count, int rank,
+                                         rs_stream_pieces *out, size_t buffer_memory,
+                                         const char *dir, rsmooth_error *error) {
     uint64_t *starts = rs_alloc_array(count ? count : 1, sizeof *starts);
     if (!starts)
         return no_memory(error);
     for (size_t i = 0; i < count; i++)
         starts[i] = pieces[i].vertex_start;
     rs_region_writer w;
-    bool ok = rs_region_writer_init(&w, fd, count, 4, starts, buffer_memory);
+    size_t vertex_bytes = out->vertex_record - sizeof(uint32_t);
+    bool ok =
+        rs_region_writer_init(&w, out->vertex_fd, count, out->vertex_record, starts, buffer_memory);
     rs_free(starts);
     if (!ok)
         return no_memory(error);
-    for (uint64_t v = 0; ok && v < positions->count; v++) {
-        int32_t id = g->piece[vertex_cell(g, positions, v)];
-        uint32_t v32 = (uint32_t)v;
-        ok = pieces[id].rank != rank || rs_region_append(&w, (size_t)id, &v32);
+    unsigned char record[sizeof(uint32_t) + 3 * sizeof(double)];
+    rsmooth_status st = RSMOOTH_OK;
+    for (uint64_t first = 0; ok && first < vertices->count; first += vertices->run) {
+        st = rs_stream_vertices_load(vertices, first, error);
+        if (st != RSMOOTH_OK)
+            break;
+        const unsigned char *xyz = vertices->xyz;
+        for (uint64_t v = first; ok && v < first + vertices->loaded; v++) {
+            int32_t id = g->piece[vertex_cell(g, vertices, v)];
+            if (pieces[id].rank != rank)
+                continue;
+            uint32_t v32 = (uint32_t)v;
+            memcpy(record, &v32, sizeof v32);
+            memcpy(record + sizeof v32, xyz + (v - first) * vertex_bytes, vertex_bytes);
+            ok = rs_region_append(&w, (size_t)id, record);
+        }
     }
     ok = rs_region_writer_finish(&w) && ok; /* (finish frees the writer) */
+    if (st != RSMOOTH_OK)
+        return st;
     return ok ? RSMOOTH_OK : unwritten(dir, error);
 }
 
@@ -362,7 +390,8 @@ static rsmooth_status write_facet_lists(facet_pass_job *job, int fd, size_t buff
     for (size_t i = 0; st == RSMOOTH_OK && i < count; i++)
         starts[i] = job->pieces[i].facet_start;
     for (size_t c = 0; st == RSMOOTH_OK && c < job->chunks; c++) {
-        if (!rs_region_writer_init(writers + c, fd, count, 12, starts, buffer_memory / job->chunks))
+        if (!rs_region_writer_init(writers + c, fd, count, job->corners->record, starts,
+                                   buffer_memory / job->chunks))
             st = no_memory(error);
         for (size_t i = 0; st == RSMOOTH_OK && i < count; i++)
             starts[i] += job->counts[c * count + i];
@@ -379,10 +408,11 @@ static rsmooth_status write_facet_lists(facet_pass_job *job, int fd, size_t buff
     return st;
 }
 
-rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int triangles_fd,
-                                      uint64_t triangle_count, const rs_stream_stats *stats,
-                                      double halo, uint64_t piece_vertices, size_t buffer_memory,
-                                      int rank, int ranks, const char *dir, rs_stream_pieces *out,
+rsmooth_status rs_stream_pieces_build(rs_stream_vertices *vertices,
+                                      const rs_stream_corners *corners,
+                                      const rs_stream_stats *stats, double halo,
+                                      uint64_t piece_vertices, size_t buffer_memory, int rank,
+                                      int ranks, const char *dir, rs_stream_pieces *out,
                                       rsmooth_error *error) {
     memset(out, 0, sizeof *out);
     out->vertex_fd = out->facet_fd = -1;
@@ -396,16 +426,15 @@ rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int 
         st = no_memory(error);
         goto done;
     }
-    for (uint64_t v = 0; v < positions->count; v++)
-        g.count[vertex_cell(&g, positions, v)]++;
+    st = count_vertices(vertices, &g, error);
+    if (st != RSMOOTH_OK)
+        goto done;
     box all = {{0, 0, 0}, {g.dims[0], g.dims[1], g.dims[2]}};
-    if (!cut(&ct, all, positions->count)) {
+    if (!cut(&ct, all, vertices->count)) {
         st = no_memory(error);
         goto done;
     }
-    job = (facet_pass_job){.pos = positions,
-                           .fd = triangles_fd,
-                           .triangles = triangle_count,
+    job = (facet_pass_job){.corners = corners,
                            .g = &g,
                            .boxes = ct.boxes,
                            .pieces = ct.pieces,
@@ -429,19 +458,20 @@ rsmooth_status rs_stream_pieces_build(const rs_stream_positions *positions, int 
                      "cannot create a temporary file in %s", dir);
         goto done;
     }
-    uint64_t vertices = 0, facets = 0; /* this rank's pieces' lists, one after another */
+    uint64_t listed = 0, facets = 0; /* this rank's pieces' lists, one after another */
     for (size_t i = 0; i < ct.count; i++) {
         rs_piece *p = &ct.pieces[i];
-        p->vertex_start = vertices;
+        p->vertex_start = listed;
         p->facet_start = facets;
         if (p->rank == rank) {
-            vertices += p->vertex_count;
+            listed += p->vertex_count;
             facets += p->facet_count;
         }
     }
-    out->temporary_bytes = 4 * vertices + 12 * facets;
-    st = write_vertex_lists(positions, &g, ct.pieces, ct.count, rank, out->vertex_fd, buffer_memory,
-                            dir, error);
+    out->vertex_record = sizeof(uint32_t) + 3 * (corners->f32 ? sizeof(float) : sizeof(double));
+    out->temporary_bytes = out->vertex_record * listed + corners->record * facets;
+    st =
+        write_vertex_lists(vertices, &g, ct.pieces, ct.count, rank, out, buffer_memory, dir, error);
     if (st == RSMOOTH_OK)
         st = write_facet_lists(&job, out->facet_fd, buffer_memory, dir, error);
 

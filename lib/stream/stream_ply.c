@@ -307,6 +307,7 @@ typedef struct vertex_chunk {
 
 typedef struct vertex_job {
     const rs_stream_ply *ply;
+    uint64_t first; /* the vertex xyz[0] is */
     void *xyz;
     vertex_chunk *chunk;
 } vertex_job;
@@ -321,15 +322,17 @@ static void read_rows(void *ctx, size_t begin, size_t end, size_t chunk_index) {
         chunk->extent.hi[k] = -INFINITY;
     }
     rs_stream_reader r;
-    if (!rs_stream_reader_open(
-            &r, ply->fd, ply->path, ply->vertex_start + (uint64_t)begin * ply->vertex_stride,
-            ply->vertex_start + (uint64_t)end * ply->vertex_stride, READ_BUFFER)) {
+    uint64_t first = job->first + begin, last = job->first + end;
+    if (!rs_stream_reader_open(&r, ply->fd, ply->path,
+                               ply->vertex_start + first * ply->vertex_stride,
+                               ply->vertex_start + last * ply->vertex_stride, READ_BUFFER)) {
         chunk->no_memory = true;
         return;
     }
     bool f32 = ply->xyz_type == RS_PLY_FLOAT32;
     rs_stream_extent *extent = &chunk->extent;
-    for (uint64_t i = begin; i < end && chunk->bad == UINT64_MAX; i++) {
+    for (uint64_t i = first; i < last && chunk->bad == UINT64_MAX; i++) {
+        uint64_t at = 3 * (i - job->first);
         const unsigned char *row = rs_stream_read(&r, ply->vertex_stride);
         if (!row) {
             chunk->unread = true;
@@ -346,27 +349,27 @@ static void read_rows(void *ctx, size_t begin, size_t end, size_t chunk_index) {
             extent->lo[k] = fmin(extent->lo[k], c);
             extent->hi[k] = fmax(extent->hi[k], c);
             if (f32)
-                ((float *)job->xyz)[3 * i + (uint64_t)k] = (float)c;
+                ((float *)job->xyz)[at + (uint64_t)k] = (float)c;
             else
-                ((double *)job->xyz)[3 * i + (uint64_t)k] = c;
+                ((double *)job->xyz)[at + (uint64_t)k] = c;
         }
     }
     rs_stream_reader_close(&r);
 }
 
-rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz, rs_stream_extent *extent,
-                                           rsmooth_error *error) {
+rsmooth_status rs_stream_ply_read_range(rs_stream_ply *ply, uint64_t first, uint64_t count,
+                                        void *xyz, rs_stream_extent *extent, rsmooth_error *error) {
     uint64_t end = ply->vertex_start + ply->vertex_count * ply->vertex_stride;
     if (end > ply->size)
         return rs_fail_parse(error, -1, (int64_t)ply->size, RS_STREAM_WHERE,
                              "%s: the file ends inside the vertex block", ply->path);
     /* rows on every core, each chunk from its own place in the file; the extent's minima and
      * maxima and the first bad vertex do not depend on how the rows were cut */
-    size_t rows = (size_t)ply->vertex_count, chunks = rs_parallel_chunks(rows, 65536);
-    vertex_chunk *chunk = rs_calloc_array(chunks, sizeof *chunk);
+    size_t rows = (size_t)count, chunks = rs_parallel_chunks(rows, 65536);
+    vertex_chunk *chunk = rs_calloc_array(chunks ? chunks : 1, sizeof *chunk);
     if (!chunk)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
-    vertex_job job = {ply, xyz, chunk};
+    vertex_job job = {ply, first, xyz, chunk};
     rs_parallel_for(rows, 65536, read_rows, &job);
     for (int k = 0; k < 3; k++) {
         extent->lo[k] = INFINITY;
@@ -393,8 +396,6 @@ rsmooth_status rs_stream_ply_read_vertices(rs_stream_ply *ply, void *xyz, rs_str
         extent->magnitude = fmax(extent->magnitude, chunk[c].extent.magnitude);
     }
     rs_free(chunk);
-    if (st == RSMOOTH_OK)
-        ply->magnitude = extent->magnitude;
     return st;
 }
 

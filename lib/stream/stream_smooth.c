@@ -1,7 +1,8 @@
 /* rsmooth_stream_smooth: the filter on a mesh file larger than memory.
  *
- *   1. the vertex block into memory (the one array that grows with the mesh), the faces fanned
- *      into triangles on disk;
+ *   1. the vertex block read (held whole when it fits, else a run of vertices at a time), the
+ *      faces fanned into triangles on disk, and those joined with their corners' positions
+ *      (stream_corners.c): no later step looks a position up by vertex id;
  *   2. the mesh's figures (stream_stats.c) and the halo of a piece (rsmooth_piece_halo);
  *   3. the pieces and their lists on disk (stream_pieces.c), sized to the memory cap;
  *   4. the output: a copy of the input, unnamed until it is complete;
@@ -61,10 +62,9 @@ typedef struct stream_call {
     rsmooth_stream_report rep;
     char dir[4096]; /* temporaries */
     rs_stream_ply ply;
-    void *xyz;
-    rs_stream_positions positions;
-    int triangles_fd;
-    rs_output out; /* the output: its target, and the copy the results go into */
+    rs_stream_vertices vertices; /* held whole, or a run at a time */
+    rs_stream_corners corners;   /* the triangles with their corners' positions */
+    rs_output out;               /* the output: its target, and the copy the results go into */
     uint64_t triangle_count;
     rs_stream_stats stats;
     double halo;
@@ -180,6 +180,49 @@ static rsmooth_status check_arguments(stream_call *c, const rsmooth_params *para
                              RS_STREAM_WHERE, error);
 }
 
+static rsmooth_status cancelled(const stream_call *c, double fraction, rsmooth_error *error) {
+    return report_progress(c, fraction)
+               ? RSMOOTH_OK
+               : rs_fail(error, RSMOOTH_ERROR_CANCELLED, RS_STREAM_WHERE, "cancelled");
+}
+
+/* Step 1: the vertices (their extent), the triangles, and the corner records. The positions get
+ * what the cap leaves beside the fixed buffers: all of them when they fit in half of it (then
+ * they stay, and the passes after need not read them again), else runs as long as the cap
+ * allows, one pass over the triangles per run. */
+static rsmooth_status read_input(stream_call *c, rs_stream_extent *extent, rsmooth_error *error) {
+    bool f32 = c->ply.xyz_type == RS_PLY_FLOAT32;
+    uint64_t position_bytes = c->ply.vertex_count * 3 * (f32 ? 4 : 8);
+    uint64_t room = c->opt.max_memory - FIXED_BYTES;
+    uint64_t held = position_bytes <= room / 2 ? position_bytes : room;
+    rsmooth_status st = rs_stream_vertices_open(&c->vertices, &c->ply, held, extent, error);
+    if (st == RSMOOTH_OK)
+        st = cancelled(c, 0.03, error);
+    if (st != RSMOOTH_OK)
+        return st;
+    int ids_fd = rs_stream_temporary(c->dir);
+    c->corners.fd = rs_stream_temporary(c->dir);
+    if (ids_fd < 0 || c->corners.fd < 0) {
+        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                     "cannot create a temporary file in %s: %s", c->dir, strerror(errno));
+        if (ids_fd >= 0)
+            close(ids_fd);
+        return st;
+    }
+    st = rs_stream_ply_write_triangles(&c->ply, ids_fd, &c->triangle_count, error);
+    if (st == RSMOOTH_OK && c->ply.face_count == 0) /* the in-memory reader's word for it */
+        st = rs_fail_parse(error, -1, (int64_t)c->ply.size, RS_STREAM_WHERE,
+                           "%s: %llu vertices but no faces and no vertex normals: a mesh needs "
+                           "faces, a point cloud normals (nx, ny, nz)",
+                           c->input, (unsigned long long)c->ply.vertex_count);
+    if (st == RSMOOTH_OK)
+        st = rs_stream_corners_write(&c->vertices, ids_fd, c->triangle_count, &c->corners, error);
+    c->corners.ids_fd = ids_fd; /* for the statistics' counting passes, then closed */
+    if (st == RSMOOTH_OK && c->vertices.run < c->vertices.count)
+        rs_stream_vertices_release(&c->vertices); /* the statistics get the room */
+    return st;
+}
+
 /* Steps 1-3: everything before the output is touched. */
 static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
     double t0 = now_ms();
@@ -189,49 +232,29 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
         return st;
     c->rep.vertex_count = c->ply.vertex_count;
     c->rep.face_count = c->ply.face_count;
-    bool f32 = c->ply.xyz_type == RS_PLY_FLOAT32;
-    uint64_t position_bytes = c->ply.vertex_count * 3 * (f32 ? 4 : 8);
     uint64_t cap = c->opt.max_memory;
-    uint64_t least = position_bytes + FIXED_BYTES + MIN_PIECE_VERTICES * PIECE_BYTES_PER_VERTEX;
+    uint64_t least = FIXED_BYTES + MIN_PIECE_VERTICES * PIECE_BYTES_PER_VERTEX;
     if (cap < least)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
-                       "%s: a memory cap of %.1f MB is too small: its %llu vertex positions "
-                       "alone take %.1f MB; give at least %llu MB",
-                       c->input, (double)cap / (1 << 20), (unsigned long long)c->ply.vertex_count,
-                       (double)position_bytes / (1 << 20), (unsigned long long)((least >> 20) + 1));
-    c->xyz = rs_alloc_array((size_t)c->ply.vertex_count, 3 * (f32 ? 4 : 8));
-    if (!c->xyz)
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
-                       "no memory for %llu vertex positions",
-                       (unsigned long long)c->ply.vertex_count);
-    c->positions = (rs_stream_positions){c->xyz, f32, c->ply.vertex_count};
+                       "%s: a memory cap of %.1f MB is too small: its buffers and the smallest "
+                       "piece take %.1f MB; give at least %llu MB",
+                       c->input, (double)cap / (1 << 20), (double)least / (1 << 20),
+                       (unsigned long long)((least >> 20) + 1));
     rs_stream_extent extent;
-    st = rs_stream_ply_read_vertices(&c->ply, c->xyz, &extent, error);
+    st = read_input(c, &extent, error);
+    if (st == RSMOOTH_OK)
+        st = cancelled(c, 0.08, error);
     if (st != RSMOOTH_OK)
         return st;
-    if (!report_progress(c, 0.03))
-        return rs_fail(error, RSMOOTH_ERROR_CANCELLED, RS_STREAM_WHERE, "cancelled");
-    c->triangles_fd = rs_stream_temporary(c->dir);
-    if (c->triangles_fd < 0)
-        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                       "cannot create a temporary file in %s: %s", c->dir, strerror(errno));
-    st = rs_stream_ply_write_triangles(&c->ply, c->triangles_fd, &c->triangle_count, error);
-    if (st != RSMOOTH_OK)
-        return st;
-    if (c->ply.face_count == 0) /* what the in-memory reader says: a point cloud needs normals */
-        return rs_fail_parse(error, -1, (int64_t)c->ply.size, RS_STREAM_WHERE,
-                             "%s: %llu vertices but no faces and no vertex normals: a mesh needs "
-                             "faces, a point cloud normals (nx, ny, nz)",
-                             c->input, (unsigned long long)c->ply.vertex_count);
     c->rep.triangle_count = c->triangle_count;
     c->rep.ms_read = now_ms() - t0;
-    if (!report_progress(c, 0.08))
-        return rs_fail(error, RSMOOTH_ERROR_CANCELLED, RS_STREAM_WHERE, "cancelled");
 
     double t1 = now_ms();
-    uint64_t work = cap - position_bytes - FIXED_BYTES / 2;
-    st = rs_stream_statistics(&c->positions, c->triangles_fd, c->triangle_count, &extent, work,
+    uint64_t held = c->vertices.xyz ? c->vertices.run * 3 * (c->vertices.f32 ? 4 : 8) : 0;
+    st = rs_stream_statistics(&c->corners, c->ply.vertex_count, &extent, cap - held - FIXED_BYTES,
                               &c->stats, error);
+    close(c->corners.ids_fd); /* its disk comes back: the records hold the ids too */
+    c->corners.ids_fd = -1;
     if (st != RSMOOTH_OK)
         return st;
     if (!c->stats.whole)
@@ -247,24 +270,29 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
         return st;
     c->rep.halo = c->halo;
     c->rep.ms_statistics = now_ms() - t1;
-    if (!report_progress(c, 0.15))
-        return rs_fail(error, RSMOOTH_ERROR_CANCELLED, RS_STREAM_WHERE, "cancelled");
+    st = cancelled(c, 0.15, error);
+    if (st != RSMOOTH_OK)
+        return st;
 
     double t2 = now_ms();
-    c->piece_vertices = (cap - position_bytes - FIXED_BYTES) / PIECE_BYTES_PER_VERTEX;
-    c->rep.memory_planned =
-        position_bytes + FIXED_BYTES + c->piece_vertices * PIECE_BYTES_PER_VERTEX;
-    st = rs_stream_pieces_build(&c->positions, c->triangles_fd, c->triangle_count, &c->stats,
-                                c->halo, c->piece_vertices, GRID_BYTES, c->opt.rank, c->opt.ranks,
-                                c->dir, &c->pieces, error);
+    /* the pieces run once the positions are let go: they have the cap but the fixed buffers */
+    c->piece_vertices = (cap - FIXED_BYTES) / PIECE_BYTES_PER_VERTEX;
+    c->rep.memory_planned = FIXED_BYTES + c->piece_vertices * PIECE_BYTES_PER_VERTEX;
+    st = rs_stream_pieces_build(&c->vertices, &c->corners, &c->stats, c->halo, c->piece_vertices,
+                                GRID_BYTES, c->opt.rank, c->opt.ranks, c->dir, &c->pieces, error);
+    rs_stream_vertices_release(&c->vertices);
+    close(c->corners.fd); /* the pieces' lists hold what the filter needs: its disk comes back */
+    c->corners.fd = -1;
     if (st != RSMOOTH_OK)
         return st;
     c->rep.pieces = c->pieces.count;
-    c->rep.temporary_bytes = 12 * c->triangle_count + c->pieces.temporary_bytes;
+    c->rep.position_runs = c->vertices.runs_read;
+    /* at their largest: the triangles' ids beside the records, or the records beside the lists */
+    uint64_t joining = (12 + c->corners.record) * c->triangle_count;
+    uint64_t listing = c->corners.record * c->triangle_count + c->pieces.temporary_bytes;
+    c->rep.temporary_bytes = joining > listing ? joining : listing;
     c->rep.ms_buckets = now_ms() - t2;
-    return report_progress(c, 0.2)
-               ? RSMOOTH_OK
-               : rs_fail(error, RSMOOTH_ERROR_CANCELLED, RS_STREAM_WHERE, "cancelled");
+    return cancelled(c, 0.2, error);
 }
 
 /* Step 4: the copy of the input the results go into, beside the output's target. Alone: unnamed
@@ -354,64 +382,109 @@ static rsmooth_status filter_piece(stream_call *c, double *xyz, size_t k, const 
     return RSMOOTH_OK;
 }
 
-/* Step 5 for one piece: its lists read, its vertices numbered core first (then the others as the
- * facets first name them), filtered, written. */
+/* Vertex `id` into the piece (at its position `at`, 3 values of the file's type) unless it is
+ * there; *number receives its number in the piece. */
+static bool piece_vertex(id_table *table, size_t *k, uint32_t id, bool f32, const unsigned char *at,
+                         double *xyz, uint32_t *number) {
+    size_t i = id_slot(table, id);
+    if (table->key[i] != UINT32_MAX) {
+        *number = table->value[i];
+        return true;
+    }
+    if (2 * (*k + 1) > table->mask) { /* a piece this connected: grow the table */
+        id_table bigger;
+        if (!id_table_init(&bigger, 2 * (*k + 1)))
+            return false;
+        for (size_t q = 0; q <= table->mask; q++)
+            if (table->key[q] != UINT32_MAX) {
+                size_t b = id_slot(&bigger, table->key[q]);
+                bigger.key[b] = table->key[q];
+                bigger.value[b] = table->value[q];
+            }
+        id_table_free(table);
+        *table = bigger;
+        i = id_slot(table, id);
+    }
+    table->key[i] = id;
+    table->value[i] = (uint32_t)*k;
+    *number = (uint32_t)*k;
+    for (int c = 0; c < 3; c++) {
+        if (f32) {
+            float x;
+            memcpy(&x, at + sizeof x * (size_t)c, sizeof x);
+            xyz[3 * *k + (size_t)c] = (double)x;
+        } else
+            memcpy(xyz + 3 * *k + (size_t)c, at + sizeof(double) * (size_t)c, sizeof(double));
+    }
+    (*k)++;
+    return true;
+}
+
+/* A piece's arrays from its lists: its core vertices first (ids into `core`), then the others as
+ * the facets first name them, each with the position its record carries; the facets renumbered
+ * into `tri`. *k receives the piece's vertex count. */
+static bool assemble(const unsigned char *core_records, size_t n, size_t vertex_record,
+                     const unsigned char *facet_records, size_t m, size_t facet_record, bool f32,
+                     id_table *table, uint32_t *core, uint32_t *tri, double *xyz, size_t *k) {
+    *k = 0;
+    for (size_t v = 0; v < n; v++) {
+        const unsigned char *rec = core_records + v * vertex_record;
+        memcpy(core + v, rec, sizeof *core);
+        uint32_t number;
+        if (!piece_vertex(table, k, core[v], f32, rec + sizeof *core, xyz, &number))
+            return false;
+    }
+    size_t value = f32 ? sizeof(float) : sizeof(double);
+    for (size_t f = 0; f < m; f++) {
+        const unsigned char *rec = facet_records + f * facet_record;
+        uint32_t ids[3];
+        rs_stream_record_ids(rec, ids);
+        for (int c = 0; c < 3; c++) {
+            const unsigned char *at = rec + 3 * sizeof(uint32_t) + 3 * value * (size_t)c;
+            if (!piece_vertex(table, k, ids[c], f32, at, xyz, tri + 3 * f + (size_t)c))
+                return false;
+        }
+    }
+    return true;
+}
+
+/* Step 5 for one piece: its lists read, its arrays assembled, filtered, written. */
 static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error *error) {
     double t_piece = now_ms();
     size_t n = (size_t)p->vertex_count, m = (size_t)p->facet_count;
+    size_t vertex_record = c->pieces.vertex_record, facet_record = c->corners.record;
+    unsigned char *core_records = rs_alloc_array(n ? n : 1, vertex_record);
+    unsigned char *facet_records = rs_alloc_array(m ? m : 1, facet_record);
     uint32_t *core = rs_alloc_array(n ? n : 1, sizeof *core);
     uint32_t *tri = rs_alloc_array(m ? m : 1, 3 * sizeof *tri);
     /* at most n + 3m vertices; a piece's facets share their corners about 6 ways */
-    size_t most = n + 3 * m;
+    size_t most = n + 3 * m, k = 0;
     double *xyz = rs_alloc_array(most ? most : 1, 3 * sizeof *xyz);
     double *out = rs_alloc_array(n ? n : 1, 3 * sizeof *out);
     id_table table = {NULL, NULL, 0};
     rsmooth_status st = RSMOOTH_OK;
-    if (!core || !tri || !xyz || !out || !id_table_init(&table, n + m)) {
+    if (!core_records || !facet_records || !core || !tri || !xyz || !out ||
+        !id_table_init(&table, n + m)) {
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
                      "no memory for a piece of %zu facets", m);
         goto done;
     }
-    if (!rs_pread_all(c->pieces.vertex_fd, core, n * 4, p->vertex_start * 4) ||
-        !rs_pread_all(c->pieces.facet_fd, tri, m * 12, p->facet_start * 12)) {
+    if (!rs_pread_all(c->pieces.vertex_fd, core_records, n * vertex_record,
+                      p->vertex_start * vertex_record) ||
+        !rs_pread_all(c->pieces.facet_fd, facet_records, m * facet_record,
+                      p->facet_start * facet_record)) {
         st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot read a temporary file: %s",
                      strerror(errno));
         goto done;
     }
-    size_t k = 0;
-    for (; k < n; k++) {
-        size_t i = id_slot(&table, core[k]);
-        table.key[i] = core[k];
-        table.value[i] = (uint32_t)k;
-        rs_stream_position(&c->positions, core[k], xyz + 3 * k);
+    if (!assemble(core_records, n, vertex_record, facet_records, m, facet_record, c->corners.f32,
+                  &table, core, tri, xyz, &k)) {
+        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
+                     "no memory for a piece of %zu facets", m);
+        goto done;
     }
-    for (size_t j = 0; j < 3 * m; j++) {
-        size_t i = id_slot(&table, tri[j]);
-        if (table.key[i] == UINT32_MAX) {
-            if (2 * (k + 1) > table.mask) { /* a piece this connected: grow the table */
-                id_table bigger;
-                if (!id_table_init(&bigger, 2 * (k + 1))) {
-                    st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
-                                 "no memory for a piece of %zu facets", m);
-                    goto done;
-                }
-                for (size_t q = 0; q <= table.mask; q++)
-                    if (table.key[q] != UINT32_MAX) {
-                        size_t b = id_slot(&bigger, table.key[q]);
-                        bigger.key[b] = table.key[q];
-                        bigger.value[b] = table.value[q];
-                    }
-                id_table_free(&table);
-                table = bigger;
-                i = id_slot(&table, tri[j]);
-            }
-            table.key[i] = tri[j];
-            table.value[i] = (uint32_t)k;
-            rs_stream_position(&c->positions, tri[j], xyz + 3 * k);
-            k++;
-        }
-        tri[j] = table.value[i];
-    }
+    rs_free(facet_records); /* the arrays hold it all now */
+    facet_records = NULL;
     id_table_free(&table);
     table.key = table.value = NULL;
     c->rep.ms_assemble += now_ms() - t_piece;
@@ -427,6 +500,8 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
     c->rep.ms_write += now_ms() - t;
 done:
     id_table_free(&table);
+    rs_free(core_records);
+    rs_free(facet_records);
     rs_free(core);
     rs_free(tri);
     rs_free(xyz);
@@ -480,7 +555,7 @@ rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input, co
     c->ctx = ctx;
     c->input = input;
     c->output = output;
-    c->triangles_fd = -1;
+    c->corners.fd = c->corners.ids_fd = -1;
     c->out.fd = -1;
     c->out.guard = -1;
     c->ply.fd = -1;
@@ -520,12 +595,14 @@ rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input, co
         memcpy(report, &c->rep, size);
         report->struct_size = size;
     }
-    if (c->triangles_fd >= 0)
-        close(c->triangles_fd);
+    if (c->corners.fd >= 0)
+        close(c->corners.fd);
+    if (c->corners.ids_fd >= 0)
+        close(c->corners.ids_fd);
     rs_stream_pieces_free(&c->pieces);
     if (c->ply.fd >= 0)
         rs_stream_ply_close(&c->ply);
-    rs_free(c->xyz);
+    rs_stream_vertices_release(&c->vertices);
     rs_free(c);
     return st;
 }

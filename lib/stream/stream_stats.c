@@ -1,5 +1,6 @@
-/* The whole mesh's figures, from its triangles on disk, summed in the order the in-memory path
- * sums them (lib/core/mesh.c), so that the sigmas and the area scale are the same bits:
+/* The whole mesh's figures, from its corner records on disk (no position is looked up by vertex
+ * id), summed in the order the in-memory path sums them (lib/core/mesh.c), so that the sigmas and
+ * the area scale are the same bits:
  *
  *   - the mean edge length over unique edges: each edge belongs to its lower vertex, vertices in
  *     ascending order, a vertex's edges in the order the triangles first name them (mesh.c's
@@ -7,9 +8,11 @@
  *   - the mean area: facets summed per block of 8192 triangles, the blocks' sums in order.
  *
  * Both sum at the in-memory path's own power-of-two scale (scale.c, from the same sampled
- * triangles), so even where squares under- or overflow at other scales the figures agree. The
- * lengths and the blocks' sums are made on every core (rs_parallel_for); only the final sums run
- * in one thread, in that order, so the bits do not depend on the number of threads. */
+ * triangles), so even where squares under- or overflow at other scales the figures agree. An
+ * edge's length is measured from the record that places it in its bucket (the counting pass reads
+ * the ids file alone while it is kept); the buckets' order and the blocks' sums are made on every
+ * core (rs_parallel_for); only the final sums run in one thread, in that order, so the bits do not
+ * depend on the number of threads. */
 #include "core/edge_bucket.h"
 #include "core/parts.h"
 #include "stream/stream_internal.h"
@@ -21,71 +24,115 @@
 /* mesh.c's block of the area sums */
 #define GEOMETRY_BLOCK 8192
 
-static void scaled_position(const rs_stream_positions *p, uint32_t v, double scale, double out[3]) {
-    rs_stream_position(p, v, out);
-    for (int k = 0; k < 3; k++)
-        out[k] *= scale;
-}
-
 static rsmooth_status read_fail(rsmooth_error *error) {
     return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                   "cannot read the temporary triangle file");
+                   "cannot read the temporary corner file");
 }
 
-/* The vertices whose edges edge_lengths measures: each lower vertex's bucket of upper ends. */
+/* An edge as a lower vertex's bucket holds it: its upper end and its length (in two arrays,
+ * 12 bytes an edge; this pair only while a large bucket is sorted). */
+typedef struct edge_end {
+    uint32_t upper;
+    double length;
+} edge_end;
+
+static int edge_end_compare(const void *a, const void *b) {
+    return rs_edge_compare(&((const edge_end *)a)->upper, &((const edge_end *)b)->upper);
+}
+
+/* The lower vertices whose buckets edge_marks orders. */
 typedef struct edge_job {
-    const rs_stream_positions *pos;
-    double scale;
-    uint32_t lo;         /* the first lower vertex */
-    const size_t *start; /* bucket i: upper[start[i], start[i + 1]) */
+    const size_t *start; /* bucket i: upper and length [start[i], start[i + 1]) */
     uint32_t *upper;
-    double *length; /* per upper end: its edge's length, or -1 for an edge seen before */
+    double *length;
+    bool no_memory;
 } edge_job;
 
-/* Buckets [begin, end), on every core: each sorted when large (mesh.c's rule), its repeated
- * edges marked, the others measured. */
-static void edge_lengths(void *ctx, size_t begin, size_t end, size_t chunk) {
+/* A bucket of more than RS_EDGE_SCAN_LIMIT edges sorted by upper end, its lengths along. */
+static bool sort_bucket(uint32_t *upper, double *length, size_t n) {
+    edge_end *pairs = rs_alloc_array(n, sizeof *pairs);
+    if (!pairs)
+        return false;
+    for (size_t j = 0; j < n; j++)
+        pairs[j] = (edge_end){upper[j], length[j]};
+    qsort(pairs, n, sizeof *pairs, edge_end_compare);
+    for (size_t j = 0; j < n; j++) {
+        upper[j] = pairs[j].upper;
+        length[j] = pairs[j].length;
+    }
+    rs_free(pairs);
+    return true;
+}
+
+/* Buckets [begin, end), on every core: each put in the order its edges are counted in
+ * (core/edge_bucket.h: sorted when large; repeated edges have the same length, so the sort's
+ * order among them does not matter), and a repeated edge's length set to -1. */
+static void edge_marks(void *ctx, size_t begin, size_t end, size_t chunk) {
     (void)chunk;
-    const edge_job *job = ctx;
+    edge_job *job = ctx;
     for (size_t i = begin; i < end; i++) {
-        uint32_t *bucket = job->upper + job->start[i];
+        uint32_t *upper = job->upper + job->start[i];
         double *length = job->length + job->start[i];
         size_t n = job->start[i + 1] - job->start[i];
-        rs_edge_bucket_order(bucket, n);
-        double p[3];
-        if (n > 0)
-            scaled_position(job->pos, job->lo + (uint32_t)i, job->scale, p);
-        for (size_t j = 0; j < n; j++) {
-            length[j] = -1;
-            if (rs_edge_repeats(bucket, n, j))
-                continue;
-            double q[3], d[3];
-            scaled_position(job->pos, bucket[j], job->scale, q);
-            for (int k = 0; k < 3; k++)
-                d[k] = p[k] - q[k];
-            length[j] = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        if (n > RS_EDGE_SCAN_LIMIT && !sort_bucket(upper, length, n)) {
+            job->no_memory = true; /* (a flag written only to true: no race that matters) */
+            return;
         }
+        for (size_t j = 0; j < n; j++)
+            if (rs_edge_repeats(upper, n, j))
+                length[j] = -1;
     }
 }
 
-/* Sum and count of the unique edges whose lower vertex lies in [lo, hi); `capacity` upper ends
- * fit in `upper` and their lengths in `length`. *fits is false (nothing summed) when the range
- * has more edges than that. The lengths are measured on every core and summed here in the
- * in-memory path's order. */
-static rsmooth_status edge_range(const rs_stream_positions *pos, int fd, uint64_t triangles,
-                                 double scale, uint32_t lo, uint32_t hi, size_t *start,
-                                 uint32_t *upper, double *length, size_t capacity, double *sum,
-                                 uint64_t *unique, bool *fits, rsmooth_error *error) {
+/* Edge e (0-2) of a record: from corner e to corner e + 1, its length measured lower end minus
+ * upper end at `scale`, as mesh.c measures it from the positions. */
+static void record_edge(bool f32, const unsigned char *rec, const uint32_t tri[3], int e,
+                        double scale, uint32_t *upper_end, double *length) {
+    int ca = e, cb = (e + 1) % 3;
+    uint32_t a = tri[ca], b = tri[cb];
+    int lower = a < b ? ca : cb, upper = a < b ? cb : ca;
+    double p[3], q[3], d[3];
+    rs_stream_record_corner(f32, rec, lower, p);
+    rs_stream_record_corner(f32, rec, upper, q);
+    for (int k = 0; k < 3; k++)
+        d[k] = p[k] * scale - q[k] * scale;
+    *upper_end = a < b ? b : a;
+    *length = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+}
+
+/* The next triangle's ids, and its record when `rec` is asked for: counting needs only the ids,
+ * read from the ids file while it is kept (a quarter of the bytes or less). */
+static bool next_ids(rs_stream_reader *r, const rs_stream_corners *corners, bool ids_only,
+                     uint32_t tri[3], const unsigned char **rec) {
+    if (ids_only)
+        return rs_stream_next_triangle(r, tri);
+    *rec = rs_stream_next_record(r, corners);
+    if (*rec)
+        rs_stream_record_ids(*rec, tri);
+    return *rec != NULL;
+}
+
+/* Sum and count of the unique edges whose lower vertex lies in [lo, hi); `capacity` edges fit
+ * in `upper` and `length`. *fits is false (nothing summed) when the range has more edges than
+ * that. The lengths come from the corner records, the buckets are ordered on every core, and the
+ * sum runs here in the in-memory path's order. */
+static rsmooth_status edge_range(const rs_stream_corners *corners, double scale, uint32_t lo,
+                                 uint32_t hi, size_t *start, uint32_t *upper, double *length,
+                                 size_t capacity, double *sum, uint64_t *unique, bool *fits,
+                                 rsmooth_error *error) {
     size_t span = (size_t)(hi - lo);
     for (int fill = 0; fill < 2; fill++) { /* count, then place */
         if (fill == 0)
             memset(start, 0, (span + 1) * sizeof *start);
         rs_stream_reader r;
-        if (!rs_stream_triangles_open(&r, fd, triangles))
+        bool ids_only = fill == 0 && corners->ids_fd >= 0;
+        if (ids_only ? !rs_stream_triangles_open(&r, corners->ids_fd, corners->count)
+                     : !rs_stream_corners_open_range(&r, corners, 0, corners->count))
             return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
-        for (uint64_t t = 0; t < triangles; t++) {
+        for (uint64_t t = 0; t < corners->count; t++) {
+            const unsigned char *rec = NULL;
             uint32_t tri[3];
-            if (!rs_stream_next_triangle(&r, tri)) {
+            if (!next_ids(&r, corners, ids_only, tri, &rec)) {
                 rs_stream_reader_close(&r);
                 return read_fail(error);
             }
@@ -94,10 +141,12 @@ static rsmooth_status edge_range(const rs_stream_positions *pos, int fd, uint64_
                 uint32_t low = a < b ? a : b;
                 if (a == b || low < lo || low >= hi)
                     continue;
-                if (fill == 0)
+                if (fill == 0) {
                     start[low - lo + 1]++;
-                else
-                    upper[start[low - lo]++] = a < b ? b : a;
+                    continue;
+                }
+                size_t at = start[low - lo]++;
+                record_edge(corners->f32, rec, tri, e, scale, upper + at, length + at);
             }
         }
         rs_stream_reader_close(&r);
@@ -113,8 +162,11 @@ static rsmooth_status edge_range(const rs_stream_positions *pos, int fd, uint64_
     for (size_t v = span; v > 0; v--) /* the fill moved each start to the next's */
         start[v] = start[v - 1];
     start[0] = 0;
-    edge_job job = {pos, scale, lo, start, upper, length};
-    rs_parallel_for(span, 4096, edge_lengths, &job);
+    edge_job job = {start, upper, length, false};
+    rs_parallel_for(span, 4096, edge_marks, &job);
+    if (job.no_memory)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
+                       "no memory to sort a vertex's edges");
     for (size_t e = 0; e < start[span]; e++) /* in order: the in-memory path's bits */
         if (!(length[e] < 0)) {
             *sum += length[e];
@@ -124,55 +176,52 @@ static rsmooth_status edge_range(const rs_stream_positions *pos, int fd, uint64_
     return RSMOOTH_OK;
 }
 
-static rsmooth_status mean_edge_length(const rs_stream_positions *pos, int fd, uint64_t triangles,
+static rsmooth_status mean_edge_length(const rs_stream_corners *corners, uint64_t v_count,
                                        double scale, uint64_t memory, double *out,
                                        rsmooth_error *error) {
-    uint64_t v_count = pos->count;
-    /* a first guess at the run of vertices that fits: each holds about 3 T / V upper ends */
+    uint64_t triangles = corners->count;
+    /* a first guess at the run of vertices that fits: each holds about 3 T / V edges */
     double per_vertex = 8 + 12 * (v_count ? 3.0 * (double)triangles / (double)v_count : 0) * 1.25;
     uint64_t span = (uint64_t)((double)memory / per_vertex);
     if (span < 1024)
         span = 1024;
     if (span > v_count)
         span = v_count;
+    /* one set of arrays for every run (runs only shrink): freed and made again per run, the
+     * allocator's heap crept up by about a run's arrays each time */
+    size_t *start = rs_alloc_array((size_t)span + 1, sizeof *start);
+    uint64_t used = 8 * (span + 1);
+    /* an upper end (4 bytes) and its length (8) per edge */
+    size_t capacity = memory > used ? (size_t)((memory - used) / 12) : 0;
+    if (capacity > 3 * triangles)
+        capacity = (size_t)(3 * triangles);
+    uint32_t *upper = rs_alloc_array(capacity ? capacity : 1, sizeof *upper);
+    double *length = rs_alloc_array(capacity ? capacity : 1, sizeof *length);
+    rsmooth_status st = RSMOOTH_OK;
+    if (!start || !upper || !length)
+        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
+                     "no memory for the edges of %llu vertices", (unsigned long long)span);
     double sum = 0;
     uint64_t unique = 0;
-    for (uint64_t lo = 0; lo < v_count;) {
+    for (uint64_t lo = 0; st == RSMOOTH_OK && lo < v_count;) {
         uint64_t hi = lo + span < v_count ? lo + span : v_count;
-        size_t *start = rs_alloc_array((size_t)(hi - lo) + 1, sizeof *start);
-        uint64_t used = 8 * (hi - lo + 1);
-        /* an upper end (4 bytes) and its length (8) per edge */
-        size_t capacity = memory > used ? (size_t)((memory - used) / 12) : 0;
-        if (capacity > 3 * triangles)
-            capacity = (size_t)(3 * triangles);
-        uint32_t *upper = rs_alloc_array(capacity ? capacity : 1, sizeof *upper);
-        double *length = rs_alloc_array(capacity ? capacity : 1, sizeof *length);
-        if (!start || !upper || !length) {
-            rs_free(start);
-            rs_free(upper);
-            rs_free(length);
-            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
-                           "no memory for the edges of %llu vertices",
-                           (unsigned long long)(hi - lo));
-        }
         bool fits = false;
-        rsmooth_status st = edge_range(pos, fd, triangles, scale, (uint32_t)lo, (uint32_t)hi, start,
-                                       upper, length, capacity, &sum, &unique, &fits, error);
-        rs_free(start);
-        rs_free(upper);
-        rs_free(length);
-        if (st != RSMOOTH_OK)
-            return st;
-        if (!fits && hi - lo <= 1)
-            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
-                           "vertex %llu has more edges than the memory cap holds",
-                           (unsigned long long)lo);
-        if (!fits) {
+        st = edge_range(corners, scale, (uint32_t)lo, (uint32_t)hi, start, upper, length, capacity,
+                        &sum, &unique, &fits, error);
+        if (st == RSMOOTH_OK && !fits && hi - lo <= 1)
+            st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
+                         "vertex %llu has more edges than the memory cap holds",
+                         (unsigned long long)lo);
+        else if (!fits)
             span = (hi - lo) / 2; /* denser than guessed: retry this run halved */
-            continue;
-        }
-        lo = hi;
+        else
+            lo = hi;
     }
+    rs_free(start);
+    rs_free(upper);
+    rs_free(length);
+    if (st != RSMOOTH_OK)
+        return st;
     *out = unique ? sum / (double)unique : 0;
     return RSMOOTH_OK;
 }
@@ -187,9 +236,7 @@ typedef struct facet_chunk {
 } facet_chunk;
 
 typedef struct facet_job {
-    const rs_stream_positions *pos;
-    int fd;
-    uint64_t triangles;
+    const rs_stream_corners *corners;
     double scale;
     double *block_sum; /* per block of GEOMETRY_BLOCK triangles: its facets' areas, in order */
     facet_chunk *chunk;
@@ -199,34 +246,37 @@ typedef struct facet_job {
 static void facet_blocks(void *ctx, size_t begin, size_t end, size_t chunk_index) {
     facet_job *job = ctx;
     facet_chunk *chunk = job->chunk + chunk_index;
-    const rs_stream_positions *pos = job->pos;
+    const rs_stream_corners *corners = job->corners;
     uint64_t first = (uint64_t)begin * GEOMETRY_BLOCK, last = (uint64_t)end * GEOMETRY_BLOCK;
-    if (last > job->triangles)
-        last = job->triangles;
+    if (last > corners->count)
+        last = corners->count;
     rs_stream_reader r;
     chunk->histogram = rs_calloc_array(RS_PART_BIN_COUNT, sizeof *chunk->histogram);
-    if (!chunk->histogram || !rs_stream_triangles_open_range(&r, job->fd, first, last)) {
+    if (!chunk->histogram || !rs_stream_corners_open_range(&r, corners, first, last)) {
         chunk->no_memory = true;
         return;
     }
-    rsmooth_scalar scalar = pos->f32 ? RSMOOTH_FLOAT32 : RSMOOTH_FLOAT64;
+    static const uint32_t local[3] = {0, 1, 2};
+    bool f32 = corners->f32;
+    rsmooth_scalar scalar = f32 ? RSMOOTH_FLOAT32 : RSMOOTH_FLOAT64;
     for (size_t b = begin; b < end && !chunk->unread; b++) {
         double block_sum = 0;
         uint64_t block_end = (uint64_t)(b + 1) * GEOMETRY_BLOCK;
         for (uint64_t t = (uint64_t)b * GEOMETRY_BLOCK; t < block_end && t < last; t++) {
-            uint32_t tri[3];
-            if (!rs_stream_next_triangle(&r, tri)) {
+            const unsigned char *rec = rs_stream_next_record(&r, corners);
+            if (!rec) {
                 chunk->unread = true;
                 break;
             }
-            double hi = 0; /* the parts test, in the caller's units as in memory */
-            int16_t bin = rs_scale_bin(rs_triangle_scale(scalar, pos->xyz, tri, &hi));
+            double hi = 0, xyz[9]; /* the parts test, in the caller's units as in memory */
+            int16_t bin = rs_scale_bin(
+                rs_triangle_scale(scalar, rs_stream_record_xyz(f32, rec, xyz), local, &hi));
             if (bin != RS_NO_BIN) {
                 chunk->histogram[bin - RS_PART_BIN_MIN]++;
                 chunk->longest = fmax(chunk->longest, hi);
             }
             double p[9], centroid[3], area = 0;
-            if (rs_stream_facet(pos, tri, job->scale, p, centroid, &area)) {
+            if (rs_stream_facet(f32, rec, job->scale, p, centroid, &area)) {
                 chunk->facets++;
                 block_sum += area;
                 for (int c = 0; c < 3; c++) {
@@ -243,15 +293,11 @@ static void facet_blocks(void *ctx, size_t begin, size_t end, size_t chunk_index
 
 /* Facet count, mean area and reach, in blocks as mesh.c sums them: the blocks on every core,
  * then their sums in block order, so the bits do not depend on the number of threads. */
-static rsmooth_status facet_figures(const rs_stream_positions *pos, int fd, uint64_t triangles,
-                                    double scale, rs_stream_stats *stats, rsmooth_error *error) {
-    size_t blocks = (size_t)((triangles + GEOMETRY_BLOCK - 1) / GEOMETRY_BLOCK);
+static rsmooth_status facet_figures(const rs_stream_corners *corners, double scale,
+                                    rs_stream_stats *stats, rsmooth_error *error) {
+    size_t blocks = (size_t)((corners->count + GEOMETRY_BLOCK - 1) / GEOMETRY_BLOCK);
     size_t chunks = rs_parallel_chunks(blocks, 4);
-    facet_job job = {pos,
-                     fd,
-                     triangles,
-                     scale,
-                     rs_alloc_array(blocks ? blocks : 1, sizeof(double)),
+    facet_job job = {corners, scale, rs_alloc_array(blocks ? blocks : 1, sizeof(double)),
                      rs_calloc_array(chunks ? chunks : 1, sizeof(facet_chunk))};
     size_t *histogram = rs_calloc_array(RS_PART_BIN_COUNT, sizeof *histogram);
     bool ok = job.block_sum && job.chunk && histogram;
@@ -292,40 +338,51 @@ static rsmooth_status facet_figures(const rs_stream_positions *pos, int fd, uint
 }
 
 /* The in-memory path's scale (scale.c): from the same sampled triangles (one in every
- * T / 4096, as rs_mesh_scale strides), read from the triangle file. */
-static rsmooth_status whole_scale(const rs_stream_positions *pos, int fd, uint64_t triangles,
-                                  double magnitude, double *scale, rsmooth_error *error) {
+ * T / 4096, as rs_mesh_scale strides), their corners read from the records. */
+static rsmooth_status whole_scale(const rs_stream_corners *corners, double magnitude, double *scale,
+                                  rsmooth_error *error) {
     enum { SAMPLES = 4096 }; /* scale.c's SCALE_SAMPLES */
+    uint64_t triangles = corners->count;
     uint64_t stride = triangles > SAMPLES ? triangles / SAMPLES : 1;
     size_t count = (size_t)((triangles + stride - 1) / stride);
-    uint32_t *sampled = rs_alloc_array(count ? count : 1, 3 * sizeof *sampled);
-    if (!sampled)
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "scale samples");
-    for (size_t i = 0; i < count; i++)
-        if (!rs_pread_all(fd, sampled + 3 * i, 12, (uint64_t)i * stride * 12)) {
-            rs_free(sampled);
-            return read_fail(error);
-        }
-    rsmooth_status st = rs_mesh_scale(pos->f32 ? RSMOOTH_FLOAT32 : RSMOOTH_FLOAT64, pos->xyz,
-                                      sampled, count, magnitude, scale, error, RS_STREAM_WHERE);
-    rs_free(sampled);
+    size_t vertex_bytes = 3 * (corners->f32 ? sizeof(float) : sizeof(double));
+    uint32_t *local = rs_alloc_array(count ? count : 1, 3 * sizeof *local);
+    unsigned char *xyz = rs_alloc_array(count ? count : 1, 3 * vertex_bytes);
+    unsigned char *rec = rs_alloc_array(1, corners->record);
+    rsmooth_status st = RSMOOTH_OK;
+    if (!local || !xyz || !rec)
+        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "scale samples");
+    for (size_t i = 0; st == RSMOOTH_OK && i < count; i++) {
+        if (!rs_pread_all(corners->fd, rec, corners->record,
+                          (uint64_t)i * stride * corners->record))
+            st = read_fail(error);
+        /* the sample's corners as vertices 3i, 3i + 1, 3i + 2 */
+        memcpy(xyz + 3 * i * vertex_bytes, rec + 12, 3 * vertex_bytes);
+        for (int c = 0; c < 3; c++)
+            local[3 * i + (size_t)c] = (uint32_t)(3 * i + (size_t)c);
+    }
+    if (st == RSMOOTH_OK)
+        st = rs_mesh_scale(corners->f32 ? RSMOOTH_FLOAT32 : RSMOOTH_FLOAT64, xyz, local, count,
+                           magnitude, scale, error, RS_STREAM_WHERE);
+    rs_free(local);
+    rs_free(xyz);
+    rs_free(rec);
     return st;
 }
 
-rsmooth_status rs_stream_statistics(const rs_stream_positions *positions, int triangles_fd,
-                                    uint64_t triangle_count, const rs_stream_extent *extent,
-                                    uint64_t memory, rs_stream_stats *stats, rsmooth_error *error) {
+rsmooth_status rs_stream_statistics(const rs_stream_corners *corners, uint64_t vertex_count,
+                                    const rs_stream_extent *extent, uint64_t memory,
+                                    rs_stream_stats *stats, rsmooth_error *error) {
     memset(stats, 0, sizeof *stats);
     memcpy(stats->lo, extent->lo, sizeof stats->lo);
     memcpy(stats->hi, extent->hi, sizeof stats->hi);
-    rsmooth_status st = whole_scale(positions, triangles_fd, triangle_count, extent->magnitude,
-                                    &stats->scale, error);
+    rsmooth_status st = whole_scale(corners, extent->magnitude, &stats->scale, error);
     if (st != RSMOOTH_OK)
         return st;
-    st = mean_edge_length(positions, triangles_fd, triangle_count, stats->scale, memory,
+    st = mean_edge_length(corners, vertex_count, stats->scale, memory,
                           &stats->scaled_mean_edge_length, error);
     if (st != RSMOOTH_OK)
         return st;
     stats->mean_edge_length = stats->scaled_mean_edge_length / stats->scale;
-    return facet_figures(positions, triangles_fd, triangle_count, stats->scale, stats, error);
+    return facet_figures(corners, stats->scale, stats, error);
 }
