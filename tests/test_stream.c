@@ -2,7 +2,8 @@
  *   - a noisy cylinder of 400k triangles under a memory cap far below what the in-memory run
  *     holds: the same positions bit for bit on the OpenCL device (the requirement is 1e-6 mean edge
  *     lengths; pieces see the whole mesh's cells, and the kernels' differences do not depend on
- *     how vertices share blocks); under a cap below its positions (read in runs) the same bytes;
+ *     how vertices share blocks); under a cap below its positions (read in runs) the same bytes,
+ *     with 32-bit and with 64-bit vertex ids in the temporary files;
  *   - the reference path (ctx NULL): the same bits as rsmooth_smooth(NULL, ...) in memory, and
  *     the same bytes when 3 ranks (threads, synced through a barrier) share the pieces;
  *   - bilateral normals (a wider halo); a float32, big-endian file with colours, a face property
@@ -272,6 +273,7 @@ int main(void) {
     CHECK(rep.mean_edge_length == edge); /* summed in the same order: the same bits */
     CHECK(dev == 0);
     CHECK(rep.position_runs == 1); /* 4.8 MB of positions fit in half of what the cap leaves */
+    CHECK(rep.vertex_id_bits == 32);
     free(expected);
     /* The mesh's figures are made on every core (stream_stats.c): 1 and 5 host threads cut the
      * work differently and must give the same bytes. */
@@ -295,22 +297,32 @@ int main(void) {
     unsetenv("RSMOOTH_HOST_THREADS");
     /* A cap that holds only part of the positions (10 MB: 2 MB beside the fixed buffers, for
      * 4.8 MB of positions): they are read in runs by each pass that needs them, and the corner
-     * records carry them to the pieces. The same bytes. */
-    rsmooth_stream_report runs_rep;
-    CHECK_STATUS(stream(ctx, big, path_in_dir("runs.ply"), 10u << 20, NULL, &runs_rep, &err),
-                 RSMOOTH_OK);
-    size_t runs_size;
-    unsigned char *runs_bytes = slurp(path_in_dir("runs.ply"), &runs_size);
-    printf("cap 10 MB: %llu runs of positions read, %zu pieces, planned %llu MB; output %s\n",
-           (unsigned long long)runs_rep.position_runs, runs_rep.pieces,
-           (unsigned long long)(runs_rep.memory_planned >> 20),
-           runs_size == capped_size && !memcmp(runs_bytes, capped, runs_size) ? "the same bytes"
-                                                                              : "DIFFERS");
-    CHECK(runs_rep.position_runs >= 3 * 3); /* 3 runs each: extent, corners, grid, lists */
-    CHECK_LE(runs_rep.memory_planned, 10u << 20);
-    CHECK(runs_size == capped_size && memcmp(runs_bytes, capped, runs_size) == 0);
-    free(runs_bytes);
-    remove(path_in_dir("runs.ply"));
+     * records carry them to the pieces. Then the same with 64-bit vertex ids in every temporary
+     * file, as meshes of 2^32 - 1 vertices and more have them (RSMOOTH_STREAM_WIDE_IDS forces
+     * them on a small one). The same bytes. */
+    for (int wide = 0; wide < 2; wide++) {
+        if (wide)
+            setenv("RSMOOTH_STREAM_WIDE_IDS", "1", 1);
+        rsmooth_stream_report runs_rep;
+        CHECK_STATUS(stream(ctx, big, path_in_dir("runs.ply"), 10u << 20, NULL, &runs_rep, &err),
+                     RSMOOTH_OK);
+        size_t runs_size;
+        unsigned char *runs_bytes = slurp(path_in_dir("runs.ply"), &runs_size);
+        bool same = runs_size == capped_size && !memcmp(runs_bytes, capped, runs_size);
+        printf("cap 10 MB, %u-bit ids: %llu runs of positions read, %zu pieces, planned %llu MB, "
+               "temporaries %llu MB; output %s\n",
+               runs_rep.vertex_id_bits, (unsigned long long)runs_rep.position_runs, runs_rep.pieces,
+               (unsigned long long)(runs_rep.memory_planned >> 20),
+               (unsigned long long)(runs_rep.temporary_bytes >> 20),
+               same ? "the same bytes" : "DIFFERS");
+        CHECK(runs_rep.position_runs >= 3 * 3); /* 3 runs each: extent, corners, grid, lists */
+        CHECK(runs_rep.vertex_id_bits == (wide ? 64u : 32u));
+        CHECK_LE(runs_rep.memory_planned, 10u << 20);
+        CHECK(same);
+        free(runs_bytes);
+        remove(path_in_dir("runs.ply"));
+    }
+    unsetenv("RSMOOTH_STREAM_WIDE_IDS");
     free(capped);
 
     /* 2. Bilateral normals widen the halo. */

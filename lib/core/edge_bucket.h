@@ -36,4 +36,19 @@ static inline bool rs_edge_repeats(const uint32_t *bucket, size_t n, size_t j) {
     return false;
 }
 
+/* The same rule on 64-bit vertex ids (streaming: meshes of 2^32 - 1 vertices and more). */
+static inline int rs_edge_compare64(const void *a, const void *b) {
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+static inline bool rs_edge_repeats64(const uint64_t *bucket, size_t n, size_t j) {
+    if (n > RS_EDGE_SCAN_LIMIT)
+        return j > 0 && bucket[j] == bucket[j - 1];
+    for (size_t k = 0; k < j; k++)
+        if (bucket[k] == bucket[j])
+            return true;
+    return false;
+}
+
 #endif /* RSMOOTH_EDGE_BUCKET_H */

@@ -67,6 +67,10 @@ static const rs_environment_entry table[RS_ENV_COUNT] = {
                                 "1: output files are written through a named temporary beside "
                                 "the target instead of an unnamed one",
                                 "unnamed where the file system has them", NULL},
+    [RS_ENV_STREAM_WIDE_IDS] = {"RSMOOTH_STREAM_WIDE_IDS",
+                                "1: streaming (--max-memory, rsmooth-mpi) writes 64-bit vertex ids "
+                                "to its temporary files whatever the vertex count (for tests)",
+                                "64-bit from 2^32 - 1 vertices on", NULL},
 };
 
 const rs_environment_entry *rs_environment_table(void) {

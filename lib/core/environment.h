@@ -28,6 +28,7 @@ typedef enum rs_env {
     RS_ENV_BUILD_OPTIONS,   /* appended to the OpenCL build options */
     RS_ENV_OPENCL_LIBRARY,  /* the OpenCL loader's file */
     RS_ENV_NAMED_TEMPORARY, /* 1: output files go through a named temporary */
+    RS_ENV_STREAM_WIDE_IDS, /* 1: streaming writes 64-bit vertex ids for any mesh (tests) */
     RS_ENV_COUNT
 } rs_env;
 

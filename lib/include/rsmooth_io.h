@@ -308,6 +308,9 @@ typedef struct rsmooth_stream_report {
      * whole, more when the cap holds only a run of them at a time (each pass that needs them
      * reads every run again). (Added in 0.11) */
     uint64_t position_runs;
+    /** The vertex ids' width in the temporary files: 32, or 64 for meshes of 2^32 - 1 vertices
+     * and more (up to 2^48). (Added in 0.11) */
+    unsigned vertex_id_bits;
 } rsmooth_stream_report;
 
 /** Zeroes `report` and sets its struct_size. Accepts NULL. */
@@ -337,7 +340,8 @@ RSMOOTH_API void rsmooth_stream_report_init(rsmooth_stream_report *report);
  * removes it first, then takes its previous action (the default, or the program's own handler).
  *
  * What streams: binary PLY (either byte order) with float or double x, y, z, faces of any size
- * (fanned into triangles as the reader does), up to 2^32 - 1 vertices and any number of faces.
+ * (fanned into triangles as the reader does), up to 2^48 vertices (64-bit ids on disk from 2^32 - 1
+ * on) and any number of faces.
  * Memory: nothing grows with the mesh. The vertex positions are held whole when they fit in half
  * of the cap, else read a run at a time (report->position_runs); the triangles carry their
  * corners' positions on disk (about 48 bytes a triangle for float files, 84 for double, besides

@@ -31,7 +31,7 @@ rsmooth_status rs_io_check_vertex(const double xyz[3], size_t number, int64_t li
     return RSMOOTH_OK;
 }
 
-rsmooth_status rs_io_check_position_values(const double *xyz, size_t count, const uint32_t *ids,
+rsmooth_status rs_io_check_position_values(const double *xyz, size_t count, const uint64_t *ids,
                                            const char *where, rsmooth_error *error) {
     for (size_t i = 0; i < 3 * count; i++) {
         double x = xyz[i];

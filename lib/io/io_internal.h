@@ -86,7 +86,7 @@ rsmooth_status rs_io_mesh_check_values(const rsmooth_mesh *mesh, const char *whe
 
 /* rs_io_mesh_check_values' check of positions on `count` of them: the i-th at xyz + 3 i, named
  * vertex ids[i] (i when ids is NULL; the streamed writer checks a piece's at a time). */
-rsmooth_status rs_io_check_position_values(const double *xyz, size_t count, const uint32_t *ids,
+rsmooth_status rs_io_check_position_values(const double *xyz, size_t count, const uint64_t *ids,
                                            const char *where, rsmooth_error *error);
 
 /* A coordinate float32 cannot hold at the mesh's own scale: beyond FLT_MAX, or rounded by more

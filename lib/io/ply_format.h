@@ -195,7 +195,7 @@ bool rs_io_ply_write_binary_header(FILE *stream, const rs_ply_extras *x, bool pl
  * coordinate magnitude), on `count` positions: the i-th at xyz + 3 i, vertex ids[i] (i when ids
  * is NULL), of vertex element `v`. RSMOOTH_ERROR_INVALID_ARGUMENT naming the first that fails,
  * in rs_io_ply_check's words. */
-rsmooth_status rs_io_ply_check_positions(const double *xyz, size_t count, const uint32_t *ids,
+rsmooth_status rs_io_ply_check_positions(const double *xyz, size_t count, const uint64_t *ids,
                                          const rs_ply_element *v, double largest,
                                          rsmooth_error *error);
 

@@ -394,9 +394,10 @@ rsmooth_status rs_ply_find_elements(rs_ply_reader *r, rsmooth_error *error) {
     if (r->vertex_element->count == 0)
         return rs_fail_parse(error, r->vertex_element->header_line, -1, where,
                              "no vertices: 'element vertex 0'");
-    if (r->vertex_element->count >= RS_IO_MAX_VERTICES)
+    if (r->vertex_element->count >= (r->max_vertices ? r->max_vertices : RS_IO_MAX_VERTICES))
         return rs_fail_parse(error, r->vertex_element->header_line, -1, where,
-                             "%llu vertices: too many (indices are 32-bit)",
+                             r->max_vertices ? "%llu vertices: too many (at most 2^48)"
+                                             : "%llu vertices: too many (indices are 32-bit)",
                              (unsigned long long)r->vertex_element->count);
     r->vertex_count = (size_t)r->vertex_element->count;
     return RSMOOTH_OK;

@@ -20,6 +20,9 @@ typedef struct rs_ply_reader {
     rs_ply_encoding encoding;
     bool swap;        /* binary data in the other byte order than the host's */
     rs_ply_extras *x; /* the header, and the values kept */
+    /* vertices accepted: 0 for fewer than RS_IO_MAX_VERTICES (the in-memory path's 32-bit ids);
+     * streaming, with 64-bit ids, takes more */
+    uint64_t max_vertices;
     /* results */
     rs_ply_element *vertex_element, *face_element;
     size_t vertex_count;

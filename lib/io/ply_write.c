@@ -377,7 +377,7 @@ static bool holds_written(const rs_ply_property *p, double value) {
 /* Component c of `count` triples (the i-th at values + 3 i, vertex ids[i], or i when ids is NULL)
  * against property p's type, naming the first that does not fit. */
 static rsmooth_status check_component(const rs_ply_property *p, const double *values, int c,
-                                      size_t count, const uint32_t *ids, rsmooth_error *error) {
+                                      size_t count, const uint64_t *ids, rsmooth_error *error) {
     for (size_t i = 0; i < count; i++) {
         double value = values[3 * i + (size_t)c];
         if (!holds_written(p, value))
@@ -391,7 +391,7 @@ static rsmooth_status check_component(const rs_ply_property *p, const double *va
 /* The float32 x y z (`axis[c]` of type float for the bits of `float_axes`: 1 x, 2 y, 4 z) must
  * hold the positions (addressed as check_component's) at the scale of `largest`, the mesh's
  * largest coordinate magnitude (rs_io_float32_misfit), vertex by vertex. */
-static rsmooth_status check_float32_scale(const double *xyz, size_t count, const uint32_t *ids,
+static rsmooth_status check_float32_scale(const double *xyz, size_t count, const uint64_t *ids,
                                           unsigned float_axes, const rs_ply_property *const axis[3],
                                           double largest, rsmooth_error *error) {
     const double tolerance = rs_io_float32_tolerance(largest);
@@ -443,7 +443,7 @@ static rsmooth_status check_vertex_values(const rsmooth_mesh *mesh, const rs_ply
                                error);
 }
 
-rsmooth_status rs_io_ply_check_positions(const double *xyz, size_t count, const uint32_t *ids,
+rsmooth_status rs_io_ply_check_positions(const double *xyz, size_t count, const uint64_t *ids,
                                          const rs_ply_element *v, double largest,
                                          rsmooth_error *error) {
     rsmooth_status status = rs_io_check_position_values(xyz, count, ids, where, error);

@@ -20,11 +20,12 @@ typedef struct corner_job {
     bool *failed; /* per chunk: a read or write failed, or no memory */
 } corner_job;
 
-static bool fill_block(const corner_job *job, uint64_t first, size_t n, uint32_t *ids,
+static bool fill_block(const corner_job *job, uint64_t first, size_t n, unsigned char *ids,
                        unsigned char *records) {
     const rs_stream_vertices *v = job->v;
     size_t record = job->out->record, vertex_bytes = 3 * (v->f32 ? sizeof(float) : sizeof(double));
-    if (!rs_pread_all(job->ids_fd, ids, 12 * n, 12 * first))
+    size_t id_bytes = job->out->id_bytes, triangle_bytes = 3 * id_bytes;
+    if (!rs_pread_all(job->ids_fd, ids, triangle_bytes * n, triangle_bytes * first))
         return false;
     if (job->fresh)
         memset(records, 0, n * record);
@@ -34,12 +35,13 @@ static bool fill_block(const corner_job *job, uint64_t first, size_t n, uint32_t
     for (size_t t = 0; t < n; t++) {
         unsigned char *rec = records + t * record;
         if (job->fresh)
-            memcpy(rec, ids + 3 * t, 12);
+            memcpy(rec, ids + triangle_bytes * t, triangle_bytes);
         for (int c = 0; c < 3; c++) {
-            uint64_t id = ids[3 * t + (size_t)c];
+            uint64_t id =
+                rs_stream_get_id(ids + triangle_bytes * t + id_bytes * (size_t)c, id_bytes);
             if (id >= v->first && id - v->first < v->loaded)
-                memcpy(rec + 12 + (size_t)c * vertex_bytes, xyz + (id - v->first) * vertex_bytes,
-                       vertex_bytes);
+                memcpy(rec + triangle_bytes + (size_t)c * vertex_bytes,
+                       xyz + (id - v->first) * vertex_bytes, vertex_bytes);
         }
     }
     return rs_pwrite_all(job->out->fd, records, n * record, first * record);
@@ -49,7 +51,7 @@ static void corner_chunks(void *ctx, size_t begin, size_t end, size_t chunk_inde
     (void)chunk_index;
     const corner_job *job = ctx;
     uint64_t triangles = job->out->count;
-    uint32_t *ids = rs_alloc_array(BLOCK, 3 * sizeof *ids);
+    unsigned char *ids = rs_alloc_array(BLOCK, 3 * job->out->id_bytes);
     unsigned char *records = rs_alloc_array(BLOCK, job->out->record);
     for (size_t c = begin; c < end; c++) {
         bool ok = ids && records;
@@ -62,11 +64,13 @@ static void corner_chunks(void *ctx, size_t begin, size_t end, size_t chunk_inde
     rs_free(records);
 }
 
-rsmooth_status rs_stream_corners_write(rs_stream_vertices *v, int ids_fd, uint64_t triangles,
-                                       rs_stream_corners *out, rsmooth_error *error) {
+rsmooth_status rs_stream_corners_write(rs_stream_vertices *v, int ids_fd, size_t id_bytes,
+                                       uint64_t triangles, rs_stream_corners *out,
+                                       rsmooth_error *error) {
     out->ids_fd = ids_fd;
     out->f32 = v->f32;
-    out->record = rs_stream_corner_record(v->f32);
+    out->id_bytes = id_bytes;
+    out->record = 3 * id_bytes + 9 * (v->f32 ? sizeof(float) : sizeof(double));
     out->count = triangles;
     corner_job job = {v, ids_fd, out, rs_parallel_chunks((size_t)triangles, BLOCK), true, NULL};
     job.failed = rs_calloc_array(job.chunks ? job.chunks : 1, sizeof *job.failed);

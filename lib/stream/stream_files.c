@@ -70,12 +70,10 @@ const unsigned char *rs_stream_read(rs_stream_reader *r, size_t n) {
     return p;
 }
 
-bool rs_stream_triangles_open(rs_stream_reader *r, int fd, uint64_t triangle_count) {
-    return rs_stream_triangles_open_range(r, fd, 0, triangle_count);
-}
-
-bool rs_stream_triangles_open_range(rs_stream_reader *r, int fd, uint64_t first, uint64_t end) {
-    return rs_stream_reader_open(r, fd, "triangles", first * 12, end * 12, 1u << 20);
+bool rs_stream_triangles_open_range(rs_stream_reader *r, int fd, size_t id_bytes, uint64_t first,
+                                    uint64_t end) {
+    return rs_stream_reader_open(r, fd, "triangles", first * 3 * id_bytes, end * 3 * id_bytes,
+                                 1u << 20);
 }
 
 int rs_stream_temporary(const char *dir) {

@@ -43,16 +43,37 @@ static inline uint64_t rs_stream_reader_offset(const rs_stream_reader *r) {
     return r->pos - (r->len - r->at);
 }
 
-/* The temporary triangle file (3 uint32 vertex ids per triangle), read front to back. */
-bool rs_stream_triangles_open(rs_stream_reader *r, int fd, uint64_t triangle_count);
-/* Triangles [first, end) only: readers of one file at different places may run at once (each
- * reads with pread at its own offset). */
-bool rs_stream_triangles_open_range(rs_stream_reader *r, int fd, uint64_t first, uint64_t end);
+/* Vertex ids on disk: 4 bytes each while the mesh has fewer than 2^32 - 1 vertices, else 8
+ * (rs_stream_ply.id_bytes); in memory always 64-bit. */
+static inline uint64_t rs_stream_get_id(const unsigned char *at, size_t id_bytes) {
+    if (id_bytes == 4) {
+        uint32_t id;
+        memcpy(&id, at, sizeof id);
+        return id;
+    }
+    uint64_t id;
+    memcpy(&id, at, sizeof id);
+    return id;
+}
+
+static inline void rs_stream_put_id(unsigned char *at, uint64_t id, size_t id_bytes) {
+    if (id_bytes == 4) {
+        uint32_t id32 = (uint32_t)id;
+        memcpy(at, &id32, sizeof id32);
+    } else
+        memcpy(at, &id, sizeof id);
+}
+
+/* The temporary triangle file (3 vertex ids of id_bytes each per triangle), read front to back:
+ * triangles [first, end). Readers of one file at different places may run at once (each reads
+ * with pread at its own offset). */
+bool rs_stream_triangles_open_range(rs_stream_reader *r, int fd, size_t id_bytes, uint64_t first,
+                                    uint64_t end);
 /* The next triangle's ids into tri; false at the end or on a read error. */
-static inline bool rs_stream_next_triangle(rs_stream_reader *r, uint32_t tri[3]) {
-    const unsigned char *rec = rs_stream_read(r, 3 * sizeof(uint32_t));
-    if (rec)
-        memcpy(tri, rec, 3 * sizeof(uint32_t));
+static inline bool rs_stream_next_triangle(rs_stream_reader *r, size_t id_bytes, uint64_t tri[3]) {
+    const unsigned char *rec = rs_stream_read(r, 3 * id_bytes);
+    for (int c = 0; rec && c < 3; c++)
+        tri[c] = rs_stream_get_id(rec + (size_t)c * id_bytes, id_bytes);
     return rec != NULL;
 }
 
@@ -104,6 +125,7 @@ typedef struct rs_stream_ply {
     rs_ply_type xyz_type; /* FLOAT32 or FLOAT64, the same for x, y and z */
     uint64_t face_start;  /* the face block */
     double magnitude;     /* the largest |coordinate| read: the mesh's scale for float32 */
+    size_t id_bytes;      /* a vertex id on disk: 4, or 8 from 2^32 - 1 vertices on (or forced) */
     char *out_header;     /* the output's header bytes, its mark included */
     size_t out_header_size;
 } rs_stream_ply;
@@ -125,20 +147,20 @@ typedef struct rs_stream_extent {
 } rs_stream_extent;
 
 /* Reads the faces, fans each into triangles as the in-memory reader does, and writes their
- * vertex indices (3 uint32 each) to `triangles_fd`; *triangle_count receives how many. */
+ * vertex indices (3 of id_bytes each) to `triangles_fd`; *triangle_count receives how many. */
 rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_fd,
                                              uint64_t *triangle_count, rsmooth_error *error);
 
 /* Refuses positions (3 doubles each, of the vertices `ids[0, n)`) the output cannot hold, as
  * rs_io_ply_check refuses them in memory (its message, after "OUTPUT: cannot write: "):
  * RSMOOTH_ERROR_NUMERICAL, before any of them is written. */
-rsmooth_status rs_stream_ply_check_positions(const rs_stream_ply *ply, const uint32_t *ids,
+rsmooth_status rs_stream_ply_check_positions(const rs_stream_ply *ply, const uint64_t *ids,
                                              size_t n, const double *xyz, const char *output,
                                              rsmooth_error *error);
 
 /* Writes vertex positions (3 doubles each) of the vertices `ids[0, n)` (ascending) into the
  * output file `out_fd` (rs_stream_ply_write_copy's), in the file's type. */
-bool rs_stream_ply_write_positions(const rs_stream_ply *ply, int out_fd, const uint32_t *ids,
+bool rs_stream_ply_write_positions(const rs_stream_ply *ply, int out_fd, const uint64_t *ids,
                                    size_t n, const double *xyz);
 
 /* Reads vertex rows [first, first + count) into `xyz` (3 per vertex from xyz[0], floats when
@@ -181,25 +203,23 @@ static inline void rs_stream_vertex(const rs_stream_vertices *v, uint64_t id, do
 
 /* ---- stream_corners.c ---------------------------------------------------------------------- */
 
-/* The triangles as corner records on disk: a triangle's three vertex ids (uint32), then its
+/* The triangles as corner records on disk: a triangle's three vertex ids (id_bytes each), then its
  * corners' x y z in the file's type. Every later pass reads its positions from them (or from
  * the pieces' lists, made of the same records), so no pass needs the whole mesh's positions. */
 typedef struct rs_stream_corners {
     int fd;
     int ids_fd; /* the same triangles' ids alone, while kept (else -1): for passes that count */
     bool f32;
-    size_t record; /* bytes per triangle */
+    size_t id_bytes; /* 4 or 8 */
+    size_t record;   /* bytes per triangle */
     uint64_t count;
 } rs_stream_corners;
 
-static inline size_t rs_stream_corner_record(bool f32) {
-    return 3 * sizeof(uint32_t) + 9 * (f32 ? sizeof(float) : sizeof(double));
-}
-
-/* Writes the corner records of the `triangles` in `ids_fd` (3 uint32 each) to out->fd, reading
- * the positions a run of vertices at a time: one pass over the triangles per run. */
-rsmooth_status rs_stream_corners_write(rs_stream_vertices *v, int ids_fd, uint64_t triangles,
-                                       rs_stream_corners *out, rsmooth_error *error);
+/* Writes the corner records of the `triangles` in `ids_fd` (3 ids of id_bytes each) to out->fd,
+ * reading the positions a run of vertices at a time: one pass over the triangles per run. */
+rsmooth_status rs_stream_corners_write(rs_stream_vertices *v, int ids_fd, size_t id_bytes,
+                                       uint64_t triangles, rs_stream_corners *out,
+                                       rsmooth_error *error);
 
 /* Records [first, end) front to back; readers of one file at different places may run at once
  * (each reads with pread at its own offset). */
@@ -212,14 +232,23 @@ static inline const unsigned char *rs_stream_next_record(rs_stream_reader *r,
     return rs_stream_read(r, c->record);
 }
 
-static inline void rs_stream_record_ids(const unsigned char *rec, uint32_t tri[3]) {
-    memcpy(tri, rec, 3 * sizeof(uint32_t));
+static inline void rs_stream_record_ids(const rs_stream_corners *c, const unsigned char *rec,
+                                        uint64_t tri[3]) {
+    for (int k = 0; k < 3; k++)
+        tri[k] = rs_stream_get_id(rec + (size_t)k * c->id_bytes, c->id_bytes);
+}
+
+/* A record's nine coordinates (three corners' x y z, in the file's type). */
+static inline const unsigned char *rs_stream_record_values(const rs_stream_corners *c,
+                                                           const unsigned char *rec) {
+    return rec + 3 * c->id_bytes;
 }
 
 /* Corner c's (0-2) position in a record. */
-static inline void rs_stream_record_corner(bool f32, const unsigned char *rec, int c,
-                                           double out[3]) {
-    const unsigned char *at = rec + 3 * sizeof(uint32_t);
+static inline void rs_stream_record_corner(const rs_stream_corners *corners,
+                                           const unsigned char *rec, int c, double out[3]) {
+    const unsigned char *at = rs_stream_record_values(corners, rec);
+    bool f32 = corners->f32;
     for (int k = 0; k < 3; k++) {
         if (f32) {
             float x;
@@ -232,20 +261,21 @@ static inline void rs_stream_record_corner(bool f32, const unsigned char *rec, i
 
 /* A record's corners in the file's type, as an xyz array of three vertices (for the functions
  * of core/ that read positions through vertex ids 0, 1, 2). */
-static inline const void *rs_stream_record_xyz(bool f32, const unsigned char *rec,
+static inline const void *rs_stream_record_xyz(const rs_stream_corners *c, const unsigned char *rec,
                                                double aligned[9]) {
-    memcpy(aligned, rec + 3 * sizeof(uint32_t), 9 * (f32 ? sizeof(float) : sizeof(double)));
+    memcpy(aligned, rs_stream_record_values(c, rec), 9 * (c->f32 ? sizeof(float) : sizeof(double)));
     return aligned;
 }
 
 /* rs_triangle_geometry of a record's triangle with its corners times `scale` (internal units):
  * whether it is a facet, and then its corners and centroid (scaled) and area. */
-static inline bool rs_stream_facet(bool f32, const unsigned char *rec, double scale,
-                                   double corners[9], double centroid[3], double *area) {
+static inline bool rs_stream_facet(const rs_stream_corners *records, const unsigned char *rec,
+                                   double scale, double corners[9], double centroid[3],
+                                   double *area) {
     static const uint32_t local[3] = {0, 1, 2};
     double normal[3];
     for (int c = 0; c < 3; c++) {
-        rs_stream_record_corner(f32, rec, c, corners + 3 * c);
+        rs_stream_record_corner(records, rec, c, corners + 3 * c);
         for (int k = 0; k < 3; k++)
             corners[3 * c + k] *= scale;
     }
@@ -285,7 +315,8 @@ typedef struct rs_stream_pieces {
     rs_piece *pieces;
     size_t count;
     int vertex_fd, facet_fd; /* the lists (only of this rank's pieces) */
-    size_t vertex_record;    /* a vertex's id (uint32), then its x y z in the file's type */
+    size_t id_bytes;         /* a vertex id's bytes in the lists: 4 or 8 */
+    size_t vertex_record;    /* a vertex's id (id_bytes), then its x y z in the file's type */
     uint64_t temporary_bytes;
 } rs_stream_pieces;
 

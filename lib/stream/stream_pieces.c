@@ -222,7 +222,7 @@ static void facet_run(facet_pass_job *job, size_t c) {
             break;
         }
         double p[9], centroid[3], area;
-        if (!rs_stream_facet(corners->f32, rec, job->scale, p, centroid, &area))
+        if (!rs_stream_facet(corners, rec, job->scale, p, centroid, &area))
             continue; /* zero-area triangles weigh nothing anywhere */
         for (int k = 0; k < 3; k++)
             centroid[k] /= job->scale; /* exact: a power of two */
@@ -350,13 +350,13 @@ static rsmooth_status write_vertex_lists(rs_stream_vertices *vertices, const cel
     for (size_t i = 0; i < count; i++)
         starts[i] = pieces[i].vertex_start;
     rs_region_writer w;
-    size_t vertex_bytes = out->vertex_record - sizeof(uint32_t);
+    size_t id_bytes = out->id_bytes, vertex_bytes = out->vertex_record - id_bytes;
     bool ok =
         rs_region_writer_init(&w, out->vertex_fd, count, out->vertex_record, starts, buffer_memory);
     rs_free(starts);
     if (!ok)
         return no_memory(error);
-    unsigned char record[sizeof(uint32_t) + 3 * sizeof(double)];
+    unsigned char record[sizeof(uint64_t) + 3 * sizeof(double)];
     rsmooth_status st = RSMOOTH_OK;
     for (uint64_t first = 0; ok && first < vertices->count; first += vertices->run) {
         st = rs_stream_vertices_load(vertices, first, error);
@@ -367,9 +367,8 @@ static rsmooth_status write_vertex_lists(rs_stream_vertices *vertices, const cel
             int32_t id = g->piece[vertex_cell(g, vertices, v)];
             if (pieces[id].rank != rank)
                 continue;
-            uint32_t v32 = (uint32_t)v;
-            memcpy(record, &v32, sizeof v32);
-            memcpy(record + sizeof v32, xyz + (v - first) * vertex_bytes, vertex_bytes);
+            rs_stream_put_id(record, v, id_bytes);
+            memcpy(record + id_bytes, xyz + (v - first) * vertex_bytes, vertex_bytes);
             ok = rs_region_append(&w, (size_t)id, record);
         }
     }
@@ -468,7 +467,8 @@ rsmooth_status rs_stream_pieces_build(rs_stream_vertices *vertices,
             facets += p->facet_count;
         }
     }
-    out->vertex_record = sizeof(uint32_t) + 3 * (corners->f32 ? sizeof(float) : sizeof(double));
+    out->id_bytes = corners->id_bytes;
+    out->vertex_record = out->id_bytes + 3 * (corners->f32 ? sizeof(float) : sizeof(double));
     out->temporary_bytes = out->vertex_record * listed + corners->record * facets;
     st =
         write_vertex_lists(vertices, &g, ct.pieces, ct.count, rank, out, buffer_memory, dir, error);

@@ -1,6 +1,7 @@
 /* A binary PLY read in pieces: the header through the in-memory reader's own parser, then the
  * vertex block and the faces front to back, and results written back into a copy at their rows. */
 #define _GNU_SOURCE
+#include "core/environment.h"
 #include "stream/stream_internal.h"
 
 #include <errno.h>
@@ -266,6 +267,7 @@ rsmooth_status rs_stream_ply_open(rs_stream_ply *ply, const char *path, uint64_t
     if (!ply->header.x)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "PLY header");
     ply->header.x->vertex_element = ply->header.x->face_element = SIZE_MAX;
+    ply->header.max_vertices = 1ull << 48; /* ids are 64-bit here; indices exact in a double */
     rsmooth_error detail;
     st = rs_ply_parse_header(&ply->header, &detail);
     if (st == RSMOOTH_OK)
@@ -285,6 +287,8 @@ rsmooth_status rs_stream_ply_open(rs_stream_ply *ply, const char *path, uint64_t
     ply->plain = rs_ply_is_plain(&ply->header);
     ply->out_swap = !rs_ply_host_is_le(); /* rs_io_ply_write writes little-endian */
     st = find_layout(ply, error);
+    const char *wide = rs_environment_now(RS_ENV_STREAM_WIDE_IDS);
+    ply->id_bytes = ply->vertex_count >= UINT32_MAX || (wide && !strcmp(wide, "1")) ? 8 : 4;
     return st == RSMOOTH_OK ? output_header(ply, error) : st;
 }
 
@@ -451,7 +455,8 @@ rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_f
     if (!rs_stream_reader_open(&r, ply->fd, ply->path, ply->face_start, ply->size, READ_BUFFER))
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
     enum { OUT_TRIANGLES = 1 << 16 };
-    uint32_t *out = rs_alloc_array(OUT_TRIANGLES, 3 * sizeof *out);
+    size_t id_bytes = ply->id_bytes, triangle_bytes = 3 * id_bytes;
+    unsigned char *out = rs_alloc_array(OUT_TRIANGLES, triangle_bytes);
     if (!out) {
         rs_stream_reader_close(&r);
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "face buffer");
@@ -493,7 +498,7 @@ rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_f
                                    (unsigned long long)i, (unsigned long long)n);
                 break;
             }
-            uint32_t first = 0, previous = 0;
+            uint64_t first = 0, previous = 0;
             for (uint64_t j = 0; j < n; j++) {
                 uint64_t item_at = rs_stream_reader_offset(&r);
                 const unsigned char *c = rs_stream_read(&r, item);
@@ -509,17 +514,17 @@ rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_f
                                             (unsigned long long)ply->vertex_count);
                     break;
                 }
-                uint32_t index = (uint32_t)v;
+                uint64_t index = (uint64_t)v;
                 if (j == 0)
                     first = index;
                 if (j >= 2) { /* the fan the in-memory reader makes: (v0, v[j-1], v[j]) */
-                    uint32_t *t = out + 3 * buffered++;
-                    t[0] = first;
-                    t[1] = previous;
-                    t[2] = index;
+                    unsigned char *t = out + triangle_bytes * buffered++;
+                    rs_stream_put_id(t, first, id_bytes);
+                    rs_stream_put_id(t + id_bytes, previous, id_bytes);
+                    rs_stream_put_id(t + 2 * id_bytes, index, id_bytes);
                     if (buffered == OUT_TRIANGLES) {
-                        if (!rs_pwrite_all(triangles_fd, out, buffered * 3 * sizeof *out,
-                                           written * 3 * sizeof *out))
+                        if (!rs_pwrite_all(triangles_fd, out, buffered * triangle_bytes,
+                                           written * triangle_bytes))
                             st = io_fail("temporary file", "cannot write", error);
                         written += buffered;
                         buffered = 0;
@@ -530,7 +535,7 @@ rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_f
         }
     }
     if (st == RSMOOTH_OK && buffered > 0 &&
-        !rs_pwrite_all(triangles_fd, out, buffered * 3 * sizeof *out, written * 3 * sizeof *out))
+        !rs_pwrite_all(triangles_fd, out, buffered * triangle_bytes, written * triangle_bytes))
         st = io_fail("temporary file", "cannot write", error);
     written += buffered;
     uint64_t face_end = rs_stream_reader_offset(&r);
@@ -625,7 +630,7 @@ bool rs_stream_ply_write_copy(const rs_stream_ply *ply, int out_fd) {
                           ply->data_end - ply->data_start);
 }
 
-rsmooth_status rs_stream_ply_check_positions(const rs_stream_ply *ply, const uint32_t *ids,
+rsmooth_status rs_stream_ply_check_positions(const rs_stream_ply *ply, const uint64_t *ids,
                                              size_t n, const double *xyz, const char *output,
                                              rsmooth_error *error) {
     rsmooth_error detail;
@@ -642,7 +647,7 @@ rsmooth_status rs_stream_ply_check_positions(const rs_stream_ply *ply, const uin
                    detail.message);
 }
 
-bool rs_stream_ply_write_positions(const rs_stream_ply *ply, int out_fd, const uint32_t *ids,
+bool rs_stream_ply_write_positions(const rs_stream_ply *ply, int out_fd, const uint64_t *ids,
                                    size_t n, const double *xyz) {
     enum { RUN_ROWS = 4096 };
     size_t stride = ply->vertex_stride;
@@ -656,7 +661,7 @@ bool rs_stream_ply_write_positions(const rs_stream_ply *ply, int out_fd, const u
         size_t run = 1; /* consecutive ids: one read and one write */
         while (i + run < n && run < RUN_ROWS && ids[i + run] == ids[i] + run)
             run++;
-        uint64_t at = output_offset(ply, ply->vertex_start + (uint64_t)ids[i] * stride);
+        uint64_t at = output_offset(ply, ply->vertex_start + ids[i] * stride);
         ok = whole_rows || rs_pread_all(out_fd, rows, run * stride, at);
         for (size_t j = 0; ok && j < run; j++)
             for (int k = 0; k < 3; k++)

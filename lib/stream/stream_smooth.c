@@ -216,7 +216,8 @@ static rsmooth_status read_input(stream_call *c, rs_stream_extent *extent, rsmoo
                            "faces, a point cloud normals (nx, ny, nz)",
                            c->input, (unsigned long long)c->ply.vertex_count);
     if (st == RSMOOTH_OK)
-        st = rs_stream_corners_write(&c->vertices, ids_fd, c->triangle_count, &c->corners, error);
+        st = rs_stream_corners_write(&c->vertices, ids_fd, c->ply.id_bytes, c->triangle_count,
+                                     &c->corners, error);
     c->corners.ids_fd = ids_fd; /* for the statistics' counting passes, then closed */
     if (st == RSMOOTH_OK && c->vertices.run < c->vertices.count)
         rs_stream_vertices_release(&c->vertices); /* the statistics get the room */
@@ -287,8 +288,9 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
         return st;
     c->rep.pieces = c->pieces.count;
     c->rep.position_runs = c->vertices.runs_read;
+    c->rep.vertex_id_bits = (unsigned)(8 * c->ply.id_bytes);
     /* at their largest: the triangles' ids beside the records, or the records beside the lists */
-    uint64_t joining = (12 + c->corners.record) * c->triangle_count;
+    uint64_t joining = (3 * c->ply.id_bytes + c->corners.record) * c->triangle_count;
     uint64_t listing = c->corners.record * c->triangle_count + c->pieces.temporary_bytes;
     c->rep.temporary_bytes = joining > listing ? joining : listing;
     c->rep.ms_buckets = now_ms() - t2;
@@ -312,7 +314,8 @@ static rsmooth_status make_copy(stream_call *c, rsmooth_error *error) {
 
 /* Global vertex id -> the piece's own numbering: an open-addressing table, ids as keys. */
 typedef struct id_table {
-    uint32_t *key, *value; /* UINT32_MAX: empty */
+    uint64_t *key; /* UINT64_MAX: empty */
+    uint32_t *value;
     size_t mask;
 } id_table;
 
@@ -335,9 +338,9 @@ static void id_table_free(id_table *t) {
 }
 
 /* The slot of `id`: where it is, or the empty slot where it goes. */
-static size_t id_slot(const id_table *t, uint32_t id) {
-    size_t i = (size_t)((id * 0x9E3779B1u) >> 7) & t->mask;
-    while (t->key[i] != id && t->key[i] != UINT32_MAX)
+static size_t id_slot(const id_table *t, uint64_t id) {
+    size_t i = (size_t)((id * 0x9E3779B97F4A7C15ull) >> 32) & t->mask;
+    while (t->key[i] != id && t->key[i] != UINT64_MAX)
         i = (i + 1) & t->mask;
     return i;
 }
@@ -384,10 +387,10 @@ static rsmooth_status filter_piece(stream_call *c, double *xyz, size_t k, const 
 
 /* Vertex `id` into the piece (at its position `at`, 3 values of the file's type) unless it is
  * there; *number receives its number in the piece. */
-static bool piece_vertex(id_table *table, size_t *k, uint32_t id, bool f32, const unsigned char *at,
+static bool piece_vertex(id_table *table, size_t *k, uint64_t id, bool f32, const unsigned char *at,
                          double *xyz, uint32_t *number) {
     size_t i = id_slot(table, id);
-    if (table->key[i] != UINT32_MAX) {
+    if (table->key[i] != UINT64_MAX) {
         *number = table->value[i];
         return true;
     }
@@ -396,7 +399,7 @@ static bool piece_vertex(id_table *table, size_t *k, uint32_t id, bool f32, cons
         if (!id_table_init(&bigger, 2 * (*k + 1)))
             return false;
         for (size_t q = 0; q <= table->mask; q++)
-            if (table->key[q] != UINT32_MAX) {
+            if (table->key[q] != UINT64_MAX) {
                 size_t b = id_slot(&bigger, table->key[q]);
                 bigger.key[b] = table->key[q];
                 bigger.value[b] = table->value[q];
@@ -423,27 +426,30 @@ static bool piece_vertex(id_table *table, size_t *k, uint32_t id, bool f32, cons
 /* A piece's arrays from its lists: its core vertices first (ids into `core`), then the others as
  * the facets first name them, each with the position its record carries; the facets renumbered
  * into `tri`. *k receives the piece's vertex count. */
-static bool assemble(const unsigned char *core_records, size_t n, size_t vertex_record,
-                     const unsigned char *facet_records, size_t m, size_t facet_record, bool f32,
-                     id_table *table, uint32_t *core, uint32_t *tri, double *xyz, size_t *k) {
+static bool assemble(const stream_call *c, const unsigned char *core_records, size_t n,
+                     const unsigned char *facet_records, size_t m, id_table *table, uint64_t *core,
+                     uint32_t *tri, double *xyz, size_t *k) {
+    const rs_stream_corners *corners = &c->corners;
+    size_t id_bytes = c->pieces.id_bytes, vertex_record = c->pieces.vertex_record;
+    bool f32 = corners->f32;
     *k = 0;
     for (size_t v = 0; v < n; v++) {
         const unsigned char *rec = core_records + v * vertex_record;
-        memcpy(core + v, rec, sizeof *core);
+        core[v] = rs_stream_get_id(rec, id_bytes);
         uint32_t number;
-        if (!piece_vertex(table, k, core[v], f32, rec + sizeof *core, xyz, &number))
+        if (!piece_vertex(table, k, core[v], f32, rec + id_bytes, xyz, &number))
             return false;
     }
     size_t value = f32 ? sizeof(float) : sizeof(double);
     for (size_t f = 0; f < m; f++) {
-        const unsigned char *rec = facet_records + f * facet_record;
-        uint32_t ids[3];
-        rs_stream_record_ids(rec, ids);
-        for (int c = 0; c < 3; c++) {
-            const unsigned char *at = rec + 3 * sizeof(uint32_t) + 3 * value * (size_t)c;
-            if (!piece_vertex(table, k, ids[c], f32, at, xyz, tri + 3 * f + (size_t)c))
+        const unsigned char *rec = facet_records + f * corners->record;
+        uint64_t ids[3];
+        rs_stream_record_ids(corners, rec, ids);
+        const unsigned char *values = rs_stream_record_values(corners, rec);
+        for (int q = 0; q < 3; q++)
+            if (!piece_vertex(table, k, ids[q], f32, values + 3 * value * (size_t)q, xyz,
+                              tri + 3 * f + (size_t)q))
                 return false;
-        }
     }
     return true;
 }
@@ -455,7 +461,7 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
     size_t vertex_record = c->pieces.vertex_record, facet_record = c->corners.record;
     unsigned char *core_records = rs_alloc_array(n ? n : 1, vertex_record);
     unsigned char *facet_records = rs_alloc_array(m ? m : 1, facet_record);
-    uint32_t *core = rs_alloc_array(n ? n : 1, sizeof *core);
+    uint64_t *core = rs_alloc_array(n ? n : 1, sizeof *core);
     uint32_t *tri = rs_alloc_array(m ? m : 1, 3 * sizeof *tri);
     /* at most n + 3m vertices; a piece's facets share their corners about 6 ways */
     size_t most = n + 3 * m, k = 0;
@@ -477,8 +483,7 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
                      strerror(errno));
         goto done;
     }
-    if (!assemble(core_records, n, vertex_record, facet_records, m, facet_record, c->corners.f32,
-                  &table, core, tri, xyz, &k)) {
+    if (!assemble(c, core_records, n, facet_records, m, &table, core, tri, xyz, &k)) {
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
                      "no memory for a piece of %zu facets", m);
         goto done;
@@ -486,7 +491,8 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
     rs_free(facet_records); /* the arrays hold it all now */
     facet_records = NULL;
     id_table_free(&table);
-    table.key = table.value = NULL;
+    table.key = NULL;
+    table.value = NULL;
     c->rep.ms_assemble += now_ms() - t_piece;
     st = filter_piece(c, xyz, k, tri, m, n, out, error);
     if (st == RSMOOTH_OK) /* what the in-memory writer refuses, before any of it is written */

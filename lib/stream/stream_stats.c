@@ -30,26 +30,26 @@ static rsmooth_status read_fail(rsmooth_error *error) {
 }
 
 /* An edge as a lower vertex's bucket holds it: its upper end and its length (in two arrays,
- * 12 bytes an edge; this pair only while a large bucket is sorted). */
+ * 16 bytes an edge; this pair only while a large bucket is sorted). */
 typedef struct edge_end {
-    uint32_t upper;
+    uint64_t upper;
     double length;
 } edge_end;
 
 static int edge_end_compare(const void *a, const void *b) {
-    return rs_edge_compare(&((const edge_end *)a)->upper, &((const edge_end *)b)->upper);
+    return rs_edge_compare64(&((const edge_end *)a)->upper, &((const edge_end *)b)->upper);
 }
 
 /* The lower vertices whose buckets edge_marks orders. */
 typedef struct edge_job {
     const size_t *start; /* bucket i: upper and length [start[i], start[i + 1]) */
-    uint32_t *upper;
+    uint64_t *upper;
     double *length;
     bool no_memory;
 } edge_job;
 
 /* A bucket of more than RS_EDGE_SCAN_LIMIT edges sorted by upper end, its lengths along. */
-static bool sort_bucket(uint32_t *upper, double *length, size_t n) {
+static bool sort_bucket(uint64_t *upper, double *length, size_t n) {
     edge_end *pairs = rs_alloc_array(n, sizeof *pairs);
     if (!pairs)
         return false;
@@ -71,7 +71,7 @@ static void edge_marks(void *ctx, size_t begin, size_t end, size_t chunk) {
     (void)chunk;
     edge_job *job = ctx;
     for (size_t i = begin; i < end; i++) {
-        uint32_t *upper = job->upper + job->start[i];
+        uint64_t *upper = job->upper + job->start[i];
         double *length = job->length + job->start[i];
         size_t n = job->start[i + 1] - job->start[i];
         if (n > RS_EDGE_SCAN_LIMIT && !sort_bucket(upper, length, n)) {
@@ -79,21 +79,22 @@ static void edge_marks(void *ctx, size_t begin, size_t end, size_t chunk) {
             return;
         }
         for (size_t j = 0; j < n; j++)
-            if (rs_edge_repeats(upper, n, j))
+            if (rs_edge_repeats64(upper, n, j))
                 length[j] = -1;
     }
 }
 
 /* Edge e (0-2) of a record: from corner e to corner e + 1, its length measured lower end minus
  * upper end at `scale`, as mesh.c measures it from the positions. */
-static void record_edge(bool f32, const unsigned char *rec, const uint32_t tri[3], int e,
-                        double scale, uint32_t *upper_end, double *length) {
+static void record_edge(const rs_stream_corners *corners, const unsigned char *rec,
+                        const uint64_t tri[3], int e, double scale, uint64_t *upper_end,
+                        double *length) {
     int ca = e, cb = (e + 1) % 3;
-    uint32_t a = tri[ca], b = tri[cb];
+    uint64_t a = tri[ca], b = tri[cb];
     int lower = a < b ? ca : cb, upper = a < b ? cb : ca;
     double p[3], q[3], d[3];
-    rs_stream_record_corner(f32, rec, lower, p);
-    rs_stream_record_corner(f32, rec, upper, q);
+    rs_stream_record_corner(corners, rec, lower, p);
+    rs_stream_record_corner(corners, rec, upper, q);
     for (int k = 0; k < 3; k++)
         d[k] = p[k] * scale - q[k] * scale;
     *upper_end = a < b ? b : a;
@@ -103,12 +104,12 @@ static void record_edge(bool f32, const unsigned char *rec, const uint32_t tri[3
 /* The next triangle's ids, and its record when `rec` is asked for: counting needs only the ids,
  * read from the ids file while it is kept (a quarter of the bytes or less). */
 static bool next_ids(rs_stream_reader *r, const rs_stream_corners *corners, bool ids_only,
-                     uint32_t tri[3], const unsigned char **rec) {
+                     uint64_t tri[3], const unsigned char **rec) {
     if (ids_only)
-        return rs_stream_next_triangle(r, tri);
+        return rs_stream_next_triangle(r, corners->id_bytes, tri);
     *rec = rs_stream_next_record(r, corners);
     if (*rec)
-        rs_stream_record_ids(*rec, tri);
+        rs_stream_record_ids(corners, *rec, tri);
     return *rec != NULL;
 }
 
@@ -116,8 +117,8 @@ static bool next_ids(rs_stream_reader *r, const rs_stream_corners *corners, bool
  * in `upper` and `length`. *fits is false (nothing summed) when the range has more edges than
  * that. The lengths come from the corner records, the buckets are ordered on every core, and the
  * sum runs here in the in-memory path's order. */
-static rsmooth_status edge_range(const rs_stream_corners *corners, double scale, uint32_t lo,
-                                 uint32_t hi, size_t *start, uint32_t *upper, double *length,
+static rsmooth_status edge_range(const rs_stream_corners *corners, double scale, uint64_t lo,
+                                 uint64_t hi, size_t *start, uint64_t *upper, double *length,
                                  size_t capacity, double *sum, uint64_t *unique, bool *fits,
                                  rsmooth_error *error) {
     size_t span = (size_t)(hi - lo);
@@ -126,19 +127,20 @@ static rsmooth_status edge_range(const rs_stream_corners *corners, double scale,
             memset(start, 0, (span + 1) * sizeof *start);
         rs_stream_reader r;
         bool ids_only = fill == 0 && corners->ids_fd >= 0;
-        if (ids_only ? !rs_stream_triangles_open(&r, corners->ids_fd, corners->count)
+        if (ids_only ? !rs_stream_triangles_open_range(&r, corners->ids_fd, corners->id_bytes, 0,
+                                                       corners->count)
                      : !rs_stream_corners_open_range(&r, corners, 0, corners->count))
             return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
         for (uint64_t t = 0; t < corners->count; t++) {
             const unsigned char *rec = NULL;
-            uint32_t tri[3];
+            uint64_t tri[3];
             if (!next_ids(&r, corners, ids_only, tri, &rec)) {
                 rs_stream_reader_close(&r);
                 return read_fail(error);
             }
             for (int e = 0; e < 3; e++) {
-                uint32_t a = tri[e], b = tri[(e + 1) % 3];
-                uint32_t low = a < b ? a : b;
+                uint64_t a = tri[e], b = tri[(e + 1) % 3];
+                uint64_t low = a < b ? a : b;
                 if (a == b || low < lo || low >= hi)
                     continue;
                 if (fill == 0) {
@@ -146,7 +148,7 @@ static rsmooth_status edge_range(const rs_stream_corners *corners, double scale,
                     continue;
                 }
                 size_t at = start[low - lo]++;
-                record_edge(corners->f32, rec, tri, e, scale, upper + at, length + at);
+                record_edge(corners, rec, tri, e, scale, upper + at, length + at);
             }
         }
         rs_stream_reader_close(&r);
@@ -181,7 +183,7 @@ static rsmooth_status mean_edge_length(const rs_stream_corners *corners, uint64_
                                        rsmooth_error *error) {
     uint64_t triangles = corners->count;
     /* a first guess at the run of vertices that fits: each holds about 3 T / V edges */
-    double per_vertex = 8 + 12 * (v_count ? 3.0 * (double)triangles / (double)v_count : 0) * 1.25;
+    double per_vertex = 8 + 16 * (v_count ? 3.0 * (double)triangles / (double)v_count : 0) * 1.25;
     uint64_t span = (uint64_t)((double)memory / per_vertex);
     if (span < 1024)
         span = 1024;
@@ -191,11 +193,11 @@ static rsmooth_status mean_edge_length(const rs_stream_corners *corners, uint64_
      * allocator's heap crept up by about a run's arrays each time */
     size_t *start = rs_alloc_array((size_t)span + 1, sizeof *start);
     uint64_t used = 8 * (span + 1);
-    /* an upper end (4 bytes) and its length (8) per edge */
-    size_t capacity = memory > used ? (size_t)((memory - used) / 12) : 0;
+    /* an upper end (8 bytes) and its length (8) per edge */
+    size_t capacity = memory > used ? (size_t)((memory - used) / 16) : 0;
     if (capacity > 3 * triangles)
         capacity = (size_t)(3 * triangles);
-    uint32_t *upper = rs_alloc_array(capacity ? capacity : 1, sizeof *upper);
+    uint64_t *upper = rs_alloc_array(capacity ? capacity : 1, sizeof *upper);
     double *length = rs_alloc_array(capacity ? capacity : 1, sizeof *length);
     rsmooth_status st = RSMOOTH_OK;
     if (!start || !upper || !length)
@@ -206,8 +208,8 @@ static rsmooth_status mean_edge_length(const rs_stream_corners *corners, uint64_
     for (uint64_t lo = 0; st == RSMOOTH_OK && lo < v_count;) {
         uint64_t hi = lo + span < v_count ? lo + span : v_count;
         bool fits = false;
-        st = edge_range(corners, scale, (uint32_t)lo, (uint32_t)hi, start, upper, length, capacity,
-                        &sum, &unique, &fits, error);
+        st = edge_range(corners, scale, lo, hi, start, upper, length, capacity, &sum, &unique,
+                        &fits, error);
         if (st == RSMOOTH_OK && !fits && hi - lo <= 1)
             st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
                          "vertex %llu has more edges than the memory cap holds",
@@ -257,8 +259,7 @@ static void facet_blocks(void *ctx, size_t begin, size_t end, size_t chunk_index
         return;
     }
     static const uint32_t local[3] = {0, 1, 2};
-    bool f32 = corners->f32;
-    rsmooth_scalar scalar = f32 ? RSMOOTH_FLOAT32 : RSMOOTH_FLOAT64;
+    rsmooth_scalar scalar = corners->f32 ? RSMOOTH_FLOAT32 : RSMOOTH_FLOAT64;
     for (size_t b = begin; b < end && !chunk->unread; b++) {
         double block_sum = 0;
         uint64_t block_end = (uint64_t)(b + 1) * GEOMETRY_BLOCK;
@@ -270,13 +271,13 @@ static void facet_blocks(void *ctx, size_t begin, size_t end, size_t chunk_index
             }
             double hi = 0, xyz[9]; /* the parts test, in the caller's units as in memory */
             int16_t bin = rs_scale_bin(
-                rs_triangle_scale(scalar, rs_stream_record_xyz(f32, rec, xyz), local, &hi));
+                rs_triangle_scale(scalar, rs_stream_record_xyz(corners, rec, xyz), local, &hi));
             if (bin != RS_NO_BIN) {
                 chunk->histogram[bin - RS_PART_BIN_MIN]++;
                 chunk->longest = fmax(chunk->longest, hi);
             }
             double p[9], centroid[3], area = 0;
-            if (rs_stream_facet(f32, rec, job->scale, p, centroid, &area)) {
+            if (rs_stream_facet(corners, rec, job->scale, p, centroid, &area)) {
                 chunk->facets++;
                 block_sum += area;
                 for (int c = 0; c < 3; c++) {
@@ -357,7 +358,7 @@ static rsmooth_status whole_scale(const rs_stream_corners *corners, double magni
                           (uint64_t)i * stride * corners->record))
             st = read_fail(error);
         /* the sample's corners as vertices 3i, 3i + 1, 3i + 2 */
-        memcpy(xyz + 3 * i * vertex_bytes, rec + 12, 3 * vertex_bytes);
+        memcpy(xyz + 3 * i * vertex_bytes, rs_stream_record_values(corners, rec), 3 * vertex_bytes);
         for (int c = 0; c < 3; c++)
             local[3 * i + (size_t)c] = (uint32_t)(3 * i + (size_t)c);
     }
