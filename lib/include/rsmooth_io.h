@@ -343,13 +343,13 @@ RSMOOTH_API void rsmooth_stream_report_init(rsmooth_stream_report *report);
  * (fanned into triangles as the reader does), up to 2^48 vertices (64-bit ids on disk from 2^32 - 1
  * on) and any number of faces.
  * Memory: nothing grows with the mesh. The vertex positions are held whole when they fit in half
- * of the cap, else read a run at a time (report->position_runs); the triangles carry their
- * corners' positions on disk (about 48 bytes a triangle for float files, 84 for double, besides
- * the pieces' lists). Refused with RSMOOTH_ERROR_UNSUPPORTED and a message: other formats, vertex
- * normals in the file (the in-memory path recomputes them), params that need the whole mesh (see
- * rsmooth_piece_halo). RSMOOTH_ERROR_OUT_OF_MEMORY names the cap needed when max_memory cannot
- * hold the buffers and one piece (about 10 MB). Progress and cancellation through params'
- * callbacks. */
+ * of the cap, else read a run at a time (report->position_runs), the triangles then carrying their
+ * corners' positions on disk (corner records: about 110 bytes a triangle at their largest for
+ * float files, with the pieces' lists, against 26 when the positions are held). Refused with
+ * RSMOOTH_ERROR_UNSUPPORTED and a message: other formats, vertex normals in the file (the in-memory
+ * path recomputes them), params that need the whole mesh (see rsmooth_piece_halo).
+ * RSMOOTH_ERROR_OUT_OF_MEMORY names the cap needed when max_memory cannot hold the buffers and one
+ * piece (about 10 MB). Progress and cancellation through params' callbacks. */
 RSMOOTH_API rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input,
                                                  const char *output, const rsmooth_params *params,
                                                  const rsmooth_stream_options *options,

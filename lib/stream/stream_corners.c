@@ -1,10 +1,13 @@
-/* The triangles with their corners' positions: the join of the triangle file (vertex ids) with the
- * vertex block, a run of vertices at a time. Each run is one pass over the triangles that fills
- * the corners whose vertex the run holds; the first pass makes the records, the others read them
- * back. The triangles are cut into blocks on every core; a block's records are read and written
- * at their own offsets, so the file does not depend on the number of threads. */
+/* The triangles with their corners' positions. When every position is held, a record is made as
+ * it is read (the triangle file's ids, the positions looked up). Else the triangle file (vertex
+ * ids) is joined with the vertex block into a file, a run of vertices at a time: each run is one
+ * pass over the triangles that fills the corners whose vertex the run holds; the first pass makes
+ * the records, the others read them back. The triangles are cut into blocks on every core; a
+ * block's records are read and written at their own offsets, so the file does not depend on the
+ * number of threads. */
 #include "stream/stream_internal.h"
 
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -64,23 +67,46 @@ static void corner_chunks(void *ctx, size_t begin, size_t end, size_t chunk_inde
     rs_free(records);
 }
 
-rsmooth_status rs_stream_corners_write(rs_stream_vertices *v, int ids_fd, size_t id_bytes,
-                                       uint64_t triangles, rs_stream_corners *out,
-                                       rsmooth_error *error) {
+/* A record made from a triangle's ids (as the triangle file holds them) and the held positions. */
+static void make_record(const rs_stream_corners *c, const unsigned char *ids, unsigned char *out) {
+    const rs_stream_vertices *v = c->held;
+    size_t triangle_bytes = 3 * c->id_bytes;
+    size_t vertex_bytes = 3 * (c->f32 ? sizeof(float) : sizeof(double));
+    memcpy(out, ids, triangle_bytes);
+    for (int q = 0; q < 3; q++) {
+        uint64_t id = rs_stream_get_id(ids + c->id_bytes * (size_t)q, c->id_bytes);
+        memcpy(out + triangle_bytes + (size_t)q * vertex_bytes,
+               (const unsigned char *)v->xyz + (id - v->first) * vertex_bytes, vertex_bytes);
+    }
+}
+
+rsmooth_status rs_stream_corners_make(rs_stream_vertices *v, int ids_fd, size_t id_bytes,
+                                      uint64_t triangles, const char *dir, rs_stream_corners *out,
+                                      rsmooth_error *error) {
+    out->fd = -1;
     out->ids_fd = ids_fd;
+    out->held = NULL;
     out->f32 = v->f32;
     out->id_bytes = id_bytes;
     out->record = 3 * id_bytes + 9 * (v->f32 ? sizeof(float) : sizeof(double));
     out->count = triangles;
+    if (v->xyz && v->first == 0 && v->loaded == v->count) {
+        out->held = v; /* made as read: no file */
+        return RSMOOTH_OK;
+    }
+    out->fd = rs_stream_temporary(dir);
+    if (out->fd < 0)
+        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                       "cannot create a temporary file in %s: %s", dir, strerror(errno));
     corner_job job = {v, ids_fd, out, rs_parallel_chunks((size_t)triangles, BLOCK), true, NULL};
     job.failed = rs_calloc_array(job.chunks ? job.chunks : 1, sizeof *job.failed);
     if (!job.failed)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "corner records");
     rsmooth_status st = RSMOOTH_OK;
-    /* the run held last first: when all vertices are held, no read at all */
-    uint64_t held = v->loaded ? v->first : 0;
+    /* the run held last first (read while measuring the extent) */
+    uint64_t loaded = v->loaded ? v->first : 0;
     for (uint64_t i = 0; st == RSMOOTH_OK && i < v->count; i += v->run) {
-        uint64_t first = i == 0 ? held : i == held ? 0 : i;
+        uint64_t first = i == 0 ? loaded : i == loaded ? 0 : i;
         st = rs_stream_vertices_load(v, first, error);
         if (st != RSMOOTH_OK)
             break;
@@ -95,8 +121,37 @@ rsmooth_status rs_stream_corners_write(rs_stream_vertices *v, int ids_fd, size_t
     return st;
 }
 
-bool rs_stream_corners_open_range(rs_stream_reader *r, const rs_stream_corners *c, uint64_t first,
-                                  uint64_t end) {
-    return rs_stream_reader_open(r, c->fd, "corners", first * c->record, end * c->record,
+bool rs_corner_reader_open(rs_corner_reader *cr, const rs_stream_corners *c, uint64_t first,
+                           uint64_t end) {
+    cr->c = c;
+    if (c->held)
+        return rs_stream_triangles_open_range(&cr->r, c->ids_fd, c->id_bytes, first, end);
+    return rs_stream_reader_open(&cr->r, c->fd, "corners", first * c->record, end * c->record,
                                  (1u << 20) / c->record * c->record);
+}
+
+const unsigned char *rs_corner_next(rs_corner_reader *cr) {
+    const rs_stream_corners *c = cr->c;
+    if (!c->held)
+        return rs_stream_read(&cr->r, c->record);
+    const unsigned char *ids = rs_stream_read(&cr->r, 3 * c->id_bytes);
+    if (!ids)
+        return NULL;
+    make_record(c, ids, cr->made);
+    return cr->made;
+}
+
+void rs_corner_reader_close(rs_corner_reader *cr) {
+    rs_stream_reader_close(&cr->r);
+}
+
+bool rs_stream_corner_at(const rs_stream_corners *c, uint64_t t, unsigned char *out) {
+    if (!c->held)
+        return rs_pread_all(c->fd, out, c->record, t * c->record);
+    unsigned char ids[3 * sizeof(uint64_t)];
+    size_t triangle_bytes = 3 * c->id_bytes;
+    if (!rs_pread_all(c->ids_fd, ids, triangle_bytes, t * triangle_bytes))
+        return false;
+    make_record(c, ids, out);
+    return true;
 }

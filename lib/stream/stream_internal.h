@@ -203,34 +203,43 @@ static inline void rs_stream_vertex(const rs_stream_vertices *v, uint64_t id, do
 
 /* ---- stream_corners.c ---------------------------------------------------------------------- */
 
-/* The triangles as corner records on disk: a triangle's three vertex ids (id_bytes each), then its
- * corners' x y z in the file's type. Every later pass reads its positions from them (or from
- * the pieces' lists, made of the same records), so no pass needs the whole mesh's positions. */
+/* The triangles as corner records: a triangle's three vertex ids (id_bytes each), then its
+ * corners' x y z in the file's type. Every later pass reads its positions from them (or from the
+ * pieces' lists, made of the same records), so no pass needs the whole mesh's positions. When the
+ * positions are held whole anyway, the records are made as they are read, from the triangle file
+ * and the positions (the same bytes, a quarter of the reading); else they are written to a file
+ * once, one pass over the triangles per run of vertices the cap holds. */
 typedef struct rs_stream_corners {
-    int fd;
-    int ids_fd; /* the same triangles' ids alone, while kept (else -1): for passes that count */
+    int fd;                         /* the records, or -1 when they are made from `held` */
+    int ids_fd;                     /* the triangles' ids alone (the caller's; closed by it) */
+    const rs_stream_vertices *held; /* every position, or NULL */
     bool f32;
     size_t id_bytes; /* 4 or 8 */
     size_t record;   /* bytes per triangle */
     uint64_t count;
 } rs_stream_corners;
 
-/* Writes the corner records of the `triangles` in `ids_fd` (3 ids of id_bytes each) to out->fd,
- * reading the positions a run of vertices at a time: one pass over the triangles per run. */
-rsmooth_status rs_stream_corners_write(rs_stream_vertices *v, int ids_fd, size_t id_bytes,
-                                       uint64_t triangles, rs_stream_corners *out,
-                                       rsmooth_error *error);
+/* The corner records of the `triangles` in `ids_fd` (3 ids of id_bytes each): made as they are
+ * read when `v` holds every position, else written to a temporary file in `dir`. */
+rsmooth_status rs_stream_corners_make(rs_stream_vertices *v, int ids_fd, size_t id_bytes,
+                                      uint64_t triangles, const char *dir, rs_stream_corners *out,
+                                      rsmooth_error *error);
 
-/* Records [first, end) front to back; readers of one file at different places may run at once
- * (each reads with pread at its own offset). */
-bool rs_stream_corners_open_range(rs_stream_reader *r, const rs_stream_corners *c, uint64_t first,
-                                  uint64_t end);
+/* Records [first, end) front to back. Readers of one triangle set at different places may run at
+ * once (each reads with pread at its own offset). */
+typedef struct rs_corner_reader {
+    rs_stream_reader r;
+    const rs_stream_corners *c;
+    unsigned char made[3 * sizeof(uint64_t) + 9 * sizeof(double)];
+} rs_corner_reader;
 
+bool rs_corner_reader_open(rs_corner_reader *cr, const rs_stream_corners *c, uint64_t first,
+                           uint64_t end);
 /* The next record, or NULL at the end or on a read error. */
-static inline const unsigned char *rs_stream_next_record(rs_stream_reader *r,
-                                                         const rs_stream_corners *c) {
-    return rs_stream_read(r, c->record);
-}
+const unsigned char *rs_corner_next(rs_corner_reader *cr);
+void rs_corner_reader_close(rs_corner_reader *cr);
+/* Record t into out (c->record bytes). */
+bool rs_stream_corner_at(const rs_stream_corners *c, uint64_t t, unsigned char *out);
 
 static inline void rs_stream_record_ids(const rs_stream_corners *c, const unsigned char *rec,
                                         uint64_t tri[3]) {
@@ -316,7 +325,10 @@ typedef struct rs_stream_pieces {
     size_t count;
     int vertex_fd, facet_fd; /* the lists (only of this rank's pieces) */
     size_t id_bytes;         /* a vertex id's bytes in the lists: 4 or 8 */
-    size_t vertex_record;    /* a vertex's id (id_bytes), then its x y z in the file's type */
+    /* A list's entries: a vertex's id (id_bytes) and a facet's corner record; only the ids when
+     * the positions are held whole (the filter looks them up then, as the lists would cost four
+     * times the bytes to write and read) */
+    size_t vertex_record, facet_record;
     uint64_t temporary_bytes;
 } rs_stream_pieces;
 

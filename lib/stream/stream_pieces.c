@@ -198,6 +198,7 @@ typedef struct facet_pass_job {
     size_t piece_count;
     double scale, halo;
     int rank;
+    size_t facet_record;       /* bytes of a record the lists keep: all, or the ids alone */
     uint64_t *counts;          /* chunks x pieces: each run's facets of each piece */
     rs_region_writer *writers; /* per run (the writing pass), or NULL (the counting pass) */
     bool *unread, *unwritten;  /* per run */
@@ -207,8 +208,8 @@ static void facet_run(facet_pass_job *job, size_t c) {
     const rs_stream_corners *corners = job->corners;
     uint64_t first = corners->count * c / job->chunks;
     uint64_t last = corners->count * (c + 1) / job->chunks;
-    rs_stream_reader r;
-    if (!rs_stream_corners_open_range(&r, corners, first, last)) {
+    rs_corner_reader r;
+    if (!rs_corner_reader_open(&r, corners, first, last)) {
         job->unread[c] = true;
         return;
     }
@@ -216,7 +217,7 @@ static void facet_run(facet_pass_job *job, size_t c) {
     int32_t near[MAX_NEAR];
     uint64_t *counts = job->counts + c * job->piece_count;
     for (uint64_t t = first; t < last && !job->unwritten[c]; t++) {
-        const unsigned char *rec = rs_stream_next_record(&r, corners);
+        const unsigned char *rec = rs_corner_next(&r);
         if (!rec) {
             job->unread[c] = true;
             break;
@@ -235,7 +236,7 @@ static void facet_run(facet_pass_job *job, size_t c) {
                 job->unwritten[c] = true;
         }
     }
-    rs_stream_reader_close(&r);
+    rs_corner_reader_close(&r);
 }
 
 static void facet_runs(void *ctx, size_t begin, size_t end, size_t chunk) {
@@ -389,7 +390,7 @@ static rsmooth_status write_facet_lists(facet_pass_job *job, int fd, size_t buff
     for (size_t i = 0; st == RSMOOTH_OK && i < count; i++)
         starts[i] = job->pieces[i].facet_start;
     for (size_t c = 0; st == RSMOOTH_OK && c < job->chunks; c++) {
-        if (!rs_region_writer_init(writers + c, fd, count, job->corners->record, starts,
+        if (!rs_region_writer_init(writers + c, fd, count, job->facet_record, starts,
                                    buffer_memory / job->chunks))
             st = no_memory(error);
         for (size_t i = 0; st == RSMOOTH_OK && i < count; i++)
@@ -468,8 +469,12 @@ rsmooth_status rs_stream_pieces_build(rs_stream_vertices *vertices,
         }
     }
     out->id_bytes = corners->id_bytes;
-    out->vertex_record = out->id_bytes + 3 * (corners->f32 ? sizeof(float) : sizeof(double));
-    out->temporary_bytes = out->vertex_record * listed + corners->record * facets;
+    /* ids alone when the positions are held whole (a record's ids come first) */
+    size_t xyz = corners->held ? 0 : 3 * (corners->f32 ? sizeof(float) : sizeof(double));
+    out->vertex_record = out->id_bytes + xyz;
+    out->facet_record = corners->held ? 3 * out->id_bytes : corners->record;
+    job.facet_record = out->facet_record;
+    out->temporary_bytes = out->vertex_record * listed + out->facet_record * facets;
     st =
         write_vertex_lists(vertices, &g, ct.pieces, ct.count, rank, out, buffer_memory, dir, error);
     if (st == RSMOOTH_OK)

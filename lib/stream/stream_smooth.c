@@ -63,6 +63,7 @@ typedef struct stream_call {
     char dir[4096]; /* temporaries */
     rs_stream_ply ply;
     rs_stream_vertices vertices; /* held whole, or a run at a time */
+    bool held;                   /* whole, from the plan to the end: the lists hold ids alone */
     rs_stream_corners corners;   /* the triangles with their corners' positions */
     rs_output out;               /* the output: its target, and the copy the results go into */
     uint64_t triangle_count;
@@ -200,15 +201,10 @@ static rsmooth_status read_input(stream_call *c, rs_stream_extent *extent, rsmoo
         st = cancelled(c, 0.03, error);
     if (st != RSMOOTH_OK)
         return st;
-    int ids_fd = rs_stream_temporary(c->dir);
-    c->corners.fd = rs_stream_temporary(c->dir);
-    if (ids_fd < 0 || c->corners.fd < 0) {
-        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                     "cannot create a temporary file in %s: %s", c->dir, strerror(errno));
-        if (ids_fd >= 0)
-            close(ids_fd);
-        return st;
-    }
+    int ids_fd = c->corners.ids_fd = rs_stream_temporary(c->dir);
+    if (ids_fd < 0)
+        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                       "cannot create a temporary file in %s: %s", c->dir, strerror(errno));
     st = rs_stream_ply_write_triangles(&c->ply, ids_fd, &c->triangle_count, error);
     if (st == RSMOOTH_OK && c->ply.face_count == 0) /* the in-memory reader's word for it */
         st = rs_fail_parse(error, -1, (int64_t)c->ply.size, RS_STREAM_WHERE,
@@ -216,10 +212,9 @@ static rsmooth_status read_input(stream_call *c, rs_stream_extent *extent, rsmoo
                            "faces, a point cloud normals (nx, ny, nz)",
                            c->input, (unsigned long long)c->ply.vertex_count);
     if (st == RSMOOTH_OK)
-        st = rs_stream_corners_write(&c->vertices, ids_fd, c->ply.id_bytes, c->triangle_count,
-                                     &c->corners, error);
-    c->corners.ids_fd = ids_fd; /* for the statistics' counting passes, then closed */
-    if (st == RSMOOTH_OK && c->vertices.run < c->vertices.count)
+        st = rs_stream_corners_make(&c->vertices, ids_fd, c->ply.id_bytes, c->triangle_count,
+                                    c->dir, &c->corners, error);
+    if (st == RSMOOTH_OK && !c->corners.held)
         rs_stream_vertices_release(&c->vertices); /* the statistics get the room */
     return st;
 }
@@ -251,11 +246,14 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
     c->rep.ms_read = now_ms() - t0;
 
     double t1 = now_ms();
+    /* the positions' bytes in memory: all of them, or none (released after the records) */
     uint64_t held = c->vertices.xyz ? c->vertices.run * 3 * (c->vertices.f32 ? 4 : 8) : 0;
     st = rs_stream_statistics(&c->corners, c->ply.vertex_count, &extent, cap - held - FIXED_BYTES,
                               &c->stats, error);
-    close(c->corners.ids_fd); /* its disk comes back: the records hold the ids too */
-    c->corners.ids_fd = -1;
+    if (!c->corners.held) { /* its disk comes back: the records hold the ids too */
+        close(c->corners.ids_fd);
+        c->corners.ids_fd = -1;
+    }
     if (st != RSMOOTH_OK)
         return st;
     if (!c->stats.whole)
@@ -276,22 +274,34 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
         return st;
 
     double t2 = now_ms();
-    /* the pieces run once the positions are let go: they have the cap but the fixed buffers */
-    c->piece_vertices = (cap - FIXED_BYTES) / PIECE_BYTES_PER_VERTEX;
-    c->rep.memory_planned = FIXED_BYTES + c->piece_vertices * PIECE_BYTES_PER_VERTEX;
+    /* the pieces have the cap but the fixed buffers and the positions when those are held (the
+     * lists then hold ids alone); else the positions are let go first */
+    c->held = c->corners.held != NULL;
+    held = c->held ? held : 0;
+    c->piece_vertices = (cap - held - FIXED_BYTES) / PIECE_BYTES_PER_VERTEX;
+    c->rep.memory_planned = held + FIXED_BYTES + c->piece_vertices * PIECE_BYTES_PER_VERTEX;
     st = rs_stream_pieces_build(&c->vertices, &c->corners, &c->stats, c->halo, c->piece_vertices,
                                 GRID_BYTES, c->opt.rank, c->opt.ranks, c->dir, &c->pieces, error);
-    rs_stream_vertices_release(&c->vertices);
-    close(c->corners.fd); /* the pieces' lists hold what the filter needs: its disk comes back */
-    c->corners.fd = -1;
+    /* at their largest, beside the pieces' lists: the triangles' ids, and the corner records
+     * when they were written (the positions not held) */
+    uint64_t ids = 3 * c->ply.id_bytes * c->triangle_count;
+    uint64_t records = c->corners.fd >= 0 ? c->corners.record * c->triangle_count : 0;
+    /* the pieces' lists (and the positions, when held) hold what the filter needs: the rest goes */
+    if (!c->held)
+        rs_stream_vertices_release(&c->vertices);
+    c->corners.held = NULL;
+    if (c->corners.fd >= 0)
+        close(c->corners.fd);
+    if (c->corners.ids_fd >= 0)
+        close(c->corners.ids_fd);
+    c->corners.fd = c->corners.ids_fd = -1;
     if (st != RSMOOTH_OK)
         return st;
     c->rep.pieces = c->pieces.count;
     c->rep.position_runs = c->vertices.runs_read;
     c->rep.vertex_id_bits = (unsigned)(8 * c->ply.id_bytes);
-    /* at their largest: the triangles' ids beside the records, or the records beside the lists */
-    uint64_t joining = (3 * c->ply.id_bytes + c->corners.record) * c->triangle_count;
-    uint64_t listing = c->corners.record * c->triangle_count + c->pieces.temporary_bytes;
+    uint64_t joining = ids + records,
+             listing = (records ? records : ids) + c->pieces.temporary_bytes;
     c->rep.temporary_bytes = joining > listing ? joining : listing;
     c->rep.ms_buckets = now_ms() - t2;
     return cancelled(c, 0.2, error);
@@ -313,36 +323,61 @@ static rsmooth_status make_copy(stream_call *c, rsmooth_error *error) {
 }
 
 /* Global vertex id -> the piece's own numbering: an open-addressing table, ids as keys. */
+typedef struct id_slot_entry {
+    uint32_t key;   /* the id's low 32 bits */
+    uint32_t value; /* UINT32_MAX: empty */
+} id_slot_entry;
+
+/* Key and value side by side in 8 bytes (a lookup that hits touches one cache line, and the
+ * table stays as small as 32-bit ids make it); the ids' high halves apart, only for meshes of
+ * 2^32 - 1 vertices and more. */
 typedef struct id_table {
-    uint64_t *key; /* UINT64_MAX: empty */
-    uint32_t *value;
+    id_slot_entry *slot;
+    uint32_t *high; /* or NULL */
     size_t mask;
 } id_table;
 
-static bool id_table_init(id_table *t, size_t count) {
+static bool id_table_init(id_table *t, size_t count, bool wide) {
     size_t size = 16;
     while (size < 2 * count)
         size *= 2;
     t->mask = size - 1;
-    t->key = rs_alloc_array(size, sizeof *t->key);
-    t->value = rs_alloc_array(size, sizeof *t->value);
-    if (!t->key || !t->value)
+    t->slot = rs_alloc_array(size, sizeof *t->slot);
+    t->high = wide ? rs_alloc_array(size, sizeof *t->high) : NULL;
+    if (!t->slot || (wide && !t->high))
         return false;
-    memset(t->key, 0xff, size * sizeof *t->key);
+    memset(t->slot, 0xff, size * sizeof *t->slot);
     return true;
 }
 
 static void id_table_free(id_table *t) {
-    rs_free(t->key);
-    rs_free(t->value);
+    rs_free(t->slot);
+    rs_free(t->high);
+    t->slot = NULL;
+    t->high = NULL;
+}
+
+static bool slot_empty(const id_table *t, size_t i) {
+    return t->slot[i].value == UINT32_MAX;
 }
 
 /* The slot of `id`: where it is, or the empty slot where it goes. */
 static size_t id_slot(const id_table *t, uint64_t id) {
-    size_t i = (size_t)((id * 0x9E3779B97F4A7C15ull) >> 32) & t->mask;
-    while (t->key[i] != id && t->key[i] != UINT64_MAX)
+    uint32_t low = (uint32_t)id, high = (uint32_t)(id >> 32);
+    size_t i = (size_t)(((low ^ high) * 0x9E3779B1u) >> 7) & t->mask;
+    while (!slot_empty(t, i) && (t->slot[i].key != low || (t->high && t->high[i] != high)))
         i = (i + 1) & t->mask;
     return i;
+}
+
+static void slot_put(id_table *t, size_t i, uint64_t id, uint32_t value) {
+    t->slot[i] = (id_slot_entry){(uint32_t)id, value};
+    if (t->high)
+        t->high[i] = (uint32_t)(id >> 32);
+}
+
+static uint64_t slot_id(const id_table *t, size_t i) {
+    return (uint64_t)t->slot[i].key | (t->high ? (uint64_t)t->high[i] << 32 : 0);
 }
 
 /* The filter on an assembled piece (k vertices at xyz, its n core vertices first; m triangles):
@@ -390,26 +425,24 @@ static rsmooth_status filter_piece(stream_call *c, double *xyz, size_t k, const 
 static bool piece_vertex(id_table *table, size_t *k, uint64_t id, bool f32, const unsigned char *at,
                          double *xyz, uint32_t *number) {
     size_t i = id_slot(table, id);
-    if (table->key[i] != UINT64_MAX) {
-        *number = table->value[i];
+    if (!slot_empty(table, i)) {
+        *number = table->slot[i].value;
         return true;
     }
     if (2 * (*k + 1) > table->mask) { /* a piece this connected: grow the table */
         id_table bigger;
-        if (!id_table_init(&bigger, 2 * (*k + 1)))
+        if (!id_table_init(&bigger, 2 * (*k + 1), table->high != NULL))
             return false;
         for (size_t q = 0; q <= table->mask; q++)
-            if (table->key[q] != UINT64_MAX) {
-                size_t b = id_slot(&bigger, table->key[q]);
-                bigger.key[b] = table->key[q];
-                bigger.value[b] = table->value[q];
+            if (!slot_empty(table, q)) {
+                uint64_t key = slot_id(table, q);
+                slot_put(&bigger, id_slot(&bigger, key), key, table->slot[q].value);
             }
         id_table_free(table);
         *table = bigger;
         i = id_slot(table, id);
     }
-    table->key[i] = id;
-    table->value[i] = (uint32_t)*k;
+    slot_put(table, i, id, (uint32_t)*k);
     *number = (uint32_t)*k;
     for (int c = 0; c < 3; c++) {
         if (f32) {
@@ -423,31 +456,42 @@ static bool piece_vertex(id_table *table, size_t *k, uint64_t id, bool f32, cons
     return true;
 }
 
+/* Vertex `id`'s position as the file's type: from its list entry (`at`), or the held positions. */
+static const unsigned char *position_of(const stream_call *c, uint64_t id,
+                                        const unsigned char *at) {
+    const rs_stream_vertices *v = &c->vertices;
+    size_t vertex_bytes = 3 * (v->f32 ? sizeof(float) : sizeof(double));
+    return c->held ? (const unsigned char *)v->xyz + id * vertex_bytes : at;
+}
+
 /* A piece's arrays from its lists: its core vertices first (ids into `core`), then the others as
- * the facets first name them, each with the position its record carries; the facets renumbered
- * into `tri`. *k receives the piece's vertex count. */
+ * the facets first name them, each with the position its entry carries (or the held positions);
+ * the facets renumbered into `tri`. *k receives the piece's vertex count. */
 static bool assemble(const stream_call *c, const unsigned char *core_records, size_t n,
                      const unsigned char *facet_records, size_t m, id_table *table, uint64_t *core,
                      uint32_t *tri, double *xyz, size_t *k) {
     const rs_stream_corners *corners = &c->corners;
     size_t id_bytes = c->pieces.id_bytes, vertex_record = c->pieces.vertex_record;
+    size_t facet_record = c->pieces.facet_record;
     bool f32 = corners->f32;
     *k = 0;
     for (size_t v = 0; v < n; v++) {
         const unsigned char *rec = core_records + v * vertex_record;
         core[v] = rs_stream_get_id(rec, id_bytes);
         uint32_t number;
-        if (!piece_vertex(table, k, core[v], f32, rec + id_bytes, xyz, &number))
+        if (!piece_vertex(table, k, core[v], f32, position_of(c, core[v], rec + id_bytes), xyz,
+                          &number))
             return false;
     }
     size_t value = f32 ? sizeof(float) : sizeof(double);
     for (size_t f = 0; f < m; f++) {
-        const unsigned char *rec = facet_records + f * corners->record;
+        const unsigned char *rec = facet_records + f * facet_record;
         uint64_t ids[3];
         rs_stream_record_ids(corners, rec, ids);
         const unsigned char *values = rs_stream_record_values(corners, rec);
         for (int q = 0; q < 3; q++)
-            if (!piece_vertex(table, k, ids[q], f32, values + 3 * value * (size_t)q, xyz,
+            if (!piece_vertex(table, k, ids[q], f32,
+                              position_of(c, ids[q], values + 3 * value * (size_t)q), xyz,
                               tri + 3 * f + (size_t)q))
                 return false;
     }
@@ -458,11 +502,15 @@ static bool assemble(const stream_call *c, const unsigned char *core_records, si
 static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error *error) {
     double t_piece = now_ms();
     size_t n = (size_t)p->vertex_count, m = (size_t)p->facet_count;
-    size_t vertex_record = c->pieces.vertex_record, facet_record = c->corners.record;
+    size_t vertex_record = c->pieces.vertex_record, facet_record = c->pieces.facet_record;
     unsigned char *core_records = rs_alloc_array(n ? n : 1, vertex_record);
-    unsigned char *facet_records = rs_alloc_array(m ? m : 1, facet_record);
     uint64_t *core = rs_alloc_array(n ? n : 1, sizeof *core);
     uint32_t *tri = rs_alloc_array(m ? m : 1, 3 * sizeof *tri);
+    /* entries of three 32-bit ids are read into tri itself and renumbered in place (each
+     * facet's ids are read before its numbers are written): fewer fresh pages per piece */
+    bool in_place = facet_record == 3 * sizeof *tri;
+    unsigned char *facet_records =
+        in_place ? (unsigned char *)tri : rs_alloc_array(m ? m : 1, facet_record);
     /* at most n + 3m vertices; a piece's facets share their corners about 6 ways */
     size_t most = n + 3 * m, k = 0;
     double *xyz = rs_alloc_array(most ? most : 1, 3 * sizeof *xyz);
@@ -470,7 +518,7 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
     id_table table = {NULL, NULL, 0};
     rsmooth_status st = RSMOOTH_OK;
     if (!core_records || !facet_records || !core || !tri || !xyz || !out ||
-        !id_table_init(&table, n + m)) {
+        !id_table_init(&table, n + m, c->ply.id_bytes == 8)) {
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
                      "no memory for a piece of %zu facets", m);
         goto done;
@@ -488,11 +536,12 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
                      "no memory for a piece of %zu facets", m);
         goto done;
     }
-    rs_free(facet_records); /* the arrays hold it all now */
+    if (!in_place) /* the arrays hold it all now */
+        rs_free(facet_records);
     facet_records = NULL;
     id_table_free(&table);
-    table.key = NULL;
-    table.value = NULL;
+    table.slot = NULL;
+    table.high = NULL;
     c->rep.ms_assemble += now_ms() - t_piece;
     st = filter_piece(c, xyz, k, tri, m, n, out, error);
     if (st == RSMOOTH_OK) /* what the in-memory writer refuses, before any of it is written */
@@ -507,7 +556,8 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
 done:
     id_table_free(&table);
     rs_free(core_records);
-    rs_free(facet_records);
+    if (!in_place)
+        rs_free(facet_records);
     rs_free(core);
     rs_free(tri);
     rs_free(xyz);

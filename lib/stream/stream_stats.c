@@ -45,8 +45,23 @@ typedef struct edge_job {
     const size_t *start; /* bucket i: upper and length [start[i], start[i + 1]) */
     uint64_t *upper;
     double *length;
+    /* when the positions are held whole: the lengths are measured here (on every core, each
+     * bucket's lower vertex lo + i) rather than while the edges are placed */
+    const rs_stream_vertices *held;
+    uint64_t lo;
+    double scale;
     bool no_memory;
 } edge_job;
+
+/* The length of the edge from held vertex a (lower) to b, at `scale`, as mesh.c measures it. */
+static double held_length(const rs_stream_vertices *v, uint64_t a, uint64_t b, double scale) {
+    double p[3], q[3], d[3];
+    rs_stream_vertex(v, a, p);
+    rs_stream_vertex(v, b, q);
+    for (int k = 0; k < 3; k++)
+        d[k] = p[k] * scale - q[k] * scale;
+    return sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+}
 
 /* A bucket of more than RS_EDGE_SCAN_LIMIT edges sorted by upper end, its lengths along. */
 static bool sort_bucket(uint64_t *upper, double *length, size_t n) {
@@ -74,13 +89,17 @@ static void edge_marks(void *ctx, size_t begin, size_t end, size_t chunk) {
         uint64_t *upper = job->upper + job->start[i];
         double *length = job->length + job->start[i];
         size_t n = job->start[i + 1] - job->start[i];
-        if (n > RS_EDGE_SCAN_LIMIT && !sort_bucket(upper, length, n)) {
+        if (job->held && n > RS_EDGE_SCAN_LIMIT)
+            qsort(upper, n, sizeof *upper, rs_edge_compare64);
+        else if (n > RS_EDGE_SCAN_LIMIT && !sort_bucket(upper, length, n)) {
             job->no_memory = true; /* (a flag written only to true: no race that matters) */
             return;
         }
         for (size_t j = 0; j < n; j++)
             if (rs_edge_repeats64(upper, n, j))
                 length[j] = -1;
+            else if (job->held)
+                length[j] = held_length(job->held, job->lo + i, upper[j], job->scale);
     }
 }
 
@@ -103,11 +122,11 @@ static void record_edge(const rs_stream_corners *corners, const unsigned char *r
 
 /* The next triangle's ids, and its record when `rec` is asked for: counting needs only the ids,
  * read from the ids file while it is kept (a quarter of the bytes or less). */
-static bool next_ids(rs_stream_reader *r, const rs_stream_corners *corners, bool ids_only,
+static bool next_ids(rs_corner_reader *r, const rs_stream_corners *corners, bool ids_only,
                      uint64_t tri[3], const unsigned char **rec) {
     if (ids_only)
-        return rs_stream_next_triangle(r, corners->id_bytes, tri);
-    *rec = rs_stream_next_record(r, corners);
+        return rs_stream_next_triangle(&r->r, corners->id_bytes, tri);
+    *rec = rs_corner_next(r);
     if (*rec)
         rs_stream_record_ids(corners, *rec, tri);
     return *rec != NULL;
@@ -125,17 +144,17 @@ static rsmooth_status edge_range(const rs_stream_corners *corners, double scale,
     for (int fill = 0; fill < 2; fill++) { /* count, then place */
         if (fill == 0)
             memset(start, 0, (span + 1) * sizeof *start);
-        rs_stream_reader r;
-        bool ids_only = fill == 0 && corners->ids_fd >= 0;
-        if (ids_only ? !rs_stream_triangles_open_range(&r, corners->ids_fd, corners->id_bytes, 0,
+        rs_corner_reader r;
+        bool ids_only = fill == 0 || corners->held; /* held: measured after, on every core */
+        if (ids_only ? !rs_stream_triangles_open_range(&r.r, corners->ids_fd, corners->id_bytes, 0,
                                                        corners->count)
-                     : !rs_stream_corners_open_range(&r, corners, 0, corners->count))
+                     : !rs_corner_reader_open(&r, corners, 0, corners->count))
             return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
         for (uint64_t t = 0; t < corners->count; t++) {
             const unsigned char *rec = NULL;
             uint64_t tri[3];
             if (!next_ids(&r, corners, ids_only, tri, &rec)) {
-                rs_stream_reader_close(&r);
+                rs_corner_reader_close(&r);
                 return read_fail(error);
             }
             for (int e = 0; e < 3; e++) {
@@ -148,10 +167,13 @@ static rsmooth_status edge_range(const rs_stream_corners *corners, double scale,
                     continue;
                 }
                 size_t at = start[low - lo]++;
-                record_edge(corners, rec, tri, e, scale, upper + at, length + at);
+                if (corners->held)
+                    upper[at] = a < b ? b : a;
+                else
+                    record_edge(corners, rec, tri, e, scale, upper + at, length + at);
             }
         }
-        rs_stream_reader_close(&r);
+        rs_corner_reader_close(&r);
         if (fill == 0) {
             for (size_t v = 0; v < span; v++)
                 start[v + 1] += start[v];
@@ -164,7 +186,7 @@ static rsmooth_status edge_range(const rs_stream_corners *corners, double scale,
     for (size_t v = span; v > 0; v--) /* the fill moved each start to the next's */
         start[v] = start[v - 1];
     start[0] = 0;
-    edge_job job = {start, upper, length, false};
+    edge_job job = {start, upper, length, corners->held, lo, scale, false};
     rs_parallel_for(span, 4096, edge_marks, &job);
     if (job.no_memory)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
@@ -252,9 +274,9 @@ static void facet_blocks(void *ctx, size_t begin, size_t end, size_t chunk_index
     uint64_t first = (uint64_t)begin * GEOMETRY_BLOCK, last = (uint64_t)end * GEOMETRY_BLOCK;
     if (last > corners->count)
         last = corners->count;
-    rs_stream_reader r;
+    rs_corner_reader r;
     chunk->histogram = rs_calloc_array(RS_PART_BIN_COUNT, sizeof *chunk->histogram);
-    if (!chunk->histogram || !rs_stream_corners_open_range(&r, corners, first, last)) {
+    if (!chunk->histogram || !rs_corner_reader_open(&r, corners, first, last)) {
         chunk->no_memory = true;
         return;
     }
@@ -264,7 +286,7 @@ static void facet_blocks(void *ctx, size_t begin, size_t end, size_t chunk_index
         double block_sum = 0;
         uint64_t block_end = (uint64_t)(b + 1) * GEOMETRY_BLOCK;
         for (uint64_t t = (uint64_t)b * GEOMETRY_BLOCK; t < block_end && t < last; t++) {
-            const unsigned char *rec = rs_stream_next_record(&r, corners);
+            const unsigned char *rec = rs_corner_next(&r);
             if (!rec) {
                 chunk->unread = true;
                 break;
@@ -289,7 +311,7 @@ static void facet_blocks(void *ctx, size_t begin, size_t end, size_t chunk_index
         }
         job->block_sum[b] = block_sum;
     }
-    rs_stream_reader_close(&r);
+    rs_corner_reader_close(&r);
 }
 
 /* Facet count, mean area and reach, in blocks as mesh.c sums them: the blocks on every core,
@@ -354,8 +376,7 @@ static rsmooth_status whole_scale(const rs_stream_corners *corners, double magni
     if (!local || !xyz || !rec)
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "scale samples");
     for (size_t i = 0; st == RSMOOTH_OK && i < count; i++) {
-        if (!rs_pread_all(corners->fd, rec, corners->record,
-                          (uint64_t)i * stride * corners->record))
+        if (!rs_stream_corner_at(corners, (uint64_t)i * stride, rec))
             st = read_fail(error);
         /* the sample's corners as vertices 3i, 3i + 1, 3i + 2 */
         memcpy(xyz + 3 * i * vertex_bytes, rs_stream_record_values(corners, rec), 3 * vertex_bytes);
