@@ -1,10 +1,10 @@
-/* The triangles with their corners' positions. When every position is held, a record is made as
- * it is read (the triangle file's ids, the positions looked up). Else the triangle file (vertex
- * ids) is joined with the vertex block into a file, a run of vertices at a time: each run is one
- * pass over the triangles that fills the corners whose vertex the run holds; the first pass makes
- * the records, the others read them back. The triangles are cut into blocks on every core; a
- * block's records are read and written at their own offsets, so the file does not depend on the
- * number of threads. */
+/* The triangles with their corners' positions. When every position is held, a pass reads the
+ * triangle file's ids and finds each corner in the held positions (rs_corner_view). Else the
+ * triangle file (vertex ids) is joined with the vertex block into a file, a run of vertices at a
+ * time: each run is one pass over the triangles that fills the corners whose vertex the run holds;
+ * the first pass makes the records, the others read them back. The triangles are cut into blocks on
+ * every core; a block's records are read and written at their own offsets, so the file does not
+ * depend on the number of threads. */
 #include "stream/stream_internal.h"
 
 #include <errno.h>
@@ -130,15 +130,24 @@ bool rs_corner_reader_open(rs_corner_reader *cr, const rs_stream_corners *c, uin
                                  (1u << 20) / c->record * c->record);
 }
 
-const unsigned char *rs_corner_next(rs_corner_reader *cr) {
+bool rs_corner_next(rs_corner_reader *cr, rs_corner_view *view) {
     const rs_stream_corners *c = cr->c;
-    if (!c->held)
-        return rs_stream_read(&cr->r, c->record);
-    const unsigned char *ids = rs_stream_read(&cr->r, 3 * c->id_bytes);
-    if (!ids)
-        return NULL;
-    make_record(c, ids, cr->made);
-    return cr->made;
+    size_t triangle_bytes = 3 * c->id_bytes;
+    size_t vertex_bytes = 3 * (c->f32 ? sizeof(float) : sizeof(double));
+    const unsigned char *entry = rs_stream_read(&cr->r, c->held ? triangle_bytes : c->record);
+    if (!entry)
+        return false;
+    view->entry = entry;
+    for (int q = 0; q < 3; q++) {
+        if (!c->held) {
+            view->xyz[q] = entry + triangle_bytes + (size_t)q * vertex_bytes;
+            continue;
+        }
+        const rs_stream_vertices *v = c->held;
+        uint64_t id = rs_stream_get_id(entry + c->id_bytes * (size_t)q, c->id_bytes);
+        view->xyz[q] = (const unsigned char *)v->xyz + (id - v->first) * vertex_bytes;
+    }
+    return true;
 }
 
 void rs_corner_reader_close(rs_corner_reader *cr) {

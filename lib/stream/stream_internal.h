@@ -225,20 +225,27 @@ rsmooth_status rs_stream_corners_make(rs_stream_vertices *v, int ids_fd, size_t 
                                       uint64_t triangles, const char *dir, rs_stream_corners *out,
                                       rsmooth_error *error);
 
-/* Records [first, end) front to back. Readers of one triangle set at different places may run at
- * once (each reads with pread at its own offset). */
+/* A triangle as a pass reads it: what the pieces' lists keep of it (its record, or its ids alone
+ * when the positions are held), and where each corner's x y z lie (in the record, or in the held
+ * positions: nothing is copied to make a record). */
+typedef struct rs_corner_view {
+    const unsigned char *entry; /* its three vertex ids first */
+    const unsigned char *xyz[3];
+} rs_corner_view;
+
+/* Triangles [first, end) front to back. Readers of one triangle set at different places may run
+ * at once (each reads with pread at its own offset). */
 typedef struct rs_corner_reader {
     rs_stream_reader r;
     const rs_stream_corners *c;
-    unsigned char made[3 * sizeof(uint64_t) + 9 * sizeof(double)];
 } rs_corner_reader;
 
 bool rs_corner_reader_open(rs_corner_reader *cr, const rs_stream_corners *c, uint64_t first,
                            uint64_t end);
-/* The next record, or NULL at the end or on a read error. */
-const unsigned char *rs_corner_next(rs_corner_reader *cr);
+/* The next triangle into *view (valid until the next call); false at the end or on a read error. */
+bool rs_corner_next(rs_corner_reader *cr, rs_corner_view *view);
 void rs_corner_reader_close(rs_corner_reader *cr);
-/* Record t into out (c->record bytes). */
+/* Triangle t's whole record into out (c->record bytes). */
 bool rs_stream_corner_at(const rs_stream_corners *c, uint64_t t, unsigned char *out);
 
 static inline void rs_stream_record_ids(const rs_stream_corners *c, const unsigned char *rec,
@@ -253,40 +260,41 @@ static inline const unsigned char *rs_stream_record_values(const rs_stream_corne
     return rec + 3 * c->id_bytes;
 }
 
-/* Corner c's (0-2) position in a record. */
-static inline void rs_stream_record_corner(const rs_stream_corners *corners,
-                                           const unsigned char *rec, int c, double out[3]) {
-    const unsigned char *at = rs_stream_record_values(corners, rec);
-    bool f32 = corners->f32;
+/* Corner q's (0-2) position. */
+static inline void rs_stream_view_corner(const rs_stream_corners *c, const rs_corner_view *view,
+                                         int q, double out[3]) {
+    const unsigned char *at = view->xyz[q];
     for (int k = 0; k < 3; k++) {
-        if (f32) {
+        if (c->f32) {
             float x;
-            memcpy(&x, at + sizeof x * (size_t)(3 * c + k), sizeof x);
+            memcpy(&x, at + sizeof x * (size_t)k, sizeof x);
             out[k] = (double)x;
         } else
-            memcpy(out + k, at + sizeof(double) * (size_t)(3 * c + k), sizeof(double));
+            memcpy(out + k, at + sizeof(double) * (size_t)k, sizeof(double));
     }
 }
 
-/* A record's corners in the file's type, as an xyz array of three vertices (for the functions
- * of core/ that read positions through vertex ids 0, 1, 2). */
-static inline const void *rs_stream_record_xyz(const rs_stream_corners *c, const unsigned char *rec,
-                                               double aligned[9]) {
-    memcpy(aligned, rs_stream_record_values(c, rec), 9 * (c->f32 ? sizeof(float) : sizeof(double)));
+/* The corners in the file's type, as an xyz array of three vertices (for the functions of core/
+ * that read positions through vertex ids 0, 1, 2). */
+static inline const void *rs_stream_view_xyz(const rs_stream_corners *c, const rs_corner_view *view,
+                                             double aligned[9]) {
+    size_t vertex_bytes = 3 * (c->f32 ? sizeof(float) : sizeof(double));
+    for (int q = 0; q < 3; q++)
+        memcpy((unsigned char *)aligned + (size_t)q * vertex_bytes, view->xyz[q], vertex_bytes);
     return aligned;
 }
 
-/* rs_triangle_geometry of a record's triangle with its corners times `scale` (internal units):
- * whether it is a facet, and then its corners and centroid (scaled) and area. */
-static inline bool rs_stream_facet(const rs_stream_corners *records, const unsigned char *rec,
+/* rs_triangle_geometry of a triangle with its corners times `scale` (internal units): whether it
+ * is a facet, and then its corners and centroid (scaled) and area. */
+static inline bool rs_stream_facet(const rs_stream_corners *c, const rs_corner_view *view,
                                    double scale, double corners[9], double centroid[3],
                                    double *area) {
     static const uint32_t local[3] = {0, 1, 2};
     double normal[3];
-    for (int c = 0; c < 3; c++) {
-        rs_stream_record_corner(records, rec, c, corners + 3 * c);
+    for (int q = 0; q < 3; q++) {
+        rs_stream_view_corner(c, view, q, corners + 3 * q);
         for (int k = 0; k < 3; k++)
-            corners[3 * c + k] *= scale;
+            corners[3 * q + k] *= scale;
     }
     return rs_triangle_geometry(corners, local, centroid, normal, area);
 }

@@ -217,13 +217,13 @@ static void facet_run(facet_pass_job *job, size_t c) {
     int32_t near[MAX_NEAR];
     uint64_t *counts = job->counts + c * job->piece_count;
     for (uint64_t t = first; t < last && !job->unwritten[c]; t++) {
-        const unsigned char *rec = rs_corner_next(&r);
-        if (!rec) {
+        rs_corner_view view;
+        if (!rs_corner_next(&r, &view)) {
             job->unread[c] = true;
             break;
         }
         double p[9], centroid[3], area;
-        if (!rs_stream_facet(corners, rec, job->scale, p, centroid, &area))
+        if (!rs_stream_facet(corners, &view, job->scale, p, centroid, &area))
             continue; /* zero-area triangles weigh nothing anywhere */
         for (int k = 0; k < 3; k++)
             centroid[k] /= job->scale; /* exact: a power of two */
@@ -232,7 +232,7 @@ static void facet_run(facet_pass_job *job, size_t c) {
             if (!job->writers)
                 counts[near[i]]++;
             else if (job->pieces[near[i]].rank == job->rank &&
-                     !rs_region_append(job->writers + c, (size_t)near[i], rec))
+                     !rs_region_append(job->writers + c, (size_t)near[i], view.entry))
                 job->unwritten[c] = true;
         }
     }

@@ -29,8 +29,9 @@ static rsmooth_status read_fail(rsmooth_error *error) {
                    "cannot read the temporary corner file");
 }
 
-/* An edge as a lower vertex's bucket holds it: its upper end and its length (in two arrays,
- * 16 bytes an edge; this pair only while a large bucket is sorted). */
+/* An edge as a lower vertex's bucket holds it: its upper end and its length (in arrays: the upper
+ * ends' low 32 bits, their high halves only for 64-bit ids, the lengths: 12 bytes an edge, 16 with
+ * 64-bit ids; this pair only while a large bucket is sorted). */
 typedef struct edge_end {
     uint64_t upper;
     double length;
@@ -43,7 +44,8 @@ static int edge_end_compare(const void *a, const void *b) {
 /* The lower vertices whose buckets edge_marks orders. */
 typedef struct edge_job {
     const size_t *start; /* bucket i: upper and length [start[i], start[i + 1]) */
-    uint64_t *upper;
+    uint32_t *upper;     /* the low 32 bits */
+    uint32_t *high;      /* the high 32 bits, or NULL (32-bit ids) */
     double *length;
     /* when the positions are held whole: the lengths are measured here (on every core, each
      * bucket's lower vertex lo + i) rather than while the edges are placed */
@@ -79,41 +81,56 @@ static bool sort_bucket(uint64_t *upper, double *length, size_t n) {
     return true;
 }
 
-/* Buckets [begin, end), on every core: each put in the order its edges are counted in
- * (core/edge_bucket.h: sorted when large; repeated edges have the same length, so the sort's
- * order among them does not matter), and a repeated edge's length set to -1. */
+/* Bucket i put in the order its edges are counted in (core/edge_bucket.h: sorted when large;
+ * repeated edges have the same length, so the sort's order among them does not matter), a
+ * repeated edge's length set to -1, and, when the positions are held, the others measured. Only
+ * the lengths are summed after, in bucket order: the upper ends need not be written back. */
+static bool order_bucket(const edge_job *job, size_t i) {
+    size_t first = job->start[i], n = job->start[i + 1] - first;
+    double *length = job->length + first;
+    uint64_t small[RS_EDGE_SCAN_LIMIT];
+    uint64_t *upper = n <= RS_EDGE_SCAN_LIMIT ? small : rs_alloc_array(n, sizeof *upper);
+    if (!upper)
+        return false;
+    for (size_t j = 0; j < n; j++)
+        upper[j] = job->upper[first + j] | (job->high ? (uint64_t)job->high[first + j] << 32 : 0);
+    bool ok = true;
+    if (n > RS_EDGE_SCAN_LIMIT && job->held)
+        qsort(upper, n, sizeof *upper, rs_edge_compare64);
+    else if (n > RS_EDGE_SCAN_LIMIT)
+        ok = sort_bucket(upper, length, n);
+    for (size_t j = 0; ok && j < n; j++)
+        if (rs_edge_repeats64(upper, n, j))
+            length[j] = -1;
+        else if (job->held)
+            length[j] = held_length(job->held, job->lo + i, upper[j], job->scale);
+    if (upper != small)
+        rs_free(upper);
+    return ok;
+}
+
+/* Buckets [begin, end), on every core. */
 static void edge_marks(void *ctx, size_t begin, size_t end, size_t chunk) {
     (void)chunk;
     edge_job *job = ctx;
-    for (size_t i = begin; i < end; i++) {
-        uint64_t *upper = job->upper + job->start[i];
-        double *length = job->length + job->start[i];
-        size_t n = job->start[i + 1] - job->start[i];
-        if (job->held && n > RS_EDGE_SCAN_LIMIT)
-            qsort(upper, n, sizeof *upper, rs_edge_compare64);
-        else if (n > RS_EDGE_SCAN_LIMIT && !sort_bucket(upper, length, n)) {
+    for (size_t i = begin; i < end; i++)
+        if (!order_bucket(job, i)) {
             job->no_memory = true; /* (a flag written only to true: no race that matters) */
             return;
         }
-        for (size_t j = 0; j < n; j++)
-            if (rs_edge_repeats64(upper, n, j))
-                length[j] = -1;
-            else if (job->held)
-                length[j] = held_length(job->held, job->lo + i, upper[j], job->scale);
-    }
 }
 
 /* Edge e (0-2) of a record: from corner e to corner e + 1, its length measured lower end minus
  * upper end at `scale`, as mesh.c measures it from the positions. */
-static void record_edge(const rs_stream_corners *corners, const unsigned char *rec,
+static void record_edge(const rs_stream_corners *corners, const rs_corner_view *view,
                         const uint64_t tri[3], int e, double scale, uint64_t *upper_end,
                         double *length) {
     int ca = e, cb = (e + 1) % 3;
     uint64_t a = tri[ca], b = tri[cb];
     int lower = a < b ? ca : cb, upper = a < b ? cb : ca;
     double p[3], q[3], d[3];
-    rs_stream_record_corner(corners, rec, lower, p);
-    rs_stream_record_corner(corners, rec, upper, q);
+    rs_stream_view_corner(corners, view, lower, p);
+    rs_stream_view_corner(corners, view, upper, q);
     for (int k = 0; k < 3; k++)
         d[k] = p[k] * scale - q[k] * scale;
     *upper_end = a < b ? b : a;
@@ -123,13 +140,13 @@ static void record_edge(const rs_stream_corners *corners, const unsigned char *r
 /* The next triangle's ids, and its record when `rec` is asked for: counting needs only the ids,
  * read from the ids file while it is kept (a quarter of the bytes or less). */
 static bool next_ids(rs_corner_reader *r, const rs_stream_corners *corners, bool ids_only,
-                     uint64_t tri[3], const unsigned char **rec) {
+                     uint64_t tri[3], rs_corner_view *view) {
     if (ids_only)
         return rs_stream_next_triangle(&r->r, corners->id_bytes, tri);
-    *rec = rs_corner_next(r);
-    if (*rec)
-        rs_stream_record_ids(corners, *rec, tri);
-    return *rec != NULL;
+    if (!rs_corner_next(r, view))
+        return false;
+    rs_stream_record_ids(corners, view->entry, tri);
+    return true;
 }
 
 /* Sum and count of the unique edges whose lower vertex lies in [lo, hi); `capacity` edges fit
@@ -137,9 +154,9 @@ static bool next_ids(rs_corner_reader *r, const rs_stream_corners *corners, bool
  * that. The lengths come from the corner records, the buckets are ordered on every core, and the
  * sum runs here in the in-memory path's order. */
 static rsmooth_status edge_range(const rs_stream_corners *corners, double scale, uint64_t lo,
-                                 uint64_t hi, size_t *start, uint64_t *upper, double *length,
-                                 size_t capacity, double *sum, uint64_t *unique, bool *fits,
-                                 rsmooth_error *error) {
+                                 uint64_t hi, size_t *start, uint32_t *upper, uint32_t *high,
+                                 double *length, size_t capacity, double *sum, uint64_t *unique,
+                                 bool *fits, rsmooth_error *error) {
     size_t span = (size_t)(hi - lo);
     for (int fill = 0; fill < 2; fill++) { /* count, then place */
         if (fill == 0)
@@ -151,9 +168,9 @@ static rsmooth_status edge_range(const rs_stream_corners *corners, double scale,
                      : !rs_corner_reader_open(&r, corners, 0, corners->count))
             return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
         for (uint64_t t = 0; t < corners->count; t++) {
-            const unsigned char *rec = NULL;
+            rs_corner_view view;
             uint64_t tri[3];
-            if (!next_ids(&r, corners, ids_only, tri, &rec)) {
+            if (!next_ids(&r, corners, ids_only, tri, &view)) {
                 rs_corner_reader_close(&r);
                 return read_fail(error);
             }
@@ -167,10 +184,12 @@ static rsmooth_status edge_range(const rs_stream_corners *corners, double scale,
                     continue;
                 }
                 size_t at = start[low - lo]++;
-                if (corners->held)
-                    upper[at] = a < b ? b : a;
-                else
-                    record_edge(corners, rec, tri, e, scale, upper + at, length + at);
+                uint64_t up = a < b ? b : a;
+                if (!corners->held)
+                    record_edge(corners, &view, tri, e, scale, &up, length + at);
+                upper[at] = (uint32_t)up;
+                if (high)
+                    high[at] = (uint32_t)(up >> 32);
             }
         }
         rs_corner_reader_close(&r);
@@ -186,7 +205,7 @@ static rsmooth_status edge_range(const rs_stream_corners *corners, double scale,
     for (size_t v = span; v > 0; v--) /* the fill moved each start to the next's */
         start[v] = start[v - 1];
     start[0] = 0;
-    edge_job job = {start, upper, length, corners->held, lo, scale, false};
+    edge_job job = {start, upper, high, length, corners->held, lo, scale, false};
     rs_parallel_for(span, 4096, edge_marks, &job);
     if (job.no_memory)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
@@ -205,7 +224,10 @@ static rsmooth_status mean_edge_length(const rs_stream_corners *corners, uint64_
                                        rsmooth_error *error) {
     uint64_t triangles = corners->count;
     /* a first guess at the run of vertices that fits: each holds about 3 T / V edges */
-    double per_vertex = 8 + 16 * (v_count ? 3.0 * (double)triangles / (double)v_count : 0) * 1.25;
+    bool wide = corners->id_bytes == 8;
+    size_t edge_bytes = wide ? 16 : 12; /* upper end (and its high half) and length */
+    double per_vertex =
+        8 + (double)edge_bytes * (v_count ? 3.0 * (double)triangles / (double)v_count : 0) * 1.25;
     uint64_t span = (uint64_t)((double)memory / per_vertex);
     if (span < 1024)
         span = 1024;
@@ -215,14 +237,14 @@ static rsmooth_status mean_edge_length(const rs_stream_corners *corners, uint64_
      * allocator's heap crept up by about a run's arrays each time */
     size_t *start = rs_alloc_array((size_t)span + 1, sizeof *start);
     uint64_t used = 8 * (span + 1);
-    /* an upper end (8 bytes) and its length (8) per edge */
-    size_t capacity = memory > used ? (size_t)((memory - used) / 16) : 0;
+    size_t capacity = memory > used ? (size_t)((memory - used) / edge_bytes) : 0;
     if (capacity > 3 * triangles)
         capacity = (size_t)(3 * triangles);
-    uint64_t *upper = rs_alloc_array(capacity ? capacity : 1, sizeof *upper);
+    uint32_t *upper = rs_alloc_array(capacity ? capacity : 1, sizeof *upper);
+    uint32_t *high = wide ? rs_alloc_array(capacity ? capacity : 1, sizeof *high) : NULL;
     double *length = rs_alloc_array(capacity ? capacity : 1, sizeof *length);
     rsmooth_status st = RSMOOTH_OK;
-    if (!start || !upper || !length)
+    if (!start || !upper || !length || (wide && !high))
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
                      "no memory for the edges of %llu vertices", (unsigned long long)span);
     double sum = 0;
@@ -230,7 +252,7 @@ static rsmooth_status mean_edge_length(const rs_stream_corners *corners, uint64_
     for (uint64_t lo = 0; st == RSMOOTH_OK && lo < v_count;) {
         uint64_t hi = lo + span < v_count ? lo + span : v_count;
         bool fits = false;
-        st = edge_range(corners, scale, lo, hi, start, upper, length, capacity, &sum, &unique,
+        st = edge_range(corners, scale, lo, hi, start, upper, high, length, capacity, &sum, &unique,
                         &fits, error);
         if (st == RSMOOTH_OK && !fits && hi - lo <= 1)
             st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
@@ -243,6 +265,7 @@ static rsmooth_status mean_edge_length(const rs_stream_corners *corners, uint64_
     }
     rs_free(start);
     rs_free(upper);
+    rs_free(high);
     rs_free(length);
     if (st != RSMOOTH_OK)
         return st;
@@ -286,20 +309,20 @@ static void facet_blocks(void *ctx, size_t begin, size_t end, size_t chunk_index
         double block_sum = 0;
         uint64_t block_end = (uint64_t)(b + 1) * GEOMETRY_BLOCK;
         for (uint64_t t = (uint64_t)b * GEOMETRY_BLOCK; t < block_end && t < last; t++) {
-            const unsigned char *rec = rs_corner_next(&r);
-            if (!rec) {
+            rs_corner_view view;
+            if (!rs_corner_next(&r, &view)) {
                 chunk->unread = true;
                 break;
             }
             double hi = 0, xyz[9]; /* the parts test, in the caller's units as in memory */
             int16_t bin = rs_scale_bin(
-                rs_triangle_scale(scalar, rs_stream_record_xyz(corners, rec, xyz), local, &hi));
+                rs_triangle_scale(scalar, rs_stream_view_xyz(corners, &view, xyz), local, &hi));
             if (bin != RS_NO_BIN) {
                 chunk->histogram[bin - RS_PART_BIN_MIN]++;
                 chunk->longest = fmax(chunk->longest, hi);
             }
             double p[9], centroid[3], area = 0;
-            if (rs_stream_facet(corners, rec, job->scale, p, centroid, &area)) {
+            if (rs_stream_facet(corners, &view, job->scale, p, centroid, &area)) {
                 chunk->facets++;
                 block_sum += area;
                 for (int c = 0; c < 3; c++) {
