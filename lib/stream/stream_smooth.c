@@ -456,12 +456,13 @@ static bool piece_vertex(id_table *table, size_t *k, uint64_t id, bool f32, cons
     return true;
 }
 
-/* Vertex `id`'s position as the file's type: from its list entry (`at`), or the held positions. */
+/* Vertex `id`'s position as the file's type: in the held positions, or at byte `offset` of its
+ * list entry `entry` (an entry of ids alone carries none). */
 static const unsigned char *position_of(const stream_call *c, uint64_t id,
-                                        const unsigned char *at) {
+                                        const unsigned char *entry, size_t offset) {
     const rs_stream_vertices *v = &c->vertices;
     size_t vertex_bytes = 3 * (v->f32 ? sizeof(float) : sizeof(double));
-    return c->held ? (const unsigned char *)v->xyz + id * vertex_bytes : at;
+    return c->held ? (const unsigned char *)v->xyz + id * vertex_bytes : entry + offset;
 }
 
 /* A piece's arrays from its lists: its core vertices first (ids into `core`), then the others as
@@ -479,7 +480,7 @@ static bool assemble(const stream_call *c, const unsigned char *core_records, si
         const unsigned char *rec = core_records + v * vertex_record;
         core[v] = rs_stream_get_id(rec, id_bytes);
         uint32_t number;
-        if (!piece_vertex(table, k, core[v], f32, position_of(c, core[v], rec + id_bytes), xyz,
+        if (!piece_vertex(table, k, core[v], f32, position_of(c, core[v], rec, id_bytes), xyz,
                           &number))
             return false;
     }
@@ -488,11 +489,10 @@ static bool assemble(const stream_call *c, const unsigned char *core_records, si
         const unsigned char *rec = facet_records + f * facet_record;
         uint64_t ids[3];
         rs_stream_record_ids(corners, rec, ids);
-        const unsigned char *values = rs_stream_record_values(corners, rec);
         for (int q = 0; q < 3; q++)
             if (!piece_vertex(table, k, ids[q], f32,
-                              position_of(c, ids[q], values + 3 * value * (size_t)q), xyz,
-                              tri + 3 * f + (size_t)q))
+                              position_of(c, ids[q], rec, 3 * id_bytes + 3 * value * (size_t)q),
+                              xyz, tri + 3 * f + (size_t)q))
                 return false;
     }
     return true;
