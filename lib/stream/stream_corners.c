@@ -80,7 +80,7 @@ static void make_record(const rs_stream_corners *c, const unsigned char *ids, un
     }
 }
 
-rsmooth_status rs_stream_corners_make(rs_stream_vertices *v, int ids_fd, size_t id_bytes,
+rsmooth_status rs_stream_corners_make(rs_stream_vertices *v, bool hold, int ids_fd, size_t id_bytes,
                                       uint64_t triangles, const char *dir, rs_stream_corners *out,
                                       rsmooth_error *error) {
     out->fd = -1;
@@ -90,7 +90,7 @@ rsmooth_status rs_stream_corners_make(rs_stream_vertices *v, int ids_fd, size_t 
     out->id_bytes = id_bytes;
     out->record = 3 * id_bytes + 9 * (v->f32 ? sizeof(float) : sizeof(double));
     out->count = triangles;
-    if (v->xyz && v->first == 0 && v->loaded == v->count) {
+    if (hold && v->xyz && v->first == 0 && v->loaded == v->count) {
         out->held = v; /* made as read: no file */
         return RSMOOTH_OK;
     }

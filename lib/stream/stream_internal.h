@@ -219,9 +219,10 @@ typedef struct rs_stream_corners {
     uint64_t count;
 } rs_stream_corners;
 
-/* The corner records of the `triangles` in `ids_fd` (3 ids of id_bytes each): made as they are
- * read when `v` holds every position, else written to a temporary file in `dir`. */
-rsmooth_status rs_stream_corners_make(rs_stream_vertices *v, int ids_fd, size_t id_bytes,
+/* The corner records of the `triangles` in `ids_fd` (3 ids of id_bytes each): read through the
+ * held positions when `hold` and `v` holds every position, else written to a temporary file in
+ * `dir` (positions that fill the cap go to the file too: the pieces need the room). */
+rsmooth_status rs_stream_corners_make(rs_stream_vertices *v, bool hold, int ids_fd, size_t id_bytes,
                                       uint64_t triangles, const char *dir, rs_stream_corners *out,
                                       rsmooth_error *error);
 

@@ -195,8 +195,9 @@ static rsmooth_status read_input(stream_call *c, rs_stream_extent *extent, rsmoo
     bool f32 = c->ply.xyz_type == RS_PLY_FLOAT32;
     uint64_t position_bytes = c->ply.vertex_count * 3 * (f32 ? 4 : 8);
     uint64_t room = c->opt.max_memory - FIXED_BYTES;
-    uint64_t held = position_bytes <= room / 2 ? position_bytes : room;
-    rsmooth_status st = rs_stream_vertices_open(&c->vertices, &c->ply, held, extent, error);
+    bool hold = position_bytes <= room / 2;
+    rsmooth_status st =
+        rs_stream_vertices_open(&c->vertices, &c->ply, hold ? position_bytes : room, extent, error);
     if (st == RSMOOTH_OK)
         st = cancelled(c, 0.03, error);
     if (st != RSMOOTH_OK)
@@ -212,7 +213,7 @@ static rsmooth_status read_input(stream_call *c, rs_stream_extent *extent, rsmoo
                            "faces, a point cloud normals (nx, ny, nz)",
                            c->input, (unsigned long long)c->ply.vertex_count);
     if (st == RSMOOTH_OK)
-        st = rs_stream_corners_make(&c->vertices, ids_fd, c->ply.id_bytes, c->triangle_count,
+        st = rs_stream_corners_make(&c->vertices, hold, ids_fd, c->ply.id_bytes, c->triangle_count,
                                     c->dir, &c->corners, error);
     if (st == RSMOOTH_OK && !c->corners.held)
         rs_stream_vertices_release(&c->vertices); /* the statistics get the room */
