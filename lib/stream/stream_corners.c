@@ -67,17 +67,23 @@ static void corner_chunks(void *ctx, size_t begin, size_t end, size_t chunk_inde
     rs_free(records);
 }
 
-/* A record made from a triangle's ids (as the triangle file holds them) and the held positions. */
-static void make_record(const rs_stream_corners *c, const unsigned char *ids, unsigned char *out) {
+/* Corner q's x y z in the held positions, for a triangle's ids as the triangle file holds them. */
+static const unsigned char *held_corner(const rs_stream_corners *c, const unsigned char *ids,
+                                        int q) {
     const rs_stream_vertices *v = c->held;
+    uint64_t id = rs_stream_get_id(ids + c->id_bytes * (size_t)q, c->id_bytes);
+    return (const unsigned char *)v->xyz +
+           (id - v->first) * 3 * (c->f32 ? sizeof(float) : sizeof(double));
+}
+
+/* A record made from a triangle's ids and the held positions. */
+static void make_record(const rs_stream_corners *c, const unsigned char *ids, unsigned char *out) {
     size_t triangle_bytes = 3 * c->id_bytes;
     size_t vertex_bytes = 3 * (c->f32 ? sizeof(float) : sizeof(double));
     memcpy(out, ids, triangle_bytes);
-    for (int q = 0; q < 3; q++) {
-        uint64_t id = rs_stream_get_id(ids + c->id_bytes * (size_t)q, c->id_bytes);
-        memcpy(out + triangle_bytes + (size_t)q * vertex_bytes,
-               (const unsigned char *)v->xyz + (id - v->first) * vertex_bytes, vertex_bytes);
-    }
+    for (int q = 0; q < 3; q++)
+        memcpy(out + triangle_bytes + (size_t)q * vertex_bytes, held_corner(c, ids, q),
+               vertex_bytes);
 }
 
 rsmooth_status rs_stream_corners_make(rs_stream_vertices *v, bool hold, int ids_fd, size_t id_bytes,
@@ -138,15 +144,9 @@ bool rs_corner_next(rs_corner_reader *cr, rs_corner_view *view) {
     if (!entry)
         return false;
     view->entry = entry;
-    for (int q = 0; q < 3; q++) {
-        if (!c->held) {
-            view->xyz[q] = entry + triangle_bytes + (size_t)q * vertex_bytes;
-            continue;
-        }
-        const rs_stream_vertices *v = c->held;
-        uint64_t id = rs_stream_get_id(entry + c->id_bytes * (size_t)q, c->id_bytes);
-        view->xyz[q] = (const unsigned char *)v->xyz + (id - v->first) * vertex_bytes;
-    }
+    for (int q = 0; q < 3; q++)
+        view->xyz[q] =
+            c->held ? held_corner(c, entry, q) : entry + triangle_bytes + (size_t)q * vertex_bytes;
     return true;
 }
 

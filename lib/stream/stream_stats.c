@@ -55,14 +55,20 @@ typedef struct edge_job {
     bool no_memory;
 } edge_job;
 
-/* The length of the edge from held vertex a (lower) to b, at `scale`, as mesh.c measures it. */
-static double held_length(const rs_stream_vertices *v, uint64_t a, uint64_t b, double scale) {
-    double p[3], q[3], d[3];
-    rs_stream_vertex(v, a, p);
-    rs_stream_vertex(v, b, q);
+/* An edge's length from its lower end p to its upper end q, at `scale`, as mesh.c measures it. */
+static double edge_length_at(const double p[3], const double q[3], double scale) {
+    double d[3];
     for (int k = 0; k < 3; k++)
         d[k] = p[k] * scale - q[k] * scale;
     return sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+}
+
+/* The length of the edge from held vertex a (lower) to b. */
+static double held_length(const rs_stream_vertices *v, uint64_t a, uint64_t b, double scale) {
+    double p[3], q[3];
+    rs_stream_vertex(v, a, p);
+    rs_stream_vertex(v, b, q);
+    return edge_length_at(p, q, scale);
 }
 
 /* A bucket of more than RS_EDGE_SCAN_LIMIT edges sorted by upper end, its lengths along. */
@@ -128,13 +134,11 @@ static void record_edge(const rs_stream_corners *corners, const rs_corner_view *
     int ca = e, cb = (e + 1) % 3;
     uint64_t a = tri[ca], b = tri[cb];
     int lower = a < b ? ca : cb, upper = a < b ? cb : ca;
-    double p[3], q[3], d[3];
+    double p[3], q[3];
     rs_stream_view_corner(corners, view, lower, p);
     rs_stream_view_corner(corners, view, upper, q);
-    for (int k = 0; k < 3; k++)
-        d[k] = p[k] * scale - q[k] * scale;
     *upper_end = a < b ? b : a;
-    *length = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    *length = edge_length_at(p, q, scale);
 }
 
 /* The next triangle's ids, and its record when `rec` is asked for: counting needs only the ids,

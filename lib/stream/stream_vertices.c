@@ -19,25 +19,32 @@ static size_t vertex_bytes(const rs_stream_vertices *v) {
     return 3 * (v->f32 ? sizeof(float) : sizeof(double));
 }
 
-rsmooth_status rs_stream_vertices_load(rs_stream_vertices *v, uint64_t first,
-                                       rsmooth_error *error) {
-    if (v->xyz && first == v->first && v->loaded == run_end(v, first) - first)
-        return RSMOOTH_OK;
+/* Reads the run that starts at `first` into xyz (made when it is not there), its extent into
+ * *extent. */
+static rsmooth_status read_run(rs_stream_vertices *v, uint64_t first, rs_stream_extent *extent,
+                               rsmooth_error *error) {
     if (!v->xyz)
         v->xyz = rs_alloc_array((size_t)(v->run ? v->run : 1), vertex_bytes(v));
     if (!v->xyz)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
                        "no memory for %llu vertex positions", (unsigned long long)v->run);
-    rs_stream_extent unused;
     v->loaded = 0;
     rsmooth_status st =
-        rs_stream_ply_read_range(v->ply, first, run_end(v, first) - first, v->xyz, &unused, error);
+        rs_stream_ply_read_range(v->ply, first, run_end(v, first) - first, v->xyz, extent, error);
     if (st != RSMOOTH_OK)
         return st;
     v->first = first;
     v->loaded = run_end(v, first) - first;
     v->runs_read++;
     return RSMOOTH_OK;
+}
+
+rsmooth_status rs_stream_vertices_load(rs_stream_vertices *v, uint64_t first,
+                                       rsmooth_error *error) {
+    if (v->xyz && first == v->first && v->loaded == run_end(v, first) - first)
+        return RSMOOTH_OK;
+    rs_stream_extent unused;
+    return read_run(v, first, &unused, error);
 }
 
 rsmooth_status rs_stream_vertices_open(rs_stream_vertices *v, rs_stream_ply *ply, uint64_t memory,
@@ -51,10 +58,6 @@ rsmooth_status rs_stream_vertices_open(rs_stream_vertices *v, rs_stream_ply *ply
         v->run = MIN_RUN;
     if (v->run > v->count)
         v->run = v->count;
-    v->xyz = rs_alloc_array((size_t)(v->run ? v->run : 1), vertex_bytes(v));
-    if (!v->xyz)
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
-                       "no memory for %llu vertex positions", (unsigned long long)v->run);
     for (int k = 0; k < 3; k++) {
         extent->lo[k] = INFINITY;
         extent->hi[k] = -INFINITY;
@@ -63,14 +66,9 @@ rsmooth_status rs_stream_vertices_open(rs_stream_vertices *v, rs_stream_ply *ply
     /* every run once, in file order: the extent, and the first bad vertex found first */
     for (uint64_t first = 0; first < v->count; first += v->run) {
         rs_stream_extent part;
-        v->loaded = 0;
-        rsmooth_status st =
-            rs_stream_ply_read_range(ply, first, run_end(v, first) - first, v->xyz, &part, error);
+        rsmooth_status st = read_run(v, first, &part, error);
         if (st != RSMOOTH_OK)
             return st;
-        v->first = first;
-        v->loaded = run_end(v, first) - first;
-        v->runs_read++;
         for (int k = 0; k < 3; k++) {
             extent->lo[k] = fmin(extent->lo[k], part.lo[k]);
             extent->hi[k] = fmax(extent->hi[k], part.hi[k]);
