@@ -309,17 +309,39 @@ typedef struct rs_stream_stats {
     /* the two at `scale` (internal units), as the in-memory path holds them: in the caller's
      * units a mesh at 1e-300 has no representable area */
     double scaled_mean_edge_length, scaled_mean_area;
-    double reach; /* largest centroid-to-corner distance of a facet */
+    double reach;       /* largest centroid-to-corner distance of a facet */
+    double reach_bound; /* a bound on it from the longest edge, known before the facets' pass */
     uint64_t facet_count;
     double lo[3], hi[3]; /* the vertices' bounding box */
     bool whole;          /* one part, no edge out of line (core/parts.h): what streams */
 } rs_stream_stats;
 
-/* The figures of the mesh of `vertex_count` vertices whose triangles are `corners`, with at most
- * `memory` bytes of working memory for the unique edges. */
+/* The figures of the mesh of `vertex_count` vertices whose triangles are `corners` that its edges
+ * give (the scale, the mean edge length, the reach's bound), with at most `memory` bytes of
+ * working memory for the unique edges. The facets' figures come in a second pass. */
 rsmooth_status rs_stream_statistics(const rs_stream_corners *corners, uint64_t vertex_count,
                                     const rs_stream_extent *extent, uint64_t memory,
                                     rs_stream_stats *stats, rsmooth_error *error);
+
+/* What the facets' pass does besides: the cut counts each facet's pieces in it (one read of the
+ * triangles' corners instead of two). `triangle` is called with each triangle, its centroid in
+ * the caller's units (NULL for a triangle of no area, which is no facet), in triangle order within
+ * each chunk of rs_stream_facet_chunks; the chunks run on every core at once. */
+typedef struct rs_facet_visitor {
+    void (*triangle)(void *ctx, size_t chunk, const double centroid[3]);
+    void *ctx;
+} rs_facet_visitor;
+
+/* The chunks of the facets' pass over `triangles`: chunk c holds triangles [first(c),
+ * first(c + 1)), first(chunks) = triangles. */
+size_t rs_stream_facet_chunks(uint64_t triangles);
+uint64_t rs_stream_facet_chunk_first(uint64_t triangles, size_t chunks, size_t c);
+
+/* The facet count, mean area, reach and parts test (stats->scale set), with `visitor` (or NULL)
+ * called on every facet. */
+rsmooth_status rs_stream_facet_figures(const rs_stream_corners *corners,
+                                       const rs_facet_visitor *visitor, rs_stream_stats *stats,
+                                       rsmooth_error *error);
 
 /* ---- stream_pieces.c ----------------------------------------------------------------------- */
 
@@ -341,14 +363,15 @@ typedef struct rs_stream_pieces {
     uint64_t temporary_bytes;
 } rs_stream_pieces;
 
-/* Cuts the mesh into pieces of at most about `piece_vertices` core vertices, shares them among
- * `ranks` by their facet counts, and writes (for this `rank`'s pieces) each piece's core
- * vertices and its facets within `halo` (corner records) to temporary files in `dir`. */
+/* Cuts the mesh into pieces of at most about `piece_vertices` core vertices, counts each piece's
+ * facets within `halo` in the facets' pass (which fills the rest of `stats`; nothing more is done
+ * when it finds the mesh is not whole), shares the pieces among `ranks` by their facet counts,
+ * and writes (for this `rank`'s pieces) each piece's core vertices and its facets (corner
+ * records) to temporary files in `dir`. */
 rsmooth_status rs_stream_pieces_build(rs_stream_vertices *vertices,
-                                      const rs_stream_corners *corners,
-                                      const rs_stream_stats *stats, double halo,
-                                      uint64_t piece_vertices, size_t buffer_memory, int rank,
-                                      int ranks, const char *dir, rs_stream_pieces *out,
+                                      const rs_stream_corners *corners, rs_stream_stats *stats,
+                                      double halo, uint64_t piece_vertices, size_t buffer_memory,
+                                      int rank, int ranks, const char *dir, rs_stream_pieces *out,
                                       rsmooth_error *error);
 void rs_stream_pieces_free(rs_stream_pieces *pieces);
 

@@ -12,6 +12,8 @@
 #include <unistd.h>
 
 #define MAX_CELLS (1u << 21)
+#define MAX_NEAR 512 /* pieces a facet can be near */
+#define CODE_BUFFER (64u << 10)
 
 typedef struct cell_grid {
     double lo[3], size[3];
@@ -153,10 +155,21 @@ static bool cut(cutter *ct, box bx, uint64_t n) {
 /* The pieces whose boxes lie within `halo` of point c (at most `max` of them), in `out`. */
 static size_t pieces_near(const cell_grid *g, const box *boxes, const double c[3], double halo,
                           int32_t *out, size_t max) {
-    int32_t a[3], b[3];
+    int32_t a[3], b[3], own[3];
     for (int k = 0; k < 3; k++) {
         a[k] = cell_coordinate(g, c[k] - halo, k);
         b[k] = cell_coordinate(g, c[k] + halo, k);
+    }
+    /* most facets: every cell within the halo in the box of the centroid's own piece, which is
+     * then the only one (boxes do not overlap, and c lies in its own) */
+    cell_of(g, c, own);
+    int32_t first = g->piece[cell_index(g, own)];
+    bool alone = first >= 0 && max > 0;
+    for (int k = 0; k < 3 && alone; k++)
+        alone = a[k] >= boxes[first].a[k] && b[k] < boxes[first].b[k];
+    if (alone) {
+        out[0] = first;
+        return 1;
     }
     size_t n = 0;
     int32_t q[3];
@@ -185,10 +198,10 @@ static size_t pieces_near(const cell_grid *g, const box *boxes, const double c[3
     return n;
 }
 
-/* The triangles of a facet pass, cut into `chunks` runs that run on every core. Both passes cut
- * them the same way, so that the writing pass knows from the counting pass where each run's
- * records of each piece go: after the earlier runs' records, as one pass in order would put
- * them. */
+/* The triangles of the facets' pass, cut into `chunks` runs that run on every core
+ * (rs_stream_facet_chunks); the writing pass cuts them the same way, so that it knows from the
+ * counts where each run's records of each piece go: after the earlier runs' records, as one pass
+ * in order would put them. */
 typedef struct facet_pass_job {
     const rs_stream_corners *corners;
     size_t chunks;
@@ -200,43 +213,102 @@ typedef struct facet_pass_job {
     int rank;
     size_t facet_record;       /* bytes of a record the lists keep: all, or the ids alone */
     uint64_t *counts;          /* chunks x pieces: each run's facets of each piece */
-    rs_region_writer *writers; /* per run (the writing pass), or NULL (the counting pass) */
-    bool *unread, *unwritten;  /* per run */
+    rs_region_writer *writers; /* per run: the lists (the writing pass) or the codes (counting) */
+    /* Per triangle, the piece it lies in alone (most do), or PIECE_NONE or PIECE_SEVERAL: the
+     * counting writes them so the writing pass need not look up a corner but for the few near
+     * several pieces. code_bytes: 2 while the piece ids fit, else 4. */
+    int code_fd;
+    size_t code_bytes;
+    bool *unread, *unwritten; /* per run */
 } facet_pass_job;
 
+#define PIECE_NONE UINT32_MAX          /* no area, or no piece near */
+#define PIECE_SEVERAL (UINT32_MAX - 1) /* near more than one: looked for again */
+
+static void put_code(unsigned char *at, uint32_t code, size_t bytes) {
+    if (bytes == 2) {
+        uint16_t narrow = code >= PIECE_SEVERAL ? (uint16_t)(code - 0xffff0000u) : (uint16_t)code;
+        memcpy(at, &narrow, sizeof narrow);
+    } else
+        memcpy(at, &code, sizeof code);
+}
+
+static uint32_t get_code(const unsigned char *at, size_t bytes) {
+    if (bytes == 2) {
+        uint16_t narrow;
+        memcpy(&narrow, at, sizeof narrow);
+        return narrow >= (uint16_t)PIECE_SEVERAL ? 0xffff0000u + narrow : narrow;
+    }
+    uint32_t code;
+    memcpy(&code, at, sizeof code);
+    return code;
+}
+
+/* The counting: a triangle of the facets' pass (rs_facet_visitor), counted in each piece near
+ * it, its code written. */
+static void count_facet(void *ctx, size_t c, const double centroid[3]) {
+    facet_pass_job *job = ctx;
+    int32_t near[MAX_NEAR];
+    uint64_t *counts = job->counts + c * job->piece_count;
+    size_t n = centroid ? pieces_near(job->g, job->boxes, centroid, job->halo, near, MAX_NEAR) : 0;
+    for (size_t i = 0; i < n; i++)
+        counts[near[i]]++;
+    unsigned char code[4];
+    put_code(code,
+             n == 0   ? PIECE_NONE
+             : n == 1 ? (uint32_t)near[0]
+                      : PIECE_SEVERAL,
+             job->code_bytes);
+    if (!rs_region_append(job->writers + c, 0, code))
+        job->unwritten[c] = true;
+}
+
+/* The writing: run c of the triangles again, each facet's entry appended to this rank's pieces
+ * it lies near (found again only for a facet near several). */
 static void facet_run(facet_pass_job *job, size_t c) {
     const rs_stream_corners *corners = job->corners;
-    uint64_t first = corners->count * c / job->chunks;
-    uint64_t last = corners->count * (c + 1) / job->chunks;
+    uint64_t first = rs_stream_facet_chunk_first(corners->count, job->chunks, c);
+    uint64_t last = rs_stream_facet_chunk_first(corners->count, job->chunks, c + 1);
+    size_t bytes = job->code_bytes;
     rs_corner_reader r;
-    if (!rs_corner_reader_open(&r, corners, first, last)) {
+    rs_stream_reader codes;
+    if (!rs_stream_reader_open(&codes, job->code_fd, "codes", first * bytes, last * bytes,
+                               CODE_BUFFER / bytes * bytes)) {
         job->unread[c] = true;
         return;
     }
-    enum { MAX_NEAR = 512 };
+    if (!rs_corner_reader_open(&r, corners, first, last)) {
+        rs_stream_reader_close(&codes);
+        job->unread[c] = true;
+        return;
+    }
     int32_t near[MAX_NEAR];
-    uint64_t *counts = job->counts + c * job->piece_count;
     for (uint64_t t = first; t < last && !job->unwritten[c]; t++) {
         rs_corner_view view;
-        if (!rs_corner_next(&r, &view)) {
+        const unsigned char *code_at = rs_stream_read(&codes, bytes);
+        if (!code_at || !rs_corner_next(&r, &view)) {
             job->unread[c] = true;
             break;
         }
-        double p[9], centroid[3], area;
-        if (!rs_stream_facet(corners, &view, job->scale, p, centroid, &area))
-            continue; /* zero-area triangles weigh nothing anywhere */
-        for (int k = 0; k < 3; k++)
-            centroid[k] /= job->scale; /* exact: a power of two */
-        size_t n = pieces_near(job->g, job->boxes, centroid, job->halo, near, MAX_NEAR);
-        for (size_t i = 0; i < n; i++) {
-            if (!job->writers)
-                counts[near[i]]++;
-            else if (job->pieces[near[i]].rank == job->rank &&
-                     !rs_region_append(job->writers + c, (size_t)near[i], view.entry))
-                job->unwritten[c] = true;
+        uint32_t code = get_code(code_at, bytes);
+        size_t n = 0;
+        if (code == PIECE_SEVERAL) {
+            double p[9], centroid[3], area;
+            rs_stream_facet(corners, &view, job->scale, p, centroid, &area); /* (not 0: counted) */
+            for (int k = 0; k < 3; k++)
+                centroid[k] /= job->scale; /* exact: a power of two */
+            n = pieces_near(job->g, job->boxes, centroid, job->halo, near, MAX_NEAR);
+        } else if (code != PIECE_NONE) {
+            near[0] = (int32_t)code;
+            n = 1;
         }
+        for (size_t i = 0; i < n; i++)
+            if (job->pieces[near[i]].rank == job->rank &&
+                !rs_region_append(job->writers + c, (size_t)near[i], view.entry))
+                job->unwritten[c] = true;
     }
     rs_corner_reader_close(&r);
+    rs_stream_reader_close(&codes);
 }
 
 static void facet_runs(void *ctx, size_t begin, size_t end, size_t chunk) {
@@ -245,8 +317,7 @@ static void facet_runs(void *ctx, size_t begin, size_t end, size_t chunk) {
         facet_run(ctx, c);
 }
 
-/* One pass over the triangles: counts each run's facets of each piece (writers NULL), or writes
- * this rank's pieces' facet records. */
+/* The writing pass over the triangles: this rank's pieces' facet records. */
 static rsmooth_status facet_pass(facet_pass_job *job, rs_region_writer *writers,
                                  rsmooth_error *error) {
     job->writers = writers;
@@ -306,21 +377,51 @@ static rsmooth_status unwritten(const char *dir, rsmooth_error *error) {
 }
 
 static void facet_job_free(facet_pass_job *job) {
+    if (job->code_fd >= 0)
+        close(job->code_fd);
     rs_free(job->counts);
     rs_free(job->unread);
     rs_free(job->unwritten);
 }
 
-/* Each piece's facet count (the counting pass), with the runs' counts kept in job. */
+/* Each piece's facet count, in the facets' pass that fills the rest of `stats`, with the runs'
+ * counts kept in job and each triangle's code written to job->code_fd. */
 static rsmooth_status count_facets(facet_pass_job *job, rs_piece *pieces, size_t count,
-                                   rsmooth_error *error) {
-    job->chunks = rs_parallel_chunks((size_t)job->corners->count, 65536);
+                                   rs_stream_stats *stats, const char *dir, rsmooth_error *error) {
+    uint64_t triangles = job->corners->count;
+    job->chunks = rs_stream_facet_chunks(triangles);
     job->counts = rs_calloc_array(job->chunks * (count ? count : 1), sizeof(uint64_t));
-    job->unread = rs_alloc_array(job->chunks, sizeof(bool));
-    job->unwritten = rs_alloc_array(job->chunks, sizeof(bool));
-    if (!job->counts || !job->unread || !job->unwritten)
+    job->unread = rs_calloc_array(job->chunks, sizeof(bool));
+    job->unwritten = rs_calloc_array(job->chunks, sizeof(bool));
+    job->writers = rs_calloc_array(job->chunks, sizeof *job->writers);
+    if (!job->counts || !job->unread || !job->unwritten || !job->writers)
         return no_memory(error);
-    rsmooth_status st = facet_pass(job, NULL, error);
+    job->code_bytes = count < 0xfffe ? 2 : 4;
+    job->code_fd = rs_stream_temporary(dir);
+    if (job->code_fd < 0)
+        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                       "cannot create a temporary file in %s", dir);
+    rsmooth_status st = RSMOOTH_OK;
+    for (size_t c = 0; st == RSMOOTH_OK && c < job->chunks; c++) {
+        uint64_t first = rs_stream_facet_chunk_first(triangles, job->chunks, c);
+        if (!rs_region_writer_init(job->writers + c, job->code_fd, 1, job->code_bytes, &first,
+                                   CODE_BUFFER))
+            st = no_memory(error);
+    }
+    rs_facet_visitor counting = {count_facet, job};
+    if (st == RSMOOTH_OK)
+        st = rs_stream_facet_figures(job->corners, &counting, stats, error);
+    bool written = true;
+    for (size_t c = 0; c < job->chunks; c++) {
+        written = !job->unwritten[c] && written;
+        if (st == RSMOOTH_OK)
+            written = rs_region_writer_finish(job->writers + c) && written;
+        rs_region_writer_free(job->writers + c);
+    }
+    rs_free(job->writers);
+    job->writers = NULL;
+    if (st == RSMOOTH_OK && !written)
+        st = unwritten(dir, error);
     for (size_t c = 0; st == RSMOOTH_OK && c < job->chunks; c++)
         for (size_t i = 0; i < count; i++)
             pieces[i].facet_count += job->counts[c * count + i];
@@ -409,10 +510,9 @@ static rsmooth_status write_facet_lists(facet_pass_job *job, int fd, size_t buff
 }
 
 rsmooth_status rs_stream_pieces_build(rs_stream_vertices *vertices,
-                                      const rs_stream_corners *corners,
-                                      const rs_stream_stats *stats, double halo,
-                                      uint64_t piece_vertices, size_t buffer_memory, int rank,
-                                      int ranks, const char *dir, rs_stream_pieces *out,
+                                      const rs_stream_corners *corners, rs_stream_stats *stats,
+                                      double halo, uint64_t piece_vertices, size_t buffer_memory,
+                                      int rank, int ranks, const char *dir, rs_stream_pieces *out,
                                       rsmooth_error *error) {
     memset(out, 0, sizeof *out);
     out->vertex_fd = out->facet_fd = -1;
@@ -420,6 +520,7 @@ rsmooth_status rs_stream_pieces_build(rs_stream_vertices *vertices,
     cutter ct = {&g, piece_vertices ? piece_vertices : 1, NULL, NULL, 0, 0};
     facet_pass_job job;
     memset(&job, 0, sizeof job);
+    job.code_fd = -1;
     rsmooth_status st = RSMOOTH_OK;
     size_t max_cells = buffer_memory / 8 < MAX_CELLS ? buffer_memory / 8 : MAX_CELLS;
     if (!grid_init(&g, stats, halo, max_cells < 1 ? 1 : max_cells)) {
@@ -443,9 +544,10 @@ rsmooth_status rs_stream_pieces_build(rs_stream_vertices *vertices,
                            /* a little beyond the halo: a facet exactly at it must not round out
                             * (as tiles.c) */
                            .halo = halo * (1 + 1e-6),
-                           .rank = rank};
-    st = count_facets(&job, ct.pieces, ct.count, error);
-    if (st != RSMOOTH_OK)
+                           .rank = rank,
+                           .code_fd = -1};
+    st = count_facets(&job, ct.pieces, ct.count, stats, dir, error);
+    if (st != RSMOOTH_OK || !stats->whole) /* (the caller says why a mesh not whole stops) */
         goto done;
     if (!share(ct.pieces, ct.count, ranks < 1 ? 1 : ranks)) {
         st = no_memory(error);
@@ -474,7 +576,8 @@ rsmooth_status rs_stream_pieces_build(rs_stream_vertices *vertices,
     out->vertex_record = out->id_bytes + xyz;
     out->facet_record = corners->held ? 3 * out->id_bytes : corners->record;
     job.facet_record = out->facet_record;
-    out->temporary_bytes = out->vertex_record * listed + out->facet_record * facets;
+    out->temporary_bytes =
+        out->vertex_record * listed + out->facet_record * facets + job.code_bytes * corners->count;
     st =
         write_vertex_lists(vertices, &g, ct.pieces, ct.count, rank, out, buffer_memory, dir, error);
     if (st == RSMOOTH_OK)

@@ -257,15 +257,10 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
     }
     if (st != RSMOOTH_OK)
         return st;
-    if (!c->stats.whole)
-        return rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, RS_STREAM_WHERE,
-                       "%s holds parts of very different size, or vertices far off the surface "
-                       "(triangles out of scale with the rest): streaming does not keep them "
-                       "apart yet; smooth it without --max-memory",
-                       c->input);
     c->rep.mean_edge_length = c->stats.mean_edge_length;
-    c->rep.facet_count = c->stats.facet_count;
-    st = rsmooth_piece_halo(&c->params, c->stats.mean_edge_length, c->stats.reach, &c->halo, error);
+    /* the halo from the reach's bound: the pieces are counted in the pass that measures it */
+    st = rsmooth_piece_halo(&c->params, c->stats.mean_edge_length, c->stats.reach_bound, &c->halo,
+                            error);
     if (st != RSMOOTH_OK)
         return st;
     c->rep.halo = c->halo;
@@ -283,6 +278,13 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
     c->rep.memory_planned = held + FIXED_BYTES + c->piece_vertices * PIECE_BYTES_PER_VERTEX;
     st = rs_stream_pieces_build(&c->vertices, &c->corners, &c->stats, c->halo, c->piece_vertices,
                                 GRID_BYTES, c->opt.rank, c->opt.ranks, c->dir, &c->pieces, error);
+    if (st == RSMOOTH_OK && !c->stats.whole)
+        st = rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, RS_STREAM_WHERE,
+                     "%s holds parts of very different size, or vertices far off the surface "
+                     "(triangles out of scale with the rest): streaming does not keep them "
+                     "apart yet; smooth it without --max-memory",
+                     c->input);
+    c->rep.facet_count = c->stats.facet_count;
     /* at their largest, beside the pieces' lists: the triangles' ids, and the corner records
      * when they were written (the positions not held) */
     uint64_t ids = 3 * c->ply.id_bytes * c->triangle_count;

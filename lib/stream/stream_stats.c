@@ -23,6 +23,9 @@
 
 /* mesh.c's block of the area sums */
 #define GEOMETRY_BLOCK 8192
+/* A facet's corner lies at most 2/3 of its longest edge from its centroid (two thirds of a
+ * median, and no median is longer than the longest side); 0.7 leaves room for rounding. */
+#define REACH_PER_EDGE 0.7
 
 static rsmooth_status read_fail(rsmooth_error *error) {
     return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
@@ -153,14 +156,14 @@ static bool next_ids(rs_corner_reader *r, const rs_stream_corners *corners, bool
     return true;
 }
 
-/* Sum and count of the unique edges whose lower vertex lies in [lo, hi); `capacity` edges fit
- * in `upper` and `length`. *fits is false (nothing summed) when the range has more edges than
+/* Sum, longest and count of the unique edges whose lower vertex lies in [lo, hi); `capacity` edges
+ * fit in `upper` and `length`. *fits is false (nothing summed) when the range has more edges than
  * that. The lengths come from the corner records, the buckets are ordered on every core, and the
  * sum runs here in the in-memory path's order. */
 static rsmooth_status edge_range(const rs_stream_corners *corners, double scale, uint64_t lo,
                                  uint64_t hi, size_t *start, uint32_t *upper, uint32_t *high,
-                                 double *length, size_t capacity, double *sum, uint64_t *unique,
-                                 bool *fits, rsmooth_error *error) {
+                                 double *length, size_t capacity, double *sum, double *longest,
+                                 uint64_t *unique, bool *fits, rsmooth_error *error) {
     size_t span = (size_t)(hi - lo);
     for (int fill = 0; fill < 2; fill++) { /* count, then place */
         if (fill == 0)
@@ -217,6 +220,7 @@ static rsmooth_status edge_range(const rs_stream_corners *corners, double scale,
     for (size_t e = 0; e < start[span]; e++) /* in order: the in-memory path's bits */
         if (!(length[e] < 0)) {
             *sum += length[e];
+            *longest = fmax(*longest, length[e]);
             (*unique)++;
         }
     *fits = true;
@@ -224,7 +228,7 @@ static rsmooth_status edge_range(const rs_stream_corners *corners, double scale,
 }
 
 static rsmooth_status mean_edge_length(const rs_stream_corners *corners, uint64_t v_count,
-                                       double scale, uint64_t memory, double *out,
+                                       double scale, uint64_t memory, double *out, double *longest,
                                        rsmooth_error *error) {
     uint64_t triangles = corners->count;
     /* a first guess at the run of vertices that fits: each holds about 3 T / V edges */
@@ -256,8 +260,8 @@ static rsmooth_status mean_edge_length(const rs_stream_corners *corners, uint64_
     for (uint64_t lo = 0; st == RSMOOTH_OK && lo < v_count;) {
         uint64_t hi = lo + span < v_count ? lo + span : v_count;
         bool fits = false;
-        st = edge_range(corners, scale, lo, hi, start, upper, high, length, capacity, &sum, &unique,
-                        &fits, error);
+        st = edge_range(corners, scale, lo, hi, start, upper, high, length, capacity, &sum, longest,
+                        &unique, &fits, error);
         if (st == RSMOOTH_OK && !fits && hi - lo <= 1)
             st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
                          "vertex %llu has more edges than the memory cap holds",
@@ -291,7 +295,18 @@ typedef struct facet_job {
     double scale;
     double *block_sum; /* per block of GEOMETRY_BLOCK triangles: its facets' areas, in order */
     facet_chunk *chunk;
+    const rs_facet_visitor *visitor; /* or NULL */
 } facet_job;
+
+size_t rs_stream_facet_chunks(uint64_t triangles) {
+    return rs_parallel_chunks((size_t)((triangles + GEOMETRY_BLOCK - 1) / GEOMETRY_BLOCK), 4);
+}
+
+uint64_t rs_stream_facet_chunk_first(uint64_t triangles, size_t chunks, size_t c) {
+    uint64_t blocks = (triangles + GEOMETRY_BLOCK - 1) / GEOMETRY_BLOCK;
+    uint64_t first = blocks * c / chunks * GEOMETRY_BLOCK; /* rs_parallel_for's split of blocks */
+    return first < triangles ? first : triangles;
+}
 
 /* Blocks [begin, end): each block's area summed in triangle order, as mesh.c sums it. */
 static void facet_blocks(void *ctx, size_t begin, size_t end, size_t chunk_index) {
@@ -326,13 +341,23 @@ static void facet_blocks(void *ctx, size_t begin, size_t end, size_t chunk_index
                 chunk->longest = fmax(chunk->longest, hi);
             }
             double p[9], centroid[3], area = 0;
-            if (rs_stream_facet(corners, &view, job->scale, p, centroid, &area)) {
+            bool facet = rs_stream_facet(corners, &view, job->scale, p, centroid, &area);
+            if (!facet && job->visitor)
+                job->visitor->triangle(job->visitor->ctx, chunk_index, NULL);
+            if (facet) {
                 chunk->facets++;
                 block_sum += area;
+                double far = 0; /* sqrt is monotone: the root of the largest square is the same */
                 for (int c = 0; c < 3; c++) {
                     double d[3];
                     rs_sub3(p + 3 * c, centroid, d);
-                    chunk->reach = fmax(chunk->reach, sqrt(rs_dot3(d, d)));
+                    far = fmax(far, rs_dot3(d, d));
+                }
+                chunk->reach = fmax(chunk->reach, sqrt(far));
+                if (job->visitor) {
+                    for (int k = 0; k < 3; k++)
+                        centroid[k] /= job->scale; /* exact: a power of two */
+                    job->visitor->triangle(job->visitor->ctx, chunk_index, centroid);
                 }
             }
         }
@@ -343,12 +368,14 @@ static void facet_blocks(void *ctx, size_t begin, size_t end, size_t chunk_index
 
 /* Facet count, mean area and reach, in blocks as mesh.c sums them: the blocks on every core,
  * then their sums in block order, so the bits do not depend on the number of threads. */
-static rsmooth_status facet_figures(const rs_stream_corners *corners, double scale,
-                                    rs_stream_stats *stats, rsmooth_error *error) {
+rsmooth_status rs_stream_facet_figures(const rs_stream_corners *corners,
+                                       const rs_facet_visitor *visitor, rs_stream_stats *stats,
+                                       rsmooth_error *error) {
+    double scale = stats->scale;
     size_t blocks = (size_t)((corners->count + GEOMETRY_BLOCK - 1) / GEOMETRY_BLOCK);
     size_t chunks = rs_parallel_chunks(blocks, 4);
     facet_job job = {corners, scale, rs_alloc_array(blocks ? blocks : 1, sizeof(double)),
-                     rs_calloc_array(chunks ? chunks : 1, sizeof(facet_chunk))};
+                     rs_calloc_array(chunks ? chunks : 1, sizeof(facet_chunk)), visitor};
     size_t *histogram = rs_calloc_array(RS_PART_BIN_COUNT, sizeof *histogram);
     bool ok = job.block_sum && job.chunk && histogram;
     if (ok)
@@ -428,10 +455,12 @@ rsmooth_status rs_stream_statistics(const rs_stream_corners *corners, uint64_t v
     rsmooth_status st = whole_scale(corners, extent->magnitude, &stats->scale, error);
     if (st != RSMOOTH_OK)
         return st;
+    double longest = 0;
     st = mean_edge_length(corners, vertex_count, stats->scale, memory,
-                          &stats->scaled_mean_edge_length, error);
+                          &stats->scaled_mean_edge_length, &longest, error);
     if (st != RSMOOTH_OK)
         return st;
     stats->mean_edge_length = stats->scaled_mean_edge_length / stats->scale;
-    return facet_figures(corners, stats->scale, stats, error);
+    stats->reach_bound = REACH_PER_EDGE * longest / stats->scale;
+    return RSMOOTH_OK;
 }
