@@ -375,4 +375,21 @@ rsmooth_status rs_stream_pieces_build(rs_stream_vertices *vertices,
                                       rsmooth_error *error);
 void rs_stream_pieces_free(rs_stream_pieces *pieces);
 
+/* ---- stream_assemble.c --------------------------------------------------------------------- */
+
+/* Where a piece's lists' entries and positions come from. */
+typedef struct rs_piece_source {
+    const rs_stream_vertices *held; /* the positions held whole, or NULL: the entries carry them */
+    bool f32;                       /* positions in the file's float32 (else float64) */
+    size_t id_bytes, vertex_record, facet_record; /* rs_stream_pieces' */
+} rs_piece_source;
+
+/* A piece's arrays from its n core vertices' and m facets' list entries: the core's ids into
+ * `core`, every vertex's position into xyz (the core first; at most n + 3 m of them, *k
+ * receives how many), the facets renumbered into `tri` (which may be `facet_records` itself when
+ * those are three 32-bit ids each). false when out of memory. */
+bool rs_stream_assemble(const rs_piece_source *src, const unsigned char *core_records, size_t n,
+                        const unsigned char *facet_records, size_t m, uint64_t *core, uint32_t *tri,
+                        double *xyz, size_t *k);
+
 #endif /* RSMOOTH_STREAM_INTERNAL_H */

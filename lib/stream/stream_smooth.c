@@ -325,64 +325,6 @@ static rsmooth_status make_copy(stream_call *c, rsmooth_error *error) {
     return RSMOOTH_OK;
 }
 
-/* Global vertex id -> the piece's own numbering: an open-addressing table, ids as keys. */
-typedef struct id_slot_entry {
-    uint32_t key;   /* the id's low 32 bits */
-    uint32_t value; /* UINT32_MAX: empty */
-} id_slot_entry;
-
-/* Key and value side by side in 8 bytes (a lookup that hits touches one cache line, and the
- * table stays as small as 32-bit ids make it); the ids' high halves apart, only for meshes of
- * 2^32 - 1 vertices and more. */
-typedef struct id_table {
-    id_slot_entry *slot;
-    uint32_t *high; /* or NULL */
-    size_t mask;
-} id_table;
-
-static bool id_table_init(id_table *t, size_t count, bool wide) {
-    size_t size = 16;
-    while (size < 2 * count)
-        size *= 2;
-    t->mask = size - 1;
-    t->slot = rs_alloc_array(size, sizeof *t->slot);
-    t->high = wide ? rs_alloc_array(size, sizeof *t->high) : NULL;
-    if (!t->slot || (wide && !t->high))
-        return false;
-    memset(t->slot, 0xff, size * sizeof *t->slot);
-    return true;
-}
-
-static void id_table_free(id_table *t) {
-    rs_free(t->slot);
-    rs_free(t->high);
-    t->slot = NULL;
-    t->high = NULL;
-}
-
-static bool slot_empty(const id_table *t, size_t i) {
-    return t->slot[i].value == UINT32_MAX;
-}
-
-/* The slot of `id`: where it is, or the empty slot where it goes. */
-static size_t id_slot(const id_table *t, uint64_t id) {
-    uint32_t low = (uint32_t)id, high = (uint32_t)(id >> 32);
-    size_t i = (size_t)(((low ^ high) * 0x9E3779B1u) >> 7) & t->mask;
-    while (!slot_empty(t, i) && (t->slot[i].key != low || (t->high && t->high[i] != high)))
-        i = (i + 1) & t->mask;
-    return i;
-}
-
-static void slot_put(id_table *t, size_t i, uint64_t id, uint32_t value) {
-    t->slot[i] = (id_slot_entry){(uint32_t)id, value};
-    if (t->high)
-        t->high[i] = (uint32_t)(id >> 32);
-}
-
-static uint64_t slot_id(const id_table *t, size_t i) {
-    return (uint64_t)t->slot[i].key | (t->high ? (uint64_t)t->high[i] << 32 : 0);
-}
-
 /* The filter on an assembled piece (k vertices at xyz, its n core vertices first; m triangles):
  * the core's results into `out`. It is handed over in internal units, its positions times the
  * whole mesh's scale (exact: a power of two) and the figures as the in-memory path holds them, at
@@ -423,84 +365,6 @@ static rsmooth_status filter_piece(stream_call *c, double *xyz, size_t k, const 
     return RSMOOTH_OK;
 }
 
-/* Vertex `id` into the piece (at its position `at`, 3 values of the file's type) unless it is
- * there; *number receives its number in the piece. */
-static bool piece_vertex(id_table *table, size_t *k, uint64_t id, bool f32, const unsigned char *at,
-                         double *xyz, uint32_t *number) {
-    size_t i = id_slot(table, id);
-    if (!slot_empty(table, i)) {
-        *number = table->slot[i].value;
-        return true;
-    }
-    if (2 * (*k + 1) > table->mask) { /* a piece this connected: grow the table */
-        id_table bigger;
-        if (!id_table_init(&bigger, 2 * (*k + 1), table->high != NULL))
-            return false;
-        for (size_t q = 0; q <= table->mask; q++)
-            if (!slot_empty(table, q)) {
-                uint64_t key = slot_id(table, q);
-                slot_put(&bigger, id_slot(&bigger, key), key, table->slot[q].value);
-            }
-        id_table_free(table);
-        *table = bigger;
-        i = id_slot(table, id);
-    }
-    slot_put(table, i, id, (uint32_t)*k);
-    *number = (uint32_t)*k;
-    for (int c = 0; c < 3; c++) {
-        if (f32) {
-            float x;
-            memcpy(&x, at + sizeof x * (size_t)c, sizeof x);
-            xyz[3 * *k + (size_t)c] = (double)x;
-        } else
-            memcpy(xyz + 3 * *k + (size_t)c, at + sizeof(double) * (size_t)c, sizeof(double));
-    }
-    (*k)++;
-    return true;
-}
-
-/* Vertex `id`'s position as the file's type: in the held positions, or at byte `offset` of its
- * list entry `entry` (an entry of ids alone carries none). */
-static const unsigned char *position_of(const stream_call *c, uint64_t id,
-                                        const unsigned char *entry, size_t offset) {
-    const rs_stream_vertices *v = &c->vertices;
-    size_t vertex_bytes = 3 * (v->f32 ? sizeof(float) : sizeof(double));
-    return c->held ? (const unsigned char *)v->xyz + id * vertex_bytes : entry + offset;
-}
-
-/* A piece's arrays from its lists: its core vertices first (ids into `core`), then the others as
- * the facets first name them, each with the position its entry carries (or the held positions);
- * the facets renumbered into `tri`. *k receives the piece's vertex count. */
-static bool assemble(const stream_call *c, const unsigned char *core_records, size_t n,
-                     const unsigned char *facet_records, size_t m, id_table *table, uint64_t *core,
-                     uint32_t *tri, double *xyz, size_t *k) {
-    const rs_stream_corners *corners = &c->corners;
-    size_t id_bytes = c->pieces.id_bytes, vertex_record = c->pieces.vertex_record;
-    size_t facet_record = c->pieces.facet_record;
-    bool f32 = corners->f32;
-    *k = 0;
-    for (size_t v = 0; v < n; v++) {
-        const unsigned char *rec = core_records + v * vertex_record;
-        core[v] = rs_stream_get_id(rec, id_bytes);
-        uint32_t number;
-        if (!piece_vertex(table, k, core[v], f32, position_of(c, core[v], rec, id_bytes), xyz,
-                          &number))
-            return false;
-    }
-    size_t value = f32 ? sizeof(float) : sizeof(double);
-    for (size_t f = 0; f < m; f++) {
-        const unsigned char *rec = facet_records + f * facet_record;
-        uint64_t ids[3];
-        rs_stream_record_ids(corners, rec, ids);
-        for (int q = 0; q < 3; q++)
-            if (!piece_vertex(table, k, ids[q], f32,
-                              position_of(c, ids[q], rec, 3 * id_bytes + 3 * value * (size_t)q),
-                              xyz, tri + 3 * f + (size_t)q))
-                return false;
-    }
-    return true;
-}
-
 /* Step 5 for one piece: its lists read, its arrays assembled, filtered, written. */
 static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error *error) {
     double t_piece = now_ms();
@@ -518,10 +382,8 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
     size_t most = n + 3 * m, k = 0;
     double *xyz = rs_alloc_array(most ? most : 1, 3 * sizeof *xyz);
     double *out = rs_alloc_array(n ? n : 1, 3 * sizeof *out);
-    id_table table = {NULL, NULL, 0};
     rsmooth_status st = RSMOOTH_OK;
-    if (!core_records || !facet_records || !core || !tri || !xyz || !out ||
-        !id_table_init(&table, n + m, c->ply.id_bytes == 8)) {
+    if (!core_records || !facet_records || !core || !tri || !xyz || !out) {
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
                      "no memory for a piece of %zu facets", m);
         goto done;
@@ -534,7 +396,9 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
                      strerror(errno));
         goto done;
     }
-    if (!assemble(c, core_records, n, facet_records, m, &table, core, tri, xyz, &k)) {
+    rs_piece_source src = {c->held ? &c->vertices : NULL, c->corners.f32, c->pieces.id_bytes,
+                           vertex_record, facet_record};
+    if (!rs_stream_assemble(&src, core_records, n, facet_records, m, core, tri, xyz, &k)) {
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
                      "no memory for a piece of %zu facets", m);
         goto done;
@@ -542,9 +406,6 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
     if (!in_place) /* the arrays hold it all now */
         rs_free(facet_records);
     facet_records = NULL;
-    id_table_free(&table);
-    table.slot = NULL;
-    table.high = NULL;
     c->rep.ms_assemble += now_ms() - t_piece;
     st = filter_piece(c, xyz, k, tri, m, n, out, error);
     if (st == RSMOOTH_OK) /* what the in-memory writer refuses, before any of it is written */
@@ -557,7 +418,6 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
                      strerror(errno));
     c->rep.ms_write += now_ms() - t;
 done:
-    id_table_free(&table);
     rs_free(core_records);
     if (!in_place)
         rs_free(facet_records);

@@ -156,67 +156,120 @@ static bool next_ids(rs_corner_reader *r, const rs_stream_corners *corners, bool
     return true;
 }
 
-/* Sum, longest and count of the unique edges whose lower vertex lies in [lo, hi); `capacity` edges
- * fit in `upper` and `length`. *fits is false (nothing summed) when the range has more edges than
- * that. The lengths come from the corner records, the buckets are ordered on every core, and the
- * sum runs here in the in-memory path's order. */
-static rsmooth_status edge_range(const rs_stream_corners *corners, double scale, uint64_t lo,
-                                 uint64_t hi, size_t *start, uint32_t *upper, uint32_t *high,
-                                 double *length, size_t capacity, double *sum, double *longest,
-                                 uint64_t *unique, bool *fits, rsmooth_error *error) {
-    size_t span = (size_t)(hi - lo);
-    for (int fill = 0; fill < 2; fill++) { /* count, then place */
-        if (fill == 0)
-            memset(start, 0, (span + 1) * sizeof *start);
-        rs_corner_reader r;
-        bool ids_only = fill == 0 || corners->held; /* held: measured after, on every core */
-        if (ids_only ? !rs_stream_triangles_open_range(&r.r, corners->ids_fd, corners->id_bytes, 0,
-                                                       corners->count)
-                     : !rs_corner_reader_open(&r, corners, 0, corners->count))
-            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "read buffer");
-        for (uint64_t t = 0; t < corners->count; t++) {
-            rs_corner_view view;
-            uint64_t tri[3];
-            if (!next_ids(&r, corners, ids_only, tri, &view)) {
-                rs_corner_reader_close(&r);
-                return read_fail(error);
-            }
-            for (int e = 0; e < 3; e++) {
-                uint64_t a = tri[e], b = tri[(e + 1) % 3];
-                uint64_t low = a < b ? a : b;
-                if (a == b || low < lo || low >= hi)
-                    continue;
-                if (fill == 0) {
-                    start[low - lo + 1]++;
-                    continue;
-                }
-                size_t at = start[low - lo]++;
-                uint64_t up = a < b ? b : a;
-                if (!corners->held)
-                    record_edge(corners, &view, tri, e, scale, &up, length + at);
-                upper[at] = (uint32_t)up;
-                if (high)
-                    high[at] = (uint32_t)(up >> 32);
-            }
+/* The edges of lower vertices [lo, hi) counted, then placed, by runs of triangles on every core:
+ * run c counts its edges of vertex lo + i in at[c * span + i], which then becomes where its first
+ * one goes in the vertex's bucket (after the earlier runs'), so each bucket holds its edges in
+ * triangle order, as one pass would put them, for any number of threads. */
+typedef struct edge_pass {
+    const rs_stream_corners *corners;
+    double scale;
+    uint64_t lo, hi;
+    size_t span, runs;
+    uint32_t *at;        /* runs x span */
+    const size_t *start; /* the buckets (the placing) */
+    uint32_t *upper, *high;
+    double *length;
+    bool place;
+    bool *unread; /* per run */
+} edge_pass;
+
+static void edge_run(edge_pass *pass, size_t c) {
+    const rs_stream_corners *corners = pass->corners;
+    uint64_t first = corners->count * c / pass->runs, last = corners->count * (c + 1) / pass->runs;
+    uint32_t *at = pass->at + c * pass->span;
+    rs_corner_reader r;
+    bool ids_only = !pass->place || corners->held; /* held: measured after, on every core */
+    if (ids_only
+            ? !rs_stream_triangles_open_range(&r.r, corners->ids_fd, corners->id_bytes, first, last)
+            : !rs_corner_reader_open(&r, corners, first, last)) {
+        pass->unread[c] = true;
+        return;
+    }
+    for (uint64_t t = first; t < last; t++) {
+        rs_corner_view view;
+        uint64_t tri[3];
+        if (!next_ids(&r, corners, ids_only, tri, &view)) {
+            pass->unread[c] = true;
+            break;
         }
-        rs_corner_reader_close(&r);
-        if (fill == 0) {
-            for (size_t v = 0; v < span; v++)
-                start[v + 1] += start[v];
-            if (start[span] > capacity) {
-                *fits = false;
-                return RSMOOTH_OK;
+        for (int e = 0; e < 3; e++) {
+            uint64_t a = tri[e], b = tri[(e + 1) % 3];
+            uint64_t low = a < b ? a : b;
+            if (a == b || low < pass->lo || low >= pass->hi)
+                continue;
+            size_t i = (size_t)(low - pass->lo);
+            if (!pass->place) {
+                at[i]++;
+                continue;
             }
+            size_t slot = pass->start[i] + at[i]++;
+            uint64_t up = a < b ? b : a;
+            if (!corners->held)
+                record_edge(corners, &view, tri, e, pass->scale, &up, pass->length + slot);
+            pass->upper[slot] = (uint32_t)up;
+            if (pass->high)
+                pass->high[slot] = (uint32_t)(up >> 32);
         }
     }
-    for (size_t v = span; v > 0; v--) /* the fill moved each start to the next's */
-        start[v] = start[v - 1];
+    rs_corner_reader_close(&r);
+}
+
+static void edge_runs(void *ctx, size_t begin, size_t end, size_t chunk) {
+    (void)chunk;
+    for (size_t c = begin; c < end; c++)
+        edge_run(ctx, c);
+}
+
+/* The runs' counts into bucket starts and each run's first place in them; false when a bucket
+ * holds 2^32 edges or more (no memory cap gets near). */
+static bool edge_starts(edge_pass *pass, size_t *start) {
     start[0] = 0;
-    edge_job job = {start, upper, high, length, corners->held, lo, scale, false};
+    for (size_t i = 0; i < pass->span; i++) {
+        uint64_t sum = 0;
+        for (size_t c = 0; c < pass->runs; c++) {
+            uint32_t n = pass->at[c * pass->span + i];
+            pass->at[c * pass->span + i] = (uint32_t)sum;
+            sum += n;
+        }
+        if (sum > UINT32_MAX)
+            return false;
+        start[i + 1] = start[i] + (size_t)sum;
+    }
+    return true;
+}
+
+/* Sum, longest and count of the unique edges whose lower vertex lies in [lo, hi); `capacity` edges
+ * fit in `upper` and `length`. *fits is false (nothing summed) when the range has more edges than
+ * that. The edges are counted and placed by runs of triangles and the buckets ordered on every
+ * core; the sum runs here in the in-memory path's order. */
+static rsmooth_status edge_range(edge_pass *pass, size_t *start, size_t capacity, double *sum,
+                                 double *longest, uint64_t *unique, bool *fits,
+                                 rsmooth_error *error) {
+    size_t span = pass->span;
+    memset(pass->at, 0, pass->runs * span * sizeof *pass->at);
+    memset(pass->unread, 0, pass->runs * sizeof *pass->unread);
+    for (int place = 0; place < 2; place++) { /* count, then place */
+        pass->place = place;
+        pass->start = start;
+        rs_parallel_for(pass->runs, 1, edge_runs, pass);
+        for (size_t c = 0; c < pass->runs; c++)
+            if (pass->unread[c])
+                return read_fail(error);
+        if (!place && !edge_starts(pass, start))
+            return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
+                           "a vertex has 2^32 edges or more");
+        if (!place && start[span] > capacity) {
+            *fits = false;
+            return RSMOOTH_OK;
+        }
+    }
+    edge_job job = {start,    pass->upper, pass->high, pass->length, pass->corners->held,
+                    pass->lo, pass->scale, false};
     rs_parallel_for(span, 4096, edge_marks, &job);
     if (job.no_memory)
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
                        "no memory to sort a vertex's edges");
+    const double *length = pass->length;
     for (size_t e = 0; e < start[span]; e++) /* in order: the in-memory path's bits */
         if (!(length[e] < 0)) {
             *sum += length[e];
@@ -227,15 +280,24 @@ static rsmooth_status edge_range(const rs_stream_corners *corners, double scale,
     return RSMOOTH_OK;
 }
 
+/* Runs of triangles the edges are counted and placed in: a few (each costs 4 bytes per vertex of
+ * a run of vertices), on every core. */
+#define EDGE_RUNS_MAX 8
+
 static rsmooth_status mean_edge_length(const rs_stream_corners *corners, uint64_t v_count,
                                        double scale, uint64_t memory, double *out, double *longest,
                                        rsmooth_error *error) {
     uint64_t triangles = corners->count;
+    edge_pass pass = {.corners = corners, .scale = scale};
+    pass.runs = rs_parallel_chunks((size_t)triangles, 65536);
+    pass.runs = pass.runs > EDGE_RUNS_MAX ? EDGE_RUNS_MAX : pass.runs;
     /* a first guess at the run of vertices that fits: each holds about 3 T / V edges */
     bool wide = corners->id_bytes == 8;
-    size_t edge_bytes = wide ? 16 : 12; /* upper end (and its high half) and length */
+    size_t edge_bytes = wide ? 16 : 12;      /* upper end (and its high half) and length */
+    size_t vertex_bytes = 8 + 4 * pass.runs; /* its bucket's start, each run's place in it */
     double per_vertex =
-        8 + (double)edge_bytes * (v_count ? 3.0 * (double)triangles / (double)v_count : 0) * 1.25;
+        (double)vertex_bytes +
+        (double)edge_bytes * (v_count ? 3.0 * (double)triangles / (double)v_count : 0) * 1.25;
     uint64_t span = (uint64_t)((double)memory / per_vertex);
     if (span < 1024)
         span = 1024;
@@ -244,15 +306,17 @@ static rsmooth_status mean_edge_length(const rs_stream_corners *corners, uint64_
     /* one set of arrays for every run (runs only shrink): freed and made again per run, the
      * allocator's heap crept up by about a run's arrays each time */
     size_t *start = rs_alloc_array((size_t)span + 1, sizeof *start);
-    uint64_t used = 8 * (span + 1);
+    pass.at = rs_alloc_array((size_t)span ? (size_t)span : 1, pass.runs * sizeof *pass.at);
+    pass.unread = rs_alloc_array(pass.runs, sizeof *pass.unread);
+    uint64_t used = vertex_bytes * (span + 1);
     size_t capacity = memory > used ? (size_t)((memory - used) / edge_bytes) : 0;
     if (capacity > 3 * triangles)
         capacity = (size_t)(3 * triangles);
-    uint32_t *upper = rs_alloc_array(capacity ? capacity : 1, sizeof *upper);
-    uint32_t *high = wide ? rs_alloc_array(capacity ? capacity : 1, sizeof *high) : NULL;
-    double *length = rs_alloc_array(capacity ? capacity : 1, sizeof *length);
+    pass.upper = rs_alloc_array(capacity ? capacity : 1, sizeof *pass.upper);
+    pass.high = wide ? rs_alloc_array(capacity ? capacity : 1, sizeof *pass.high) : NULL;
+    pass.length = rs_alloc_array(capacity ? capacity : 1, sizeof *pass.length);
     rsmooth_status st = RSMOOTH_OK;
-    if (!start || !upper || !length || (wide && !high))
+    if (!start || !pass.at || !pass.unread || !pass.upper || !pass.length || (wide && !pass.high))
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
                      "no memory for the edges of %llu vertices", (unsigned long long)span);
     double sum = 0;
@@ -260,8 +324,10 @@ static rsmooth_status mean_edge_length(const rs_stream_corners *corners, uint64_
     for (uint64_t lo = 0; st == RSMOOTH_OK && lo < v_count;) {
         uint64_t hi = lo + span < v_count ? lo + span : v_count;
         bool fits = false;
-        st = edge_range(corners, scale, lo, hi, start, upper, high, length, capacity, &sum, longest,
-                        &unique, &fits, error);
+        pass.lo = lo;
+        pass.hi = hi;
+        pass.span = (size_t)(hi - lo);
+        st = edge_range(&pass, start, capacity, &sum, longest, &unique, &fits, error);
         if (st == RSMOOTH_OK && !fits && hi - lo <= 1)
             st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
                          "vertex %llu has more edges than the memory cap holds",
@@ -272,9 +338,11 @@ static rsmooth_status mean_edge_length(const rs_stream_corners *corners, uint64_
             lo = hi;
     }
     rs_free(start);
-    rs_free(upper);
-    rs_free(high);
-    rs_free(length);
+    rs_free(pass.at);
+    rs_free(pass.unread);
+    rs_free(pass.upper);
+    rs_free(pass.high);
+    rs_free(pass.length);
     if (st != RSMOOTH_OK)
         return st;
     *out = unique ? sum / (double)unique : 0;
