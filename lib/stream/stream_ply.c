@@ -442,6 +442,71 @@ static size_t element_index(const rs_stream_ply *ply, const rs_ply_element *e) {
     return (size_t)(e - ply->header.x->elements);
 }
 
+/* Nearly every file's faces: one list property alone, a one-byte count and 32-bit indices, three
+ * each; rows of 13 bytes then, read on every core. */
+typedef struct triangle_rows {
+    const rs_stream_ply *ply;
+    int fd;
+    size_t row;
+    bool is_signed;
+    bool *odd; /* per chunk: a row that is not three indices in range (the general reader then) */
+} triangle_rows;
+
+static void triangle_chunk(void *ctx, size_t begin, size_t end, size_t chunk) {
+    triangle_rows *job = ctx;
+    const rs_stream_ply *ply = job->ply;
+    enum { ROWS = 1 << 15 };
+    size_t id_bytes = ply->id_bytes, row = job->row;
+    unsigned char *in = rs_alloc_array(ROWS, row);
+    unsigned char *out = rs_alloc_array(ROWS, 3 * id_bytes);
+    bool odd = !in || !out;
+    for (uint64_t first = begin; !odd && first < end; first += ROWS) {
+        size_t n = end - first < ROWS ? (size_t)(end - first) : ROWS;
+        odd = !rs_pread_all(ply->fd, in, n * row, ply->face_start + first * row);
+        for (size_t i = 0; !odd && i < n; i++) {
+            const unsigned char *r = in + i * row;
+            odd = r[0] != 3;
+            for (int c = 0; c < 3 && !odd; c++) {
+                unsigned char b[4];
+                for (int k = 0; k < 4; k++)
+                    b[k] = r[1 + 4 * c + (ply->swap ? 3 - k : k)];
+                uint32_t u;
+                memcpy(&u, b, sizeof u);
+                odd = (job->is_signed && (int32_t)u < 0) || u >= ply->vertex_count;
+                rs_stream_put_id(out + (3 * i + (size_t)c) * id_bytes, u, id_bytes);
+            }
+        }
+        odd = odd || !rs_pwrite_all(job->fd, out, n * 3 * id_bytes, first * 3 * id_bytes);
+    }
+    rs_free(in);
+    rs_free(out);
+    job->odd[chunk] = odd;
+}
+
+/* The faces as rows of 13 bytes, when the header says so and every row is a triangle in range;
+ * false (nothing to be relied on written) otherwise, and on any read or write error: the general
+ * reader then says what is wrong. */
+static bool fixed_triangles(rs_stream_ply *ply, const rs_ply_element *f, int triangles_fd) {
+    const rs_ply_property *p = f->property_count == 1 ? &f->properties[0] : NULL;
+    if (!p || p->role != RS_PLY_FACE_LIST || rs_ply_type_size(p->count_type) != 1 ||
+        (p->type != RS_PLY_INT32 && p->type != RS_PLY_UINT32) || f->count > UINT64_MAX / 13 ||
+        ply->face_start + f->count * 13 > ply->size)
+        return false;
+    size_t chunks = rs_parallel_chunks((size_t)f->count, 1 << 16);
+    triangle_rows job = {ply, triangles_fd, 13, p->type == RS_PLY_INT32,
+                         rs_calloc_array(chunks, sizeof(bool))};
+    if (!job.odd)
+        return false;
+    rs_parallel_for((size_t)f->count, 1 << 16, triangle_chunk, &job);
+    bool ok = true;
+    for (size_t c = 0; c < chunks; c++)
+        ok = ok && !job.odd[c];
+    rs_free(job.odd);
+    if (!ok && ftruncate(triangles_fd, 0) != 0) /* (the general reader writes it from the start) */
+        return false;
+    return ok;
+}
+
 rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_fd,
                                              uint64_t *triangle_count, rsmooth_error *error) {
     *triangle_count = 0;
@@ -450,6 +515,10 @@ rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_f
         const rs_ply_element *v = ply->header.vertex_element;
         return check_end(ply, element_index(ply, v) + 1,
                          ply->vertex_start + v->count * ply->vertex_stride, error);
+    }
+    if (fixed_triangles(ply, f, triangles_fd)) {
+        *triangle_count = f->count;
+        return check_end(ply, element_index(ply, f) + 1, ply->face_start + f->count * 13, error);
     }
     rs_stream_reader r;
     if (!rs_stream_reader_open(&r, ply->fd, ply->path, ply->face_start, ply->size, READ_BUFFER))
