@@ -1,5 +1,6 @@
 /* The piece and stream C API refuse what would return garbage:
- *   - rsmooth_smooth_piece checks every field of rsmooth_piece_info, a scale the whole-mesh path
+ *   - rsmooth_smooth_piece checks every field of rsmooth_piece_info (and reads a record of the
+ *     first published size, its newer fields at 0), a scale the whole-mesh path
  *     cannot choose (2^-1030) or one that is not the whole mesh's (2^300, 2^-300 on a mesh of
  *     0.1 edges) among them, and returns INVALID_ARGUMENT naming it with nothing written; the
  *     scales a whole mesh of this piece could have give the in-memory reference path's bits;
@@ -153,6 +154,9 @@ static void check_info_fields(rsmooth_context *ctx, piece_case *c) {
     bad.core_count = c->mesh.vertex_count + 1;
     check_refused(ctx, c, &bad, "info->core_count");
     bad = good;
+    bad.keep_memory = 2;
+    check_refused(ctx, c, &bad, "info->keep_memory");
+    bad = good;
     bad.struct_size = 0;
     check_refused(ctx, c, &bad, "info->struct_size");
     check_refused(ctx, c, NULL, "info is NULL");
@@ -172,6 +176,22 @@ static void check_valid_scales(piece_case *c) {
             differ += c->out[k] != c->expected[k];
         printf("  scale %-8g: %zu coordinates differ from the in-memory reference path\n",
                info.scale, differ);
+        CHECK(differ == 0);
+    }
+    /* a record of the first published size (0.7: keep_memory beyond it, read as 0, whatever the
+     * bytes there), and one keeping its memory: the same bits */
+    for (int variant = 0; variant < 2; variant++) {
+        rsmooth_piece_info info = c->info;
+        info.keep_memory = variant == 0 ? 99 : 1;
+        if (variant == 0)
+            info.struct_size = offsetof(rsmooth_piece_info, keep_memory);
+        rsmooth_error err;
+        CHECK_STATUS(smooth(NULL, c, &info, NULL, c->out, &err), RSMOOTH_OK);
+        size_t differ = 0;
+        for (size_t k = 0; k < 3 * c->mesh.vertex_count; k++)
+            differ += c->out[k] != c->expected[k];
+        printf("  %s: %zu coordinates differ\n",
+               variant == 0 ? "a 0.7-size record" : "keep_memory 1", differ);
         CHECK(differ == 0);
     }
 }

@@ -76,16 +76,32 @@ rsmooth_status rsmooth_piece_halo(const rsmooth_params *params, double mean_edge
     return RSMOOTH_OK;
 }
 
+/* The first published rsmooth_piece_info (0.7): a caller built against it stays valid, the fields
+ * added since at their defaults. */
+#define PIECE_INFO_V0_SIZE (offsetof(rsmooth_piece_info, scale) + sizeof(double))
+
+/* The caller's record as this version has it, the fields its struct_size leaves out at 0. */
+static rsmooth_status read_info(const rsmooth_piece_info *info, rsmooth_piece_info *full,
+                                rsmooth_error *error) {
+    if (!info)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "info is NULL");
+    if (info->struct_size < PIECE_INFO_V0_SIZE)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                       "info->struct_size %zu: call rsmooth_piece_info_init first",
+                       info->struct_size);
+    rsmooth_piece_info_init(full);
+    memcpy(full, info, info->struct_size < sizeof *full ? info->struct_size : sizeof *full);
+    full->struct_size = sizeof *full;
+    return RSMOOTH_OK;
+}
+
 /* The fields a caller sets, before anything is read: the whole mesh's figures as the in-memory
  * path has them (positive wherever a mesh has a facet) and a scale it can choose (scale.c). */
 static rsmooth_status check_info(const rsmooth_piece_info *info, size_t vertex_count,
                                  rsmooth_error *error) {
-    if (!info)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "info is NULL");
-    if (info->struct_size < sizeof *info)
+    if (info->keep_memory != 0 && info->keep_memory != 1)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "info->struct_size %zu: call rsmooth_piece_info_init first",
-                       info->struct_size);
+                       "info->keep_memory must be 0 or 1 (got %d)", info->keep_memory);
     if (info->core_count > vertex_count)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
                        "info->core_count %zu exceeds the piece's %zu vertices", info->core_count,
@@ -193,14 +209,18 @@ static rsmooth_status solve_reference(const rs_problem *pb, size_t core, double 
 
 rsmooth_status rsmooth_smooth_piece(rsmooth_context *ctx, const double *positions,
                                     size_t vertex_count, const uint32_t *indices,
-                                    size_t triangle_count, const rsmooth_piece_info *info,
+                                    size_t triangle_count, const rsmooth_piece_info *caller_info,
                                     const rsmooth_params *params, double *out_positions,
                                     rsmooth_report *report, rsmooth_error *error) {
     double t_start = rs_now_ms();
     rs_error_clear(error);
     rs_problem pb; /* freed on every path: empty until prepare_piece fills it */
     memset(&pb, 0, sizeof pb);
-    rsmooth_status st = check_info(info, vertex_count, error);
+    rsmooth_piece_info full;
+    const rsmooth_piece_info *info = &full;
+    rsmooth_status st = read_info(caller_info, &full, error);
+    if (st == RSMOOTH_OK)
+        st = check_info(info, vertex_count, error);
     if (st != RSMOOTH_OK)
         return st;
     if (ctx) {
@@ -226,6 +246,7 @@ rsmooth_status rsmooth_smooth_piece(rsmooth_context *ctx, const double *position
             st = solve_reference(&pb, info->core_count, out_positions, report, t_start, error);
     }
     rs_problem_free(&pb);
-    rs_release_free_memory();
+    if (!info->keep_memory)
+        rs_release_free_memory();
     return st;
 }

@@ -35,10 +35,19 @@ double rs_triangle_scale(rsmooth_scalar scalar, const void *positions, const uin
     return e0 + e1 + e2 - lo - *longest; /* the median */
 }
 
+/* floor(4 log2(scale)) exactly, from the exponent and the mantissa against 2^(-3/4), 2^(-1/2)
+ * and 2^(-1/4) (each the smallest double at or above it): no libm call per triangle, and no
+ * rounding of log2 near a bin's edge. */
+_Static_assert(RS_PART_BINS_PER_OCTAVE == 4, "rs_scale_bin's thresholds are quarter octaves");
+
 int16_t rs_scale_bin(double scale) {
     if (!(scale > 0) || !isfinite(scale))
         return RS_NO_BIN;
-    return (int16_t)floor(RS_PART_BINS_PER_OCTAVE * log2(scale));
+    int e = 0;
+    double f = frexp(scale, &e); /* scale = f 2^e, f in [1/2, 1) */
+    int quarters =
+        (f >= 0x1.306fe0a31b716p-1) + (f >= 0x1.6a09e667f3bcdp-1) + (f >= 0x1.ae89f995ad3aep-1);
+    return (int16_t)(RS_PART_BINS_PER_OCTAVE * (e - 1) + quarters);
 }
 
 size_t rs_cut_parts(const size_t *histogram, uint32_t *part_of_bin, double *limit,

@@ -6,8 +6,8 @@
  *   2. the mesh's figures (stream_stats.c) and the halo of a piece (rsmooth_piece_halo);
  *   3. the pieces and their lists on disk (stream_pieces.c), sized to the memory cap;
  *   4. the output: a copy of the input, unnamed until it is complete;
- *   5. each piece (this rank's) filtered (rsmooth_smooth_piece) and its core vertices written
- *      into the copy at their rows;
+ *   5. each piece (this rank's) filtered (rsmooth_smooth_piece, its memory kept for the next)
+ *      and its core vertices written into the copy at their rows;
  *   6. the copy named as the output, atomically.
  * Ranks (the MPI driver) run 1-3 alike, rank 0 makes the copy, and each writes its own pieces'
  * rows: disjoint bytes of one file. */
@@ -351,6 +351,7 @@ static rsmooth_status filter_piece(stream_call *c, double *xyz, size_t k, const 
     info.mean_edge_length = c->stats.scaled_mean_edge_length;
     info.mean_area = c->stats.scaled_mean_area;
     info.scale = 1;
+    info.keep_memory = 1; /* for the next piece; handed back once, at the end */
     rsmooth_report rep;
     rsmooth_report_init(&rep);
     rsmooth_status st =
@@ -523,5 +524,6 @@ rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input, co
         rs_stream_ply_close(&c->ply);
     rs_stream_vertices_release(&c->vertices);
     rs_free(c);
+    rs_release_free_memory(); /* what the pieces kept (rsmooth_piece_info.keep_memory) */
     return st;
 }
