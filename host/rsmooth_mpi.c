@@ -52,6 +52,18 @@ static const char *device_for_rank(const char *device, int local_rank, char *buf
     return buf;
 }
 
+/* The host stages' threads (reading, statistics, cutting, each piece's host work): the node's
+ * cores shared among the ranks on it, unless RSMOOTH_HOST_THREADS says otherwise; every rank on
+ * every core would run the node's cores times over. */
+static void share_cores(int local_ranks) {
+    if (getenv("RSMOOTH_HOST_THREADS") || local_ranks < 1)
+        return;
+    long cores = sysconf(_SC_NPROCESSORS_ONLN), share = cores / local_ranks;
+    char threads[24];
+    snprintf(threads, sizeof threads, "%ld", share < 1 ? 1 : share);
+    setenv("RSMOOTH_HOST_THREADS", threads, 1);
+}
+
 /* Parses the command line (only rank 0 prints what is wrong with it). */
 static int parse(int argc, char **argv, int rank, options *opt) {
     int saved = -1, saved_out = -1;
@@ -76,6 +88,8 @@ static int parse(int argc, char **argv, int rank, options *opt) {
                 "same plan and filters its share on its own device; the output is the single\n"
                 "process's byte for byte. --max-memory is each rank's cap (default 1G); '%%l' in\n"
                 "--device is the rank's index on its node (--device 0:%%l: one GPU per rank).\n"
+                "Each rank's host threads are its share of the node's cores\n"
+                "(RSMOOTH_HOST_THREADS, if set, instead).\n"
                 "The options are rsmooth's:\n\n");
             break;
         }
@@ -111,7 +125,10 @@ int main(int argc, char **argv) {
     MPI_Comm node;
     MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, &node);
     MPI_Comm_rank(node, &local_rank);
+    int local_ranks = 1;
+    MPI_Comm_size(node, &local_ranks);
     MPI_Comm_free(&node);
+    share_cores(local_ranks);
 
     options opt;
     int code = parse(argc, argv, rank, &opt);
