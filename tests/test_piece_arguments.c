@@ -162,6 +162,17 @@ static void check_info_fields(rsmooth_context *ctx, piece_case *c) {
     check_refused(ctx, c, NULL, "info is NULL");
 }
 
+/* The reference path on the piece with `info`: how many coordinates differ from the in-memory
+ * reference path's. */
+static size_t differ_with(piece_case *c, const rsmooth_piece_info *info) {
+    rsmooth_error err;
+    CHECK_STATUS(smooth(NULL, c, info, NULL, c->out, &err), RSMOOTH_OK);
+    size_t differ = 0;
+    for (size_t k = 0; k < 3 * c->mesh.vertex_count; k++)
+        differ += c->out[k] != c->expected[k];
+    return differ;
+}
+
 /* Scales a whole mesh of this piece could have: the reference path's bits (a power of two
  * changes no bit while nothing over- or underflows). */
 static void check_valid_scales(piece_case *c) {
@@ -169,11 +180,7 @@ static void check_valid_scales(piece_case *c) {
     for (int i = -1; i < (int)(sizeof exponents / sizeof *exponents); i++) {
         rsmooth_piece_info info = c->info;
         info.scale = i < 0 ? 0 : ldexp(1, exponents[i]);
-        rsmooth_error err;
-        CHECK_STATUS(smooth(NULL, c, &info, NULL, c->out, &err), RSMOOTH_OK);
-        size_t differ = 0;
-        for (size_t k = 0; k < 3 * c->mesh.vertex_count; k++)
-            differ += c->out[k] != c->expected[k];
+        size_t differ = differ_with(c, &info);
         printf("  scale %-8g: %zu coordinates differ from the in-memory reference path\n",
                info.scale, differ);
         CHECK(differ == 0);
@@ -185,11 +192,7 @@ static void check_valid_scales(piece_case *c) {
         info.keep_memory = variant == 0 ? 99 : 1;
         if (variant == 0)
             info.struct_size = offsetof(rsmooth_piece_info, keep_memory);
-        rsmooth_error err;
-        CHECK_STATUS(smooth(NULL, c, &info, NULL, c->out, &err), RSMOOTH_OK);
-        size_t differ = 0;
-        for (size_t k = 0; k < 3 * c->mesh.vertex_count; k++)
-            differ += c->out[k] != c->expected[k];
+        size_t differ = differ_with(c, &info);
         printf("  %s: %zu coordinates differ\n",
                variant == 0 ? "a 0.7-size record" : "keep_memory 1", differ);
         CHECK(differ == 0);

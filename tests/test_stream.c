@@ -179,6 +179,20 @@ static rsmooth_status stream(rsmooth_context *ctx, const char *in, const char *o
     return st;
 }
 
+/* `m` written to `in` as float32 in the other byte order than this machine's (with the extras
+ * or not) and streamed to `out` under 12 MB: its deviation from the in-memory positions, which
+ * *expected receives. */
+static double swapped_case(rsmooth_context *ctx, const shape_mesh *m, const char *in,
+                           const char *out, bool extras, double **expected,
+                           rsmooth_stream_report *rep) {
+    double edge = 0;
+    rsmooth_error err;
+    write_ply(in, m, true, true, extras, false);
+    *expected = smooth_in_memory(ctx, in, NULL, &edge);
+    CHECK_STATUS(stream(ctx, in, out, 12u << 20, NULL, rep, &err), RSMOOTH_OK);
+    return deviation(out, *expected, edge);
+}
+
 /* ---- ranks as threads: the sync is a barrier and a shared maximum */
 
 typedef struct ranks_state {
@@ -395,11 +409,7 @@ int main(void) {
     /* 4. float32, the other byte order, extras: the bytes the in-memory writer gives the same
      * positions (little-endian, every other value and the header as read). */
     char *odd = strdup(path_in_dir("odd.ply"));
-    write_ply(odd, &small, true, true, true, false);
-    expected = smooth_in_memory(ctx, odd, NULL, &edge);
-    CHECK_STATUS(stream(ctx, odd, path_in_dir("odd_out.ply"), 12u << 20, NULL, &rep, &err),
-                 RSMOOTH_OK);
-    dev = deviation(path_in_dir("odd_out.ply"), expected, edge);
+    dev = swapped_case(ctx, &small, odd, path_in_dir("odd_out.ply"), true, &expected, &rep);
     rsmooth_mesh *written = NULL;
     CHECK_STATUS(rsmooth_mesh_read_file(odd, &written, &err), RSMOOTH_OK);
     memcpy(written->positions, expected, written->vertex_count * 3 * sizeof *expected);
@@ -424,11 +434,8 @@ int main(void) {
     /* 4b. the other byte order without extras: faces of 13-byte rows, read on every core with
      * their indices swapped (stream_ply.c's fixed rows) */
     char *swapped = strdup(path_in_dir("swapped.ply"));
-    write_ply(swapped, &small, true, true, false, false);
-    expected = smooth_in_memory(ctx, swapped, NULL, &edge);
-    CHECK_STATUS(stream(ctx, swapped, path_in_dir("swapped_out.ply"), 12u << 20, NULL, &rep, &err),
-                 RSMOOTH_OK);
-    dev = deviation(path_in_dir("swapped_out.ply"), expected, edge);
+    dev =
+        swapped_case(ctx, &small, swapped, path_in_dir("swapped_out.ply"), false, &expected, &rep);
     printf("float32 big-endian, fixed face rows: %llu triangles, deviation %.3g\n",
            (unsigned long long)rep.triangle_count, dev);
     CHECK(rep.triangle_count == small.triangle_count);
