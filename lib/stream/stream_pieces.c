@@ -198,6 +198,15 @@ static size_t pieces_near(const cell_grid *g, const box *boxes, const double c[3
     return n;
 }
 
+static rsmooth_status no_memory(rsmooth_error *error) {
+    return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "no memory for pieces");
+}
+
+static rsmooth_status unwritten(const char *dir, rsmooth_error *error) {
+    return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                   "cannot write a temporary file in %s (disk full?)", dir);
+}
+
 /* The triangles of the facets' pass, cut into `chunks` runs that run on every core
  * (rs_stream_facet_chunks); the writing pass cuts them the same way, so that it knows from the
  * counts where each run's records of each piece go: after the earlier runs' records, as one pass
@@ -318,7 +327,7 @@ static void facet_runs(void *ctx, size_t begin, size_t end, size_t chunk) {
 }
 
 /* The writing pass over the triangles: this rank's pieces' facet records. */
-static rsmooth_status facet_pass(facet_pass_job *job, rs_region_writer *writers,
+static rsmooth_status facet_pass(facet_pass_job *job, rs_region_writer *writers, const char *dir,
                                  rsmooth_error *error) {
     job->writers = writers;
     memset(job->unread, 0, job->chunks * sizeof *job->unread);
@@ -329,8 +338,7 @@ static rsmooth_status facet_pass(facet_pass_job *job, rs_region_writer *writers,
             return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
                            "cannot read the temporary corner file");
         if (job->unwritten[c])
-            return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                           "cannot write a temporary file (disk full?)");
+            return unwritten(dir, error);
     }
     return RSMOOTH_OK;
 }
@@ -365,15 +373,6 @@ static bool share(rs_piece *pieces, size_t count, int ranks) {
     rs_free(order);
     rs_free(load);
     return true;
-}
-
-static rsmooth_status no_memory(rsmooth_error *error) {
-    return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "no memory for pieces");
-}
-
-static rsmooth_status unwritten(const char *dir, rsmooth_error *error) {
-    return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                   "cannot write a temporary file in %s (disk full?)", dir);
 }
 
 static void facet_job_free(facet_pass_job *job) {
@@ -498,7 +497,7 @@ static rsmooth_status write_facet_lists(facet_pass_job *job, int fd, size_t buff
             starts[i] += job->counts[c * count + i];
     }
     if (st == RSMOOTH_OK)
-        st = facet_pass(job, writers, error);
+        st = facet_pass(job, writers, dir, error);
     for (size_t c = 0; st == RSMOOTH_OK && c < job->chunks; c++)
         if (!rs_region_writer_finish(writers + c))
             st = unwritten(dir, error);
