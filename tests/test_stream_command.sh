@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # rsmooth --max-memory and rsmooth-mpi end to end: the streamed result against the in-memory one
 # (rsmooth compare: RMS and Hausdorff distance, in mean edge lengths), rsmooth-mpi on 1, 2 and 3
-# ranks against the single process byte for byte, the refusals with their exit status, and no
-# temporary or partial file left behind.
+# ranks against the single process byte for byte, the refusals with their exit status, a full disk
+# named, and no temporary or partial file left behind.
 # usage: test_stream_command.sh RSMOOTH SHAPE [RSMOOTH_MPI MPIRUN]
 set -uo pipefail
 rsmooth=$1
@@ -78,6 +78,26 @@ for signal in TERM KILL; do  # (a background job ignores SIGINT)
   [ $? -gt 128 ] || fail "the run was not ended by SIG$signal"
   left=$(ls -A killed | grep -v '^big' || true)
   [ -z "$left" ] || fail "killed with SIG$signal, it left: $left"
+done
+
+# a full disk (a limit on the size of the files it writes stands in for one, SIGXFSZ ignored): the
+# run stops with the folder's name in its message, leaving no temporary and no output. 2 MB: the
+# triangles' file fills it; 6 MB: the pieces' lists do (the reference path: no kernel cache is
+# written either)
+mkdir -p full
+for limit in 2000 6000; do # (bash's ulimit -f counts KB)
+  (
+    trap '' XFSZ
+    ulimit -f "$limit"
+    exec "$rsmooth" killed/big.ply -o full/out.ply --max-memory 20M --tmpdir full \
+      --device reference -q
+  ) >out.txt 2>err.txt
+  got=$?
+  [ "$got" -eq 2 ] || fail "a full disk ($limit KB): exit $got -- $(cat err.txt)"
+  grep -q "cannot write a temporary file in full (disk full?)" err.txt ||
+    fail "a full disk ($limit KB): $(cat err.txt)"
+  [ -z "$(ls -A full)" ] || fail "a full disk ($limit KB) left: $(ls -A full)"
+  echo "a full disk at $limit KB: $(cat err.txt)"
 done
 
 if [ -n "$mpi" ]; then

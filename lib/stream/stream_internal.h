@@ -147,8 +147,9 @@ typedef struct rs_stream_extent {
 } rs_stream_extent;
 
 /* Reads the faces, fans each into triangles as the in-memory reader does, and writes their
- * vertex indices (3 of id_bytes each) to `triangles_fd`; *triangle_count receives how many. */
-rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_fd,
+ * vertex indices (3 of id_bytes each) to `triangles_fd`, a temporary file in `dir` (which a
+ * failed write names); *triangle_count receives how many. */
+rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_fd, const char *dir,
                                              uint64_t *triangle_count, rsmooth_error *error);
 
 /* Refuses positions (3 doubles each, of the vertices `ids[0, n)`) the output cannot hold, as

@@ -29,6 +29,11 @@ static rsmooth_status unsupported(const char *path, const char *why, rsmooth_err
                    path, why);
 }
 
+static rsmooth_status unwritten(const char *dir, rsmooth_error *error) {
+    return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                   "cannot write a temporary file in %s (disk full?): %s", dir, strerror(errno));
+}
+
 /* A value of type t stored in the file's byte order. */
 static double value_at(const unsigned char *p, rs_ply_type t, bool swap) {
     if (!swap)
@@ -507,7 +512,7 @@ static bool fixed_triangles(rs_stream_ply *ply, const rs_ply_element *f, int tri
     return ok;
 }
 
-rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_fd,
+rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_fd, const char *dir,
                                              uint64_t *triangle_count, rsmooth_error *error) {
     *triangle_count = 0;
     const rs_ply_element *f = ply->header.face_element;
@@ -594,7 +599,7 @@ rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_f
                     if (buffered == OUT_TRIANGLES) {
                         if (!rs_pwrite_all(triangles_fd, out, buffered * triangle_bytes,
                                            written * triangle_bytes))
-                            st = io_fail("temporary file", "cannot write", error);
+                            st = unwritten(dir, error);
                         written += buffered;
                         buffered = 0;
                     }
@@ -605,7 +610,7 @@ rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_f
     }
     if (st == RSMOOTH_OK && buffered > 0 &&
         !rs_pwrite_all(triangles_fd, out, buffered * triangle_bytes, written * triangle_bytes))
-        st = io_fail("temporary file", "cannot write", error);
+        st = unwritten(dir, error);
     written += buffered;
     uint64_t face_end = rs_stream_reader_offset(&r);
     rs_free(out);

@@ -206,7 +206,7 @@ static rsmooth_status read_input(stream_call *c, rs_stream_extent *extent, rsmoo
     if (ids_fd < 0)
         return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
                        "cannot create a temporary file in %s: %s", c->dir, strerror(errno));
-    st = rs_stream_ply_write_triangles(&c->ply, ids_fd, &c->triangle_count, error);
+    st = rs_stream_ply_write_triangles(&c->ply, ids_fd, c->dir, &c->triangle_count, error);
     if (st == RSMOOTH_OK && c->ply.face_count == 0) /* the in-memory reader's word for it */
         st = rs_fail_parse(error, -1, (int64_t)c->ply.size, RS_STREAM_WHERE,
                            "%s: %llu vertices but no faces and no vertex normals: a mesh needs "
