@@ -2,8 +2,10 @@
  * boxes of cells are halved (at the median count, along their longest side) until each holds at
  * most the vertices a piece may have. A piece's core vertices are those in its box; its facets
  * are every triangle of non-zero area whose centroid lies within the halo of the box, so it holds
- * every facet its vertices' results depend on (piece.c). Pieces go to ranks by their facet counts
- * (the longest first, each to the least loaded rank), the same on every rank. */
+ * every facet its vertices' results depend on (piece.c). The facets are counted in the
+ * statistics' facets' pass (each triangle's piece noted when it lies in one alone) and written in
+ * a second pass. Pieces go to ranks by their facet counts (the longest first, each to the least
+ * loaded rank), the same on every rank. */
 #include "stream/stream_internal.h"
 
 #include <math.h>

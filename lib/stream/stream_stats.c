@@ -8,11 +8,13 @@
  *   - the mean area: facets summed per block of 8192 triangles, the blocks' sums in order.
  *
  * Both sum at the in-memory path's own power-of-two scale (scale.c, from the same sampled
- * triangles), so even where squares under- or overflow at other scales the figures agree. An
- * edge's length is measured from the record that places it in its bucket (the counting pass reads
- * the ids file alone while it is kept); the buckets' order and the blocks' sums are made on every
- * core (rs_parallel_for); only the final sums run in one thread, in that order, so the bits do not
- * depend on the number of threads. */
+ * triangles), so even where squares under- or overflow at other scales the figures agree. The
+ * edges are counted and placed by runs of triangles on every core (the counting reads the ids file
+ * alone while it is kept), an edge's length measured from the record that places it, or from the
+ * held positions when its bucket is ordered; the buckets' order and the blocks' sums are made on
+ * every core (rs_parallel_for); only the final sums run in one thread, in that order, so the bits
+ * do not depend on the number of threads. The facets' pass (rs_stream_facet_figures) comes after
+ * the cut into pieces, whose counts it takes too. */
 #include "core/edge_bucket.h"
 #include "core/parts.h"
 #include "stream/stream_internal.h"
