@@ -160,7 +160,7 @@ const char cli_usage_text[] =
     "                        OpenCL runtime's own memory; nothing in memory grows with the mesh\n"
     "                        (the positions are read in runs when they do not fit), and a cap\n"
     "                        below about 10M is refused with the size needed. The temporary files\n"
-    "                        (--tmpdir) take about 26 bytes a triangle, 110 when the positions do\n"
+    "                        (--tmpdir) take about 28 bytes a triangle, 110 when the positions do\n"
     "                        not fit in half of SIZE. Input: binary PLY (either byte order, float\n"
     "                        or double x y z) without vertex normals (nx ny nz); other input is\n"
     "                        refused. The output is the input byte for byte but x, y and z\n"
