@@ -119,8 +119,7 @@ rsmooth_status rs_stream_corners_make(rs_stream_vertices *v, bool hold, int ids_
         rs_parallel_for(job.chunks, 1, corner_chunks, &job);
         for (size_t c = 0; c < job.chunks && st == RSMOOTH_OK; c++)
             if (job.failed[c])
-                st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                             "cannot write the temporary corner file in %s (disk full?)", dir);
+                st = rs_stream_unwritten(dir, 0, error);
         job.fresh = false;
     }
     rs_free(job.failed);

@@ -76,6 +76,12 @@ bool rs_stream_triangles_open_range(rs_stream_reader *r, int fd, size_t id_bytes
                                  1u << 20);
 }
 
+rsmooth_status rs_stream_unwritten(const char *dir, int errnum, rsmooth_error *error) {
+    return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                   "cannot write a temporary file in %s (disk full?)%s%s", dir, errnum ? ": " : "",
+                   errnum ? strerror(errnum) : "");
+}
+
 int rs_stream_temporary(const char *dir) {
 #ifdef O_TMPFILE
     int unnamed = open(dir, O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);

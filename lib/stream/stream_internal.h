@@ -80,6 +80,10 @@ static inline bool rs_stream_next_triangle(rs_stream_reader *r, size_t id_bytes,
 /* An unnamed temporary file in `dir` (O_TMPFILE, else created and unlinked at once), so that
  * nothing is left behind however the process ends. -1 with errno on failure. */
 int rs_stream_temporary(const char *dir);
+/* A temporary file in `dir` could not be written: RSMOOTH_ERROR_IO naming the folder, with
+ * strerror(errnum) when the failed call's errno is at hand (errnum 0: a write on another thread,
+ * whose errno this one does not see). */
+rsmooth_status rs_stream_unwritten(const char *dir, int errnum, rsmooth_error *error);
 
 /* Copies `size` bytes of `from` at `from_offset` to `to` at `to_offset` (copy_file_range where
  * it works). */
@@ -310,8 +314,9 @@ typedef struct rs_stream_stats {
     /* the two at `scale` (internal units), as the in-memory path holds them: in the caller's
      * units a mesh at 1e-300 has no representable area */
     double scaled_mean_edge_length, scaled_mean_area;
-    double reach;       /* largest centroid-to-corner distance of a facet */
-    double reach_bound; /* a bound on it from the longest edge, known before the facets' pass */
+    double reach;       /* largest centroid-to-corner distance of a facet (checked against: */
+    double reach_bound; /* a bound on it from the longest edge, which sets the halo before the
+                         * facets' pass measures the reach itself) */
     uint64_t facet_count;
     double lo[3], hi[3]; /* the vertices' bounding box */
     bool whole;          /* one part, no edge out of line (core/parts.h): what streams */

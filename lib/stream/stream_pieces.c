@@ -204,11 +204,6 @@ static rsmooth_status no_memory(rsmooth_error *error) {
     return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE, "no memory for pieces");
 }
 
-static rsmooth_status unwritten(const char *dir, rsmooth_error *error) {
-    return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                   "cannot write a temporary file in %s (disk full?)", dir);
-}
-
 /* The triangles of the facets' pass, cut into `chunks` runs that run on every core
  * (rs_stream_facet_chunks); the writing pass cuts them the same way, so that it knows from the
  * counts where each run's records of each piece go: after the earlier runs' records, as one pass
@@ -340,7 +335,7 @@ static rsmooth_status facet_pass(facet_pass_job *job, rs_region_writer *writers,
             return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
                            "cannot read the temporary corner file");
         if (job->unwritten[c])
-            return unwritten(dir, error);
+            return rs_stream_unwritten(dir, 0, error);
     }
     return RSMOOTH_OK;
 }
@@ -422,7 +417,7 @@ static rsmooth_status count_facets(facet_pass_job *job, rs_piece *pieces, size_t
     rs_free(job->writers);
     job->writers = NULL;
     if (st == RSMOOTH_OK && !written)
-        st = unwritten(dir, error);
+        st = rs_stream_unwritten(dir, 0, error);
     for (size_t c = 0; st == RSMOOTH_OK && c < job->chunks; c++)
         for (size_t i = 0; i < count; i++)
             pieces[i].facet_count += job->counts[c * count + i];
@@ -478,7 +473,7 @@ static rsmooth_status write_vertex_lists(rs_stream_vertices *vertices, const cel
     ok = rs_region_writer_finish(&w) && ok; /* (finish frees the writer) */
     if (st != RSMOOTH_OK)
         return st;
-    return ok ? RSMOOTH_OK : unwritten(dir, error);
+    return ok ? RSMOOTH_OK : rs_stream_unwritten(dir, 0, error);
 }
 
 /* This rank's pieces' facet lists: each run of triangles through its own writer, its records
@@ -502,7 +497,7 @@ static rsmooth_status write_facet_lists(facet_pass_job *job, int fd, size_t buff
         st = facet_pass(job, writers, dir, error);
     for (size_t c = 0; st == RSMOOTH_OK && c < job->chunks; c++)
         if (!rs_region_writer_finish(writers + c))
-            st = unwritten(dir, error);
+            st = rs_stream_unwritten(dir, 0, error);
     for (size_t c = 0; writers && c < job->chunks; c++)
         rs_region_writer_free(writers + c);
     rs_free(writers);

@@ -29,11 +29,6 @@ static rsmooth_status unsupported(const char *path, const char *why, rsmooth_err
                    path, why);
 }
 
-static rsmooth_status unwritten(const char *dir, rsmooth_error *error) {
-    return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                   "cannot write a temporary file in %s (disk full?): %s", dir, strerror(errno));
-}
-
 /* A value of type t stored in the file's byte order. */
 static double value_at(const unsigned char *p, rs_ply_type t, bool swap) {
     if (!swap)
@@ -448,11 +443,11 @@ static size_t element_index(const rs_stream_ply *ply, const rs_ply_element *e) {
 }
 
 /* Nearly every file's faces: one list property alone, a one-byte count and 32-bit indices, three
- * each; rows of 13 bytes then, read on every core. */
+ * each; rows of FACE_ROW bytes then, read on every core. */
+#define FACE_ROW 13
 typedef struct triangle_rows {
     const rs_stream_ply *ply;
     int fd;
-    size_t row;
     bool is_signed;
     bool *odd; /* per chunk: a row that is not three indices in range (the general reader then) */
 } triangle_rows;
@@ -461,7 +456,7 @@ static void triangle_chunk(void *ctx, size_t begin, size_t end, size_t chunk) {
     triangle_rows *job = ctx;
     const rs_stream_ply *ply = job->ply;
     enum { ROWS = 1 << 15 };
-    size_t id_bytes = ply->id_bytes, row = job->row;
+    size_t id_bytes = ply->id_bytes, row = FACE_ROW;
     unsigned char *in = rs_alloc_array(ROWS, row);
     unsigned char *out = rs_alloc_array(ROWS, 3 * id_bytes);
     bool odd = !in || !out;
@@ -488,17 +483,17 @@ static void triangle_chunk(void *ctx, size_t begin, size_t end, size_t chunk) {
     job->odd[chunk] = odd;
 }
 
-/* The faces as rows of 13 bytes, when the header says so and every row is a triangle in range;
- * false (nothing to be relied on written) otherwise, and on any read or write error: the general
- * reader then says what is wrong. */
+/* The faces as rows of FACE_ROW bytes, when the header says so and every row is a triangle in
+ * range; false (nothing to be relied on written) otherwise, and on any read or write error: the
+ * general reader then says what is wrong. */
 static bool fixed_triangles(rs_stream_ply *ply, const rs_ply_element *f, int triangles_fd) {
     const rs_ply_property *p = f->property_count == 1 ? &f->properties[0] : NULL;
     if (!p || p->role != RS_PLY_FACE_LIST || rs_ply_type_size(p->count_type) != 1 ||
-        (p->type != RS_PLY_INT32 && p->type != RS_PLY_UINT32) || f->count > UINT64_MAX / 13 ||
-        ply->face_start + f->count * 13 > ply->size)
+        (p->type != RS_PLY_INT32 && p->type != RS_PLY_UINT32) || f->count > UINT64_MAX / FACE_ROW ||
+        ply->face_start + f->count * FACE_ROW > ply->size)
         return false;
     size_t chunks = rs_parallel_chunks((size_t)f->count, 1 << 16);
-    triangle_rows job = {ply, triangles_fd, 13, p->type == RS_PLY_INT32,
+    triangle_rows job = {ply, triangles_fd, p->type == RS_PLY_INT32,
                          rs_calloc_array(chunks, sizeof(bool))};
     if (!job.odd)
         return false;
@@ -523,7 +518,8 @@ rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_f
     }
     if (fixed_triangles(ply, f, triangles_fd)) {
         *triangle_count = f->count;
-        return check_end(ply, element_index(ply, f) + 1, ply->face_start + f->count * 13, error);
+        return check_end(ply, element_index(ply, f) + 1, ply->face_start + f->count * FACE_ROW,
+                         error);
     }
     rs_stream_reader r;
     if (!rs_stream_reader_open(&r, ply->fd, ply->path, ply->face_start, ply->size, READ_BUFFER))
@@ -599,7 +595,7 @@ rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_f
                     if (buffered == OUT_TRIANGLES) {
                         if (!rs_pwrite_all(triangles_fd, out, buffered * triangle_bytes,
                                            written * triangle_bytes))
-                            st = unwritten(dir, error);
+                            st = rs_stream_unwritten(dir, errno, error);
                         written += buffered;
                         buffered = 0;
                     }
@@ -610,7 +606,7 @@ rsmooth_status rs_stream_ply_write_triangles(rs_stream_ply *ply, int triangles_f
     }
     if (st == RSMOOTH_OK && buffered > 0 &&
         !rs_pwrite_all(triangles_fd, out, buffered * triangle_bytes, written * triangle_bytes))
-        st = unwritten(dir, error);
+        st = rs_stream_unwritten(dir, errno, error);
     written += buffered;
     uint64_t face_end = rs_stream_reader_offset(&r);
     rs_free(out);

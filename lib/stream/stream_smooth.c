@@ -278,6 +278,11 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
     c->rep.memory_planned = held + FIXED_BYTES + c->piece_vertices * PIECE_BYTES_PER_VERTEX;
     st = rs_stream_pieces_build(&c->vertices, &c->corners, &c->stats, c->halo, c->piece_vertices,
                                 GRID_BYTES, c->opt.rank, c->opt.ranks, c->dir, &c->pieces, error);
+    if (st == RSMOOTH_OK && c->stats.reach > c->stats.reach_bound) /* (the bound's premise) */
+        st = rs_fail(error, RSMOOTH_ERROR_NUMERICAL, RS_STREAM_WHERE,
+                     "%s: a facet's corner lies %g from its centroid, beyond the %g its longest "
+                     "edge allows: the pieces' halo would leave facets out",
+                     c->input, c->stats.reach, c->stats.reach_bound);
     if (st == RSMOOTH_OK && !c->stats.whole)
         st = rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, RS_STREAM_WHERE,
                      "%s holds parts of very different size, or vertices far off the surface "
