@@ -3,9 +3,12 @@
 #include "cli_args.h"
 #include "cli_device.h"
 #include "cli_files.h"
+#include "cli_mask.h"
 #include "cli_progress.h"
 
+#include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* The option that needs the whole mesh in memory, or NULL. */
@@ -14,9 +17,7 @@ static const char *whole_mesh_option(const options *opt) {
     return opt->best                            ? "--best"
            : opt->auto_params                   ? "--auto"
            : p->vertex_updates > 0              ? "--vertex-updates"
-           : p->passes != 1                     ? "--passes"
            : opt->colors                        ? "--sigma-c"
-           : opt->mask                          ? "--mask"
            : opt->confidence                    ? "--confidence"
            : opt->stats                         ? "--stats"
            : cli_method_uses_edges(opt->method) ? "--method"
@@ -33,8 +34,8 @@ int cli_stream_check(const options *opt) {
     const char *option = whole_mesh_option(opt);
     if (option)
         return cli_usage_error(NULL,
-                               "--max-memory filters each piece of the mesh in one pass "
-                               "from the pieces around it: %s needs the whole mesh in "
+                               "--max-memory filters each piece of the mesh from the "
+                               "pieces around it, pass by pass: %s needs the whole mesh in "
                                "memory (drop one of them)",
                                option);
     bool std_stream = opt->output_option && !strcmp(opt->output_option, "-");
@@ -91,17 +92,37 @@ void cli_stream_print_json(const rsmooth_stream_report *r, const options *opt, i
            (unsigned long long)r->vertex_count, (unsigned long long)r->face_count,
            (unsigned long long)r->triangle_count, (unsigned long long)r->facet_count,
            r->mean_edge_length, r->halo);
-    printf(",\"pieces\":%zu,\"pieces_here\":%zu,\"piece_facets_max\":%llu,"
+    printf(",\"passes\":%d,\"pieces\":%zu,\"pieces_here\":%zu,\"piece_facets_max\":%llu,"
            "\"facets_filtered\":%llu,\"temporary_bytes\":%llu,\"position_runs\":%llu,"
-           "\"device\":",
-           r->pieces, r->pieces_here, (unsigned long long)r->piece_facets_max,
+           "\"input_bytes_read\":%llu,\"device\":",
+           r->passes, r->pieces, r->pieces_here, (unsigned long long)r->piece_facets_max,
            (unsigned long long)r->facets_filtered, (unsigned long long)r->temporary_bytes,
-           (unsigned long long)r->position_runs);
+           (unsigned long long)r->position_runs, (unsigned long long)r->input_bytes_read);
     cli_print_json_string(r->device);
     printf(",\"ms\":{\"read\":%.3f,\"statistics\":%.3f,\"cut\":%.3f,\"copy\":%.3f,"
            "\"assemble\":%.3f,\"filter\":%.3f,\"write\":%.3f,\"total\":%.3f}}\n",
            r->ms_read, r->ms_statistics, r->ms_buckets, r->ms_copy, r->ms_assemble, r->ms_filter,
            r->ms_write, r->ms_total);
+}
+
+int cli_stream_mask(const options *opt, const char *path, uint8_t **mask) {
+    *mask = NULL;
+    if (!opt->mask)
+        return -1;
+    uint64_t vertex_count = 0;
+    rsmooth_error err;
+    rsmooth_status st = rsmooth_stream_vertex_count(path, &vertex_count, &err);
+    if (st != RSMOOTH_OK) {
+        cli_stream_print_error("rsmooth", err.message);
+        return cli_stream_exit_code(st);
+    }
+    if (vertex_count > SIZE_MAX) {
+        fprintf(stderr, "rsmooth: %s: %llu vertices: too many for a --mask on this machine\n", path,
+                (unsigned long long)vertex_count);
+        return EXIT_USAGE;
+    }
+    int code = cli_read_mask(opt->mask, (size_t)vertex_count, path, mask);
+    return code == EXIT_OK ? -1 : code;
 }
 
 int cli_stream_file(const options *opt, const char *path) {
@@ -113,20 +134,27 @@ int cli_stream_file(const options *opt, const char *path) {
                 opt->output);
         return EXIT_USAGE;
     }
+    uint8_t *mask = NULL; /* one byte a vertex, as in memory */
+    int code = cli_stream_mask(opt, path, &mask);
+    if (code >= 0)
+        return code;
     cli_progress bar;
     cli_progress_init(&bar, opt->quiet, opt->progress);
     cli_progress_stage(&bar, "streaming", 0, 1);
     rsmooth_context *ctx = NULL;
     double ms_setup = 0;
-    int code = cli_open_device(opt, &bar, &ctx, &ms_setup);
-    if (code >= 0)
+    code = cli_open_device(opt, &bar, &ctx, &ms_setup);
+    if (code >= 0) {
+        free(mask);
         return code;
+    }
     rsmooth_stream_options so;
     rsmooth_stream_options_init(&so);
     so.max_memory = opt->max_memory;
     so.tmpdir = opt->tmpdir;
     so.replace = opt->force || opt->in_place;
     rsmooth_params params = opt->params;
+    params.move_mask = mask;
     if (bar.enabled) {
         params.progress = cli_progress_callback;
         params.progress_user = &bar;
@@ -135,6 +163,7 @@ int cli_stream_file(const options *opt, const char *path) {
     rsmooth_stream_report_init(&rep);
     rsmooth_error err;
     rsmooth_status st = rsmooth_stream_smooth(ctx, path, opt->output, &params, &so, &rep, &err);
+    free(mask);
     if (st == RSMOOTH_OK)
         cli_progress_done(&bar);
     cli_progress_clear(&bar);
@@ -147,14 +176,17 @@ int cli_stream_file(const options *opt, const char *path) {
         fprintf(stderr, "rsmooth: %s: warning: %s\n", opt->output, rep.notes);
     if (opt->json)
         cli_stream_print_json(&rep, opt, 1);
+    char passes[48] = ""; /* "3 passes, " */
+    if (rep.passes != 1)
+        snprintf(passes, sizeof passes, "%d passes, ", rep.passes);
     if (!opt->quiet)
         fprintf(stderr,
-                "rsmooth: %s: %llu vertices, %llu triangles, mean edge %.6g; streamed in %zu "
+                "rsmooth: %s: %llu vertices, %llu triangles, mean edge %.6g; streamed in %s%zu "
                 "piece%s (the largest %llu facets with its halo) under --max-memory %llu MB on "
                 "%s: read %.1f s, statistics %.1f s, cut %.1f s, copy %.1f s, assemble %.1f s, "
                 "filter %.1f s, write %.1f s; wrote %s\n",
                 opt->input, (unsigned long long)rep.vertex_count,
-                (unsigned long long)rep.triangle_count, rep.mean_edge_length, rep.pieces,
+                (unsigned long long)rep.triangle_count, rep.mean_edge_length, passes, rep.pieces,
                 rep.pieces == 1 ? "" : "s", (unsigned long long)rep.piece_facets_max,
                 (unsigned long long)(opt->max_memory >> 20),
                 rep.device[0] ? rep.device : "no device (no facets)", rep.ms_read / 1000,

@@ -15,10 +15,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-enum { PART_INPUT, PART_PARAMETERS, PART_CAP, PART_OUTPUT, PARTS };
+enum { PART_INPUT, PART_PARAMETERS, PART_CAP, PART_OUTPUT, PART_MASK, PARTS };
 static const char *const part_names[PARTS] = {
     "the input file (its size, time or content)", "the parameters (or the rsmooth version)",
-    "--max-memory", "the output (-o, --force, --in-place)"};
+    "--max-memory", "the output (-o, --force, --in-place)",
+    "--mask (given or not, the file's size, time or content)"};
 
 #define HEAD_BYTES (64 * 1024)
 #define SAMPLES 16
@@ -102,6 +103,10 @@ static void fingerprint_parts(const options *opt, part d[PARTS]) {
     add_text(&d[PART_OUTPUT], opt->output);
     const int flags[3] = {opt->force, opt->in_place, (int)opt->format};
     add(&d[PART_OUTPUT], flags, sizeof flags);
+    /* each rank reads it: the same file's bytes (by whatever name), or none on every rank */
+    add_text(&d[PART_MASK], opt->mask ? "--mask" : NULL);
+    if (opt->mask)
+        add_input(&d[PART_MASK], opt->mask);
 }
 
 int mpi_agree(const options *opt, int rank, int ranks) {

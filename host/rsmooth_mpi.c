@@ -64,21 +64,39 @@ static void share_cores(int local_ranks) {
     setenv("RSMOOTH_HOST_THREADS", threads, 1);
 }
 
+/* What every rank finds alike (a usage error, --help, a bad --mask) printed once: the other
+ * ranks' standard error and output go to /dev/null until speak_again. */
+static void quiet_others(int rank, int saved[2]) {
+    saved[0] = saved[1] = -1;
+    if (rank == 0)
+        return;
+    fflush(stderr);
+    fflush(stdout);
+    saved[0] = dup(STDERR_FILENO);
+    saved[1] = dup(STDOUT_FILENO);
+    FILE *null = fopen("/dev/null", "w");
+    if (null) {
+        dup2(fileno(null), STDERR_FILENO);
+        dup2(fileno(null), STDOUT_FILENO);
+        fclose(null);
+    }
+}
+
+static void speak_again(int saved[2]) {
+    if (saved[0] < 0)
+        return;
+    fflush(stderr);
+    fflush(stdout);
+    dup2(saved[0], STDERR_FILENO);
+    dup2(saved[1], STDOUT_FILENO);
+    close(saved[0]);
+    close(saved[1]);
+}
+
 /* Parses the command line (only rank 0 prints what is wrong with it). */
 static int parse(int argc, char **argv, int rank, options *opt) {
-    int saved = -1, saved_out = -1;
-    if (rank != 0) { /* one copy of a usage error or of --help, not one per rank */
-        fflush(stderr);
-        fflush(stdout);
-        saved = dup(STDERR_FILENO);
-        saved_out = dup(STDOUT_FILENO);
-        FILE *null = fopen("/dev/null", "w");
-        if (null) {
-            dup2(fileno(null), STDERR_FILENO);
-            dup2(fileno(null), STDOUT_FILENO);
-            fclose(null);
-        }
-    }
+    int saved[2];
+    quiet_others(rank, saved);
     for (int i = 1; i < argc && strcmp(argv[i], "--") != 0; i++)
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             printf(
@@ -106,14 +124,7 @@ static int parse(int argc, char **argv, int rank, options *opt) {
         if (code >= 0)
             cli_options_free(opt);
     }
-    if (saved >= 0) {
-        fflush(stderr);
-        fflush(stdout);
-        dup2(saved, STDERR_FILENO);
-        dup2(saved_out, STDOUT_FILENO);
-        close(saved);
-        close(saved_out);
-    }
+    speak_again(saved);
     return code;
 }
 
@@ -163,7 +174,16 @@ int main(int argc, char **argv) {
     rsmooth_context *ctx = NULL;
     double ms_setup = 0;
     code = worst_code(cli_open_device(&opt, &bar, &ctx, &ms_setup));
+    uint8_t *mask = NULL; /* every rank reads --mask (the same file: mpi_agree) */
+    if (code < 0) {
+        int saved[2];
+        quiet_others(rank, saved);
+        code = worst_code(cli_stream_mask(&opt, opt.input, &mask));
+        speak_again(saved);
+    }
+    opt.params.move_mask = mask;
     if (code >= 0) {
+        free(mask);
         rsmooth_context_destroy(ctx);
         cli_options_free(&opt);
         MPI_Finalize();
@@ -192,10 +212,10 @@ int main(int argc, char **argv) {
     if (st == RSMOOTH_OK && !quiet)
         fprintf(stderr,
                 "rsmooth-mpi: rank %d of %d on %s: %zu pieces, %llu facets with halos, "
-                "assemble %.1f s, filter %.1f s, write %.1f s\n",
+                "%.1f MB of the input read; assemble %.1f s, filter %.1f s, write %.1f s\n",
                 rank, ranks, rep.device[0] ? rep.device : "no device (no pieces)", rep.pieces_here,
-                (unsigned long long)rep.facets_filtered, rep.ms_assemble / 1000,
-                rep.ms_filter / 1000, rep.ms_write / 1000);
+                (unsigned long long)rep.facets_filtered, (double)rep.input_bytes_read / 1e6,
+                rep.ms_assemble / 1000, rep.ms_filter / 1000, rep.ms_write / 1000);
     MPI_Barrier(MPI_COMM_WORLD); /* the ranks' lines before the summary */
     if (st == RSMOOTH_OK && rank == 0) {
         if (rep.notes[0] && !quiet)

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # rsmooth-mpi refuses ranks that were not given the same job: two ranks
 # started with different --max-memory (different pieces: 12,800 of 50,625 vertices were left
-# unsmoothed), a different input file, different parameters, a different output: each exits 2,
-# names rank 1 and what differs, and writes nothing. A different --device per rank (MPMD) is
+# unsmoothed), a different input file, different parameters, a different output or --mask: each
+# exits 2, names rank 1 and what differs, and writes nothing. A different --device per rank (MPMD) is
 # allowed and gives the single process's bytes.
 # usage: test_mpi_agree.sh RSMOOTH SHAPE RSMOOTH_MPI MPIRUN
 set -uo pipefail
@@ -44,6 +44,12 @@ check_refused "the input file" in.ply "${base[@]}" -- copy.ply "${base[@]}"
 check_refused "the parameters" in.ply "${base[@]}" -- in.ply "${base[@]}" --sigma-f 3
 check_refused "the parameters" in.ply "${base[@]}" -- in.ply "${base[@]}" --normals bilateral
 check_refused "the output" in.ply "${base[@]}" -- in.ply -o elsewhere.ply --max-memory 12M
+# each rank reads --mask: another list on one rank, or a mask on one rank only, would smooth a
+# mesh neither asked for
+seq 0 3 40000 > mask_a.txt
+seq 1 3 40000 > mask_b.txt
+check_refused "--mask" in.ply "${base[@]}" --mask mask_a.txt -- in.ply "${base[@]}" --mask mask_b.txt
+check_refused "--mask" in.ply "${base[@]}" --mask mask_a.txt -- in.ply "${base[@]}"
 [ -e elsewhere.ply ] && fail "a refused run wrote elsewhere.ply"
 left=$(ls -A | grep '^\.rsmooth' || true)
 [ -z "$left" ] || fail "refused runs left: $left"

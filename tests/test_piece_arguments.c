@@ -7,6 +7,8 @@
  *   - refusals before the piece is prepared (NULL out_positions, passes 2, overlapping buffers)
  *     free nothing they did not allocate, on the device and on the reference path (the stack is
  *     filled with junk first, so an uninitialised record is freed as garbage, as it was);
+ *   - a piece's weights and confidences (outputs) are the in-memory run's bits, on the device
+ *     and on the reference path; an output overlapping another is refused;
  *   - rsmooth_piece_halo refuses a halo beyond double range (mean edge 1e308);
  *   - rsmooth_stream_smooth refuses ranks without a sync and a rank without ranks, before it
  *     reads or writes anything. */
@@ -218,6 +220,58 @@ static void check_early_refusals(rsmooth_context *ctx, piece_case *c) {
            ctx ? "device" : "reference");
 }
 
+/* The whole mesh as one piece, its first half the core: the core's weights and confidences are
+ * the in-memory run's on the same path, bit for bit. */
+static void check_outputs(rsmooth_context *ctx, piece_case *c) {
+    size_t v = c->mesh.vertex_count, core = v / 2;
+    float *weight = malloc(v * sizeof *weight), *confidence = malloc(v * sizeof *confidence);
+    float *piece_weight = malloc(v * sizeof *weight);
+    float *piece_confidence = malloc(v * sizeof *confidence);
+    CHECK(weight && confidence && piece_weight && piece_confidence);
+    rsmooth_error err;
+    double *whole = malloc(v * 3 * sizeof *whole);
+    CHECK(whole != NULL);
+    if (ctx)
+        CHECK_STATUS(rsmooth_smooth(ctx, RSMOOTH_FLOAT64, c->mesh.xyz, v, c->mesh.indices,
+                                    c->mesh.triangle_count, NULL, whole,
+                                    OUTPUTS(weight, confidence, NULL), &err),
+                     RSMOOTH_OK);
+    else
+        CHECK_STATUS(rsmooth_smooth(NULL, RSMOOTH_FLOAT64, c->mesh.xyz, v, c->mesh.indices,
+                                    c->mesh.triangle_count, NULL, whole,
+                                    OUTPUTS(weight, confidence, NULL), &err),
+                     RSMOOTH_OK);
+    rsmooth_piece_info info = c->info;
+    info.core_count = core;
+    for (size_t i = 0; i < v; i++)
+        piece_weight[i] = piece_confidence[i] = -1;
+    CHECK_STATUS(rsmooth_smooth_piece(ctx, c->mesh.xyz, v, c->mesh.indices, c->mesh.triangle_count,
+                                      &info, NULL, c->out,
+                                      OUTPUTS(piece_weight, piece_confidence, NULL), &err),
+                 RSMOOTH_OK);
+    size_t differ = 0, past = 0;
+    for (size_t i = 0; i < core; i++)
+        differ += piece_weight[i] != weight[i] || piece_confidence[i] != confidence[i] ||
+                  memcmp(c->out + 3 * i, whole + 3 * i, 3 * sizeof *whole) != 0;
+    for (size_t i = core; i < v; i++) /* nothing beyond the core */
+        past += piece_weight[i] != -1 || piece_confidence[i] != -1;
+    printf("  %s: %zu of %zu core vertices differ in position, weight or confidence from the "
+           "in-memory run; %zu written past the core\n",
+           ctx ? "device" : "reference", differ, core, past);
+    CHECK(differ == 0 && past == 0);
+    CHECK_STATUS(rsmooth_smooth_piece(ctx, c->mesh.xyz, v, c->mesh.indices, c->mesh.triangle_count,
+                                      &info, NULL, c->out,
+                                      OUTPUTS(piece_weight, piece_weight + 1, NULL), &err),
+                 RSMOOTH_ERROR_INVALID_ARGUMENT);
+    printf("  overlapping outputs: %s\n", err.message);
+    CHECK(strstr(err.message, "outputs->weight overlaps") != NULL);
+    free(whole);
+    free(weight);
+    free(confidence);
+    free(piece_weight);
+    free(piece_confidence);
+}
+
 static void check_halo(void) {
     double halo = -1;
     rsmooth_error err;
@@ -282,6 +336,9 @@ int main(void) {
     check_early_refusals(NULL, &c);
     check_early_refusals(ctx, &c);
     check_halo();
+    printf("weights and confidences of a piece's core:\n");
+    check_outputs(NULL, &c);
+    check_outputs(ctx, &c);
     printf("the scales a whole mesh of this piece could have:\n");
     check_valid_scales(&c);
     printf("refused fields:\n");

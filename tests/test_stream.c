@@ -6,6 +6,10 @@
  *     with 32-bit and with 64-bit vertex ids in the temporary files;
  *   - the reference path (ctx NULL): the same bits as rsmooth_smooth(NULL, ...) in memory, and
  *     the same bytes when 3 ranks (threads, synced through a barrier) share the pieces;
+ *   - three passes with pass_confidence and a move mask, each pass streamed from the one
+ *     before: the in-memory bits, alone and over 3 ranks; the held vertices' bytes the input's,
+ *     and the confidence rule moving fewer vertices than the passes without it; the same on a
+ *     float32 file read in runs (its passes after the first read doubles);
  *   - bilateral normals (a wider halo); a float32, big-endian file with colours, a face property
  *     and an element after the faces: the bytes the in-memory writer gives the same positions;
  *     big-endian without them (faces of fixed rows, read on every core): the same positions;
@@ -220,6 +224,7 @@ typedef struct rank_job {
     ranks_state *state;
     int rank, ranks;
     const char *in, *out;
+    const rsmooth_params *params;
     rsmooth_status status;
     rsmooth_stream_report rep;
 } rank_job;
@@ -236,10 +241,110 @@ static void *run_rank(void *arg) {
     so.sync_user = job->state;
     rsmooth_error err;
     rsmooth_stream_report_init(&job->rep);
-    job->status = rsmooth_stream_smooth(NULL, job->in, job->out, NULL, &so, &job->rep, &err);
+    job->status = rsmooth_stream_smooth(NULL, job->in, job->out, job->params, &so, &job->rep, &err);
     if (job->status != RSMOOTH_OK)
         fprintf(stderr, "rank %d: %s\n", job->rank, err.message);
     return NULL;
+}
+
+/* `in` streamed by 3 ranks (threads) into `out`; the pieces they shared, all passes. */
+static size_t three_ranks(const char *in, const char *out, const rsmooth_params *params) {
+    ranks_state state;
+    pthread_barrier_init(&state.barrier, NULL, 3);
+    pthread_mutex_init(&state.lock, NULL);
+    state.worst = 0;
+    rank_job jobs[3];
+    pthread_t threads[3];
+    for (int r = 0; r < 3; r++) {
+        jobs[r] = (rank_job){&state, r, 3, in, out, params, RSMOOTH_OK, {0}};
+        pthread_create(&threads[r], NULL, run_rank, &jobs[r]);
+    }
+    size_t shared = 0;
+    for (int r = 0; r < 3; r++) {
+        pthread_join(threads[r], NULL);
+        CHECK_STATUS(jobs[r].status, RSMOOTH_OK);
+        shared += jobs[r].rep.pieces_here;
+    }
+    printf("3 ranks: %zu + %zu + %zu of %zu pieces\n", jobs[0].rep.pieces_here,
+           jobs[1].rep.pieces_here, jobs[2].rep.pieces_here, jobs[0].rep.pieces);
+    CHECK(shared == jobs[0].rep.pieces);
+    pthread_barrier_destroy(&state.barrier);
+    pthread_mutex_destroy(&state.lock);
+    return shared;
+}
+
+/* Whether two files hold the same bytes. */
+static bool same_files(const char *a_path, const char *b_path) {
+    size_t a_size, b_size;
+    unsigned char *a = slurp(a_path, &a_size), *b = slurp(b_path, &b_size);
+    bool same = a_size == b_size && !memcmp(a, b, a_size);
+    free(a);
+    free(b);
+    return same;
+}
+
+/* Vertices whose position differs between two results, and held vertices (mask 0) whose result
+ * is not the input's position bit for bit. */
+static void count_moves(const char *input, const double *a, const double *b, const uint8_t *mask,
+                        size_t *differ, size_t *held_moved) {
+    rsmooth_mesh *mesh = NULL;
+    rsmooth_error err;
+    CHECK_STATUS(rsmooth_mesh_read_file(input, &mesh, &err), RSMOOTH_OK);
+    *differ = *held_moved = 0;
+    for (size_t v = 0; v < mesh->vertex_count; v++) {
+        *differ += memcmp(a + 3 * v, b + 3 * v, 3 * sizeof *a) != 0;
+        *held_moved += !mask[v] && memcmp(a + 3 * v, mesh->positions + 3 * v, 3 * sizeof *a) != 0;
+    }
+    rsmooth_mesh_destroy(mesh);
+}
+
+/* Three passes, pass_confidence 0.6 and a mask holding every fourth vertex, streamed from `in`
+ * under `cap` (ctx's device or the reference path): the in-memory bits (the fold guard off, as
+ * on pieces). */
+static void passes_case(rsmooth_context *ctx, const char *in, size_t vertex_count, uint64_t cap,
+                        bool ranks) {
+    uint8_t *mask = malloc(vertex_count);
+    CHECK(mask != NULL);
+    for (size_t v = 0; v < vertex_count; v++)
+        mask[v] = v % 4 != 0;
+    rsmooth_params plain;
+    rsmooth_params_init(&plain);
+    plain.guard = 0;
+    plain.passes = 3;
+    plain.move_mask = mask;
+    rsmooth_params kept = plain;
+    kept.pass_confidence = 0.6;
+    double edge = 0;
+    double *expected = smooth_in_memory(ctx, in, &kept, &edge);
+    double *without = smooth_in_memory(ctx, in, &plain, &edge);
+    size_t differ, held_moved;
+    count_moves(in, expected, without, mask, &differ, &held_moved);
+    rsmooth_stream_report rep;
+    rsmooth_error err;
+    const char *out = path_in_dir("passes.ply");
+    CHECK_STATUS(stream(ctx, in, out, cap, &kept, &rep, &err), RSMOOTH_OK);
+    double dev = deviation(out, expected, edge);
+    printf("3 passes, confidence 0.6, 1 vertex in 4 held, cap %llu MB: %d passes, %zu pieces, "
+           "%llu runs of positions, temporaries %llu MB; deviation %.3g; the confidence rule "
+           "changes %zu of %zu vertices; held vertices moved %zu\n",
+           (unsigned long long)(cap >> 20), rep.passes, rep.pieces,
+           (unsigned long long)rep.position_runs, (unsigned long long)(rep.temporary_bytes >> 20),
+           dev, differ, vertex_count, held_moved);
+    CHECK(rep.passes == 3);
+    CHECK(dev == 0);
+    CHECK(differ > vertex_count / 100); /* the rule does something */
+    CHECK(held_moved == 0);
+    if (ranks) {
+        three_ranks(in, path_in_dir("passes_ranks.ply"), &kept);
+        bool same = same_files(out, path_in_dir("passes_ranks.ply"));
+        printf("3 ranks, 3 passes: output %s the single run's\n", same ? "equals" : "DIFFERS");
+        CHECK(same);
+        remove(path_in_dir("passes_ranks.ply"));
+    }
+    remove(out);
+    free(expected);
+    free(without);
+    free(mask);
 }
 
 static void check_refusal(rsmooth_context *ctx, const char *in, uint64_t cap,
@@ -289,6 +394,14 @@ int main(void) {
     CHECK(dev == 0);
     CHECK(rep.position_runs == 1); /* 4.8 MB of positions fit in half of what the cap leaves */
     CHECK(rep.vertex_id_bits == 32);
+    /* the input read once (header, vertex rows, faces) and its data once more for the copy */
+    size_t input_size;
+    unsigned char *input = slurp(big, &input_size);
+    size_t header_size = (size_t)(strstr((char *)input, "end_header\n") - (char *)input) + 11;
+    printf("input %zu bytes (header %zu): %llu read\n", input_size, header_size,
+           (unsigned long long)rep.input_bytes_read);
+    CHECK(rep.input_bytes_read == 2 * input_size - header_size);
+    free(input);
     free(expected);
     /* The mesh's figures are made on every core (stream_stats.c): 1 and 5 host threads cut the
      * work differently and must give the same bytes. */
@@ -379,32 +492,14 @@ int main(void) {
     CHECK(rep.pieces >= 2);
     CHECK(dev == 0);
     free(expected);
-    ranks_state state;
-    pthread_barrier_init(&state.barrier, NULL, 3);
-    pthread_mutex_init(&state.lock, NULL);
-    state.worst = 0;
-    rank_job jobs[3];
-    pthread_t threads[3];
-    for (int r = 0; r < 3; r++) {
-        jobs[r] = (rank_job){&state, r, 3, in, path_in_dir("ranks.ply"), RSMOOTH_OK, {0}};
-        pthread_create(&threads[r], NULL, run_rank, &jobs[r]);
-    }
-    size_t shared = 0;
-    for (int r = 0; r < 3; r++) {
-        pthread_join(threads[r], NULL);
-        CHECK_STATUS(jobs[r].status, RSMOOTH_OK);
-        shared += jobs[r].rep.pieces_here;
-    }
-    size_t a_size, b_size;
-    unsigned char *a = slurp(path_in_dir("ref.ply"), &a_size);
-    unsigned char *b = slurp(path_in_dir("ranks.ply"), &b_size);
-    printf("3 ranks: %zu + %zu + %zu of %zu pieces; output %s the single run's\n",
-           jobs[0].rep.pieces_here, jobs[1].rep.pieces_here, jobs[2].rep.pieces_here,
-           jobs[0].rep.pieces, a_size == b_size && !memcmp(a, b, a_size) ? "equals" : "DIFFERS");
-    CHECK(shared == jobs[0].rep.pieces && jobs[0].rep.pieces == rep.pieces);
-    CHECK(a_size == b_size && memcmp(a, b, a_size) == 0);
-    free(a);
-    free(b);
+    size_t shared = three_ranks(in, path_in_dir("ranks.ply"), NULL);
+    bool same = same_files(path_in_dir("ref.ply"), path_in_dir("ranks.ply"));
+    printf("3 ranks: output %s the single run's\n", same ? "equals" : "DIFFERS");
+    CHECK(shared == rep.pieces);
+    CHECK(same);
+
+    /* 3b. Passes, their confidence rule and a mask: the reference path alone and over 3 ranks */
+    passes_case(NULL, in, small.vertex_count, 12u << 20, true);
 
     /* 4. float32, the other byte order, extras: the bytes the in-memory writer gives the same
      * positions (little-endian, every other value and the header as read). */
@@ -417,8 +512,9 @@ int main(void) {
                                          RSMOOTH_FORMAT_PLY_BINARY, &err),
                  RSMOOTH_OK);
     rsmooth_mesh_destroy(written);
-    a = slurp(path_in_dir("odd_memory.ply"), &a_size);
-    b = slurp(path_in_dir("odd_out.ply"), &b_size);
+    size_t a_size, b_size;
+    unsigned char *a = slurp(path_in_dir("odd_memory.ply"), &a_size);
+    unsigned char *b = slurp(path_in_dir("odd_out.ply"), &b_size);
     size_t differ = a_size == b_size ? 0 : SIZE_MAX;
     for (size_t i = 0; i < a_size && a_size == b_size; i++)
         differ += a[i] != b[i];
@@ -443,14 +539,25 @@ int main(void) {
     free(expected);
     free(swapped);
 
+    /* 4c. Passes on the device from a float32 file, whose positions the first pass holds and
+     * the later ones (doubles) read in runs under 10 MB */
+    shape_mesh mid;
+    CHECK(shape_capped_cylinder(&mid, 1.0, 1.5, 100000) == 0);
+    CHECK(shape_add_normal_noise(&mid, 0.3 * shape_mean_edge_length(&mid), 11) == 0);
+    const char *mid_path = path_in_dir("mid.ply");
+    write_ply(mid_path, &mid, true, false, false, false);
+    passes_case(ctx, mid_path, mid.vertex_count, 10u << 20, false);
+    remove(mid_path);
+    shape_free(&mid);
+
     /* 5. Refusals. */
     const char *normals = path_in_dir("normals.ply");
     write_ply(normals, &small, true, false, false, true);
     check_refusal(ctx, normals, 64u << 20, NULL, RSMOOTH_ERROR_UNSUPPORTED, "vertex normals");
-    rsmooth_params two;
-    rsmooth_params_init(&two);
-    two.passes = 2;
-    check_refusal(ctx, in, 64u << 20, &two, RSMOOTH_ERROR_UNSUPPORTED, "passes");
+    rsmooth_params staged;
+    rsmooth_params_init(&staged);
+    staged.vertex_updates = 2;
+    check_refusal(ctx, in, 64u << 20, &staged, RSMOOTH_ERROR_UNSUPPORTED, "vertex_updates");
     check_refusal(ctx, big, 2u << 20, NULL, RSMOOTH_ERROR_OUT_OF_MEMORY, "give at least");
     check_refusal(ctx, path_in_dir("missing.ply"), 64u << 20, NULL, RSMOOTH_ERROR_IO,
                   "cannot open");

@@ -34,8 +34,8 @@ cmp -s reference_memory.ply reference_streamed.ply ||
   fail "the reference path streamed is not the in-memory file byte for byte"
 
 # what needs the whole mesh is refused before any work, with the usage status
-for option in --best --auto "--passes 2" "--vertex-updates 3" --stats "--method taubin" \
-              "--mask m.txt" --ascii "--format obj"; do
+for option in --best --auto "--vertex-updates 3" --stats "--method taubin" \
+              "--confidence c.ply" --ascii "--format obj"; do
   # shellcheck disable=SC2086
   expect 2 "$rsmooth" noisy.ply -o refused.ply --max-memory 64M $option
   grep -q "max-memory" err.txt || fail "$option under --max-memory: $(cat err.txt)"
@@ -189,7 +189,21 @@ memory=$(cat err.txt)
 expect 2 "$rsmooth" extra.ply -o refused.ply --max-memory 10M -q
 [ "$(cat err.txt)" = "$memory" ] && echo "negative count: $memory" ||
   fail "negative list count: streamed '$(cat err.txt)', in memory '$memory'"
+# (f) passes, each streamed from the one before, their confidence rule and a mask: the in-memory
+# bytes (the guard off, as on pieces); a mask naming a vertex the file lacks is refused, naming it
+seq 0 4 29000 > m.txt
+agree passes noisy.ply --no-guard --passes 3 --pass-confidence 0.6 --mask m.txt
+echo 99999 > bad_mask.txt
+expect 2 "$rsmooth" noisy.ply -o refused.ply --max-memory 10M --mask bad_mask.txt
+grep -q "bad_mask.txt" err.txt || fail "a mask index out of range: $(cat err.txt)"
+[ ! -e refused.ply ] || fail "a refused mask left refused.ply"
 if [ -n "$mpi" ]; then # the ranks write the same file
+  rm -f mpi_passes.ply
+  expect 0 "$mpirun" -n 2 --oversubscribe "$mpi" noisy.ply -o mpi_passes.ply --max-memory 10M -q \
+    --no-guard --passes 3 --pass-confidence 0.6 --mask m.txt
+  cmp -s mpi_passes.ply agree_passes.memory.ply &&
+    echo "rsmooth-mpi -n 2, 3 passes with a mask: the in-memory bytes" ||
+    fail "rsmooth-mpi -n 2 with passes and a mask differs from the in-memory file"
   for pair in bom.ply:byte_order_mark tiny.ply:tiny_double; do
     input=${pair%%:*} name=${pair#*:}
     rm -f "mpi_$input"

@@ -168,7 +168,8 @@ static rsmooth_status check_scale_fits(const rs_problem *pb, const double *posit
 static rsmooth_status prepare_piece(rs_problem *pb, const double *positions, size_t vertex_count,
                                     const uint32_t *indices, size_t triangle_count,
                                     const rsmooth_piece_info *info, const rsmooth_params *params,
-                                    double *out_positions, bool keep, rsmooth_error *error) {
+                                    double *out_positions, const rsmooth_outputs *o, bool keep,
+                                    rsmooth_error *error) {
     rsmooth_params p;
     rsmooth_status st = check_piece_params(params, &p, error, where);
     if (st != RSMOOTH_OK)
@@ -176,14 +177,29 @@ static rsmooth_status prepare_piece(rs_problem *pb, const double *positions, siz
     if (!out_positions)
         return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "out_positions is NULL");
     size_t out_bytes = info->core_count * 3 * sizeof(double);
-    if (!rs_mul_overflows(vertex_count, 3 * sizeof(double)) &&
-        !rs_mul_overflows(triangle_count, 3 * sizeof(uint32_t)) &&
-        (rs_ranges_overlap(out_positions, out_bytes, positions,
-                           vertex_count * 3 * sizeof(double)) ||
-         rs_ranges_overlap(out_positions, out_bytes, indices,
-                           triangle_count * 3 * sizeof(uint32_t))))
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
-                       "out_positions overlaps the piece's positions or indices");
+    size_t in_bytes = rs_mul_overflows(vertex_count, 3 * sizeof(double))
+                          ? SIZE_MAX
+                          : vertex_count * 3 * sizeof(double);
+    size_t index_bytes = rs_mul_overflows(triangle_count, 3 * sizeof(uint32_t))
+                             ? SIZE_MAX
+                             : triangle_count * 3 * sizeof(uint32_t);
+    size_t per_vertex = info->core_count * sizeof(float);
+    /* every output apart from every other and from the inputs */
+    const void *outs[3] = {out_positions, o->weight, o->confidence};
+    size_t out_sizes[3] = {out_bytes, per_vertex, per_vertex};
+    for (int a = 0; a < 3; a++) {
+        bool overlap = in_bytes != SIZE_MAX && index_bytes != SIZE_MAX &&
+                       (rs_ranges_overlap(outs[a], out_sizes[a], positions, in_bytes) ||
+                        rs_ranges_overlap(outs[a], out_sizes[a], indices, index_bytes));
+        for (int b = a + 1; b < 3; b++)
+            overlap = overlap || rs_ranges_overlap(outs[a], out_sizes[a], outs[b], out_sizes[b]);
+        if (overlap)
+            return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where,
+                           "%s overlaps another output or the piece's positions or indices",
+                           a == 0   ? "out_positions"
+                           : a == 1 ? "outputs->weight"
+                                    : "outputs->confidence");
+    }
     st = rs_problem_prepare_within(pb, RSMOOTH_FLOAT64, positions, vertex_count, indices,
                                    triangle_count, &p, RS_UNCHECKED_OUTPUT, keep, info, error,
                                    where);
@@ -194,16 +210,28 @@ static rsmooth_status prepare_piece(rs_problem *pb, const double *positions, siz
 
 /* The reference path on the whole piece, its core vertices kept. */
 static rsmooth_status solve_reference(const rs_problem *pb, size_t core, double *out,
-                                      rsmooth_report *report, double t_start,
+                                      const rsmooth_outputs *o, double t_start,
                                       rsmooth_error *error) {
-    double *all = rs_alloc_array(pb->vertex_count, 3 * sizeof *all);
-    if (!all)
-        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the piece");
-    rsmooth_status st = rs_reference_solve(pb, RSMOOTH_FLOAT64, all, NULL, NULL, NULL, report,
-                                           t_start, error, where);
+    size_t n = pb->vertex_count;
+    double *all = rs_alloc_array(n, 3 * sizeof *all);
+    float *weight = o->weight ? rs_alloc_array(n, sizeof *weight) : NULL;
+    float *confidence = o->confidence ? rs_alloc_array(n, sizeof *confidence) : NULL;
+    rsmooth_status st = RSMOOTH_OK;
+    if (!all || (o->weight && !weight) || (o->confidence && !confidence))
+        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, where, "no memory for the piece");
     if (st == RSMOOTH_OK)
+        st = rs_reference_solve(pb, RSMOOTH_FLOAT64, all, weight, confidence, NULL, o->report,
+                                t_start, error, where);
+    if (st == RSMOOTH_OK) {
         memcpy(out, all, core * 3 * sizeof *out);
+        if (weight)
+            memcpy(o->weight, weight, core * sizeof *weight);
+        if (confidence)
+            memcpy(o->confidence, confidence, core * sizeof *confidence);
+    }
     rs_free(all);
+    rs_free(weight);
+    rs_free(confidence);
     return st;
 }
 
@@ -211,14 +239,17 @@ rsmooth_status rsmooth_smooth_piece(rsmooth_context *ctx, const double *position
                                     size_t vertex_count, const uint32_t *indices,
                                     size_t triangle_count, const rsmooth_piece_info *caller_info,
                                     const rsmooth_params *params, double *out_positions,
-                                    rsmooth_report *report, rsmooth_error *error) {
+                                    const rsmooth_outputs *outputs, rsmooth_error *error) {
     double t_start = rs_now_ms();
     rs_error_clear(error);
     rs_problem pb; /* freed on every path: empty until prepare_piece fills it */
     memset(&pb, 0, sizeof pb);
     rsmooth_piece_info full;
     const rsmooth_piece_info *info = &full;
-    rsmooth_status st = read_info(caller_info, &full, error);
+    rsmooth_outputs o;
+    rsmooth_status st = rs_read_outputs(outputs, &o, error, where);
+    if (st == RSMOOTH_OK)
+        st = read_info(caller_info, &full, error);
     if (st == RSMOOTH_OK)
         st = check_info(info, vertex_count, error);
     if (st != RSMOOTH_OK)
@@ -229,22 +260,22 @@ rsmooth_status rsmooth_smooth_piece(rsmooth_context *ctx, const double *position
         if (st != RSMOOTH_OK)
             return st;
         st = prepare_piece(&pb, positions, vertex_count, indices, triangle_count, info, params,
-                           out_positions, false, error);
+                           out_positions, &o, false, error);
         rs_device_call call = {ctx, where, NULL};
-        rs_result_sink sink = {RSMOOTH_FLOAT64,  out_positions, NULL, NULL, NULL,
+        rs_result_sink sink = {RSMOOTH_FLOAT64,  out_positions, o.weight, o.confidence, NULL,
                                info->core_count, NULL};
         if (st == RSMOOTH_OK && info->core_count > 0)
-            st = rs_device_pass(&call, &pb, &sink, false, NULL, report, t_start, error);
-        if (st == RSMOOTH_OK)
-            st = rs_check_results(RSMOOTH_FLOAT64, out_positions, NULL, NULL, info->core_count,
-                                  "vertex", error, where);
+            st = rs_device_pass(&call, &pb, &sink, false, NULL, o.report, t_start, error);
         rs_device_leave(ctx, saved);
     } else {
         st = prepare_piece(&pb, positions, vertex_count, indices, triangle_count, info, params,
-                           out_positions, true, error);
+                           out_positions, &o, true, error);
         if (st == RSMOOTH_OK)
-            st = solve_reference(&pb, info->core_count, out_positions, report, t_start, error);
+            st = solve_reference(&pb, info->core_count, out_positions, &o, t_start, error);
     }
+    if (st == RSMOOTH_OK)
+        st = rs_check_results(RSMOOTH_FLOAT64, out_positions, o.weight, o.confidence,
+                              info->core_count, "vertex", error, where);
     rs_problem_free(&pb);
     if (!info->keep_memory)
         rs_release_free_memory();

@@ -955,18 +955,18 @@ RSMOOTH_API rsmooth_status rsmooth_piece_halo(const rsmooth_params *params, doub
 /** The filter on a piece of a larger mesh: its first info->core_count vertices move as they would
  * in a run on the whole mesh, provided the piece holds every triangle whose centroid lies within
  * rsmooth_piece_halo of them (more do no harm). Positions are double, packed; out_positions
- * receives 3 * core_count values. The whole mesh's mean edge length, mean facet area and scale
- * stand in for the piece's own, so results are the whole run's bit for bit, on a device (as tiles
- * are, see rsmooth_context_options.memory_budget) and on the reference path (ctx NULL). Params as
- * rsmooth_piece_halo accepts them. Errors as rsmooth_smooth, and RSMOOTH_ERROR_INVALID_ARGUMENT
- * naming the field of `info` outside its range (see rsmooth_piece_info); nothing written on
- * failure. Thread-safety as rsmooth_smooth. (Added in 0.7) */
-RSMOOTH_API rsmooth_status rsmooth_smooth_piece(rsmooth_context *ctx, const double *positions,
-                                                size_t vertex_count, const uint32_t *indices,
-                                                size_t triangle_count,
-                                                const rsmooth_piece_info *info,
-                                                const rsmooth_params *params, double *out_positions,
-                                                rsmooth_report *report, rsmooth_error *error);
+ * receives 3 * core_count values, and outputs (NULL: none) the core's weights and confidences
+ * (core_count floats each) and the report. The whole mesh's mean edge length, mean facet area and
+ * scale stand in for the piece's own, so results are the whole run's bit for bit, on a device (as
+ * tiles are, see rsmooth_context_options.memory_budget) and on the reference path (ctx NULL).
+ * Params as rsmooth_piece_halo accepts them. Errors as rsmooth_smooth, and
+ * RSMOOTH_ERROR_INVALID_ARGUMENT naming the field of `info` outside its range (see
+ * rsmooth_piece_info); nothing written on failure. Thread-safety as rsmooth_smooth. (Added in 0.7;
+ * `outputs` in place of 0.10's report in 0.11) */
+RSMOOTH_API rsmooth_status rsmooth_smooth_piece(
+    rsmooth_context *ctx, const double *positions, size_t vertex_count, const uint32_t *indices,
+    size_t triangle_count, const rsmooth_piece_info *info, const rsmooth_params *params,
+    double *out_positions, const rsmooth_outputs *outputs, rsmooth_error *error);
 
 #ifdef __cplusplus
 }

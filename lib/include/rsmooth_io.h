@@ -285,7 +285,8 @@ typedef struct rsmooth_stream_report {
     /** @} */
     double mean_edge_length;   /**< of the input, its units: the unit of the relative sigmas */
     double halo;               /**< how far around a piece its facets reach, mesh units */
-    size_t pieces;             /**< pieces the mesh was cut into (all ranks) */
+    size_t pieces;             /**< pieces the mesh was cut into (all ranks; each pass is cut
+                                * afresh, and this sums the passes) */
     size_t pieces_here;        /**< of them, those this rank filtered */
     uint64_t piece_facets_max; /**< facets of the largest piece, its halo's included */
     uint64_t facets_filtered;  /**< facets this rank's pieces held, halos included */
@@ -311,6 +312,12 @@ typedef struct rsmooth_stream_report {
     /** The vertex ids' width in the temporary files: 32, or 64 for meshes of 2^32 - 1 vertices
      * and more (up to 2^48). (Added in 0.11) */
     unsigned vertex_id_bits;
+    /** Passes of the filter run, each streamed (params.passes). (Added in 0.11) */
+    int passes;
+    /** Bytes of the input this rank read: its header, the vertex rows each time a pass read
+     * them, the faces and what follows them, and (rank 0) the data copied into the output.
+     * (Added in 0.11) */
+    uint64_t input_bytes_read;
 } rsmooth_stream_report;
 
 /** Zeroes `report` and sets its struct_size. Accepts NULL. */
@@ -347,14 +354,28 @@ RSMOOTH_API void rsmooth_stream_report_init(rsmooth_stream_report *report);
  * corners' positions on disk (corner records: about 110 bytes a triangle at their largest for
  * float files, with the pieces' lists, against 26 when the positions are held). Refused with
  * RSMOOTH_ERROR_UNSUPPORTED and a message: other formats, vertex normals in the file (the in-memory
- * path recomputes them), params that need the whole mesh (see rsmooth_piece_halo).
+ * path recomputes them), params that need the whole mesh (the normal update stage, colours, the
+ * region choice: see rsmooth_piece_halo).
+ * Passes (params.passes, with pass_confidence) and a move mask stream too, their results the
+ * in-memory ones bit for bit: each pass after the first reads the positions the one before wrote
+ * to disk (24 bytes a vertex, twice, and 4 twice more for pass_confidence: alone in a temporary
+ * file, ranks past the end of the partial output), its figures and pieces made afresh; passes 0
+ * gives the input back. params.move_mask is the caller's memory, one byte for each of the input's
+ * vertices (rsmooth_stream_vertex_count).
  * RSMOOTH_ERROR_OUT_OF_MEMORY names the cap needed when max_memory cannot hold the buffers and one
- * piece (about 10 MB). Progress and cancellation through params' callbacks. */
+ * piece (about 10 MB). Progress and cancellation through params' callbacks (the passes share
+ * the range). */
 RSMOOTH_API rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input,
                                                  const char *output, const rsmooth_params *params,
                                                  const rsmooth_stream_options *options,
                                                  rsmooth_stream_report *report,
                                                  rsmooth_error *error);
+
+/** The vertex count of the binary PLY `path` from its header alone, read as rsmooth_stream_smooth
+ * reads it: the length of a params.move_mask for it. Errors as that call's for the header
+ * (RSMOOTH_ERROR_IO, _PARSE, _UNSUPPORTED, naming the file). (Added in 0.11) */
+RSMOOTH_API rsmooth_status rsmooth_stream_vertex_count(const char *path, uint64_t *vertex_count,
+                                                       rsmooth_error *error);
 
 #ifdef __cplusplus
 }

@@ -6,6 +6,7 @@
  *   stream_corners.c   the triangles joined with their corners' positions (corner records)
  *   stream_stats.c     the whole mesh's figures, summed as the in-memory path sums them
  *   stream_pieces.c    spatial pieces: a grid of counts cut into boxes, and their files
+ *   stream_passes.c    the positions (and confidences) between passes of the filter
  *   stream_smooth.c    the pipeline (rsmooth_stream_smooth)
  */
 #ifndef RSMOOTH_STREAM_INTERNAL_H
@@ -130,6 +131,7 @@ typedef struct rs_stream_ply {
     uint64_t face_start;  /* the face block */
     double magnitude;     /* the largest |coordinate| read: the mesh's scale for float32 */
     size_t id_bytes;      /* a vertex id on disk: 4, or 8 from 2^32 - 1 vertices on (or forced) */
+    uint64_t rows_read;   /* vertex rows read, each time a pass read them (the report's) */
     char *out_header;     /* the output's header bytes, its mark included */
     size_t out_header_size;
 } rs_stream_ply;
@@ -320,6 +322,9 @@ typedef struct rs_stream_stats {
     uint64_t facet_count;
     double lo[3], hi[3]; /* the vertices' bounding box */
     bool whole;          /* one part, no edge out of line (core/parts.h): what streams */
+    bool parts_tested;   /* (the caller's) the input was found whole: a later pass's positions
+                          * are cut into pieces whatever `whole` says of them, as the in-memory
+                          * passes run on the input's parts */
 } rs_stream_stats;
 
 /* The figures of the mesh of `vertex_count` vertices whose triangles are `corners` that its edges
@@ -397,5 +402,42 @@ typedef struct rs_piece_source {
 bool rs_stream_assemble(const rs_piece_source *src, const unsigned char *core_records, size_t n,
                         const unsigned char *facet_records, size_t m, uint64_t *core, uint32_t *tri,
                         double *xyz, size_t *k);
+
+/* ---- stream_passes.c ----------------------------------------------------------------------- */
+
+/* The positions between passes (two double blocks, each read as a PLY's vertex block of x y z
+ * doubles) and the vertices' confidences (two float blocks), in a temporary file of their own or
+ * in a file the ranks share, from byte `base` on. */
+typedef struct rs_pass_store {
+    int fd;
+    bool own; /* a temporary of its own (closed), else a shared file's tail (cut off) */
+    uint64_t base, vertex_count;
+    rs_stream_ply block[2];
+} rs_pass_store;
+
+/* In `shared_fd` from `base` on, or (shared_fd -1) in a new temporary file in `dir`. */
+rsmooth_status rs_pass_store_open(rs_pass_store *s, int shared_fd, uint64_t base,
+                                  uint64_t vertex_count, const char *dir, rsmooth_error *error);
+/* Confidences of the vertices ids[0, n) (ascending) in float block k (0 or 1). */
+bool rs_pass_store_read_confidence(const rs_pass_store *s, int k, const uint64_t *ids, size_t n,
+                                   float *out);
+bool rs_pass_store_write_confidence(const rs_pass_store *s, int k, const uint64_t *ids, size_t n,
+                                    const float *values);
+/* What the in-memory loop does after each pass (passes/passes.c), for a piece's n core vertices
+ * (ids `core`, ascending; positions xyz[0, 3n) as this pass read them, results in `out` and
+ * `confidence`): from the second pass on, a vertex whose confidence in the pass before (float
+ * block (pass - 1) % 2) was at least keep_confidence (> 0) keeps that pass's position and
+ * confidence; a vertex the mask holds still keeps its input position, where every pass found it.
+ * false when the confidences cannot be read (errno set) or no memory. */
+typedef struct rs_pass_rule {
+    int pass;               /* from 0 */
+    double keep_confidence; /* params.pass_confidence; 0: none */
+    const uint8_t *mask;    /* params.move_mask (0: held still), or NULL */
+} rs_pass_rule;
+
+bool rs_pass_rules(const rs_pass_store *s, const rs_pass_rule *rule, const uint64_t *core, size_t n,
+                   const double *xyz, double *out, float *confidence);
+/* Closes its own file, or (`cut`) cuts the shared one back to `base`; false if that fails. */
+bool rs_pass_store_close(rs_pass_store *s, bool cut);
 
 #endif /* RSMOOTH_STREAM_INTERNAL_H */

@@ -543,7 +543,8 @@ rsmooth_status rs_stream_pieces_build(rs_stream_vertices *vertices,
                            .rank = rank,
                            .code_fd = -1};
     st = count_facets(&job, ct.pieces, ct.count, stats, dir, error);
-    if (st != RSMOOTH_OK || !stats->whole) /* (the caller says why a mesh not whole stops) */
+    /* (the caller says why a mesh not whole stops) */
+    if (st != RSMOOTH_OK || (!stats->whole && !stats->parts_tested))
         goto done;
     if (!share(ct.pieces, ct.count, ranks < 1 ? 1 : ranks)) {
         st = no_memory(error);

@@ -9,8 +9,11 @@
  *   5. each piece (this rank's) filtered (rsmooth_smooth_piece, its memory kept for the next)
  *      and its core vertices written into the copy at their rows;
  *   6. the copy named as the output, atomically.
- * Ranks (the MPI driver) run 1-3 alike, rank 0 makes the copy, and each writes its own pieces'
- * rows: disjoint bytes of one file. */
+ * Passes after the first (params.passes) run 1-3 and 5 again on the positions the pass before
+ * wrote into a double block (stream_passes.c) instead of the input's, the triangles kept; only
+ * the last writes into the copy. Ranks (the MPI driver) run 1-3 alike, rank 0 makes the copy,
+ * and each writes its own pieces' rows: disjoint bytes of one file, and all of a pass's before
+ * any rank starts the next. */
 #define _GNU_SOURCE /* O_TMPFILE, linkat, renameat2 */
 #include "io/output_file.h"
 #include "stream/stream_internal.h"
@@ -53,6 +56,21 @@ void rsmooth_stream_report_init(rsmooth_stream_report *report) {
     report->struct_size = sizeof *report;
 }
 
+rsmooth_status rsmooth_stream_vertex_count(const char *path, uint64_t *vertex_count,
+                                           rsmooth_error *error) {
+    static const char where[] = "rsmooth_stream_vertex_count";
+    rs_error_clear(error);
+    if (!path || !vertex_count)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, where, "%s is NULL",
+                       path ? "vertex_count" : "path");
+    rs_stream_ply ply;
+    rsmooth_status st = rs_stream_ply_open(&ply, path, DEFAULT_MAX_MEMORY / 4, error);
+    if (st == RSMOOTH_OK)
+        *vertex_count = ply.vertex_count;
+    rs_stream_ply_close(&ply); /* (what a failed open holds too) */
+    return st;
+}
+
 typedef struct stream_call {
     rsmooth_context *ctx;
     const char *input, *output;
@@ -67,6 +85,13 @@ typedef struct stream_call {
     rs_stream_corners corners;   /* the triangles with their corners' positions */
     rs_output out;               /* the output: its target, and the copy the results go into */
     uint64_t triangle_count;
+    int ids_fd;            /* the triangles' vertex ids, kept while a pass is to come */
+    int passes;            /* of the filter (params.passes; 0: the input comes back) */
+    int pass;              /* the one running, from 0 */
+    rs_pass_rule rule;     /* what the in-memory loop does after each pass */
+    rs_pass_store store;   /* the positions between passes (passes above 1) */
+    rs_stream_ply *source; /* the positions this pass reads: the input's, or a block */
+    uint64_t output_size;  /* the copy's, where a rank's store begins */
     rs_stream_stats stats;
     double halo;
     uint64_t piece_vertices;
@@ -81,10 +106,13 @@ static int sync_ranks(const stream_call *c, int status) {
     return c->opt.ranks > 1 && c->opt.sync ? c->opt.sync(c->opt.sync_user, status) : status;
 }
 
+/* `fraction` of the pass running, as a fraction of the whole call. */
 static bool report_progress(const stream_call *c, double fraction) {
     const rsmooth_params *p = c->caller_params;
     if (!p)
         return true;
+    if (c->passes > 1)
+        fraction = (c->pass + fraction) / c->passes;
     if (p->progress)
         p->progress(p->progress_user, fraction);
     return !p->progress_cancel || p->progress_cancel(p->progress_user, fraction) == 0;
@@ -161,10 +189,6 @@ static rsmooth_status check_arguments(stream_call *c, const rsmooth_params *para
     }
     if (c->opt.max_memory == 0)
         c->opt.max_memory = DEFAULT_MAX_MEMORY;
-    double halo = 0; /* the params' checks, before any file is read */
-    rsmooth_status st = rsmooth_piece_halo(params, 1, 0, &halo, error);
-    if (st != RSMOOTH_OK)
-        return st;
     c->caller_params = params;
     if (params)
         c->params = *params;
@@ -172,6 +196,19 @@ static rsmooth_status check_arguments(stream_call *c, const rsmooth_params *para
         rsmooth_params_init(&c->params);
     c->params.progress = NULL;
     c->params.progress_cancel = NULL;
+    /* the passes' loop is this call's (each pass a streamed one), the pieces' params one pass's */
+    c->passes = c->params.passes;
+    c->rule.mask = c->params.move_mask;
+    c->params.passes = 1;
+    c->params.move_mask = NULL;
+    if (c->passes < 0 || c->passes > RS_MAX_ROUNDS)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, RS_STREAM_WHERE,
+                       "passes must be in [0, %d] (got %d)", RS_MAX_ROUNDS, c->passes);
+    double halo = 0; /* the params' checks, before any file is read */
+    rsmooth_status st = rsmooth_piece_halo(&c->params, 1, 0, &halo, error);
+    if (st != RSMOOTH_OK)
+        return st;
+    c->rule.keep_confidence = c->passes > 1 ? c->params.pass_confidence : 0;
     st = check_tmpdir(c, error);
     if (st != RSMOOTH_OK)
         return st;
@@ -190,39 +227,52 @@ static rsmooth_status cancelled(const stream_call *c, double fraction, rsmooth_e
 /* Step 1: the vertices (their extent), the triangles, and the corner records. The positions get
  * what the cap leaves beside the fixed buffers: all of them when they fit in half of it (then
  * they stay, and the passes after need not read them again), else runs as long as the cap
- * allows, one pass over the triangles per run. */
+ * allows, one pass over the triangles per run. The first pass reads the input's positions and
+ * writes the triangles; a later one reads the positions the pass before wrote. */
 static rsmooth_status read_input(stream_call *c, rs_stream_extent *extent, rsmooth_error *error) {
-    bool f32 = c->ply.xyz_type == RS_PLY_FLOAT32;
+    bool f32 = c->source->xyz_type == RS_PLY_FLOAT32;
     uint64_t position_bytes = c->ply.vertex_count * 3 * (f32 ? 4 : 8);
     uint64_t room = c->opt.max_memory - FIXED_BYTES;
     bool hold = position_bytes <= room / 2;
-    rsmooth_status st =
-        rs_stream_vertices_open(&c->vertices, &c->ply, hold ? position_bytes : room, extent, error);
+    rsmooth_status st = rs_stream_vertices_open(&c->vertices, c->source,
+                                                hold ? position_bytes : room, extent, error);
     if (st == RSMOOTH_OK)
         st = cancelled(c, 0.03, error);
     if (st != RSMOOTH_OK)
         return st;
-    int ids_fd = c->corners.ids_fd = rs_stream_temporary(c->dir);
-    if (ids_fd < 0)
-        return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                       "cannot create a temporary file in %s: %s", c->dir, strerror(errno));
-    st = rs_stream_ply_write_triangles(&c->ply, ids_fd, c->dir, &c->triangle_count, error);
-    if (st == RSMOOTH_OK && c->ply.face_count == 0) /* the in-memory reader's word for it */
-        st = rs_fail_parse(error, -1, (int64_t)c->ply.size, RS_STREAM_WHERE,
-                           "%s: %llu vertices but no faces and no vertex normals: a mesh needs "
-                           "faces, a point cloud normals (nx, ny, nz)",
-                           c->input, (unsigned long long)c->ply.vertex_count);
+    if (c->ids_fd < 0) {
+        c->ids_fd = rs_stream_temporary(c->dir);
+        if (c->ids_fd < 0)
+            return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                           "cannot create a temporary file in %s: %s", c->dir, strerror(errno));
+        st = rs_stream_ply_write_triangles(&c->ply, c->ids_fd, c->dir, &c->triangle_count, error);
+        if (st == RSMOOTH_OK && c->ply.face_count == 0) /* the in-memory reader's word for it */
+            st = rs_fail_parse(error, -1, (int64_t)c->ply.size, RS_STREAM_WHERE,
+                               "%s: %llu vertices but no faces and no vertex normals: a mesh "
+                               "needs faces, a point cloud normals (nx, ny, nz)",
+                               c->input, (unsigned long long)c->ply.vertex_count);
+    }
+    c->corners.ids_fd = c->ids_fd;
     if (st == RSMOOTH_OK)
-        st = rs_stream_corners_make(&c->vertices, hold, ids_fd, c->ply.id_bytes, c->triangle_count,
-                                    c->dir, &c->corners, error);
+        st = rs_stream_corners_make(&c->vertices, hold, c->ids_fd, c->ply.id_bytes,
+                                    c->triangle_count, c->dir, &c->corners, error);
     if (st == RSMOOTH_OK && !c->corners.held)
         rs_stream_vertices_release(&c->vertices); /* the statistics get the room */
     return st;
 }
 
-/* Steps 1-3: everything before the output is touched. */
-static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
-    double t0 = now_ms();
+/* The triangles' ids once the records (or the pieces' lists) hold them: their disk comes back,
+ * unless a later pass reads them again. */
+static void drop_triangle_ids(stream_call *c) {
+    if (c->ids_fd >= 0 && c->pass + 1 >= c->passes) {
+        close(c->ids_fd);
+        c->ids_fd = -1;
+    }
+    c->corners.ids_fd = -1;
+}
+
+/* The input's header, and whether the cap can hold anything at all. */
+static rsmooth_status open_input(stream_call *c, rsmooth_error *error) {
     /* the header, its parse and the output's: about three times its size */
     rsmooth_status st = rs_stream_ply_open(&c->ply, c->input, c->opt.max_memory / 4, error);
     if (st != RSMOOTH_OK)
@@ -237,34 +287,59 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
                        "piece take %.1f MB; give at least %llu MB",
                        c->input, (double)cap / (1 << 20), (double)least / (1 << 20),
                        (unsigned long long)((least >> 20) + 1));
+    c->source = &c->ply;
+    return RSMOOTH_OK;
+}
+
+/* The mesh's figures for this pass, and the halo. The passes after the first keep the first's
+ * sigmas in mesh units, as the in-memory loop fixes them from the input's mean edge length; the
+ * input's parts test holds for them all. */
+static rsmooth_status figures(stream_call *c, const rs_stream_extent *extent, uint64_t held,
+                              rsmooth_error *error) {
+    rsmooth_status st =
+        rs_stream_statistics(&c->corners, c->ply.vertex_count, extent,
+                             c->opt.max_memory - held - FIXED_BYTES, &c->stats, error);
+    if (!c->corners.held) /* the records hold the ids too */
+        drop_triangle_ids(c);
+    if (st != RSMOOTH_OK)
+        return st;
+    if (c->pass == 0) {
+        c->rep.mean_edge_length = c->stats.mean_edge_length;
+        if (c->passes > 1 && !c->params.absolute && c->stats.mean_edge_length > 0) {
+            double unit = c->stats.mean_edge_length;
+            c->params.sigma_f *= unit;
+            c->params.sigma_g *= unit; /* +INFINITY stays */
+            c->params.normal_sigma_s *= unit;
+            c->params.absolute = 1;
+        }
+    }
+    /* the halo from the reach's bound: the pieces are counted in the pass that measures it */
+    st = rsmooth_piece_halo(&c->params, c->stats.mean_edge_length, c->stats.reach_bound, &c->halo,
+                            error);
+    c->rep.halo = c->halo;
+    return st;
+}
+
+/* Steps 1-3 of a pass: everything before the output is touched (the first pass) or the pass's
+ * results are written. */
+static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
+    double t0 = now_ms();
     rs_stream_extent extent;
-    st = read_input(c, &extent, error);
+    rsmooth_status st = read_input(c, &extent, error);
     if (st == RSMOOTH_OK)
         st = cancelled(c, 0.08, error);
     if (st != RSMOOTH_OK)
         return st;
     c->rep.triangle_count = c->triangle_count;
-    c->rep.ms_read = now_ms() - t0;
+    c->rep.ms_read += now_ms() - t0;
 
     double t1 = now_ms();
     /* the positions' bytes in memory: all of them, or none (released after the records) */
     uint64_t held = c->vertices.xyz ? c->vertices.run * 3 * (c->vertices.f32 ? 4 : 8) : 0;
-    st = rs_stream_statistics(&c->corners, c->ply.vertex_count, &extent, cap - held - FIXED_BYTES,
-                              &c->stats, error);
-    if (!c->corners.held) { /* its disk comes back: the records hold the ids too */
-        close(c->corners.ids_fd);
-        c->corners.ids_fd = -1;
-    }
+    st = figures(c, &extent, held, error);
     if (st != RSMOOTH_OK)
         return st;
-    c->rep.mean_edge_length = c->stats.mean_edge_length;
-    /* the halo from the reach's bound: the pieces are counted in the pass that measures it */
-    st = rsmooth_piece_halo(&c->params, c->stats.mean_edge_length, c->stats.reach_bound, &c->halo,
-                            error);
-    if (st != RSMOOTH_OK)
-        return st;
-    c->rep.halo = c->halo;
-    c->rep.ms_statistics = now_ms() - t1;
+    c->rep.ms_statistics += now_ms() - t1;
     st = cancelled(c, 0.15, error);
     if (st != RSMOOTH_OK)
         return st;
@@ -272,10 +347,15 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
     double t2 = now_ms();
     /* the pieces have the cap but the fixed buffers and the positions when those are held (the
      * lists then hold ids alone); else the positions are let go first */
+    uint64_t cap = c->opt.max_memory;
     c->held = c->corners.held != NULL;
     held = c->held ? held : 0;
     c->piece_vertices = (cap - held - FIXED_BYTES) / PIECE_BYTES_PER_VERTEX;
-    c->rep.memory_planned = held + FIXED_BYTES + c->piece_vertices * PIECE_BYTES_PER_VERTEX;
+    uint64_t planned = held + FIXED_BYTES + c->piece_vertices * PIECE_BYTES_PER_VERTEX;
+    if (planned > c->rep.memory_planned)
+        c->rep.memory_planned = planned;
+    rs_stream_pieces_free(&c->pieces);
+    c->stats.parts_tested = c->pass > 0;
     st = rs_stream_pieces_build(&c->vertices, &c->corners, &c->stats, c->halo, c->piece_vertices,
                                 GRID_BYTES, c->opt.rank, c->opt.ranks, c->dir, &c->pieces, error);
     if (st == RSMOOTH_OK && c->stats.reach > c->stats.reach_bound) /* (the bound's premise) */
@@ -283,7 +363,7 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
                      "%s: a facet's corner lies %g from its centroid, beyond the %g its longest "
                      "edge allows: the pieces' halo would leave facets out",
                      c->input, c->stats.reach, c->stats.reach_bound);
-    if (st == RSMOOTH_OK && !c->stats.whole)
+    if (st == RSMOOTH_OK && !c->stats.whole && c->pass == 0)
         st = rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, RS_STREAM_WHERE,
                      "%s holds parts of very different size, or vertices far off the surface "
                      "(triangles out of scale with the rest): streaming does not keep them "
@@ -300,18 +380,24 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
     c->corners.held = NULL;
     if (c->corners.fd >= 0)
         close(c->corners.fd);
-    if (c->corners.ids_fd >= 0)
-        close(c->corners.ids_fd);
-    c->corners.fd = c->corners.ids_fd = -1;
+    c->corners.fd = -1;
+    drop_triangle_ids(c);
     if (st != RSMOOTH_OK)
         return st;
-    c->rep.pieces = c->pieces.count;
-    c->rep.position_runs = c->vertices.runs_read;
+    c->rep.pieces += c->pieces.count;
+    c->rep.position_runs += c->vertices.runs_read;
     c->rep.vertex_id_bits = (unsigned)(8 * c->ply.id_bytes);
-    uint64_t joining = ids + records,
-             listing = (records ? records : ids) + c->pieces.temporary_bytes;
-    c->rep.temporary_bytes = joining > listing ? joining : listing;
-    c->rep.ms_buckets = now_ms() - t2;
+    /* a later pass keeps the ids beside the lists, and the blocks between passes */
+    uint64_t kept = c->ids_fd >= 0 ? ids : 0;
+    uint64_t store = c->passes > 1 && c->opt.ranks == 1
+                         ? c->ply.vertex_count * (c->rule.keep_confidence > 0 ? 56 : 48)
+                         : 0;
+    uint64_t joining = ids + records + store,
+             listing = (records ? records : ids) + c->pieces.temporary_bytes + kept + store;
+    uint64_t temporary = joining > listing ? joining : listing;
+    if (temporary > c->rep.temporary_bytes)
+        c->rep.temporary_bytes = temporary;
+    c->rep.ms_buckets += now_ms() - t2;
     return cancelled(c, 0.2, error);
 }
 
@@ -336,9 +422,12 @@ static rsmooth_status make_copy(stream_call *c, rsmooth_error *error) {
  * scale 1: in the caller's units a mesh at 1e-300 has no double for its mean area. The results
  * come back divided by the scale, as the in-memory path divides them. */
 static rsmooth_status filter_piece(stream_call *c, double *xyz, size_t k, const uint32_t *tri,
-                                   size_t m, size_t n, double *out, rsmooth_error *error) {
+                                   size_t m, size_t n, double *out, float *confidence,
+                                   rsmooth_error *error) {
     if (c->stats.facet_count == 0) { /* nothing moves, as in memory (and no mean area) */
         memcpy(out, xyz, n * 3 * sizeof *out);
+        for (size_t v = 0; confidence && v < n; v++)
+            confidence[v] = 0;
         return RSMOOTH_OK;
     }
     const double scale = c->stats.scale;
@@ -359,8 +448,10 @@ static rsmooth_status filter_piece(stream_call *c, double *xyz, size_t k, const 
     info.keep_memory = 1; /* for the next piece; handed back once, at the end */
     rsmooth_report rep;
     rsmooth_report_init(&rep);
+    rsmooth_outputs outputs = {
+        .struct_size = sizeof outputs, .confidence = confidence, .report = &rep};
     rsmooth_status st =
-        rsmooth_smooth_piece(c->ctx, xyz, k, tri, m, &info, &params, out, &rep, error);
+        rsmooth_smooth_piece(c->ctx, xyz, k, tri, m, &info, &params, out, &outputs, error);
     if (st != RSMOOTH_OK)
         return st;
     if (!c->rep.device[0])
@@ -369,6 +460,35 @@ static rsmooth_status filter_piece(stream_call *c, double *xyz, size_t k, const 
     for (size_t i = 0; i < 3 * n; i++)
         out[i] *= unscale;
     return RSMOOTH_OK;
+}
+
+/* The pass's results for a piece's core: into the copy (the last pass, checked as the in-memory
+ * writer checks them first), else into the block the next pass reads, with the confidences it
+ * keeps vertices by. */
+static rsmooth_status write_results(stream_call *c, const uint64_t *core, size_t n,
+                                    const double *out, const float *confidence,
+                                    rsmooth_error *error) {
+    bool last = c->pass + 1 == c->passes;
+    if (last) {
+        rsmooth_status st = rs_stream_ply_check_positions(&c->ply, core, n, out, c->output, error);
+        if (st != RSMOOTH_OK)
+            return st;
+        if (!rs_stream_ply_write_positions(&c->ply, c->out.fd, core, n, out))
+            return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",
+                           c->output, strerror(errno));
+        return RSMOOTH_OK;
+    }
+    int errnum = 0;
+    if (!rs_stream_ply_write_positions(&c->store.block[c->pass % 2], c->store.fd, core, n, out) ||
+        (confidence &&
+         !rs_pass_store_write_confidence(&c->store, c->pass % 2, core, n, confidence)))
+        errnum = errno ? errno : EIO;
+    if (!errnum)
+        return RSMOOTH_OK;
+    return c->store.own ? rs_stream_unwritten(c->dir, errnum, error)
+                        : rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                                  "cannot write the positions between passes into %s: %s",
+                                  c->out.temporary, strerror(errnum));
 }
 
 /* Step 5 for one piece: its lists read, its arrays assembled, filtered, written. */
@@ -388,8 +508,15 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
     size_t most = n + 3 * m, k = 0;
     double *xyz = rs_alloc_array(most ? most : 1, 3 * sizeof *xyz);
     double *out = rs_alloc_array(n ? n : 1, 3 * sizeof *out);
+    /* the rules after a pass (stream_passes.c) read the core's positions before the pass, and
+     * the next pass keeps vertices by their confidence */
+    bool rules = c->rule.mask || (c->rule.keep_confidence > 0 && c->pass > 0);
+    bool confident = c->rule.keep_confidence > 0;
+    double *before = rules ? rs_alloc_array(n ? n : 1, 3 * sizeof *before) : NULL;
+    float *confidence = confident ? rs_alloc_array(n ? n : 1, sizeof *confidence) : NULL;
     rsmooth_status st = RSMOOTH_OK;
-    if (!core_records || !facet_records || !core || !tri || !xyz || !out) {
+    if (!core_records || !facet_records || !core || !tri || !xyz || !out || (rules && !before) ||
+        (confident && !confidence)) {
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
                      "no memory for a piece of %zu facets", m);
         goto done;
@@ -412,16 +539,18 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
     if (!in_place) /* the arrays hold it all now */
         rs_free(facet_records);
     facet_records = NULL;
+    if (before)
+        memcpy(before, xyz, n * 3 * sizeof *before);
     c->rep.ms_assemble += now_ms() - t_piece;
-    st = filter_piece(c, xyz, k, tri, m, n, out, error);
-    if (st == RSMOOTH_OK) /* what the in-memory writer refuses, before any of it is written */
-        st = rs_stream_ply_check_positions(&c->ply, core, n, out, c->output, error);
+    st = filter_piece(c, xyz, k, tri, m, n, out, confidence, error);
+    if (st == RSMOOTH_OK && rules &&
+        !rs_pass_rules(&c->store, &c->rule, core, n, before, out, confidence))
+        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                     "cannot read the confidences between passes: %s", strerror(errno));
     if (st != RSMOOTH_OK)
         goto done;
     double t = now_ms();
-    if (!rs_stream_ply_write_positions(&c->ply, c->out.fd, core, n, out))
-        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s", c->output,
-                     strerror(errno));
+    st = write_results(c, core, n, out, confidence, error);
     c->rep.ms_write += now_ms() - t;
 done:
     rs_free(core_records);
@@ -431,11 +560,14 @@ done:
     rs_free(tri);
     rs_free(xyz);
     rs_free(out);
+    rs_free(before);
+    rs_free(confidence);
     return st;
 }
 
 static rsmooth_status run_pieces(stream_call *c, rsmooth_error *error) {
-    double t0 = now_ms();
+    double t0 = now_ms(), others = c->rep.ms_write + c->rep.ms_assemble;
+    c->rule.pass = c->pass;
     uint64_t total = 0, done = 0;
     for (size_t i = 0; i < c->pieces.count; i++)
         if (c->pieces.pieces[i].rank == c->opt.rank)
@@ -455,7 +587,7 @@ static rsmooth_status run_pieces(stream_call *c, rsmooth_error *error) {
         if (!report_progress(c, 0.25 + 0.75 * (double)done / (double)(total ? total : 1)))
             return rs_fail(error, RSMOOTH_ERROR_CANCELLED, RS_STREAM_WHERE, "cancelled");
     }
-    c->rep.ms_filter = now_ms() - t0 - c->rep.ms_write - c->rep.ms_assemble;
+    c->rep.ms_filter += now_ms() - t0 - (c->rep.ms_write + c->rep.ms_assemble - others);
     return RSMOOTH_OK;
 }
 
@@ -466,6 +598,63 @@ static rsmooth_status others_failed(int worst, rsmooth_status mine, rsmooth_erro
     return rs_fail(error, (rsmooth_status)worst, RS_STREAM_WHERE,
                    "another rank failed (%s); its message says why",
                    rsmooth_status_str((rsmooth_status)worst));
+}
+
+/* Step 4 and what the passes need from it: the copy (rank 0's), open on every rank, and the
+ * store between passes (alone a temporary of its own; ranks the copy's tail, which they share). */
+static rsmooth_status open_copy(stream_call *c, rsmooth_error *error) {
+    rsmooth_status st = RSMOOTH_OK;
+    if (c->opt.rank == 0) {
+        double t = now_ms();
+        st = make_copy(c, error);
+        c->rep.ms_copy = now_ms() - t;
+    }
+    st = others_failed(sync_ranks(c, st), st, error);
+    if (st == RSMOOTH_OK && c->opt.rank != 0)
+        st = rs_output_create_partial(&c->out, false, RS_STREAM_WHERE, error);
+    c->output_size = c->ply.out_header_size + (c->ply.data_end - c->ply.data_start);
+    if (st == RSMOOTH_OK && c->passes > 1)
+        st = c->opt.ranks > 1
+                 ? rs_pass_store_open(&c->store, c->out.fd, c->output_size, c->ply.vertex_count,
+                                      c->dir, error)
+                 : rs_pass_store_open(&c->store, -1, 0, c->ply.vertex_count, c->dir, error);
+    return st;
+}
+
+/* Steps 1-3 and 5 of each pass, the copy made after the first pass's plan; every rank's rows of
+ * a pass on disk before any rank reads them (or rank 0 names the file). `st`: how the call went
+ * so far. Every rank meets the others as often as they: after a failure anywhere all stop after
+ * the first pass's meetings. */
+static rsmooth_status run_passes(stream_call *c, rsmooth_status st, rsmooth_error *error) {
+    int passes = c->passes > 0 ? c->passes : 1;  /* none: the first plan alone checks the mesh */
+    c->rep.input_bytes_read = c->ply.data_start; /* the header */
+    for (c->pass = 0; c->pass < passes; c->pass++) {
+        c->source = c->pass == 0 ? &c->ply : &c->store.block[(c->pass - 1) % 2];
+        if (st == RSMOOTH_OK)
+            st = plan(c, error);
+        st = others_failed(sync_ranks(c, st), st, error);
+        if (c->pass == 0) /* the faces and what follows them */
+            c->rep.input_bytes_read += c->ply.face_start ? c->ply.size - c->ply.face_start : 0;
+        if (st == RSMOOTH_OK && c->pass == 0)
+            st = open_copy(c, error);
+        if (st == RSMOOTH_OK && c->passes > 0) {
+            st = run_pieces(c, error);
+            c->rep.passes++;
+        }
+        int fd = c->pass + 1 >= passes ? c->out.fd : c->store.fd;
+        if (st == RSMOOTH_OK && c->opt.ranks > 1 && fsync(fd) != 0)
+            st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",
+                         c->out.temporary, strerror(errno));
+        st = others_failed(sync_ranks(c, st), st, error);
+        rs_stream_vertices_release(&c->vertices); /* the next pass reads its own */
+        if (st != RSMOOTH_OK)
+            break;
+    }
+    c->pass = passes - 1;
+    c->rep.input_bytes_read += c->ply.rows_read * c->ply.vertex_stride;
+    if (c->opt.rank == 0 && c->out.fd >= 0)
+        c->rep.input_bytes_read += c->ply.data_end - c->ply.data_start; /* the copy */
+    return st;
 }
 
 rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input, const char *output,
@@ -480,7 +669,8 @@ rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input, co
     c->ctx = ctx;
     c->input = input;
     c->output = output;
-    c->corners.fd = c->corners.ids_fd = -1;
+    c->corners.fd = c->corners.ids_fd = c->ids_fd = -1;
+    c->store.fd = -1;
     c->out.fd = -1;
     c->out.guard = -1;
     c->ply.fd = -1;
@@ -488,23 +678,12 @@ rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input, co
     rsmooth_stream_report_init(&c->rep);
     rsmooth_status st = check_arguments(c, params, options, error);
     if (st == RSMOOTH_OK)
-        st = plan(c, error);
-    st = others_failed(sync_ranks(c, st), st, error);
-    if (st == RSMOOTH_OK && c->opt.rank == 0) {
-        double t = now_ms();
-        st = make_copy(c, error);
-        c->rep.ms_copy = now_ms() - t;
-    }
-    st = others_failed(sync_ranks(c, st), st, error);
-    if (st == RSMOOTH_OK && c->opt.rank != 0)
-        st = rs_output_create_partial(&c->out, false, RS_STREAM_WHERE, error);
-    if (st == RSMOOTH_OK)
-        st = run_pieces(c, error);
-    /* every rank's rows on disk before rank 0 names the file */
-    if (st == RSMOOTH_OK && c->opt.ranks > 1 && fsync(c->out.fd) != 0)
+        st = open_input(c, error);
+    st = run_passes(c, st, error);
+    /* the copy cut back to the output's size: ranks kept the positions between passes after it */
+    if (c->opt.rank == 0 && !rs_pass_store_close(&c->store, st == RSMOOTH_OK) && st == RSMOOTH_OK)
         st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",
                      c->out.temporary, strerror(errno));
-    st = others_failed(sync_ranks(c, st), st, error);
     if (c->opt.rank == 0 && c->out.fd >= 0 && st == RSMOOTH_OK)
         st = rs_output_publish(&c->out, c->opt.replace != 0, RS_STREAM_WHERE, error);
     if (st == RSMOOTH_OK && c->out.notes[0])
@@ -520,10 +699,12 @@ rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input, co
         memcpy(report, &c->rep, size);
         report->struct_size = size;
     }
+    if (c->opt.rank != 0)
+        rs_pass_store_close(&c->store, false);
     if (c->corners.fd >= 0)
         close(c->corners.fd);
-    if (c->corners.ids_fd >= 0)
-        close(c->corners.ids_fd);
+    if (c->ids_fd >= 0)
+        close(c->ids_fd);
     rs_stream_pieces_free(&c->pieces);
     if (c->ply.fd >= 0)
         rs_stream_ply_close(&c->ply);

@@ -36,6 +36,7 @@ static rsmooth_status read_run(rs_stream_vertices *v, uint64_t first, rs_stream_
     v->first = first;
     v->loaded = run_end(v, first) - first;
     v->runs_read++;
+    v->ply->rows_read += v->loaded;
     return RSMOOTH_OK;
 }
 
