@@ -647,6 +647,7 @@ static rsmooth_status run_passes(stream_call *c, rsmooth_status st, rsmooth_erro
                          c->out.temporary, strerror(errno));
         st = others_failed(sync_ranks(c, st), st, error);
         rs_stream_vertices_release(&c->vertices); /* the next pass reads its own */
+        rs_release_free_memory(); /* what the pieces kept: the next pass's plan needs the room */
         if (st != RSMOOTH_OK)
             break;
     }
