@@ -217,19 +217,32 @@ static bool patch_lists_build(guided_job *job) {
     return ok;
 }
 
-/* Mean distance between the centroids of edge-adjacent facets, each pair once: the edges of
- * facet f's patch that have f on one side (listed first, f being its patch's first facet). */
-static double adjacent_distance(const guided_job *job) {
+/* Facet f's share of the mean distance between the centroids of edge-adjacent facets: its
+ * distances to those of higher index (the edges of its patch with f on one side, listed first,
+ * f being its patch's first facet), summed in the patch's order; *pairs receives how many. */
+static double adjacent_share(const guided_job *job, size_t f, size_t *pairs) {
     const guided_lists *l = &job->lists;
+    double share = 0;
+    *pairs = 0;
+    for (size_t e = l->edge_start[f]; e < l->edge_start[f + 1] && l->edge[2 * e] == f; e++)
+        if (l->edge[2 * e + 1] > f) {
+            share += sqrt(gap2(job->facets->centroid + 3 * f,
+                               job->facets->centroid + 3 * (size_t)l->edge[2 * e + 1]));
+            ++*pairs;
+        }
+    return share;
+}
+
+/* The mean over every pair once: the facets' shares summed in facet order, so that pieces of a
+ * larger mesh, each giving the shares of its facets, give the same bits (stage_piece.c). */
+static double adjacent_distance(const guided_job *job) {
     double sum = 0;
     size_t pairs = 0;
-    for (size_t f = 0; f < job->facets->count; f++)
-        for (size_t e = l->edge_start[f]; e < l->edge_start[f + 1] && l->edge[2 * e] == f; e++)
-            if (l->edge[2 * e + 1] > f) {
-                sum += sqrt(gap2(job->facets->centroid + 3 * f,
-                                 job->facets->centroid + 3 * (size_t)l->edge[2 * e + 1]));
-                pairs++;
-            }
+    for (size_t f = 0; f < job->facets->count; f++) {
+        size_t n;
+        sum += adjacent_share(job, f, &n);
+        pairs += n;
+    }
     return pairs ? sum / (double)pairs : 0;
 }
 
@@ -393,9 +406,11 @@ void rs_guided_destroy(rs_guided *g) {
     rs_free(g);
 }
 
-rs_guided *rs_guided_create(const rs_facets *facets, const rs_adjacency *adj,
-                            const uint32_t *indices, double sigma_s, double sigma_n,
-                            double radius) {
+/* The lists and work arrays; the reach `radius` times the facets' own mean adjacent-centroid
+ * distance, or (radius < 0) `reach` itself. */
+static rs_guided *guided_create(const rs_facets *facets, const rs_adjacency *adj,
+                                const uint32_t *indices, double sigma_s, double sigma_n,
+                                double radius, double reach) {
     rs_guided *g = rs_calloc_array(1, sizeof *g);
     if (!g)
         return NULL;
@@ -413,7 +428,7 @@ rs_guided *rs_guided_create(const rs_facets *facets, const rs_adjacency *adj,
     job->guidance = rs_alloc_array(nf, 3 * sizeof(double));
     bool ok =
         g->prev && job->patch_mean && job->patch_score && job->guidance && patch_lists_build(job);
-    job->reach = ok ? radius * adjacent_distance(job) : 0;
+    job->reach = !ok ? 0 : radius < 0 ? reach : radius * adjacent_distance(job);
     g->filter = job->reach > 0;
     if (ok && g->filter)
         ok = rs_grid_build(&g->grid, facets->centroid, facets->count, job->reach, NULL) ==
@@ -424,6 +439,26 @@ rs_guided *rs_guided_create(const rs_facets *facets, const rs_adjacency *adj,
         return NULL;
     }
     return g;
+}
+
+rs_guided *rs_guided_create(const rs_facets *facets, const rs_adjacency *adj,
+                            const uint32_t *indices, double sigma_s, double sigma_n,
+                            double radius) {
+    return guided_create(facets, adj, indices, sigma_s, sigma_n, radius, 0);
+}
+
+rs_guided *rs_guided_create_reach(const rs_facets *facets, const rs_adjacency *adj,
+                                  const uint32_t *indices, double sigma_s, double sigma_n,
+                                  double reach) {
+    return guided_create(facets, adj, indices, sigma_s, sigma_n, -1, reach);
+}
+
+double rs_guided_adjacent_share(const rs_guided *g, size_t f, size_t *pairs) {
+    return adjacent_share(&g->job, f, pairs);
+}
+
+double rs_guided_reach(const rs_guided *g) {
+    return g->job.reach;
 }
 
 void rs_guided_step(rs_guided *g, const rs_facets *facets, int rounds, double *normals) {
