@@ -25,7 +25,9 @@ if [ "${1:-}" = format ]; then
   packages+=(clang-format-14) # `make format`: one version, the layout differs between them
 fi
 if [ "${1:-}" = blender ]; then
-  packages+=(blender)
+  # the add-on's test reads its results through numpy: Debian's Blender runs the system Python,
+  # and does not pull numpy in on a machine without it
+  packages+=(blender python3-numpy)
 fi
 if [ "${1:-}" = experiments ]; then
   packages+=(python3 python3-numpy python3-scipy python3-matplotlib)

@@ -14,9 +14,9 @@
 /* The option that needs the whole mesh in memory, or NULL. */
 static const char *whole_mesh_option(const options *opt) {
     const rsmooth_params *p = &opt->params;
-    return opt->best                            ? "--best"
-           : opt->auto_params                   ? "--auto"
-           : p->vertex_updates > 0              ? "--vertex-updates"
+    return opt->auto_params ? "--auto"
+           : p->stage_normals == RSMOOTH_STAGE_NORMALS_LEARNED && p->vertex_updates > 0
+               ? "--stage learned"
            : opt->colors                        ? "--sigma-c"
            : opt->confidence                    ? "--confidence"
            : opt->stats                         ? "--stats"
@@ -49,9 +49,12 @@ int cli_stream_check(const options *opt) {
         return cli_usage_error(NULL, "--max-memory writes the input's own binary PLY: drop "
                                      "--ascii and --format");
     if (opt->params.guard && !opt->quiet) /* (what the pieces cannot do yet, said once) */
-        fprintf(stderr, "rsmooth: --max-memory: the fold guard does not run on pieces yet: the "
-                        "result is the in-memory one with --no-guard (triangles the filter turns "
-                        "over are not pulled back)\n");
+        fprintf(stderr,
+                "rsmooth: --max-memory: the fold guard does not run on pieces yet: the "
+                "result is the in-memory one with --no-guard (triangles the filter turns "
+                "over are not pulled back%s)\n",
+                opt->params.vertex_updates > 0 ? ", and the stage runs on a mesh that reads clean"
+                                               : "");
     return -1;
 }
 
@@ -92,12 +95,14 @@ void cli_stream_print_json(const rsmooth_stream_report *r, const options *opt, i
            (unsigned long long)r->vertex_count, (unsigned long long)r->face_count,
            (unsigned long long)r->triangle_count, (unsigned long long)r->facet_count,
            r->mean_edge_length, r->halo);
-    printf(",\"passes\":%d,\"pieces\":%zu,\"pieces_here\":%zu,\"piece_facets_max\":%llu,"
+    printf(",\"stage_cycles\":%d,\"passes\":%d,\"pieces\":%zu,\"pieces_here\":%zu,\"piece_facets_"
+           "max\":%llu,"
            "\"facets_filtered\":%llu,\"temporary_bytes\":%llu,\"position_runs\":%llu,"
            "\"input_bytes_read\":%llu,\"device\":",
-           r->passes, r->pieces, r->pieces_here, (unsigned long long)r->piece_facets_max,
-           (unsigned long long)r->facets_filtered, (unsigned long long)r->temporary_bytes,
-           (unsigned long long)r->position_runs, (unsigned long long)r->input_bytes_read);
+           r->stage_cycles, r->passes, r->pieces, r->pieces_here,
+           (unsigned long long)r->piece_facets_max, (unsigned long long)r->facets_filtered,
+           (unsigned long long)r->temporary_bytes, (unsigned long long)r->position_runs,
+           (unsigned long long)r->input_bytes_read);
     cli_print_json_string(r->device);
     printf(",\"ms\":{\"read\":%.3f,\"statistics\":%.3f,\"cut\":%.3f,\"copy\":%.3f,"
            "\"assemble\":%.3f,\"filter\":%.3f,\"write\":%.3f,\"total\":%.3f}}\n",
@@ -176,8 +181,11 @@ int cli_stream_file(const options *opt, const char *path) {
         fprintf(stderr, "rsmooth: %s: warning: %s\n", opt->output, rep.notes);
     if (opt->json)
         cli_stream_print_json(&rep, opt, 1);
-    char passes[48] = ""; /* "3 passes, " */
-    if (rep.passes != 1)
+    char passes[80] = ""; /* "10 stage cycles and 1 pass, " */
+    if (rep.stage_cycles > 0)
+        snprintf(passes, sizeof passes, "%d stage cycles and %d pass%s, ", rep.stage_cycles,
+                 rep.passes, rep.passes == 1 ? "" : "es");
+    else if (rep.passes != 1)
         snprintf(passes, sizeof passes, "%d passes, ", rep.passes);
     if (!opt->quiet)
         fprintf(stderr,

@@ -5,7 +5,9 @@
 # streaming run reports, how often it read the positions, and the capped result against the
 # in-memory one (with --no-guard, as streaming has no fold guard yet; compare_ply_positions.py
 # needs numpy); at 16M also a cap below the positions (MPI_CAP) and rsmooth-mpi on 1, 2 and 4
-# ranks under it. Figures, not assertions: run it on a quiet machine.
+# ranks under it (each rank's bytes of the input read on stderr); at 4M the best mode (--best
+# --no-guard) in memory and under the cap, byte for byte. Figures, not assertions: run it on a
+# quiet machine.
 #
 # usage: scripts/large_meshes.sh BUILD WORKDIR [MAX_TRIANGLES_IN_MEMORY ["TRIANGLES:CAP ..."]
 #        [MPI_CAP]]
@@ -62,6 +64,18 @@ for spec in $sizes; do
     echo "| $n | in memory, --no-guard | $wall | $rss | | | | |"
   fi
   capped cap$n "$cap"
+  if [ "$n" -eq 4000000 ]; then # the best mode: the stage a streamed step per cycle
+    read -r wall rss < <(run best_mem$n "$build/rsmooth" "$mesh" -o best_mem$n.ply --force --best \
+      --no-guard)
+    echo "| $n | --best, in memory | $wall | $rss | | | | |"
+    read -r wall rss < <(run best_cap$n "$build/rsmooth" "$mesh" -o best_cap$n.ply --force --best \
+      --no-guard --max-memory "$cap" --json)
+    pieces=$(grep -o '"pieces":[0-9]*' best_cap$n.out | cut -d: -f2)
+    temp=$(grep -o '"temporary_bytes":[0-9]*' best_cap$n.out | cut -d: -f2)
+    same=$(cmp -s best_mem$n.ply best_cap$n.ply && echo "the in-memory bytes" || echo "DIFFERS")
+    echo "| $n | --best --max-memory $cap | $wall | $rss | $pieces | | $((temp >> 20)) | $same |"
+    rm -f best_mem$n.ply best_cap$n.ply
+  fi
   if [ "$n" -eq 16000000 ]; then
     capped low$n "$mpi_cap" # below the positions (96 MB at 16M)
     for ranks in 1 2 4; do

@@ -176,9 +176,9 @@ static double pieces_reach(const shape_mesh *m, const rs_stage_setting *setting,
         double *s = malloc((p.t_count ? p.t_count : 1) * sizeof *s);
         uint32_t *n = malloc((p.t_count ? p.t_count : 1) * sizeof *n);
         CHECK(s && n);
-        CHECK_STATUS(rs_stage_piece_shares(p.input, p.k, p.tri, p.t_count, setting, whole->scale,
-                                           s, n),
-                     RSMOOTH_OK);
+        CHECK_STATUS(
+            rs_stage_piece_shares(p.input, p.k, p.tri, p.t_count, setting, whole->scale, s, n),
+            RSMOOTH_OK);
         for (size_t t = 0; t < p.t_count; t++)
             if (p.tri[3 * t] < p.core) {
                 share[p.tri_global[t]] = s[t];
@@ -279,10 +279,10 @@ int main(void) {
     double edge = shape_mean_edge_length(&roof);
     CHECK(shape_add_normal_noise(&roof, 0.35 * edge, 21) == 0);
     CHECK(shape_unindex(&roof, &soup) == 0);
-    rs_stage_setting mid = {.sigma_s = edge, .sigma_n = 0.2, .radius = 3, .rounds = 1,
-                            .updates = 10, .cycles = 1};
-    rs_stage_setting other = {.sigma_s = 0.7 * edge, .sigma_n = 0.3, .radius = 2, .rounds = 2,
-                              .updates = 3, .cycles = 1};
+    rs_stage_setting mid = {
+        .sigma_s = edge, .sigma_n = 0.2, .radius = 3, .rounds = 1, .updates = 10, .cycles = 1};
+    rs_stage_setting other = {
+        .sigma_s = 0.7 * edge, .sigma_n = 0.3, .radius = 2, .rounds = 2, .updates = 3, .cycles = 1};
     check_shares("mesh", &roof, &mid);
     check_shares("soup", &soup, &mid);
     check_cycles("mid setting", &roof, &mid, NULL, 2);

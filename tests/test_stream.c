@@ -10,6 +10,9 @@
  *     before: the in-memory bits, alone and over 3 ranks; the held vertices' bytes the input's,
  *     and the confidence rule moving fewer vertices than the passes without it; the same on a
  *     float32 file read in runs (its passes after the first read doubles);
+ *   - the best mode (the normal update stage, a step per cycle, then its robust pass) with a
+ *     mask: the in-memory bits on the device and, over 3 ranks, on the reference path; a cap too
+ *     small for the stage's halo refused with the size it needs;
  *   - bilateral normals (a wider halo); a float32, big-endian file with colours, a face property
  *     and an element after the faces: the bytes the in-memory writer gives the same positions;
  *     big-endian without them (faces of fixed rows, read on every core): the same positions;
@@ -225,6 +228,7 @@ typedef struct rank_job {
     int rank, ranks;
     const char *in, *out;
     const rsmooth_params *params;
+    uint64_t cap;
     rsmooth_status status;
     rsmooth_stream_report rep;
 } rank_job;
@@ -233,7 +237,7 @@ static void *run_rank(void *arg) {
     rank_job *job = arg;
     rsmooth_stream_options so;
     rsmooth_stream_options_init(&so);
-    so.max_memory = 12u << 20;
+    so.max_memory = job->cap;
     so.replace = 1;
     so.rank = job->rank;
     so.ranks = job->ranks;
@@ -248,7 +252,8 @@ static void *run_rank(void *arg) {
 }
 
 /* `in` streamed by 3 ranks (threads) into `out`; the pieces they shared, all passes. */
-static size_t three_ranks(const char *in, const char *out, const rsmooth_params *params) {
+static size_t three_ranks(const char *in, const char *out, const rsmooth_params *params,
+                          uint64_t cap) {
     ranks_state state;
     pthread_barrier_init(&state.barrier, NULL, 3);
     pthread_mutex_init(&state.lock, NULL);
@@ -256,7 +261,7 @@ static size_t three_ranks(const char *in, const char *out, const rsmooth_params 
     rank_job jobs[3];
     pthread_t threads[3];
     for (int r = 0; r < 3; r++) {
-        jobs[r] = (rank_job){&state, r, 3, in, out, params, RSMOOTH_OK, {0}};
+        jobs[r] = (rank_job){&state, r, 3, in, out, params, cap, RSMOOTH_OK, {0}};
         pthread_create(&threads[r], NULL, run_rank, &jobs[r]);
     }
     size_t shared = 0;
@@ -335,7 +340,7 @@ static void passes_case(rsmooth_context *ctx, const char *in, size_t vertex_coun
     CHECK(differ > vertex_count / 100); /* the rule does something */
     CHECK(held_moved == 0);
     if (ranks) {
-        three_ranks(in, path_in_dir("passes_ranks.ply"), &kept);
+        three_ranks(in, path_in_dir("passes_ranks.ply"), &kept, 12u << 20);
         bool same = same_files(out, path_in_dir("passes_ranks.ply"));
         printf("3 ranks, 3 passes: output %s the single run's\n", same ? "equals" : "DIFFERS");
         CHECK(same);
@@ -344,6 +349,54 @@ static void passes_case(rsmooth_context *ctx, const char *in, size_t vertex_coun
     remove(out);
     free(expected);
     free(without);
+    free(mask);
+}
+
+/* The best mode (3 of its cycles) with a mask holding every fifth vertex, streamed from `in`
+ * under `cap`: the in-memory bits (the fold guard off); over 3 ranks too with `ranks`. */
+static void stage_case(rsmooth_context *ctx, const char *in, size_t vertex_count, uint64_t cap,
+                       bool ranks) {
+    uint8_t *mask = malloc(vertex_count);
+    CHECK(mask != NULL);
+    for (size_t v = 0; v < vertex_count; v++)
+        mask[v] = v % 5 != 0;
+    rsmooth_params best;
+    rsmooth_params_init_best(&best);
+    best.guard = 0;
+    best.stage_repeats = 3;
+    best.move_mask = mask;
+    double edge = 0;
+    double *expected = smooth_in_memory(ctx, in, &best, &edge);
+    rsmooth_params plain = best; /* the stage's share of the result: without it */
+    plain.vertex_updates = 0;
+    double *unstaged = smooth_in_memory(ctx, in, &plain, &edge);
+    size_t differ, held_moved;
+    count_moves(in, expected, unstaged, mask, &differ, &held_moved);
+    rsmooth_stream_report rep;
+    rsmooth_error err;
+    const char *out = path_in_dir("best.ply");
+    CHECK_STATUS(stream(ctx, in, out, cap, &best, &rep, &err), RSMOOTH_OK);
+    double dev = deviation(out, expected, edge);
+    printf("best mode, 3 cycles, 1 vertex in 5 held, cap %llu MB on %s: %d cycles and %d pass "
+           "streamed, %zu pieces (the largest %llu facets), temporaries %llu MB; deviation %.3g; "
+           "the stage moves %zu of %zu vertices; held vertices moved %zu\n",
+           (unsigned long long)(cap >> 20), ctx ? "the device" : "the reference path",
+           rep.stage_cycles, rep.passes, rep.pieces, (unsigned long long)rep.piece_facets_max,
+           (unsigned long long)(rep.temporary_bytes >> 20), dev, differ, vertex_count, held_moved);
+    CHECK(rep.stage_cycles == 3 && rep.passes == 1);
+    CHECK(dev == 0);
+    CHECK(differ > vertex_count / 2);
+    CHECK(held_moved == 0);
+    if (ranks) {
+        three_ranks(in, path_in_dir("best_ranks.ply"), &best, cap);
+        bool same = same_files(out, path_in_dir("best_ranks.ply"));
+        printf("3 ranks, best mode: output %s the single run's\n", same ? "equals" : "DIFFERS");
+        CHECK(same);
+        remove(path_in_dir("best_ranks.ply"));
+    }
+    remove(out);
+    free(expected);
+    free(unstaged);
     free(mask);
 }
 
@@ -492,7 +545,7 @@ int main(void) {
     CHECK(rep.pieces >= 2);
     CHECK(dev == 0);
     free(expected);
-    size_t shared = three_ranks(in, path_in_dir("ranks.ply"), NULL);
+    size_t shared = three_ranks(in, path_in_dir("ranks.ply"), NULL, 12u << 20);
     bool same = same_files(path_in_dir("ref.ply"), path_in_dir("ranks.ply"));
     printf("3 ranks: output %s the single run's\n", same ? "equals" : "DIFFERS");
     CHECK(shared == rep.pieces);
@@ -547,6 +600,9 @@ int main(void) {
     const char *mid_path = path_in_dir("mid.ply");
     write_ply(mid_path, &mid, true, false, false, false);
     passes_case(ctx, mid_path, mid.vertex_count, 10u << 20, false);
+    /* 4d. the best mode on the device, and over 3 ranks on the reference path */
+    stage_case(ctx, mid_path, mid.vertex_count, 48u << 20, false);
+    stage_case(NULL, mid_path, mid.vertex_count, 48u << 20, true);
     remove(mid_path);
     shape_free(&mid);
 
@@ -555,9 +611,13 @@ int main(void) {
     write_ply(normals, &small, true, false, false, true);
     check_refusal(ctx, normals, 64u << 20, NULL, RSMOOTH_ERROR_UNSUPPORTED, "vertex normals");
     rsmooth_params staged;
-    rsmooth_params_init(&staged);
-    staged.vertex_updates = 2;
-    check_refusal(ctx, in, 64u << 20, &staged, RSMOOTH_ERROR_UNSUPPORTED, "vertex_updates");
+    rsmooth_params_init_best(&staged);
+    staged.stage_normals = RSMOOTH_STAGE_NORMALS_LEARNED;
+    check_refusal(ctx, in, 64u << 20, &staged, RSMOOTH_ERROR_UNSUPPORTED, "stage_normals");
+    staged.stage_normals = RSMOOTH_STAGE_NORMALS_GUIDED; /* its halo needs more than 12 MB */
+    check_refusal(ctx, in, 12u << 20, &staged, RSMOOTH_ERROR_OUT_OF_MEMORY, "give at least");
+    staged.discrepancy_level = 0.3; /* the choice per region reads the whole mesh */
+    check_refusal(ctx, in, 64u << 20, &staged, RSMOOTH_ERROR_UNSUPPORTED, "discrepancy_level");
     check_refusal(ctx, big, 2u << 20, NULL, RSMOOTH_ERROR_OUT_OF_MEMORY, "give at least");
     check_refusal(ctx, path_in_dir("missing.ply"), 64u << 20, NULL, RSMOOTH_ERROR_IO,
                   "cannot open");

@@ -314,6 +314,9 @@ typedef struct rsmooth_stream_report {
     unsigned vertex_id_bits;
     /** Passes of the filter run, each streamed (params.passes). (Added in 0.11) */
     int passes;
+    /** Cycles of the normal update stage run, each streamed (params.vertex_updates above 0:
+     * params.stage_repeats of them). (Added in 0.11) */
+    int stage_cycles;
     /** Bytes of the input this rank read: its header, the vertex rows each time a pass read
      * them, the faces and what follows them, and (rank 0) the data copied into the output.
      * (Added in 0.11) */

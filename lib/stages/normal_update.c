@@ -105,15 +105,6 @@ static bool refine_after(const rs_stage_setting *setting, double *xyz, size_t ve
     return ok;
 }
 
-double rs_stage_scale(const double *xyz, size_t vertex_count, double sigma_s) {
-    double largest = 0;
-    for (size_t i = 0; i < 3 * vertex_count; i++)
-        largest = fmax(largest, fabs(xyz[i]));
-    int exponent;
-    frexp(fmax(largest, sigma_s), &exponent);
-    return ldexp(1.0, -exponent);
-}
-
 rsmooth_status rs_normal_update_stage(double *xyz, size_t vertex_count, const uint32_t *indices,
                                       size_t triangle_count, const rs_stage_setting *setting,
                                       const uint8_t *move_mask, const rs_stage_place *place,

@@ -108,6 +108,8 @@ typedef struct rs_stage_place {
  * sigma_s when that is larger, brought just below 1, so squared distances neither overflow nor
  * underflow whatever the mesh's units. */
 double rs_stage_scale(const double *xyz, size_t vertex_count, double sigma_s);
+/* The same from the largest |coordinate| (stage_piece.c: a stream has it from its extent). */
+double rs_stage_scale_of(double largest, double sigma_s);
 
 /* The whole stage on `xyz` (double, in place). Vertices whose move_mask byte is 0 stay. `place`
  * may be NULL (the host); `stats` (may be NULL) gets what it measured. */

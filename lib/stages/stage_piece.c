@@ -20,6 +20,19 @@
  * 2/3 of a median from the centroid, a median at most sqrt(3)/2 of the longest edge). */
 #define CENTROID_REACH 0.58
 
+double rs_stage_scale_of(double largest, double sigma_s) {
+    int exponent;
+    frexp(fmax(largest, sigma_s), &exponent);
+    return ldexp(1.0, -exponent);
+}
+
+double rs_stage_scale(const double *xyz, size_t vertex_count, double sigma_s) {
+    double largest = 0;
+    for (size_t i = 0; i < 3 * vertex_count; i++)
+        largest = fmax(largest, fabs(xyz[i]));
+    return rs_stage_scale_of(largest, sigma_s);
+}
+
 double rs_stage_cycle_halo(const rs_stage_setting *setting, double longest_edge, double reach,
                            double displacement) {
     /* From a core vertex: `updates` rings of vertices (each update reads the facets at its
@@ -93,10 +106,10 @@ rsmooth_status rs_stage_whole_figures(const double *input, size_t vertex_count,
     rs_adjacency adj;
     bool ok = rs_facets_build(&facets, xyz, indices, triangle_count);
     bool adjacency = ok && rs_adjacency_build(&adj, xyz, vertex_count, indices, &facets);
-    rs_guided *g = adjacency ? rs_guided_create(&facets, &adj, indices,
-                                                setting->sigma_s * whole->scale,
-                                                setting->sigma_n, setting->radius)
-                             : NULL;
+    rs_guided *g = adjacency
+                       ? rs_guided_create(&facets, &adj, indices, setting->sigma_s * whole->scale,
+                                          setting->sigma_n, setting->radius)
+                       : NULL;
     if (g)
         whole->reach = rs_guided_reach(g) / whole->scale;
     rs_guided_destroy(g);

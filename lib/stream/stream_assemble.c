@@ -9,6 +9,7 @@
  * through the facets, whose order is kept. */
 #include "stream/stream_internal.h"
 
+#include <errno.h>
 #include <string.h>
 
 /* Position `at` (3 values of the file's type) into xyz[3 v .. 3 v + 2]. */
@@ -53,7 +54,7 @@ static uint32_t *core_order(const uint64_t *core, size_t n) {
 
 bool rs_stream_assemble(const rs_piece_source *src, const unsigned char *core_records, size_t n,
                         const unsigned char *facet_records, size_t m, uint64_t *core, uint32_t *tri,
-                        double *xyz, size_t *k) {
+                        double *xyz, size_t *k, uint64_t *all_ids) {
     size_t id_bytes = src->id_bytes;
     for (size_t v = 0; v < n; v++) {
         const unsigned char *rec = core_records + v * src->vertex_record;
@@ -86,6 +87,8 @@ bool rs_stream_assemble(const rs_piece_source *src, const unsigned char *core_re
                 const unsigned char *rec = facet_records + f * src->facet_record;
                 put_position(xyz, count, src->f32,
                              position_of(src, id, rec, 3 * id_bytes + 3 * value * q));
+                if (all_ids)
+                    all_ids[count] = id;
                 number = (uint32_t)count++;
             }
         }
@@ -94,6 +97,62 @@ bool rs_stream_assemble(const rs_piece_source *src, const unsigned char *core_re
     rs_free(order);
     rs_free(ids);
     rs_free(slot);
+    for (size_t v = 0; all_ids && v < n; v++)
+        all_ids[v] = core[v];
     *k = count;
     return ok;
+}
+
+void rs_stream_piece_arrays_free(rs_stream_piece_arrays *a) {
+    rs_free(a->core);
+    rs_free(a->ids);
+    rs_free(a->xyz);
+    rs_free(a->tri);
+    rs_free(a->triangle);
+    memset(a, 0, sizeof *a);
+}
+
+rsmooth_status rs_stream_piece_load(const rs_stream_pieces *pieces, const rs_piece_source *src,
+                                    const rs_piece *p, bool want_ids, rs_stream_piece_arrays *a,
+                                    rsmooth_error *error) {
+    memset(a, 0, sizeof *a);
+    size_t n = a->n = (size_t)p->vertex_count, m = a->m = (size_t)p->facet_count;
+    size_t vertex_record = pieces->vertex_record, facet_record = pieces->facet_record;
+    unsigned char *core_records = rs_alloc_array(n ? n : 1, vertex_record);
+    a->core = rs_alloc_array(n ? n : 1, sizeof *a->core);
+    a->tri = rs_alloc_array(m ? m : 1, 3 * sizeof *a->tri);
+    /* entries of three 32-bit ids are read into tri itself and renumbered in place (each
+     * facet's ids are read before its numbers are written): fewer fresh pages per piece */
+    bool in_place = facet_record == 3 * sizeof *a->tri;
+    unsigned char *facet_records =
+        in_place ? (unsigned char *)a->tri : rs_alloc_array(m ? m : 1, facet_record);
+    /* at most n + 3m vertices; a piece's facets share their corners about 6 ways */
+    size_t most = n + 3 * m;
+    a->xyz = rs_alloc_array(most ? most : 1, 3 * sizeof *a->xyz);
+    a->ids = want_ids ? rs_alloc_array(most ? most : 1, sizeof *a->ids) : NULL;
+    a->triangle = pieces->triangle_ids ? rs_alloc_array(m ? m : 1, sizeof *a->triangle) : NULL;
+    rsmooth_status st = RSMOOTH_OK;
+    if (!core_records || !facet_records || !a->core || !a->tri || !a->xyz ||
+        (want_ids && !a->ids) || (pieces->triangle_ids && !a->triangle))
+        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
+                     "no memory for a piece of %zu facets", m);
+    else if (!rs_pread_all(pieces->vertex_fd, core_records, n * vertex_record,
+                           p->vertex_start * vertex_record) ||
+             !rs_pread_all(pieces->facet_fd, facet_records, m * facet_record,
+                           p->facet_start * facet_record))
+        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot read a temporary file: %s",
+                     strerror(errno));
+    for (size_t f = 0; st == RSMOOTH_OK && a->triangle && f < m; f++)
+        memcpy(a->triangle + f, facet_records + (f + 1) * facet_record - sizeof *a->triangle,
+               sizeof *a->triangle);
+    if (st == RSMOOTH_OK && !rs_stream_assemble(src, core_records, n, facet_records, m, a->core,
+                                                a->tri, a->xyz, &a->k, a->ids))
+        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
+                     "no memory for a piece of %zu facets", m);
+    rs_free(core_records);
+    if (!in_place)
+        rs_free(facet_records);
+    if (st != RSMOOTH_OK)
+        rs_stream_piece_arrays_free(a);
+    return st;
 }

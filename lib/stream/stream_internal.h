@@ -6,7 +6,8 @@
  *   stream_corners.c   the triangles joined with their corners' positions (corner records)
  *   stream_stats.c     the whole mesh's figures, summed as the in-memory path sums them
  *   stream_pieces.c    spatial pieces: a grid of counts cut into boxes, and their files
- *   stream_passes.c    the positions (and confidences) between passes of the filter
+ *   stream_passes.c    the positions (and confidences, the stage's shares) between steps
+ *   stream_stage.c     the normal update stage's steps on a piece
  *   stream_smooth.c    the pipeline (rsmooth_stream_smooth)
  */
 #ifndef RSMOOTH_STREAM_INTERNAL_H
@@ -175,6 +176,10 @@ bool rs_stream_ply_write_positions(const rs_stream_ply *ply, int out_fd, const u
 rsmooth_status rs_stream_ply_read_range(rs_stream_ply *ply, uint64_t first, uint64_t count,
                                         void *xyz, rs_stream_extent *extent, rsmooth_error *error);
 
+/* The positions (as doubles) of the vertices ids[0, n), read from their rows (a run of
+ * consecutive ids at a time); false on a read error (errno set) or when out of memory. */
+bool rs_stream_ply_read_rows(const rs_stream_ply *ply, const uint64_t *ids, size_t n, double *xyz);
+
 /* ---- stream_vertices.c --------------------------------------------------------------------- */
 
 /* The vertex positions, in the file's type: all held when they fit in the memory given, else
@@ -216,6 +221,9 @@ static inline void rs_stream_vertex(const rs_stream_vertices *v, uint64_t id, do
  * positions are held whole anyway, the records are made as they are read, from the triangle file
  * and the positions (the same bytes, a quarter of the reading); else they are written to a file
  * once, one pass over the triangles per run of vertices the cap holds. */
+/* The largest corner record: three 64-bit ids and nine doubles. */
+#define RS_STREAM_RECORD_MAX (3 * sizeof(uint64_t) + 9 * sizeof(double))
+
 typedef struct rs_stream_corners {
     int fd;                         /* the records, or -1 when they are made from `held` */
     int ids_fd;                     /* the triangles' ids alone (the caller's; closed by it) */
@@ -316,9 +324,11 @@ typedef struct rs_stream_stats {
     /* the two at `scale` (internal units), as the in-memory path holds them: in the caller's
      * units a mesh at 1e-300 has no representable area */
     double scaled_mean_edge_length, scaled_mean_area;
-    double reach;       /* largest centroid-to-corner distance of a facet (checked against: */
-    double reach_bound; /* a bound on it from the longest edge, which sets the halo before the
-                         * facets' pass measures the reach itself) */
+    double longest_edge; /* caller's units */
+    double magnitude;    /* the largest |coordinate| */
+    double reach;        /* largest centroid-to-corner distance of a facet (checked against: */
+    double reach_bound;  /* a bound on it from the longest edge, which sets the halo before the
+                          * facets' pass measures the reach itself) */
     uint64_t facet_count;
     double lo[3], hi[3]; /* the vertices' bounding box */
     bool whole;          /* one part, no edge out of line (core/parts.h): what streams */
@@ -371,19 +381,22 @@ typedef struct rs_stream_pieces {
      * the positions are held whole (the filter looks them up then, as the lists would cost four
      * times the bytes to write and read) */
     size_t vertex_record, facet_record;
+    bool triangle_ids; /* a facet's entry ends with its triangle's index (8 bytes) */
     uint64_t temporary_bytes;
 } rs_stream_pieces;
 
-/* Cuts the mesh into pieces of at most about `piece_vertices` core vertices, counts each piece's
+/* Cuts the mesh into pieces of at most about `piece_vertices` core vertices (smaller, when some
+ * piece holds more than `facets_max` facets with its halo; 0: no bound), counts each piece's
  * facets within `halo` in the facets' pass (which fills the rest of `stats`; nothing more is done
  * when it finds the mesh is not whole), shares the pieces among `ranks` by their facet counts,
  * and writes (for this `rank`'s pieces) each piece's core vertices and its facets (corner
- * records) to temporary files in `dir`. */
+ * records, in triangle order; each followed by the triangle's index with `triangle_ids`) to
+ * temporary files in `dir`. */
 rsmooth_status rs_stream_pieces_build(rs_stream_vertices *vertices,
                                       const rs_stream_corners *corners, rs_stream_stats *stats,
-                                      double halo, uint64_t piece_vertices, size_t buffer_memory,
-                                      int rank, int ranks, const char *dir, rs_stream_pieces *out,
-                                      rsmooth_error *error);
+                                      double halo, uint64_t piece_vertices, uint64_t facets_max,
+                                      size_t buffer_memory, int rank, int ranks, bool triangle_ids,
+                                      const char *dir, rs_stream_pieces *out, rsmooth_error *error);
 void rs_stream_pieces_free(rs_stream_pieces *pieces);
 
 /* ---- stream_assemble.c --------------------------------------------------------------------- */
@@ -397,11 +410,12 @@ typedef struct rs_piece_source {
 
 /* A piece's arrays from its n core vertices' and m facets' list entries: the core's ids into
  * `core`, every vertex's position into xyz (the core first; at most n + 3 m of them, *k
- * receives how many), the facets renumbered into `tri` (which may be `facet_records` itself when
- * those are three 32-bit ids each). false when out of memory. */
+ * receives how many) and, when all_ids is not NULL, its id there, the facets renumbered into
+ * `tri` (which may be `facet_records` itself when those are three 32-bit ids each). false when
+ * out of memory. */
 bool rs_stream_assemble(const rs_piece_source *src, const unsigned char *core_records, size_t n,
                         const unsigned char *facet_records, size_t m, uint64_t *core, uint32_t *tri,
-                        double *xyz, size_t *k);
+                        double *xyz, size_t *k, uint64_t *all_ids);
 
 /* ---- stream_passes.c ----------------------------------------------------------------------- */
 
@@ -411,13 +425,22 @@ bool rs_stream_assemble(const rs_piece_source *src, const unsigned char *core_re
 typedef struct rs_pass_store {
     int fd;
     bool own; /* a temporary of its own (closed), else a shared file's tail (cut off) */
-    uint64_t base, vertex_count;
+    uint64_t base, vertex_count, triangle_count;
     rs_stream_ply block[2];
 } rs_pass_store;
 
 /* In `shared_fd` from `base` on, or (shared_fd -1) in a new temporary file in `dir`. */
 rsmooth_status rs_pass_store_open(rs_pass_store *s, int shared_fd, uint64_t base,
-                                  uint64_t vertex_count, const char *dir, rsmooth_error *error);
+                                  uint64_t vertex_count, uint64_t triangle_count, const char *dir,
+                                  rsmooth_error *error);
+/* The stage's reach shares of the triangles `triangles[0, n)` (ascending), and their sum and
+ * pairs' count over every triangle, in triangle order (those no piece gave count 0). */
+bool rs_pass_store_write_shares(const rs_pass_store *s, const uint64_t *triangles, size_t n,
+                                const double *share, const uint32_t *pairs);
+bool rs_pass_store_sum_shares(const rs_pass_store *s, double *sum, uint64_t *pairs);
+/* A value per rank (its slot), and the largest of `ranks` slots once every rank has put its. */
+bool rs_pass_store_put_slot(const rs_pass_store *s, int rank, double value);
+bool rs_pass_store_largest_slot(const rs_pass_store *s, int ranks, double *largest);
 /* Confidences of the vertices ids[0, n) (ascending) in float block k (0 or 1). */
 bool rs_pass_store_read_confidence(const rs_pass_store *s, int k, const uint64_t *ids, size_t n,
                                    float *out);
@@ -439,5 +462,42 @@ bool rs_pass_rules(const rs_pass_store *s, const rs_pass_rule *rule, const uint6
                    const double *xyz, double *out, float *confidence);
 /* Closes its own file, or (`cut`) cuts the shared one back to `base`; false if that fails. */
 bool rs_pass_store_close(rs_pass_store *s, bool cut);
+
+/* A piece's arrays, as rs_stream_piece_load makes them. */
+typedef struct rs_stream_piece_arrays {
+    size_t n, k, m;     /* core vertices (the first n), all vertices, facets */
+    uint64_t *core;     /* the core's ids */
+    uint64_t *ids;      /* every vertex's id (the core's first), when asked for */
+    double *xyz;        /* 3 per vertex, the source's positions as doubles */
+    uint32_t *tri;      /* 3 per facet, the piece's numbers, in triangle order */
+    uint64_t *triangle; /* per facet: its triangle's index (lists with triangle_ids), or NULL */
+} rs_stream_piece_arrays;
+
+/* Piece p's lists read and assembled (rs_stream_assemble), every vertex's id with want_ids. */
+rsmooth_status rs_stream_piece_load(const rs_stream_pieces *pieces, const rs_piece_source *src,
+                                    const rs_piece *p, bool want_ids, rs_stream_piece_arrays *a,
+                                    rsmooth_error *error);
+void rs_stream_piece_arrays_free(rs_stream_piece_arrays *a);
+
+/* ---- stream_stage.c ------------------------------------------------------------------------ */
+
+struct rs_stage_setting;
+struct rs_stage_whole;
+
+/* The guided reach's shares of the triangles whose first corner is the piece's own (its arrays
+ * from the lists with triangle ids, positions the input's), written into `store` at their
+ * triangles' places; `scale` the stage's. */
+rsmooth_status rs_stream_stage_shares(const rs_pass_store *store, const rs_stream_piece_arrays *p,
+                                      const struct rs_stage_setting *setting, double scale,
+                                      rsmooth_error *error);
+/* One cycle of the stage on the piece (its arrays with every vertex's id, positions the cycle's
+ * start), its lists from the positions `input`'s rows hold; the core's results in p->xyz,
+ * *displacement raised to their largest distance from the input. `mask` the caller's move mask
+ * (by vertex id) or NULL. The results stay doubles between steps whatever the file's type, as
+ * the file read whole is (its positions are doubles in memory). */
+rsmooth_status rs_stream_stage_cycle(const rs_stream_ply *input, rs_stream_piece_arrays *p,
+                                     const struct rs_stage_setting *setting,
+                                     const struct rs_stage_whole *whole, const uint8_t *mask,
+                                     double *displacement, rsmooth_error *error);
 
 #endif /* RSMOOTH_STREAM_INTERNAL_H */

@@ -1,10 +1,11 @@
-/* Between passes of the filter (params.passes above 1): each pass reads the positions the pass
- * before wrote, as the in-memory loop reads its double array (passes/passes.c). They lie in a
- * double block of the vertex count (24 bytes a vertex), two of them, one read while the other
- * is written; where passes after the first keep their confident vertices (pass_confidence),
- * each vertex's confidence (4 bytes) in two blocks likewise. A block of positions is read and
- * written as the vertex block of a PLY of x y z doubles and nothing else, so the input's
- * readers serve it unchanged.
+/* Between the streamed steps (the stage's cycles, the filter's passes: params.vertex_updates,
+ * params.passes): each step reads the positions the step before wrote, as the in-memory loops
+ * read their double arrays (passes/passes.c). They lie in a double block of the vertex count (24
+ * bytes a vertex), two of them, one read while the other is written; where passes after the
+ * first keep their confident vertices (pass_confidence), each vertex's confidence (4 bytes) in
+ * two blocks likewise; the stage's reach its shares per triangle (12 bytes), and the ranks'
+ * largest displacements a slot each. A block of positions is read and written as the vertex
+ * block of a PLY of x y z doubles and nothing else, so the input's readers serve it unchanged.
  *
  * Alone the blocks are a temporary file of their own; ranks share the partial output's bytes
  * past its end instead (every rank has it open already, it is removed however the run ends, and
@@ -13,11 +14,13 @@
 #include "stream/stream_internal.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
 
 #define POSITION_BYTES (3 * sizeof(double))
+#define SHARE_BYTES (sizeof(double) + sizeof(uint32_t))
 /* Consecutive ids read or written in one call, at most. */
 #define RUN_IDS 4096
 
@@ -26,12 +29,22 @@ static uint64_t confidence_at(const rs_pass_store *s, int k) {
            (uint64_t)k * s->vertex_count * sizeof(float);
 }
 
+static uint64_t shares_at(const rs_pass_store *s) {
+    return confidence_at(s, 2);
+}
+
+static uint64_t slot_at(const rs_pass_store *s, int rank) {
+    return shares_at(s) + s->triangle_count * SHARE_BYTES + (uint64_t)rank * sizeof(double);
+}
+
 rsmooth_status rs_pass_store_open(rs_pass_store *s, int shared_fd, uint64_t base,
-                                  uint64_t vertex_count, const char *dir, rsmooth_error *error) {
+                                  uint64_t vertex_count, uint64_t triangle_count, const char *dir,
+                                  rsmooth_error *error) {
     memset(s, 0, sizeof *s);
     s->fd = shared_fd;
     s->base = base;
     s->vertex_count = vertex_count;
+    s->triangle_count = triangle_count;
     if (shared_fd < 0) {
         s->fd = rs_stream_temporary(dir);
         s->own = true;
@@ -90,6 +103,66 @@ bool rs_pass_store_close(rs_pass_store *s, bool cut) {
         ok = ftruncate(s->fd, (off_t)s->base) == 0;
     s->fd = -1;
     return ok;
+}
+
+bool rs_pass_store_write_shares(const rs_pass_store *s, const uint64_t *triangles, size_t n,
+                                const double *share, const uint32_t *pairs) {
+    enum { RUN = 4096 };
+    unsigned char buf[RUN * SHARE_BYTES];
+    for (size_t i = 0; i < n;) {
+        size_t run = 1; /* consecutive triangles: one write */
+        while (i + run < n && run < RUN && triangles[i + run] == triangles[i] + run)
+            run++;
+        for (size_t j = 0; j < run; j++) {
+            memcpy(buf + j * SHARE_BYTES, share + i + j, sizeof(double));
+            memcpy(buf + j * SHARE_BYTES + sizeof(double), pairs + i + j, sizeof(uint32_t));
+        }
+        if (!rs_pwrite_all(s->fd, buf, run * SHARE_BYTES,
+                           shares_at(s) + triangles[i] * SHARE_BYTES))
+            return false;
+        i += run;
+    }
+    return true;
+}
+
+bool rs_pass_store_sum_shares(const rs_pass_store *s, double *sum, uint64_t *pairs) {
+    rs_stream_reader r;
+    uint64_t at = shares_at(s);
+    if (!rs_stream_reader_open(&r, s->fd, "shares", at, at + s->triangle_count * SHARE_BYTES,
+                               (1u << 20) / SHARE_BYTES * SHARE_BYTES))
+        return false;
+    *sum = 0;
+    *pairs = 0;
+    bool ok = true;
+    for (uint64_t t = 0; ok && t < s->triangle_count; t++) { /* triangle order, as in memory */
+        const unsigned char *e = rs_stream_read(&r, SHARE_BYTES);
+        ok = e != NULL;
+        if (ok) {
+            double share;
+            uint32_t n;
+            memcpy(&share, e, sizeof share);
+            memcpy(&n, e + sizeof share, sizeof n);
+            *sum += share;
+            *pairs += n;
+        }
+    }
+    rs_stream_reader_close(&r);
+    return ok;
+}
+
+bool rs_pass_store_put_slot(const rs_pass_store *s, int rank, double value) {
+    return rs_pwrite_all(s->fd, &value, sizeof value, slot_at(s, rank));
+}
+
+bool rs_pass_store_largest_slot(const rs_pass_store *s, int ranks, double *largest) {
+    *largest = 0;
+    for (int r = 0; r < ranks; r++) {
+        double value;
+        if (!rs_pread_all(s->fd, &value, sizeof value, slot_at(s, r)))
+            return false;
+        *largest = fmax(*largest, value);
+    }
+    return true;
 }
 
 bool rs_pass_rules(const rs_pass_store *s, const rs_pass_rule *rule, const uint64_t *core, size_t n,

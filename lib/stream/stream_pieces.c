@@ -89,6 +89,9 @@ static uint64_t box_count(const cell_grid *g, const box *bx) {
     return n;
 }
 
+/* Pieces smaller than this are not cut to keep a wide halo's pieces within their memory. */
+#define MIN_CUT_VERTICES 1024
+
 typedef struct cutter {
     cell_grid *grid;
     uint64_t target;
@@ -218,6 +221,7 @@ typedef struct facet_pass_job {
     double scale, halo;
     int rank;
     size_t facet_record;       /* bytes of a record the lists keep: all, or the ids alone */
+    bool triangle_ids;         /* and after it the triangle's index (8 bytes) */
     uint64_t *counts;          /* chunks x pieces: each run's facets of each piece */
     rs_region_writer *writers; /* per run: the lists (the writing pass) or the codes (counting) */
     /* Per triangle, the piece it lies in alone (most do), or PIECE_NONE or PIECE_SEVERAL: the
@@ -308,9 +312,17 @@ static void facet_run(facet_pass_job *job, size_t c) {
             near[0] = (int32_t)code;
             n = 1;
         }
+        const unsigned char *entry = view.entry;
+        unsigned char with_index[RS_STREAM_RECORD_MAX + sizeof t];
+        if (job->triangle_ids && n > 0) {
+            size_t kept = job->facet_record - sizeof t;
+            memcpy(with_index, view.entry, kept);
+            memcpy(with_index + kept, &t, sizeof t);
+            entry = with_index;
+        }
         for (size_t i = 0; i < n; i++)
             if (job->pieces[near[i]].rank == job->rank &&
-                !rs_region_append(job->writers + c, (size_t)near[i], view.entry))
+                !rs_region_append(job->writers + c, (size_t)near[i], entry))
                 job->unwritten[c] = true;
     }
     rs_corner_reader_close(&r);
@@ -507,8 +519,9 @@ static rsmooth_status write_facet_lists(facet_pass_job *job, int fd, size_t buff
 
 rsmooth_status rs_stream_pieces_build(rs_stream_vertices *vertices,
                                       const rs_stream_corners *corners, rs_stream_stats *stats,
-                                      double halo, uint64_t piece_vertices, size_t buffer_memory,
-                                      int rank, int ranks, const char *dir, rs_stream_pieces *out,
+                                      double halo, uint64_t piece_vertices, uint64_t facets_max,
+                                      size_t buffer_memory, int rank, int ranks, bool triangle_ids,
+                                      const char *dir, rs_stream_pieces *out,
                                       rsmooth_error *error) {
     memset(out, 0, sizeof *out);
     out->vertex_fd = out->facet_fd = -1;
@@ -527,22 +540,42 @@ rsmooth_status rs_stream_pieces_build(rs_stream_vertices *vertices,
     if (st != RSMOOTH_OK)
         goto done;
     box all = {{0, 0, 0}, {g.dims[0], g.dims[1], g.dims[2]}};
-    if (!cut(&ct, all, vertices->count)) {
-        st = no_memory(error);
-        goto done;
+    /* cut, and the facets each piece's halo brings counted: a piece over facets_max (its halo
+     * far wider than the core expected) has the pieces cut smaller, a few times at most */
+    for (int attempt = 0;; attempt++) {
+        if (!cut(&ct, all, vertices->count)) {
+            st = no_memory(error);
+            goto done;
+        }
+        job = (facet_pass_job){.corners = corners,
+                               .g = &g,
+                               .boxes = ct.boxes,
+                               .pieces = ct.pieces,
+                               .piece_count = ct.count,
+                               .scale = stats->scale,
+                               /* a little beyond the halo: a facet exactly at it must not round
+                                * out (as tiles.c) */
+                               .halo = halo * (1 + 1e-6),
+                               .rank = rank,
+                               .code_fd = -1};
+        st = count_facets(&job, ct.pieces, ct.count, stats, dir, error);
+        uint64_t largest = 0;
+        for (size_t i = 0; i < ct.count; i++)
+            largest = ct.pieces[i].facet_count > largest ? ct.pieces[i].facet_count : largest;
+        if (st != RSMOOTH_OK || !facets_max || largest <= facets_max || attempt == 3 ||
+            ct.target <= MIN_CUT_VERTICES)
+            break;
+        double shrink = 0.9 * (double)facets_max / (double)largest;
+        ct.target = (uint64_t)((double)ct.target * shrink);
+        if (ct.target < MIN_CUT_VERTICES)
+            ct.target = MIN_CUT_VERTICES;
+        facet_job_free(&job);
+        rs_free(ct.boxes);
+        rs_free(ct.pieces);
+        ct.boxes = NULL;
+        ct.pieces = NULL;
+        ct.count = ct.capacity = 0;
     }
-    job = (facet_pass_job){.corners = corners,
-                           .g = &g,
-                           .boxes = ct.boxes,
-                           .pieces = ct.pieces,
-                           .piece_count = ct.count,
-                           .scale = stats->scale,
-                           /* a little beyond the halo: a facet exactly at it must not round out
-                            * (as tiles.c) */
-                           .halo = halo * (1 + 1e-6),
-                           .rank = rank,
-                           .code_fd = -1};
-    st = count_facets(&job, ct.pieces, ct.count, stats, dir, error);
     /* (the caller says why a mesh not whole stops) */
     if (st != RSMOOTH_OK || (!stats->whole && !stats->parts_tested))
         goto done;
@@ -572,7 +605,11 @@ rsmooth_status rs_stream_pieces_build(rs_stream_vertices *vertices,
     size_t xyz = corners->held ? 0 : 3 * (corners->f32 ? sizeof(float) : sizeof(double));
     out->vertex_record = out->id_bytes + xyz;
     out->facet_record = corners->held ? 3 * out->id_bytes : corners->record;
+    out->triangle_ids = triangle_ids;
+    if (triangle_ids)
+        out->facet_record += sizeof(uint64_t);
     job.facet_record = out->facet_record;
+    job.triangle_ids = triangle_ids;
     out->temporary_bytes =
         out->vertex_record * listed + out->facet_record * facets + job.code_bytes * corners->count;
     st =

@@ -33,7 +33,7 @@ static rsmooth_status unsupported(const char *path, const char *why, rsmooth_err
 static double value_at(const unsigned char *p, rs_ply_type t, bool swap) {
     if (!swap)
         return rs_ply_host_value(p, t);
-    unsigned char b[8];
+    unsigned char b[8] = {0}; /* (a type of no size reads 0) */
     size_t n = rs_ply_type_size(t);
     for (size_t i = 0; i < n; i++)
         b[i] = p[n - 1 - i];
@@ -401,6 +401,26 @@ rsmooth_status rs_stream_ply_read_range(rs_stream_ply *ply, uint64_t first, uint
     }
     rs_free(chunk);
     return st;
+}
+
+bool rs_stream_ply_read_rows(const rs_stream_ply *ply, const uint64_t *ids, size_t n, double *xyz) {
+    enum { RUN_ROWS = 4096 };
+    size_t stride = ply->vertex_stride;
+    unsigned char *rows = rs_alloc_array(RUN_ROWS, stride);
+    bool ok = rows != NULL;
+    for (size_t i = 0; ok && i < n;) {
+        size_t run = 1; /* consecutive ids: one read */
+        while (i + run < n && run < RUN_ROWS && ids[i + run] == ids[i] + run)
+            run++;
+        ok = rs_pread_all(ply->fd, rows, run * stride, ply->vertex_start + ids[i] * stride);
+        for (size_t j = 0; ok && j < run; j++)
+            for (int k = 0; k < 3; k++)
+                xyz[3 * (i + j) + (size_t)k] =
+                    value_at(rows + j * stride + ply->xyz_offset[k], ply->xyz_type, ply->swap);
+        i += run;
+    }
+    rs_free(rows);
+    return ok;
 }
 
 /* The in-memory reader's last check: after the elements the header declares, blanks only (a

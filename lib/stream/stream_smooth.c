@@ -9,13 +9,16 @@
  *   5. each piece (this rank's) filtered (rsmooth_smooth_piece, its memory kept for the next)
  *      and its core vertices written into the copy at their rows;
  *   6. the copy named as the output, atomically.
- * Passes after the first (params.passes) run 1-3 and 5 again on the positions the pass before
- * wrote into a double block (stream_passes.c) instead of the input's, the triangles kept; only
+ * Each of 1-3 and 5 is a step; more steps run them again. The normal update stage
+ * (params.vertex_updates, stream_stage.c) first gathers its reach's shares, then runs a step per
+ * cycle; the filter runs a step per pass (params.passes). Each step after the first reads the
+ * positions the one before wrote into a double block (stream_passes.c), the triangles kept; only
  * the last writes into the copy. Ranks (the MPI driver) run 1-3 alike, rank 0 makes the copy,
- * and each writes its own pieces' rows: disjoint bytes of one file, and all of a pass's before
+ * and each writes its own pieces' rows: disjoint bytes of one file, and all of a step's before
  * any rank starts the next. */
 #define _GNU_SOURCE /* O_TMPFILE, linkat, renameat2 */
 #include "io/output_file.h"
+#include "stages/normal_update.h"
 #include "stream/stream_internal.h"
 
 #include <errno.h>
@@ -34,6 +37,10 @@
  * and their halo. Measured peak over the cap's share on the demo shapes: see README "Large
  * meshes". */
 #define PIECE_BYTES_PER_VERTEX 1200
+/* The normal update stage's steps per facet of a piece, its wide halo's included: its lists
+ * (each facet's neighbours within the guided reach, its patch and the patch's edges) and work
+ * arrays. Measured: about 1000 on the 4M terrain under 256M. */
+#define STAGE_BYTES_PER_FACET 1100
 /* Working memory besides the positions and the pieces: read buffers of 1 MB, the cell grid
  * (GRID_BYTES) and the lists' write buffers (as much again). */
 #define GRID_BYTES (2ull << 20)
@@ -85,18 +92,45 @@ typedef struct stream_call {
     rs_stream_corners corners;   /* the triangles with their corners' positions */
     rs_output out;               /* the output: its target, and the copy the results go into */
     uint64_t triangle_count;
-    int ids_fd;            /* the triangles' vertex ids, kept while a pass is to come */
-    int passes;            /* of the filter (params.passes; 0: the input comes back) */
-    int pass;              /* the one running, from 0 */
-    rs_pass_rule rule;     /* what the in-memory loop does after each pass */
-    rs_pass_store store;   /* the positions between passes (passes above 1) */
-    rs_stream_ply *source; /* the positions this pass reads: the input's, or a block */
-    uint64_t output_size;  /* the copy's, where a rank's store begins */
+    int ids_fd; /* the triangles' vertex ids, kept while a step is to come */
+    /* The steps, each streamed (a plan, then the pieces): with the stage, its reach's shares and
+     * its cycles; then the filter's passes. A position step (a cycle or a pass) reads what the
+     * one before wrote (the first, the input), the last writes the output. */
+    int steps, step;
+    int cycles;             /* the stage's (0: none) */
+    rs_stage_setting stage; /* its widths in mesh units once the input's unit is known */
+    rs_stage_whole whole;   /* its scale and reach, of the input */
+    double displacement;    /* how far a vertex lies from its input position, at most */
+    double moved;           /* the same, of this rank's pieces in the step running */
+    double input_longest;   /* the input's longest edge */
+    int passes;             /* of the filter (params.passes; 0: the input comes back) */
+    int pass;               /* the one running, from 0 */
+    rs_pass_rule rule;      /* what the in-memory loop does after each pass */
+    rs_pass_store store;    /* the positions between passes (passes above 1) */
+    rs_stream_ply *source;  /* the positions this pass reads: the input's, or a block */
+    uint64_t output_size;   /* the copy's, where a rank's store begins */
     rs_stream_stats stats;
     double halo;
     uint64_t piece_vertices;
     rs_stream_pieces pieces;
 } stream_call;
+
+typedef enum step_kind { STEP_SHARES, STEP_CYCLE, STEP_PASS } step_kind;
+
+static step_kind kind_of(const stream_call *c) {
+    if (c->cycles == 0)
+        return STEP_PASS;
+    return c->step == 0 ? STEP_SHARES : c->step <= c->cycles ? STEP_CYCLE : STEP_PASS;
+}
+
+/* The position steps (the cycles, then the passes) from 0; the shares' step is -1. */
+static int position_step(const stream_call *c) {
+    return c->cycles ? c->step - 1 : c->step;
+}
+
+static bool last_position_step(const stream_call *c) {
+    return position_step(c) + 1 == c->cycles + c->passes;
+}
 
 static double now_ms(void) {
     return rs_now_ms();
@@ -111,8 +145,8 @@ static bool report_progress(const stream_call *c, double fraction) {
     const rsmooth_params *p = c->caller_params;
     if (!p)
         return true;
-    if (c->passes > 1)
-        fraction = (c->pass + fraction) / c->passes;
+    if (c->steps > 1)
+        fraction = (c->step + fraction) / c->steps;
     if (p->progress)
         p->progress(p->progress_user, fraction);
     return !p->progress_cancel || p->progress_cancel(p->progress_user, fraction) == 0;
@@ -153,6 +187,51 @@ static rsmooth_status check_tmpdir(stream_call *c, rsmooth_error *error) {
     return RSMOOTH_OK;
 }
 
+/* The caller's params taken apart: the stage's cycles and the passes are this call's steps, the
+ * pieces' params one pass's. Checked before any file is read. */
+static rsmooth_status take_params(stream_call *c, const rsmooth_params *params,
+                                  rsmooth_error *error) {
+    c->caller_params = params;
+    if (params)
+        c->params = *params;
+    else
+        rsmooth_params_init(&c->params);
+    rsmooth_params *p = &c->params;
+    p->progress = NULL;
+    p->progress_cancel = NULL;
+    if (p->passes < 0 || p->passes > RS_MAX_ROUNDS)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, RS_STREAM_WHERE,
+                       "passes must be in [0, %d] (got %d)", RS_MAX_ROUNDS, p->passes);
+    if (p->vertex_updates < 0 || p->vertex_updates > RS_MAX_UPDATES)
+        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, RS_STREAM_WHERE,
+                       "vertex_updates must be in [0, %d] (got %d)", RS_MAX_UPDATES,
+                       p->vertex_updates);
+    if (p->vertex_updates > 0 && p->stage_normals == RSMOOTH_STAGE_NORMALS_LEARNED)
+        return rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, RS_STREAM_WHERE,
+                       "stage_normals learned: streaming runs the guided stage only (yet)");
+    c->passes = p->passes;
+    c->rule.mask = p->move_mask;
+    c->cycles = p->vertex_updates > 0 ? p->stage_repeats : 0;
+    c->stage = (rs_stage_setting){.sigma_s = p->guided_sigma_s,
+                                  .sigma_n = p->guided_sigma_n,
+                                  .radius = p->guided_radius,
+                                  .rounds = p->guided_rounds,
+                                  .updates = p->vertex_updates,
+                                  .cycles = 1};
+    p->passes = 1;
+    p->move_mask = NULL;
+    p->vertex_updates = 0;
+    double halo = 0; /* the rest of the params' checks (the stage's widths among them) */
+    rsmooth_status st = rsmooth_piece_halo(p, 1, 0, &halo, error);
+    if (st != RSMOOTH_OK)
+        return st;
+    c->rule.keep_confidence = c->passes > 1 ? p->pass_confidence : 0;
+    c->steps = (c->cycles ? 1 + c->cycles : 0) + c->passes;
+    if (c->steps == 0) /* nothing runs: one plan checks the mesh, the input comes back */
+        c->steps = 1;
+    return RSMOOTH_OK;
+}
+
 static rsmooth_status check_arguments(stream_call *c, const rsmooth_params *params,
                                       const rsmooth_stream_options *options, rsmooth_error *error) {
     if (!c->input || !c->output)
@@ -189,27 +268,9 @@ static rsmooth_status check_arguments(stream_call *c, const rsmooth_params *para
     }
     if (c->opt.max_memory == 0)
         c->opt.max_memory = DEFAULT_MAX_MEMORY;
-    c->caller_params = params;
-    if (params)
-        c->params = *params;
-    else
-        rsmooth_params_init(&c->params);
-    c->params.progress = NULL;
-    c->params.progress_cancel = NULL;
-    /* the passes' loop is this call's (each pass a streamed one), the pieces' params one pass's */
-    c->passes = c->params.passes;
-    c->rule.mask = c->params.move_mask;
-    c->params.passes = 1;
-    c->params.move_mask = NULL;
-    if (c->passes < 0 || c->passes > RS_MAX_ROUNDS)
-        return rs_fail(error, RSMOOTH_ERROR_INVALID_ARGUMENT, RS_STREAM_WHERE,
-                       "passes must be in [0, %d] (got %d)", RS_MAX_ROUNDS, c->passes);
-    double halo = 0; /* the params' checks, before any file is read */
-    rsmooth_status st = rsmooth_piece_halo(&c->params, 1, 0, &halo, error);
-    if (st != RSMOOTH_OK)
-        return st;
-    c->rule.keep_confidence = c->passes > 1 ? c->params.pass_confidence : 0;
-    st = check_tmpdir(c, error);
+    rsmooth_status st = take_params(c, params, error);
+    if (st == RSMOOTH_OK)
+        st = check_tmpdir(c, error);
     if (st != RSMOOTH_OK)
         return st;
     /* what the command checks for its in-memory outputs: only files, links to them written
@@ -264,7 +325,7 @@ static rsmooth_status read_input(stream_call *c, rs_stream_extent *extent, rsmoo
 /* The triangles' ids once the records (or the pieces' lists) hold them: their disk comes back,
  * unless a later pass reads them again. */
 static void drop_triangle_ids(stream_call *c) {
-    if (c->ids_fd >= 0 && c->pass + 1 >= c->passes) {
+    if (c->ids_fd >= 0 && c->step + 1 >= c->steps) {
         close(c->ids_fd);
         c->ids_fd = -1;
     }
@@ -291,9 +352,25 @@ static rsmooth_status open_input(stream_call *c, rsmooth_error *error) {
     return RSMOOTH_OK;
 }
 
-/* The mesh's figures for this pass, and the halo. The passes after the first keep the first's
- * sigmas in mesh units, as the in-memory loop fixes them from the input's mean edge length; the
- * input's parts test holds for them all. */
+/* The first step's figures: the input's unit, which fixes the widths in mesh units for every step
+ * after (as the in-memory loops fix them: the stage and the passes after the first), and the
+ * stage's scale. */
+static void input_figures(stream_call *c) {
+    double unit = c->stats.mean_edge_length;
+    c->rep.mean_edge_length = unit;
+    c->input_longest = c->stats.longest_edge;
+    rsmooth_params *p = &c->params;
+    if ((c->cycles > 0 || c->passes > 1) && !p->absolute && unit > 0) {
+        p->sigma_f *= unit;
+        p->sigma_g *= unit; /* +INFINITY stays */
+        p->normal_sigma_s *= unit;
+        c->stage.sigma_s *= unit;
+        p->absolute = 1;
+    }
+    c->whole.scale = rs_stage_scale_of(c->stats.magnitude, c->stage.sigma_s);
+}
+
+/* The mesh's figures for this step, and the halo its pieces need. */
 static rsmooth_status figures(stream_call *c, const rs_stream_extent *extent, uint64_t held,
                               rsmooth_error *error) {
     rsmooth_status st =
@@ -303,24 +380,60 @@ static rsmooth_status figures(stream_call *c, const rs_stream_extent *extent, ui
         drop_triangle_ids(c);
     if (st != RSMOOTH_OK)
         return st;
-    if (c->pass == 0) {
-        c->rep.mean_edge_length = c->stats.mean_edge_length;
-        if (c->passes > 1 && !c->params.absolute && c->stats.mean_edge_length > 0) {
-            double unit = c->stats.mean_edge_length;
-            c->params.sigma_f *= unit;
-            c->params.sigma_g *= unit; /* +INFINITY stays */
-            c->params.normal_sigma_s *= unit;
-            c->params.absolute = 1;
-        }
+    if (c->step == 0)
+        input_figures(c);
+    switch (kind_of(c)) {
+    case STEP_SHARES:
+        c->halo = rs_stage_shares_halo(c->stats.longest_edge);
+        break;
+    case STEP_CYCLE:
+        c->halo = rs_stage_cycle_halo(&c->stage, fmax(c->input_longest, c->stats.longest_edge),
+                                      c->whole.reach, c->displacement);
+        break;
+    case STEP_PASS: /* from the reach's bound: the pieces are counted in the pass measuring it */
+        st = rsmooth_piece_halo(&c->params, c->stats.mean_edge_length, c->stats.reach_bound,
+                                &c->halo, error);
+        break;
     }
-    /* the halo from the reach's bound: the pieces are counted in the pass that measures it */
-    st = rsmooth_piece_halo(&c->params, c->stats.mean_edge_length, c->stats.reach_bound, &c->halo,
-                            error);
     c->rep.halo = c->halo;
     return st;
 }
 
-/* Steps 1-3 of a pass: everything before the output is touched (the first pass) or the pass's
+/* The cap a stage piece needs: a core of the smallest piece's vertices and `halo` around it, on a
+ * surface (about 2 facets a vertex, a vertex a mean edge apart). */
+static double stage_cap_needed(const stream_call *c, uint64_t room, double halo) {
+    double across = halo / (c->stats.mean_edge_length > 0 ? c->stats.mean_edge_length : 1);
+    double side = sqrt((double)MIN_PIECE_VERTICES) + 2 * across;
+    return 2 * side * side * STAGE_BYTES_PER_FACET + (double)(c->opt.max_memory - room);
+}
+
+/* The stage's pieces: their facets, halo included, bounded by what `room` holds; their cores as
+ * large as the halo around them allows (as stage_cap_needed reckons), which the cut corrects where
+ * a piece still holds more. A cap too small for the halo is refused with the size it needs: at
+ * the first step already for the first cycle's (its reach taken as radius mean edges, and a
+ * quarter more for what the cycles move), so that a run seldom stops later. */
+static rsmooth_status stage_pieces(stream_call *c, uint64_t room, uint64_t *facets_max,
+                                   rsmooth_error *error) {
+    *facets_max = room / STAGE_BYTES_PER_FACET;
+    double halo = c->halo;
+    if (kind_of(c) == STEP_SHARES)
+        halo =
+            fmax(halo, 1.25 * rs_stage_cycle_halo(&c->stage, c->stats.longest_edge,
+                                                  c->stage.radius * c->stats.mean_edge_length, 0));
+    double needed = stage_cap_needed(c, room, halo);
+    if (needed > (double)c->opt.max_memory)
+        return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
+                       "%s: the normal update stage's pieces reach %.0f mean edges beyond their "
+                       "vertices: a memory cap of %.1f MB cannot hold one; give at least %.0f MB",
+                       c->input, halo / c->stats.mean_edge_length,
+                       (double)c->opt.max_memory / (1 << 20), ceil(needed / (1 << 20)));
+    double across = c->halo / (c->stats.mean_edge_length > 0 ? c->stats.mean_edge_length : 1);
+    double side = sqrt((double)*facets_max / 2) - 2 * across;
+    c->piece_vertices = side > 1 ? (uint64_t)(side * side) : 1;
+    return RSMOOTH_OK;
+}
+
+/* Steps 1-3 of a step: everything before the output is touched (the first step) or the step's
  * results are written. */
 static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
     double t0 = now_ms();
@@ -350,20 +463,30 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
     uint64_t cap = c->opt.max_memory;
     c->held = c->corners.held != NULL;
     held = c->held ? held : 0;
-    c->piece_vertices = (cap - held - FIXED_BYTES) / PIECE_BYTES_PER_VERTEX;
-    uint64_t planned = held + FIXED_BYTES + c->piece_vertices * PIECE_BYTES_PER_VERTEX;
+    uint64_t room = cap - held - FIXED_BYTES, facets_max = 0;
+    if (kind_of(c) == STEP_PASS)
+        c->piece_vertices = room / PIECE_BYTES_PER_VERTEX;
+    else {
+        st = stage_pieces(c, room, &facets_max, error);
+        if (st != RSMOOTH_OK)
+            return st;
+    }
+    uint64_t planned = held + FIXED_BYTES +
+                       (facets_max ? facets_max * STAGE_BYTES_PER_FACET
+                                   : c->piece_vertices * PIECE_BYTES_PER_VERTEX);
     if (planned > c->rep.memory_planned)
         c->rep.memory_planned = planned;
     rs_stream_pieces_free(&c->pieces);
-    c->stats.parts_tested = c->pass > 0;
+    c->stats.parts_tested = c->step > 0;
     st = rs_stream_pieces_build(&c->vertices, &c->corners, &c->stats, c->halo, c->piece_vertices,
-                                GRID_BYTES, c->opt.rank, c->opt.ranks, c->dir, &c->pieces, error);
+                                facets_max, GRID_BYTES, c->opt.rank, c->opt.ranks,
+                                kind_of(c) == STEP_SHARES, c->dir, &c->pieces, error);
     if (st == RSMOOTH_OK && c->stats.reach > c->stats.reach_bound) /* (the bound's premise) */
         st = rs_fail(error, RSMOOTH_ERROR_NUMERICAL, RS_STREAM_WHERE,
                      "%s: a facet's corner lies %g from its centroid, beyond the %g its longest "
                      "edge allows: the pieces' halo would leave facets out",
                      c->input, c->stats.reach, c->stats.reach_bound);
-    if (st == RSMOOTH_OK && !c->stats.whole && c->pass == 0)
+    if (st == RSMOOTH_OK && !c->stats.whole && c->step == 0)
         st = rs_fail(error, RSMOOTH_ERROR_UNSUPPORTED, RS_STREAM_WHERE,
                      "%s holds parts of very different size, or vertices far off the surface "
                      "(triangles out of scale with the rest): streaming does not keep them "
@@ -387,10 +510,11 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
     c->rep.pieces += c->pieces.count;
     c->rep.position_runs += c->vertices.runs_read;
     c->rep.vertex_id_bits = (unsigned)(8 * c->ply.id_bytes);
-    /* a later pass keeps the ids beside the lists, and the blocks between passes */
+    /* a later step keeps the ids beside the lists, and the blocks between steps */
     uint64_t kept = c->ids_fd >= 0 ? ids : 0;
-    uint64_t store = c->passes > 1 && c->opt.ranks == 1
-                         ? c->ply.vertex_count * (c->rule.keep_confidence > 0 ? 56 : 48)
+    uint64_t store = c->steps > 1 && c->opt.ranks == 1
+                         ? c->ply.vertex_count * (c->rule.keep_confidence > 0 ? 56 : 48) +
+                               (c->cycles ? 12 * c->triangle_count : 0)
                          : 0;
     uint64_t joining = ids + records + store,
              listing = (records ? records : ids) + c->pieces.temporary_bytes + kept + store;
@@ -462,14 +586,13 @@ static rsmooth_status filter_piece(stream_call *c, double *xyz, size_t k, const 
     return RSMOOTH_OK;
 }
 
-/* The pass's results for a piece's core: into the copy (the last pass, checked as the in-memory
- * writer checks them first), else into the block the next pass reads, with the confidences it
- * keeps vertices by. */
+/* A step's results for a piece's core: into the copy (the last, checked as the in-memory writer
+ * checks them first), else into the block the next step reads, with the confidences the next
+ * pass keeps vertices by. */
 static rsmooth_status write_results(stream_call *c, const uint64_t *core, size_t n,
                                     const double *out, const float *confidence,
                                     rsmooth_error *error) {
-    bool last = c->pass + 1 == c->passes;
-    if (last) {
+    if (last_position_step(c)) {
         rsmooth_status st = rs_stream_ply_check_positions(&c->ply, core, n, out, c->output, error);
         if (st != RSMOOTH_OK)
             return st;
@@ -479,7 +602,8 @@ static rsmooth_status write_results(stream_call *c, const uint64_t *core, size_t
         return RSMOOTH_OK;
     }
     int errnum = 0;
-    if (!rs_stream_ply_write_positions(&c->store.block[c->pass % 2], c->store.fd, core, n, out) ||
+    const rs_stream_ply *block = &c->store.block[position_step(c) % 2];
+    if (!rs_stream_ply_write_positions(block, c->store.fd, core, n, out) ||
         (confidence &&
          !rs_pass_store_write_confidence(&c->store, c->pass % 2, core, n, confidence)))
         errnum = errno ? errno : EIO;
@@ -487,26 +611,13 @@ static rsmooth_status write_results(stream_call *c, const uint64_t *core, size_t
         return RSMOOTH_OK;
     return c->store.own ? rs_stream_unwritten(c->dir, errnum, error)
                         : rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
-                                  "cannot write the positions between passes into %s: %s",
+                                  "cannot write the positions between steps into %s: %s",
                                   c->out.temporary, strerror(errnum));
 }
 
-/* Step 5 for one piece: its lists read, its arrays assembled, filtered, written. */
-static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error *error) {
-    double t_piece = now_ms();
-    size_t n = (size_t)p->vertex_count, m = (size_t)p->facet_count;
-    size_t vertex_record = c->pieces.vertex_record, facet_record = c->pieces.facet_record;
-    unsigned char *core_records = rs_alloc_array(n ? n : 1, vertex_record);
-    uint64_t *core = rs_alloc_array(n ? n : 1, sizeof *core);
-    uint32_t *tri = rs_alloc_array(m ? m : 1, 3 * sizeof *tri);
-    /* entries of three 32-bit ids are read into tri itself and renumbered in place (each
-     * facet's ids are read before its numbers are written): fewer fresh pages per piece */
-    bool in_place = facet_record == 3 * sizeof *tri;
-    unsigned char *facet_records =
-        in_place ? (unsigned char *)tri : rs_alloc_array(m ? m : 1, facet_record);
-    /* at most n + 3m vertices; a piece's facets share their corners about 6 ways */
-    size_t most = n + 3 * m, k = 0;
-    double *xyz = rs_alloc_array(most ? most : 1, 3 * sizeof *xyz);
+/* Step 5 of a pass for one piece: filtered, the rules after a pass applied, written. */
+static rsmooth_status pass_piece(stream_call *c, rs_stream_piece_arrays *a, rsmooth_error *error) {
+    size_t n = a->n;
     double *out = rs_alloc_array(n ? n : 1, 3 * sizeof *out);
     /* the rules after a pass (stream_passes.c) read the core's positions before the pass, and
      * the next pass keeps vertices by their confidence */
@@ -515,59 +626,58 @@ static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error
     double *before = rules ? rs_alloc_array(n ? n : 1, 3 * sizeof *before) : NULL;
     float *confidence = confident ? rs_alloc_array(n ? n : 1, sizeof *confidence) : NULL;
     rsmooth_status st = RSMOOTH_OK;
-    if (!core_records || !facet_records || !core || !tri || !xyz || !out || (rules && !before) ||
-        (confident && !confidence)) {
+    if (!out || (rules && !before) || (confident && !confidence))
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
-                     "no memory for a piece of %zu facets", m);
-        goto done;
-    }
-    if (!rs_pread_all(c->pieces.vertex_fd, core_records, n * vertex_record,
-                      p->vertex_start * vertex_record) ||
-        !rs_pread_all(c->pieces.facet_fd, facet_records, m * facet_record,
-                      p->facet_start * facet_record)) {
-        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot read a temporary file: %s",
-                     strerror(errno));
-        goto done;
-    }
-    rs_piece_source src = {c->held ? &c->vertices : NULL, c->corners.f32, c->pieces.id_bytes,
-                           vertex_record, facet_record};
-    if (!rs_stream_assemble(&src, core_records, n, facet_records, m, core, tri, xyz, &k)) {
-        st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
-                     "no memory for a piece of %zu facets", m);
-        goto done;
-    }
-    if (!in_place) /* the arrays hold it all now */
-        rs_free(facet_records);
-    facet_records = NULL;
-    if (before)
-        memcpy(before, xyz, n * 3 * sizeof *before);
-    c->rep.ms_assemble += now_ms() - t_piece;
-    st = filter_piece(c, xyz, k, tri, m, n, out, confidence, error);
+                     "no memory for a piece of %zu facets", a->m);
+    if (st == RSMOOTH_OK && before)
+        memcpy(before, a->xyz, n * 3 * sizeof *before);
+    if (st == RSMOOTH_OK)
+        st = filter_piece(c, a->xyz, a->k, a->tri, a->m, n, out, confidence, error);
     if (st == RSMOOTH_OK && rules &&
-        !rs_pass_rules(&c->store, &c->rule, core, n, before, out, confidence))
+        !rs_pass_rules(&c->store, &c->rule, a->core, n, before, out, confidence))
         st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
                      "cannot read the confidences between passes: %s", strerror(errno));
-    if (st != RSMOOTH_OK)
-        goto done;
     double t = now_ms();
-    st = write_results(c, core, n, out, confidence, error);
+    if (st == RSMOOTH_OK)
+        st = write_results(c, a->core, n, out, confidence, error);
     c->rep.ms_write += now_ms() - t;
-done:
-    rs_free(core_records);
-    if (!in_place)
-        rs_free(facet_records);
-    rs_free(core);
-    rs_free(tri);
-    rs_free(xyz);
     rs_free(out);
     rs_free(before);
     rs_free(confidence);
     return st;
 }
 
+/* Step 5 for one piece: its lists read, its arrays assembled, then the step's work on it. */
+static rsmooth_status run_piece(stream_call *c, const rs_piece *p, rsmooth_error *error) {
+    double t_piece = now_ms();
+    step_kind kind = kind_of(c);
+    rs_piece_source src = {c->held ? &c->vertices : NULL, c->corners.f32, c->pieces.id_bytes,
+                           c->pieces.vertex_record, c->pieces.facet_record};
+    rs_stream_piece_arrays a;
+    rsmooth_status st = rs_stream_piece_load(&c->pieces, &src, p, kind == STEP_CYCLE, &a, error);
+    if (st != RSMOOTH_OK)
+        return st;
+    c->rep.ms_assemble += now_ms() - t_piece;
+    if (kind == STEP_PASS)
+        st = pass_piece(c, &a, error);
+    else if (kind == STEP_SHARES)
+        st = rs_stream_stage_shares(&c->store, &a, &c->stage, c->whole.scale, error);
+    else {
+        st = rs_stream_stage_cycle(&c->ply, &a, &c->stage, &c->whole, c->rule.mask, &c->moved,
+                                   error);
+        double t = now_ms();
+        if (st == RSMOOTH_OK)
+            st = write_results(c, a.core, a.n, a.xyz, NULL, error);
+        c->rep.ms_write += now_ms() - t;
+    }
+    rs_stream_piece_arrays_free(&a);
+    return st;
+}
+
 static rsmooth_status run_pieces(stream_call *c, rsmooth_error *error) {
     double t0 = now_ms(), others = c->rep.ms_write + c->rep.ms_assemble;
     c->rule.pass = c->pass;
+    c->moved = 0;
     uint64_t total = 0, done = 0;
     for (size_t i = 0; i < c->pieces.count; i++)
         if (c->pieces.pieces[i].rank == c->opt.rank)
@@ -613,45 +723,83 @@ static rsmooth_status open_copy(stream_call *c, rsmooth_error *error) {
     if (st == RSMOOTH_OK && c->opt.rank != 0)
         st = rs_output_create_partial(&c->out, false, RS_STREAM_WHERE, error);
     c->output_size = c->ply.out_header_size + (c->ply.data_end - c->ply.data_start);
-    if (st == RSMOOTH_OK && c->passes > 1)
+    if (st == RSMOOTH_OK && c->steps > 1)
         st = c->opt.ranks > 1
                  ? rs_pass_store_open(&c->store, c->out.fd, c->output_size, c->ply.vertex_count,
-                                      c->dir, error)
-                 : rs_pass_store_open(&c->store, -1, 0, c->ply.vertex_count, c->dir, error);
+                                      c->triangle_count, c->dir, error)
+                 : rs_pass_store_open(&c->store, -1, 0, c->ply.vertex_count, c->triangle_count,
+                                      c->dir, error);
     return st;
 }
 
-/* Steps 1-3 and 5 of each pass, the copy made after the first pass's plan; every rank's rows of
- * a pass on disk before any rank reads them (or rank 0 names the file). `st`: how the call went
+/* After a step every rank has written: the stage's reach from the shares, or the largest
+ * displacement after a cycle (the ranks' own through their slots in the store). */
+static rsmooth_status after_step(stream_call *c, rsmooth_error *error) {
+    if (kind_of(c) == STEP_SHARES) {
+        double sum;
+        uint64_t pairs;
+        if (!rs_pass_store_sum_shares(&c->store, &sum, &pairs))
+            return rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                           "cannot read the guided filter's shares: %s", strerror(errno));
+        c->whole.reach = rs_stage_reach(&c->stage, sum, pairs, c->whole.scale);
+        return RSMOOTH_OK;
+    }
+    if (kind_of(c) != STEP_CYCLE)
+        return RSMOOTH_OK;
+    if (c->opt.ranks == 1) {
+        c->displacement = fmax(c->displacement, c->moved);
+        return RSMOOTH_OK;
+    }
+    rsmooth_status st = rs_pass_store_put_slot(&c->store, c->opt.rank, c->moved)
+                            ? RSMOOTH_OK
+                            : rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE,
+                                      "cannot write %s: %s", c->out.temporary, strerror(errno));
+    st = others_failed(sync_ranks(c, st), st, error);
+    double largest = 0;
+    if (st == RSMOOTH_OK && !rs_pass_store_largest_slot(&c->store, c->opt.ranks, &largest))
+        st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot read %s: %s",
+                     c->out.temporary, strerror(errno));
+    c->displacement = fmax(c->displacement, largest);
+    return st;
+}
+
+/* Steps 1-3 and 5 of each step, the copy made after the first one's plan; every rank's rows of
+ * a step on disk before any rank reads them (or rank 0 names the file). `st`: how the call went
  * so far. Every rank meets the others as often as they: after a failure anywhere all stop after
- * the first pass's meetings. */
-static rsmooth_status run_passes(stream_call *c, rsmooth_status st, rsmooth_error *error) {
-    int passes = c->passes > 0 ? c->passes : 1;  /* none: the first plan alone checks the mesh */
+ * the first step's meetings. */
+static rsmooth_status run_steps(stream_call *c, rsmooth_status st, rsmooth_error *error) {
     c->rep.input_bytes_read = c->ply.data_start; /* the header */
-    for (c->pass = 0; c->pass < passes; c->pass++) {
-        c->source = c->pass == 0 ? &c->ply : &c->store.block[(c->pass - 1) % 2];
+    for (c->step = 0; c->step < c->steps; c->step++) {
+        int p = position_step(c);
+        c->pass = p - c->cycles;
+        c->source = p <= 0 ? &c->ply : &c->store.block[(p - 1) % 2];
         if (st == RSMOOTH_OK)
             st = plan(c, error);
         st = others_failed(sync_ranks(c, st), st, error);
-        if (c->pass == 0) /* the faces and what follows them */
+        if (c->step == 0) /* the faces and what follows them */
             c->rep.input_bytes_read += c->ply.face_start ? c->ply.size - c->ply.face_start : 0;
-        if (st == RSMOOTH_OK && c->pass == 0)
+        if (st == RSMOOTH_OK && c->step == 0)
             st = open_copy(c, error);
-        if (st == RSMOOTH_OK && c->passes > 0) {
+        bool runs = c->passes > 0 || c->cycles > 0;
+        if (st == RSMOOTH_OK && runs)
             st = run_pieces(c, error);
-            c->rep.passes++;
-        }
-        int fd = c->pass + 1 >= passes ? c->out.fd : c->store.fd;
-        if (st == RSMOOTH_OK && c->opt.ranks > 1 && fsync(fd) != 0)
+        int fd = c->step + 1 >= c->steps ? c->out.fd : c->store.fd;
+        if (st == RSMOOTH_OK && c->opt.ranks > 1 && runs && fsync(fd) != 0)
             st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",
                          c->out.temporary, strerror(errno));
         st = others_failed(sync_ranks(c, st), st, error);
-        rs_stream_vertices_release(&c->vertices); /* the next pass reads its own */
-        rs_release_free_memory(); /* what the pieces kept: the next pass's plan needs the room */
+        if (st == RSMOOTH_OK && runs && kind_of(c) != STEP_PASS) {
+            st = after_step(c, error); /* (every rank agrees before the next step's plan) */
+            st = others_failed(sync_ranks(c, st), st, error);
+        }
+        c->rep.passes += st == RSMOOTH_OK && runs && kind_of(c) == STEP_PASS;
+        c->rep.stage_cycles += st == RSMOOTH_OK && kind_of(c) == STEP_CYCLE;
+        rs_stream_vertices_release(&c->vertices); /* the next step reads its own */
+        rs_release_free_memory(); /* what the pieces kept: the next step's plan needs the room */
         if (st != RSMOOTH_OK)
             break;
     }
-    c->pass = passes - 1;
+    c->step = c->steps - 1;
     c->rep.input_bytes_read += c->ply.rows_read * c->ply.vertex_stride;
     if (c->opt.rank == 0 && c->out.fd >= 0)
         c->rep.input_bytes_read += c->ply.data_end - c->ply.data_start; /* the copy */
@@ -680,7 +828,7 @@ rsmooth_status rsmooth_stream_smooth(rsmooth_context *ctx, const char *input, co
     rsmooth_status st = check_arguments(c, params, options, error);
     if (st == RSMOOTH_OK)
         st = open_input(c, error);
-    st = run_passes(c, st, error);
+    st = run_steps(c, st, error);
     /* the copy cut back to the output's size: ranks kept the positions between passes after it */
     if (c->opt.rank == 0 && !rs_pass_store_close(&c->store, st == RSMOOTH_OK) && st == RSMOOTH_OK)
         st = rs_fail(error, RSMOOTH_ERROR_IO, RS_STREAM_WHERE, "cannot write %s: %s",

@@ -531,6 +531,8 @@ rsmooth_status rs_stream_statistics(const rs_stream_corners *corners, uint64_t v
     if (st != RSMOOTH_OK)
         return st;
     stats->mean_edge_length = stats->scaled_mean_edge_length / stats->scale;
-    stats->reach_bound = REACH_PER_EDGE * longest / stats->scale;
+    stats->longest_edge = longest / stats->scale;
+    stats->reach_bound = REACH_PER_EDGE * stats->longest_edge;
+    stats->magnitude = extent->magnitude;
     return RSMOOTH_OK;
 }
