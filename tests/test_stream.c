@@ -303,101 +303,104 @@ static void count_moves(const char *input, const double *a, const double *b, con
     rsmooth_mesh_destroy(mesh);
 }
 
-/* Three passes, pass_confidence 0.6 and a mask holding every fourth vertex, streamed from `in`
- * under `cap` (ctx's device or the reference path): the in-memory bits (the fold guard off, as
- * on pieces). */
-static void passes_case(rsmooth_context *ctx, const char *in, size_t vertex_count, uint64_t cap,
-                        bool ranks) {
+/* `with` (a mask in it) streamed from `in` under `cap` (ctx's device or the reference path)
+ * into `out`, against its in-memory bits (the fold guard off, as on pieces): the deviation in
+ * *dev, and the vertices where `without` in memory differs from `with` (what the option under
+ * test changes) and the mask's held vertices that moved; over 3 ranks (reference path) too. */
+typedef struct case_figures {
+    double dev;
+    size_t differ, held_moved;
+    bool ranks_same;
+    rsmooth_stream_report rep;
+} case_figures;
+
+static void streamed_case(rsmooth_context *ctx, const char *in, const char *out, uint64_t cap,
+                          const rsmooth_params *with, const rsmooth_params *without, bool ranks,
+                          case_figures *f) {
+    double edge = 0;
+    double *expected = smooth_in_memory(ctx, in, with, &edge);
+    double *other = smooth_in_memory(ctx, in, without, &edge);
+    count_moves(in, expected, other, with->move_mask, &f->differ, &f->held_moved);
+    rsmooth_error err;
+    CHECK_STATUS(stream(ctx, in, out, cap, with, &f->rep, &err), RSMOOTH_OK);
+    f->dev = deviation(out, expected, edge);
+    f->ranks_same = true;
+    if (ranks) {
+        three_ranks(in, path_in_dir("case_ranks.ply"), with, cap);
+        f->ranks_same = same_files(out, path_in_dir("case_ranks.ply"));
+        remove(path_in_dir("case_ranks.ply"));
+    }
+    remove(out);
+    free(expected);
+    free(other);
+}
+
+/* A mask holding every `nth` vertex. */
+static uint8_t *every_nth_held(size_t vertex_count, size_t nth) {
     uint8_t *mask = malloc(vertex_count);
     CHECK(mask != NULL);
     for (size_t v = 0; v < vertex_count; v++)
-        mask[v] = v % 4 != 0;
+        mask[v] = v % nth != 0;
+    return mask;
+}
+
+/* Three passes, pass_confidence 0.6 and a mask holding every fourth vertex: the rule changes
+ * vertices, the held ones keep their bytes, the in-memory bits. */
+static void passes_case(rsmooth_context *ctx, const char *in, size_t vertex_count, uint64_t cap,
+                        bool ranks) {
     rsmooth_params plain;
     rsmooth_params_init(&plain);
     plain.guard = 0;
     plain.passes = 3;
-    plain.move_mask = mask;
+    plain.move_mask = every_nth_held(vertex_count, 4);
     rsmooth_params kept = plain;
     kept.pass_confidence = 0.6;
-    double edge = 0;
-    double *expected = smooth_in_memory(ctx, in, &kept, &edge);
-    double *without = smooth_in_memory(ctx, in, &plain, &edge);
-    size_t differ, held_moved;
-    count_moves(in, expected, without, mask, &differ, &held_moved);
-    rsmooth_stream_report rep;
-    rsmooth_error err;
-    const char *out = path_in_dir("passes.ply");
-    CHECK_STATUS(stream(ctx, in, out, cap, &kept, &rep, &err), RSMOOTH_OK);
-    double dev = deviation(out, expected, edge);
+    case_figures f;
+    streamed_case(ctx, in, path_in_dir("passes.ply"), cap, &kept, &plain, ranks, &f);
     printf("3 passes, confidence 0.6, 1 vertex in 4 held, cap %llu MB: %d passes, %zu pieces, "
            "%llu runs of positions, temporaries %llu MB; deviation %.3g; the confidence rule "
-           "changes %zu of %zu vertices; held vertices moved %zu\n",
-           (unsigned long long)(cap >> 20), rep.passes, rep.pieces,
-           (unsigned long long)rep.position_runs, (unsigned long long)(rep.temporary_bytes >> 20),
-           dev, differ, vertex_count, held_moved);
-    CHECK(rep.passes == 3);
-    CHECK(dev == 0);
-    CHECK(differ > vertex_count / 100); /* the rule does something */
-    CHECK(held_moved == 0);
-    if (ranks) {
-        three_ranks(in, path_in_dir("passes_ranks.ply"), &kept, 12u << 20);
-        bool same = same_files(out, path_in_dir("passes_ranks.ply"));
-        printf("3 ranks, 3 passes: output %s the single run's\n", same ? "equals" : "DIFFERS");
-        CHECK(same);
-        remove(path_in_dir("passes_ranks.ply"));
-    }
-    remove(out);
-    free(expected);
-    free(without);
-    free(mask);
+           "changes %zu of %zu vertices; held vertices moved %zu%s\n",
+           (unsigned long long)(cap >> 20), f.rep.passes, f.rep.pieces,
+           (unsigned long long)f.rep.position_runs,
+           (unsigned long long)(f.rep.temporary_bytes >> 20), f.dev, f.differ, vertex_count,
+           f.held_moved,
+           ranks ? (f.ranks_same ? "; 3 ranks: the same bytes" : "; 3 ranks DIFFER") : "");
+    CHECK(f.rep.passes == 3);
+    CHECK(f.dev == 0);
+    CHECK(f.differ > vertex_count / 100); /* the rule does something */
+    CHECK(f.held_moved == 0);
+    CHECK(f.ranks_same);
+    free((void *)plain.move_mask);
 }
 
-/* The best mode (3 of its cycles) with a mask holding every fifth vertex, streamed from `in`
- * under `cap`: the in-memory bits (the fold guard off); over 3 ranks too with `ranks`. */
+/* The best mode (3 of its cycles) with a mask holding every fifth vertex: the stage moves most
+ * vertices, the held ones keep their bytes, the in-memory bits. */
 static void stage_case(rsmooth_context *ctx, const char *in, size_t vertex_count, uint64_t cap,
                        bool ranks) {
-    uint8_t *mask = malloc(vertex_count);
-    CHECK(mask != NULL);
-    for (size_t v = 0; v < vertex_count; v++)
-        mask[v] = v % 5 != 0;
     rsmooth_params best;
     rsmooth_params_init_best(&best);
     best.guard = 0;
     best.stage_repeats = 3;
-    best.move_mask = mask;
-    double edge = 0;
-    double *expected = smooth_in_memory(ctx, in, &best, &edge);
+    best.move_mask = every_nth_held(vertex_count, 5);
     rsmooth_params plain = best; /* the stage's share of the result: without it */
     plain.vertex_updates = 0;
-    double *unstaged = smooth_in_memory(ctx, in, &plain, &edge);
-    size_t differ, held_moved;
-    count_moves(in, expected, unstaged, mask, &differ, &held_moved);
-    rsmooth_stream_report rep;
-    rsmooth_error err;
-    const char *out = path_in_dir("best.ply");
-    CHECK_STATUS(stream(ctx, in, out, cap, &best, &rep, &err), RSMOOTH_OK);
-    double dev = deviation(out, expected, edge);
+    case_figures f;
+    streamed_case(ctx, in, path_in_dir("best.ply"), cap, &best, &plain, ranks, &f);
     printf("best mode, 3 cycles, 1 vertex in 5 held, cap %llu MB on %s: %d cycles and %d pass "
            "streamed, %zu pieces (the largest %llu facets), temporaries %llu MB; deviation %.3g; "
-           "the stage moves %zu of %zu vertices; held vertices moved %zu\n",
+           "the stage moves %zu of %zu vertices; held vertices moved %zu%s\n",
            (unsigned long long)(cap >> 20), ctx ? "the device" : "the reference path",
-           rep.stage_cycles, rep.passes, rep.pieces, (unsigned long long)rep.piece_facets_max,
-           (unsigned long long)(rep.temporary_bytes >> 20), dev, differ, vertex_count, held_moved);
-    CHECK(rep.stage_cycles == 3 && rep.passes == 1);
-    CHECK(dev == 0);
-    CHECK(differ > vertex_count / 2);
-    CHECK(held_moved == 0);
-    if (ranks) {
-        three_ranks(in, path_in_dir("best_ranks.ply"), &best, cap);
-        bool same = same_files(out, path_in_dir("best_ranks.ply"));
-        printf("3 ranks, best mode: output %s the single run's\n", same ? "equals" : "DIFFERS");
-        CHECK(same);
-        remove(path_in_dir("best_ranks.ply"));
-    }
-    remove(out);
-    free(expected);
-    free(unstaged);
-    free(mask);
+           f.rep.stage_cycles, f.rep.passes, f.rep.pieces,
+           (unsigned long long)f.rep.piece_facets_max,
+           (unsigned long long)(f.rep.temporary_bytes >> 20), f.dev, f.differ, vertex_count,
+           f.held_moved,
+           ranks ? (f.ranks_same ? "; 3 ranks: the same bytes" : "; 3 ranks DIFFER") : "");
+    CHECK(f.rep.stage_cycles == 3 && f.rep.passes == 1);
+    CHECK(f.dev == 0);
+    CHECK(f.differ > vertex_count / 2);
+    CHECK(f.held_moved == 0);
+    CHECK(f.ranks_same);
+    free((void *)best.move_mask);
 }
 
 static void check_refusal(rsmooth_context *ctx, const char *in, uint64_t cap,

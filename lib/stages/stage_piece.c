@@ -52,6 +52,49 @@ double rs_stage_shares_halo(double longest_edge) {
     return 4 * CENTROID_REACH * longest_edge; /* a patch: the facets at f's corners, and theirs */
 }
 
+/* What the whole mesh's stage builds once on its input, built on a piece's (or the whole mesh's)
+ * input positions at the stage's scale: the facets, the welded adjacency and the guided filter's
+ * lists, its neighbour sets within `reach` (stage units), or radius times the facets' own mean
+ * adjacent-centroid distance when reach < 0. */
+typedef struct stage_lists {
+    double *at_input; /* the positions at the stage's scale */
+    rs_facets facets;
+    rs_adjacency adj;
+    rs_guided *guided;
+    bool built, adjacency;
+} stage_lists;
+
+static void lists_free(stage_lists *l) {
+    rs_guided_destroy(l->guided);
+    if (l->adjacency)
+        rs_adjacency_free(&l->adj);
+    if (l->built)
+        rs_facets_free(&l->facets);
+    rs_free(l->at_input);
+}
+
+/* false when out of memory (*l freed then). */
+static bool lists_build(stage_lists *l, const double *input, size_t vertex_count,
+                        const uint32_t *indices, size_t triangle_count,
+                        const rs_stage_setting *setting, double scale, double reach) {
+    memset(l, 0, sizeof *l);
+    l->at_input = rs_alloc_array(vertex_count ? vertex_count : 1, 3 * sizeof *l->at_input);
+    for (size_t i = 0; l->at_input && i < 3 * vertex_count; i++)
+        l->at_input[i] = input[i] * scale;
+    l->built = l->at_input && rs_facets_build(&l->facets, l->at_input, indices, triangle_count);
+    l->adjacency =
+        l->built && rs_adjacency_build(&l->adj, l->at_input, vertex_count, indices, &l->facets);
+    if (l->adjacency)
+        l->guided = reach < 0
+                        ? rs_guided_create(&l->facets, &l->adj, indices, setting->sigma_s * scale,
+                                           setting->sigma_n, setting->radius)
+                        : rs_guided_create_reach(&l->facets, &l->adj, indices,
+                                                 setting->sigma_s * scale, setting->sigma_n, reach);
+    if (!l->guided)
+        lists_free(l);
+    return l->guided != NULL;
+}
+
 rsmooth_status rs_stage_piece_shares(const double *input, size_t vertex_count,
                                      const uint32_t *indices, size_t triangle_count,
                                      const rs_stage_setting *setting, double scale, double *share,
@@ -60,30 +103,16 @@ rsmooth_status rs_stage_piece_shares(const double *input, size_t vertex_count,
         share[t] = 0;
         pairs[t] = 0;
     }
-    double *xyz = rs_alloc_array(vertex_count ? vertex_count : 1, 3 * sizeof *xyz);
-    if (!xyz)
+    stage_lists l; /* the patches alone (no neighbour sets: a reach of 0) */
+    if (!lists_build(&l, input, vertex_count, indices, triangle_count, setting, scale, 0))
         return RSMOOTH_ERROR_OUT_OF_MEMORY;
-    for (size_t i = 0; i < 3 * vertex_count; i++)
-        xyz[i] = input[i] * scale;
-    rs_facets facets;
-    rs_adjacency adj;
-    bool built = rs_facets_build(&facets, xyz, indices, triangle_count);
-    bool adjacency = built && rs_adjacency_build(&adj, xyz, vertex_count, indices, &facets);
-    /* the patches alone (no neighbour sets: a reach of 0) */
-    rs_guided *g =
-        adjacency ? rs_guided_create_reach(&facets, &adj, indices, 1, setting->sigma_n, 0) : NULL;
-    for (size_t f = 0; g && f < facets.count; f++) {
+    for (size_t f = 0; f < l.facets.count; f++) {
         size_t n;
-        share[facets.triangle[f]] = rs_guided_adjacent_share(g, f, &n);
-        pairs[facets.triangle[f]] = (uint32_t)n;
+        share[l.facets.triangle[f]] = rs_guided_adjacent_share(l.guided, f, &n);
+        pairs[l.facets.triangle[f]] = (uint32_t)n;
     }
-    rs_guided_destroy(g);
-    if (adjacency)
-        rs_adjacency_free(&adj);
-    if (built)
-        rs_facets_free(&facets);
-    rs_free(xyz);
-    return g ? RSMOOTH_OK : RSMOOTH_ERROR_OUT_OF_MEMORY;
+    lists_free(&l);
+    return RSMOOTH_OK;
 }
 
 double rs_stage_reach(const rs_stage_setting *setting, double share_sum, uint64_t pairs,
@@ -97,28 +126,12 @@ rsmooth_status rs_stage_whole_figures(const double *input, size_t vertex_count,
                                       const rs_stage_setting *setting, rs_stage_whole *whole) {
     whole->scale = rs_stage_scale(input, vertex_count, setting->sigma_s);
     whole->reach = 0;
-    double *xyz = rs_alloc_array(vertex_count ? vertex_count : 1, 3 * sizeof *xyz);
-    if (!xyz)
+    stage_lists l;
+    if (!lists_build(&l, input, vertex_count, indices, triangle_count, setting, whole->scale, -1))
         return RSMOOTH_ERROR_OUT_OF_MEMORY;
-    for (size_t i = 0; i < 3 * vertex_count; i++)
-        xyz[i] = input[i] * whole->scale;
-    rs_facets facets;
-    rs_adjacency adj;
-    bool ok = rs_facets_build(&facets, xyz, indices, triangle_count);
-    bool adjacency = ok && rs_adjacency_build(&adj, xyz, vertex_count, indices, &facets);
-    rs_guided *g = adjacency
-                       ? rs_guided_create(&facets, &adj, indices, setting->sigma_s * whole->scale,
-                                          setting->sigma_n, setting->radius)
-                       : NULL;
-    if (g)
-        whole->reach = rs_guided_reach(g) / whole->scale;
-    rs_guided_destroy(g);
-    if (adjacency)
-        rs_adjacency_free(&adj);
-    if (ok)
-        rs_facets_free(&facets);
-    rs_free(xyz);
-    return g ? RSMOOTH_OK : RSMOOTH_ERROR_OUT_OF_MEMORY;
+    whole->reach = rs_guided_reach(l.guided) / whole->scale;
+    lists_free(&l);
+    return RSMOOTH_OK;
 }
 
 rsmooth_status rs_stage_cycle_piece(const double *input, double *xyz, size_t vertex_count,
@@ -128,40 +141,23 @@ rsmooth_status rs_stage_cycle_piece(const double *input, double *xyz, size_t ver
     if (setting->updates < 1 || vertex_count == 0)
         return RSMOOTH_OK;
     const double scale = whole->scale, unscale = 1 / scale;
-    double *at_input = rs_alloc_array(vertex_count, 3 * sizeof *at_input);
-    if (!at_input)
+    stage_lists l;
+    if (!lists_build(&l, input, vertex_count, indices, triangle_count, setting, scale,
+                     whole->reach * scale))
         return RSMOOTH_ERROR_OUT_OF_MEMORY;
-    for (size_t i = 0; i < 3 * vertex_count; i++) {
-        at_input[i] = input[i] * scale;
+    double *normals = rs_alloc_array(l.facets.count ? l.facets.count : 1, 3 * sizeof(double));
+    bool ok = normals != NULL;
+    for (size_t i = 0; ok && i < 3 * vertex_count; i++)
         xyz[i] *= scale;
+    if (ok && l.facets.count > 0) { /* the cycle, as normal_update.c runs each */
+        rs_facets_update(&l.facets, xyz, indices);
+        rs_guided_step(l.guided, &l.facets, setting->rounds, normals);
+        ok = rs_vertex_update(xyz, vertex_count, indices, &l.facets, &l.adj, normals,
+                              setting->updates, move_mask);
     }
-    rs_facets facets;
-    rs_adjacency adj;
-    rs_guided *guided = NULL;
-    double *normals = NULL;
-    bool built = rs_facets_build(&facets, at_input, indices, triangle_count);
-    bool adjacency = built && rs_adjacency_build(&adj, at_input, vertex_count, indices, &facets);
-    bool ok = adjacency;
-    if (ok) {
-        normals = rs_alloc_array(facets.count ? facets.count : 1, 3 * sizeof(double));
-        guided = rs_guided_create_reach(&facets, &adj, indices, setting->sigma_s * scale,
-                                        setting->sigma_n, whole->reach * scale);
-        ok = normals && guided;
-    }
-    if (ok && facets.count > 0) { /* the cycle, as normal_update.c runs each */
-        rs_facets_update(&facets, xyz, indices);
-        rs_guided_step(guided, &facets, setting->rounds, normals);
-        ok = rs_vertex_update(xyz, vertex_count, indices, &facets, &adj, normals, setting->updates,
-                              move_mask);
-    }
-    rs_guided_destroy(guided);
-    rs_free(normals);
-    if (adjacency)
-        rs_adjacency_free(&adj);
-    if (built)
-        rs_facets_free(&facets);
-    rs_free(at_input);
-    for (size_t i = 0; i < 3 * vertex_count; i++)
+    for (size_t i = 0; normals && i < 3 * vertex_count; i++)
         xyz[i] *= unscale;
+    rs_free(normals);
+    lists_free(&l);
     return ok ? RSMOOTH_OK : RSMOOTH_ERROR_OUT_OF_MEMORY;
 }

@@ -63,9 +63,8 @@ rsmooth_status rs_stream_stage_cycle(const rs_stream_ply *input, rs_stream_piece
                      input->path, strerror(errno));
     for (size_t v = 0; held && v < p->k; v++)
         held[v] = mask[p->ids[v]];
-    if (st == RSMOOTH_OK &&
-        rs_stage_cycle_piece(at_input, p->xyz, p->k, p->tri, p->m, setting, whole, held) !=
-            RSMOOTH_OK)
+    if (st == RSMOOTH_OK && rs_stage_cycle_piece(at_input, p->xyz, p->k, p->tri, p->m, setting,
+                                                 whole, held) != RSMOOTH_OK)
         st = rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
                      "no memory for the normal update stage on a piece of %zu facets", p->m);
     for (size_t v = 0; st == RSMOOTH_OK && v < p->n; v++) {
