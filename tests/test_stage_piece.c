@@ -270,7 +270,7 @@ int main(void) {
     /* a roof: a grid folded along a crease, wide enough that a piece with its halo holds about
      * half of it */
     shape_mesh roof, soup;
-    CHECK(shape_plane(&roof, 200, 200, 1.0) == 0);
+    CHECK(shape_plane(&roof, 160, 160, 1.0) == 0);
     double middle = 0;
     for (size_t v = 0; v < roof.vertex_count; v++)
         middle = fmax(middle, roof.xyz[3 * v] / 2);
