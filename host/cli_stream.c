@@ -53,8 +53,9 @@ int cli_stream_check(const options *opt) {
                 "rsmooth: --max-memory: the fold guard does not run on pieces yet: the "
                 "result is the in-memory one with --no-guard (triangles the filter turns "
                 "over are not pulled back%s)\n",
-                opt->params.vertex_updates > 0 ? ", and the stage runs on a mesh that reads clean"
-                                               : "");
+                opt->params.vertex_updates > 0
+                    ? ", nor is the stage skipped on a mesh that reads clean"
+                    : "");
     return -1;
 }
 

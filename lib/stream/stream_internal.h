@@ -79,6 +79,15 @@ static inline bool rs_stream_next_triangle(rs_stream_reader *r, size_t id_bytes,
     return rec != NULL;
 }
 
+/* How many of ids[i, n) (at most `most`) are consecutive numbers from ids[i]: the rows, records
+ * or slots one read or write serves. */
+static inline size_t rs_stream_id_run(const uint64_t *ids, size_t i, size_t n, size_t most) {
+    size_t run = 1;
+    while (i + run < n && run < most && ids[i + run] == ids[i] + run)
+        run++;
+    return run;
+}
+
 /* An unnamed temporary file in `dir` (O_TMPFILE, else created and unlinked at once), so that
  * nothing is left behind however the process ends. -1 with errno on failure. */
 int rs_stream_temporary(const char *dir);
@@ -433,6 +442,10 @@ typedef struct rs_pass_store {
 rsmooth_status rs_pass_store_open(rs_pass_store *s, int shared_fd, uint64_t base,
                                   uint64_t vertex_count, uint64_t triangle_count, const char *dir,
                                   rsmooth_error *error);
+/* The disk the store takes at most: the two position blocks, the confidences' when they are
+ * kept, the stage's shares when it runs. */
+uint64_t rs_pass_store_bytes(uint64_t vertex_count, uint64_t triangle_count, bool confidences,
+                             bool shares);
 /* The stage's reach shares of the triangles `triangles[0, n)` (ascending), and their sum and
  * pairs' count over every triangle, in triangle order (those no piece gave count 0). */
 bool rs_pass_store_write_shares(const rs_pass_store *s, const uint64_t *triangles, size_t n,

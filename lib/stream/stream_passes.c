@@ -37,6 +37,12 @@ static uint64_t slot_at(const rs_pass_store *s, int rank) {
     return shares_at(s) + s->triangle_count * SHARE_BYTES + (uint64_t)rank * sizeof(double);
 }
 
+uint64_t rs_pass_store_bytes(uint64_t vertex_count, uint64_t triangle_count, bool confidences,
+                             bool shares) {
+    return vertex_count * (2 * POSITION_BYTES + (confidences ? 2 * sizeof(float) : 0)) +
+           (shares ? triangle_count * SHARE_BYTES : 0);
+}
+
 rsmooth_status rs_pass_store_open(rs_pass_store *s, int shared_fd, uint64_t base,
                                   uint64_t vertex_count, uint64_t triangle_count, const char *dir,
                                   rsmooth_error *error) {
@@ -72,9 +78,7 @@ rsmooth_status rs_pass_store_open(rs_pass_store *s, int shared_fd, uint64_t base
 static bool confidence_runs(const rs_pass_store *s, int k, const uint64_t *ids, size_t n,
                             float *values, bool write) {
     for (size_t i = 0; i < n;) {
-        size_t run = 1;
-        while (i + run < n && run < RUN_IDS && ids[i + run] == ids[i] + run)
-            run++;
+        size_t run = rs_stream_id_run(ids, i, n, RUN_IDS);
         uint64_t at = confidence_at(s, k) + ids[i] * sizeof(float);
         bool ok = write ? rs_pwrite_all(s->fd, values + i, run * sizeof(float), at)
                         : rs_pread_all(s->fd, values + i, run * sizeof(float), at);
@@ -110,9 +114,7 @@ bool rs_pass_store_write_shares(const rs_pass_store *s, const uint64_t *triangle
     enum { RUN = 4096 };
     unsigned char buf[RUN * SHARE_BYTES];
     for (size_t i = 0; i < n;) {
-        size_t run = 1; /* consecutive triangles: one write */
-        while (i + run < n && run < RUN && triangles[i + run] == triangles[i] + run)
-            run++;
+        size_t run = rs_stream_id_run(triangles, i, n, RUN); /* consecutive: one write */
         for (size_t j = 0; j < run; j++) {
             memcpy(buf + j * SHARE_BYTES, share + i + j, sizeof(double));
             memcpy(buf + j * SHARE_BYTES + sizeof(double), pairs + i + j, sizeof(uint32_t));

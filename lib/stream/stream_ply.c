@@ -409,9 +409,7 @@ bool rs_stream_ply_read_rows(const rs_stream_ply *ply, const uint64_t *ids, size
     unsigned char *rows = rs_alloc_array(RUN_ROWS, stride);
     bool ok = rows != NULL;
     for (size_t i = 0; ok && i < n;) {
-        size_t run = 1; /* consecutive ids: one read */
-        while (i + run < n && run < RUN_ROWS && ids[i + run] == ids[i] + run)
-            run++;
+        size_t run = rs_stream_id_run(ids, i, n, RUN_ROWS); /* consecutive ids: one read */
         ok = rs_pread_all(ply->fd, rows, run * stride, ply->vertex_start + ids[i] * stride);
         for (size_t j = 0; ok && j < run; j++)
             for (int k = 0; k < 3; k++)
@@ -748,9 +746,8 @@ bool rs_stream_ply_write_positions(const rs_stream_ply *ply, int out_fd, const u
         return false;
     bool ok = true;
     for (size_t i = 0; ok && i < n;) {
-        size_t run = 1; /* consecutive ids: one read and one write */
-        while (i + run < n && run < RUN_ROWS && ids[i + run] == ids[i] + run)
-            run++;
+        /* consecutive ids: one read and one write */
+        size_t run = rs_stream_id_run(ids, i, n, RUN_ROWS);
         uint64_t at = output_offset(ply, ply->vertex_start + ids[i] * stride);
         ok = whole_rows || rs_pread_all(out_fd, rows, run * stride, at);
         for (size_t j = 0; ok && j < run; j++)

@@ -399,11 +399,15 @@ static rsmooth_status figures(stream_call *c, const rs_stream_extent *extent, ui
     return st;
 }
 
+/* A length in the step's mean edges (about the vertices' spacing on a surface). */
+static double in_mean_edges(const stream_call *c, double length) {
+    return length / (c->stats.mean_edge_length > 0 ? c->stats.mean_edge_length : 1);
+}
+
 /* The cap a stage piece needs: a core of the smallest piece's vertices and `halo` around it, on a
  * surface (about 2 facets a vertex, a vertex a mean edge apart). */
 static double stage_cap_needed(const stream_call *c, uint64_t room, double halo) {
-    double across = halo / (c->stats.mean_edge_length > 0 ? c->stats.mean_edge_length : 1);
-    double side = sqrt((double)MIN_PIECE_VERTICES) + 2 * across;
+    double side = sqrt((double)MIN_PIECE_VERTICES) + 2 * in_mean_edges(c, halo);
     return 2 * side * side * STAGE_BYTES_PER_FACET + (double)(c->opt.max_memory - room);
 }
 
@@ -425,10 +429,9 @@ static rsmooth_status stage_pieces(stream_call *c, uint64_t room, uint64_t *face
         return rs_fail(error, RSMOOTH_ERROR_OUT_OF_MEMORY, RS_STREAM_WHERE,
                        "%s: the normal update stage's pieces reach %.0f mean edges beyond their "
                        "vertices: a memory cap of %.1f MB cannot hold one; give at least %.0f MB",
-                       c->input, halo / c->stats.mean_edge_length,
-                       (double)c->opt.max_memory / (1 << 20), ceil(needed / (1 << 20)));
-    double across = c->halo / (c->stats.mean_edge_length > 0 ? c->stats.mean_edge_length : 1);
-    double side = sqrt((double)*facets_max / 2) - 2 * across;
+                       c->input, in_mean_edges(c, halo), (double)c->opt.max_memory / (1 << 20),
+                       ceil(needed / (1 << 20)));
+    double side = sqrt((double)*facets_max / 2) - 2 * in_mean_edges(c, c->halo);
     c->piece_vertices = side > 1 ? (uint64_t)(side * side) : 1;
     return RSMOOTH_OK;
 }
@@ -513,8 +516,8 @@ static rsmooth_status plan(stream_call *c, rsmooth_error *error) {
     /* a later step keeps the ids beside the lists, and the blocks between steps */
     uint64_t kept = c->ids_fd >= 0 ? ids : 0;
     uint64_t store = c->steps > 1 && c->opt.ranks == 1
-                         ? c->ply.vertex_count * (c->rule.keep_confidence > 0 ? 56 : 48) +
-                               (c->cycles ? 12 * c->triangle_count : 0)
+                         ? rs_pass_store_bytes(c->ply.vertex_count, c->triangle_count,
+                                               c->rule.keep_confidence > 0, c->cycles > 0)
                          : 0;
     uint64_t joining = ids + records + store,
              listing = (records ? records : ids) + c->pieces.temporary_bytes + kept + store;
